@@ -1,0 +1,1 @@
+"""Shared fixtures. Physics tests cite the seed equation, table or figure they reproduce."""

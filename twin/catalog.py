@@ -1,0 +1,103 @@
+"""Bearing designations and lubricant grades -> validated specs.
+
+- 6208: exactly seed 000 Table 1 (Rb 6.3, Ri 24.0, Ro 36.6, Rc 6.552, Rz 4.19 mm, Z = 9).
+- 7208: seed 004 Table 1 and section 3 (same ball and raceway radii, Z = 13, Rz = 1.01 mm,
+  conformity B = (Rci + Rce)/(2 Rb) - 1 = 0.14, i.e. groove radii 0.57 D). The seed gives no
+  contact angle; 15 deg (the 72xx C execution) is the one that reproduces its load parameter
+  eps = 2.46 under Fr = Fa = 3000 N (Harris: eps > 2 needs Fr tan(alpha) / Fa < ~0.3; with the
+  40 deg B execution Fr tan(alpha) / Fa = 0.84 and eps < 0.5).
+- 6200-6210 (but 6208): public catalog boundary dimensions (bore d, outside diameter D) with the
+  ball count and ball diameter of the usual steel-cage execution; pitch diameter (d + D)/2,
+  groove radii 0.52 Dw as in the seed's 6208, cage elements sized like the seed's (30 um pocket
+  clearance on the pitch circle). Approximate: manufacturers differ by a few percent.
+"""
+
+from __future__ import annotations
+
+import math
+
+from twin.spec import BearingSpec, Geometry, Lubricant, Mounting
+
+# designation: (bore mm, outside diameter mm, ball count, ball diameter mm)
+_DEEP_GROOVE_MM = {
+    "6200": (10.0, 30.0, 8, 4.762),
+    "6201": (12.0, 32.0, 7, 5.953),
+    "6202": (15.0, 35.0, 8, 5.953),
+    "6203": (17.0, 40.0, 8, 6.747),
+    "6204": (20.0, 47.0, 8, 7.938),
+    "6205": (25.0, 52.0, 9, 7.938),
+    "6206": (30.0, 62.0, 9, 9.525),
+    "6207": (35.0, 72.0, 9, 11.112),
+    "6209": (45.0, 85.0, 10, 12.7),
+    "6210": (50.0, 90.0, 10, 12.7),
+}
+
+_POCKET_CLEARANCE_M = 30e-6
+
+# ISO 3448 grade (nu_40 in mm^2/s) -> nu_100 [mm^2/s] of a VI ~ 100 mineral oil (ASTM D2270 table)
+_ISO_VG_NU100_MM2_S = {10: 2.6, 15: 3.3, 22: 4.2, 32: 5.4, 46: 6.8, 68: 8.7, 100: 11.1,
+                       150: 14.5, 220: 18.8, 320: 24.0, 460: 30.5}
+
+
+def _seed_6208() -> Geometry:
+    return Geometry(
+        ball_radius_m=6.3e-3, ball_count=9, inner_raceway_radius_m=24.0e-3,
+        outer_raceway_radius_m=36.6e-3, inner_groove_radius_m=6.552e-3,
+        outer_groove_radius_m=6.552e-3, cage_element_radius_m=4.19e-3,
+        nominal_contact_angle_deg=0.0, cage_mass_kg=0.02)
+
+
+def _seed_7208() -> Geometry:
+    rb = 6.3e-3
+    groove = 0.5 * (1.0 + 0.14) * 2.0 * rb  # B = 0.14 (seed 004 section 3) -> 7.182 mm
+    return Geometry(
+        ball_radius_m=rb, ball_count=13, inner_raceway_radius_m=24.0e-3,
+        outer_raceway_radius_m=36.6e-3, inner_groove_radius_m=groove, outer_groove_radius_m=groove,
+        cage_element_radius_m=1.01e-3, nominal_contact_angle_deg=15.0, cage_mass_kg=0.025)
+
+
+def _deep_groove(bore_mm: float, od_mm: float, z: int, dw_mm: float) -> Geometry:
+    rb = 0.5 * dw_mm * 1e-3
+    pitch = 0.25 * (bore_mm + od_mm) * 1e-3
+    half_chord = 2.0 * pitch * math.sin(math.pi / (2 * z))
+    return Geometry(
+        ball_radius_m=rb, ball_count=z, inner_raceway_radius_m=pitch - rb,
+        outer_raceway_radius_m=pitch + rb, inner_groove_radius_m=0.52 * 2 * rb,
+        outer_groove_radius_m=0.52 * 2 * rb,
+        cage_element_radius_m=half_chord - rb - _POCKET_CLEARANCE_M,
+        cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3)
+
+
+def designations() -> list[str]:
+    """Every designation the catalog knows, sorted."""
+    return sorted(["6208", "7208", *_DEEP_GROOVE_MM])
+
+
+def bearing(designation: str = "6208", *, diametral_clearance_m: float = 0.0,
+            lubricant: Lubricant | None = None, **spec_fields) -> BearingSpec:
+    """The spec of a catalog bearing with the given mounting clearance [m] and lubricant."""
+    key = designation.strip().upper()
+    if key == "6208":
+        geometry, kind = _seed_6208(), "deep_groove"
+    elif key == "7208":
+        geometry, kind = _seed_7208(), "angular_contact"
+    elif key in _DEEP_GROOVE_MM:
+        geometry, kind = _deep_groove(*_DEEP_GROOVE_MM[key]), "deep_groove"
+    else:
+        raise ValueError(f"designation: unknown bearing {designation!r}; known: {', '.join(designations())}")
+    mounting = Mounting(diametral_clearance_m=diametral_clearance_m)
+    return BearingSpec(designation=key, kind=kind, geometry=geometry, mounting=mounting,
+                       lubricant=lubricant or Lubricant(), **spec_fields)
+
+
+def lubricant(name: str = "seed-000") -> Lubricant:
+    """A named oil: 'seed-000' (eta = 0.04 Pa s at 40 degC) or an ISO VG grade ('ISO VG 68')."""
+    key = name.strip().upper().replace("ISO", "").replace("VG", "").replace(" ", "")
+    if name.strip().lower() == "seed-000":
+        return Lubricant()
+    if key.isdigit() and int(key) in _ISO_VG_NU100_MM2_S:
+        grade = int(key)
+        return Lubricant(name=f"ISO VG {grade}", kinematic_viscosity_40c_m2_s=grade * 1e-6,
+                         kinematic_viscosity_100c_m2_s=_ISO_VG_NU100_MM2_S[grade] * 1e-6)
+    raise ValueError(f"lubricant: unknown {name!r}; use 'seed-000' or 'ISO VG n' with n in "
+                     f"{sorted(_ISO_VG_NU100_MM2_S)}")

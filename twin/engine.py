@@ -1,0 +1,197 @@
+"""`Twin`: the Python face of the engine (set_setpoint, advance, snapshot).
+
+It owns one immutable `BearingModel` and one mutable `TwinState` and calls the compiled
+`step_n(model arrays, state arrays, setpoint vector, n)` once per frame. No threads, no I/O.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from twin import catalog
+from twin.kernels import layout as L
+from twin.kernels.step import evaluate, step_n
+from twin.model import BearingModel, make_model
+from twin.physics.friction import REGIME_NAMES
+from twin.physics.hertz import max_pressure_pa
+from twin.physics.viscosity import dynamic_viscosity_pa_s
+from twin.setpoint import Setpoint, SetpointUpdate, check_limits
+from twin.snapshot import BallState, ContactState, SetpointState, Snapshot
+from twin.spec import BearingSpec, ModelOptions
+from twin.state import TwinState, make_state
+from twin.warmstart import warm_start
+
+FRAME_STEPS = 1000  # steps per compiled call (1 ms of simulated time at dt = 1 us)
+
+
+def _finite_or_none(value: float) -> float | None:
+    return float(value) if math.isfinite(value) else None
+
+
+class Twin:
+    """A running bearing twin.
+
+    >>> twin = Twin("6208")                       # warm-started at 500 rad/s, 3000 N
+    >>> twin.set_setpoint(radial_load_n=5000.0)   # partial update
+    >>> twin.advance(0.01)                        # 10 ms of simulated time
+    >>> twin.snapshot().balls[0].inner.load_n
+    """
+
+    def __init__(self, bearing: str | BearingSpec = "6208", *, options: ModelOptions | None = None,
+                 setpoint: Setpoint | None = None, bearing_id: str = "default",
+                 diametral_clearance_m: float | None = None, warm: bool = True):
+        spec = bearing if isinstance(bearing, BearingSpec) else catalog.bearing(bearing)
+        if diametral_clearance_m is not None:
+            mounting = spec.mounting.model_copy(update={"diametral_clearance_m": diametral_clearance_m})
+            spec = BearingSpec.model_validate({**spec.model_dump(), "mounting": mounting.model_dump()})
+        self.bearing_id = bearing_id
+        self.model: BearingModel = make_model(spec, options)
+        self.state: TwinState = make_state(self.model)
+        self._setpoint_vector = np.zeros(L.N_SETPOINT)
+        self._setpoint = Setpoint()
+        self.seq = 0
+        self.restarts = 0
+        self.status = "ok"
+        self._last_torque_n_m = 0.0
+        self._apply(setpoint or Setpoint())
+        self.reset(warm=warm)
+
+    # ---- setpoint ---------------------------------------------------------------------------
+    @property
+    def limits(self) -> dict[str, tuple[float, float]]:
+        """Allowed (low, high) of each setpoint field for this bearing."""
+        m = self.model
+        axial_low = 0.0 if m.spec.kind == "angular_contact" else -m.max_axial_load_n
+        return {
+            "shaft_speed_rad_s": (0.0, m.max_shaft_speed_rad_s),
+            "radial_load_n": (0.0, m.max_radial_load_n),
+            "axial_load_n": (axial_low, m.max_axial_load_n),
+            "oil_temperature_c": (-30.0, 150.0),
+        }
+
+    @property
+    def setpoint(self) -> Setpoint:
+        """The setpoint in force."""
+        return self._setpoint
+
+    def _apply(self, new: Setpoint) -> Setpoint:
+        check_limits(new, self.limits)
+        self._setpoint = new
+        v = self._setpoint_vector
+        v[L.S_SHAFT_SPEED] = new.shaft_speed_rad_s
+        v[L.S_RADIAL_LOAD] = new.radial_load_n
+        v[L.S_AXIAL_LOAD] = new.axial_load_n
+        v[L.S_VISCOSITY] = dynamic_viscosity_pa_s(self.model.spec.lubricant, new.oil_temperature_c)
+        return new
+
+    def set_setpoint(self, update: SetpointUpdate | None = None, **fields) -> Setpoint:
+        """Apply a partial setpoint (validated; raises SetpointError / ValidationError naming the
+        field and its range). Takes effect at the next frame; returns the setpoint in force."""
+        update = update or SetpointUpdate(**fields)
+        return self._apply(update.apply_to(self._setpoint))
+
+    # ---- running ----------------------------------------------------------------------------
+    def reset(self, *, warm: bool = True, shaft_speed_rad_s: float | None = None) -> None:
+        """Restart from the quasi-static equilibrium at the current setpoint (or at rest)."""
+        sp = self._setpoint
+        speed = sp.shaft_speed_rad_s if shaft_speed_rad_s is None else shaft_speed_rad_s
+        if warm:
+            warm_start(self.model, self.state, speed, sp.radial_load_n, sp.axial_load_n)
+        else:
+            warm_start(self.model, self.state, speed, 0.0, 0.0)
+        m = self.model
+        evaluate(m.params, m.contact_groove, m.race_tribology, self._setpoint_vector,
+                 *self.state.kernel_args())
+
+    def _frame(self, n: int) -> int:
+        s = self.state
+        s.scalars[L.X_TORQUE_SUM] = 0.0
+        s.scalars[L.X_TORQUE_COUNT] = 0.0
+        m = self.model
+        status, done = step_n(m.params, m.contact_groove, m.race_tribology,
+                              self._setpoint_vector,
+                              *s.kernel_args(), n)
+        if s.scalars[L.X_TORQUE_COUNT] > 0:
+            self._last_torque_n_m = s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT]
+        if status != L.STATUS_OK:
+            self._recover(status)
+        return done
+
+    def _recover(self, status: int) -> None:
+        """A kernel reported a diverged or overloaded state: restart from the warm start at the
+        setpoint in force, keep the simulated time, count it, say why in `status`."""
+        t = float(self.state.scalars[L.X_TIME])
+        reason = L.STATUS_NAMES[status]
+        if not math.isfinite(t):
+            t = 0.0
+        self.restarts += 1
+        self.reset()
+        self.state.scalars[L.X_TIME] = t
+        self.status = f"restarted: {reason} at t = {t:.6f} s"
+
+    def advance(self, seconds: float, frame_steps: int = FRAME_STEPS) -> None:
+        """Integrate `seconds` of simulated time in frames of `frame_steps` steps."""
+        if not (math.isfinite(seconds) and seconds >= 0.0):
+            raise ValueError(f"seconds = {seconds!r}: must be finite and >= 0")
+        remaining = int(round(seconds / self.model.dt_s))
+        while remaining > 0:
+            n = min(frame_steps, remaining)
+            remaining -= self._frame(n)
+
+    @property
+    def time_s(self) -> float:
+        """Simulated time [s]."""
+        return float(self.state.scalars[L.X_TIME])
+
+    # ---- outputs ----------------------------------------------------------------------------
+    def ball_azimuths_rad(self) -> np.ndarray:
+        """Ball centre angles from the load line (+x), in (-pi, pi] [rad]."""
+        x = self.state.ball_position_m
+        return np.arctan2(x[:, 1], x[:, 0])
+
+    def _contact(self, j: int, r: int) -> ContactState:
+        c = self.state.contacts[:, 2 * j + r]
+        loaded = c[L.C_LOAD] > 0.0
+        regime = REGIME_NAMES[int(c[L.C_REGIME])] if loaded else "no_contact"
+        return ContactState(
+            load_n=float(c[L.C_LOAD]),
+            h_min_m=_finite_or_none(c[L.C_H_MIN]) if loaded else None,
+            h_c_m=_finite_or_none(c[L.C_H_C]) if loaded else None,
+            **{"lambda": _finite_or_none(c[L.C_LAMBDA]) if loaded else None},
+            regime=regime, mu=float(c[L.C_MU]) if loaded else 0.0,
+            entrainment_speed_m_s=float(c[L.C_ENTRAINMENT]) if loaded else 0.0,
+            slide_roll_ratio=float(c[L.C_SRR]) if loaded else 0.0,
+            contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.C_NZ])))) if loaded else 0.0,
+            max_pressure_pa=float(max_pressure_pa(c[L.C_LOAD], c[L.C_SEMI_MAJOR], c[L.C_SEMI_MINOR])),
+        )
+
+    def snapshot(self, real_time_factor: float | None = None) -> Snapshot:
+        """An immutable copy of the public state (schema bearing-twin/state/1)."""
+        s = self.state
+        x, v, w = s.ball_position_m, s.ball_velocity_m_s, s.ball_angular_velocity_rad_s
+        az = self.ball_azimuths_rad()
+        rho2 = x[:, 0] ** 2 + x[:, 1] ** 2
+        orbital = (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]) / rho2
+        spin = np.linalg.norm(w, axis=1)
+        balls = tuple(
+            BallState(index=j, azimuth_rad=float(az[j]), spin_rad_s=float(spin[j]),
+                      orbital_speed_rad_s=float(orbital[j]),
+                      cage_load_n=float(s.cage_load_n[j].max()),
+                      inner=self._contact(j, 0), outer=self._contact(j, 1))
+            for j in range(self.model.ball_count))
+        self.seq += 1
+        sp = self._setpoint
+        return Snapshot(
+            bearing_id=self.bearing_id, designation=self.model.spec.designation, seq=self.seq,
+            time_s=self.time_s,
+            real_time_factor=_finite_or_none(real_time_factor) if real_time_factor is not None else None,
+            status=self.status, restarts=self.restarts,
+            setpoint=SetpointState(**sp.model_dump()),
+            shaft_speed_rad_s=float(s.scalars[L.X_SHAFT_SPEED]),
+            cage_speed_rad_s=float(s.scalars[L.X_CAGE_SPEED]),
+            inner_ring_displacement_m=tuple(float(a) for a in s.ring_position_m),
+            friction_torque_n_m=float(self._last_torque_n_m),
+            viscosity_pa_s=float(self._setpoint_vector[L.S_VISCOSITY]),
+            balls=balls)

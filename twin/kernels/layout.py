@@ -1,0 +1,92 @@
+"""Index layout of the flat float64 vectors the kernels share (model, setpoint, state scalars,
+per-contact outputs). Module-level ints are compile-time constants for numba."""
+
+# ---- model parameter vector (immutable, built by twin.model) --------------------------------
+P_DT = 0
+P_BALL_RADIUS = 1
+P_BALL_MASS = 2
+P_BALL_INERTIA = 3
+P_RING_MASS = 4
+P_CAGE_INERTIA = 5
+P_CAGE_RADIUS = 6          # radius of the circle carrying the cage elements [m]
+P_CAGE_CONTACT_DISTANCE = 7  # ball-centre to cage-element-centre distance at first touch [m]
+P_CAGE_STIFFNESS = 8       # eq. 3 K [N/m^1.5]
+P_CAGE_REDUCED_MASS = 9    # ball / cage-at-pitch reduced mass [kg]
+P_E_PRIME = 10
+P_G_PARAM = 11             # xi E'
+P_ROUGHNESS = 12           # 1.25 sqrt(s1^2 + s2^2)
+P_KT_RATIO = 13
+P_CT_RATIO = 14
+P_ALPHA_E = 15
+P_RAMP = 16
+P_FILM_FORMULA = 17        # 0 Hamrock-Dowson, 1 Masjedi-Khonsari
+P_FRICTION_MODEL = 18      # 0 Stribeck line, 1 asperity share
+P_SUBSTEPS = 19
+P_ROLLING = 20             # 1: seed 001 rolling resistance on
+P_BALL_REDUCED_TANGENT_MASS = 21  # m / (1 + m Rb^2 / I) [kg]
+P_MAX_PENETRATION = 22     # status threshold [m]
+P_BALL_PITCH_SPRING = 23   # unused by dynamics (warm start regularisation) [N/m]
+N_PARAMS = 24
+
+# ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
+R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]
+R_GROOVE_CENTRE_Z = 1       # its axial position relative to the ring centre [m]
+R_GROOVE_RADIUS = 2         # groove curvature radius [m]
+R_STIFFNESS = 3             # Hertz K [N/m^1.5]
+R_RX = 4
+R_RY = 5
+R_K_ELLIPTICITY = 6
+R_EBAR = 7
+R_SEMI_MAJOR_COEF = 8       # a = coef * Q^(1/3)
+R_SEMI_MINOR_COEF = 9       # b = coef * Q^(1/3)
+N_RACE_PARAMS = 10
+
+# ---- setpoint vector (what the kernel needs of the current setpoint) ------------------------
+S_SHAFT_SPEED = 0     # target [rad/s]
+S_RADIAL_LOAD = 1     # [N], applied on the inner ring along +x
+S_AXIAL_LOAD = 2      # [N], along +z
+S_VISCOSITY = 3       # dynamic viscosity at the oil temperature [Pa s]
+N_SETPOINT = 4
+
+# ---- state scalars ---------------------------------------------------------------------------
+X_TIME = 0
+X_SHAFT_SPEED = 1     # current (ramped) shaft speed [rad/s]
+X_SHAFT_ANGLE = 2
+X_CAGE_ANGLE = 3
+X_CAGE_SPEED = 4
+X_CAGE_TORQUE = 5
+X_STEP = 6            # steps since start (for the tribology sub-rate)
+X_DRIVE_TORQUE = 7    # instantaneous torque the contacts apply to the inner ring about +z [N m]
+X_TORQUE_SUM = 8      # sum of X_DRIVE_TORQUE over steps since the last reset
+X_TORQUE_COUNT = 9
+X_MAX_PENETRATION = 10  # largest ball-raceway penetration since the last reset [m]
+N_SCALARS = 11
+
+# ---- per-contact outputs: contacts[C_*, c], c = 2 ball + race (0 inner, 1 outer) -------------
+C_LOAD = 0           # elastic normal load [N]
+C_PENETRATION = 1
+C_ENTRAINMENT = 2    # [m/s]
+C_SRR = 3            # slide-to-roll ratio [-]
+C_H_MIN = 4          # [m]
+C_H_C = 5            # [m]
+C_LAMBDA = 6
+C_REGIME = 7
+C_MU = 8
+C_FLUID_DAMPING = 9  # C_fluid [N s/m]
+C_ROLLING_FORCE = 10  # seed 001 hydrodynamic + hysteresis rolling force [N]
+C_CONTACT_ANGLE = 11  # [rad]
+C_NX = 12            # contact normal (groove centre -> ball centre), world frame
+C_NY = 13
+C_NZ = 14
+C_SEMI_MAJOR = 15    # [m]
+C_SEMI_MINOR = 16    # [m]
+C_SPIN_MOMENT = 17   # seed 001 pivoting moment magnitude [N m]
+C_ROLLING_PER_SPEED = 18  # rolling force / entrainment speed, cached at the sub-rate [N s/m]
+C_TANGENT_DAMPING = 19    # tangential damping Ct, cached at the sub-rate [N s/m]
+N_CONTACT = 20
+
+# ---- kernel status codes ----------------------------------------------------------------------
+STATUS_OK = 0
+STATUS_NOT_FINITE = 1
+STATUS_PENETRATION = 2
+STATUS_NAMES = ("ok", "diverged: non-finite state", "overloaded: excessive contact penetration")

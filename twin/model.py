@@ -1,0 +1,190 @@
+"""Compile a `BearingSpec` once into an immutable `BearingModel` (MuJoCo's mjModel role).
+
+Every derived constant the kernels need lives in two read-only float64 arrays (`params`, indexed
+by `twin.kernels.layout.P_*`, and `race_params[r]`, r = 0 inner, 1 outer, indexed by `R_*`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from twin.kernels import layout as L
+from twin.kernels.tribology import tribology_coefficients
+from twin.physics import hertz
+from twin.spec import BearingSpec, ModelOptions
+
+# ISO 76 static limit for ball bearings: 4.2 GPa; the model refuses loads whose analytic maximum
+# contact pressure would exceed this factor times the limit (plastic flow beyond Hertz theory).
+STATIC_PRESSURE_LIMIT_PA = 4.2e9
+MODEL_PRESSURE_FACTOR = 1.5
+
+
+@dataclass(frozen=True)
+class BearingModel:
+    """Immutable compiled bearing: arrays for the kernels plus derived figures for people."""
+
+    spec: BearingSpec
+    options: ModelOptions
+    params: np.ndarray
+    race_params: np.ndarray
+    contact_groove: np.ndarray
+    race_tribology: np.ndarray
+    ball_count: int
+    pitch_radius_m: float
+    contact_angle_rad: float
+    inner_ring_radius_at_contact_m: float
+    max_radial_load_n: float
+    max_axial_load_n: float
+    max_shaft_speed_rad_s: float
+
+    @property
+    def dt_s(self) -> float:
+        """Integration step [s]."""
+        return float(self.params[L.P_DT])
+
+    # ---- rolling-bearing kinematics (rigid, no slip; outer ring fixed) ----------------------
+    def cage_speed_rad_s(self, shaft_speed_rad_s: float) -> float:
+        """FTF in rad/s: omega/2 (1 - D cos(alpha)/dm)."""
+        g = self.ball_radius_m * math.cos(self.contact_angle_rad) / self.pitch_radius_m
+        return 0.5 * shaft_speed_rad_s * (1.0 - g)
+
+    @property
+    def ball_radius_m(self) -> float:
+        """Ball radius Rb [m]."""
+        return float(self.params[L.P_BALL_RADIUS])
+
+    def defect_frequencies_hz(self, shaft_speed_rad_s: float) -> dict[str, float]:
+        """FTF, BPFO, BPFI, BSF [Hz] for a fixed outer ring (Harris, Rolling Bearing Analysis)."""
+        fs = shaft_speed_rad_s / (2.0 * math.pi)
+        g = self.ball_radius_m * math.cos(self.contact_angle_rad) / self.pitch_radius_m
+        z = self.ball_count
+        return {
+            "ftf_hz": 0.5 * fs * (1.0 - g),
+            "bpfo_hz": 0.5 * z * fs * (1.0 - g),
+            "bpfi_hz": 0.5 * z * fs * (1.0 + g),
+            "bsf_hz": fs * self.pitch_radius_m / (2.0 * self.ball_radius_m) * (1.0 - g * g),
+        }
+
+    def ball_spin_rad_s(self, shaft_speed_rad_s: float) -> float:
+        """|omega_ball| in pure rolling, the fixed-frame magnitude (seed 000: omega Ri / (2 Rb) at
+        zero contact angle, 952.38 rad/s for the 6208 at 500 rad/s)."""
+        wc = self.cage_speed_rad_s(shaft_speed_rad_s)
+        return abs(wc) * self.pitch_radius_m / self.ball_radius_m
+
+
+def _race_row(spec: BearingSpec, inner: bool, alpha: float, e_prime: float) -> np.ndarray:
+    g = spec.geometry
+    rb = g.ball_radius_m
+    pitch = g.pitch_radius_m
+    groove = g.inner_groove_radius_m if inner else g.outer_groove_radius_m
+    offset = groove - rb
+    row = np.zeros(L.N_RACE_PARAMS)
+    if inner:
+        row[L.R_GROOVE_CENTRE_RADIUS] = pitch + offset * math.cos(alpha)
+        row[L.R_GROOVE_CENTRE_Z] = offset * math.sin(alpha)
+        r2x = (pitch - rb * math.cos(alpha)) / math.cos(alpha)
+        rx = hertz.convex_radius_m(rb, r2x)
+    else:
+        row[L.R_GROOVE_CENTRE_RADIUS] = (pitch - offset * math.cos(alpha)
+                                         + 0.5 * spec.mounting.diametral_clearance_m)
+        row[L.R_GROOVE_CENTRE_Z] = -offset * math.sin(alpha)
+        r2x = (pitch + rb * math.cos(alpha)) / math.cos(alpha)
+        rx = hertz.concave_radius_m(rb, r2x)
+    ry = hertz.concave_radius_m(rb, groove)
+    k = hertz.ellipticity(rx, ry)
+    ebar = hertz.elliptic_integral_second_kind(rx, ry)
+    r = hertz.curvature_sum_radius_m(rx, ry)
+    row[L.R_GROOVE_RADIUS] = groove
+    row[L.R_STIFFNESS] = hertz.raceway_stiffness_n_m15(rx, ry, e_prime)
+    row[L.R_RX] = rx
+    row[L.R_RY] = ry
+    row[L.R_K_ELLIPTICITY] = k
+    row[L.R_EBAR] = ebar
+    row[L.R_SEMI_MAJOR_COEF] = (6.0 * k * k * ebar * r / (math.pi * e_prime)) ** (1.0 / 3.0)
+    row[L.R_SEMI_MINOR_COEF] = (6.0 * ebar * r / (math.pi * k * e_prime)) ** (1.0 / 3.0)
+    return row
+
+
+def _load_at_pressure(row: np.ndarray, pressure_pa: float) -> float:
+    """Ball load [N] at which the Hertz maximum pressure of this race reaches pressure_pa."""
+    # p = 3 Q / (2 pi a b), a b = ca cb Q^(2/3) -> Q^(1/3) = 2 pi ca cb p / 3
+    return (2.0 * math.pi * row[L.R_SEMI_MAJOR_COEF] * row[L.R_SEMI_MINOR_COEF] * pressure_pa / 3.0) ** 3
+
+
+def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> BearingModel:
+    """Compile spec + options into the immutable model."""
+    options = options or ModelOptions()
+    g, mat = spec.geometry, spec.material
+    rb = g.ball_radius_m
+    z = g.ball_count
+    alpha = math.radians(g.nominal_contact_angle_deg)
+    e_prime = hertz.effective_modulus_pa(mat.youngs_modulus_pa, mat.poisson_ratio)
+    shear = hertz.shear_modulus_pa(mat.youngs_modulus_pa, mat.poisson_ratio)
+    ball_mass = mat.density_kg_m3 * 4.0 / 3.0 * math.pi * rb ** 3
+    ball_inertia = 0.4 * ball_mass * rb * rb
+    pitch = g.pitch_radius_m
+    cage_inertia = g.cage_mass_kg * pitch * pitch
+    cage_mass_at_pitch = cage_inertia / pitch ** 2
+    half_chord = 2.0 * pitch * math.sin(math.pi / (2 * z))
+    # cage elements sit at half pitch between balls; keep at least 20 um pocket clearance
+    contact_distance = min(rb + g.cage_element_radius_m, half_chord - 20e-6)
+
+    p = np.zeros(L.N_PARAMS)
+    p[L.P_DT] = options.time_step_s
+    p[L.P_BALL_RADIUS] = rb
+    p[L.P_BALL_MASS] = ball_mass
+    p[L.P_BALL_INERTIA] = ball_inertia
+    p[L.P_RING_MASS] = spec.mounting.rotor_mass_kg
+    p[L.P_CAGE_INERTIA] = cage_inertia
+    p[L.P_CAGE_RADIUS] = pitch
+    p[L.P_CAGE_CONTACT_DISTANCE] = contact_distance
+    p[L.P_CAGE_STIFFNESS] = hertz.ball_ball_stiffness_n_m15(rb, g.cage_element_radius_m, shear,
+                                                           mat.poisson_ratio)
+    p[L.P_CAGE_REDUCED_MASS] = ball_mass * cage_mass_at_pitch / (ball_mass + cage_mass_at_pitch)
+    p[L.P_E_PRIME] = e_prime
+    p[L.P_G_PARAM] = spec.lubricant.pressure_viscosity_pa_inv * e_prime
+    p[L.P_ROUGHNESS] = spec.surface.composite_roughness_m
+    p[L.P_KT_RATIO] = options.tangential_stiffness_ratio
+    p[L.P_CT_RATIO] = options.tangential_damping_ratio
+    p[L.P_ALPHA_E] = options.restitution_coefficient_s_m
+    p[L.P_RAMP] = options.speed_ramp_rad_s2
+    p[L.P_FILM_FORMULA] = 0.0 if options.film_formula == "hamrock_dowson" else 1.0
+    p[L.P_FRICTION_MODEL] = 0.0 if options.friction_model == "stribeck_line" else 1.0
+    p[L.P_SUBSTEPS] = options.tribology_substeps
+    p[L.P_ROLLING] = 1.0 if options.rolling_resistance else 0.0
+    p[L.P_BALL_REDUCED_TANGENT_MASS] = ball_mass / (1.0 + ball_mass * rb * rb / ball_inertia)
+    p[L.P_MAX_PENETRATION] = 0.01 * rb
+    p[L.P_BALL_PITCH_SPRING] = 1e3
+
+    race = np.stack([_race_row(spec, True, alpha, e_prime), _race_row(spec, False, alpha, e_prime)])
+    # load limits: analytic Qmax = Fr / (Z Jr), Jr(0.5) = 0.2288 (seed 000 eq. A3)
+    q_limit = min(_load_at_pressure(race[0], MODEL_PRESSURE_FACTOR * STATIC_PRESSURE_LIMIT_PA),
+                  _load_at_pressure(race[1], MODEL_PRESSURE_FACTOR * STATIC_PRESSURE_LIMIT_PA))
+    max_radial = q_limit * z * 0.2288 * max(math.cos(alpha), 0.2)
+    max_axial = q_limit * z * max(math.sin(alpha), 0.2)
+    # limiting speed by the n dm rule of thumb (1.2e6 mm/min for oil-lubricated ball bearings)
+    max_speed = 1.2e6 / (2.0 * pitch * 1e3) * 2.0 * math.pi / 60.0
+    # per contact c = 2 ball + race: groove-centre radius, height, groove - ball radius, Hertz K
+    groove = np.empty((4, 2 * z))
+    for r in range(2):
+        groove[0, r::2] = race[r, L.R_GROOVE_CENTRE_RADIUS]
+        groove[1, r::2] = race[r, L.R_GROOVE_CENTRE_Z]
+        groove[2, r::2] = race[r, L.R_GROOVE_RADIUS] - rb
+        groove[3, r::2] = race[r, L.R_STIFFNESS]
+    tribology = np.stack([
+        tribology_coefficients(race[r, L.R_RX], race[r, L.R_RY], race[r, L.R_K_ELLIPTICITY], e_prime,
+                               p[L.P_G_PARAM], rb, race[r, L.R_SEMI_MAJOR_COEF],
+                               race[r, L.R_SEMI_MINOR_COEF], options.film_formula)
+        for r in range(2)])
+    for a in (p, race, groove, tribology):
+        a.setflags(write=False)
+    return BearingModel(
+        spec=spec, options=options, params=p, race_params=race, contact_groove=groove,
+        race_tribology=tribology,
+        ball_count=z, pitch_radius_m=pitch,
+        contact_angle_rad=alpha, inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),
+        max_radial_load_n=float(max_radial), max_axial_load_n=float(max_axial),
+        max_shaft_speed_rad_s=float(max_speed))

@@ -1,0 +1,84 @@
+"""The public state message, schema "bearing-twin/state/1" (DESIGN.md): immutable, units in
+every field name, JSON without NaN or Infinity (undefined values are null)."""
+
+from __future__ import annotations
+
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+SCHEMA = "bearing-twin/state/1"
+
+_FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+Regime = Literal["no_contact", "boundary", "mixed", "full_film"]
+
+
+class ContactState(BaseModel):
+    """One ball-raceway contact."""
+
+    model_config = _FROZEN
+    load_n: float = Field(description="Normal (elastic Hertz) load [N].")
+    h_min_m: float | None = Field(description="Minimum film thickness [m]; null without contact.")
+    h_c_m: float | None = Field(description="Central film thickness [m]; null without contact.")
+    lambda_: float | None = Field(alias="lambda", serialization_alias="lambda",
+                                  description="Film parameter Lambda = h_min / (1.25 sqrt(s1^2 + s2^2)) [-]; null without contact.")
+    regime: Regime = Field(description="Lubrication regime (seed 000 Table 2).")
+    mu: float = Field(description="Sliding friction coefficient [-] (0 without contact).")
+    entrainment_speed_m_s: float = Field(description="Mean surface speed relative to the contact [m/s].")
+    slide_roll_ratio: float = Field(description="Sliding / entrainment speed, signed [-].")
+    contact_angle_rad: float = Field(description="Angle of the contact normal to the radial plane [rad].")
+    max_pressure_pa: float = Field(description="Hertz maximum pressure [Pa].")
+
+
+class BallState(BaseModel):
+    """One ball and its inner and outer contacts."""
+
+    model_config = _FROZEN
+    index: int = Field(description="Ball number, 0..Z-1.")
+    azimuth_rad: float = Field(description="Angle from the radial load line, in (-pi, pi], positive with the shaft rotation [rad].")
+    spin_rad_s: float = Field(description="Magnitude of the ball's absolute angular velocity [rad/s].")
+    orbital_speed_rad_s: float = Field(description="Angular speed of the ball centre about the bearing axis [rad/s].")
+    cage_load_n: float = Field(description="Largest ball-cage contact force [N].")
+    inner: ContactState
+    outer: ContactState
+
+
+class SetpointState(BaseModel):
+    """The setpoint in force."""
+
+    model_config = _FROZEN
+    shaft_speed_rad_s: float = Field(description="Shaft speed setpoint [rad/s].")
+    radial_load_n: float = Field(description="Radial load [N].")
+    axial_load_n: float = Field(description="Axial load [N].")
+    oil_temperature_c: float = Field(description="Oil temperature [degC].")
+
+
+class Snapshot(BaseModel):
+    """Everything the world may see of one twin at one instant."""
+
+    model_config = _FROZEN
+    schema_: str = Field(default=SCHEMA, alias="schema", serialization_alias="schema",
+                         description="Message schema identifier.")
+    bearing_id: str = Field(description="Twin name.")
+    designation: str = Field(description="Bearing designation.")
+    seq: int = Field(description="Per-twin counter of snapshots (gaps reveal drops).")
+    time_s: float = Field(description="Simulated time [s].")
+    real_time_factor: float | None = Field(description="Simulated seconds per wall second over the last frames [-]; null when not measured.")
+    status: str = Field(description="'ok' or what went wrong and what the twin did about it.")
+    restarts: int = Field(description="Warm restarts after a diverged or overloaded state.")
+    setpoint: SetpointState
+    shaft_speed_rad_s: float = Field(description="Current (ramped) shaft speed [rad/s].")
+    cage_speed_rad_s: float = Field(description="Cage angular speed [rad/s].")
+    inner_ring_displacement_m: tuple[float, float, float] = Field(description="Inner ring centre (x along the radial load, y, z axial) [m].")
+    friction_torque_n_m: float = Field(description="Torque the shaft supplies to the bearing, averaged over the last frame [N m].")
+    viscosity_pa_s: float = Field(description="Oil dynamic viscosity at the oil temperature [Pa s].")
+    balls: tuple[BallState, ...]
+
+    def to_json(self) -> str:
+        """JSON text with the contract's field names."""
+        return self.model_dump_json(by_alias=True)
+
+    def to_dict(self) -> dict:
+        """Plain dict with the contract's field names."""
+        return self.model_dump(by_alias=True, mode="json")

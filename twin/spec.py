@@ -1,0 +1,175 @@
+"""What a person writes to describe a bearing: validated, SI, every field with its unit.
+
+`BearingSpec` is the human input; `twin.model.make_model` compiles it once into the immutable
+arrays the kernels use (MuJoCo's spec -> model split). Validation errors name the field and the
+allowed range (pydantic reports the field path; the messages below give the range).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Literal
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+_FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+
+class Geometry(BaseModel):
+    """Internal geometry of the bearing (seed 000 Table 1 names in brackets)."""
+
+    model_config = _FROZEN
+
+    ball_radius_m: float = Field(gt=0.0, le=0.1, description="Ball radius Rb [m].")
+    ball_count: int = Field(ge=3, le=64, description="Number of balls Z [-].")
+    inner_raceway_radius_m: float = Field(
+        gt=0.0, le=1.0,
+        description="Inner raceway radius Ri [m]: from the bearing axis to the inner contact, "
+        "measured along the nominal contact line (groove bottom for a deep-groove bearing).")
+    outer_raceway_radius_m: float = Field(
+        gt=0.0, le=1.0, description="Outer raceway radius Ro [m], measured like Ri.")
+    inner_groove_radius_m: float = Field(gt=0.0, le=0.1, description="Inner groove curvature radius [m].")
+    outer_groove_radius_m: float = Field(gt=0.0, le=0.1, description="Outer groove curvature radius Rc [m].")
+    cage_element_radius_m: float = Field(
+        gt=0.0, le=0.05,
+        description="Radius Rz [m] of the cage elements (seed 000: spheres between neighbouring "
+        "balls, rigidly attached to the cage).")
+    nominal_contact_angle_deg: float = Field(
+        default=0.0, ge=0.0, le=45.0,
+        description="Unloaded contact angle [deg]: 0 for deep-groove, e.g. 40 for a 7208 B.")
+    cage_mass_kg: float = Field(default=0.02, gt=0.0, le=100.0, description="Cage mass [kg].")
+
+    @model_validator(mode="after")
+    def _fits(self) -> "Geometry":
+        rb = self.ball_radius_m
+        for name in ("inner_groove_radius_m", "outer_groove_radius_m"):
+            rg = getattr(self, name)
+            if not (1.0 * rb < rg <= 1.25 * rb):
+                raise ValueError(
+                    f"{name} = {rg:g} m: a ball of radius {rb:g} m needs a groove radius in "
+                    f"({rb:g}, {1.25 * rb:g}] m (conformity f = Rg/D in (0.5, 0.625])")
+        if self.outer_raceway_radius_m <= self.inner_raceway_radius_m + rb:
+            raise ValueError("outer_raceway_radius_m must exceed inner_raceway_radius_m + ball radius")
+        gap = self.outer_raceway_radius_m - self.inner_raceway_radius_m - 2.0 * rb
+        if abs(gap) > 0.05 * rb:
+            raise ValueError(
+                f"outer_raceway_radius_m - inner_raceway_radius_m - 2 ball_radius_m = {gap:g} m: "
+                f"the ball must fill the raceway gap within +-{0.05 * rb:g} m; set clearance in "
+                "Mounting.diametral_clearance_m instead")
+        pitch = 0.5 * (self.inner_raceway_radius_m + self.outer_raceway_radius_m)
+        half_chord = 2.0 * pitch * math.sin(math.pi / (2 * self.ball_count))
+        if half_chord < rb + 1e-6:
+            raise ValueError(
+                f"ball_count = {self.ball_count}: the balls do not fit on the pitch circle "
+                f"(centre spacing {2 * half_chord:g} m < ball diameter {2 * rb:g} m)")
+        if half_chord - rb < 0.5 * self.cage_element_radius_m:
+            raise ValueError(
+                f"cage_element_radius_m = {self.cage_element_radius_m:g} m does not fit between "
+                f"neighbouring balls (room {half_chord - rb:g} m)")
+        return self
+
+    @property
+    def pitch_radius_m(self) -> float:
+        """Pitch radius [m], (Ri + Ro) / 2."""
+        return 0.5 * (self.inner_raceway_radius_m + self.outer_raceway_radius_m)
+
+
+class Material(BaseModel):
+    """Ring and ball material (seed 000: steel, E = 210 GPa, nu = 0.3)."""
+
+    model_config = _FROZEN
+
+    youngs_modulus_pa: float = Field(default=210e9, gt=1e9, le=1e12, description="Young's modulus E [Pa].")
+    poisson_ratio: float = Field(default=0.3, gt=0.0, lt=0.5, description="Poisson's ratio nu [-].")
+    density_kg_m3: float = Field(default=7850.0, gt=100.0, le=30000.0, description="Density [kg/m^3].")
+
+
+class Surface(BaseModel):
+    """Surface roughness, arithmetic mean Ra (seed 000 eq. 7: races 0.3 um, balls negligible)."""
+
+    model_config = _FROZEN
+
+    race_roughness_m: float = Field(default=0.3e-6, gt=0.0, le=1e-4, description="Raceway roughness sigma_a1 [m].")
+    ball_roughness_m: float = Field(default=0.0, ge=0.0, le=1e-4, description="Ball roughness sigma_a2 [m].")
+
+    @property
+    def composite_roughness_m(self) -> float:
+        """1.25 sqrt(sigma_a1^2 + sigma_a2^2) [m], the denominator of seed 000 eq. 7."""
+        return 1.25 * math.hypot(self.race_roughness_m, self.ball_roughness_m)
+
+
+class Lubricant(BaseModel):
+    """Oil: kinematic viscosity at 40 and 100 degC (ASTM D341 Walther law between them).
+
+    The default `seed-000` oil has exactly eta = 0.04 Pa s at 40 degC (seed 000 eq. 5, ref. [37])
+    with an ISO VG 46 mineral-oil slope; `twin.catalog.lubricant("ISO VG 68")` etc. give others.
+    """
+
+    model_config = _FROZEN
+
+    name: str = Field(default="seed-000", max_length=64, description="Lubricant name.")
+    kinematic_viscosity_40c_m2_s: float = Field(
+        default=0.04 / (870.0 * (1.0 - 6.5e-4 * 25.0)), gt=1e-7, le=1e-2,
+        description="Kinematic viscosity at 40 degC [m^2/s].")
+    kinematic_viscosity_100c_m2_s: float = Field(
+        default=6.8e-6, gt=1e-7, le=1e-3, description="Kinematic viscosity at 100 degC [m^2/s].")
+    density_15c_kg_m3: float = Field(default=870.0, gt=500.0, le=2000.0, description="Density at 15 degC [kg/m^3].")
+    pressure_viscosity_pa_inv: float = Field(
+        default=2.3e-8, gt=0.0, le=1e-7, description="Pressure-viscosity coefficient xi [1/Pa] (seed 000: 2.3e-8).")
+
+    @model_validator(mode="after")
+    def _order(self) -> "Lubricant":
+        if self.kinematic_viscosity_100c_m2_s >= self.kinematic_viscosity_40c_m2_s:
+            raise ValueError("kinematic_viscosity_100c_m2_s must be below kinematic_viscosity_40c_m2_s")
+        return self
+
+
+class Mounting(BaseModel):
+    """How the bearing is mounted."""
+
+    model_config = _FROZEN
+
+    diametral_clearance_m: float = Field(
+        default=0.0, ge=-50e-6, le=200e-6,
+        description="Diametral clearance Pd [m]; negative = preload (seed 000 Appendix A: +-12.6 um).")
+    rotor_mass_kg: float = Field(
+        default=0.5, gt=0.01, le=1000.0,
+        description="Mass carried by the inner ring [kg]: the ring plus the share of the shaft.")
+
+
+class BearingSpec(BaseModel):
+    """A complete bearing description: geometry, materials, surfaces, lubricant, mounting."""
+
+    model_config = _FROZEN
+
+    designation: str = Field(max_length=32, description="Catalog designation, e.g. '6208'.")
+    kind: Literal["deep_groove", "angular_contact"] = "deep_groove"
+    geometry: Geometry
+    material: Material = Material()
+    surface: Surface = Surface()
+    lubricant: Lubricant = Lubricant()
+    mounting: Mounting = Mounting()
+
+
+class ModelOptions(BaseModel):
+    """Numerical and model choices, fixed when a model is compiled."""
+
+    model_config = _FROZEN
+
+    time_step_s: float = Field(default=1e-6, ge=1e-8, le=5e-6, description="Integration step dt [s] (seed 000: 1 us).")
+    film_formula: Literal["hamrock_dowson", "masjedi_khonsari"] = Field(
+        default="hamrock_dowson", description="Minimum film formula: seed 000 eq. 6 or seed 004 eq. 6.")
+    friction_model: Literal["stribeck_line", "asperity_share"] = Field(
+        default="stribeck_line", description="mu(Lambda): seed 000 section 2.3 or seed 001 eq. A2.")
+    tribology_substeps: int = Field(
+        default=10, ge=1, le=10, description="Film/Lambda/mu/damping refreshed every this many steps (<= 10 us at 1 us).")
+    tangential_stiffness_ratio: float = Field(
+        default=0.8, ge=2.0 / 3.0, le=1.0, description="Kt/Kn [-] (seed 000 section 2.1: [2/3, 1]).")
+    tangential_damping_ratio: float = Field(
+        default=0.1, ge=0.0, le=1.0,
+        description="Tangential damping as a fraction of critical for the contact's reduced mass [-].")
+    restitution_coefficient_s_m: float = Field(
+        default=0.08, ge=0.0, le=1.0, description="alpha_e of seed 000 eq. 4 [s/m].")
+    speed_ramp_rad_s2: float = Field(
+        default=5000.0, gt=0.0, le=1e6, description="Shaft acceleration limit towards the speed setpoint [rad/s^2].")
+    rolling_resistance: bool = Field(default=True, description="Apply seed 001 rolling force and moments.")
