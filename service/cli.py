@@ -106,7 +106,19 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--repeats", type=int, default=5, help="repeats (best and median reported)")
     bench.add_argument("--json", action="store_true")
     bench.set_defaults(func=_cmd_bench)
+    report = sub.add_parser("report", help="validation report against the seeds (Markdown + PNG plots)")
+    report.add_argument("--out", default="reports", help="output directory (default reports/)")
+    report.add_argument("--quick", action="store_true", help="fewer points and shorter runs")
+    report.set_defaults(func=_cmd_report)
     return parser
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from service.report import write_report
+
+    path = write_report(args.out, quick=args.quick)
+    print(f"report written to {path}")
+    return 0
 
 
 def main(argv: list[str] | None = None) -> int:
