@@ -50,19 +50,47 @@ def _equilibrium_residual(x_um, model: BearingModel, azimuths, fr, fa, cage_spee
     return res
 
 
-def solve_equilibrium(model: BearingModel, azimuths, radial_load_n, axial_load_n, cage_speed_rad_s):
-    """Ring shift [m] (3,), ball radial offsets from the pitch circle [m] and axial positions [m]."""
+def _initial_guess_um(model: BearingModel, azimuths, fr, fa) -> np.ndarray:
+    """Ring shift and ball offsets from the rigid-ring Hertz estimate (Stribeck's Qmax for the
+    radial part, an even share for the axial part), so that the solver does not start at the
+    zero-penetration point where every contact stiffness vanishes."""
     z = model.ball_count
-    x0 = np.zeros(3 + 2 * z)
-    sol = optimize.root(_equilibrium_residual, x0, args=(model, azimuths, radial_load_n, axial_load_n,
-                                                        cage_speed_rad_s),
-                        method="hybr", options={"xtol": 1e-13, "maxfev": 20000})
-    if not sol.success:
-        sol = optimize.root(_equilibrium_residual, sol.x, args=(model, azimuths, radial_load_n,
-                                                               axial_load_n, cage_speed_rad_s),
-                            method="lm", options={"xtol": 1e-14, "maxiter": 20000})
+    race = model.race_params
+    ki, ko = race[0, L.R_STIFFNESS], race[1, L.R_STIFFNESS]
+    k_eff = (ki ** (-2 / 3) + ko ** (-2 / 3)) ** -1.5
+    outer_share = ko ** (-2 / 3) / (ki ** (-2 / 3) + ko ** (-2 / 3))
+    alpha = model.contact_angle_rad
+    pd = model.spec.mounting.diametral_clearance_m
+    qmax = max(fr, 1.0) / (z * 0.2288)
+    delta_r = (qmax / k_eff) ** (2 / 3) / max(math.cos(alpha), 0.2) + 0.5 * max(pd, 0.0)
+    delta_a = 0.0
+    if alpha > 0.0 and fa > 0.0:
+        delta_a = (fa / (z * k_eff * math.sin(alpha))) ** (2 / 3) / math.sin(alpha)
+    x = np.zeros(3 + 2 * z)
+    x[0], x[2] = delta_r, delta_a
+    for j in range(z):
+        total = (delta_r * math.cos(azimuths[j]) * math.cos(alpha) + delta_a * math.sin(alpha)
+                 - 0.5 * pd)
+        d_out = outer_share * max(total, 0.0)
+        x[3 + 2 * j] = d_out * math.cos(alpha) + 0.5 * pd
+        x[4 + 2 * j] = d_out * math.sin(alpha)
+    return x * 1e6
+
+
+def solve_equilibrium(model: BearingModel, azimuths, radial_load_n, axial_load_n, cage_speed_rad_s):
+    """Ring shift [m] (3,), ball radial offsets from the pitch circle [m], ball axial positions
+    [m], and whether the residual forces are below 1e-6 of the load."""
+    args = (model, azimuths, radial_load_n, axial_load_n, cage_speed_rad_s)
+    x0 = _initial_guess_um(model, azimuths, radial_load_n, axial_load_n)
+    scale = max(radial_load_n, abs(axial_load_n), 1.0)
+    sol = optimize.root(_equilibrium_residual, x0, args=args, method="hybr",
+                        options={"xtol": 1e-13, "maxfev": 20000})
+    if np.max(np.abs(_equilibrium_residual(sol.x, *args))) > 1e-6 * scale:
+        sol = optimize.root(_equilibrium_residual, sol.x, args=args, method="lm",
+                            options={"xtol": 1e-15, "ftol": 1e-15, "maxiter": 20000})
+    ok = bool(np.max(np.abs(_equilibrium_residual(sol.x, *args))) <= 1e-6 * scale)
     x = sol.x * 1e-6
-    return x[:3], x[3::2], x[4::2], bool(sol.success)
+    return x[:3], x[3::2], x[4::2], ok
 
 
 def warm_start(model: BearingModel, state: TwinState, shaft_speed_rad_s: float, radial_load_n: float,

@@ -1,0 +1,51 @@
+"""The in-loop log-form tribology (twin.kernels.tribology) equals the law functions of
+twin.physics it is compiled from (seed 000 eqs. 5-7, seed 004 eq. 6, seed 001 eqs. 1-5, 9, 11)."""
+
+import math
+
+import numpy as np
+import pytest
+
+from twin import catalog
+from twin.kernels import layout as L
+from twin.kernels.tribology import contact_tribology
+from twin.model import make_model
+from twin.physics import damping, ehl, rolling
+from twin.spec import ModelOptions
+
+
+@pytest.mark.parametrize("formula", ["hamrock_dowson", "masjedi_khonsari"])
+def test_fast_path_equals_laws(formula):
+    model = make_model(catalog.bearing("6208"), ModelOptions(film_formula=formula))
+    rng = np.random.default_rng(7)
+    p = model.params
+    for _ in range(200):
+        r = int(rng.integers(0, 2))
+        q = float(10 ** rng.uniform(0, 4))       # 1 N .. 10 kN
+        u = float(10 ** rng.uniform(-2, 1.5))    # 1 cm/s .. 30 m/s
+        eta = float(10 ** rng.uniform(-3, -0.5))
+        tr = model.race_tribology[r]
+        out = contact_tribology(q, u, eta, p[L.P_ROUGHNESS], *tr, 0, True)
+        rx, ry = model.race_params[r, L.R_RX], model.race_params[r, L.R_RY]
+        k = model.race_params[r, L.R_K_ELLIPTICITY]
+        e = p[L.P_E_PRIME]
+        args = (rx, ehl.speed_parameter(eta, u, e, rx), p[L.P_G_PARAM], ehl.load_parameter(q, e, rx), k)
+        h = (ehl.hamrock_dowson_h_min_m if formula == "hamrock_dowson" else ehl.masjedi_khonsari_h_min_m)(*args)
+        assert out[0] == pytest.approx(h, rel=1e-10)
+        assert out[1] == pytest.approx(ehl.hamrock_dowson_h_c_m(*args), rel=1e-10)
+        assert out[2] == pytest.approx(h / p[L.P_ROUGHNESS], rel=1e-10)
+        a = out[5]
+        assert a == pytest.approx(model.race_params[r, L.R_SEMI_MAJOR_COEF] * q ** (1 / 3), rel=1e-12)
+        assert out[7] == pytest.approx(damping.fluid_damping_n_s_m(eta, a, 6.3e-3, h), rel=1e-10)
+        ratio = ry / rx
+        fr = (rolling.rolling_force_transition_n(e, rx, ratio, q, eta, u)
+              + rolling.hysteresis_moment_n_m(12.6e-3, q, ratio) / 6.3e-3)
+        assert out[8] == pytest.approx(fr, rel=1e-10)
+        assert out[9] == pytest.approx(rolling.pivoting_moment_n_m(out[4], q, a, ratio), rel=1e-10)
+
+
+def test_no_entrainment_is_boundary_without_film_force():
+    model = make_model(catalog.bearing("6208"))
+    out = contact_tribology(1000.0, 0.0, 0.04, 3.75e-7, *model.race_tribology[0], 0, True)
+    assert out[0] == 0.0 and out[2] == 0.0 and out[3] == 1 and out[4] == 0.1
+    assert all(math.isfinite(v) for v in out)
