@@ -1,0 +1,45 @@
+"""The console script: simulate prints the contract as JSON, report writes Markdown and plots."""
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+
+def _run(*args, timeout=300):
+    return subprocess.run([sys.executable, "-m", "service.cli", *args], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def test_simulate_json_is_the_contract():
+    res = _run("simulate", "--bearing", "6208", "--radial-load", "3000", "--speed", "500",
+               "--duration", "0.005", "--json")
+    assert res.returncode == 0, res.stderr
+    snap = json.loads(res.stdout, parse_constant=lambda c: pytest.fail(f"non-finite {c}"))
+    assert snap["schema"] == "bearing-twin/state/1"
+    assert snap["time_s"] == pytest.approx(0.005)
+    assert len(snap["balls"]) == 9
+    ball = snap["balls"][0]
+    assert set(ball["inner"]) >= {"load_n", "entrainment_speed_m_s", "slide_roll_ratio", "h_min_m", "lambda",
+                                  "regime", "mu"}
+    assert snap["setpoint"]["radial_load_n"] == 3000.0
+
+
+def test_simulate_refuses_bad_input_by_name():
+    res = _run("simulate", "--radial-load", "-10", "--duration", "0.001")
+    assert res.returncode == 2
+    assert "radial_load_n" in res.stderr and "Traceback" not in res.stderr
+    res = _run("simulate", "--clearance", "0.01", "--duration", "0.001")
+    assert res.returncode == 2 and "diametral_clearance_m" in res.stderr
+
+
+def test_report_quick(tmp_path):
+    res = _run("report", "--out", str(tmp_path), "--quick", timeout=600)
+    assert res.returncode == 0, res.stderr
+    text = (tmp_path / "report.md").read_text()
+    for png in ("lambda_azimuth_500.png", "lambda_speed.png", "lambda_load.png", "lambda_clearance.png",
+                "startup.png", "seed001_torque.png"):
+        assert (tmp_path / png).stat().st_size > 10_000
+        assert png in text
+    assert "0.6797" in text and "-0.0727" in text
