@@ -102,16 +102,14 @@ class Twin:
         else:
             warm_start(self.model, self.state, speed, 0.0, 0.0)
         m = self.model
-        evaluate(m.params, m.contact_groove, m.race_tribology, self._setpoint_vector,
-                 *self.state.kernel_args())
+        evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
 
     def _frame(self, n: int) -> int:
         s = self.state
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
         m = self.model
-        status, done = step_n(m.params, m.contact_groove, m.race_tribology,
-                              self._setpoint_vector,
+        status, done = step_n(m.params, m.race_tribology, self._setpoint_vector,
                               *s.kernel_args(), n)
         if s.scalars[L.X_TORQUE_COUNT] > 0:
             self._last_torque_n_m = s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT]
@@ -163,7 +161,7 @@ class Twin:
             regime=regime, mu=float(c[L.C_MU]) if loaded else 0.0,
             entrainment_speed_m_s=float(c[L.C_ENTRAINMENT]) if loaded else 0.0,
             slide_roll_ratio=float(c[L.C_SRR]) if loaded else 0.0,
-            contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.C_NZ])))) if loaded else 0.0,
+            contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.G_NZ])))) if loaded else 0.0,
             max_pressure_pa=float(max_pressure_pa(c[L.C_LOAD], c[L.C_SEMI_MAJOR], c[L.C_SEMI_MINOR])),
         )
 

@@ -30,7 +30,6 @@ class BearingModel:
     options: ModelOptions
     params: np.ndarray
     race_params: np.ndarray
-    contact_groove: np.ndarray
     race_tribology: np.ndarray
     ball_count: int
     pitch_radius_m: float
@@ -167,22 +166,15 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     max_axial = q_limit * z * max(math.sin(alpha), 0.2)
     # limiting speed by the n dm rule of thumb (1.2e6 mm/min for oil-lubricated ball bearings)
     max_speed = 1.2e6 / (2.0 * pitch * 1e3) * 2.0 * math.pi / 60.0
-    # per contact c = 2 ball + race: groove-centre radius, height, groove - ball radius, Hertz K
-    groove = np.empty((4, 2 * z))
-    for r in range(2):
-        groove[0, r::2] = race[r, L.R_GROOVE_CENTRE_RADIUS]
-        groove[1, r::2] = race[r, L.R_GROOVE_CENTRE_Z]
-        groove[2, r::2] = race[r, L.R_GROOVE_RADIUS] - rb
-        groove[3, r::2] = race[r, L.R_STIFFNESS]
     tribology = np.stack([
         tribology_coefficients(race[r, L.R_RX], race[r, L.R_RY], race[r, L.R_K_ELLIPTICITY], e_prime,
                                p[L.P_G_PARAM], rb, race[r, L.R_SEMI_MAJOR_COEF],
                                race[r, L.R_SEMI_MINOR_COEF], options.film_formula)
         for r in range(2)])
-    for a in (p, race, groove, tribology):
+    for a in (p, race, tribology):
         a.setflags(write=False)
     return BearingModel(
-        spec=spec, options=options, params=p, race_params=race, contact_groove=groove,
+        spec=spec, options=options, params=p, race_params=race,
         race_tribology=tribology,
         ball_count=z, pitch_radius_m=pitch,
         contact_angle_rad=alpha, inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),

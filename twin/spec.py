@@ -21,7 +21,7 @@ class Geometry(BaseModel):
     model_config = _FROZEN
 
     ball_radius_m: float = Field(gt=0.0, le=0.1, description="Ball radius Rb [m].")
-    ball_count: int = Field(ge=3, le=64, description="Number of balls Z [-].")
+    ball_count: int = Field(ge=3, le=16, description="Number of balls Z [-] (at most 16: the kernel has 32 contact lanes).")
     inner_raceway_radius_m: float = Field(
         gt=0.0, le=1.0,
         description="Inner raceway radius Ri [m]: from the bearing axis to the inner contact, "

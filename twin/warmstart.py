@@ -109,9 +109,7 @@ def warm_start(model: BearingModel, state: TwinState, shaft_speed_rad_s: float, 
     state.scalars[L.X_CAGE_SPEED] = cage_speed
     state.ring_position_m[:] = ring
     state.ring_velocity_m_s[:] = 0.0
-    state.tangential_spring_m[:] = 0.0
-    state.contacts[:] = 0.0
-    state.contacts[L.C_LAMBDA] = -1.0
+    state.clear_contacts()
     for j in range(z):
         c, s = math.cos(azimuths[j]), math.sin(azimuths[j])
         rho = model.pitch_radius_m + d_rho[j]

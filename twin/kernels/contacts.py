@@ -1,10 +1,8 @@
-"""Contact kernels: ball-raceway (torus groove) and ball-cage-element forces, and the per-contact
-tribology. Scalar in, tuple out: the hot loop (`twin.kernels.step`) owns every array access.
+"""Contact kernels: ball-raceway (torus groove) and ball-cage-element contacts.
 
-Measured reasons for the style: passing arrays to a non-inlined numba function costs an atomic
-incref/decref pair per array per call, so the per-contact laws are scalar functions (inlined by
-LLVM); the branch-free geometry pass vectorises (vsqrtpd), while a vectorised force pass did not
-(too many arrays for LLVM's runtime alias checks) and was slower than the fused scalar loop.
+The ball-raceway contacts of all balls are processed as lanes of one flat array `w` (row k of
+contact c at w[k * CW + c], see `twin.kernels.layout`): a branch-free geometry pass and a
+branch-free force pass that LLVM vectorises. Ball-cage contacts are scalar (mostly open).
 
 Frame: bearing axis +z, radial load along +x (azimuth 0 = most loaded), shaft speed about +z.
 """
@@ -14,7 +12,13 @@ import math
 from numba import njit
 
 from twin.jit import JIT, JIT_VECTOR
-from twin.physics.damping import regime_damping_n_s_m
+from twin.kernels.layout import (
+    C_FLUID_DAMPING, C_LAMBDA, C_MU, C_ROLLING_PER_SPEED, C_SPIN_MOMENT, C_TANGENT_DAMPING, CW,
+    G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY, K_OVZ,
+    K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_GROOVE_CENTRE_RADIUS,
+    M_GROOVE_CENTRE_Z, M_GROOVE_CLEARANCE, M_STIFFNESS, O_EX, O_EY, O_EZ, O_FX, O_FY, O_FZ,
+    O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, T_XI0, T_XI1, T_XI2,
+)
 
 
 @njit(**JIT)
@@ -31,116 +35,159 @@ def groove_penetration(px, py, pz, groove_centre_radius, groove_centre_z, groove
     if rho <= 0.0:
         return -1.0, 1.0, 0.0, 0.0
     inv_rho = 1.0 / rho
-    erx = px * inv_rho
-    ery = py * inv_rho
-    dx = px - groove_centre_radius * erx
-    dy = py - groove_centre_radius * ery
+    dx = px - groove_centre_radius * px * inv_rho
+    dy = py - groove_centre_radius * py * inv_rho
     dz = pz - groove_centre_z
     d = math.sqrt(dx * dx + dy * dy + dz * dz)
     if d <= 0.0:
-        return -(groove_radius - ball_radius), erx, ery, 0.0
+        return -(groove_radius - ball_radius), px * inv_rho, py * inv_rho, 0.0
     inv_d = 1.0 / d
     return d - (groove_radius - ball_radius), dx * inv_d, dy * inv_d, dz * inv_d
 
 
 @njit(**JIT_VECTOR)
-def raceway_geometry(rel, groove, out):
-    """Seed 000 Fig. 3 torus geometry for every ball-raceway contact at once (vectorised).
-
-    rel[0:3, c]: ball centre relative to its ring's centre [m] for contact c = 2 ball + race;
-    groove[0:4, c]: groove-centre circle radius, its height, groove radius - ball radius [m], Hertz
-    K [N/m^1.5]. Writes out[0, c] = penetration delta [m] (<= 0: no contact), out[1:4, c] = unit
-    normal from the groove-curvature centre to the ball centre, out[4, c] = sqrt(max(delta, 0)),
-    out[5, c] = elastic load K delta^1.5 [N] (0 without contact). Branch-free so that LLVM turns
-    the square roots and divisions into vector instructions (measured 6 ns per contact instead
-    of ~45 ns for the fused scalar form)."""
-    for c in range(rel.shape[1]):
-        px = rel[0, c]
-        py = rel[1, c]
-        pz = rel[2, c]
+def raceway_geometry(w, nc):
+    """`groove_penetration` for every contact lane at once (vectorised, branch-free): reads
+    K_PX..K_PZ and the M_* groove rows, writes G_DELTA, G_NX..G_NZ, G_SQRT_DELTA and
+    G_LOAD = K delta^1.5 (seed 000 eq. 2; 0 when open)."""
+    for c in range(nc):
+        px = w[K_PX * CW + c]
+        py = w[K_PY * CW + c]
+        pz = w[K_PZ * CW + c]
         rho = math.sqrt(px * px + py * py)
-        scale = 1.0 - groove[0, c] / rho
+        scale = 1.0 - w[M_GROOVE_CENTRE_RADIUS * CW + c] / rho
         dx = px * scale
         dy = py * scale
-        dz = pz - groove[1, c]
+        dz = pz - w[M_GROOVE_CENTRE_Z * CW + c]
         d = math.sqrt(dx * dx + dy * dy + dz * dz)
         inv_d = 1.0 / d
-        delta = d - groove[2, c]
-        out[0, c] = delta
-        out[1, c] = dx * inv_d
-        out[2, c] = dy * inv_d
-        out[3, c] = dz * inv_d
-        sq = math.sqrt(max(delta, 0.0))
-        out[4, c] = sq
-        out[5, c] = groove[3, c] * max(delta, 0.0) * sq
+        delta = d - w[M_GROOVE_CLEARANCE * CW + c]
+        pos = max(delta, 0.0)
+        sq = math.sqrt(pos)
+        w[G_DELTA * CW + c] = delta
+        w[G_NX * CW + c] = dx * inv_d
+        w[G_NY * CW + c] = dy * inv_d
+        w[G_NZ * CW + c] = dz * inv_d
+        w[G_SQRT_DELTA * CW + c] = sq
+        w[G_LOAD * CW + c] = w[M_STIFFNESS * CW + c] * pos * sq
 
 
-@njit(**JIT)
-def contact_slip(rb, nx, ny, nz, bx, by, qx, qy, bvx, bvy, bvz, wx, wy, wz, ovx, ovy, ovz,
-                 ring_speed, orbital_speed):
-    """Surface kinematics of a ball-race contact at the point rb n from the ball centre (q from
-    the ring centre, b the ball centre in the world frame). Returns the tangential slip velocity
-    ball minus ring (tx, ty, tz) [m/s] and the tangential entrainment velocity (ex, ey, ez) [m/s]:
-    the mean of the two surface velocities relative to the contact point, which orbits with the
-    ball at orbital_speed (DESIGN.md reading of seed 000 eq. 6: ~7.25 m/s for the 6208 at 500 rad/s)."""
-    vbx = bvx + rb * (wy * nz - wz * ny)
-    vby = bvy + rb * (wz * nx - wx * nz)
-    vbz = bvz + rb * (wx * ny - wy * nx)
-    vrx = ovx - ring_speed * qy
-    vry = ovy + ring_speed * qx
-    vrz = ovz
-    sx = vbx - vrx
-    sy = vby - vry
-    sz = vbz - vrz
-    sn = sx * nx + sy * ny + sz * nz
-    ex = 0.5 * (vbx + vrx) + orbital_speed * (by + rb * ny)
-    ey = 0.5 * (vby + vry) - orbital_speed * (bx + rb * nx)
-    ez = 0.5 * (vbz + vrz)
-    en = ex * nx + ey * ny + ez * nz
-    return (sx - sn * nx, sy - sn * ny, sz - sn * nz, ex - en * nx, ey - en * ny, ez - en * nz)
+@njit(**JIT_VECTOR)
+def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
+    """Seed 000 eq. 8 for every contact lane at once (vectorised, branch-free):
 
+    - kinematics: slip (ball minus ring surface velocity, tangential) and entrainment (mean
+      surface velocity relative to the contact point, which orbits with the ball; DESIGN.md
+      reading of eq. 6, ~7.25 m/s for the 6208 at 500 rad/s);
+    - Fn = K delta^1.5 + C_n(Lambda) d(delta)/dt, never adhesive, C_n per Table 2: C_hyst =
+      3 alpha_e K delta^1.5 / 2 (eq. 4) for Lambda <= 1, C_hyst C_fluid / (C_hyst + C_fluid) for
+      1 < Lambda <= 3, C_fluid (eq. 5) above;
+    - Ft = -(Kt xi + Ct v_t) capped at mu Fn (tangential spring xi with a Coulomb limit,
+      Cundall-Strack: the spring is reset to the capped force when sliding), Kt = ratio dQ/ddelta;
+    - seed 001 rolling resistance at the ball centre along the entrainment, and the pivoting
+      moment against the spin of the ball relative to the ring about the normal.
 
-@njit(**JIT)
-def normal_force_n(q_elastic, film_param, c_fluid, alpha_e, penetration_rate):
-    """Fn = K delta^1.5 + C_n(Lambda) d(delta)/dt, never adhesive (seed 000 eq. 8 with eq. 4,
-    C_hyst = 3 alpha_e K delta^1.5 / 2, eq. 5 and Table 2)."""
-    c_n = regime_damping_n_s_m(film_param, 1.5 * alpha_e * q_elastic, c_fluid)
-    fn = q_elastic + c_n * penetration_rate
-    return fn if fn > 0.0 else 0.0
-
-
-@njit(**JIT)
-def tangential_force(xix, xiy, xiz, nx, ny, nz, tx, ty, tz, dt, kt, ct, limit):
-    """Seed 000 eq. 8 tangential law: spring history xi rotated into the tangent plane plus this
-    step's slip, trial force -Kt xi - Ct v_t, capped at mu Fn (Cundall-Strack: when sliding the
-    spring is reset to the capped force). Returns (Ftx, Fty, Ftz, xi_x, xi_y, xi_z)."""
-    xn = xix * nx + xiy * ny + xiz * nz
-    xix = xix - xn * nx + tx * dt
-    xiy = xiy - xn * ny + ty * dt
-    xiz = xiz - xn * nz + tz * dt
-    ftx = -kt * xix - ct * tx
-    fty = -kt * xiy - ct * ty
-    ftz = -kt * xiz - ct * tz
-    ft2 = ftx * ftx + fty * fty + ftz * ftz
-    if ft2 > limit * limit:
-        scale = limit / math.sqrt(ft2)
+    Reads the G_*, K_*, M_STIFFNESS rows and the cached C_* rows; writes the O_* rows and the
+    spring T_XI* (reset where the contact is open)."""
+    for c in range(nc):
+        loaded = 1.0 if w[G_DELTA * CW + c] > 0.0 else 0.0
+        nx = w[G_NX * CW + c]
+        ny = w[G_NY * CW + c]
+        nz = w[G_NZ * CW + c]
+        qx = w[K_PX * CW + c] + rb * nx
+        qy = w[K_PY * CW + c] + rb * ny
+        wx = w[K_WX * CW + c]
+        wy = w[K_WY * CW + c]
+        wz = w[K_WZ * CW + c]
+        spin = w[K_SPIN * CW + c]
+        bvx = w[K_VX * CW + c]
+        bvy = w[K_VY * CW + c]
+        bvz = w[K_VZ * CW + c]
+        ovx = w[K_OVX * CW + c]
+        ovy = w[K_OVY * CW + c]
+        ovz = w[K_OVZ * CW + c]
+        # surface velocities at the contact point, slip and entrainment
+        vbx = bvx + rb * (wy * nz - wz * ny)
+        vby = bvy + rb * (wz * nx - wx * nz)
+        vbz = bvz + rb * (wx * ny - wy * nx)
+        vrx = ovx - spin * qy
+        vry = ovy + spin * qx
+        vrz = ovz
+        sx = vbx - vrx
+        sy = vby - vry
+        sz = vbz - vrz
+        sn = sx * nx + sy * ny + sz * nz
+        tx = sx - sn * nx
+        ty = sy - sn * ny
+        tz = sz - sn * nz
+        orbit = w[K_ORBIT * CW + c]
+        ex = 0.5 * (vbx + vrx) + orbit * (w[K_BY * CW + c] + rb * ny)
+        ey = 0.5 * (vby + vry) - orbit * (w[K_BX * CW + c] + rb * nx)
+        ez = 0.5 * (vbz + vrz)
+        en = ex * nx + ey * ny + ez * nz
+        ex -= en * nx
+        ey -= en * ny
+        ez -= en * nz
+        # normal force with the regime damping of Table 2
+        q_el = w[G_LOAD * CW + c]
+        lam = w[C_LAMBDA * CW + c]
+        c_fluid = w[C_FLUID_DAMPING * CW + c]
+        c_hyst = 1.5 * alpha_e * q_el
+        c_series = c_hyst * c_fluid / (c_hyst + c_fluid + 1e-300)
+        c_n = c_fluid if lam > 3.0 else c_series
+        c_n = c_hyst if (lam <= 1.0 or c_fluid <= 0.0) else c_n
+        rate = (bvx - ovx) * nx + (bvy - ovy) * ny + (bvz - ovz) * nz
+        fn = loaded * max(q_el + c_n * rate, 0.0)
+        # tangential spring with Coulomb limit
+        kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
+        xix = w[T_XI0 * CW + c]
+        xiy = w[T_XI1 * CW + c]
+        xiz = w[T_XI2 * CW + c]
+        xn = xix * nx + xiy * ny + xiz * nz
+        xix = xix - xn * nx + tx * dt
+        xiy = xiy - xn * ny + ty * dt
+        xiz = xiz - xn * nz + tz * dt
+        ct = w[C_TANGENT_DAMPING * CW + c]
+        ftx = -kt * xix - ct * tx
+        fty = -kt * xiy - ct * ty
+        ftz = -kt * xiz - ct * tz
+        limit = w[C_MU * CW + c] * fn
+        ft = math.sqrt(ftx * ftx + fty * fty + ftz * ftz)
+        sliding = ft > limit
+        scale = limit / (ft + 1e-300) if sliding else 1.0
         ftx *= scale
         fty *= scale
         ftz *= scale
-        inv_kt = 1.0 / kt
-        xix = -ftx * inv_kt
-        xiy = -fty * inv_kt
-        xiz = -ftz * inv_kt
-    return ftx, fty, ftz, xix, xiy, xiz
-
-
-@njit(**JIT)
-def pivoting_moment_signed(spin_moment, wx, wy, wz, nx, ny, nz, ring_speed):
-    """Seed 001 pivoting moment about the normal [N m], opposing the spin of the ball relative
-    to the ring about the contact normal."""
-    spin_rel = (wx * nx + wy * ny + wz * nz) - ring_speed * nz
-    mp = -spin_moment if spin_rel > 0.0 else spin_moment
-    return 0.0 if spin_rel == 0.0 else mp
+        inv_kt = 1.0 / (kt + 1e-300)
+        xix = -ftx * inv_kt if sliding else xix
+        xiy = -fty * inv_kt if sliding else xiy
+        xiz = -ftz * inv_kt if sliding else xiz
+        # rolling resistance (seed 001) and pivoting moment
+        roll = w[C_ROLLING_PER_SPEED * CW + c]
+        spin_rel = (wx * nx + wy * ny + wz * nz) - spin * nz
+        ms = w[C_SPIN_MOMENT * CW + c]
+        mp = -ms if spin_rel > 0.0 else ms
+        mp = loaded * (0.0 if spin_rel == 0.0 else mp)
+        fx = -fn * nx + loaded * (ftx + roll * ex)
+        fy = -fn * ny + loaded * (fty + roll * ey)
+        fz = -fn * nz + loaded * (ftz + roll * ez)
+        w[O_FX * CW + c] = fx
+        w[O_FY * CW + c] = fy
+        w[O_FZ * CW + c] = fz
+        w[O_TX * CW + c] = loaded * rb * (ny * ftz - nz * fty) + mp * nx
+        w[O_TY * CW + c] = loaded * rb * (nz * ftx - nx * ftz) + mp * ny
+        w[O_TZ * CW + c] = loaded * rb * (nx * fty - ny * ftx) + mp * nz
+        # reaction on the ring: -F at the contact point and -M, about the ring axis
+        w[O_RING_TZ * CW + c] = -(qx * fy - qy * fx) - mp * nz
+        w[O_EX * CW + c] = ex
+        w[O_EY * CW + c] = ey
+        w[O_EZ * CW + c] = ez
+        w[O_SX * CW + c] = tx
+        w[O_SY * CW + c] = ty
+        w[O_SZ * CW + c] = tz
+        w[T_XI0 * CW + c] = loaded * xix
+        w[T_XI1 * CW + c] = loaded * xiy
+        w[T_XI2 * CW + c] = loaded * xiz
 
 
 @njit(**JIT)
