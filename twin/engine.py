@@ -18,7 +18,9 @@ from twin.physics.friction import REGIME_NAMES
 from twin.physics.hertz import max_pressure_pa
 from twin.physics.viscosity import dynamic_viscosity_pa_s
 from twin.setpoint import Setpoint, SetpointUpdate, check_limits
+from twin.electrical import bearing_network
 from twin.snapshot import BallState, ContactState, SetpointState, Snapshot
+from twin.snapshot import ElectricalState as ElectricalSnapshot
 from twin.spec import BearingSpec, ModelOptions
 from twin.state import TwinState, make_state
 from twin.warmstart import warm_start
@@ -69,6 +71,8 @@ class Twin:
             "radial_load_n": (0.0, m.max_radial_load_n),
             "axial_load_n": (axial_low, m.max_axial_load_n),
             "oil_temperature_c": (-30.0, 150.0),
+            "shaft_current_a": (0.0, 100.0),
+            "shaft_voltage_v": (0.0, 1000.0),
         }
 
     @property
@@ -149,7 +153,7 @@ class Twin:
         x = self.state.ball_position_m
         return np.arctan2(x[:, 1], x[:, 0])
 
-    def _contact(self, j: int, r: int) -> ContactState:
+    def _contact(self, j: int, r: int, net) -> ContactState:
         c = self.state.contacts[:, 2 * j + r]
         loaded = c[L.C_LOAD] > 0.0
         regime = REGIME_NAMES[int(c[L.C_REGIME])] if loaded else "no_contact"
@@ -163,7 +167,14 @@ class Twin:
             slide_roll_ratio=float(c[L.C_SRR]) if loaded else 0.0,
             contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.G_NZ])))) if loaded else 0.0,
             max_pressure_pa=float(max_pressure_pa(c[L.C_LOAD], c[L.C_SEMI_MAJOR], c[L.C_SEMI_MINOR])),
+            resistance_ohm=_finite_or_none(net.contact_resistance_ohm[2 * j + r]),
+            capacitance_f=float(net.contact_capacitance_f[2 * j + r]),
         )
+
+    def electrical(self):
+        """The bearing's electrical network at the current state (twin.electrical)."""
+        sp = self._setpoint
+        return bearing_network(self.model, self.state.contacts, sp.shaft_voltage_v, sp.shaft_current_a)
 
     def snapshot(self, real_time_factor: float | None = None) -> Snapshot:
         """An immutable copy of the public state (schema bearing-twin/state/1)."""
@@ -173,11 +184,14 @@ class Twin:
         rho2 = x[:, 0] ** 2 + x[:, 1] ** 2
         orbital = (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]) / rho2
         spin = np.linalg.norm(w, axis=1)
+        net = self.electrical()
         balls = tuple(
             BallState(index=j, azimuth_rad=float(az[j]), spin_rad_s=float(spin[j]),
                       orbital_speed_rad_s=float(orbital[j]),
                       cage_load_n=float(s.cage_load_n[j].max()),
-                      inner=self._contact(j, 0), outer=self._contact(j, 1))
+                      inner=self._contact(j, 0, net), outer=self._contact(j, 1, net),
+                      resistance_ohm=_finite_or_none(net.ball_resistance_ohm[j]),
+                      capacitance_f=float(net.ball_capacitance_f[j]))
             for j in range(self.model.ball_count))
         self.seq += 1
         sp = self._setpoint
@@ -192,4 +206,11 @@ class Twin:
             inner_ring_displacement_m=tuple(float(a) for a in s.ring_position_m),
             friction_torque_n_m=float(self._last_torque_n_m),
             viscosity_pa_s=float(self._setpoint_vector[L.S_VISCOSITY]),
+            electrical=ElectricalSnapshot(
+                resistance_ohm=_finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,
+                impedance_ohm=net.impedance_ohm, phase_rad=net.phase_rad,
+                frequency_hz=net.frequency_hz, shaft_voltage_v=net.shaft_voltage_v,
+                shaft_current_a=net.shaft_current_a, max_film_field_v_m=net.max_film_field_v_m,
+                current_density_a_m2=net.current_density_a_m2, discharge_risk=net.discharge_risk,
+                reason=net.reason),
             balls=balls)

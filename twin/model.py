@@ -157,6 +157,11 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_BALL_REDUCED_TANGENT_MASS] = ball_mass / (1.0 + ball_mass * rb * rb / ball_inertia)
     p[L.P_MAX_PENETRATION] = 0.01 * rb
     p[L.P_BALL_PITCH_SPRING] = 1e3
+    el = spec.electrical
+    p[L.P_OIL_PERMITTIVITY] = el.oil_relative_permittivity
+    p[L.P_GAP_LIMIT] = el.outer_gap_limit_m
+    p[L.P_ASPERITY_RESISTANCE] = el.metallic_contact_resistance_ohm
+    p[L.P_OIL_RESISTIVITY] = el.oil_resistivity_ohm_m
 
     race = np.stack([_race_row(spec, True, alpha, e_prime), _race_row(spec, False, alpha, e_prime)])
     # load limits: analytic Qmax = Fr / (Z Jr), Jr(0.5) = 0.2288 (seed 000 eq. A3)

@@ -23,6 +23,8 @@ class Setpoint(BaseModel):
     radial_load_n: float = Field(default=3000.0, ge=0.0, le=1e6, description="Radial load on the inner ring [N].")
     axial_load_n: float = Field(default=0.0, ge=-1e6, le=1e6, description="Axial load on the inner ring [N].")
     oil_temperature_c: float = Field(default=40.0, ge=-30.0, le=150.0, description="Oil temperature [degC].")
+    shaft_current_a: float = Field(default=0.0, ge=0.0, le=100.0, description="Current through the bearing, shaft to housing [A].")
+    shaft_voltage_v: float = Field(default=0.0, ge=0.0, le=1000.0, description="Shaft-to-housing voltage amplitude [V].")
 
 
 class SetpointUpdate(BaseModel):
@@ -34,6 +36,8 @@ class SetpointUpdate(BaseModel):
     radial_load_n: float | None = Field(default=None, ge=0.0, le=1e6, description="Radial load on the inner ring [N].")
     axial_load_n: float | None = Field(default=None, ge=-1e6, le=1e6, description="Axial load on the inner ring [N].")
     oil_temperature_c: float | None = Field(default=None, ge=-30.0, le=150.0, description="Oil temperature [degC].")
+    shaft_current_a: float | None = Field(default=None, ge=0.0, le=100.0, description="Current through the bearing, shaft to housing [A].")
+    shaft_voltage_v: float | None = Field(default=None, ge=0.0, le=1000.0, description="Shaft-to-housing voltage amplitude [V].")
 
     def apply_to(self, current: Setpoint) -> Setpoint:
         """The setpoint after this update."""
@@ -41,7 +45,7 @@ class SetpointUpdate(BaseModel):
 
 
 _UNITS = {"shaft_speed_rad_s": "rad/s", "radial_load_n": "N", "axial_load_n": "N",
-          "oil_temperature_c": "degC"}
+          "oil_temperature_c": "degC", "shaft_current_a": "A", "shaft_voltage_v": "V"}
 
 
 def check_limits(setpoint: Setpoint, limits: dict[str, tuple[float, float]]) -> None:

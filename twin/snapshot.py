@@ -29,6 +29,8 @@ class ContactState(BaseModel):
     slide_roll_ratio: float = Field(description="Sliding / entrainment speed, signed [-].")
     contact_angle_rad: float = Field(description="Angle of the contact normal to the radial plane [rad].")
     max_pressure_pa: float = Field(description="Hertz maximum pressure [Pa].")
+    resistance_ohm: float | None = Field(description="Parallel-RC resistance of the contact [ohm]; null: open circuit (no conduction).")
+    capacitance_f: float = Field(description="Parallel-RC capacitance of the contact (film or open gap) [F].")
 
 
 class BallState(BaseModel):
@@ -42,6 +44,25 @@ class BallState(BaseModel):
     cage_load_n: float = Field(description="Largest ball-cage contact force [N].")
     inner: ContactState
     outer: ContactState
+    resistance_ohm: float | None = Field(description="Inner and outer contact resistances in series [ohm]; null: open circuit.")
+    capacitance_f: float = Field(description="Inner and outer contact capacitances in series [F].")
+
+
+class ElectricalState(BaseModel):
+    """The bearing as an electrical component, and its discharge indicators."""
+
+    model_config = _FROZEN
+    resistance_ohm: float | None = Field(description="Equivalent parallel resistance 1/Re(Y) at the frequency [ohm]; null: no conduction.")
+    capacitance_f: float = Field(description="Equivalent parallel capacitance Im(Y)/omega [F].")
+    impedance_ohm: float = Field(description="Impedance magnitude at the frequency [ohm].")
+    phase_rad: float = Field(description="Impedance phase [rad]: -pi/2 capacitive, 0 resistive.")
+    frequency_hz: float = Field(description="Frequency of the impedance [Hz].")
+    shaft_voltage_v: float = Field(description="Voltage across the bearing (set, or current x |Z|) [V].")
+    shaft_current_a: float = Field(description="Current through the bearing (set, or voltage / |Z|) [A].")
+    max_film_field_v_m: float = Field(description="Largest electric field across a film or gap [V/m].")
+    current_density_a_m2: float = Field(description="Largest apparent current density over a loaded contact area [A/m^2].")
+    discharge_risk: Literal["none", "possible", "likely"] = Field(description="Electrical discharge risk.")
+    reason: str = Field(description="Why the risk is what it is.")
 
 
 class SetpointState(BaseModel):
@@ -52,6 +73,8 @@ class SetpointState(BaseModel):
     radial_load_n: float = Field(description="Radial load [N].")
     axial_load_n: float = Field(description="Axial load [N].")
     oil_temperature_c: float = Field(description="Oil temperature [degC].")
+    shaft_current_a: float = Field(description="Shaft current setpoint [A].")
+    shaft_voltage_v: float = Field(description="Shaft voltage setpoint [V].")
 
 
 class Snapshot(BaseModel):
@@ -73,6 +96,7 @@ class Snapshot(BaseModel):
     inner_ring_displacement_m: tuple[float, float, float] = Field(description="Inner ring centre (x along the radial load, y, z axial) [m].")
     friction_torque_n_m: float = Field(description="Torque the shaft supplies to the bearing, averaged over the last frame [N m].")
     viscosity_pa_s: float = Field(description="Oil dynamic viscosity at the oil temperature [Pa s].")
+    electrical: ElectricalState
     balls: tuple[BallState, ...]
 
     def to_json(self) -> str:

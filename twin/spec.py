@@ -124,6 +124,48 @@ class Lubricant(BaseModel):
         return self
 
 
+class Electrical(BaseModel):
+    """Electrical properties of the lubricated contacts and their calibration constants.
+
+    Defaults: mineral oil eps_r 2.2 and 1e10 ohm m (Prashad, Tribology in electrical
+    environments, 2005, ch. 1-2); a fully metallic Hertz contact of ~0.1 ohm (Holm constriction of
+    a ~0.2 mm steel contact spot plus film resistance of the oxide, the same order Prashad reports
+    for bearings under current); 15 MV/m dielectric strength of a thin oil film; 0.1 and
+    0.7 A/mm^2 apparent current density thresholds between harmless, damage possible and
+    fluting (Prashad ch. 6; bearing makers' guidance); 10 kHz inverter switching frequency.
+    """
+
+    model_config = _FROZEN
+
+    oil_relative_permittivity: float = Field(
+        default=2.2, gt=1.0, le=100.0, description="Relative permittivity of the oil at ambient pressure [-].")
+    oil_resistivity_ohm_m: float = Field(
+        default=1e10, gt=0.0, le=1e16, description="Oil volume resistivity [ohm m].")
+    metallic_contact_resistance_ohm: float = Field(
+        default=0.1, gt=0.0, le=1e6,
+        description="Resistance of one contact with all its load on asperities (Lambda -> 0) [ohm].")
+    outer_gap_limit_m: float = Field(
+        default=50e-6, gt=0.0, le=1e-3,
+        description="The outer-zone capacitance is integrated until the oil gap has grown by this much [m].")
+    rest_capacitance_f: float = Field(
+        default=20e-12, ge=0.0, le=1e-6,
+        description="Capacitance of the rest of the bearing (rings through cage and air/oil) [F].")
+    frequency_hz: float = Field(
+        default=10e3, gt=0.0, le=1e8, description="Frequency of the reported impedance [Hz].")
+    breakdown_field_v_m: float = Field(
+        default=15e6, gt=0.0, le=1e10, description="Dielectric strength of the oil film [V/m].")
+    harmless_current_density_a_m2: float = Field(
+        default=0.1e6, gt=0.0, description="Below this apparent current density no damage is expected [A/m^2].")
+    fluting_current_density_a_m2: float = Field(
+        default=0.7e6, gt=0.0, description="Above this apparent current density fluting is likely [A/m^2].")
+
+    @model_validator(mode="after")
+    def _thresholds(self) -> "Electrical":
+        if self.fluting_current_density_a_m2 <= self.harmless_current_density_a_m2:
+            raise ValueError("fluting_current_density_a_m2 must exceed harmless_current_density_a_m2")
+        return self
+
+
 class Mounting(BaseModel):
     """How the bearing is mounted."""
 
@@ -149,6 +191,7 @@ class BearingSpec(BaseModel):
     surface: Surface = Surface()
     lubricant: Lubricant = Lubricant()
     mounting: Mounting = Mounting()
+    electrical: Electrical = Electrical()
 
 
 class ModelOptions(BaseModel):

@@ -25,7 +25,7 @@ def test_fast_path_equals_laws(formula):
         u = float(10 ** rng.uniform(-2, 1.5))    # 1 cm/s .. 30 m/s
         eta = float(10 ** rng.uniform(-3, -0.5))
         tr = model.race_tribology[r]
-        out = contact_tribology(q, u, eta, p[L.P_ROUGHNESS], *tr, 0, True)
+        out = contact_tribology(q, u, eta, p[L.P_ROUGHNESS], *tr[:15], 0, True)
         rx, ry = model.race_params[r, L.R_RX], model.race_params[r, L.R_RY]
         k = model.race_params[r, L.R_K_ELLIPTICITY]
         e = p[L.P_E_PRIME]
@@ -46,6 +46,6 @@ def test_fast_path_equals_laws(formula):
 
 def test_no_entrainment_is_boundary_without_film_force():
     model = make_model(catalog.bearing("6208"))
-    out = contact_tribology(1000.0, 0.0, 0.04, 3.75e-7, *model.race_tribology[0], 0, True)
+    out = contact_tribology(1000.0, 0.0, 0.04, 3.75e-7, *model.race_tribology[0, :15], 0, True)
     assert out[0] == 0.0 and out[2] == 0.0 and out[3] == 1 and out[4] == 0.1
     assert all(math.isfinite(v) for v in out)

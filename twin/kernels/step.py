@@ -12,7 +12,7 @@ from numba import njit
 from twin.jit import JIT
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
-    C_ENTRAINMENT, C_FLUID_DAMPING, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
+    C_CAPACITANCE, C_ENTRAINMENT, C_FLUID_DAMPING, C_RESISTANCE, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
     C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT, C_SRR,
     C_TANGENT_DAMPING, CW, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
     K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, N_CACHED,
@@ -20,12 +20,13 @@ from twin.kernels.layout import (
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
+    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
     P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
 )
-from twin.kernels.tribology import contact_tribology
+from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 
 
 # Below this entrainment speed [m/s] the rolling resistance (applied as (F_R / u) times the
@@ -132,6 +133,15 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             w[C_ENTRAINMENT * CW + c] = u
             w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
                                   + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
+            if tri[1] > 0.0:
+                res_ohm, cap_f = contact_electrical(
+                    q_el, tri[2], tri[1], tri[5], tri[6], tr[r, T_RX], tr[r, T_RY],
+                    p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT], p[P_ASPERITY_RESISTANCE],
+                    p[P_OIL_RESISTIVITY])
+            else:  # no film (no entrainment): metallic contact, no dielectric
+                res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
+            w[C_RESISTANCE * CW + c] = res_ohm
+            w[C_CAPACITANCE * CW + c] = cap_f
     scal[X_MAX_PENETRATION] = max_pen
     ring_fx = 0.0
     ring_fy = 0.0

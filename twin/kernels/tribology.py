@@ -17,6 +17,11 @@ from numba import njit
 
 from twin.jit import JIT
 from twin.physics import ehl, rolling
+from twin.physics.electrical import (
+    asperity_resistance_ohm, clausius_mossotti_permittivity, dowson_higginson_density_ratio,
+    hertz_zone_capacitance_f, oil_film_resistance_ohm, outer_zone_capacitance_f,
+    parallel_resistance_ohm,
+)
 from twin.physics.friction import regime_code, stribeck_line_mu
 from twin.physics.rolling import asperity_load_share, sliding_friction_coefficient_asperity_share
 
@@ -36,7 +41,9 @@ T_LN_M = 11        # M ~ Q (eta u)^-0.75 (seed 001 eq. 4)
 T_LN_HYST = 12     # hysteresis moment / Rb ~ Q^1.33 (seed 001 eq. 9) [N]
 T_HYST_EXP_Q = 13
 T_PIVOT = 14       # pivoting moment / (mu Q a) (seed 001 eq. 11)
-N_TRIBOLOGY = 15
+T_RX = 15          # Rx [m] (for the outer-zone capacitance)
+T_RY = 16          # Ry [m]
+N_TRIBOLOGY = 17
 
 _ONE_EU = 1.0  # eta u = 1 N/m (eta = 1 Pa s, u = 1 m/s)
 
@@ -67,6 +74,7 @@ def tribology_coefficients(rx_m: float, ry_m: float, k_ellipticity: float, e_pri
     t[T_LN_HYST] = math.log(rolling.hysteresis_moment_n_m(2.0 * ball_radius_m, 1.0, ratio) / ball_radius_m)
     t[T_HYST_EXP_Q] = 1.33
     t[T_PIVOT] = rolling.pivoting_moment_n_m(1.0, 1.0, 1.0, ratio)
+    t[T_RX], t[T_RY] = rx_m, ry_m
     return t
 
 
@@ -111,3 +119,22 @@ def _mu(film_parameter, friction_model):
     if friction_model == 0:
         return stribeck_line_mu(film_parameter)
     return sliding_friction_coefficient_asperity_share(asperity_load_share(film_parameter), 0.03, 0.11)
+
+
+@njit(**JIT)
+def contact_electrical(load_n, film_parameter, h_c_m, semi_major_m, semi_minor_m, rx_m, ry_m,
+                       oil_permittivity, gap_limit_m, metallic_resistance_ohm, oil_resistivity_ohm_m):
+    """Parallel RC of one loaded contact (seed 000 end of section 2.2): capacitance of the
+    Hertz zone on the central film, with the permittivity raised by the mean Hertz pressure
+    (Dowson-Higginson density, seed 003 eq. 2, through Clausius-Mossotti), plus the oil-filled gap
+    around it; resistance of the asperity contacts (metallic resistance / asperity load share,
+    seed 001 eq. A2) in parallel with the oil's leakage. Returns (R [ohm], C [F])."""
+    mean_pressure = load_n / (math.pi * semi_major_m * semi_minor_m)
+    eps = clausius_mossotti_permittivity(oil_permittivity, dowson_higginson_density_ratio(mean_pressure))
+    capacitance = (hertz_zone_capacitance_f(eps, semi_major_m, semi_minor_m, h_c_m)
+                   + outer_zone_capacitance_f(oil_permittivity, rx_m, ry_m, h_c_m, gap_limit_m))
+    share = asperity_load_share(film_parameter)
+    resistance = parallel_resistance_ohm(
+        asperity_resistance_ohm(metallic_resistance_ohm, share),
+        oil_film_resistance_ohm(oil_resistivity_ohm_m, h_c_m, semi_major_m, semi_minor_m))
+    return resistance, capacitance

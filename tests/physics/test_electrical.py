@@ -1,0 +1,149 @@
+"""Electrical RC-equivalent of the contacts and the bearing network (seed 000 end of section 2.2:
+asperity contacts resistive, film capacitive, parallel RC following the regime; seed 004
+conclusion; Dowson-Higginson density of seed 003 eq. 2 in the permittivity)."""
+
+import math
+
+import numpy as np
+import pytest
+from pydantic import ValidationError
+
+from twin import catalog
+from twin.electrical import bearing_network
+from twin.engine import Twin
+from twin.kernels import layout as L
+from twin.kernels.tribology import contact_electrical
+from twin.physics import electrical as el
+from twin.setpoint import Setpoint
+from twin.spec import Electrical
+
+EPS0 = 8.8541878128e-12
+RX, RY = 4.99e-3, 163.8e-3  # 6208 inner contact
+
+
+def test_laws_by_hand():
+    # Dowson-Higginson at 1 GPa: 1 + 0.6/(1 + 1.7) = 1.2222
+    assert el.dowson_higginson_density_ratio(1e9) == pytest.approx(1 + 0.6 / 2.7, rel=1e-12)
+    # Clausius-Mossotti: (eps-1)/(eps+2) = 1.2222 * (2.2-1)/(2.2+2) = 0.34921 -> eps = 2.6098
+    k = (1 + 0.6 / 2.7) * 1.2 / 4.2
+    assert el.clausius_mossotti_permittivity(2.2, 1 + 0.6 / 2.7) == pytest.approx((1 + 2 * k) / (1 - k), rel=1e-12)
+    assert (1 + 2 * k) / (1 - k) == pytest.approx(2.6098, rel=1e-4)
+    # plate capacitor over a 1.7 x 0.19 mm ellipse on 1 um: 8.854e-12 * 2.6 * pi * 1.7e-3 * 0.19e-3 / 1e-6
+    hand = EPS0 * 2.6 * math.pi * 1.7e-3 * 0.19e-3 / 1e-6
+    assert el.hertz_zone_capacitance_f(2.6, 1.7e-3, 0.19e-3, 1e-6) == pytest.approx(hand, rel=1e-12)
+    assert hand == pytest.approx(23.36e-12, rel=1e-3)
+    # outer zone: eps0 eps 2 pi sqrt(Rx Ry) ln((h + g) / h)
+    hand = EPS0 * 2.2 * 2 * math.pi * math.sqrt(RX * RY) * math.log(51.0)
+    assert el.outer_zone_capacitance_f(2.2, RX, RY, 1e-6, 50e-6) == pytest.approx(hand, rel=1e-12)
+    assert el.oil_film_resistance_ohm(1e10, 1e-6, 1.7e-3, 0.19e-3) == pytest.approx(1e4 / (math.pi * 3.23e-7), rel=1e-12)
+    assert el.parallel_resistance_ohm(2.0, 2.0) == 1.0
+    assert el.parallel_resistance_ohm(math.inf, 3.0) == 3.0
+    assert math.isinf(el.asperity_resistance_ohm(0.1, 0.0))
+
+
+def _contact_rc(load, lam, h_c, rx=RX, ry=RY):
+    a = 1.514e-4 * load ** (1 / 3)  # 6208 inner Hamrock-Brewe coefficient, a = c Q^(1/3)
+    b = a / 9.23
+    return contact_electrical(load, lam, h_c, a, b, rx, ry, 2.2, 50e-6, 0.1, 1e10)
+
+
+def test_regime_consistency_resistive_in_boundary_capacitive_in_full_film():
+    omega = 2 * math.pi * Electrical().frequency_hz
+    r, c = _contact_rc(1000.0, 0.5, 0.2e-6)      # boundary: asperities carry most of the load
+    assert omega * r * c < 1e-3
+    r, c = _contact_rc(1000.0, 4.0, 1.5e-6)      # full film: leakage only
+    assert omega * r * c > 1e3
+
+
+def test_no_asperity_contact_means_leakage_only():
+    # seed 001 eq. A2 gives Qa/Q = 0 from Lambda = 2.26: R is the oil's leakage resistance exactly
+    a = 1.514e-4 * 1000.0 ** (1 / 3)
+    r, _ = _contact_rc(1000.0, 3.5, 1e-6)
+    assert r == pytest.approx(el.oil_film_resistance_ohm(1e10, 1e-6, a, a / 9.23), rel=1e-12)
+
+
+def test_capacitance_grows_with_load_and_falls_with_film():
+    _, c1 = _contact_rc(500.0, 2.0, 1.0e-6)
+    _, c2 = _contact_rc(2000.0, 2.0, 0.9e-6)   # more load: bigger ellipse, slightly thinner film
+    _, c3 = _contact_rc(2000.0, 3.0, 1.4e-6)   # more speed: thicker film
+    assert c2 > c1 and c3 < c2
+
+
+def test_network_identities():
+    # two balls, known contact R and C: series per ball, parallel balls, rest capacitance beside
+    model = Twin("6208").model
+    z = model.ball_count
+    rows = np.zeros((L.N_ROWS, 2 * z))
+    rows[L.G_DELTA] = -20e-6  # every contact open ...
+    for c, (res, cap) in {0: (10.0, 40e-12), 1: (1e9, 30e-12)}.items():  # ... but ball 0's
+        rows[L.G_DELTA, c] = 1e-5
+        rows[L.C_LOAD, c] = 1000.0
+        rows[L.C_RESISTANCE, c] = res
+        rows[L.C_CAPACITANCE, c] = cap
+        rows[L.C_H_MIN, c] = 1e-6
+        rows[L.C_SEMI_MAJOR, c], rows[L.C_SEMI_MINOR, c] = 1.7e-3, 0.19e-3
+    net = bearing_network(model, rows, 0.0, 0.0)
+    w = 2 * math.pi * 10e3
+    z_ball0 = 1 / (1 / 10.0 + 1j * w * 40e-12) + 1 / (1 / 1e9 + 1j * w * 30e-12)
+    y = 1 / z_ball0 + 1j * w * model.spec.electrical.rest_capacitance_f
+    for j in range(1, z):  # open balls: two gap capacitors in series
+        cin, cout = net.contact_capacitance_f[2 * j], net.contact_capacitance_f[2 * j + 1]
+        y += 1j * w * cin * cout / (cin + cout)
+    assert net.resistance_ohm == pytest.approx(1 / y.real, rel=1e-9)
+    assert net.capacitance_f == pytest.approx(y.imag / w, rel=1e-9)
+    assert net.impedance_ohm == pytest.approx(abs(1 / y), rel=1e-9)
+    assert net.ball_resistance_ohm[0] == pytest.approx(10.0 + 1e9)
+    assert net.ball_capacitance_f[0] == pytest.approx(40e-12 * 30e-12 / 70e-12)
+    assert math.isinf(net.ball_resistance_ohm[1])
+
+
+def test_6208_bearing_capacitance_tens_to_hundreds_of_pf_falling_with_speed():
+    caps = []
+    for w in (300.0, 900.0, 1500.0):
+        twin = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=w, radial_load_n=3000.0))
+        twin.advance(0.003)
+        caps.append(twin.snapshot().electrical.capacitance_f)
+    assert all(20e-12 < c < 900e-12 for c in caps)
+    assert caps[0] > caps[1] > caps[2]
+
+
+def test_boundary_bearing_is_resistive_full_film_bearing_capacitive():
+    slow = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=20.0, radial_load_n=3000.0))
+    slow.advance(0.003)
+    fast = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=1700.0, radial_load_n=1000.0))
+    fast.advance(0.003)
+    assert abs(slow.snapshot().electrical.phase_rad) < 0.1          # resistive
+    assert fast.snapshot().electrical.phase_rad < -1.4              # capacitive
+
+
+def test_discharge_risk_indicators():
+    twin = Twin("6208")
+    twin.advance(0.002)
+    assert twin.snapshot().electrical.discharge_risk == "none"
+    twin.set_setpoint(shaft_current_a=30.0)
+    e = twin.snapshot().electrical
+    assert e.discharge_risk == "likely" and "A/mm^2" in e.reason
+    assert e.current_density_a_m2 > 0.7e6
+    twin.set_setpoint(shaft_current_a=0.0, shaft_voltage_v=0.5)
+    e = twin.snapshot().electrical
+    assert e.discharge_risk in ("none", "possible") and e.max_film_field_v_m > 0
+
+
+@pytest.mark.parametrize("field, value", [("oil_relative_permittivity", 0.0), ("oil_relative_permittivity", 1.0),
+                                          ("oil_resistivity_ohm_m", -1.0), ("metallic_contact_resistance_ohm", -0.1),
+                                          ("frequency_hz", 0.0), ("breakdown_field_v_m", float("nan"))])
+def test_non_physical_electrical_inputs_refused_by_name(field, value):
+    with pytest.raises(ValidationError, match=field):
+        Electrical(**{field: value})
+
+
+def test_bad_electrical_setpoints_refused():
+    twin = Twin("6208")
+    for field, value in (("shaft_current_a", -1.0), ("shaft_voltage_v", float("inf")), ("shaft_current_a", 1e4)):
+        with pytest.raises(ValidationError, match=field):
+            twin.set_setpoint(**{field: value})
+
+
+def test_spec_carries_electrical():
+    spec = catalog.bearing("6208")
+    assert spec.electrical.oil_relative_permittivity == 2.2
