@@ -1,4 +1,4 @@
-"""`bearing-twin` command line: simulate, bench, report, serve, monitor, scenario.
+"""`bearing-twin` command line: simulate, bench, report, serve, scenario, bench-service, monitor.
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -110,7 +110,259 @@ def build_parser() -> argparse.ArgumentParser:
     report.add_argument("--out", default="reports", help="output directory (default reports/)")
     report.add_argument("--quick", action="store_true", help="fewer points and shorter runs")
     report.set_defaults(func=_cmd_report)
+
+    serve = sub.add_parser(
+        "serve", help="run the service: HTTP API, zenoh bus, rerun recording, the `default` twin",
+        description="Run the service (one uvicorn worker). Each flag overrides its BEARING_TWIN_* "
+        "environment variable, which overrides the built-in default.")
+    serve.add_argument("--host", help="HTTP bind address (default 127.0.0.1: loopback only; "
+                       "0.0.0.0 exposes the API on every interface) [BEARING_TWIN_HOST]")
+    serve.add_argument("--port", type=int, help="HTTP port (default 8000) [BEARING_TWIN_PORT]")
+    serve.add_argument("--bearing", help="designation of the `default` twin (default 6208) [BEARING_TWIN_BEARING]")
+    serve.add_argument("--twin-id", metavar="ID",
+                       help="name of the twin started with the service (default `default`; give "
+                       "each service on one zenoh network its own) [BEARING_TWIN_TWIN_ID]")
+    serve.add_argument("--zenoh-listen", metavar="ENDPOINT", action="append",
+                       help="zenoh endpoint to listen on, repeatable (default tcp/127.0.0.1:7447) "
+                       "[BEARING_TWIN_ZENOH_LISTEN]")
+    serve.add_argument("--zenoh-connect", metavar="ENDPOINT", action="append",
+                       help="zenoh router or peer to connect to, repeatable (default none) "
+                       "[BEARING_TWIN_ZENOH_CONNECT]")
+    serve.add_argument("--zenoh-mode", choices=["peer", "client", "router"],
+                       help="zenoh session mode (default peer) [BEARING_TWIN_ZENOH_MODE]")
+    serve.add_argument("--record", metavar="PATH.rrd",
+                       help="rerun recording (default recordings/bearing-twin-<UTC timestamp>.rrd) "
+                       "[BEARING_TWIN_RECORD]")
+    serve.add_argument("--spawn-viewer", action="store_true", default=None,
+                       help="also stream to a rerun viewer spawned here [BEARING_TWIN_SPAWN_VIEWER]")
+    serve.add_argument("--fast", action="store_true", default=None,
+                       help="run the twins as fast as possible, not paced to the wall clock [BEARING_TWIN_FAST]")
+    serve.add_argument("--publish-rate", type=_positive_float, metavar="HZ",
+                       help="snapshot publishing rate [Hz] (default 50) [BEARING_TWIN_PUBLISH_RATE_HZ]")
+    serve.add_argument("--no-zenoh", action="store_true", help="debugging: do not start the zenoh bus")
+    serve.add_argument("--no-record", action="store_true", help="debugging: do not record")
+    serve.add_argument("--log-level", default="info", choices=["critical", "error", "warning", "info", "debug"])
+    serve.set_defaults(func=_cmd_serve)
+
+    scenario = sub.add_parser("scenario", help="scenarios: timelines of setpoints and ramps (YAML)")
+    scenario_sub = scenario.add_subparsers(dest="scenario_command", required=True)
+    run = scenario_sub.add_parser("run", help="run a scenario file in fast mode (fresh twin per run)")
+    run.add_argument("file", help="scenario YAML file (see scenarios/ and service/scenarios.py)")
+    run.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording")
+    run.add_argument("--table", metavar="OUT.parquet", help="write the per-sample table (Parquet; .csv for CSV)")
+    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    run.set_defaults(func=_cmd_scenario_run)
+    check = scenario_sub.add_parser("check", help="validate scenario files and print what they do")
+    check.add_argument("files", nargs="+")
+    check.set_defaults(func=_cmd_scenario_check)
+
+    bsv = sub.add_parser("bench-service", help="service benchmark: real-time factor with zenoh and "
+                         "recording on, HTTP setpoint -> published snapshot delay (p50/p99)")
+    bsv.add_argument("--seconds", type=_positive_float, default=10.0, help="measurement time [s of wall time]")
+    bsv.add_argument("--rate", type=_positive_float, default=20.0, help="setpoints per second [Hz]")
+    bsv.add_argument("--bearing", default="6208")
+    bsv.add_argument("--no-zenoh", action="store_true", help="without zenoh (then only the runner-side delay)")
+    bsv.add_argument("--no-record", action="store_true", help="without the rerun recording")
+    bsv.add_argument("--json", action="store_true")
+    bsv.set_defaults(func=_cmd_bench_service)
+
+    _add_monitor(sub)
     return parser
+
+
+def _cmd_bench_service(args: argparse.Namespace) -> int:
+    from service.benchmark import run_service_benchmark
+
+    r = run_service_benchmark(seconds=args.seconds, rate_hz=args.rate, bearing=args.bearing,
+                              record=not args.no_record, zenoh_on=not args.no_zenoh)
+    if args.json:
+        print(json.dumps(r))
+        return 0
+    f = lambda v, spec="{:.2f}": "-" if v is None else spec.format(v)  # noqa: E731
+    print(f"{r['bearing']} real-time mode, zenoh {'on' if r['zenoh'] else 'off'}, recording "
+          f"{'on' if r['recording'] else 'off'}, {r['setpoints']} setpoints in {r['seconds']:g} s")
+    print(f"  real-time factor: median {f(r['real_time_factor_median'], '{:.3f}')}, "
+          f"min {f(r['real_time_factor_min'], '{:.3f}')}; overruns {r['overruns']} of {r['frames']} frames; "
+          f"dropped {r['dropped']}; recorded rows {r['recording_rows']}")
+    print(f"  HTTP PUT -> zenoh state [ms]: p50 {f(r['client_latency_ms_p50'])}, "
+          f"p99 {f(r['client_latency_ms_p99'])}, max {f(r['client_latency_ms_max'])}, lost {r['client_lost']}")
+    print(f"  accepted -> published (runner) [ms]: p50 {f(r['runner_latency_ms_p50'])}, "
+          f"p99 {f(r['runner_latency_ms_p99'])}")
+    return 0
+
+
+def _add_monitor(sub) -> None:
+    """`monitor` comes from service.monitor (zenoh); if it cannot be imported the subcommand
+    still exists and says why."""
+    import importlib.util
+
+    try:
+        available = importlib.util.find_spec("service.monitor") is not None
+    except (ImportError, ValueError):
+        available = False
+    if not available:
+        return
+    try:
+        from service.monitor import add_monitor_command
+    except Exception as exc:  # noqa: BLE001 - keep the other subcommands working
+        reason = f"{type(exc).__name__}: {exc}"
+        stub = sub.add_parser("monitor", help="live table of the twins on the zenoh bus (unavailable)")
+        stub.set_defaults(func=lambda _args: _unavailable("monitor", reason))
+        return
+    add_monitor_command(sub)
+
+
+def _unavailable(name: str, reason: str) -> int:
+    print(f"error: `bearing-twin {name}` is unavailable: {reason}", file=sys.stderr)
+    return 2
+
+
+def _serve_settings(args: argparse.Namespace):
+    """BEARING_TWIN_* environment + the flags that were given."""
+    from service.settings import ServiceSettings
+
+    overrides = {}
+    for flag, name in (("host", "host"), ("port", "port"), ("bearing", "bearing"), ("twin_id", "twin_id"),
+                       ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
+                       ("zenoh_mode", "zenoh_mode"), ("record", "record"),
+                       ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),
+                       ("publish_rate", "publish_rate_hz")):
+        value = getattr(args, flag, None)
+        if value is not None:
+            overrides[name] = value
+    if args.no_zenoh:
+        overrides["enable_zenoh"] = False
+    if args.no_record:
+        overrides["enable_recording"] = False
+    if args.record is not None:
+        overrides["enable_recording"] = True
+    return ServiceSettings(**overrides)
+
+
+def _cmd_serve(args: argparse.Namespace) -> int:
+    import logging
+
+    from pydantic import ValidationError
+
+    from twin import catalog
+
+    try:
+        settings = _serve_settings(args)
+    except ValidationError as exc:
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    if args.no_record and args.record is not None:
+        print("error: --record and --no-record contradict each other", file=sys.stderr)
+        return 2
+    if settings.bearing.strip().upper() not in catalog.designations():
+        print(f"error: bearing: unknown {settings.bearing!r}; known: {', '.join(catalog.designations())}",
+              file=sys.stderr)
+        return 2
+
+    import uvicorn
+
+    from service.app import create_app
+
+    logging.basicConfig(level=getattr(logging, args.log_level.upper()),
+                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    host = settings.host
+    where = "loopback only; --host 0.0.0.0 to expose it" if host in ("127.0.0.1", "localhost", "::1") \
+        else "reachable from other machines"
+    port = settings.port if settings.port else "<a free port, see uvicorn's line below>"
+    print(f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
+          f"twin `{settings.twin_id}` = {settings.bearing.upper()}, {'fast' if settings.fast else 'real-time'} mode",
+          flush=True)
+    if settings.enable_zenoh:
+        print(f"bearing-twin: zenoh {settings.zenoh_mode} listening on {', '.join(settings.zenoh_listen) or 'nothing'}"
+              + (f", connecting to {', '.join(settings.zenoh_connect)}" if settings.zenoh_connect else ""),
+              flush=True)
+    else:
+        print("bearing-twin: zenoh off", flush=True)
+    path = settings.recording_path
+    print(f"bearing-twin: recording to {path}" if path else "bearing-twin: not recording", flush=True)
+    config = uvicorn.Config(create_app(settings), host=host, port=settings.port, workers=1,
+                            log_level=args.log_level, lifespan="on", timeout_graceful_shutdown=3)
+    server = uvicorn.Server(config)
+    server.run()
+    return 0 if server.started else 1
+
+
+def _cmd_scenario_check(args: argparse.Namespace) -> int:
+    from service.scenarios import ScenarioError, load_scenario
+
+    status = 0
+    for file in args.files:
+        try:
+            scenario = load_scenario(file)
+        except ScenarioError as exc:
+            print(f"{file}: error: {exc}", file=sys.stderr)
+            status = 2
+            continue
+        runs = scenario.resolved_runs()
+        print(f"{file}: ok: {scenario.name}, {len(runs)} run(s), {scenario.total_duration_s:g} s simulated, "
+              f"sample every {scenario.sample_every_s:g} s")
+        for w in scenario.warnings:
+            print(f"  warning: {w}")
+    return status
+
+
+def _cmd_scenario_run(args: argparse.Namespace) -> int:
+    from service.offline import TableSink, run_scenario, write_table
+    from service.scenarios import ScenarioError, load_scenario
+
+    try:
+        scenario = load_scenario(args.file)
+    except ScenarioError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    for w in scenario.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    for path, suffixes in ((args.record, (".rrd",)), (args.table, (".parquet", ".pq", ".csv"))):
+        if path is not None and not path.lower().endswith(suffixes):
+            print(f"error: {path}: expected a file ending in {' or '.join(suffixes)}", file=sys.stderr)
+            return 2
+    total = scenario.total_duration_s
+    runs = scenario.resolved_runs()
+    print(f"{scenario.name}: {len(runs)} run(s), {total:g} s of simulated time, fast mode", file=sys.stderr)
+    table = TableSink()
+    bar = None
+    if not args.no_progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=round(total * 1000), unit="ms", desc=scenario.name, file=sys.stderr,
+                   bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} ms simulated "
+                   "[{elapsed}<{remaining}]")
+
+    def progress(done_s: float) -> None:
+        if bar is not None:
+            bar.n = min(bar.total, round(done_s * 1000))
+            bar.refresh()
+
+    try:
+        results = run_scenario(scenario, record=args.record, table=table, progress=progress)
+    except ScenarioError as exc:
+        if bar is not None:
+            bar.close()
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if bar is not None:
+        bar.close()
+    status = 0
+    for r in results:
+        snap = r.final
+        lam = [c.lambda_ for b in (snap.balls if snap else ()) for c in (b.inner, b.outer) if c.lambda_ is not None]
+        summary = (f"min Lambda {min(lam):.2f}, friction torque {snap.friction_torque_n_m * 1e3:.2f} mN m, "
+                   f"status {snap.status}") if snap is not None and lam else (f"status {snap.status}" if snap else "")
+        print(f"  {r.run.id} ({r.run.label}): {r.state}, {r.rows} samples, {r.wall_s:.1f} s wall; {summary}"
+              + (f"; error: {r.error}" if r.error else ""))
+        if r.state != "done":
+            status = 1
+    if args.table:
+        path = write_table(table.rows, args.table)
+        print(f"table: {path} ({len(table.rows)} rows)")
+    if args.record:
+        print(f"recording: {args.record}")
+    return status
 
 
 def _cmd_report(args: argparse.Namespace) -> int:

@@ -97,14 +97,18 @@ class Twin:
         return self._apply(update.apply_to(self._setpoint))
 
     # ---- running ----------------------------------------------------------------------------
-    def reset(self, *, warm: bool = True, shaft_speed_rad_s: float | None = None) -> None:
-        """Restart from the quasi-static equilibrium at the current setpoint (or at rest)."""
+    def reset(self, *, warm: bool = True, shaft_speed_rad_s: float | None = None,
+              keep_time: bool = False) -> None:
+        """Restart from the quasi-static equilibrium at the current setpoint (or unloaded when
+        `warm` is False), at `shaft_speed_rad_s` if given; `keep_time` keeps the simulated clock."""
         sp = self._setpoint
+        t = self.time_s if keep_time else 0.0
         speed = sp.shaft_speed_rad_s if shaft_speed_rad_s is None else shaft_speed_rad_s
         if warm:
             warm_start(self.model, self.state, speed, sp.radial_load_n, sp.axial_load_n)
         else:
             warm_start(self.model, self.state, speed, 0.0, 0.0)
+        self.state.scalars[L.X_TIME] = t
         m = self.model
         evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
 
@@ -129,8 +133,8 @@ class Twin:
         if not math.isfinite(t):
             t = 0.0
         self.restarts += 1
-        self.reset()
         self.state.scalars[L.X_TIME] = t
+        self.reset(keep_time=True)
         self.status = f"restarted: {reason} at t = {t:.6f} s"
 
     def advance(self, seconds: float, frame_steps: int = FRAME_STEPS) -> None:
@@ -140,7 +144,7 @@ class Twin:
         remaining = int(round(seconds / self.model.dt_s))
         while remaining > 0:
             n = min(frame_steps, remaining)
-            remaining -= self._frame(n)
+            remaining -= max(self._frame(n), 1)  # a failing frame still consumes a step: no hang
 
     @property
     def time_s(self) -> float:

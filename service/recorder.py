@@ -1,0 +1,840 @@
+"""`RerunRecorder`: a `SnapshotSink` that records one or more twins into one rerun recording.
+
+The runner thread calls `publish(snapshot)`, which only appends to a bounded queue (drop-oldest,
+counted in `dropped`) and returns. A background thread drains the queue, converts snapshots to
+plain numbers and, every `flush_interval_s`, sends what it buffered with `send_columns` (one call
+per entity, all buffered rows at once: per-row `log` is orders of magnitude dearer).
+
+Entities (per twin `bearing/{id}/...`, timelines `sim_time` (duration, seconds from
+`snapshot.time_s`) and `seq` (sequence, `snapshot.seq`)):
+
+```
+geometry/inner_raceway, geometry/outer_raceway, geometry/pitch_circle   LineStrips3D, static
+geometry/load_line                                Arrows3D, static (azimuth 0 = radial load line)
+balls                  Points3D at the ball centres, radius = ball radius, colour = inner regime
+loads/inner, loads/outer       Arrows3D from the ball centre towards the raceway, length ~ load
+ball/{i}/inner/load_n, .../inner/lambda, .../inner/mu, same for outer          Scalars
+ball/{i}/inner/resistance_ohm, .../capacitance_f, ball/{i}/resistance_ohm, ...  Scalars, when the
+                                                                        snapshot carries them
+electrical/{field}     Scalars from `snapshot.electrical` (numeric fields), when present
+electrical/discharge_risk  TextLog "risk: reason", one row whenever it changes
+friction_torque_n_m, cage_speed_rad_s                                           Scalars
+status                 TextLog, one row whenever the status text changes
+```
+
+A value that is null (Lambda without contact, electrical fields not yet modelled) is simply not
+logged for that row, so a series has one row per snapshot where it is defined.
+
+Outputs: the file given to the constructor and/or a spawned viewer (one `RecordingStream`), plus
+at most one extra file opened with `start_file` and closed with `stop_file` (its own
+`RecordingStream` with the same recording id, so it is complete on its own: static geometry,
+blueprint, and every row published while it was open). Nothing listens on the network unless
+`spawn_viewer=True` (and then only the spawned viewer does); `serve_grpc` is never called.
+
+rerun-sdk 0.41 notes: an explicit `rr.RecordingStream` per output; `flush()` then `disconnect()`
+before the file is read back; read it with `read_recording` (`rerun.chunk.RrdReader`).
+"""
+
+from __future__ import annotations
+
+import colorsys
+import logging
+import math
+import os
+import socket
+import sys
+import threading
+import time
+import uuid
+from collections import deque
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Self
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+log = logging.getLogger(__name__)
+
+SIM_TIME = "sim_time"
+SEQ = "seq"
+
+# Contact fields extracted per ball and side, in this order (getattr with a None default, so the
+# electrical fields are logged as soon as the snapshot schema carries them).
+_CONTACT_FIELDS = ("load_n", "lambda_", "mu", "contact_angle_rad", "resistance_ohm", "capacitance_f")
+_K = len(_CONTACT_FIELDS)
+_F_LOAD, _F_LAMBDA, _F_MU, _F_ANGLE, _F_R, _F_C = range(_K)
+# (field index, entity leaf) of the per-contact scalar series
+_CONTACT_SERIES = ((_F_LOAD, "load_n"), (_F_LAMBDA, "lambda"), (_F_MU, "mu"),
+                   (_F_R, "resistance_ohm"), (_F_C, "capacitance_f"))
+_BALL_ELECTRICAL = ("resistance_ohm", "capacitance_f")
+_SIDES = ("inner", "outer")
+
+_REGIME_CODE = {"no_contact": 0, "boundary": 1, "mixed": 2, "full_film": 3}
+_REGIME_RGBA = np.array([[150, 150, 150, 255],   # no_contact: grey
+                         [220, 40, 40, 255],     # boundary: red
+                         [255, 150, 0, 255],     # mixed: orange
+                         [40, 180, 70, 255]],    # full_film: green
+                        dtype=np.uint8)
+_INNER_ARROW_RGBA = (60, 120, 255, 255)
+_OUTER_ARROW_RGBA = (200, 80, 255, 255)
+_RACEWAY_RGBA = (170, 170, 180, 255)
+_PITCH_RGBA = (90, 90, 100, 255)
+
+
+def _circle(radius_m: float, n: int = 181) -> np.ndarray:
+    a = np.linspace(0.0, 2.0 * math.pi, n)
+    return np.column_stack([radius_m * np.cos(a), radius_m * np.sin(a), np.zeros(n)])
+
+
+def _ball_rgb(i: int, count: int, side: int) -> tuple[int, int, int]:
+    r, g, b = colorsys.hsv_to_rgb(i / max(count, 1), 0.75 if side == 0 else 0.55, 0.95 if side == 0 else 0.7)
+    return int(r * 255), int(g * 255), int(b * 255)
+
+
+def _display_available() -> bool:
+    if not sys.platform.startswith("linux"):
+        return True
+    return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY") or os.environ.get("WAYLAND_SOCKET"))
+
+
+def _port_open(port: int, timeout_s: float = 0.5) -> bool:
+    try:
+        with socket.create_connection(("127.0.0.1", port), timeout=timeout_s):
+            return True
+    except OSError:
+        return False
+
+
+@dataclass
+class _Twin:
+    bearing_id: str
+    designation: str
+    ball_count: int
+    pitch_radius_m: float | None = None
+    ball_radius_m: float | None = None
+    inner_raceway_radius_m: float | None = None
+    outer_raceway_radius_m: float | None = None
+    load_scale_m_per_n: float | None = None
+    has_electrical: bool = False
+    last_status: str | None = None
+    last_discharge: str | None = None
+    last_time_s: float = -math.inf
+    rows: list = field(default_factory=list)
+
+    @property
+    def has_geometry(self) -> bool:
+        return self.pitch_radius_m is not None
+
+    @property
+    def root(self) -> str:
+        return f"bearing/{self.bearing_id}"
+
+
+@dataclass
+class _Row:
+    time_s: float
+    seq: int
+    friction_torque_n_m: float
+    cage_speed_rad_s: float
+    status: str
+    contacts: list          # Z * 2 * _K floats (ball, side, field), NaN for null
+    regimes: list           # Z ints, inner-contact regime code
+    azimuth_rad: list       # Z floats
+    ball_electrical: list   # Z * 2 floats (resistance, capacitance), NaN for null
+    electrical: dict | None  # bearing-level numeric electrical fields
+    discharge: str | None    # "risk: reason" when the snapshot carries electrical.discharge_risk
+    positions_m: np.ndarray | None
+
+
+_FIELD_CACHE: dict = {}
+
+
+def _present(obj, names: tuple[str, ...]) -> tuple[str | None, ...]:
+    """`names` with None for those `obj` does not have. Cached per pydantic model class (a
+    getattr that misses on a pydantic model costs microseconds: it raises inside __getattr__)."""
+    cls = type(obj)
+    key = (cls, names)
+    found = _FIELD_CACHE.get(key)
+    if found is None:
+        declared = getattr(cls, "model_fields", None)
+        if not isinstance(declared, dict):   # duck-typed object: look at this instance
+            return tuple(n if hasattr(obj, n) else None for n in names)
+        found = tuple(n if n in declared else None for n in names)
+        _FIELD_CACHE[key] = found
+    return found
+
+
+def _values(obj, fields: tuple[str | None, ...], out: list) -> None:
+    for f in fields:
+        v = getattr(obj, f) if f is not None else None
+        out.append(math.nan if v is None else v)
+
+
+def _extract(snapshot, positions_m: np.ndarray | None) -> _Row:
+    balls = snapshot.balls
+    contacts: list = []
+    ball_el: list = []
+    if balls:
+        cf = _present(balls[0].inner, _CONTACT_FIELDS)
+        bf = _present(balls[0], _BALL_ELECTRICAL)
+        for b in balls:
+            _values(b.inner, cf, contacts)
+            _values(b.outer, cf, contacts)
+            _values(b, bf, ball_el)
+    electrical = None
+    discharge = None
+    el = getattr(snapshot, "electrical", None) if _present(snapshot, ("electrical",))[0] else None
+    if el is not None:
+        if isinstance(el, Mapping):
+            items = dict(el)
+        else:
+            names = getattr(type(el), "model_fields", None)
+            items = {k: getattr(el, k) for k in names} if isinstance(names, dict) else dict(vars(el))
+        electrical = {k: float(v) for k, v in items.items()
+                      if isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)}
+        risk = items.get("discharge_risk")
+        if isinstance(risk, str):
+            reason = items.get("reason")
+            discharge = f"{risk}: {reason}" if isinstance(reason, str) and reason else risk
+    return _Row(time_s=float(snapshot.time_s), seq=int(snapshot.seq),
+                friction_torque_n_m=float(snapshot.friction_torque_n_m),
+                cage_speed_rad_s=float(snapshot.cage_speed_rad_s), status=str(snapshot.status),
+                contacts=contacts, regimes=[_REGIME_CODE.get(b.inner.regime, 0) for b in balls],
+                azimuth_rad=[b.azimuth_rad for b in balls],
+                ball_electrical=ball_el, electrical=electrical, discharge=discharge,
+                positions_m=positions_m)
+
+
+@dataclass
+class _Output:
+    stream: rr.RecordingStream
+    path: Path | None
+    viewer: bool = False
+
+
+class RerunRecorder:
+    """Records the snapshots of one or more twins into one rerun recording (see module doc).
+
+    Usage::
+
+        rec = RerunRecorder("run.rrd")
+        rec.add_twin_from(twin)            # or add_twin("a", designation=..., pitch_radius_m=..., ...)
+        rec.publish(twin.snapshot())       # never blocks
+        rec.start_file("clip.rrd"); ...; rec.stop_file()
+        rec.close()                        # drains, sends, flushes, disconnects
+    """
+
+    def __init__(self, path: str | Path | None = None, *, spawn_viewer: bool = False,
+                 application_id: str = "bearing-twin", flush_interval_s: float = 0.1,
+                 queue_size: int = 256, viewer_port: int = 9876,
+                 series_window_s: float | None = 5.0, min_interval_s: float = 0.0):
+        if not (flush_interval_s > 0.0 and math.isfinite(flush_interval_s)):
+            raise ValueError(f"flush_interval_s = {flush_interval_s!r}: must be finite and > 0")
+        if queue_size < 1:
+            raise ValueError(f"queue_size = {queue_size!r}: must be >= 1")
+        self.application_id = application_id
+        self.recording_id = uuid.uuid4().hex
+        self.flush_interval_s = float(flush_interval_s)
+        self.queue_size = int(queue_size)
+        self.series_window_s = series_window_s
+        self.viewer_port = viewer_port
+        self.min_interval_s = float(min_interval_s)
+
+        self._queue: deque = deque()
+        self._qlock = threading.Lock()
+        self._io_lock = threading.RLock()
+        self._wake = threading.Event()
+        self._stop = threading.Event()
+        self._wake_at = max(1, self.queue_size // 2)
+        self._closed = False
+        self._dropped = 0
+        self._rows_logged = 0
+        self._errors = 0
+        self._skipped = 0
+        self._twins: dict[str, _Twin] = {}
+        self._primary: _Output | None = None
+        self._extra: _Output | None = None
+        self._blueprint_dirty = False   # (re)sent by the next send, once for many add_twin calls
+
+        self.path = Path(path) if path is not None else None
+        self._primary = self._open_primary(self.path, spawn_viewer)
+
+        self._thread = threading.Thread(target=self._run, name="rerun-recorder", daemon=True)
+        self._thread.start()
+
+    # ---- outputs ----------------------------------------------------------------------------
+    def _new_stream(self) -> rr.RecordingStream:
+        return rr.RecordingStream(self.application_id, recording_id=self.recording_id)
+
+    def _open_primary(self, path: Path | None, spawn_viewer: bool) -> _Output | None:
+        viewer = False
+        stream = None
+        if spawn_viewer:
+            if not _display_available():
+                log.warning("rerun: no display (DISPLAY/WAYLAND_DISPLAY unset): not spawning a viewer%s",
+                            f", recording to {path}" if path else "")
+            else:
+                stream = self._new_stream()
+                try:
+                    stream.spawn(port=self.viewer_port, connect=False)
+                    viewer = _port_open(self.viewer_port)
+                    if not viewer:
+                        log.warning("rerun: the spawned viewer does not listen on port %d: continuing without it",
+                                    self.viewer_port)
+                except Exception as exc:  # noqa: BLE001 - no viewer on PATH, headless, ...: warn, go on
+                    log.warning("rerun: could not spawn a viewer (%s): continuing%s",
+                                str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__,
+                                f" with the file sink {path}" if path else " without a viewer")
+        if not viewer and path is None:
+            return None
+        stream = stream or self._new_stream()
+        url = f"rerun+http://127.0.0.1:{self.viewer_port}/proxy"
+        if viewer and path is not None:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            stream.set_sinks(rr.GrpcSink(url), rr.FileSink(str(path)))
+        elif viewer:
+            stream.connect_grpc(url)
+        else:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            stream.save(str(path))
+        return _Output(stream=stream, path=path, viewer=viewer)
+
+    def _outputs(self) -> list[_Output]:
+        return [o for o in (self._primary, self._extra) if o is not None]
+
+    @staticmethod
+    def _close_output(out: _Output, timeout_s: float = 30.0) -> None:
+        try:
+            out.stream.flush(timeout_sec=timeout_s)
+        except Exception as exc:  # noqa: BLE001 - a sink's failure must not stop the others
+            log.warning("rerun: flush of %s failed: %s", out.path or "viewer", exc)
+        try:
+            out.stream.disconnect()
+        except Exception as exc:  # noqa: BLE001
+            log.warning("rerun: disconnect of %s failed: %s", out.path or "viewer", exc)
+
+    def start_file(self, path: str | Path) -> Path:
+        """Start recording into a further .rrd file while running (static geometry and blueprint
+        first, then every snapshot published from now on). Replaces (and completes) a file started
+        earlier with `start_file`. Returns the path."""
+        path = Path(path)
+        if self._closed:
+            raise RuntimeError("recorder is closed")
+        if self.path is not None and path.resolve() == self.path.resolve():
+            raise ValueError(f"{path} is the recorder's main file")
+        with self._io_lock:
+            self._drain_locked()
+            self._send_locked()        # rows published before start_file go to the old outputs only
+            if self._extra is not None:
+                self._stop_file_locked()
+            path.parent.mkdir(parents=True, exist_ok=True)
+            stream = self._new_stream()
+            stream.save(str(path))
+            out = _Output(stream=stream, path=path)
+            for tw in self._twins.values():
+                self._send_static(out, tw)
+            self._send_blueprint([out])         # the others get theirs at the next send if due
+            self._extra = out
+        return path
+
+    def stop_file(self) -> Path | None:
+        """Finish the file started with `start_file` (everything published so far is in it,
+        flushed and closed). Returns its path, or None if no file was being recorded."""
+        with self._io_lock:
+            if self._extra is None:
+                return None
+            self._drain_locked()
+            self._send_locked()
+            return self._stop_file_locked()
+
+    def _stop_file_locked(self) -> Path | None:
+        out, self._extra = self._extra, None
+        self._close_output(out)
+        return out.path
+
+    @property
+    def recording_file(self) -> Path | None:
+        """The file being recorded with `start_file`, if any."""
+        out = self._extra
+        return out.path if out is not None else None
+
+    # ---- twins ------------------------------------------------------------------------------
+    def add_twin(self, bearing_id: str, *, designation: str, pitch_radius_m: float,
+                 ball_radius_m: float, inner_raceway_radius_m: float,
+                 outer_raceway_radius_m: float, ball_count: int,
+                 load_scale_m_per_n: float | None = None) -> None:
+        """Register a twin: log its static geometry and (re)send the blueprint.
+        `load_scale_m_per_n`: arrow length per newton of contact load; by default the largest load
+        of the first loaded snapshot is drawn one ball diameter long."""
+        tw = _Twin(bearing_id=str(bearing_id), designation=str(designation), ball_count=int(ball_count),
+                   pitch_radius_m=float(pitch_radius_m), ball_radius_m=float(ball_radius_m),
+                   inner_raceway_radius_m=float(inner_raceway_radius_m),
+                   outer_raceway_radius_m=float(outer_raceway_radius_m),
+                   load_scale_m_per_n=load_scale_m_per_n)
+        with self._io_lock:
+            old = self._twins.get(tw.bearing_id)
+            if old is not None:
+                tw.rows, tw.has_electrical, tw.last_status = old.rows, old.has_electrical, old.last_status
+            self._twins[tw.bearing_id] = tw
+            outs = self._outputs()
+            for out in outs:
+                self._send_static(out, tw)
+            self._blueprint_dirty = True
+
+    def add_twin_from(self, twin, bearing_id: str | None = None) -> None:
+        """`add_twin` with the geometry of a `twin.engine.Twin`."""
+        m = twin.model
+        g = m.spec.geometry
+        self.add_twin(bearing_id or twin.bearing_id, designation=m.spec.designation,
+                      pitch_radius_m=m.pitch_radius_m, ball_radius_m=m.ball_radius_m,
+                      inner_raceway_radius_m=g.inner_raceway_radius_m,
+                      outer_raceway_radius_m=g.outer_raceway_radius_m, ball_count=m.ball_count)
+
+    @property
+    def bearing_ids(self) -> list[str]:
+        return list(self._twins)
+
+    def _send_static(self, out: _Output, tw: _Twin) -> None:
+        s = out.stream
+        root = tw.root
+        if tw.has_geometry:
+            rb = tw.ball_radius_m
+            line = rr.components.Radius.ui_points(1.5)
+            s.log(f"{root}/geometry/inner_raceway",
+                  rr.LineStrips3D([_circle(tw.inner_raceway_radius_m)], radii=line, colors=_RACEWAY_RGBA),
+                  static=True)
+            s.log(f"{root}/geometry/outer_raceway",
+                  rr.LineStrips3D([_circle(tw.outer_raceway_radius_m)], radii=line, colors=_RACEWAY_RGBA),
+                  static=True)
+            s.log(f"{root}/geometry/pitch_circle",
+                  rr.LineStrips3D([_circle(tw.pitch_radius_m)], radii=rr.components.Radius.ui_points(0.5),
+                                  colors=_PITCH_RGBA),
+                  static=True)
+            s.log(f"{root}/geometry/load_line",
+                  rr.Arrows3D(origins=[[0.0, 0.0, 0.0]], vectors=[[tw.inner_raceway_radius_m * 0.8, 0.0, 0.0]],
+                              colors=[(230, 230, 230, 255)], labels=["radial load"],
+                              radii=rr.components.Radius.ui_points(1.0)),
+                  static=True)
+            s.log(f"{root}/balls", rr.Points3D.from_fields(radii=[rb]), static=True)
+            s.log(f"{root}/loads/inner",
+                  rr.Arrows3D.from_fields(colors=[_INNER_ARROW_RGBA], radii=[0.08 * rb]), static=True)
+            s.log(f"{root}/loads/outer",
+                  rr.Arrows3D.from_fields(colors=[_OUTER_ARROW_RGBA], radii=[0.08 * rb]), static=True)
+        self._send_series_styles(out, tw)
+
+    def _send_series_styles(self, out: _Output, tw: _Twin) -> None:
+        s = out.stream
+        root = tw.root
+        z = tw.ball_count
+        leaves = ["load_n", "lambda", "mu"] + (["resistance_ohm", "capacitance_f"] if tw.has_electrical else [])
+        for i in range(z):
+            for side, name in enumerate(_SIDES):
+                color = _ball_rgb(i, z, side)
+                for leaf in leaves:
+                    s.log(f"{root}/ball/{i}/{name}/{leaf}",
+                          rr.SeriesLines(names=f"ball {i} {name}", colors=[color]), static=True)
+            if tw.has_electrical:
+                for leaf in _BALL_ELECTRICAL:
+                    s.log(f"{root}/ball/{i}/{leaf}",
+                          rr.SeriesLines(names=f"ball {i}", colors=[_ball_rgb(i, z, 0)]), static=True)
+        s.log(f"{root}/friction_torque_n_m",
+              rr.SeriesLines(names=f"{tw.bearing_id} friction torque", colors=[(255, 200, 0)]), static=True)
+        s.log(f"{root}/cage_speed_rad_s",
+              rr.SeriesLines(names=f"{tw.bearing_id} cage speed", colors=[(0, 200, 255)]), static=True)
+
+    # ---- blueprint --------------------------------------------------------------------------
+    def _twin_layout(self, tw: _Twin) -> rrb.Container:
+        root = f"/{tw.root}"
+        z = tw.ball_count
+        window = None
+        if self.series_window_s:
+            window = rrb.VisibleTimeRange(
+                SIM_TIME, start=rrb.TimeRangeBoundary.cursor_relative(seconds=-float(self.series_window_s)),
+                end=rrb.TimeRangeBoundary.cursor_relative())
+
+        def series(title: str, leaf: str, sides=_SIDES) -> rrb.TimeSeriesView:
+            contents = [f"+ {root}/ball/{i}/{side}/{leaf}" for side in sides for i in range(z)]
+            return rrb.TimeSeriesView(name=f"{tw.bearing_id}: {title}", origin=root, contents=contents,
+                                      time_ranges=window, plot_legend=rrb.PlotLegend(visible=False))
+
+        plots: list = [series("contact load [N]", "load_n"), series("film parameter Lambda [-]", "lambda"),
+                       series("friction coefficient mu [-]", "mu")]
+        shares = [2.0, 2.0, 2.0]
+        if tw.has_electrical:
+            plots.append(rrb.Tabs(series("contact resistance R [ohm]", "resistance_ohm"),
+                                  series("contact capacitance C [F]", "capacitance_f")))
+            shares.append(2.0)
+        plots.append(rrb.Horizontal(
+            rrb.TimeSeriesView(name=f"{tw.bearing_id}: friction torque [N m]", origin=root,
+                               contents=[f"+ {root}/friction_torque_n_m"], time_ranges=window),
+            rrb.TimeSeriesView(name=f"{tw.bearing_id}: cage speed [rad/s]", origin=root,
+                               contents=[f"+ {root}/cage_speed_rad_s"], time_ranges=window)))
+        shares.append(2.0)
+        plots.append(rrb.TextLogView(name=f"{tw.bearing_id}: status", origin=root,
+                                     contents=[f"+ {root}/status", f"+ {root}/electrical/discharge_risk"]))
+        shares.append(1.0)
+        if not tw.has_geometry:
+            return rrb.Vertical(*plots, row_shares=shares, name=tw.bearing_id)
+        distance = 3.0 * tw.outer_raceway_radius_m
+        view3d = rrb.Spatial3DView(
+            name=f"{tw.bearing_id} ({tw.designation})", origin=root,
+            contents=[f"+ {root}/geometry/**", f"+ {root}/balls", f"+ {root}/loads/**"],
+            # look along the axis (-z) with the radial load line (+x, azimuth 0) pointing down
+            eye_controls=rrb.EyeControls3D(position=[0.0, 0.0, distance], look_target=[0.0, 0.0, 0.0],
+                                           eye_up=[-1.0, 0.0, 0.0]),
+            line_grid=False)
+        return rrb.Horizontal(view3d, rrb.Vertical(*plots, row_shares=shares), column_shares=[1.0, 1.0], name=tw.bearing_id)
+
+    def blueprint(self) -> rrb.Blueprint:
+        """The default layout: per twin, the 3D bearing on the left and its time series on the
+        right (one tab per twin when there are several)."""
+        layouts = [self._twin_layout(tw) for tw in self._twins.values()]
+        if not layouts:
+            body = rrb.Vertical()
+        elif len(layouts) == 1:
+            body = layouts[0]
+        else:
+            body = rrb.Tabs(*layouts)
+        return rrb.Blueprint(body, rrb.TimePanel(timeline=SIM_TIME, play_state="following"))
+
+    def _send_blueprint(self, outs: list[_Output]) -> None:
+        if not outs or not self._twins:
+            return
+        bp = self.blueprint()
+        for out in outs:
+            out.stream.send_blueprint(bp, make_active=True, make_default=True)
+
+    # ---- the sink ---------------------------------------------------------------------------
+    def publish(self, snapshot, positions_m: Any = None) -> None:
+        """Queue a snapshot (and optionally the ball centres, shape (Z, 3) [m]); never blocks.
+        When the queue is full the oldest queued snapshot is dropped and counted."""
+        if self._closed:
+            with self._qlock:
+                self._dropped += 1
+            return
+        pos = None
+        if positions_m is not None:
+            try:
+                pos = np.array(positions_m, dtype=float).reshape(-1, 3)
+            except (TypeError, ValueError) as exc:   # never raise into the runner: draw from azimuth
+                log.warning("rerun recorder: positions_m ignored: %s", exc)
+        with self._qlock:
+            if len(self._queue) >= self.queue_size:
+                self._queue.popleft()
+                self._dropped += 1
+            self._queue.append((snapshot, pos))
+            n = len(self._queue)
+        if n >= self._wake_at:
+            self._wake.set()
+
+    @property
+    def dropped(self) -> int:
+        """Snapshots dropped because the queue was full (or published after close)."""
+        return self._dropped
+
+    @property
+    def rows_logged(self) -> int:
+        """Snapshots written to the recording (to at least one output)."""
+        return self._rows_logged
+
+    @property
+    def errors(self) -> int:
+        """Snapshots or flushes that failed (logged, never raised into the physics)."""
+        return self._errors
+
+    @property
+    def skipped(self) -> int:
+        """Snapshots left out on purpose: closer than `min_interval_s` of simulated time to the
+        previous recorded one of the same twin, or published while there was no output."""
+        return self._skipped
+
+    @property
+    def queued(self) -> int:
+        return len(self._queue)
+
+    @property
+    def closed(self) -> bool:
+        return self._closed
+
+    def flush(self, timeout_s: float = 30.0) -> None:
+        """Send everything queued or buffered now and wait until the outputs have written it."""
+        with self._io_lock:
+            self._drain_locked()
+            self._send_locked()
+            for out in self._outputs():
+                try:
+                    out.stream.flush(timeout_sec=timeout_s)
+                except Exception as exc:  # noqa: BLE001
+                    log.warning("rerun: flush of %s failed: %s", out.path or "viewer", exc)
+
+    def close(self) -> None:
+        """Drain the queue, send the rest, flush and disconnect every output (idempotent)."""
+        with self._qlock:
+            if self._closed:
+                return
+            self._closed = True
+        self._stop.set()
+        self._wake.set()
+        if self._thread.is_alive() and threading.current_thread() is not self._thread:
+            self._thread.join()
+        with self._io_lock:
+            self._drain_locked()
+            self._send_locked()
+            for out in self._outputs():
+                self._close_output(out)
+            self._primary = None
+            self._extra = None
+
+    def __enter__(self) -> Self:
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    # ---- worker -----------------------------------------------------------------------------
+    def _run(self) -> None:
+        next_send = time.monotonic() + self.flush_interval_s
+        while not self._stop.is_set():
+            self._wake.wait(timeout=max(0.0, next_send - time.monotonic()))
+            self._wake.clear()
+            if self._stop.is_set():
+                break
+            try:
+                with self._io_lock:
+                    self._drain_locked()
+                    if time.monotonic() >= next_send:
+                        self._send_locked()
+                        next_send = time.monotonic() + self.flush_interval_s
+            except Exception:  # never let the worker die
+                self._errors += 1
+                log.exception("rerun recorder: send failed")
+
+    def _drain_locked(self) -> None:
+        with self._qlock:
+            items = list(self._queue)
+            self._queue.clear()
+        if not items:
+            return
+        if not self._outputs():        # nowhere to write (no file, no viewer): nothing to convert
+            self._skipped += len(items)
+            return
+        for snapshot, pos in items:
+            try:
+                tw = self._twins.get(snapshot.bearing_id)
+                if tw is None:
+                    tw = self._auto_register(snapshot)
+                t = float(snapshot.time_s)
+                if self.min_interval_s > 0.0 and tw.last_time_s <= t < tw.last_time_s + self.min_interval_s:
+                    self._skipped += 1
+                    continue
+                tw.last_time_s = t
+                if len(snapshot.balls) != tw.ball_count:
+                    raise ValueError(f"{len(snapshot.balls)} balls in the snapshot, {tw.ball_count} registered")
+                if pos is not None and pos.shape != (tw.ball_count, 3):
+                    raise ValueError(f"positions_m has shape {pos.shape}, expected ({tw.ball_count}, 3)")
+                tw.rows.append(_extract(snapshot, pos))
+            except Exception as exc:  # noqa: BLE001 - a bad snapshot is skipped and counted
+                self._errors += 1
+                log.warning("rerun recorder: snapshot %s/%s skipped: %s",
+                            getattr(snapshot, "bearing_id", "?"), getattr(snapshot, "seq", "?"), exc)
+
+    def _auto_register(self, snapshot) -> _Twin:
+        log.warning("rerun recorder: twin %r was not added with add_twin: recording its series without geometry",
+                    snapshot.bearing_id)
+        tw = _Twin(bearing_id=str(snapshot.bearing_id), designation=str(snapshot.designation),
+                   ball_count=len(snapshot.balls))
+        self._twins[tw.bearing_id] = tw
+        outs = self._outputs()
+        for out in outs:
+            self._send_static(out, tw)
+        self._blueprint_dirty = True
+        return tw
+
+    def _send_locked(self) -> None:
+        outs = self._outputs()
+        for tw in self._twins.values():
+            rows, tw.rows = tw.rows, []
+            if not rows or not outs:
+                continue
+            try:
+                batch = self._columns(tw, rows, outs)
+                for path, indexes, columns in batch:
+                    for out in outs:
+                        out.stream.send_columns(path, indexes=indexes, columns=columns)
+                self._rows_logged += len(rows)
+            except Exception:
+                self._errors += len(rows)
+                log.exception("rerun recorder: %d rows of %s lost", len(rows), tw.bearing_id)
+        if self._blueprint_dirty and outs:
+            self._blueprint_dirty = False
+            self._send_blueprint(outs)
+
+    def _columns(self, tw: _Twin, rows: list[_Row], outs: list[_Output]) -> list[tuple]:
+        """Turn buffered rows into (entity path, index columns, component columns) triples."""
+        n = len(rows)
+        z = tw.ball_count
+        root = tw.root
+        # integer nanoseconds, rounded (rerun truncates float seconds: 0.002 s would become 1999999 ns)
+        t = np.round(np.fromiter((r.time_s for r in rows), dtype=np.float64, count=n) * 1e9
+                     ).astype(np.int64).astype("timedelta64[ns]")
+        seq = np.fromiter((r.seq for r in rows), dtype=np.int64, count=n)
+        idx_all = [rr.TimeColumn(SIM_TIME, duration=t), rr.TimeColumn(SEQ, sequence=seq)]
+        out: list[tuple] = []
+
+        def scalars(path: str, values: np.ndarray) -> None:
+            ok = np.isfinite(values)
+            if ok.all():
+                out.append((path, idx_all, rr.Scalars.columns(scalars=values)))
+            elif ok.any():
+                idx = [rr.TimeColumn(SIM_TIME, duration=t[ok]), rr.TimeColumn(SEQ, sequence=seq[ok])]
+                out.append((path, idx, rr.Scalars.columns(scalars=values[ok])))
+
+        c = np.array([r.contacts for r in rows], dtype=np.float64).reshape(n, z, 2, _K)
+        be = np.array([r.ball_electrical for r in rows], dtype=np.float64).reshape(n, z, 2)
+        electrical_now = bool(np.isfinite(c[..., _F_R:]).any() or np.isfinite(be).any())
+        if electrical_now and not tw.has_electrical:
+            tw.has_electrical = True
+            for o in outs:
+                self._send_series_styles(o, tw)
+            self._blueprint_dirty = True
+
+        for i in range(z):
+            for side, name in enumerate(_SIDES):
+                base = f"{root}/ball/{i}/{name}"
+                for k, leaf in _CONTACT_SERIES:
+                    if k in (_F_R, _F_C) and not tw.has_electrical:
+                        continue
+                    scalars(f"{base}/{leaf}", c[:, i, side, k])
+            if tw.has_electrical:
+                for e, leaf in enumerate(_BALL_ELECTRICAL):
+                    scalars(f"{root}/ball/{i}/{leaf}", be[:, i, e])
+        scalars(f"{root}/friction_torque_n_m", np.fromiter((r.friction_torque_n_m for r in rows), np.float64, n))
+        scalars(f"{root}/cage_speed_rad_s", np.fromiter((r.cage_speed_rad_s for r in rows), np.float64, n))
+
+        keys = sorted({k for r in rows if r.electrical for k in r.electrical})
+        for key in keys:
+            scalars(f"{root}/electrical/{key}",
+                    np.array([(r.electrical or {}).get(key, math.nan) for r in rows], dtype=np.float64))
+
+        # status and discharge risk: one text row whenever they change
+        def text_changes(path: str, attr: str, last: str, level) -> None:
+            changed = []
+            for j, r in enumerate(rows):
+                value = getattr(r, attr)
+                if value is not None and value != getattr(tw, last):
+                    changed.append(j)
+                    setattr(tw, last, value)
+            if changed:
+                sel = np.array(changed)
+                texts = [getattr(rows[j], attr) for j in changed]
+                out.append((path, [rr.TimeColumn(SIM_TIME, duration=t[sel]), rr.TimeColumn(SEQ, sequence=seq[sel])],
+                            rr.TextLog.columns(text=texts, level=[level(x) for x in texts])))
+
+        text_changes(f"{root}/status", "status", "last_status", lambda x: "INFO" if x == "ok" else "WARN")
+        text_changes(f"{root}/electrical/discharge_risk", "discharge", "last_discharge",
+                     lambda x: "ERROR" if x.startswith("likely") else "WARN" if x.startswith("possible") else "INFO")
+
+        if tw.has_geometry:
+            az = np.array([r.azimuth_rad for r in rows], dtype=np.float64)          # (n, z)
+            cos_az, sin_az = np.cos(az), np.sin(az)
+            rp = tw.pitch_radius_m
+            pos = np.stack([rp * cos_az, rp * sin_az, np.zeros_like(az)], axis=-1)  # (n, z, 3)
+            for j, r in enumerate(rows):
+                if r.positions_m is not None:
+                    pos[j] = r.positions_m
+            flat = pos.reshape(-1, 3)
+            colors = _REGIME_RGBA[np.array([r.regimes for r in rows], dtype=np.intp).reshape(-1)]
+            lengths = np.full(n, z)
+            out.append((f"{root}/balls", idx_all,
+                        rr.Points3D.columns(positions=flat, colors=colors).partition(lengths)))
+            load = c[..., _F_LOAD]                                                   # (n, z, 2)
+            if tw.load_scale_m_per_n is None:
+                peak = float(np.nanmax(load)) if load.size else 0.0
+                if peak > 0.0:
+                    tw.load_scale_m_per_n = 2.0 * tw.ball_radius_m / peak
+            scale = tw.load_scale_m_per_n or 0.0
+            angle = c[..., _F_ANGLE]
+            for side, name in enumerate(_SIDES):
+                a = np.nan_to_num(angle[:, :, side])
+                radial = -1.0 if side == 0 else 1.0        # towards the inner / outer raceway
+                length = np.nan_to_num(load[:, :, side]) * scale
+                vec = np.stack([radial * np.cos(a) * cos_az, radial * np.cos(a) * sin_az, np.sin(a)],
+                               axis=-1) * length[..., None]
+                out.append((f"{root}/loads/{name}", idx_all,
+                            rr.Arrows3D.columns(origins=flat, vectors=vec.reshape(-1, 3)).partition(lengths)))
+        return out
+
+
+# ---- reading a recording back -----------------------------------------------------------------
+def describe_recording(path: str | Path) -> dict:
+    """What an .rrd holds, read with `rerun.chunk.RrdReader`:
+
+    {"application_id", "recording_id", "blueprints": number of blueprint stores,
+     "entities": {entity path (no leading slash): {"rows": temporal rows, "static_rows": n,
+                  "components": [...], "timelines": [...]}}}
+    """
+    from rerun.chunk import RrdReader
+
+    reader = RrdReader(str(path))
+    recordings = reader.recordings()
+    info: dict = {"application_id": recordings[0].application_id if recordings else None,
+                  "recording_id": recordings[0].recording_id if recordings else None,
+                  "blueprints": len(reader.blueprints()), "entities": {}}
+    if not recordings:
+        return info
+    entities: dict = info["entities"]
+    for chunk in reader.stream(store=recordings[0]):
+        entity = chunk.entity_path.lstrip("/")
+        e = entities.setdefault(entity, {"rows": 0, "static_rows": 0, "components": set(), "timelines": set()})
+        if chunk.is_static:
+            e["static_rows"] += chunk.num_rows
+        else:
+            e["rows"] += chunk.num_rows
+            e["timelines"].update(chunk.timeline_names)
+        schema = chunk.to_record_batch().schema
+        for f in schema:
+            meta = f.metadata or {}
+            comp = meta.get(b"rerun:component") or meta.get(b"rerun.component")
+            if comp is not None:
+                e["components"].add(comp.decode())
+    for e in entities.values():
+        e["components"] = sorted(e["components"])
+        e["timelines"] = sorted(e["timelines"])
+    return info
+
+
+def read_recording(path: str | Path) -> dict[str, int]:
+    """{entity path (no leading slash, e.g. "bearing/a/friction_torque_n_m"): number of temporal
+    rows} of the first recording in an .rrd; entities with static data only map to 0; rerun's own
+    `__properties` entity is left out. Flush and disconnect (close the recorder) first."""
+    return {k: v["rows"] for k, v in describe_recording(path)["entities"].items()
+            if not k.startswith("__")}
+
+
+def read_column(path: str | Path, entity: str, column: str) -> list:
+    """The values of one column (a timeline such as "seq", or a component such as
+    "Points3D:positions" / "Scalars:scalars") over the temporal rows of one entity, in the order
+    the rows were written, one item per row (a list for components, an int for "seq", integer
+    nanoseconds for "sim_time")."""
+    import pyarrow as pa
+    from rerun.chunk import RrdReader
+
+    want = "/" + entity.lstrip("/")
+    values: list = []
+    for chunk in RrdReader(str(path)).stream():
+        if chunk.entity_path == want and not chunk.is_static:
+            batch = chunk.to_record_batch()
+            col = batch.column(batch.schema.get_field_index(column))
+            if pa.types.is_duration(col.type) or pa.types.is_timestamp(col.type):
+                col = col.cast(pa.int64())
+            values.extend(col.to_pylist())
+    return values
+
+
+def read_index(path: str | Path, entity: str, timeline: str = SEQ) -> np.ndarray:
+    """Sorted values of one timeline ("seq", or "sim_time" in integer nanoseconds) over the
+    temporal rows of one entity, e.g. the `seq` numbers that made it into the file."""
+    return np.sort(np.array(read_column(path, entity, timeline), dtype=np.int64))

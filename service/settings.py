@@ -1,0 +1,121 @@
+"""Service settings: built-in defaults < `BEARING_TWIN_*` environment variables < command-line flags.
+
+Every field carries its unit in the description. List fields (`zenoh_listen`, `zenoh_connect`)
+accept a JSON list (`'["tcp/127.0.0.1:7447"]'`) or a comma-separated string
+(`tcp/127.0.0.1:7447,tcp/[::1]:7447`) from the environment; an empty string means no endpoint.
+"""
+
+from __future__ import annotations
+
+import json
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Annotated, Literal
+
+from pydantic import Field, field_validator
+from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
+
+
+def default_recording_path() -> Path:
+    """`recordings/bearing-twin-<UTC timestamp>.rrd` (relative to the working directory)."""
+    stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
+    return Path("recordings") / f"bearing-twin-{stamp}.rrd"
+
+
+def default_scenario_dir() -> Path:
+    """./scenarios if it exists, else the scenarios/ folder next to the installed packages."""
+    here = Path("scenarios")
+    if here.is_dir():
+        return here
+    return Path(__file__).resolve().parent.parent / "scenarios"
+
+
+def _split_endpoints(value):
+    if value is None:
+        return []
+    if isinstance(value, str):
+        text = value.strip()
+        if not text:
+            return []
+        if text.startswith("["):
+            return json.loads(text)
+        return [part.strip() for part in text.split(",") if part.strip()]
+    return value
+
+
+class ServiceSettings(BaseSettings):
+    """Configuration of `bearing-twin serve` (env prefix `BEARING_TWIN_`)."""
+
+    model_config = SettingsConfigDict(env_prefix="BEARING_TWIN_", extra="ignore",
+                                      validate_default=True)
+
+    host: str = Field(default="127.0.0.1",
+                      description="HTTP bind address [IP or host name]; loopback only unless set "
+                      "(0.0.0.0 exposes the API on every interface).")
+    port: int = Field(default=8000, ge=0, le=65535,
+                      description="HTTP port [TCP port number, 0 = any free port].")
+    bearing: str = Field(default="6208",
+                         description="Catalog designation of the twin started with the service [designation, e.g. 6208].")
+    twin_id: str = Field(default="default", pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$",
+                         description="Name of the twin started with the service [text]; give each "
+                         "service on one zenoh network its own (keys are bearing/{id}/...).")
+    start_twin: bool = Field(default=True, description="Start that twin with the service [bool].")
+    zenoh_listen: Annotated[list[str], NoDecode] = Field(
+        default_factory=lambda: ["tcp/127.0.0.1:7447"],
+        description="zenoh endpoints to listen on [zenoh locator, e.g. tcp/127.0.0.1:7447].")
+    zenoh_connect: Annotated[list[str], NoDecode] = Field(
+        default_factory=list,
+        description="zenoh endpoints (routers or peers) to connect to [zenoh locator].")
+    zenoh_mode: Literal["peer", "client", "router"] = Field(
+        default="peer", description="zenoh session mode [peer | client | router].")
+    record: Path | None = Field(
+        default_factory=default_recording_path,
+        description="rerun recording written while the service runs [path to a .rrd file]; "
+        "default recordings/bearing-twin-<UTC timestamp>.rrd.")
+    spawn_viewer: bool = Field(default=False,
+                               description="Also stream to a rerun viewer spawned on this machine [bool].")
+    fast: bool = Field(default=False,
+                       description="Run the twins as fast as possible instead of paced to the wall clock [bool].")
+    publish_rate_hz: float = Field(
+        default=50.0, gt=0.0, le=1000.0,
+        description="Snapshot publishing rate [Hz] (of wall time in real-time mode, of simulated "
+        "time in fast mode).")
+    frame_s: float = Field(default=0.001, ge=1e-5, le=0.1,
+                           description="Simulated time per frame: setpoints apply between frames [s].")
+    enable_zenoh: bool = Field(default=True, description="Start the zenoh bus [bool].")
+    enable_recording: bool = Field(default=True, description="Write the rerun recording [bool].")
+    gil_switch_interval_s: float = Field(
+        default=0.0005, ge=1e-5, le=0.1,
+        description="Python thread switch interval set when the service starts [s] (sys.setswitchinterval; "
+        "Python's 5 ms default makes a runner thread wait up to 5 ms for the GIL after each 1 ms "
+        "frame while the zenoh/rerun/HTTP threads run; 0.5 ms keeps the real-time factor at 1).")
+    max_twins: int = Field(default=8, ge=1, le=256,
+                           description="Most twins one service runs at a time [count].")
+    scenario_dir: Path | None = Field(
+        default=None,
+        description="Directory of named scenarios [path]; default ./scenarios if it exists, else "
+        "the scenarios/ folder of the source tree.")
+
+    @field_validator("zenoh_listen", "zenoh_connect", mode="before")
+    @classmethod
+    def _endpoints(cls, value):
+        return _split_endpoints(value)
+
+    @field_validator("record", mode="before")
+    @classmethod
+    def _record(cls, value):
+        if isinstance(value, str) and value.strip().lower() in ("", "none", "off"):
+            return None
+        return value
+
+    @property
+    def scenarios_path(self) -> Path:
+        """The directory named scenarios are looked up in."""
+        if self.scenario_dir is not None:
+            return self.scenario_dir
+        return default_scenario_dir()
+
+    @property
+    def recording_path(self) -> Path | None:
+        """Where the service records, or None when recording is off."""
+        return self.record if self.enable_recording and self.record is not None else None
