@@ -31,6 +31,10 @@ Zenoh 1.x notes (checked against eclipse-zenoh 1.10.2):
   links we were told to open, so nothing is sent to the LAN.
 * never block in a channel handler's `recv()` on one thread while undeclaring on another
   ("RuntimeError: Already borrowed" and a stuck thread): we use Python callbacks + our queues.
+* `Publisher.matching_status` returns a `MatchingStatus` object (always truthy), not the bool
+  the stubs promise: read `.matching`. It does become true once a remote subscriber is routed.
+* a malformed *connect* endpoint does not fail `zenoh.open` (only a listen one does), so
+  `make_config` checks endpoints itself.
 * open sessions only after any fork (one service process owns the bus).
 """
 
@@ -38,6 +42,7 @@ from __future__ import annotations
 
 import atexit
 import collections
+import contextlib
 import json
 import logging
 import re
@@ -45,7 +50,7 @@ import threading
 import time
 import weakref
 from collections.abc import Callable, Iterable
-from typing import Any
+from typing import Any, Self
 
 import zenoh
 
@@ -112,7 +117,7 @@ def _one_line(exc: BaseException) -> str:
                 parts.append(f"{loc}: {e.get('msg', '')}")
             if parts:
                 return "; ".join(parts)
-        except Exception:  # noqa: BLE001 - fall back to str()
+        except Exception:  # noqa: BLE001, S110 - fall back to str()
             pass
     text = " ".join(str(exc).split())
     return text or type(exc).__name__
@@ -199,7 +204,7 @@ class TwinChannel:
                     self._dropped += 1
                 self._queue.append(snapshot)
                 self._cond.notify()
-        except Exception:  # noqa: BLE001 - a sink never raises into the physics
+        except Exception:  # noqa: BLE001, S110 - a sink never raises into the physics
             pass
 
     def close(self) -> None:
@@ -222,8 +227,9 @@ class TwinChannel:
         with self._cond:
             self._stopping = True
             self._cond.notify()
-        self._publisher_thread.join(self._flush_timeout_s)
-        self._control_thread.join(self._flush_timeout_s)
+        for thread in (self._publisher_thread, self._control_thread):
+            if thread is not threading.current_thread():  # e.g. detach from inside on_setpoint
+                thread.join(self._flush_timeout_s)
         with self._pub_lock:
             self._publishers_gone = True
             publishers = [self._state_pub, self._result_pub, *self._ball_publishers.values()]
@@ -312,14 +318,10 @@ class TwinChannel:
         if item is None or item[0] != "query":
             return
         query = item[1]
-        try:
+        with contextlib.suppress(Exception):
             query.reply_err(_dumps({"error": error}), encoding=_JSON)
-        except Exception:  # noqa: BLE001
-            pass
-        try:
+        with contextlib.suppress(Exception):
             query.drop()
-        except Exception:  # noqa: BLE001
-            pass
 
     # ---- control thread ---------------------------------------------------------------------
     def _control_loop(self) -> None:
@@ -369,15 +371,11 @@ class TwinChannel:
             query.reply(f"{self.prefix}/snapshot", text, encoding=_JSON)  # concrete key
             self.queries_answered += 1
         except Exception as exc:  # noqa: BLE001
-            try:
+            with contextlib.suppress(Exception):
                 query.reply_err(_dumps({"error": _one_line(exc)}), encoding=_JSON)
-            except Exception:  # noqa: BLE001
-                pass
         finally:
-            try:
+            with contextlib.suppress(Exception):
                 query.drop()
-            except Exception:  # noqa: BLE001
-                pass
 
 
 def _closer(ref: weakref.ref) -> Callable[[], None]:
@@ -424,10 +422,10 @@ class ZenohBus:
         """Open a bus (same as the constructor)."""
         return cls(listen, connect, mode, **kwargs)
 
-    def __enter__(self) -> ZenohBus:
+    def __enter__(self) -> Self:
         return self
 
-    def __exit__(self, *_exc: Any) -> None:
+    def __exit__(self, *_exc: object) -> None:
         self.close()
 
     @property
@@ -482,10 +480,8 @@ class ZenohBus:
             self.session.close()
         except Exception as exc:  # noqa: BLE001
             log.warning("zenoh session close failed: %s", exc)
-        try:
+        with contextlib.suppress(Exception):
             atexit.unregister(self._atexit)
-        except Exception:  # noqa: BLE001
-            pass
 
 
 def wait_until(predicate: Callable[[], bool], timeout_s: float, interval_s: float = 0.02) -> bool:

@@ -13,6 +13,7 @@ push into a queue; the main thread parses, aggregates and renders.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import math
 import queue
@@ -64,9 +65,9 @@ class TwinTable:
     def on_state(self, key: str, payload: bytes) -> None:
         try:
             data = json.loads(payload, parse_constant=_reject_constant)
-            if not isinstance(data, dict):
-                raise ValueError("not a JSON object")
         except (ValueError, UnicodeDecodeError):
+            data = None
+        if not isinstance(data, dict):
             self.invalid += 1
             return
         if "balls" not in data:  # a ball or result message matched by a wide key expression
@@ -181,16 +182,12 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
     inbox: queue.SimpleQueue = queue.SimpleQueue()
 
     def on_sample(sample: zenoh.Sample) -> None:  # zenoh thread: hand off only
-        try:
+        with contextlib.suppress(Exception):
             inbox.put(("state", str(sample.key_expr), sample.payload.to_bytes()))
-        except Exception:  # noqa: BLE001
-            pass
 
     def on_alive(sample: zenoh.Sample) -> None:
-        try:
+        with contextlib.suppress(Exception):
             inbox.put(("alive", str(sample.key_expr), sample.kind == zenoh.SampleKind.PUT))
-        except Exception:  # noqa: BLE001
-            pass
 
     def drain(timeout: float) -> int:
         n = 0
@@ -239,16 +236,14 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
                             next_refresh = time.monotonic() + _REFRESH_S
                     drain(0.0)
                     live.update(table.render(title), refresh=True)
-                if not console.is_terminal:
-                    console.line()  # Live leaves the cursor after the last line of a file
             except KeyboardInterrupt:
                 pass
+            if not console.is_terminal:
+                console.line()  # Live leaves the cursor after the last line of a file
     finally:
         for sub in subscribers:
-            try:
+            with contextlib.suppress(Exception):
                 sub.undeclare()
-            except Exception:  # noqa: BLE001
-                pass
         session.close()
     return table.snapshot()
 

@@ -16,7 +16,8 @@ from twin.kernels.step import evaluate, step_n
 from twin.model import BearingModel, make_model
 from twin.physics.friction import REGIME_NAMES
 from twin.physics.hertz import max_pressure_pa
-from twin.physics.viscosity import dynamic_viscosity_pa_s
+from twin.physics.thermal import MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k, roelands_temperature_viscosity_pa_s
+from twin.physics.viscosity import dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.setpoint import Setpoint, SetpointUpdate, check_limits
 from twin.electrical import bearing_network
 from twin.snapshot import BallState, ContactState, SetpointState, Snapshot
@@ -26,6 +27,7 @@ from twin.state import TwinState, make_state
 from twin.warmstart import warm_start
 
 FRAME_STEPS = 1000  # steps per compiled call (1 ms of simulated time at dt = 1 us)
+COUPLING_FRAMES = 10  # electro-thermal coupling refreshed every 10 frames (10 ms at 1 ms frames)
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -87,8 +89,47 @@ class Twin:
         v[L.S_SHAFT_SPEED] = new.shaft_speed_rad_s
         v[L.S_RADIAL_LOAD] = new.radial_load_n
         v[L.S_AXIAL_LOAD] = new.axial_load_n
-        v[L.S_VISCOSITY] = dynamic_viscosity_pa_s(self.model.spec.lubricant, new.oil_temperature_c)
+        lub = self.model.spec.lubricant
+        self._oil_viscosity_pa_s = dynamic_viscosity_pa_s(lub, new.oil_temperature_c)
+        self._oil_beta_k_inv = temperature_viscosity_coefficient_k_inv(lub, new.oil_temperature_c)
+        self._update_inlet_viscosity(force=True)
         return new
+
+    # ---- electro-thermal coupling (seed 003) ------------------------------------------------
+    def _update_inlet_viscosity(self, force: bool = False) -> None:
+        """Inlet viscosity = oil viscosity at the oil temperature raised by the current-discharge
+        heating of the race track (seed 003 eq. 10 with the bearing's resistance), through
+        Roelands' temperature law (seed 003 eq. 3). Recomputed every COUPLING_FRAMES frames while a
+        current flows (the network is a bearing-level quantity that changes slowly)."""
+        sp = self._setpoint
+        th = self.model.spec.thermal
+        self._frames_since_coupling = getattr(self, "_frames_since_coupling", 0) + 1
+        if not force and self._frames_since_coupling < COUPLING_FRAMES:
+            return
+        self._frames_since_coupling = 0
+        rise = 0.0
+        if sp.shaft_current_a > 0.0 and th.current_heating and hasattr(self, "state"):
+            rise = self.current_heating_k()
+        self._current_heating_k = rise
+        theta0 = sp.oil_temperature_c + 273.15
+        eta = (roelands_temperature_viscosity_pa_s(self._oil_viscosity_pa_s, theta0, theta0 + rise,
+                                                   self._oil_beta_k_inv) if rise > 0.0 else self._oil_viscosity_pa_s)
+        self._setpoint_vector[L.S_VISCOSITY] = eta
+
+    def current_heating_k(self) -> float:
+        """Race-track temperature rise from the shaft current (seed 003 eq. 10) [K]."""
+        sp = self._setpoint
+        th = self.model.spec.thermal
+        m = self.model
+        r_b = th.equivalent_resistance_ohm
+        if r_b is None:
+            net = self.electrical()
+            r_b = net.impedance_ohm * math.cos(net.phase_rad)
+        loaded = int(np.count_nonzero(self.state.contacts[L.C_LOAD, 0::2] > 0.0))
+        return min(MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k(
+            sp.shaft_current_a, r_b, 2.0 * m.pitch_radius_m, 2.0 * m.ball_radius_m, loaded,
+            float(self.state.scalars[L.X_SHAFT_SPEED]) / (2.0 * math.pi), th.crater_depth_m,
+            m.spec.material.density_kg_m3, th.ball_specific_heat_j_kg_k, m.contact_angle_rad))
 
     def set_setpoint(self, update: SetpointUpdate | None = None, **fields) -> Setpoint:
         """Apply a partial setpoint (validated; raises SetpointError / ValidationError naming the
@@ -113,6 +154,7 @@ class Twin:
         evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
 
     def _frame(self, n: int) -> int:
+        self._update_inlet_viscosity()
         s = self.state
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
@@ -216,5 +258,5 @@ class Twin:
                 frequency_hz=net.frequency_hz, shaft_voltage_v=net.shaft_voltage_v,
                 shaft_current_a=net.shaft_current_a, max_film_field_v_m=net.max_film_field_v_m,
                 current_density_a_m2=net.current_density_a_m2, discharge_risk=net.discharge_risk,
-                reason=net.reason),
+                reason=net.reason, contact_temperature_rise_k=float(self._current_heating_k)),
             balls=balls)

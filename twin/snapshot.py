@@ -63,6 +63,7 @@ class ElectricalState(BaseModel):
     current_density_a_m2: float = Field(description="Largest apparent current density over a loaded contact area [A/m^2].")
     discharge_risk: Literal["none", "possible", "likely"] = Field(description="Electrical discharge risk.")
     reason: str = Field(description="Why the risk is what it is.")
+    contact_temperature_rise_k: float = Field(description="Race-track temperature rise from the current (seed 003 eq. 10), fed into the inlet viscosity [K].")
 
 
 class SetpointState(BaseModel):
@@ -95,7 +96,7 @@ class Snapshot(BaseModel):
     cage_speed_rad_s: float = Field(description="Cage angular speed [rad/s].")
     inner_ring_displacement_m: tuple[float, float, float] = Field(description="Inner ring centre (x along the radial load, y, z axial) [m].")
     friction_torque_n_m: float = Field(description="Torque the shaft supplies to the bearing, averaged over the last frame [N m].")
-    viscosity_pa_s: float = Field(description="Oil dynamic viscosity at the oil temperature [Pa s].")
+    viscosity_pa_s: float = Field(description="Inlet viscosity used by the film: oil at the oil temperature plus the current heating [Pa s].")
     electrical: ElectricalState
     balls: tuple[BallState, ...]
 

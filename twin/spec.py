@@ -166,6 +166,30 @@ class Electrical(BaseModel):
         return self
 
 
+class Thermal(BaseModel):
+    """Electro-thermal inputs of seed 003 (Appendix 2 values as defaults)."""
+
+    model_config = _FROZEN
+
+    oil_thermal_conductivity_w_m_k: float = Field(
+        default=0.145, gt=0.0, le=10.0, description="Oil thermal conductivity k' [W/(m K)] (seed 003: 0.145).")
+    oil_thermal_expansion_k_inv: float = Field(
+        default=6.4e-4, ge=0.0, le=1e-2, description="Oil thermal expansion alpha' [1/K] (seed 003: 6.4e-4).")
+    crater_depth_m: float = Field(
+        default=3e-3, gt=0.0, le=1e-1,
+        description="Depth H_c of the heated layer under slip bands and craters in seed 003 eqs. 8-10 [m]. "
+        "Appendix 2 prints '3x10-0': read as 3e-6 m the law gives 1e4-1e5 K at 10 A and 1 ohm, read as 3e-3 m "
+        "it gives the tens of kelvin of seed 003 Fig. 3, so 3e-3 m is the default.")
+    ball_specific_heat_j_kg_k: float = Field(
+        default=460.0, gt=0.0, le=5000.0, description="Specific heat of the bearing steel c_b [J/(kg K)] (seed 003: 460).")
+    equivalent_resistance_ohm: float | None = Field(
+        default=None, gt=0.0, le=1e12,
+        description="Bearing resistance R_b of seed 003 eqs. 7-10 [ohm]; null: the resistive part "
+        "Re(Z) of the twin's own network at the impedance frequency.")
+    current_heating: bool = Field(
+        default=True, description="Feed the current-discharge heating back into the inlet viscosity.")
+
+
 class Mounting(BaseModel):
     """How the bearing is mounted."""
 
@@ -192,6 +216,7 @@ class BearingSpec(BaseModel):
     lubricant: Lubricant = Lubricant()
     mounting: Mounting = Mounting()
     electrical: Electrical = Electrical()
+    thermal: Thermal = Thermal()
 
 
 class ModelOptions(BaseModel):

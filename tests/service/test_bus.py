@@ -16,10 +16,10 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
-from service.bus import ZenohBus, make_config, wait_until  # noqa: E402
-from service.monitor import add_monitor_command, run_monitor  # noqa: E402
-from twin.engine import Twin  # noqa: E402
-from twin.setpoint import SetpointUpdate  # noqa: E402
+from service.bus import ZenohBus, make_config, wait_until
+from service.monitor import add_monitor_command, run_monitor
+from twin.engine import Twin
+from twin.setpoint import SetpointUpdate
 
 WAIT_S = 10.0
 
@@ -361,7 +361,7 @@ def test_monitor_sees_twins_of_two_services(endpoint, twin):
         bus2.close()
         bus1.close()
     assert set(rows) == {"m1", "m2", "m3"}, rows.keys()
-    for name, row in rows.items():
+    for row in rows.values():
         assert row["designation"] == "6208"
         assert row["alive"] is True
         assert row["messages"] >= 1 and row["seq"] is not None

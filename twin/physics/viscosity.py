@@ -39,3 +39,11 @@ def dynamic_viscosity_pa_s(lubricant, temperature_c: float) -> float:
     nu = kinematic_viscosity_m2_s(lubricant.kinematic_viscosity_40c_m2_s,
                                   lubricant.kinematic_viscosity_100c_m2_s, temperature_c)
     return nu * density_kg_m3(lubricant.density_15c_kg_m3, temperature_c)
+
+
+def temperature_viscosity_coefficient_k_inv(lubricant, temperature_c: float) -> float:
+    """beta = -d ln(eta) / d theta at temperature_c [1/K], from the ASTM D341 law (central
+    difference over +-1 K)."""
+    lo = dynamic_viscosity_pa_s(lubricant, temperature_c - 1.0)
+    hi = dynamic_viscosity_pa_s(lubricant, temperature_c + 1.0)
+    return (math.log(lo) - math.log(hi)) / 2.0
