@@ -27,6 +27,7 @@ from twin.state import TwinState, make_state
 from twin.warmstart import warm_start
 
 FRAME_STEPS = 1000  # steps per compiled call (1 ms of simulated time at dt = 1 us)
+RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
 COUPLING_FRAMES = 10  # electro-thermal coupling refreshed every 10 frames (10 ms at 1 ms frames)
 
 
@@ -58,9 +59,19 @@ class Twin:
         self.seq = 0
         self.restarts = 0
         self.status = "ok"
+        self.halted = False
+        self._last_restart_time_s = -math.inf
+        self._last_good_time_s = 0.0
         self._last_torque_n_m = 0.0
-        self._apply(setpoint or Setpoint())
+        self._apply(setpoint or self.default_setpoint())
         self.reset(warm=warm)
+
+    def default_setpoint(self) -> Setpoint:
+        """Seed 000's operating point (500 rad/s, 3000 N, 40 degC) where the bearing can hold it;
+        for a small bearing the radial load is a quarter of what it can hold."""
+        m = self.model
+        return Setpoint(shaft_speed_rad_s=min(500.0, 0.5 * m.max_shaft_speed_rad_s),
+                        radial_load_n=min(3000.0, round(0.25 * m.max_radial_load_n)))
 
     # ---- setpoint ---------------------------------------------------------------------------
     @property
@@ -135,7 +146,12 @@ class Twin:
         """Apply a partial setpoint (validated; raises SetpointError / ValidationError naming the
         field and its range). Takes effect at the next frame; returns the setpoint in force."""
         update = update or SetpointUpdate(**fields)
-        return self._apply(update.apply_to(self._setpoint))
+        applied = self._apply(update.apply_to(self._setpoint))
+        if self.halted:  # a new setpoint: try again from the warm start
+            self.halted = False
+            self.status = "ok"
+            self.reset(keep_time=True)
+        return applied
 
     # ---- running ----------------------------------------------------------------------------
     def reset(self, *, warm: bool = True, shaft_speed_rad_s: float | None = None,
@@ -165,28 +181,48 @@ class Twin:
             self._last_torque_n_m = s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT]
         if status != L.STATUS_OK:
             self._recover(status)
+        else:
+            self._last_good_time_s = self.time_s
         return done
 
     def _recover(self, status: int) -> None:
         """A kernel reported a diverged or overloaded state: restart from the warm start at the
-        setpoint in force, keep the simulated time, count it, say why in `status`."""
+        setpoint in force, keep the simulated time, count it, say why in `status`. If the state
+        fails again within RESTART_WINDOW_S of simulated time, the setpoint cannot be held: the
+        twin halts (time goes on, the physics does not) until the next setpoint."""
         t = float(self.state.scalars[L.X_TIME])
         reason = L.STATUS_NAMES[status]
         if not math.isfinite(t):
-            t = 0.0
+            t = self._last_good_time_s
         self.restarts += 1
+        if t - self._last_restart_time_s < RESTART_WINDOW_S:
+            self.halted = True
+            self.status = (f"halted: {reason} again within {RESTART_WINDOW_S * 1e3:.0f} ms of a restart "
+                           f"at t = {t:.6f} s; the setpoint cannot be held, waiting for a new one")
+        else:
+            self.status = f"restarted: {reason} at t = {t:.6f} s"
+        self._last_restart_time_s = t
         self.state.scalars[L.X_TIME] = t
         self.reset(keep_time=True)
-        self.status = f"restarted: {reason} at t = {t:.6f} s"
 
-    def advance(self, seconds: float, frame_steps: int = FRAME_STEPS) -> None:
-        """Integrate `seconds` of simulated time in frames of `frame_steps` steps."""
+    def advance(self, seconds: float, frame_steps: int = FRAME_STEPS, *,
+                max_restarts: int | None = None) -> int:
+        """Integrate `seconds` of simulated time in frames of `frame_steps` steps.
+
+        A state the kernel cannot hold at the setpoint in force fails again right after its warm
+        restart, i.e. at nearly every step (each restart costs a warm start): `max_restarts`
+        stops the call after that many restarts within it (None: no bound). Returns the steps
+        left undone (0 unless stopped by `max_restarts`)."""
         if not (math.isfinite(seconds) and seconds >= 0.0):
             raise ValueError(f"seconds = {seconds!r}: must be finite and >= 0")
         remaining = int(round(seconds / self.model.dt_s))
+        first = self.restarts
         while remaining > 0:
             n = min(frame_steps, remaining)
             remaining -= max(self._frame(n), 1)  # a failing frame still consumes a step: no hang
+            if max_restarts is not None and self.restarts - first >= max_restarts:
+                return max(remaining, 0)
+        return 0
 
     @property
     def time_s(self) -> float:
