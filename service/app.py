@@ -23,7 +23,13 @@ from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from service.scenarios import ScenarioError, find_scenario, list_scenarios, load_scenario, scenario_from_dict
+from service.scenarios import (
+    ScenarioError,
+    find_scenario,
+    list_scenarios,
+    load_scenario,
+    scenario_from_dict,
+)
 from service.schemas import (
     BearingCreate,
     BearingInfo,
@@ -42,6 +48,7 @@ from service.schemas import (
     parse_setpoint,
     setpoint_error,
 )
+from service.security import HardeningMiddleware
 from service.settings import ServiceSettings
 from service.wiring import TwinEntry, TwinService
 from twin.setpoint import SetpointError, SetpointUpdate
@@ -72,12 +79,64 @@ def _info(entry: TwinEntry) -> BearingInfo:
         state_url=f"/v1/bearings/{entry.id}/state", zenoh_state_key=f"bearing/{entry.id}/state")
 
 
+def _loopback(host: str) -> bool:
+    return host in ("127.0.0.1", "localhost", "::1") or host.startswith("127.")
+
+
+def access_summary(settings: ServiceSettings) -> str:
+    """One line: whether a token is required, and for what."""
+    if settings.token is None:
+        return ("no token (BEARING_TWIN_TOKEN unset): anyone who can reach the port may change "
+                "setpoints")
+    reads = "reads too (except /health)" if settings.read_requires_token else "reads open"
+    return f"bearer token required for POST/PUT/DELETE and zenoh setpoints; {reads}"
+
+
+def _document_hardening(app: FastAPI, settings: ServiceSettings) -> None:
+    """OpenAPI: the bearer scheme (when a token is set) and the 401/413/429 answers."""
+    base_openapi = app.openapi
+
+    def openapi() -> dict:
+        if app.openapi_schema is not None:
+            return app.openapi_schema
+        schema = base_openapi()
+        error_ref = {"content": {"application/json": {"schema": {"$ref": "#/components/schemas/ErrorResponse"}}}}
+        if settings.token is not None:
+            schema.setdefault("components", {}).setdefault("securitySchemes", {})["bearerToken"] = {
+                "type": "http", "scheme": "bearer",
+                "description": "BEARING_TWIN_TOKEN of the service"}
+        for path, item in schema.get("paths", {}).items():
+            for method, op in item.items():
+                if method not in ("get", "put", "post", "delete", "patch"):
+                    continue
+                responses = op.setdefault("responses", {})
+                mutating = method != "get"
+                if settings.token is not None and (mutating or (settings.read_requires_token and path != "/health")):
+                    op["security"] = [{"bearerToken": []}]
+                    responses.setdefault("401", {"description": "Missing or wrong bearer token", **error_ref})
+                if mutating:
+                    responses.setdefault("413", {"description": f"Body larger than {settings.max_body_bytes} bytes",
+                                                 **error_ref})
+                if method == "put" and path.endswith("/setpoint") and settings.setpoint_rate_hz:
+                    responses.setdefault("429", {"description": "Too many setpoints for this twin; see Retry-After",
+                                                 "headers": {"Retry-After": {"schema": {"type": "integer"},
+                                                                             "description": "seconds"}},
+                                                 **error_ref})
+        app.openapi_schema = schema
+        return schema
+
+    app.openapi = openapi
+
+
 def create_app(settings: ServiceSettings | None = None) -> FastAPI:
     """The FastAPI application for one service (see the module docstring)."""
     settings = settings or ServiceSettings()
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
+        log.info("bearing-twin: HTTP bound to %s:%s (%s); %s", settings.host, settings.port,
+                 "loopback only" if _loopback(settings.host) else "reachable from other machines",
+                 access_summary(settings))
         service = TwinService(settings)
         await run_in_threadpool(service.open)
         app.state.service = service
@@ -96,6 +155,12 @@ def create_app(settings: ServiceSettings | None = None) -> FastAPI:
         lifespan=lifespan,
     )
     app.state.settings = settings
+    app.state.service = None
+    app.add_middleware(HardeningMiddleware, token=settings.token_value,
+                       read_requires_token=settings.read_requires_token,
+                       max_body_bytes=settings.max_body_bytes,
+                       get_service=lambda: app.state.service)
+    _document_hardening(app, settings)
 
     def svc(request: Request) -> TwinService:
         return request.app.state.service

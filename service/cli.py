@@ -1,4 +1,4 @@
-"""`bearing-twin` command line: simulate, bench, report, serve, scenario, bench-service, monitor.
+"""`bearing-twin` command line: simulate, bench, report, serve, scenario, bench-service, monitor, soak.
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -167,6 +167,12 @@ def build_parser() -> argparse.ArgumentParser:
     bsv.set_defaults(func=_cmd_bench_service)
 
     _add_monitor(sub)
+    from service.soak import add_soak_command
+
+    add_soak_command(sub)
+    from service.ehl_cli import add_ehl_command
+
+    add_ehl_command(sub)
     return parser
 
 
@@ -272,6 +278,12 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     print(f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
           f"twin `{settings.twin_id}` = {settings.bearing.upper()}, {'fast' if settings.fast else 'real-time'} mode",
           flush=True)
+    from service.app import access_summary
+
+    print(f"bearing-twin: access: {access_summary(settings)}; setpoints limited to "
+          + (f"{settings.setpoint_rate_hz:g}/s per twin (bursts of {settings.setpoint_burst})"
+             if settings.setpoint_rate_hz else "no rate")
+          + f"; request bodies up to {settings.max_body_bytes} bytes", flush=True)
     if settings.enable_zenoh:
         print(f"bearing-twin: zenoh {settings.zenoh_mode} listening on {', '.join(settings.zenoh_listen) or 'nothing'}"
               + (f", connecting to {', '.join(settings.zenoh_connect)}" if settings.zenoh_connect else ""),
@@ -283,7 +295,12 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     config = uvicorn.Config(create_app(settings), host=host, port=settings.port, workers=1,
                             log_level=args.log_level, lifespan="on", timeout_graceful_shutdown=3)
     server = uvicorn.Server(config)
-    server.run()
+    try:
+        server.run()
+    except KeyboardInterrupt:
+        # uvicorn re-raises a captured SIGINT (Ctrl-C) once its graceful shutdown - our lifespan
+        # `finally`: runners stopped, zenoh closed, recordings flushed - is complete
+        return 130
     return 0 if server.started else 1
 
 

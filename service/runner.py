@@ -35,11 +35,30 @@ was accepted and the seq and wall time of the first published snapshot that refl
 Errors. An exception in the loop is caught, counted (`errors`), logged, shown in the snapshots'
 `status`, and the twin is warm-restarted at the setpoint in force; after
 `max_consecutive_errors` failures in a row the runner stops and says so (`failed`).
+
+Physics faults. The kernel reports a state it cannot hold (non-finite, excessive penetration);
+the engine then warm-restarts at the setpoint in force and counts it (`Twin.restarts`, its
+`status` says why). A setpoint inside the bearing's limits can still be one the model cannot
+hold (a load step far beyond what the contacts carry): it fails again right after each restart.
+The runner bounds that (at most 2 engine restarts per frame, `Twin.advance(max_restarts=)`) and
+falls back: the twin is warm-restarted at the LAST SAFE SETPOINT (one held for
+`safe_after_frames` frames without a restart; the twin's initial setpoint to begin with), the
+setpoint target becomes that one, `fallbacks` and the twin's `restarts` count it and `status`
+names the setpoint that was not held and why. A value that was not held (when one load or speed
+field alone rose) is remembered: from then on this twin refuses it, and anything beyond it, at
+submission (422 naming the field). No NaN reaches a snapshot: `Snapshot` refuses non-finite
+numbers, and a frame that fails is restarted before the next snapshot is taken.
+
+Access and limits (service.security). `submit_setpoint_json` (zenoh) refuses payloads larger than
+`max_payload_bytes`, payloads without the configured `token` field (it is removed before
+validation), and setpoints beyond the twin's rate (`admit_setpoint`, a token bucket shared with
+HTTP); each refusal carries a `status` (401, 413, 422, 429) like the HTTP answer would.
 """
 
 from __future__ import annotations
 
 import collections
+import json
 import logging
 import math
 import threading
@@ -48,9 +67,17 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from service.scenarios import ResolvedRun, ScenarioExecutor
-from service.schemas import InputError, parse_setpoint, parse_setpoint_json, setpoint_error
+from service.schemas import (
+    FieldError,
+    InputError,
+    parse_setpoint,
+    parse_setpoint_json,
+    setpoint_error,
+)
+from service.security import TokenBucket, token_matches
 from service.sinks import SnapshotSink
 from twin.engine import Twin
+from twin.setpoint import _UNITS as SETPOINT_UNITS
 from twin.setpoint import Setpoint, SetpointError, SetpointUpdate, check_limits
 from twin.snapshot import Snapshot
 
@@ -127,6 +154,9 @@ class TwinRunner:
                  rtf_window_s: float = 1.0, resync_after_s: float = 0.25,
                  idle_without_scenario: bool = False, max_consecutive_errors: int = 20,
                  setpoint_publish_min_interval_s: float = 0.002, timing_history: int = 10000,
+                 token: str | None = None, setpoint_rate_hz: float | None = None,
+                 setpoint_burst: int = 100, max_payload_bytes: int | None = None,
+                 safe_after_frames: int = 20, max_restarts_per_frame: int = 2,
                  clock: Callable[[], float] = time.perf_counter):
         if not (publish_rate_hz > 0 and math.isfinite(publish_rate_hz)):
             raise ValueError(f"publish_rate_hz = {publish_rate_hz!r}: must be > 0 [Hz]")
@@ -185,6 +215,23 @@ class TwinRunner:
         self._last_publish_wall = -math.inf
         self._last_publish_sim = -math.inf
         self._publish_soon = False
+
+        # access and limits
+        self.token = token
+        self.setpoint_bucket = (TokenBucket(setpoint_rate_hz, setpoint_burst)
+                                if setpoint_rate_hz else None)
+        self.max_payload_bytes = max_payload_bytes
+        self.setpoints_refused = 0              # zenoh setpoints refused (any reason)
+        # physics faults: the last safe setpoints (newest last), fallbacks, values not held
+        self.safe_after_frames = max(1, int(safe_after_frames))
+        self.max_restarts_per_frame = max(1, int(max_restarts_per_frame))
+        self._safe: collections.deque[Setpoint] = collections.deque([twin.setpoint], maxlen=8)
+        self._held_setpoint: Setpoint = twin.setpoint
+        self._held_frames = 0
+        self._restart_streak = 0                # consecutive frames with an engine restart
+        self.fallbacks = 0
+        self._not_held: dict[str, tuple[float, str]] = {}   # field -> (lowest |value| not held, why)
+        self._faults: list[tuple[str, float | None]] = []   # injected by tests (inject_fault)
 
     # ---- public, any thread ------------------------------------------------------------------
     @property
@@ -256,18 +303,56 @@ class TwinRunner:
             update = parse_setpoint(update, self.limits)
         return self._offer(update.model_dump(exclude_none=True), timed=True)
 
+    def admit_setpoint(self) -> tuple[bool, float]:
+        """Take one setpoint from this twin's rate budget: (True, 0.0) or (False, retry after [s])."""
+        if self.setpoint_bucket is None:
+            return True, 0.0
+        return self.setpoint_bucket.take()
+
     def submit_setpoint_json(self, payload: bytes | str) -> dict:
-        """zenoh's `on_setpoint`: same validation as HTTP; never raises.
-        Returns {"accepted": True, "setpoint": {...}} or {"accepted": False, "error": "..."}."""
+        """zenoh's `on_setpoint`: size cap, token, rate limit, then the same validation as HTTP;
+        never raises. Returns {"accepted": True, "setpoint": {...}} or
+        {"accepted": False, "status": 401 | 413 | 422 | 429, "error": "...", ...}.
+
+        With a token configured the payload must be a JSON object carrying it as "token" (removed
+        before validation, never echoed)."""
         try:
-            update = parse_setpoint_json(payload, self.limits)
+            size = len(payload)
+            if self.max_payload_bytes is not None and size > self.max_payload_bytes:
+                return self._refused(413, f"payload of {size} bytes is larger than the limit of "
+                                     f"{self.max_payload_bytes} bytes")
+            data = None
+            if self.token is not None:
+                try:
+                    data = json.loads(payload)
+                except (ValueError, UnicodeDecodeError, RecursionError):
+                    data = None
+                given = data.pop("token", None) if isinstance(data, dict) else None
+                if not isinstance(given, str) or not token_matches(given, self.token):
+                    return self._refused(401, "missing token: send the setpoint as a JSON object "
+                                         "with a \"token\" field" if given is None else "invalid token")
+            ok, retry_after = self.admit_setpoint()
+            if not ok:
+                return self._refused(429, f"too many setpoints: at most {self.setpoint_bucket.rate_hz:g} "
+                                     f"per second (bursts of {self.setpoint_bucket.burst}); retry after "
+                                     f"{retry_after:.3f} s", retry_after_s=retry_after)
+            if data is not None:
+                update = parse_setpoint(data, self.limits)
+            else:
+                update = parse_setpoint_json(payload, self.limits)
             setpoint = self.submit(update)
             return {"accepted": True, "setpoint": setpoint.model_dump()}
         except InputError as exc:
-            return {"accepted": False, "error": str(exc),
+            self.setpoints_refused += 1
+            return {"accepted": False, "status": exc.status_code, "error": str(exc),
                     "detail": [e.model_dump() for e in exc.errors]}
         except Exception as exc:  # noqa: BLE001 - a refusal, never a crash
-            return {"accepted": False, "error": f"{type(exc).__name__}: {exc}"}
+            self.setpoints_refused += 1
+            return {"accepted": False, "status": 422, "error": f"{type(exc).__name__}: {exc}"}
+
+    def _refused(self, status: int, message: str, **extra) -> dict:
+        self.setpoints_refused += 1
+        return {"accepted": False, "status": status, "error": message, **extra}
 
     def start_scenario(self, run: ResolvedRun, *, restart: bool = False) -> tuple[ScenarioHandle, ScenarioHandle | None]:
         """Hand a scenario run to the runner thread (a running one is cancelled). Values are
@@ -310,13 +395,32 @@ class TwinRunner:
         latest = self._latest
         return {
             "id": self.bearing_id, "running": self.running, "mode": self.mode,
-            "status": self._status_text(latest.status if latest else self.twin.status),
+            "status": latest.status if latest is not None else self._status_text(self.twin.status),
             "time_s": latest.time_s if latest else self.twin.time_s,
             "real_time_factor": self._rtf, "frames": self.frames, "overruns": self.overruns,
             "resyncs": self.resyncs, "published": self.published, "dropped": self.dropped,
             "errors": self.errors, "restarts": self.twin.restarts,
             "setpoints_accepted": self.setpoints_accepted,
+            "setpoints_refused": self.setpoints_refused,
+            "setpoints_rate_limited": self.setpoint_bucket.refused if self.setpoint_bucket else 0,
+            "fallbacks": self.fallbacks,
+            "last_safe_setpoint": self.last_safe_setpoint.model_dump(),
         }
+
+    @property
+    def last_safe_setpoint(self) -> Setpoint:
+        """The newest setpoint held for `safe_after_frames` frames without a restart."""
+        return self._safe[-1]
+
+    def inject_fault(self, kind: str, value: float | None = None) -> None:
+        """Fault injection for tests, applied by the runner thread before its next frame:
+        "nan" puts NaN into the first ball's position; "overload" sets the radial load in force
+        to `value` [N] bypassing every validation (as a bug or a corrupted setpoint would)."""
+        if kind not in ("nan", "overload"):
+            raise ValueError(f"unknown fault {kind!r}: 'nan' or 'overload'")
+        with self._lock:
+            self._faults.append((kind, value))
+        self._wake.set()
 
     def start(self, *, publish_initial: bool = True) -> TwinRunner:
         """Take the first snapshot (so GET state never finds none) and start the thread."""
@@ -359,6 +463,8 @@ class TwinRunner:
                 check_limits(new, self.limits)
             except SetpointError as exc:
                 raise InputError([setpoint_error(exc)]) from None
+            if self._not_held:
+                self._check_held(new, fields)
             if fields:
                 self._pending.update(fields)
             self._target = new
@@ -382,6 +488,98 @@ class TwinRunner:
             t.applied_wall_s = now
         self._unpublished_timings.extend(timings)
         return bool(pending) or bool(timings)
+
+    def _check_held(self, new: Setpoint, fields: dict) -> None:
+        """Refuse (InputError 422) a setpoint reaching a value this twin could not hold."""
+        errors = []
+        for name, (value, why) in list(self._not_held.items()):
+            if name in fields and abs(getattr(new, name)) >= value:
+                low, high = self.limits[name]
+                unit = SETPOINT_UNITS.get(name, "")
+                errors.append(FieldError(
+                    field=name, allowed=[max(low, -value), min(high, value)],
+                    message=f"{name} = {getattr(new, name):g} {unit}: this twin could not hold "
+                    f"{value:g} {unit} ({why}) and fell back to its last safe setpoint; values of "
+                    f"{value:g} {unit} and beyond are refused (re-create the twin to try again)"))
+        if errors:
+            raise InputError(errors)
+
+    # ---- physics faults (runner thread) ----------------------------------------------------------
+    def _advance_frame(self) -> None:
+        """One frame of physics with the fault handling of the module docstring."""
+        twin = self.twin
+        self._apply_faults()
+        before = twin.restarts
+        left = twin.advance(self.frame_s, frame_steps=self.frame_steps,
+                            max_restarts=self.max_restarts_per_frame) or 0
+        if twin.restarts == before:
+            self._restart_streak = 0
+            self._held()
+            return
+        self._restart_streak += 1
+        self._held_frames = 0
+        if left > 0 or self._restart_streak >= 2:
+            self._fall_back()
+            if left > 0:   # the rest of the frame at the safe setpoint (bounded as well)
+                twin.advance(left * twin.model.dt_s, frame_steps=self.frame_steps, max_restarts=1)
+
+    def _held(self) -> None:
+        sp = self.twin.setpoint
+        if sp != self._held_setpoint:
+            self._held_setpoint, self._held_frames = sp, 0
+        self._held_frames += 1
+        if self._held_frames >= self.safe_after_frames and sp != self._safe[-1]:
+            self._safe.append(sp)
+
+    def _fall_back(self) -> None:
+        """Warm-restart at the last safe setpoint (an older one if that fails too)."""
+        twin = self.twin
+        current = twin.setpoint
+        why = twin.status.removeprefix("restarted: ").split(" at t = ")[0]
+        if current == self._safe[-1] and self._restart_streak >= 3 and len(self._safe) > 1:
+            self._safe.pop()            # even the last safe one is not held: go further back
+        safe = self._safe[-1]
+        with self._lock:
+            self._learn_not_held(current, safe, why)
+        twin.set_setpoint(SetpointUpdate(**safe.model_dump()))   # also rewrites what the kernel sees
+        warm_restart(twin)
+        twin.restarts += 1
+        self.fallbacks += 1
+        with self._lock:
+            self._target = safe
+            self._pending.clear()       # updates merged onto the setpoint that was not held
+        self._held_setpoint, self._held_frames = safe, 0
+        changed = [n for n in SETPOINT_UNITS if getattr(current, n) != getattr(safe, n)]
+        what = ", ".join(f"{n} = {getattr(current, n):g} {SETPOINT_UNITS[n]}" for n in changed)
+        back = ", ".join(f"{n} = {getattr(safe, n):g} {SETPOINT_UNITS[n]}" for n in changed)
+        self._status_note = (f"setpoint not held ({why}): {what or 'the setpoint in force'}; "
+                             f"restarted from the warm start at the last safe setpoint"
+                             f"{' (' + back + ')' if back else ''}; fallbacks: {self.fallbacks}")
+        log.warning("twin %s: %s", self.bearing_id, self._status_note)
+        self._publish_soon = True
+
+    def _learn_not_held(self, current: Setpoint, safe: Setpoint, why: str) -> None:
+        rose = [n for n in ("radial_load_n", "axial_load_n", "shaft_speed_rad_s")
+                if abs(getattr(current, n)) > abs(getattr(safe, n))]
+        if len(rose) == 1:              # one cause only: remember the value
+            name = rose[0]
+            value = abs(getattr(current, name))
+            known = self._not_held.get(name)
+            if known is None or value < known[0]:
+                self._not_held[name] = (value, why)
+
+    def _apply_faults(self) -> None:
+        with self._lock:
+            faults, self._faults = self._faults, []
+        for kind, value in faults:
+            twin = self.twin
+            if kind == "nan":
+                twin.state.ball_position_m[0, 0] = math.nan
+            else:   # overload: bypass validation, as a bug or a corrupted setpoint would
+                from twin.kernels import layout as L
+
+                twin._setpoint = twin.setpoint.model_copy(update={"radial_load_n": float(value)})
+                twin._setpoint_vector[L.S_RADIAL_LOAD] = float(value)
 
     # ---- scenarios (runner thread) -----------------------------------------------------------
     def _scenario_tick(self) -> bool:
@@ -451,7 +649,7 @@ class TwinRunner:
                     # a scenario started or ended: sample now and restart the sample grid there
                     self._publish(self._clock())
                     next_publish_sim = self.sim_elapsed_s + self.publish_period_s
-                self.twin.advance(self.frame_s, frame_steps=self.frame_steps)
+                self._advance_frame()
                 self.frames += 1
                 self._sim_frames += 1
                 consecutive = 0

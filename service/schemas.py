@@ -297,6 +297,10 @@ class TwinHealth(BaseModel):
     errors: int = Field(description="Exceptions caught in the runner loop (each followed by a warm restart) [-].")
     restarts: int = Field(description="Engine warm restarts after a diverged or overloaded state [-].")
     setpoints_accepted: int = Field(description="Setpoint updates accepted [-].")
+    setpoints_refused: int = Field(default=0, description="zenoh setpoints refused (token, size, rate, validation) [-].")
+    setpoints_rate_limited: int = Field(default=0, description="Setpoints refused by the rate limit, HTTP 429 and zenoh [-].")
+    fallbacks: int = Field(default=0, description="Times the twin could not hold its setpoint and was warm-restarted at the last safe one [-].")
+    last_safe_setpoint: SetpointState | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")
 
 
 class Health(BaseModel):
@@ -309,3 +313,5 @@ class Health(BaseModel):
     zenoh_listen: list[str] = Field(description="zenoh endpoints listened on [zenoh locator].")
     recording: str | None = Field(description="The service-wide .rrd being written [path]; null when off.")
     recording_rows: int = Field(default=0, description="Snapshots written to the service-wide recording [-].")
+    pid: int | None = Field(default=None, description="Process id of the service [-] (for soak tests and monitoring).")
+    rss_bytes: int | None = Field(default=None, description="Resident memory of the service process [bytes]; null where /proc is unavailable.")

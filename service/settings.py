@@ -12,7 +12,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import Field, field_validator
+from pydantic import Field, SecretStr, field_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 
@@ -47,7 +47,7 @@ class ServiceSettings(BaseSettings):
     """Configuration of `bearing-twin serve` (env prefix `BEARING_TWIN_`)."""
 
     model_config = SettingsConfigDict(env_prefix="BEARING_TWIN_", extra="ignore",
-                                      validate_default=True)
+                                      validate_default=True, hide_input_in_errors=True)
 
     host: str = Field(default="127.0.0.1",
                       description="HTTP bind address [IP or host name]; loopback only unless set "
@@ -91,6 +91,27 @@ class ServiceSettings(BaseSettings):
         "frame while the zenoh/rerun/HTTP threads run; 0.5 ms keeps the real-time factor at 1).")
     max_twins: int = Field(default=8, ge=1, le=256,
                            description="Most twins one service runs at a time [count].")
+    # ---- hardening (README "Hardening") -------------------------------------------------------
+    token: SecretStr | None = Field(
+        default=None,
+        description="Bearer token [text]: when set, every mutating HTTP request (POST, PUT, DELETE) "
+        "needs `Authorization: Bearer <token>` and every zenoh setpoint a \"token\" field; unset "
+        "(default) = no authentication. Give it in the environment (BEARING_TWIN_TOKEN), not on a "
+        "command line other users can read.")
+    read_requires_token: bool = Field(
+        default=False,
+        description="Also require the token for reads (GET), except GET /health [bool].")
+    setpoint_rate_hz: float = Field(
+        default=50.0, ge=0.0, le=1e6,
+        description="Sustained setpoint rate per twin, HTTP and zenoh together [1/s]; 0 = no limit. "
+        "Beyond it: HTTP 429 with Retry-After, zenoh refusal on the result key.")
+    setpoint_burst: int = Field(
+        default=100, ge=1, le=1_000_000,
+        description="Setpoints a twin accepts in a burst before the rate applies [count].")
+    max_body_bytes: int = Field(
+        default=64 * 1024, ge=256, le=64 * 1024 * 1024,
+        description="Largest HTTP request body (and zenoh setpoint payload) accepted [bytes]; "
+        "larger: 413.")
     scenario_dir: Path | None = Field(
         default=None,
         description="Directory of named scenarios [path]; default ./scenarios if it exists, else "
@@ -100,6 +121,25 @@ class ServiceSettings(BaseSettings):
     @classmethod
     def _endpoints(cls, value):
         return _split_endpoints(value)
+
+    @field_validator("token", mode="before")
+    @classmethod
+    def _token(cls, value):
+        if isinstance(value, SecretStr):
+            value = value.get_secret_value()
+        if value is None:
+            return None
+        if isinstance(value, str):
+            if not value.strip():
+                return None   # BEARING_TWIN_TOKEN="" means no token
+            if any(c.isspace() or not c.isprintable() for c in value):
+                raise ValueError("the token must be printable characters without spaces")
+        return value
+
+    @property
+    def token_value(self) -> str | None:
+        """The token in clear (None when authentication is off)."""
+        return self.token.get_secret_value() if self.token is not None else None
 
     @field_validator("record", mode="before")
     @classmethod

@@ -17,6 +17,7 @@ same validation as HTTP (`service.schemas.parse_setpoint` + the bearing's limits
 from __future__ import annotations
 
 import logging
+import os
 import re
 import sys
 import threading
@@ -29,7 +30,13 @@ from typing import Any
 from pydantic import ValidationError
 
 from service.runner import TwinRunner
-from service.schemas import BearingCreate, FieldError, InputError, field_errors, setpoint_error
+from service.schemas import (
+    BearingCreate,
+    FieldError,
+    InputError,
+    field_errors,
+    setpoint_error,
+)
 from service.settings import ServiceSettings
 from twin import catalog
 from twin.engine import Twin
@@ -38,6 +45,9 @@ from twin.setpoint import SetpointError
 log = logging.getLogger(__name__)
 
 _ID_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
+# per-twin recording paths: relative, plain names (no control characters, spaces, '..', hidden
+# folders), so a request cannot reach outside the recordings directory or trip the file system
+_REC_PATH_RE = re.compile(r"^(?=.{1,256}$)(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/)*[A-Za-z0-9_][A-Za-z0-9_.-]*\.rrd$")
 
 
 class WiringError(RuntimeError):
@@ -232,7 +242,9 @@ class TwinService:
         entry = None
         try:
             twin = self.build_twin(req, bearing_id)
-            runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s)
+            runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s,
+                                token=s.token_value, setpoint_rate_hz=s.setpoint_rate_hz or None,
+                                setpoint_burst=s.setpoint_burst, max_payload_bytes=s.max_body_bytes)
             entry = TwinEntry(id=bearing_id, twin=twin, runner=runner,
                               lubricant=twin.model.spec.lubricant.name)
             if self.bus is not None:
@@ -282,6 +294,10 @@ class TwinService:
         if not path:
             stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
             return base / f"{bearing_id}-{stamp}.rrd"
+        if not _REC_PATH_RE.match(path):
+            raise InputError.one("path", "a recording path is a relative path of letters, digits "
+                                 "and '_', '.', '-' (folders separated by '/', none starting with "
+                                 "'.'), ending in .rrd, at most 256 characters")
         p = Path(path)
         if p.is_absolute() or ".." in p.parts:
             raise InputError.one("path", f"{path!r}: give a path relative to the recordings "
@@ -297,7 +313,13 @@ class TwinService:
         recorder_cls = _recorder_class()
         with self._recording_lock:
             self.stop_recording(entry)
-            rec = recorder_cls(target)
+            if target.exists() and not target.is_file():
+                raise InputError.one("path", f"{str(target)!r} exists and is not a file")
+            try:
+                rec = recorder_cls(target)
+            except (OSError, RuntimeError, ValueError) as exc:   # e.g. a folder that is a file
+                raise InputError.one("path", f"cannot record to {str(target)!r}: "
+                                     f"{' '.join(str(exc).split())[:200]}") from None
             rec.add_twin_from(entry.twin)
             entry.recording, entry.recording_path = rec, target
             entry.runner.add_sink(rec)
@@ -330,4 +352,18 @@ class TwinService:
             "zenoh_listen": list(self.settings.zenoh_listen) if self.bus is not None else [],
             "recording": str(rec.path) if rec is not None and getattr(rec, "path", None) else None,
             "recording_rows": int(getattr(rec, "rows_logged", 0)) if rec is not None else 0,
+            "pid": os.getpid(),
+            "rss_bytes": _own_rss_bytes(),
         }
+
+
+def _own_rss_bytes() -> int | None:
+    """Resident set size of this process from /proc/self/status (None elsewhere)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None

@@ -1,0 +1,78 @@
+"""`bearing-twin soak` (issue 6), the short CI version: 18 s against its own `serve` subprocess
+(free loopback ports, token, recording in a temp dir), then SIGTERM and the recording read back.
+The figures are reported, not judged against wall-clock thresholds (a shared, noisy machine):
+what must hold is no 5xx, no unexpected answer, no lost zenoh result, a finite state stream and
+a complete recording."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from service.settings import ServiceSettings
+from service.soak import SoakConfig, _memory, format_report, run_soak
+
+
+def test_soak_short_run_with_its_own_service(hostile, tmp_path):
+    pytest.importorskip("zenoh")
+    pytest.importorskip("rerun")
+    cmd = [sys.executable, "-m", "service.cli", "soak", "--minutes", "0.3", "--start", "--json",
+           "--seed", "7", "--rate", "12"]
+    proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    assert proc.stdout.strip(), proc.stderr
+    r = json.loads(proc.stdout)
+    detail = json.dumps(r, indent=1) + "\n" + proc.stderr[-3000:]
+    assert r["started_service"] and r["token"] == "generated"
+    sp = r["setpoints"]
+    assert min(sp["http_valid"], sp["http_invalid"], sp["zenoh_valid"], sp["zenoh_invalid"]) > 0, detail
+    assert r["http"]["server_errors"] == 0 and r["http"]["transport_errors"] == 0, detail
+    assert r["unexpected_count"] == 0, detail
+    z = r["zenoh_results"]
+    assert z["unexpected"] == 0 and z["missing"] == 0 and z["received"] == sp["zenoh_valid"] + sp["zenoh_invalid"], detail
+    s = r["stream"]
+    assert s["messages"] > 0 and s["non_finite"] == 0 and s["out_of_order"] == 0, detail
+    # gaps would mean dropped snapshots; loopback at 50 Hz should lose none, but a stalled
+    # shared machine is not this test's subject: allow a sliver, report the figure
+    assert s["dropped_messages"] <= max(2, s["messages"] // 100), detail
+    assert r["runner"]["errors"] == 0, detail
+    m = r["memory"]
+    assert m["samples"] >= 3 and m["baseline_mb"] > 0 and m["growth_pct"] is not None, detail
+    assert r["real_time_factor"]["median"] is not None
+    assert r["shutdown"]["exit_code"] in (0, -15) and not r["shutdown"]["killed"], detail
+    rec = r["recording"]
+    assert rec["complete"] and rec["rows_read"] >= rec["rows_reported"] > 0 and rec["seq_gaps"] == 0, detail
+    assert r.get("service_dir_removed")
+    assert "OK" in format_report(r) or r["failures"], detail
+
+
+def test_soak_against_a_running_service_http_only(hostile, tmp_path):
+    """Without --start: drives an existing service (here an in-process one, no zenoh)."""
+    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, scenario_dir=hostile.SCENARIOS,
+                               token="tok-123")
+    with hostile.ThreadServer(settings) as srv:
+        r = run_soak(SoakConfig(minutes=0.08, url=srv.url, token="tok-123", seed=3, rate_hz=20.0,
+                                sample_s=0.5))
+    assert r["stream"] is None and r["zenoh"] is None
+    assert r["setpoints"]["http_valid"] > 0 and r["setpoints"]["http_invalid"] > 0
+    assert r["http"]["server_errors"] == 0 and r["unexpected_count"] == 0, r["unexpected"]
+    assert r["memory"]["samples"] > 0 and r["memory"]["source"] in ("psutil", "proc")
+    assert "401" in r["http"]["status_counts"] or "413" in r["http"]["status_counts"] or "422" in r["http"]["status_counts"]
+
+
+def test_memory_growth_uses_the_first_sample_after_the_warm_up():
+    mib = 2**20
+    m = _memory([(0.0, 50 * mib), (5.0, 100 * mib), (10.0, 101 * mib), (15.0, 104 * mib), (20.0, 102 * mib)],
+                warmup=5.0, source="proc")
+    assert m["baseline_mb"] == 100.0 and m["final_mb"] == 102.0 and m["growth_pct"] == pytest.approx(2.0)
+    assert _memory([], 5.0, None)["growth_pct"] is None
+
+
+def test_soak_refuses_unbounded_runs():
+    with pytest.raises(ValueError):
+        run_soak(SoakConfig(minutes=float("inf")))
+    proc = subprocess.run([sys.executable, "-m", "service.cli", "soak", "--minutes", "0"],
+                          capture_output=True, text=True, timeout=60)
+    assert proc.returncode == 2 and "--minutes" in proc.stderr
