@@ -95,16 +95,14 @@ def _race_row(spec: BearingSpec, inner: bool, alpha: float, e_prime: float) -> n
         rx = hertz.concave_radius_m(rb, r2x)
     ry = hertz.concave_radius_m(rb, groove)
     k = hertz.ellipticity(rx, ry)
-    ebar = hertz.elliptic_integral_second_kind(rx, ry)
-    r = hertz.curvature_sum_radius_m(rx, ry)
     row[L.R_GROOVE_RADIUS] = groove
     row[L.R_STIFFNESS] = hertz.raceway_stiffness_n_m15(rx, ry, e_prime)
     row[L.R_RX] = rx
     row[L.R_RY] = ry
     row[L.R_K_ELLIPTICITY] = k
-    row[L.R_EBAR] = ebar
-    row[L.R_SEMI_MAJOR_COEF] = (6.0 * k * k * ebar * r / (math.pi * e_prime)) ** (1.0 / 3.0)
-    row[L.R_SEMI_MINOR_COEF] = (6.0 * ebar * r / (math.pi * k * e_prime)) ** (1.0 / 3.0)
+    # semi-axes grow as Q^(1/3): the law at Q = 1 N is the coefficient
+    row[L.R_SEMI_MAJOR_COEF] = hertz.semi_major_axis_m(1.0, rx, ry, e_prime)
+    row[L.R_SEMI_MINOR_COEF] = hertz.semi_minor_axis_m(1.0, rx, ry, e_prime)
     return row
 
 
@@ -157,7 +155,6 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_ROLLING] = 1.0 if options.rolling_resistance else 0.0
     p[L.P_BALL_REDUCED_TANGENT_MASS] = ball_mass / (1.0 + ball_mass * rb * rb / ball_inertia)
     p[L.P_MAX_PENETRATION] = 0.01 * rb
-    p[L.P_BALL_PITCH_SPRING] = 1e3
     el = spec.electrical
     p[L.P_OIL_PERMITTIVITY] = el.oil_relative_permittivity
     p[L.P_GAP_LIMIT] = el.outer_gap_limit_m

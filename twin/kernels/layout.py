@@ -25,12 +25,11 @@ P_SUBSTEPS = 19
 P_ROLLING = 20             # 1: seed 001 rolling resistance on
 P_BALL_REDUCED_TANGENT_MASS = 21  # m / (1 + m Rb^2 / I) [kg]
 P_MAX_PENETRATION = 22     # status threshold [m]
-P_BALL_PITCH_SPRING = 23   # unused by dynamics (warm start regularisation) [N/m]
-P_OIL_PERMITTIVITY = 24    # relative permittivity of the oil at ambient pressure [-]
-P_GAP_LIMIT = 25           # outer-zone capacitance integration limit [m]
-P_ASPERITY_RESISTANCE = 26 # resistance of a fully metallic contact [ohm]
-P_OIL_RESISTIVITY = 27     # [ohm m]
-N_PARAMS = 28
+P_OIL_PERMITTIVITY = 23    # relative permittivity of the oil at ambient pressure [-]
+P_GAP_LIMIT = 24           # outer-zone capacitance integration limit [m]
+P_ASPERITY_RESISTANCE = 25 # resistance of a fully metallic contact [ohm]
+P_OIL_RESISTIVITY = 26     # [ohm m]
+N_PARAMS = 27
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]
@@ -40,10 +39,9 @@ R_STIFFNESS = 3             # Hertz K [N/m^1.5]
 R_RX = 4
 R_RY = 5
 R_K_ELLIPTICITY = 6
-R_EBAR = 7
-R_SEMI_MAJOR_COEF = 8       # a = coef * Q^(1/3)
-R_SEMI_MINOR_COEF = 9       # b = coef * Q^(1/3)
-N_RACE_PARAMS = 10
+R_SEMI_MAJOR_COEF = 7       # a = coef * Q^(1/3)
+R_SEMI_MINOR_COEF = 8       # b = coef * Q^(1/3)
+N_RACE_PARAMS = 9
 
 # ---- setpoint vector (what the kernel needs of the current setpoint) ------------------------
 S_SHAFT_SPEED = 0     # target [rad/s]
