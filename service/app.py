@@ -295,7 +295,8 @@ def create_app(settings: ServiceSettings | None = None) -> FastAPI:
                 raise InputError.one("run", f"scenario {scenario.name!r} has no run {body.run!r}",
                                      [r.id for r in runs])
             run = matching[0]
-        run.check_twin(entry.designation, entry.diametral_clearance_m, entry.lubricant)
+        run.check_twin(entry.designation, entry.diametral_clearance_m, entry.lubricant,
+                       entry.twin.model.spec.thermal)
         _handle, replaced = entry.runner.start_scenario(run, restart=body.restart)
         return ScenarioAccepted(accepted=True, bearing_id=entry.id, name=scenario.name, run=run.id,
                                 expected_duration_s=run.duration_s, mode=entry.runner.mode,

@@ -142,7 +142,7 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
             bearing_id = scenario.name if len(runs) == 1 else run.id
             lubricant = catalog.lubricant(run.lubricant)
             spec = catalog.bearing(run.bearing, diametral_clearance_m=run.diametral_clearance_m,
-                                   lubricant=lubricant)
+                                   lubricant=lubricant, **({"thermal": run.thermal} if run.thermal else {}))
             twin = Twin(spec, setpoint=run.initial_setpoint(), bearing_id=bearing_id)
             run.check_limits(twin.limits, where=f"runs[{run.index}]." if len(runs) > 1 else "")
             runner = TwinRunner(twin, fast=True, publish_rate_hz=1.0 / run.sample_every_s,

@@ -192,7 +192,9 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
     """Run every study (with a progress bar) and write `report.md` and PNGs into out_dir."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 4
+    from service import report_ev
+
+    total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 4 + report_ev.study_count(quick)
     with tqdm(total=total, desc="bearing-twin report", unit="study") as progress:
         az_png, az = _fig_azimuth(out, quick)
         progress.update(1)
@@ -211,6 +213,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
         progress.update(1)
         s1_png, s1_rows = _fig_seed001(out)
         progress.update(1)
+        ev_md = report_ev.write_ev_section(out, quick, progress)
         bench = run_engine_benchmark(seconds=0.05 if quick else 0.2, repeats=3)
         progress.update(1)
 
@@ -248,6 +251,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
            "(3 mm, 0.633 N) the transition force is within 30 % from 120 to 210 rpm and under-predicts by "
            "30-40 % at 60-90 rpm, where the seed's own fits (n = 0.12-0.28) depart from the laws' "
            "omega^0.7 trend.\n",
+           *ev_md,
            "## Engine speed\n",
            f"`bearing-twin bench`: real-time factor {bench['real_time_factor']:.2f} (best of {bench['repeats']}), "
            f"{bench['ns_per_step']:.0f} ns per step at dt = 1 us.\n"]

@@ -54,6 +54,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_valida
 
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointUpdate
+from twin.spec import Thermal
 
 SCENARIO_SCHEMA = "bearing-twin/scenario/1"
 
@@ -204,6 +205,7 @@ class Scenario(BaseModel):
     bearing: str = Field(default="6208", max_length=32, description="Catalog designation [text].")
     diametral_clearance_m: float = Field(default=0.0, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload.")
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
+    thermal: Thermal | None = Field(default=None, description="Electro-thermal options of the bearing (twin.spec.Thermal: shear / current heating, R_b, H_c; units in each field); default: the spec's.")
     initial: SetpointUpdate = Field(default_factory=SetpointUpdate, description="Setpoint applied at t = 0 (fields with units).")
     duration_s: float = Field(gt=0.0, le=3600.0, description="Scenario length [s of simulated time].")
     sample_every_s: float = Field(default=0.001, ge=1e-5, le=10.0, description="Sample period of the table and recording [s of simulated time].")
@@ -254,7 +256,7 @@ class Scenario(BaseModel):
         if not self.runs:
             return [ResolvedRun(scenario=self.name, index=0, id="run0", label=self.name,
                                 bearing=self.bearing, diametral_clearance_m=self.diametral_clearance_m,
-                                lubricant=self.lubricant, initial=self.initial,
+                                lubricant=self.lubricant, initial=self.initial, thermal=self.thermal,
                                 steps=_drop_empty_steps(self.steps), duration_s=self.duration_s,
                                 sample_every_s=self.sample_every_s, explicit=top)]
         out = []
@@ -268,7 +270,7 @@ class Scenario(BaseModel):
                 bearing=run.bearing or self.bearing,
                 diametral_clearance_m=(self.diametral_clearance_m if run.diametral_clearance_m is None
                                        else run.diametral_clearance_m),
-                lubricant=run.lubricant or self.lubricant, initial=initial,
+                lubricant=run.lubricant or self.lubricant, initial=initial, thermal=self.thermal,
                 steps=_drop_empty_steps(run.steps if run.steps is not None else self.steps),
                 duration_s=run.duration_s or self.duration_s, sample_every_s=self.sample_every_s,
                 explicit=top | frozenset(k for k in ("bearing", "diametral_clearance_m", "lubricant")
@@ -312,10 +314,12 @@ class ResolvedRun:
     duration_s: float
     sample_every_s: float
     explicit: frozenset[str] = frozenset()   # which of bearing / clearance / lubricant were written
+    thermal: Thermal | None = None           # electro-thermal options (None: the spec's defaults)
 
-    def check_twin(self, designation: str, diametral_clearance_m: float, lubricant: str) -> None:
-        """Raise ScenarioError if the run asks for another bearing, mounting or lubricant than a
-        running twin has (those are fixed when a twin is created)."""
+    def check_twin(self, designation: str, diametral_clearance_m: float, lubricant: str,
+                   thermal: Thermal | None = None) -> None:
+        """Raise ScenarioError if the run asks for another bearing, mounting, lubricant or
+        electro-thermal options than a running twin has (those are fixed when a twin is created)."""
         wanted = {"bearing": (self.bearing, designation),
                   "diametral_clearance_m": (self.diametral_clearance_m, diametral_clearance_m),
                   "lubricant": (catalog.lubricant(self.lubricant).name, lubricant)}
@@ -329,6 +333,12 @@ class ResolvedRun:
                     name, f"run {self.id!r} of scenario {self.scenario!r} needs {name} = {want!r}, "
                     f"this twin has {have!r}: create a twin with it (POST /v1/bearings) or run the "
                     f"scenario offline (bearing-twin scenario run)", [want])
+        if self.thermal is not None and thermal is not None and self.thermal != thermal:
+            raise ScenarioError(
+                "thermal", f"run {self.id!r} of scenario {self.scenario!r} needs thermal = "
+                f"{self.thermal.model_dump()}, this twin has {thermal.model_dump()}: create a twin with it "
+                f"(POST /v1/bearings with 'thermal') or run the scenario offline (bearing-twin scenario run)",
+                [self.thermal.model_dump()])
 
     def initial_setpoint(self, base: Setpoint | None = None) -> Setpoint:
         """The complete setpoint at t = 0 (initial merged over `base` or the defaults)."""

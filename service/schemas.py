@@ -15,6 +15,7 @@ from pydantic import BaseModel, ConfigDict, Field, ValidationError
 from twin.setpoint import _UNITS as SETPOINT_UNITS
 from twin.setpoint import SetpointError, SetpointUpdate
 from twin.snapshot import SetpointState
+from twin.spec import Thermal
 
 ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
 _STRICT = ConfigDict(extra="forbid", allow_inf_nan=False)
@@ -187,6 +188,7 @@ class BearingCreate(BaseModel):
     diametral_clearance_m: float = Field(default=0.0, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload (seed 000: +-12.6e-6 m).")
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' (0.04 Pa s at 40 degC) or an ISO grade such as 'ISO VG 68' [text].")
     setpoint: SetpointUpdate | None = Field(default=None, description="Initial setpoint (partial, defaults for the rest); the twin is warm-started at it [fields with units].")
+    thermal: Thermal | None = Field(default=None, description="Electro-thermal options (seed 003): shear_heating, current_heating, equivalent_resistance_ohm [ohm], crater_depth_m [m], ...; default: the spec's (shear heating off).")
 
 
 class ScenarioStatus(BaseModel):

@@ -80,7 +80,11 @@ def open_recorder(settings: ServiceSettings):
     path = settings.recording_path
     if path is None and not settings.spawn_viewer:
         return None
-    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer)
+    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer,
+                             flush_interval_s=settings.record_flush_interval_s,
+                             segment_s=settings.record_segment_s or None,
+                             segment_bytes=round(settings.record_segment_mb * 1e6) or None,
+                             write_footer=settings.record_footer)
 
 
 @dataclass
@@ -207,7 +211,7 @@ class TwinService:
             raise InputError.one("lubricant", str(exc).removeprefix("lubricant: ")) from None
         try:
             spec = catalog.bearing(designation, diametral_clearance_m=req.diametral_clearance_m,
-                                   lubricant=lubricant)
+                                   lubricant=lubricant, **({"thermal": req.thermal} if req.thermal else {}))
         except ValidationError as exc:
             raise InputError(field_errors(exc.errors())) from None
         try:

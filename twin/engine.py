@@ -16,7 +16,10 @@ from twin.kernels.step import evaluate, step_n
 from twin.model import BearingModel, make_model
 from twin.physics.friction import REGIME_NAMES
 from twin.physics.hertz import max_pressure_pa
-from twin.physics.thermal import MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k, roelands_temperature_viscosity_pa_s
+from twin.kernels.tribology import T_HMIN_EXP_EU
+from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k,
+                                  inlet_shear_heating_temperature_rise_k, roelands_temperature_viscosity_pa_s,
+                                  thermal_film_factor)
 from twin.physics.viscosity import dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.setpoint import Setpoint, SetpointUpdate, check_limits
 from twin.electrical import bearing_network
@@ -28,6 +31,7 @@ from twin.warmstart import warm_start
 
 FRAME_STEPS = 1000  # steps per compiled call (1 ms of simulated time at dt = 1 us)
 RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
+MIN_FILM_THERMAL_FACTOR = 1e-4  # floor of the thermal film factor [-]
 COUPLING_FRAMES = 10  # electro-thermal coupling refreshed every 10 frames (10 ms at 1 ms frames)
 
 
@@ -108,24 +112,50 @@ class Twin:
 
     # ---- electro-thermal coupling (seed 003) ------------------------------------------------
     def _update_inlet_viscosity(self, force: bool = False) -> None:
-        """Inlet viscosity = oil viscosity at the oil temperature raised by the current-discharge
-        heating of the race track (seed 003 eq. 10 with the bearing's resistance), through
-        Roelands' temperature law (seed 003 eq. 3). Recomputed every COUPLING_FRAMES frames while a
-        current flows (the network is a bearing-level quantity that changes slowly)."""
-        sp = self._setpoint
-        th = self.model.spec.thermal
+        """Electro-thermal film loss (seed 003): the inlet is heated by the current discharge of the
+        race track (eq. 10, with the bearing's equivalent resistance) and by shear (eq. 6 at the
+        inlet); the film the loop computes is the isothermal film at the oil temperature times
+        the thermal film factor g(dT)^c_T calibrated against the thermal EHL solver
+        (twin.thermal_calibration). The factor enters the kernel through the one viscosity it
+        reads: eta_film = eta_oil * factor^(1 / n_u), n_u the film law's exponent of (eta u), so
+        film, Lambda, regime, mu and fluid damping all follow. Recomputed every COUPLING_FRAMES
+        frames (the drivers change slowly)."""
         self._frames_since_coupling = getattr(self, "_frames_since_coupling", 0) + 1
         if not force and self._frames_since_coupling < COUPLING_FRAMES:
             return
         self._frames_since_coupling = 0
-        rise = 0.0
-        if sp.shaft_current_a > 0.0 and th.current_heating and hasattr(self, "state"):
-            rise = self.current_heating_k()
-        self._current_heating_k = rise
+        sp = self._setpoint
+        th = self.model.spec.thermal
+        have_state = hasattr(self, "state")
+        current_rise = 0.0
+        if sp.shaft_current_a > 0.0 and th.current_heating and have_state:
+            current_rise = self.current_heating_k()
         theta0 = sp.oil_temperature_c + 273.15
-        eta = (roelands_temperature_viscosity_pa_s(self._oil_viscosity_pa_s, theta0, theta0 + rise,
-                                                   self._oil_beta_k_inv) if rise > 0.0 else self._oil_viscosity_pa_s)
-        self._setpoint_vector[L.S_VISCOSITY] = eta
+        eta0, beta = self._oil_viscosity_pa_s, self._oil_beta_k_inv
+        shear_rise = 0.0
+        if th.shear_heating and have_state:
+            shear_rise = inlet_shear_heating_temperature_rise_k(
+                self.mean_entrainment_speed_m_s(), eta0, theta0, beta, th.oil_thermal_conductivity_w_m_k,
+                other_rise_k=current_rise, shear_factor=th.inlet_shear_heating_factor)
+        rise = current_rise + shear_rise
+        factor = 1.0
+        if rise > 0.0:  # floored: below 1e-4 of the isothermal film there is no film to speak of
+            factor = max(MIN_FILM_THERMAL_FACTOR, thermal_film_factor(rise, eta0, theta0, beta, th.film_temperature_exponent))
+        self._current_heating_k = current_rise
+        self._shear_heating_k = shear_rise
+        self._film_thermal_factor = factor
+        self._inlet_viscosity_pa_s = (roelands_temperature_viscosity_pa_s(eta0, theta0, theta0 + rise, beta)
+                                      if rise > 0.0 else eta0)
+        speed_exponent = float(self.model.race_tribology[0, T_HMIN_EXP_EU])  # d ln h / d ln(eta u)
+        self._setpoint_vector[L.S_VISCOSITY] = eta0 * factor ** (1.0 / speed_exponent)
+
+    def mean_entrainment_speed_m_s(self) -> float:
+        """Mean entrainment speed of the loaded inner-race contacts (all inner contacts if none
+        is loaded) [m/s]."""
+        c = self.state.contacts
+        u = c[L.C_ENTRAINMENT, 0::2]
+        loaded = c[L.C_LOAD, 0::2] > 0.0
+        return float(np.mean(np.abs(u[loaded] if loaded.any() else u)))
 
     def current_heating_k(self) -> float:
         """Race-track temperature rise from the shaft current (seed 003 eq. 10) [K]."""
@@ -287,12 +317,16 @@ class Twin:
             cage_speed_rad_s=float(s.scalars[L.X_CAGE_SPEED]),
             inner_ring_displacement_m=tuple(float(a) for a in s.ring_position_m),
             friction_torque_n_m=float(self._last_torque_n_m),
-            viscosity_pa_s=float(self._setpoint_vector[L.S_VISCOSITY]),
+            viscosity_pa_s=float(self._inlet_viscosity_pa_s),
             electrical=ElectricalSnapshot(
                 resistance_ohm=_finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,
                 impedance_ohm=net.impedance_ohm, phase_rad=net.phase_rad,
                 frequency_hz=net.frequency_hz, shaft_voltage_v=net.shaft_voltage_v,
                 shaft_current_a=net.shaft_current_a, max_film_field_v_m=net.max_film_field_v_m,
                 current_density_a_m2=net.current_density_a_m2, discharge_risk=net.discharge_risk,
-                reason=net.reason, contact_temperature_rise_k=float(self._current_heating_k)),
+                reason=net.reason,
+                contact_temperature_rise_k=float(self._current_heating_k + self._shear_heating_k),
+                current_temperature_rise_k=float(self._current_heating_k),
+                shear_temperature_rise_k=float(self._shear_heating_k),
+                film_thermal_factor=float(self._film_thermal_factor)),
             balls=balls)

@@ -63,7 +63,10 @@ class ElectricalState(BaseModel):
     current_density_a_m2: float = Field(description="Largest apparent current density over a loaded contact area [A/m^2].")
     discharge_risk: Literal["none", "possible", "likely"] = Field(description="Electrical discharge risk.")
     reason: str = Field(description="Why the risk is what it is.")
-    contact_temperature_rise_k: float = Field(description="Race-track temperature rise from the current (seed 003 eq. 10), fed into the inlet viscosity [K].")
+    contact_temperature_rise_k: float = Field(description="Inlet temperature rise above the oil temperature: current + shear heating, fed into the film [K].")
+    current_temperature_rise_k: float = Field(default=0.0, description="Race-track temperature rise from the current discharge (seed 003 eq. 10) [K].")
+    shear_temperature_rise_k: float = Field(default=0.0, description="Inlet shear-heating temperature rise (seed 003 eq. 6 at the inlet; 0 when shear heating is off) [K].")
+    film_thermal_factor: float = Field(default=1.0, description="Film thickness / isothermal film thickness from the heating (1: none) [-].")
 
 
 class SetpointState(BaseModel):
@@ -96,7 +99,7 @@ class Snapshot(BaseModel):
     cage_speed_rad_s: float = Field(description="Cage angular speed [rad/s].")
     inner_ring_displacement_m: tuple[float, float, float] = Field(description="Inner ring centre (x along the radial load, y, z axial) [m].")
     friction_torque_n_m: float = Field(description="Torque the shaft supplies to the bearing, averaged over the last frame [N m].")
-    viscosity_pa_s: float = Field(description="Inlet viscosity used by the film: oil at the oil temperature plus the current heating [Pa s].")
+    viscosity_pa_s: float = Field(description="Inlet viscosity: the oil at the oil temperature plus the inlet's current and shear heating (Roelands, seed 003 eq. 3) [Pa s].")
     electrical: ElectricalState
     balls: tuple[BallState, ...]
 

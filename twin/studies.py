@@ -100,3 +100,59 @@ def lambda_over_revolution(shaft_speed_rad_s: float = 500.0, radial_load_n: floa
 def log_slope(x, y) -> float:
     """Least-squares slope of ln y against ln x."""
     return float(np.polyfit(np.log(np.asarray(x)), np.log(np.asarray(y)), 1)[0])
+
+
+# ---- seed 003: the EV motor bearing under shaft current --------------------------------------
+EV_BEARING = "6200"          # the catalog bearing whose speed limit covers seed 003's 50 000 rpm
+EV_RADIAL_LOAD_N = 200.0
+EV_SETTLE_S = 0.02
+
+
+@dataclass(frozen=True)
+class EVSample:
+    """Electro-thermal state of the EV twin at one operating point (inner contact of the ball
+    nearest azimuth 0), SI units."""
+
+    shaft_speed_rpm: float
+    shaft_current_a: float
+    oil_temperature_c: float
+    equivalent_resistance_ohm: float | None
+    h_min_inner_m: float
+    lambda_inner: float
+    current_temperature_rise_k: float
+    shear_temperature_rise_k: float
+    film_thermal_factor: float
+    bearing_capacitance_f: float
+    current_density_a_m2: float
+    discharge_risk: str
+
+
+def ev_operating_point(shaft_current_a: float, shaft_speed_rpm: float, *, oil_temperature_c: float = 40.0,
+                       equivalent_resistance_ohm: float | None = None, shear_heating: bool = True,
+                       radial_load_n: float = EV_RADIAL_LOAD_N, settle_s: float = EV_SETTLE_S):
+    """Seed 003's EV case on the 6200 twin (seed-000 oil, shear and current heating on unless
+    told otherwise): warm start at the operating point, settle, return (EVSample, snapshot)."""
+    from twin import catalog
+    from twin.spec import BearingSpec, Thermal
+
+    fields = {"shear_heating": shear_heating}
+    if equivalent_resistance_ohm is not None:
+        fields["equivalent_resistance_ohm"] = equivalent_resistance_ohm
+    base = catalog.bearing(EV_BEARING)
+    spec = BearingSpec.model_validate({**base.model_dump(), "thermal": Thermal(**fields).model_dump()})
+    twin = Twin(spec, setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rpm * math.pi / 30.0,
+                                        radial_load_n=radial_load_n, shaft_current_a=shaft_current_a,
+                                        oil_temperature_c=oil_temperature_c))
+    twin.advance(settle_s)
+    snap = twin.snapshot()
+    ball = min(snap.balls, key=lambda b: abs(b.azimuth_rad))
+    e = snap.electrical
+    sample = EVSample(
+        shaft_speed_rpm=shaft_speed_rpm, shaft_current_a=shaft_current_a, oil_temperature_c=oil_temperature_c,
+        equivalent_resistance_ohm=spec.thermal.equivalent_resistance_ohm, h_min_inner_m=ball.inner.h_min_m,
+        lambda_inner=ball.inner.lambda_ if ball.inner.lambda_ is not None else 0.0,
+        current_temperature_rise_k=e.current_temperature_rise_k,
+        shear_temperature_rise_k=e.shear_temperature_rise_k, film_thermal_factor=e.film_thermal_factor,
+        bearing_capacitance_f=e.capacitance_f, current_density_a_m2=e.current_density_a_m2,
+        discharge_risk=e.discharge_risk)
+    return sample, snap

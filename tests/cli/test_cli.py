@@ -39,7 +39,11 @@ def test_report_quick(tmp_path):
     assert res.returncode == 0, res.stderr
     text = (tmp_path / "report.md").read_text()
     for png in ("lambda_azimuth_500.png", "lambda_speed.png", "lambda_load.png", "lambda_clearance.png",
-                "startup.png", "seed001_torque.png"):
+                "startup.png", "seed001_torque.png", "seed003_reduction.png", "seed003_fig7_speed.png",
+                "seed003_temperature_resistance.png"):
         assert (tmp_path / png).stat().st_size > 10_000
         assert png in text
     assert "0.6797" in text and "-0.0727" in text
+    # the EV section (seed 003): Figs. 2/4 band, Fig. 7's thickest-film speed rising with current
+    assert "## EV motor bearing under shaft current (seed 003)" in text
+    assert "57.6-84.8 %" in text and "speed of the thickest film" in text

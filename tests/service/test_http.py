@@ -217,11 +217,38 @@ def test_create_two_twins_duplicate_and_delete(client):
     ({"setpoint": {"shaft_speed_rad_s": 5000.0}}, "setpoint.shaft_speed_rad_s"),
     ({"setpoint": {"radial_load_n": float("-1")}}, "setpoint.radial_load_n"),
     ({"colour": "red"}, "colour"),
+    ({"thermal": {"equivalent_resistance_ohm": -1.0}}, "thermal.equivalent_resistance_ohm"),
+    ({"thermal": {"crater_depth_m": 0.0}}, "thermal.crater_depth_m"),
+    ({"thermal": {"shear_heating": "maybe"}}, "thermal.shear_heating"),
 ])
 def test_invalid_creation_is_422(client, body, field):
     r = client.post("/v1/bearings", json=body)
     assert r.status_code == 422, r.text
     assert detail(r)[0]["field"] == field
+
+
+def test_ev_twin_with_shear_and_current_heating(client):
+    # seed 003: a 6200 created with shear heating on, driven at 20 000 rpm and 10 A, publishes the
+    # inlet heating and a thinner film than the isothermal film (factor < 1)
+    r = client.post("/v1/bearings", json={
+        "id": "ev", "designation": "6200", "lubricant": "ISO VG 32", "thermal": {"shear_heating": True},
+        "setpoint": {"shaft_speed_rad_s": 2094.4, "radial_load_n": 300.0, "shaft_current_a": 10.0}})
+    assert r.status_code == 201, r.text
+    try:
+        state = wait_for(lambda: client.get("/v1/bearings/ev/state").json(),
+                         lambda s: s["electrical"]["shear_temperature_rise_k"] > 0.0)
+        e = state["electrical"]
+        assert e["current_temperature_rise_k"] > 0.0 and 0.0 < e["film_thermal_factor"] < 1.0
+        # the EV scenario's thermal options match this twin: accepted
+        ok = client.post("/v1/bearings/ev/scenario", json={"name": "ev_motor_current_ramp"})
+        assert ok.status_code == 202, ok.text
+        # a scenario for an isothermal twin of the same bearing is refused by 'thermal'
+        inline = {"name": "cold", "bearing": "6200", "lubricant": "ISO VG 32", "duration_s": 0.01,
+                  "thermal": {"shear_heating": False}}
+        bad = client.post("/v1/bearings/ev/scenario", json={"scenario": inline})
+        assert bad.status_code == 422 and detail(bad)[0]["field"] == "thermal", bad.text
+    finally:
+        client.delete("/v1/bearings/ev")
 
 
 def test_scenarios(client):

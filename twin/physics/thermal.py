@@ -61,3 +61,58 @@ def shear_heating_temperature_rise_k(entrainment_speed_m_s: float, inlet_tempera
     num = u * inlet_temperature_k * thermal_expansion_k_inv * h * pressure_pa + 2.0 * half_width_m * viscosity_pa_s * u * u / h
     den = half_width_m * conductivity_w_m_k / h - u * thermal_expansion_k_inv * h * pressure_pa
     return num / den if den > 0.0 else math.inf
+
+
+def hamrock_dowson_temperature_film_ratio(temperature_rise_k: float, eta0_pa_s: float, theta0_k: float,
+                                          beta_k_inv: float) -> float:
+    """g = (eta(T)/eta0)^0.68 (alpha*(T)/alpha)^0.49: the Hamrock-Dowson film ratio for a uniform
+    temperature rise of the inlet, with Roelands (seed 003 eq. 3) at ambient pressure:
+    ln(eta/eta0) = (ln eta0 + 9.67)(f - 1) and alpha*(T) = alpha f, f = ((T - 138)/(T0 - 138))^-S0."""
+    if temperature_rise_k <= 0.0:
+        return 1.0
+    lnk = math.log(eta0_pa_s) + ROELANDS_LN_ETA_INF
+    s0 = beta_k_inv * (theta0_k - ROELANDS_T_K) / lnk
+    f = ((theta0_k + temperature_rise_k - ROELANDS_T_K) / (theta0_k - ROELANDS_T_K)) ** (-s0)
+    return math.exp(0.68 * lnk * (f - 1.0)) * f ** 0.49
+
+
+def inlet_shear_heating_temperature_rise_k(entrainment_speed_m_s: float, eta0_pa_s: float, theta0_k: float,
+                                           beta_k_inv: float, conductivity_w_m_k: float,
+                                           other_rise_k: float = 0.0, shear_factor: float = 1.0,
+                                           max_rise_k: float = 500.0) -> float:
+    """Shear-heating temperature rise of the inlet, where the film is formed: seed 003 eq. 6 at
+    the inlet (p -> 0: the compression term vanishes and eq. 6 reduces to dT = 2 eta u^2 / k'),
+    with eta the Roelands viscosity (eq. 3) at the heated inlet temperature theta0 + other_rise +
+    dT (self-consistent: a hotter oil shears with less heat), times `shear_factor` (calibrated
+    against the full EHL solver, twin.thermal_calibration). Solved by bisection (the right-hand
+    side falls as dT rises, so the root is unique) [K]."""
+    u = entrainment_speed_m_s
+    if u <= 0.0 or shear_factor <= 0.0:
+        return 0.0
+    coef = 2.0 * shear_factor * u * u / conductivity_w_m_k
+
+    def excess(rise: float) -> float:
+        eta = roelands_temperature_viscosity_pa_s(eta0_pa_s, theta0_k, theta0_k + other_rise_k + rise, beta_k_inv)
+        return coef * eta - rise
+
+    lo, hi = 0.0, max_rise_k
+    if excess(hi) > 0.0:
+        return max_rise_k
+    for _ in range(60):
+        mid = 0.5 * (lo + hi)
+        if excess(mid) > 0.0:
+            lo = mid
+        else:
+            hi = mid
+        if hi - lo < 1e-4:
+            break
+    return 0.5 * (lo + hi)
+
+
+def thermal_film_factor(temperature_rise_k: float, eta0_pa_s: float, theta0_k: float, beta_k_inv: float,
+                        temperature_exponent: float) -> float:
+    """Film-reduction factor h(heated inlet) / h(isothermal) = g(dT)^c: the Hamrock-Dowson film
+    ratio of a uniform inlet temperature rise (hamrock_dowson_temperature_film_ratio) raised to
+    the exponent c that the full thermal EHL solver of seed 003 gives (twin.thermal_calibration:
+    the solver's films fall faster with temperature than the isothermal formula's, c > 1)."""
+    return hamrock_dowson_temperature_film_ratio(temperature_rise_k, eta0_pa_s, theta0_k, beta_k_inv) ** temperature_exponent
