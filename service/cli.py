@@ -77,7 +77,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         print(json.dumps(result))
     else:
         print(f"{result['bearing']} at {result['radial_load_n']:.0f} N, {result['shaft_speed_rad_s']:.0f} rad/s, "
-              f"dt = {result['time_step_s'] * 1e6:.1f} us, full model")
+              f"dt = {result['time_step_s'] * 1e6:.1f} us, full model ({result['shaft_current_a']:g} A shaft current, "
+              f"shear heating {'on' if result['shear_heating'] else 'off'})")
         print(f"  real-time factor (best of {result['repeats']}): {result['real_time_factor']:.3f}")
         print(f"  real-time factor (median): {result['real_time_factor_median']:.3f}")
         print(f"  ns per step (best): {result['ns_per_step']:.0f}")
