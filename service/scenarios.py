@@ -7,6 +7,7 @@ Format (schema "bearing-twin/scenario/1"; all times are SIMULATED seconds from t
     bearing: "6208"                          # catalog designation (default 6208)
     diametral_clearance_m: 0.0               # mounting [m], negative = preload (default 0)
     lubricant: seed-000                      # 'seed-000' or 'ISO VG n' (default seed-000)
+    thermal: {shear_heating: true}           # electro-thermal options (twin.spec.Thermal; optional)
     initial:                                 # setpoint at t = 0 (partial; unset fields keep
       shaft_speed_rad_s: 0.0                 #   the twin's value, or the defaults for a fresh twin)
       radial_load_n: 3000.0
@@ -20,26 +21,24 @@ Format (schema "bearing-twin/scenario/1"; all times are SIMULATED seconds from t
       - at_s: 0.25
         set: {radial_load_n: 5000.0}         # a step change (partial setpoint)
     runs:                                    # optional: several runs of the same timeline,
-      - id: pd_minus_12_6um                  #   each with its own mounting / bearing /
-        label: "Pd = -12.6 um"               #   lubricant / initial / steps / duration_s
+      - id: pd_minus_12_6um                  #   each with its own mounting / bearing / lubricant /
+        label: "Pd = -12.6 um"               #   thermal / initial / steps / duration_s
         diametral_clearance_m: -12.6e-6
 
 Rules:
 
 * every step has exactly one of `set` or `ramp`; a ramp needs `over_s` > 0 and must end by
   `duration_s`; `at_s` is non-decreasing and below `duration_s`;
-* setpoint fields are those of `twin.setpoint.SetpointUpdate` (units in the names). Fields of the
-  public contract that this engine does not take yet (`shaft_current_a`, `shaft_voltage_v` until
-  the electrical issue lands) are SKIPPED with a warning naming where they were (the scenario
-  still runs with the rest); any other unknown field is an error;
+* setpoint fields are those of `twin.setpoint.SetpointUpdate` (units in the names); an unknown
+  field is an error;
 * values are checked against the bearing's limits before anything runs (`check_limits`), so an
   out-of-range step is refused with its position, field and the allowed range;
 * the engine's own shaft acceleration limit (ModelOptions.speed_ramp_rad_s2, 5000 rad/s^2 by
   default) still applies: a speed ramp faster than that lags behind its setpoint.
 
 A twin in a service runs one run of a scenario at a time (`POST /v1/bearings/{id}/scenario`): the
-runs must not change the twin's bearing, mounting or lubricant (those are fixed when a twin is
-created); `bearing-twin scenario run FILE` creates a fresh twin for every run.
+runs must not change the twin's bearing, mounting, lubricant or thermal options (those are fixed
+when a twin is created); `bearing-twin scenario run FILE` creates a fresh twin for every run.
 """
 
 from __future__ import annotations
@@ -120,6 +119,7 @@ class ScenarioRun(BaseModel):
     bearing: str | None = Field(default=None, max_length=32, description="Catalog designation [text].")
     diametral_clearance_m: float | None = Field(default=None, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload.")
     lubricant: str | None = Field(default=None, max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
+    thermal: Thermal | None = Field(default=None, description="Electro-thermal options replacing the scenario's (twin.spec.Thermal, units in each field).")
     initial: SetpointUpdate | None = Field(default=None, description="Initial setpoint, merged over the scenario's (fields with units).")
     steps: list[ScenarioStep] | None = Field(default=None, description="Steps replacing the scenario's.")
     duration_s: float | None = Field(default=None, gt=0.0, le=3600.0, description="Run length [s of simulated time].")
@@ -270,7 +270,8 @@ class Scenario(BaseModel):
                 bearing=run.bearing or self.bearing,
                 diametral_clearance_m=(self.diametral_clearance_m if run.diametral_clearance_m is None
                                        else run.diametral_clearance_m),
-                lubricant=run.lubricant or self.lubricant, initial=initial, thermal=self.thermal,
+                lubricant=run.lubricant or self.lubricant, initial=initial,
+                thermal=run.thermal if run.thermal is not None else self.thermal,
                 steps=_drop_empty_steps(run.steps if run.steps is not None else self.steps),
                 duration_s=run.duration_s or self.duration_s, sample_every_s=self.sample_every_s,
                 explicit=top | frozenset(k for k in ("bearing", "diametral_clearance_m", "lubricant")

@@ -34,7 +34,7 @@ def base(**kw):
 def test_shipped_scenarios_load():
     found = list_scenarios(SCENARIOS)
     for name in ("seed000_startup_steady_slowdown", "seed000_load_sweep", "seed000_clearance_sweep",
-                 "seed000_speed_sweep", "ev_motor_current_ramp"):
+                 "seed000_speed_sweep", "ev_motor_current_ramp", "ev_motor_resistance_temperature"):
         assert name in found
         scenario = load_scenario(found[name])
         assert scenario.name == name
@@ -58,7 +58,7 @@ def test_seed000_contents():
     assert all(r.initial.radial_load_n == 3000.0 and r.initial.shaft_speed_rad_s == 500.0 for r in runs)
 
 
-def test_ev_scenario_fits_its_bearing_and_skips_the_current_until_the_electrical_issue():
+def test_ev_scenario_fits_its_bearing_and_drives_the_current():
     s = load_scenario(SCENARIOS / "ev_motor_current_ramp.yaml")
     run = s.resolved_runs()[0]
     speeds = [v for _, f, v in run.iter_values() if f == "shaft_speed_rad_s"]
@@ -68,10 +68,39 @@ def test_ev_scenario_fits_its_bearing_and_skips_the_current_until_the_electrical
     with pytest.raises(ScenarioError) as exc:
         run.check_limits(Twin("6208", warm=False).limits)         # the 6208 does not
     assert "shaft_speed_rad_s" in exc.value.field
-    if "shaft_current_a" in future_setpoint_fields():
-        assert any("shaft_current_a" in w and "electrical" in w for w in s.warnings)
-    else:  # the electrical issue has landed: the current is a real setpoint now
-        assert any(f == "shaft_current_a" for _, f, _ in run.iter_values())
+    assert max(v for _, f, v in run.iter_values() if f == "shaft_current_a") == 30.0
+    assert run.thermal is not None and run.thermal.shear_heating and run.thermal.current_heating
+
+
+def test_ev_resistance_temperature_scenario_seed003_figs_8_and_10(tmp_path):
+    # seed 003 Figs. 8 and 10 through the scenario runner: at 10 A and 20 A the film is thinner
+    # with the doubled bearing resistance and with the hotter oil
+    pq = pytest.importorskip("pyarrow.parquet")
+    out = tmp_path / "ev.parquet"
+    path = SCENARIOS / "ev_motor_resistance_temperature.yaml"
+    runs = load_scenario(path).resolved_runs()
+    assert [r.thermal.equivalent_resistance_ohm for r in runs] == [2.81e-4, 5.62e-4, 2.81e-4, 5.62e-4]
+    assert main(["scenario", "run", str(path), "--table", str(out), "--no-progress"]) == 0
+    rows = pq.read_table(out).to_pylist()
+
+    def film(run, current):   # last sample of the phase (30 ms after the step)
+        phase = [r for r in rows if r["run"] == run and r["setpoint_shaft_current_a"] == current]
+        return phase[-1]["electrical_film_thermal_factor"], phase[-1]
+
+    for current in (10.0, 20.0):
+        f_low, row = film("rb_281uohm_40c", current)
+        f_high, _ = film("rb_562uohm_40c", current)
+        f_hot, _ = film("rb_281uohm_80c", current)
+        assert f_high < f_low, current
+        assert row["electrical_current_temperature_rise_k"] > 0.0
+        assert f_hot < 1.0 and f_low < 1.0
+    # hotter oil: a thinner film at the same current (the thickest inner film over the balls)
+
+    def thickest_inner_film_m(row):
+        return max(v for k, v in row.items() if k.endswith("_inner_h_min_m") and v is not None)
+
+    for current in (10.0, 20.0):
+        assert thickest_inner_film_m(film("rb_281uohm_80c", current)[1]) < thickest_inner_film_m(film("rb_281uohm_40c", current)[1])
 
 
 def test_future_field_is_skipped_with_a_message_but_typos_are_errors():
