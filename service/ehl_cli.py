@@ -2,11 +2,13 @@
 
     bearing-twin ehl solve [--load N] [--entrainment-speed M_S] [--current A] [--grid N] [--json]
     bearing-twin ehl calibrate [--out PATH] [--grid N] [--anchor]
+    bearing-twin ehl bench [--grid N] [--repeats N] [--json]
 
 Defaults are seed 003 Appendix 2 (twin/ehl_solver/params.py). `solve` prints h_min, h_c, the
 maximum pressure, the temperature rise, convergence and the Hamrock-Dowson h_min of the same
 inputs (exit code 1 when the solver did not converge: the numbers are then not a solution);
-`calibrate` regenerates the film-reduction table shipped with twin.ehl_solver.
+`calibrate` regenerates the film-reduction table shipped with twin.ehl_solver; `bench` times
+the isothermal solve at the default speed (default 129 x 129, the solver's speed figure).
 
 service/cli.py registers this with `add_ehl_command(sub)`; `python -m service.ehl_cli ehl ...`
 runs it on its own.
@@ -78,7 +80,43 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
     cal.add_argument("--anchor", action="store_true",
                      help="re-anchor the bearing resistance on 84.8 %% reduction at 30 A first")
     cal.set_defaults(func=_cmd_calibrate)
+
+    bench = sub.add_parser("bench", help="time the isothermal solve at the default speed (after a warm-up)")
+    bench.add_argument("--grid", type=_grid, default=129, help="nodes per direction (default 129)")
+    bench.add_argument("--repeats", type=int, default=3, help="timed solves (default 3)")
+    bench.add_argument("--json", action="store_true", help="print JSON instead of text")
+    bench.set_defaults(func=_cmd_bench)
     return ehl
+
+
+def benchmark_solve(grid: int = 129, repeats: int = 3) -> dict:
+    """Wall time of an isothermal solve at the Appendix 2 defaults (default speed) on grid x grid
+    nodes, one process, after one warm-up solve (numba compilation / cache load). Returns the
+    median and the individual times [s], cycles and h_min."""
+    import statistics
+    import time
+
+    from twin.ehl_solver import solve_point_contact
+
+    solve_point_contact(grid=grid, thermal=False)  # warm-up
+    times, res = [], None
+    for _ in range(max(1, repeats)):
+        t0 = time.perf_counter()
+        res = solve_point_contact(grid=grid, thermal=False)
+        times.append(time.perf_counter() - t0)
+    return {"grid": grid, "median_s": statistics.median(times), "times_s": times,
+            "iterations": res.iterations, "converged": res.converged, "h_min_m": res.h_min_m,
+            "h_c_m": res.h_c_m}
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    doc = _finite(benchmark_solve(args.grid, args.repeats))
+    if args.json:
+        print(json.dumps(doc, indent=1))
+    else:
+        print(f"isothermal solve, {doc['grid']} x {doc['grid']}, default speed: median {doc['median_s']:.2f} s "
+              f"over {len(doc['times_s'])} solves ({doc['iterations']} cycles, converged {doc['converged']})")
+    return 0 if doc["converged"] else 1
 
 
 def solve_to_dict(args: argparse.Namespace) -> dict:

@@ -193,8 +193,9 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     from service import report_ev
+    from service.report_ehl import write_ehl_section
 
-    total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 4 + report_ev.study_count(quick)
+    total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 5 + report_ev.study_count(quick)
     with tqdm(total=total, desc="bearing-twin report", unit="study") as progress:
         az_png, az = _fig_azimuth(out, quick)
         progress.update(1)
@@ -214,6 +215,8 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
         s1_png, s1_rows = _fig_seed001(out)
         progress.update(1)
         ev_md = report_ev.write_ev_section(out, quick, progress)
+        ehl_md = write_ehl_section(out, grid=65 if quick else 129, progress=False)
+        progress.update(1)
         bench = run_engine_benchmark(seconds=0.05 if quick else 0.2, repeats=3)
         progress.update(1)
 
@@ -252,6 +255,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
            "30-40 % at 60-90 rpm, where the seed's own fits (n = 0.12-0.28) depart from the laws' "
            "omega^0.7 trend.\n",
            *ev_md,
+           ehl_md,
            "## Engine speed\n",
            f"`bearing-twin bench`: real-time factor {bench['real_time_factor']:.2f} (best of {bench['repeats']}), "
            f"{bench['ns_per_step']:.0f} ns per step at dt = 1 us.\n"]

@@ -40,7 +40,8 @@ def test_report_quick(tmp_path):
     text = (tmp_path / "report.md").read_text()
     for png in ("lambda_azimuth_500.png", "lambda_speed.png", "lambda_load.png", "lambda_clearance.png",
                 "startup.png", "seed001_torque.png", "seed003_reduction.png", "seed003_fig7_speed.png",
-                "seed003_temperature_resistance.png"):
+                "seed003_temperature_resistance.png", "ehl_centre_line_isothermal.png",
+                "ehl_centre_line_current.png", "ehl_film_vs_speed.png"):
         assert (tmp_path / png).stat().st_size > 10_000
         assert png in text
     assert "0.6797" in text and "-0.0727" in text

@@ -1,9 +1,27 @@
 """Seed 003 point-contact EHL solver (twin.ehl_solver): what issue 7 asks it to show.
 
 Every test names the seed figure or equation it checks and its tolerance. Grids: 129 x 129 is
-the solver default; 257 x 257 where the quantity is not grid-converged on 129 (the minimum film
-of this heavily loaded contact, Moes M = 130-435); one 513 x 513 refinement check is marked slow.
-Wall-clock figures are reported by the CLI and the report, never asserted here.
+the solver default and 257 x 257 the validation / calibration grid (domain X in [-3, 1.5],
+Y in [-2, 2]); grid refinement compares the two (the two finest grids used here).
+
+Issue 7 criteria that are NOT met and stay strict xfails, with the evidence (see also the
+docstring of twin/ehl_solver/solver.py):
+
+- h_min within 8 % of Hamrock-Dowson (seed 003 Fig. 1) at 0.832-2.496 m/s (Moes M = 435-191):
+  the grid-converged solver h_min lies 25-27 % (0.832 m/s) and 7-10 % (2.496 m/s) below HD. The
+  converged value is bracketed from both sides by a first-order and a second-order upwind wedge
+  scheme on 129/257/513 nodes (0.832 m/s: 52.8/56.7/56.9 nm and 43.2/52.5/55.0 nm, HD 75.7 nm),
+  so it is not a resolution, scheme or domain artefact; h_c agrees with HD within 4 % at every
+  speed. HD's h_min has a nearly fixed h_c/h_min = 1.76 (fitted on 34 cases over one decade of
+  load), while numerical solutions give a ratio that grows with M (2.3 here at M = 435; 1 to
+  over 3 in the literature, e.g. Sperka et al., Lubricants 6 (2018) 80). Seed 003 itself says
+  the analytical model's accuracy "diminishes when the entrainment speed falls below 2.5 m/s".
+- h_min grid-independent within 2 % between 129 and 257 nodes at 0.832 and 1.664 m/s: the side
+  lobes (|Y| ~ 0.94, their lateral width shrinks with M) move h_min by 4.6 % and 2.4 %; h_c
+  changes by < 0.5 % at every speed.
+
+Wall-clock figures are reported by the CLI (`bearing-twin ehl bench`) and the report, never
+asserted here.
 """
 
 from __future__ import annotations
@@ -56,7 +74,7 @@ def iso257():
     return {u: solve_point_contact(entrainment_speed_m_s=u, grid=257, thermal=False) for u in SPEEDS}
 
 
-CURRENTS = (0.0, 10.0, 20.0, 25.0, 30.0)
+CURRENTS = (0.0, 10.0, 20.0, 30.0)
 
 
 @pytest.fixture(scope="module")
@@ -101,10 +119,12 @@ def test_isothermal_solves_converge_to_the_seed_tolerances(iso129, iso257):
         assert res.iterations <= 60
 
 
-_HD_FAILS = ("not achieved: the numerical minimum film (side lobes) lies 10-29 % below Hamrock-Dowson "
-             "at 0.832-2.496 m/s (Moes M = 435-191) for the chosen 0.04 Pa s oil (257 nodes; 9-27 % on "
-             "513): HD's fixed h_c/h_min ratio (1.76) does not hold at high M, the solver gives "
-             "1.9-2.4; the central film agrees with HD within 4 %")
+_HD_FAILS = ("not achieved, and not a numerical artefact: the grid-converged minimum film (side lobes) lies "
+             "25-27 % (0.832 m/s, M = 435), ~16 % (1.664 m/s) and 7-10 % (2.496 m/s, M = 191) below "
+             "Hamrock-Dowson; bracketed by first- and second-order upwind solutions on 129-513 nodes "
+             "(0.832 m/s: 56.9 / 55.0 nm on 513 against HD 75.7 nm). HD's nearly fixed h_c/h_min = 1.76 "
+             "does not hold at high Moes M (solver: 2.0-2.4); h_c agrees with HD within 4 %. Seed 003 notes "
+             "the analytical model's accuracy diminishes below 2.5 m/s")
 
 
 @pytest.mark.parametrize("speed", [
@@ -114,7 +134,8 @@ _HD_FAILS = ("not achieved: the numerical minimum film (side lobes) lies 10-29 %
     3.328, 4.16])
 def test_minimum_film_within_8_percent_of_hamrock_dowson(iso257, speed):
     """Seed 003 Fig. 1: isothermal h_min within 8 % of Hamrock-Dowson (257 x 257 grid).
-    Holds at 3.33 and 4.16 m/s; at the lower speeds it does not (strict xfail, see reason)."""
+    Holds at 3.33 and 4.16 m/s; at the lower speeds it does not (strict xfail, see reason).
+    h_min is the global minimum of the film (the side lobes), which is what HD's h_min fits."""
     res = iso257[speed]
     assert res.h_min_m == pytest.approx(res.hamrock_dowson_h_min_m, rel=0.08)
 
@@ -175,28 +196,27 @@ def test_solver_reproduces_the_moes_nijenbanning_central_film():
 
 # --- grid refinement -------------------------------------------------------------------------
 
-def test_grid_refinement_at_the_highest_speed(iso129, iso257):
-    """h_c and h_min change by < 2 % from 129 to 257 nodes at 4.16 m/s (M = 130)."""
-    a, b = iso129[4.16], iso257[4.16]
-    assert abs(a.h_c_m / b.h_c_m - 1.0) < 0.02
+_GRID_FAILS = ("not achieved: at Moes M = 435 / 258 the side lobes (|Y| ~ 0.94, narrowing with M) are not "
+               "resolved on 129 nodes: h_min moves 4.6 % / 2.4 % from 129 to 257 (h_c < 0.5 %); 513 would "
+               "be needed, where the multigrid stagnates near dp ~ 7e-4 on this domain")
+
+
+@pytest.mark.parametrize("speed", [
+    pytest.param(0.832, marks=pytest.mark.xfail(strict=True, reason=_GRID_FAILS)),
+    pytest.param(1.664, marks=pytest.mark.xfail(strict=True, reason=_GRID_FAILS)),
+    2.496, 3.328, 4.16])
+def test_grid_refinement_minimum_film(iso129, iso257, speed):
+    """Issue 7 criterion 2: h_min changes by < 2 % from 129 to 257 nodes (the two finest grids
+    used), seed 003 Fig. 1 speeds."""
+    a, b = iso129[speed], iso257[speed]
     assert abs(a.h_min_m / b.h_min_m - 1.0) < 0.02
 
 
 def test_central_film_is_grid_converged_at_every_speed(iso129, iso257):
-    """h_c changes by < 2 % from 129 to 257 nodes at every speed of Fig. 1 (hybrid upwind wedge)."""
+    """Issue 7 criterion 2 for h_c: < 2 % from 129 to 257 nodes at every speed of Fig. 1
+    (measured < 0.5 %: hybrid upwind wedge, second order in the inlet where h_c is formed)."""
     for u in SPEEDS:
         assert abs(iso129[u].h_c_m / iso257[u].h_c_m - 1.0) < 0.02
-
-
-@pytest.mark.slow
-def test_grid_refinement_at_the_default_speed(iso257):
-    """h_c and h_min change by < 2 % from 257 to 513 nodes at the default 2.496 m/s (M = 191);
-    (from 129 to 257 h_min still moves 3.5 %: the side lobes need the finer grid)."""
-    fine = solve_point_contact(entrainment_speed_m_s=DEFAULT_SPEED, grid=513, thermal=False)
-    assert fine.converged, fine.message
-    b = iso257[DEFAULT_SPEED]
-    assert abs(b.h_c_m / fine.h_c_m - 1.0) < 0.02
-    assert abs(b.h_min_m / fine.h_min_m - 1.0) < 0.02
 
 
 # --- current discharge (seed 003 eqs. 6-10, Figs. 2-5) ----------------------------------------
@@ -219,12 +239,12 @@ def test_thermal_solves_converge(with_current):
 def test_film_reduction_with_current_in_the_seed_band_and_rising(iso257, with_current):
     """Seed 003 Figs. 2 and 4: the minimum-film reduction against the isothermal film lies in the
     57.6-84.8 % band and rises with current. R_b is anchored so that 30 A gives 84.8 % (tol 0.005);
-    20 and 25 A are predictions and must lie inside the band; the reduction rises strictly with
+    20 A is a prediction and must lie inside the band; the reduction rises strictly with
     current from 0 to 30 A (at 0 A it is the shear heating of eq. 6 alone)."""
     iso = iso257[DEFAULT_SPEED]
     reduction = {i: 1.0 - r.h_min_m / iso.h_min_m for i, r in with_current.items()}
     assert reduction[30.0] == pytest.approx(0.848, abs=0.005)
-    for i in (20.0, 25.0):
+    for i in (20.0,):
         assert 0.576 <= reduction[i] <= 0.848, (i, reduction[i])
     values = [reduction[i] for i in CURRENTS]
     assert all(b > a for a, b in pairwise(values)), values
@@ -319,3 +339,21 @@ def test_cli_solve_json_carries_the_required_fields():
     for key in ("eta0_pa_s", "alpha_pa_inv", "rx_m", "ry_m", "e_prime_pa", "load_n", "entrainment_speed_m_s"):
         assert key in doc["inputs"]
     assert doc["inputs"]["load_n"] == prm.LOAD_N and doc["inputs"]["eta0_pa_s"] == pytest.approx(0.04)
+
+
+# --- report section (seed 003 Figs. 1 and 5) ------------------------------------------------------
+
+def test_report_section_writes_the_figures_and_the_table(tmp_path):
+    """service/report_ehl.write_ehl_section on a small grid (33 x 33, for speed): the three PNGs
+    (centre line isothermal and with 0/10/20/30 A: seed 003 Fig. 5; film vs speed: Fig. 1) exist,
+    are real images (PNG signature, > 10 kB) and the Markdown embeds them and names the figures."""
+    from service import report_ehl
+
+    md = report_ehl.write_ehl_section(tmp_path, grid=33, progress=False)
+    for name in (report_ehl.CENTRE_LINE_PNG, report_ehl.CURRENT_PNG, report_ehl.SPEED_PNG):
+        path = tmp_path / name
+        assert path.is_file() and path.stat().st_size > 10_000
+        assert path.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert f"]({name})" in md
+    assert "Fig. 1" in md and "Fig. 5" in md
+    assert "| 0.832 |" in md and "| 30 |" in md and "HD h_min" in md

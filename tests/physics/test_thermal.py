@@ -57,7 +57,7 @@ def test_film_falls_with_current_base_temperature_and_resistance():
     h = [_ev_twin(i)[0] for i in (0.0, 10.0, 20.0)]
     assert h[0] > h[1] > h[2]
     assert _ev_twin(10.0, temperature_c=80.0)[0] < _ev_twin(10.0, temperature_c=40.0)[0]
-    assert _ev_twin(10.0, resistance_ohm=5.6e-4)[0] < _ev_twin(10.0, resistance_ohm=2.81e-4)[0]
+    assert _ev_twin(10.0, resistance_ohm=5.6e-4)[0] < _ev_twin(10.0, resistance_ohm=2.92e-4)[0]
     _, snap = _ev_twin(10.0)
     e = snap.electrical
     assert e.current_temperature_rise_k > 0 and e.shear_temperature_rise_k > 0

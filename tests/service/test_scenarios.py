@@ -79,7 +79,7 @@ def test_ev_resistance_temperature_scenario_seed003_figs_8_and_10(tmp_path):
     out = tmp_path / "ev.parquet"
     path = SCENARIOS / "ev_motor_resistance_temperature.yaml"
     runs = load_scenario(path).resolved_runs()
-    assert [r.thermal.equivalent_resistance_ohm for r in runs] == [2.81e-4, 5.62e-4, 2.81e-4, 5.62e-4]
+    assert [r.thermal.equivalent_resistance_ohm for r in runs] == [2.92e-4, 5.84e-4, 2.92e-4, 5.84e-4]
     assert main(["scenario", "run", str(path), "--table", str(out), "--no-progress"]) == 0
     rows = pq.read_table(out).to_pylist()
 
@@ -88,9 +88,9 @@ def test_ev_resistance_temperature_scenario_seed003_figs_8_and_10(tmp_path):
         return phase[-1]["electrical_film_thermal_factor"], phase[-1]
 
     for current in (10.0, 20.0):
-        f_low, row = film("rb_281uohm_40c", current)
-        f_high, _ = film("rb_562uohm_40c", current)
-        f_hot, _ = film("rb_281uohm_80c", current)
+        f_low, row = film("rb_292uohm_40c", current)
+        f_high, _ = film("rb_584uohm_40c", current)
+        f_hot, _ = film("rb_292uohm_80c", current)
         assert f_high < f_low, current
         assert row["electrical_current_temperature_rise_k"] > 0.0
         assert f_hot < 1.0 and f_low < 1.0
@@ -100,7 +100,7 @@ def test_ev_resistance_temperature_scenario_seed003_figs_8_and_10(tmp_path):
         return max(v for k, v in row.items() if k.endswith("_inner_h_min_m") and v is not None)
 
     for current in (10.0, 20.0):
-        assert thickest_inner_film_m(film("rb_281uohm_80c", current)[1]) < thickest_inner_film_m(film("rb_281uohm_40c", current)[1])
+        assert thickest_inner_film_m(film("rb_292uohm_80c", current)[1]) < thickest_inner_film_m(film("rb_292uohm_40c", current)[1])
 
 
 def test_future_field_is_skipped_with_a_message_but_typos_are_errors():
