@@ -16,7 +16,8 @@ eps/hx^2 >= 0.3 or a neighbour is cavitated (the Poiseuille terms dominate: inle
 outside the contact), Jacobi distributive line relaxation elsewhere (the Hertzian zone, where
 the equation behaves like the integral equation of dry contact and Gauss-Seidel is unstable),
 in zebra order. The line systems keep the influence coefficients within two nodes
-(pentadiagonal, solved without pivoting); changes are under-relaxed and limited per sweep.
+(pentadiagonal, solved without pivoting; the Jacobi distributive lines lump the rest of the line
+onto the band edges, see relax_jd); changes are under-relaxed and limited per sweep.
 
 Kernels never raise: they return counts (non-finite values, zero pivots) for the driver to check.
 """
@@ -241,6 +242,25 @@ def _wedge_jacobian(rho, i, j, rx1, w, kern, o):
 
 
 @njit(**JIT)
+def _wedge_jacobian_lumped(rho, i, j, rx1, w, kern, tail, o):
+    """_wedge_jacobian for a band limited to offsets |o| <= 2, with the influence of the changes
+    beyond the band lumped onto its edges (o = +-2): tail[k] = sum_{m >= k} kern[m]. The row sum
+    of the band is then that of the full line, so a change that is constant along the line gives
+    the wedge response of the full operator, sum_o J(o) = (a0 + a1 + a2) sum_m kern: zero for
+    constant rho, as d/dX of a uniform film change must be (see relax_jd)."""
+    val = _wedge_jacobian(rho, i, j, rx1, w, kern, o)
+    if o == 2 or o == -2:
+        a0 = (1.0 + 0.5 * w) * rho[i, j]
+        a1 = -(1.0 + w) * rho[i - 1, j]
+        a2 = 0.5 * w * rho[i - 2, j] if w != 0.0 else 0.0
+        if o == 2:   # offsets o >= 3: film at i, i-1, i-2 sees distances o, o+1, o+2
+            val += (a0 * tail[3] + a1 * tail[4] + a2 * tail[5]) * rx1
+        else:        # offsets o <= -3: distances -o, -o-1, -o-2
+            val += (a0 * tail[3] + a1 * tail[2] + a2 * tail[1]) * rx1
+    return val
+
+
+@njit(**JIT)
 def relax_gs(p, h, rho, eps, f, hx, hy, kappa2, kc, kind, xi0, omega, max_step, band, rhs, x):
     """One Gauss-Seidel line sweep (lines of constant Y, j = 1 .. ny-2, in order) over the nodes
     of kind 1; Newton linearisation with eps frozen, the film's dependence on the pressures of the
@@ -323,9 +343,23 @@ def relax_jd(p, h, rho, eps, f, hx, hy, kappa2, kc, kind, xi0, omega, max_step, 
     ry2 = kappa2 / (hy * hy)
     rx1 = 1.0 / hx
     # distributive kernel along the line: Kt(m) = K(m,0) - (K(m-1,0) + K(m+1,0) + 2 K(m,1)) / 4
-    kt = np.empty(6)
-    for m in range(6):
+    # Its tail beyond the pentadiagonal band is lumped onto the band edges (tail[k] = sum over
+    # m >= k): truncated, the band's row sum is (Kt(2) - Kt(3)) / hx < 0 instead of 0, so for a
+    # change constant along the line (theta_x -> 0) the line model has the opposite sign of the
+    # Poiseuille terms that are the operator's only response there, and a mode smooth in X and
+    # alternating from line to line grows wherever 0 < eps/hx^2 < ~5e-3 (the exit side of the
+    # Hertzian zone on fine grids: local Fourier analysis, growth 1 + 4 omega xi hx^2 /
+    # (hy^2 (Kt(3) - Kt(2)) / hx) per sweep). Lumped, that row sum is exact (0 at constant rho).
+    nk = kc.shape[0] - 1
+    kt = np.empty(nk)
+    for m in range(nk):
         kt[m] = kc[m, 0] - 0.25 * (kc[abs(m - 1), 0] + kc[m + 1, 0] + 2.0 * kc[m, 1])
+    tail = np.zeros(6)
+    acc = 0.0
+    for m in range(nk - 1, 0, -1):
+        acc += kt[m]
+        if m <= 5:
+            tail[m] = acc
     zero = 0
     n = nx - 2
     for i in range(nx):
@@ -370,7 +404,7 @@ def relax_jd(p, h, rho, eps, f, hx, hy, kappa2, kc, kind, xi0, omega, max_step, 
                     pois = -0.25 * exm * rx2
                 else:
                     pois = -0.25 * exp_ * rx2
-                band[row, 2 + o] = pois - _wedge_jacobian(rho, i, j, rx1, w, kt, o)
+                band[row, 2 + o] = pois - _wedge_jacobian_lumped(rho, i, j, rx1, w, kt, tail, o)
         if not any_jd:
             continue
         zero += _band_solve(band, rhs, x, n)

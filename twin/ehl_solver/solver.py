@@ -17,9 +17,10 @@ h_min at 0.832 m/s from 53.7 to 55.0 nm, refining X alone changed it by < 1 %.
 
 The discrete Reynolds equation (seed 003 eq. 1, kernels.py; cavitation by P >= 0) is solved by
 Full Approximation Storage multigrid (Venner & Lubrecht, "Multilevel methods in lubrication",
-Elsevier 2000): Gauss-Seidel line relaxation where the Poiseuille terms dominate, Jacobi
-distributive line relaxation (zebra order) in the Hertzian zone; full-weighting restriction of
-residuals (zero in the cavitated zone), injection of pressures, bilinear prolongation of the
+Elsevier 2000): Gauss-Seidel line relaxation where the Poiseuille terms dominate (omega 0.5),
+Jacobi distributive line relaxation (zebra order, omega 0.25) in the Hertzian zone, its
+pentadiagonal line model with the far film response lumped onto the band edges (kernels.relax_jd);
+full-weighting restriction of residuals (zero in the cavitated zone), injection of pressures, bilinear prolongation of the
 corrections except within two nodes of the cavitation boundary (the exit spike, which coarse
 grids cannot represent); every grid has its own influence coefficients (FAS: the coarse film is
 that of the coarse pressure). V(2,1) cycles after a nested iteration from the coarsest grid (17 x
@@ -31,23 +32,46 @@ eps/hx^2 is large (the inlet, where the film is formed), first-order upwind wher
 (Hertzian zone, exit spike).
 
 Accuracy (isothermal, seed 003 Appendix 2, issue 7). h_c changes by < 0.5 % from 129 to 257 nodes
-at every speed of Fig. 1 and agrees with Hamrock-Dowson (HD) within 4 %. h_min (the global film
-minimum, in the side lobes: what HD's h_min fits) changes by about 1 % from 129 to 257 nodes at
-2.5-4.2 m/s, 2.4 % at 1.664 and 4.6 % at 0.832 m/s (M = 435). Its grid-converged value was
-bracketed by a first-order (xi0 = -1) and a second-order (xi0 = 0) wedge scheme, which converge
-from opposite sides (0.832 m/s, 129/257/513 nodes: 52.8/56.7/56.9 nm and 43.2/52.5/55.0 nm;
-2.496 m/s: 148.8/150.1/149.0 and 135.4/143.8/146.0 nm): about 56 nm and 147 nm, i.e. 26 % and
-8 % below HD (75.7 and 159.7 nm), while the 257-node h_min is 27.7, 16.3, 9.8, 5.3 and 2.0 %
-below HD at 0.832-4.16 m/s. So seed 003 Fig. 1's "within 8 %" holds for h_min only from about
-2.5 m/s up. The reason is HD's formula, not the discretisation: its h_c/h_min is nearly fixed
-(1.76; 34 cases over one decade of load, Hamrock & Dowson 1977), while converged numerical
-solutions give a ratio growing with the Moes load M (here 2.3 at M = 435, 1.8 at M = 130; 1 to
-over 3 in Sperka, Krupka, Hartl, Lubricants 6 (2018) 80; HD's h_min is found inaccurate also by
-Wheeler et al., Friction 4 (2016) 369). Seed 003 itself notes the analytical model's accuracy
-"diminishes when the entrainment speed falls below 2.5 m/s". HD's ellipticity is k = a/b = 1
-for the circle (k = 1.03 (Ry/Rx)^0.64 is HD's approximate fit; it would raise HD's h_min by 2 %).
-On 513 nodes the multigrid stagnates near a pressure change of 7e-4 per cycle on this domain
-(converged on the old one); 257 is the finest grid used.
+and by < 0.2 % from 257 to 513 at every speed of Fig. 1 and agrees with Hamrock-Dowson (HD) within
+4 %. h_min (the global film minimum, in the side lobes: what HD's h_min fits) changes from 129 to
+257 nodes by about 1 % at 2.5-4.2 m/s but by 4.6 % at 0.832 and 2.3 % at 1.664 m/s (M = 435 /
+258: the side lobes narrow as M grows); from 257 to 513 it changes by 1.1 / 0.4 / 0.3 / 0.3 /
+0.4 % at 0.832-4.16 m/s, so the two finest grids used at the low speeds are 257 and 513 (513 h_min
+55.3 / 101.9 / 144.6 / 184.6 / 222.4 nm). Its grid-converged value is bracketed by a first-order
+(xi0 = -1) and a second-order (xi0 = 0) wedge scheme, which converge from different sides
+(0.832 m/s, 129/257/513 nodes: 55.8/57.0/56.6 nm and 49.8/54.1/55.2 nm; 2.496 m/s:
+150.6/148.5/147.1 and 140.2/144.0/144.8 nm): about 55-57 nm and 145-147 nm, i.e. 25-27 % and
+8-9 % below HD (75.7 and 159.7 nm), while the 513-node h_min is 26.9, 15.9, 9.5, 5.0 and 1.6 %
+below HD at 0.832-4.16 m/s (257: 27.7, 16.3, 9.8, 5.3, 2.0 %). So seed 003 Fig. 1's "within 8 %"
+holds for h_min only from about 3 m/s up. The reason is HD's formula, not the discretisation: its
+h_c/h_min is nearly fixed (1.76; 34 cases over one decade of load, Hamrock & Dowson 1977), while
+converged numerical solutions give a ratio growing with the Moes load M (here 2.3 at M = 435, 1.8
+at M = 130; 1 to over 3 in Sperka, Krupka, Hartl, Lubricants 6 (2018) 80; HD's h_min is found
+inaccurate also by Wheeler et al., Friction 4 (2016) 369). Seed 003 itself notes the analytical
+model's accuracy "diminishes when the entrainment speed falls below 2.5 m/s". HD's ellipticity is
+k = a/b = 1 for the circle (k = 1.03 (Ry/Rx)^0.64 is HD's approximate fit; it would raise HD's
+h_min by 2 %).
+
+513 nodes. The multigrid used to stagnate there (pressure change ~7e-4 per cycle at 0.832 m/s,
+~1e-2 at 3.3-4.2 m/s). Two smoother defects, both invisible on 129/257 because the Poiseuille
+coefficient eps/hx^2 of a given point grows 4x per refinement:
+(1) the Jacobi distributive line model truncated the distributed influence kernel Kt at two
+nodes, so its row sum was (Kt(2) - Kt(3))/hx < 0 instead of 0. For a change smooth along X and
+alternating from line to line, whose only response is the lateral Poiseuille term, the line
+model then had the wrong sign: local Fourier analysis gives growth 1 + 4 omega xi (hx/hy)^2 /
+0.01 per sweep for 0 < xi = eps/hx^2 < ~5e-3: the exit side of the Hertzian zone, which only
+on 513 nodes holds many nodes with xi in that range. The 513 pressure grew a line-to-line checkerboard (10 %
+of p_h at X = 0.8, 0.832 m/s) that each cycle re-pumped. Fix: the tail beyond the band is lumped
+onto its edges (exact row sum; the fixed point, i.e. the discrete solution, is unchanged).
+(2) Gauss-Seidel lines use the film of the start of the sweep, i.e. they are Jacobi in the
+elastic coupling between lines; just above the switch xi = 0.3 that amplifies smooth modes
+(Fourier: 2.2 per sweep at omega 0.7, 1.5 at 0.5), and at 3.3-4.2 m/s the nodes at the lateral
+edge of the Hertzian zone flipped between the two smoothers with a residual limit cycle near
+dp ~ 2e-4. omega_gs 0.7 -> 0.5 removes it (xi_lim 0.3 -> 1 does too, at 30 % more cycles).
+Measured now (isothermal, this machine, 2 shared cores): 513 converges at 0.832 / 1.664 / 2.496 /
+3.328 / 4.16 m/s in 13 / 16 / 20 / 18 / 22 cycles, 11 / 14 / 17 / 15 / 19 s; 257 in 14-20
+cycles, 3-4 s; 129 in 20-26 cycles, ~1 s. 129 and 257 results moved by < 0.05 % (the
+discretisation is unchanged, only the path to it).
 
 Thermal case: the temperature field of eq. 6 (local h and p) + eq. 10 (current, uniform) is
 recomputed on the finest grid before every cycle (under-relaxed by 1/2) and enters Roelands
@@ -180,7 +204,7 @@ def _prolong_bilinear(ec: np.ndarray, nf: int) -> np.ndarray:
 @dataclass
 class _Settings:
     xi_lim: float = 0.3
-    omega_gs: float = 0.7
+    omega_gs: float = 0.5     # 0.7 stagnated on 513 nodes (see the module docstring)
     omega_jd: float = 0.25
     nu1: int = 2
     nu2: int = 1
