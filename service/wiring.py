@@ -80,11 +80,7 @@ def open_recorder(settings: ServiceSettings):
     path = settings.recording_path
     if path is None and not settings.spawn_viewer:
         return None
-    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer,
-                             flush_interval_s=settings.record_flush_interval_s,
-                             segment_s=settings.record_segment_s or None,
-                             segment_bytes=round(settings.record_segment_mb * 1e6) or None,
-                             write_footer=settings.record_footer)
+    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer)
 
 
 @dataclass
