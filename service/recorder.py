@@ -25,11 +25,34 @@ status                 TextLog, one row whenever the status text changes
 A value that is null (Lambda without contact, electrical fields not yet modelled) is simply not
 logged for that row, so a series has one row per snapshot where it is defined.
 
-Outputs: the file given to the constructor and/or a spawned viewer (one `RecordingStream`), plus
-at most one extra file opened with `start_file` and closed with `stop_file` (its own
-`RecordingStream` with the same recording id, so it is complete on its own: static geometry,
-blueprint, and every row published while it was open). Nothing listens on the network unless
-`spawn_viewer=True` (and then only the spawned viewer does); `serve_grpc` is never called.
+Outputs: the file given to the constructor (in segments, below) and/or a spawned viewer (each its
+own `RecordingStream`), plus at most one extra file opened with `start_file` and closed with
+`stop_file` (its own `RecordingStream` with the same recording id, so it is complete on its own:
+static geometry, blueprint, and every row published while it was open). Nothing listens on the
+network unless `spawn_viewer=True` (and then only the spawned viewer does); `serve_grpc` is never
+called.
+
+Segments. With `segment_s` and/or `segment_bytes` the main file is rotated: once the open segment
+is that old [s of wall time] or that large [bytes on disk], after a send, the recorder flushes its
+stream and points it at the next segment (the old file sink writes its end and closes the file;
+the stream itself is kept, rerun-sdk never frees one), so every segment is complete on its
+own (static geometry, series styles and blueprint first, then its rows; the same application and
+recording id, so `rerun name.rrd name-0001.rrd ...` shows one recording). Segment 0 is the path
+given (`name.rrd`), then `name-0001.rrd`, `name-0002.rrd`, ... in the same folder (`segment_path`,
+`recording_segments`; when rotation is on, stale `name-NNNN.rrd` files of an earlier recording
+to the same name are removed when the recorder opens, as `name.rrd` itself is overwritten). Every row goes to exactly
+one segment: nothing is lost or doubled at a rotation, and `close()` (the service's SIGTERM path)
+closes the open one. Read a segmented recording with `read_recording(recording_segments(path))`
+(every reader here takes a path or a list of paths).
+
+Memory. rerun-sdk 0.41's file sink keeps an entry of the RRD footer (the chunk manifest) in native
+memory for every chunk written until the file is closed (about 1 kB per chunk, nearly as much as
+the file grows; one chunk per entity per send: 128 per send for one 6208 twin with its electrical
+series, 1280 chunks/s at `flush_interval_s` 0.1, about 1 MB/s): that is the growth of rerun issue
+#12623. `write_footer=False` writes no footer and the
+memory stays flat (the file is a valid RRD stream: the viewer and `RrdReader.stream()` read it,
+`rerun rrd optimize` adds the footer afterwards); with the footer, segments bound the memory to
+that of one segment (freed when it closes).
 
 rerun-sdk 0.41 notes: an explicit `rr.RecordingStream` per output; `flush()` then `disconnect()`
 before the file is read back; read it with `read_recording` (`rerun.chunk.RrdReader`).
@@ -41,13 +64,15 @@ import colorsys
 import logging
 import math
 import os
+import re
 import socket
 import sys
 import threading
 import time
 import uuid
+import warnings
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Self
@@ -213,6 +238,82 @@ class _Output:
     stream: rr.RecordingStream
     path: Path | None
     viewer: bool = False
+    opened_at: float = field(default_factory=time.monotonic)   # monotonic [s]
+    rows: int = 0               # snapshots written to this output (to this segment for the main file)
+
+
+class _BlueprintSender:
+    """Sends blueprints through ONE blueprint stream for the recorder's lifetime.
+
+    `RecordingStream.send_blueprint` creates a new blueprint `RecordingStream` per call, and
+    rerun-sdk 0.41 never frees one (its threads keep running, rerun issue #2116): once per segment
+    that would grow without bound. Here the blueprint is logged again into the same blueprint
+    stream, behind a fresh in-memory sink, and that storage is sent (what `send_blueprint` does
+    with its throw-away stream). Uses rerun internals (`rerun_bindings.new_blueprint`,
+    `Blueprint._log_to_stream`): if they are missing, falls back to `send_blueprint`."""
+
+    def __init__(self, application_id: str):
+        self.application_id = application_id
+        self._stream: rr.RecordingStream | None = None
+        self._fallback = False
+
+    def send(self, blueprint: rrb.Blueprint, recording: rr.RecordingStream) -> None:
+        if not self._fallback:
+            try:
+                import rerun_bindings
+
+                if self._stream is None:
+                    self._stream = rr.RecordingStream._from_native(rerun_bindings.new_blueprint(
+                        application_id=self.application_id, make_default=False, make_thread_default=False,
+                        default_enabled=True))
+                storage = self._stream.memory_recording().storage
+                self._stream.set_time("blueprint", sequence=0)
+                blueprint.to_blueprint()._log_to_stream(self._stream)
+                rerun_bindings.send_blueprint(storage, True, True, recording=recording.to_native())
+                return
+            except (ImportError, AttributeError, TypeError) as exc:
+                self._fallback = True
+                log.warning("rerun: blueprint stream reuse unavailable (%s): using send_blueprint", exc)
+        recording.send_blueprint(blueprint, make_active=True, make_default=True)
+
+
+def segment_path(path: str | Path, index: int) -> Path:
+    """Path of segment `index` of the recording `path`: the path itself for 0, else
+    `<stem>-<index:04d><suffix>` in the same folder (run.rrd, run-0001.rrd, run-0002.rrd, ...)."""
+    path = Path(path)
+    if index < 0:
+        raise ValueError(f"segment index {index}: must be >= 0")
+    return path if index == 0 else path.with_name(f"{path.stem}-{index:04d}{path.suffix}")
+
+
+def _numbered_segments(path: Path) -> dict[int, Path]:
+    pattern = re.compile(re.escape(path.stem) + r"-(\d{4,})" + re.escape(path.suffix) + "$")
+    found: dict[int, Path] = {}
+    try:
+        siblings = list(path.parent.iterdir())
+    except OSError:
+        return found
+    for p in siblings:
+        m = pattern.match(p.name)
+        if m and int(m.group(1)) > 0 and p.is_file():
+            found[int(m.group(1))] = p
+    return found
+
+
+def recording_segments(path: str | Path) -> list[Path]:
+    """The segments of the recording `path` in order: `path` itself, then `<stem>-0001<suffix>`,
+    `<stem>-0002<suffix>`, ... as long as they follow each other (see the module doc). Empty when
+    `path` does not exist."""
+    path = Path(path)
+    if not path.is_file():
+        return []
+    numbered = _numbered_segments(path)
+    out = [path]
+    i = 1
+    while i in numbered:
+        out.append(numbered[i])
+        i += 1
+    return out
 
 
 class RerunRecorder:
@@ -230,11 +331,24 @@ class RerunRecorder:
     def __init__(self, path: str | Path | None = None, *, spawn_viewer: bool = False,
                  application_id: str = "bearing-twin", flush_interval_s: float = 0.1,
                  queue_size: int = 256, viewer_port: int = 9876,
-                 series_window_s: float | None = 5.0, min_interval_s: float = 0.0):
+                 series_window_s: float | None = 5.0, min_interval_s: float = 0.0,
+                 segment_s: float | None = None, segment_bytes: int | None = None,
+                 write_footer: bool = True):
+        """`segment_s` [s of wall time] / `segment_bytes` [bytes]: rotate the main file once its
+        open segment is that old / that large (None or 0 = never; see the module doc).
+        `write_footer`: end every file (segments, `start_file` files) with rerun's footer (chunk
+        manifest); False keeps the memory flat on long runs (module doc)."""
         if not (flush_interval_s > 0.0 and math.isfinite(flush_interval_s)):
             raise ValueError(f"flush_interval_s = {flush_interval_s!r}: must be finite and > 0")
         if queue_size < 1:
             raise ValueError(f"queue_size = {queue_size!r}: must be >= 1")
+        if segment_s is not None and not (segment_s >= 0.0 and math.isfinite(segment_s)):
+            raise ValueError(f"segment_s = {segment_s!r}: must be finite and >= 0 (0 = no rotation by age)")
+        if segment_bytes is not None and segment_bytes < 0:
+            raise ValueError(f"segment_bytes = {segment_bytes!r}: must be >= 0 (0 = no rotation by size)")
+        self.segment_s = float(segment_s) if segment_s else None
+        self.segment_bytes = int(segment_bytes) if segment_bytes else None
+        self.write_footer = bool(write_footer)
         self.application_id = application_id
         self.recording_id = uuid.uuid4().hex
         self.flush_interval_s = float(flush_interval_s)
@@ -255,12 +369,21 @@ class RerunRecorder:
         self._errors = 0
         self._skipped = 0
         self._twins: dict[str, _Twin] = {}
-        self._primary: _Output | None = None
+        self._viewer: _Output | None = None
+        self._primary: _Output | None = None    # the open segment of the main file
         self._extra: _Output | None = None
         self._blueprint_dirty = False   # (re)sent by the next send, once for many add_twin calls
+        self._segments: list[Path] = []
+        self._rotation_failed_at: float | None = None
+        self._blueprints = _BlueprintSender(application_id)
 
         self.path = Path(path) if path is not None else None
-        self._primary = self._open_primary(self.path, spawn_viewer)
+        self._viewer = self._open_viewer(spawn_viewer)
+        if self.path is not None:
+            if self.segment_s is not None or self.segment_bytes is not None:
+                self._remove_stale_segments(self.path)
+            self._primary = self._open_file(self.path)
+            self._segments.append(self.path)
 
         self._thread = threading.Thread(target=self._run, name="rerun-recorder", daemon=True)
         self._thread.start()
@@ -269,41 +392,49 @@ class RerunRecorder:
     def _new_stream(self) -> rr.RecordingStream:
         return rr.RecordingStream(self.application_id, recording_id=self.recording_id)
 
-    def _open_primary(self, path: Path | None, spawn_viewer: bool) -> _Output | None:
-        viewer = False
-        stream = None
-        if spawn_viewer:
-            if not _display_available():
-                log.warning("rerun: no display (DISPLAY/WAYLAND_DISPLAY unset): not spawning a viewer%s",
-                            f", recording to {path}" if path else "")
-            else:
-                stream = self._new_stream()
-                try:
-                    stream.spawn(port=self.viewer_port, connect=False)
-                    viewer = _port_open(self.viewer_port)
-                    if not viewer:
-                        log.warning("rerun: the spawned viewer does not listen on port %d: continuing without it",
-                                    self.viewer_port)
-                except Exception as exc:  # noqa: BLE001 - no viewer on PATH, headless, ...: warn, go on
-                    log.warning("rerun: could not spawn a viewer (%s): continuing%s",
-                                str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__,
-                                f" with the file sink {path}" if path else " without a viewer")
-        if not viewer and path is None:
+    def _open_viewer(self, spawn_viewer: bool) -> _Output | None:
+        """A stream to a spawned viewer (its own stream: the file segments rotate, the viewer's
+        connection does not), or None."""
+        if not spawn_viewer:
             return None
-        stream = stream or self._new_stream()
-        url = f"rerun+http://127.0.0.1:{self.viewer_port}/proxy"
-        if viewer and path is not None:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            stream.set_sinks(rr.GrpcSink(url), rr.FileSink(str(path)))
-        elif viewer:
-            stream.connect_grpc(url)
-        else:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            stream.save(str(path))
-        return _Output(stream=stream, path=path, viewer=viewer)
+        where = f", recording to {self.path}" if self.path else ""
+        if not _display_available():
+            log.warning("rerun: no display (DISPLAY/WAYLAND_DISPLAY unset): not spawning a viewer%s", where)
+            return None
+        stream = self._new_stream()
+        try:
+            stream.spawn(port=self.viewer_port, connect=False)
+            if not _port_open(self.viewer_port):
+                log.warning("rerun: the spawned viewer does not listen on port %d: continuing without it",
+                            self.viewer_port)
+                return None
+        except Exception as exc:  # noqa: BLE001 - no viewer on PATH, headless, ...: warn, go on
+            log.warning("rerun: could not spawn a viewer (%s): continuing%s",
+                        str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__,
+                        f" with the file sink {self.path}" if self.path else " without a viewer")
+            return None
+        stream.connect_grpc(f"rerun+http://127.0.0.1:{self.viewer_port}/proxy")
+        return _Output(stream=stream, path=None, viewer=True)
+
+    def _open_file(self, path: Path) -> _Output:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        stream = self._new_stream()
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            stream.save(str(path), write_footer=self.write_footer)
+        return _Output(stream=stream, path=path)
+
+    @staticmethod
+    def _remove_stale_segments(path: Path) -> None:
+        for p in _numbered_segments(path).values():
+            try:
+                p.unlink()
+                log.warning("rerun: removed %s, a segment of an earlier recording to %s", p, path)
+            except OSError as exc:
+                log.warning("rerun: could not remove the stale segment %s: %s", p, exc)
 
     def _outputs(self) -> list[_Output]:
-        return [o for o in (self._primary, self._extra) if o is not None]
+        return [o for o in (self._viewer, self._primary, self._extra) if o is not None]
 
     @staticmethod
     def _close_output(out: _Output, timeout_s: float = 30.0) -> None:
@@ -323,17 +454,14 @@ class RerunRecorder:
         path = Path(path)
         if self._closed:
             raise RuntimeError("recorder is closed")
-        if self.path is not None and path.resolve() == self.path.resolve():
-            raise ValueError(f"{path} is the recorder's main file")
+        if self.path is not None and path.resolve() in {p.resolve() for p in self._segments}:
+            raise ValueError(f"{path} is the recorder's main file (or one of its segments)")
         with self._io_lock:
             self._drain_locked()
             self._send_locked()        # rows published before start_file go to the old outputs only
             if self._extra is not None:
                 self._stop_file_locked()
-            path.parent.mkdir(parents=True, exist_ok=True)
-            stream = self._new_stream()
-            stream.save(str(path))
-            out = _Output(stream=stream, path=path)
+            out = self._open_file(path)
             for tw in self._twins.values():
                 self._send_static(out, tw)
             self._send_blueprint([out])         # the others get theirs at the next send if due
@@ -360,6 +488,71 @@ class RerunRecorder:
         """The file being recorded with `start_file`, if any."""
         out = self._extra
         return out.path if out is not None else None
+
+    @property
+    def segments(self) -> list[Path]:
+        """The segments of the main file opened so far, in order (the last one is being written
+        unless the recorder is closed); [] without a main file."""
+        return list(self._segments)
+
+    @property
+    def current_path(self) -> Path | None:
+        """The segment of the main file being written (None without a main file or once closed)."""
+        out = self._primary
+        return out.path if out is not None else None
+
+    def rotate(self) -> Path | None:
+        """Close the open segment of the main file now (everything published so far is in it) and
+        open the next one; returns the new segment's path (None without a main file)."""
+        with self._io_lock:
+            if self._closed or self._primary is None:
+                return None
+            self._drain_locked()
+            self._send_locked()
+            return self._rotate_locked()
+
+    def _rotation_due(self) -> bool:
+        out = self._primary
+        if out is None or out.rows == 0 or (self.segment_s is None and self.segment_bytes is None):
+            return False
+        now = time.monotonic()
+        if self._rotation_failed_at is not None and now - self._rotation_failed_at < 10.0:
+            return False          # a failed rotation is retried every 10 s, not at every send
+        if self.segment_s is not None and now - out.opened_at >= self.segment_s:
+            return True
+        if self.segment_bytes is not None:
+            try:
+                return out.path.stat().st_size >= self.segment_bytes
+            except OSError:
+                return False
+        return False
+
+    def _rotate_locked(self) -> Path | None:
+        """Point the main file's stream at the next segment. The stream is kept (rerun-sdk 0.41
+        never frees a `RecordingStream` nor its threads, rerun issue #2116: a new stream per
+        segment would leak about 2 MB and 4 threads per rotation); `save()` replaces its file
+        sink, and the old sink, dropped, writes its end (and footer) and closes the file."""
+        out = self._primary
+        path = segment_path(self.path, len(self._segments))
+        try:
+            out.stream.flush(timeout_sec=30.0)      # every row sent so far goes to the old segment
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                out.stream.save(str(path), write_footer=self.write_footer)
+        except Exception as exc:  # noqa: BLE001 - the old sink stays: keep writing the open segment
+            self._errors += 1
+            self._rotation_failed_at = time.monotonic()
+            log.warning("rerun: could not open the next segment %s (%s): continuing in %s", path, exc, out.path)
+            return None
+        self._rotation_failed_at = None
+        old_path, old_rows = out.path, out.rows
+        out.path, out.rows, out.opened_at = path, 0, time.monotonic()
+        self._segments.append(path)
+        for tw in self._twins.values():             # the new segment is complete on its own
+            self._send_static(out, tw)
+        self._send_blueprint([out])
+        log.info("rerun: segment %s closed (%d snapshots), recording into %s", old_path, old_rows, path)
+        return path
 
     # ---- twins ------------------------------------------------------------------------------
     def add_twin(self, bearing_id: str, *, designation: str, pitch_radius_m: float,
@@ -505,7 +698,7 @@ class RerunRecorder:
             return
         bp = self.blueprint()
         for out in outs:
-            out.stream.send_blueprint(bp, make_active=True, make_default=True)
+            self._blueprints.send(bp, out.stream)
 
     # ---- the sink ---------------------------------------------------------------------------
     def publish(self, snapshot, positions_m: Any = None) -> None:
@@ -560,7 +753,8 @@ class RerunRecorder:
         return self._closed
 
     def flush(self, timeout_s: float = 30.0) -> None:
-        """Send everything queued or buffered now and wait until the outputs have written it."""
+        """Send everything queued or buffered now and wait until the outputs have written it;
+        then rotate the main file if its segment is due (old or large enough)."""
         with self._io_lock:
             self._drain_locked()
             self._send_locked()
@@ -569,6 +763,8 @@ class RerunRecorder:
                     out.stream.flush(timeout_sec=timeout_s)
                 except Exception as exc:  # noqa: BLE001
                     log.warning("rerun: flush of %s failed: %s", out.path or "viewer", exc)
+            if not self._closed and self._rotation_due():
+                self._rotate_locked()
 
     def close(self) -> None:
         """Drain the queue, send the rest, flush and disconnect every output (idempotent)."""
@@ -585,6 +781,7 @@ class RerunRecorder:
             self._send_locked()
             for out in self._outputs():
                 self._close_output(out)
+            self._viewer = None
             self._primary = None
             self._extra = None
 
@@ -607,6 +804,8 @@ class RerunRecorder:
                     self._drain_locked()
                     if time.monotonic() >= next_send:
                         self._send_locked()
+                        if self._rotation_due():
+                            self._rotate_locked()
                         next_send = time.monotonic() + self.flush_interval_s
             except Exception:  # never let the worker die
                 self._errors += 1
@@ -665,6 +864,8 @@ class RerunRecorder:
                     for out in outs:
                         out.stream.send_columns(path, indexes=indexes, columns=columns)
                 self._rows_logged += len(rows)
+                for out in outs:
+                    out.rows += len(rows)
             except Exception:
                 self._errors += len(rows)
                 log.exception("rerun recorder: %d rows of %s lost", len(rows), tw.bearing_id)
@@ -769,72 +970,102 @@ class RerunRecorder:
 
 
 # ---- reading a recording back -----------------------------------------------------------------
-def describe_recording(path: str | Path) -> dict:
-    """What an .rrd holds, read with `rerun.chunk.RrdReader`:
+PathOrPaths = str | Path | Iterable[str | Path]
 
-    {"application_id", "recording_id", "blueprints": number of blueprint stores,
-     "entities": {entity path (no leading slash): {"rows": temporal rows, "static_rows": n,
-                  "components": [...], "timelines": [...]}}}
-    """
+
+def _paths(path: PathOrPaths) -> list[Path]:
+    if isinstance(path, (str, Path)):
+        return [Path(path)]
+    return [Path(p) for p in path]
+
+
+def _reader(path: Path):
+    """`RrdReader` of one file; the "no footer" warning of a file written with
+    `write_footer=False` is expected here and silenced."""
     from rerun.chunk import RrdReader
 
-    reader = RrdReader(str(path))
-    recordings = reader.recordings()
-    info: dict = {"application_id": recordings[0].application_id if recordings else None,
-                  "recording_id": recordings[0].recording_id if recordings else None,
-                  "blueprints": len(reader.blueprints()), "entities": {}}
-    if not recordings:
-        return info
+    with warnings.catch_warnings():
+        warnings.filterwarnings("ignore", message=".*no footer.*")
+        return RrdReader(str(path))
+
+
+def describe_recording(path: PathOrPaths) -> dict:
+    """What an .rrd (or the segments of one recording, given as a list of paths) holds, read
+    with `rerun.chunk.RrdReader`:
+
+    {"application_id", "recording_id", "blueprints": number of blueprint stores,
+     "segments": number of files read,
+     "entities": {entity path (no leading slash): {"rows": temporal rows, "static_rows": n,
+                  "components": [...], "timelines": [...]}}}
+
+    Application and recording id are those of the first file; a later file of another recording
+    raises ValueError (segments of one recording share them).
+    """
+    info: dict = {"application_id": None, "recording_id": None, "blueprints": 0, "segments": 0, "entities": {}}
     entities: dict = info["entities"]
-    for chunk in reader.stream(store=recordings[0]):
-        entity = chunk.entity_path.lstrip("/")
-        e = entities.setdefault(entity, {"rows": 0, "static_rows": 0, "components": set(), "timelines": set()})
-        if chunk.is_static:
-            e["static_rows"] += chunk.num_rows
-        else:
-            e["rows"] += chunk.num_rows
-            e["timelines"].update(chunk.timeline_names)
-        schema = chunk.to_record_batch().schema
-        for f in schema:
-            meta = f.metadata or {}
-            comp = meta.get(b"rerun:component") or meta.get(b"rerun.component")
-            if comp is not None:
-                e["components"].add(comp.decode())
+    for p in _paths(path):
+        reader = _reader(p)
+        recordings = reader.recordings()
+        info["segments"] += 1
+        info["blueprints"] += len(reader.blueprints())
+        if not recordings:
+            continue
+        ids = (recordings[0].application_id, recordings[0].recording_id)
+        if info["recording_id"] is None:
+            info["application_id"], info["recording_id"] = ids
+        elif ids != (info["application_id"], info["recording_id"]):
+            raise ValueError(f"{p} holds recording {ids}, not {(info['application_id'], info['recording_id'])}")
+        for chunk in reader.stream(store=recordings[0]):
+            entity = chunk.entity_path.lstrip("/")
+            e = entities.setdefault(entity, {"rows": 0, "static_rows": 0, "components": set(), "timelines": set()})
+            if chunk.is_static:
+                e["static_rows"] += chunk.num_rows
+            else:
+                e["rows"] += chunk.num_rows
+                e["timelines"].update(chunk.timeline_names)
+            schema = chunk.to_record_batch().schema
+            for f in schema:
+                meta = f.metadata or {}
+                comp = meta.get(b"rerun:component") or meta.get(b"rerun.component")
+                if comp is not None:
+                    e["components"].add(comp.decode())
     for e in entities.values():
         e["components"] = sorted(e["components"])
         e["timelines"] = sorted(e["timelines"])
     return info
 
 
-def read_recording(path: str | Path) -> dict[str, int]:
+def read_recording(path: PathOrPaths) -> dict[str, int]:
     """{entity path (no leading slash, e.g. "bearing/a/friction_torque_n_m"): number of temporal
-    rows} of the first recording in an .rrd; entities with static data only map to 0; rerun's own
-    `__properties` entity is left out. Flush and disconnect (close the recorder) first."""
+    rows} of the first recording in an .rrd, or summed over the segments of one recording given
+    as a list (`read_recording(recording_segments(path))`); entities with static data only map to
+    0; rerun's own `__properties` entity is left out. Flush and disconnect (close the recorder)
+    first."""
     return {k: v["rows"] for k, v in describe_recording(path)["entities"].items()
             if not k.startswith("__")}
 
 
-def read_column(path: str | Path, entity: str, column: str) -> list:
+def read_column(path: PathOrPaths, entity: str, column: str) -> list:
     """The values of one column (a timeline such as "seq", or a component such as
     "Points3D:positions" / "Scalars:scalars") over the temporal rows of one entity, in the order
-    the rows were written, one item per row (a list for components, an int for "seq", integer
-    nanoseconds for "sim_time")."""
+    the rows were written (file after file for a list of segments), one item per row (a list for
+    components, an int for "seq", integer nanoseconds for "sim_time")."""
     import pyarrow as pa
-    from rerun.chunk import RrdReader
 
     want = "/" + entity.lstrip("/")
     values: list = []
-    for chunk in RrdReader(str(path)).stream():
-        if chunk.entity_path == want and not chunk.is_static:
-            batch = chunk.to_record_batch()
-            col = batch.column(batch.schema.get_field_index(column))
-            if pa.types.is_duration(col.type) or pa.types.is_timestamp(col.type):
-                col = col.cast(pa.int64())
-            values.extend(col.to_pylist())
+    for p in _paths(path):
+        for chunk in _reader(p).stream():
+            if chunk.entity_path == want and not chunk.is_static:
+                batch = chunk.to_record_batch()
+                col = batch.column(batch.schema.get_field_index(column))
+                if pa.types.is_duration(col.type) or pa.types.is_timestamp(col.type):
+                    col = col.cast(pa.int64())
+                values.extend(col.to_pylist())
     return values
 
 
-def read_index(path: str | Path, entity: str, timeline: str = SEQ) -> np.ndarray:
+def read_index(path: PathOrPaths, entity: str, timeline: str = SEQ) -> np.ndarray:
     """Sorted values of one timeline ("seq", or "sim_time" in integer nanoseconds) over the
-    temporal rows of one entity, e.g. the `seq` numbers that made it into the file."""
+    temporal rows of one entity, e.g. the `seq` numbers that made it into the file(s)."""
     return np.sort(np.array(read_column(path, entity, timeline), dtype=np.int64))

@@ -24,14 +24,17 @@ What it does, for `minutes` of wall time:
   other than 429, an acceptance of an invalid one;
 * with `--start` it launches `bearing-twin serve` on free loopback ports with a token and a
   recording in a temp dir, and at the end stops it with SIGTERM (bounded wait) and reads the
-  recording back (`service.recorder.read_recording`): complete = at least the rows the service
-  reported, no gap in the recorded `seq`.
+  recording back, every segment of it (`service.recorder.recording_segments`; `--record-segment-s`
+  sets the service's rotation period): complete = every segment readable on its own (one
+  recording id, the static geometry, a blueprint), together at least the rows the service
+  reported, no gap in the recorded `seq`, nothing recorded twice.
 
 `ok` (exit status 0) = no error, no seq gap, memory growth under `max_memory_growth_pct`, and
 with --start a clean exit and a complete recording. `--no-record` (with --start) runs the service
-without its rerun recording, to tell the service's own memory from the rerun SDK's: rerun-sdk
-0.41 keeps native memory for every `send_columns` to a file sink (about 1 MB/s at 50 snapshots/s
-here; README "Hardening").
+without its rerun recording, to tell the service's own memory from the rerun SDK's. (rerun-sdk
+0.41's file sink holds the RRD footer's chunk manifest in memory until the file closes, about
+1 MB/s at 50 snapshots/s here: the service writes its recording without a footer by default,
+`BEARING_TWIN_RECORD_FOOTER`; README "Hardening".)
 """
 
 from __future__ import annotations
@@ -80,6 +83,7 @@ class SoakConfig:
     publish_rate_hz: float | None = None
     keep_dir: bool = False
     record: bool = True            # with start: record (and check the recording) or --no-record
+    record_segment_s: float | None = None   # with start: the service's BEARING_TWIN_RECORD_SEGMENT_S [s]
     log: Any = field(default=None, repr=False)   # callable(str) for progress lines, or None
 
 
@@ -117,7 +121,8 @@ def _strict(text: bytes | str):
 class _Started:
     """`bearing-twin serve` as a subprocess on free loopback ports, token in its environment."""
 
-    def __init__(self, token: str, publish_rate_hz: float | None, log, record: bool = True):
+    def __init__(self, token: str, publish_rate_hz: float | None, log, record: bool = True,
+                 record_segment_s: float | None = None):
         self.dir = Path(tempfile.mkdtemp(prefix="bearing-twin-soak-"))
         self.port = _free_port()
         self.zenoh_endpoint = f"tcp/127.0.0.1:{_free_port()}"
@@ -130,6 +135,8 @@ class _Started:
             cmd += ["--publish-rate", str(publish_rate_hz)]
         env = {k: v for k, v in os.environ.items() if not k.startswith("BEARING_TWIN_")}
         env.update({"BEARING_TWIN_TOKEN": token, "PYTHONUNBUFFERED": "1"})
+        if record_segment_s is not None:
+            env["BEARING_TWIN_RECORD_SEGMENT_S"] = repr(float(record_segment_s))
         self._log_file = open(self.log_path, "wb")
         self.proc = subprocess.Popen(cmd, cwd=self.dir, env=env, stdout=self._log_file,
                                      stderr=subprocess.STDOUT)
@@ -349,7 +356,8 @@ def run_soak(cfg: SoakConfig) -> dict:
     stream = None
     try:
         if cfg.start:
-            started = _Started(token, cfg.publish_rate_hz, log, record=cfg.record)
+            started = _Started(token, cfg.publish_rate_hz, log, record=cfg.record,
+                               record_segment_s=cfg.record_segment_s)
             url, zenoh_endpoint = started.url, started.zenoh_endpoint
             started.wait_ready(client)
         report.update(url=url, zenoh=zenoh_endpoint)
@@ -580,21 +588,52 @@ def _memory(rss: list[tuple[float, int]], warmup: float, source: str | None) -> 
 
 
 def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_stream_seq: int | None) -> dict:
+    """Read every segment of the recording `path` once (see the module doc)."""
     out: dict[str, Any] = {"path": str(path), "rows_reported": rows_reported, "rows_read": None,
-                           "seq_gaps": None, "complete": False, "error": None}
+                           "seq_gaps": None, "duplicates": None, "segments": 0, "segment_files": [],
+                           "complete": False, "error": None}
     try:
-        from service.recorder import read_index, read_recording
+        import numpy as np
 
-        rows = read_recording(path)
-        entity = f"bearing/{bearing_id}/friction_torque_n_m"
-        out["rows_read"] = rows.get(entity, 0)
-        seqs = read_index(path, entity)
-        gaps = int((seqs[1:] - seqs[:-1] > 1).sum()) if len(seqs) > 1 else 0
+        from service.recorder import _reader, recording_segments
+
+        entity = f"/bearing/{bearing_id}/friction_torque_n_m"
+        static = f"/bearing/{bearing_id}/geometry/inner_raceway"
+        segments = recording_segments(path)
+        if not segments:
+            raise FileNotFoundError(f"{path}: no recording")
+        seqs: list = []
+        recording_ids = set()
+        segments_ok = True
+        for seg in segments:
+            reader = _reader(seg)
+            recordings = reader.recordings()
+            info = {"file": seg.name, "bytes": seg.stat().st_size, "rows": 0, "blueprints": len(reader.blueprints()),
+                    "static_geometry": False, "recording_id": recordings[0].recording_id if recordings else None}
+            if recordings:
+                recording_ids.add(info["recording_id"])
+                for chunk in reader.stream(store=recordings[0]):
+                    if chunk.entity_path == static and chunk.is_static:
+                        info["static_geometry"] = True
+                    elif chunk.entity_path == entity and not chunk.is_static:
+                        info["rows"] += chunk.num_rows
+                        batch = chunk.to_record_batch()
+                        seqs.extend(batch.column(batch.schema.get_field_index("seq")).to_pylist())
+            segments_ok &= bool(recordings and info["blueprints"] and info["static_geometry"])
+            out["segment_files"].append(info)
+        out["segments"] = len(segments)
+        out["recording_ids"] = len(recording_ids)
+        s = np.sort(np.array(seqs, dtype=np.int64))
+        out["rows_read"] = len(s)
+        d = s[1:] - s[:-1] if len(s) > 1 else np.zeros(0, dtype=np.int64)
+        gaps = int((d > 1).sum())
         out["seq_gaps"] = gaps
-        out["first_seq"] = int(seqs[0]) if len(seqs) else None
-        out["last_seq"] = int(seqs[-1]) if len(seqs) else None
-        out["complete"] = bool(out["rows_read"] >= max(rows_reported, 1) and gaps == 0
-                               and (last_stream_seq is None or (len(seqs) and int(seqs[-1]) >= last_stream_seq)))
+        out["duplicates"] = int((d == 0).sum())
+        out["first_seq"] = int(s[0]) if len(s) else None
+        out["last_seq"] = int(s[-1]) if len(s) else None
+        out["complete"] = bool(segments_ok and len(recording_ids) == 1 and out["rows_read"] >= max(rows_reported, 1)
+                               and gaps == 0 and out["duplicates"] == 0
+                               and (last_stream_seq is None or (len(s) and int(s[-1]) >= last_stream_seq)))
     except Exception as exc:
         out["error"] = f"{type(exc).__name__}: {exc}"
     return out
@@ -666,8 +705,10 @@ def format_report(r: dict) -> str:
         lines.append(f"  SIGTERM: exit {sd['exit_code']} after {sd['seconds']} s{' (killed)' if sd['killed'] else ''}")
     if r.get("recording"):
         rec = r["recording"]
-        lines.append(f"  recording {rec['path']}: {rec['rows_read']} rows read back, {rec['rows_reported']} "
-                     f"reported, seq gaps {rec['seq_gaps']}, complete {rec['complete']}"
+        mb = sum(f["bytes"] for f in rec.get("segment_files", [])) / 1e6
+        lines.append(f"  recording {rec['path']}: {rec.get('segments', 1)} segment(s), {mb:.1f} MB, "
+                     f"{rec['rows_read']} rows read back, {rec['rows_reported']} "
+                     f"reported, seq gaps {rec['seq_gaps']}, duplicates {rec.get('duplicates')}, complete {rec['complete']}"
                      + (f", error {rec['error']}" if rec.get("error") else ""))
     for u in r.get("unexpected", [])[:10]:
         lines.append(f"  unexpected: {u}")
@@ -697,6 +738,9 @@ def add_soak_command(sub) -> None:
     p.add_argument("--keep", action="store_true", help="with --start: keep the temp dir (recording, service log)")
     p.add_argument("--no-record", action="store_true", help="with --start: run the service without its recording "
                    "(to tell the service's own memory from the rerun SDK's)")
+    p.add_argument("--record-segment-s", type=float, metavar="SECONDS",
+                   help="with --start: the service's recording rotation period [s] (BEARING_TWIN_RECORD_SEGMENT_S; "
+                   "default: the service's, 600 s)")
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=_cmd_soak)
 
@@ -705,6 +749,9 @@ def _cmd_soak(args) -> int:
     if not (0 < args.minutes <= 7 * 24 * 60):
         print("error: --minutes must be in (0, 10080]", file=sys.stderr)
         return 2
+    if args.record_segment_s is not None and not (0.0 <= args.record_segment_s < float("inf")):
+        print("error: --record-segment-s is a period in seconds >= 0 (0 = no rotation by age)", file=sys.stderr)
+        return 2
     if not (0.0 <= args.invalid <= 1.0):
         print("error: --invalid is a share in [0, 1]", file=sys.stderr)
         return 2
@@ -712,7 +759,7 @@ def _cmd_soak(args) -> int:
                      token=args.token or os.environ.get("BEARING_TWIN_TOKEN") or None, start=args.start,
                      bearing_id=args.twin_id, rate_hz=args.rate, invalid_fraction=args.invalid,
                      sample_s=args.sample, seed=args.seed, max_memory_growth_pct=args.max_memory_growth,
-                     keep_dir=args.keep, record=not args.no_record, log=lambda line: print(line, file=sys.stderr, flush=True))
+                     keep_dir=args.keep, record=not args.no_record, record_segment_s=args.record_segment_s, log=lambda line: print(line, file=sys.stderr, flush=True))
     try:
         report = run_soak(cfg)
     except (RuntimeError, ValueError) as exc:

@@ -80,7 +80,15 @@ def open_recorder(settings: ServiceSettings):
     path = settings.recording_path
     if path is None and not settings.spawn_viewer:
         return None
-    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer)
+    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer, **recorder_options(settings))
+
+
+def recorder_options(settings: ServiceSettings) -> dict:
+    """Send interval, segment rotation and footer of every recording the service writes."""
+    return dict(flush_interval_s=settings.record_flush_interval_s,
+                segment_s=settings.record_segment_s or None,
+                segment_bytes=round(settings.record_segment_mb * 1e6) or None,
+                write_footer=settings.record_footer)
 
 
 @dataclass
@@ -316,7 +324,7 @@ class TwinService:
             if target.exists() and not target.is_file():
                 raise InputError.one("path", f"{str(target)!r} exists and is not a file")
             try:
-                rec = recorder_cls(target)
+                rec = recorder_cls(target, **recorder_options(self.settings))
             except (OSError, RuntimeError, ValueError) as exc:   # e.g. a folder that is a file
                 raise InputError.one("path", f"cannot record to {str(target)!r}: "
                                      f"{' '.join(str(exc).split())[:200]}") from None

@@ -17,7 +17,13 @@ zenoh = pytest.importorskip("zenoh")
 pytest.importorskip("rerun")
 
 from service.bus import make_config
-from service.recorder import read_index, read_recording
+from service.recorder import (
+    _reader,
+    describe_recording,
+    read_index,
+    read_recording,
+    recording_segments,
+)
 
 TOKEN = "shutdown-test-token"
 AUTH = {"Authorization": f"Bearer {TOKEN}"}
@@ -128,3 +134,34 @@ def test_kill_9_keeps_closed_recordings_and_restarts_on_the_same_ports(hostile, 
         second.kill()
     assert read_recording(tmp_path / "second.rrd")[TORQUE] > 0
     json.dumps(rows)
+
+
+def test_sigterm_closes_the_open_segment_of_a_rotating_recording(hostile, tmp_path):
+    """The service-wide recording rotates (BEARING_TWIN_RECORD_SEGMENT_S, here 1 s): SIGTERM closes
+    the open segment; the segments together hold every row the service counted, each once, and
+    each is a complete recording of its own (same recording id, static geometry, blueprint)."""
+    rrd = tmp_path / "rot.rrd"
+    svc = hostile.ServeProcess(tmp_path, record=rrd, env={"BEARING_TWIN_RECORD_SEGMENT_S": "1",
+                                                          "BEARING_TWIN_RECORD_FOOTER": "true"})
+    try:
+        with httpx.Client(base_url=svc.url, timeout=30.0) as c:
+            hostile.wait_for(lambda: len(recording_segments(rrd)), lambda n: n >= 3, timeout=60)
+            rows_before = c.get("/health").json()["recording_rows"]
+        svc.signal(signal.SIGTERM, timeout=EXIT_BOUND_S)
+        assert svc.proc.returncode in (0, -signal.SIGTERM), svc.text
+        assert "Traceback" not in svc.text, svc.text
+    finally:
+        svc.kill()
+    segs = recording_segments(rrd)
+    assert len(segs) >= 3
+    ids = set()
+    for seg in segs:
+        info = describe_recording(seg)
+        ids.add(info["recording_id"])
+        assert info["blueprints"] >= 1 and "bearing/default/geometry/inner_raceway" in info["entities"], seg
+        _reader(seg).store()        # footer on: every segment, the last one too, was closed properly
+    assert len(ids) == 1
+    rows = read_recording(segs)
+    seqs = read_index(segs, TORQUE)
+    assert rows[TORQUE] >= rows_before and rows["bearing/default/balls"] == rows[TORQUE] == len(seqs)
+    assert len(set(seqs.tolist())) == len(seqs) and int((seqs[1:] - seqs[:-1] > 1).sum()) == 0

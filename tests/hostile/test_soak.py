@@ -19,8 +19,9 @@ from service.soak import SoakConfig, _memory, format_report, run_soak
 def test_soak_short_run_with_its_own_service(hostile, tmp_path):
     pytest.importorskip("zenoh")
     pytest.importorskip("rerun")
+    # the service's recording rotates every 4 s: the check reads every segment back
     cmd = [sys.executable, "-m", "service.cli", "soak", "--minutes", "0.3", "--start", "--json",
-           "--seed", "7", "--rate", "12"]
+           "--seed", "7", "--rate", "12", "--record-segment-s", "4"]
     proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=300)
     assert proc.stdout.strip(), proc.stderr
     r = json.loads(proc.stdout)
@@ -44,6 +45,9 @@ def test_soak_short_run_with_its_own_service(hostile, tmp_path):
     assert r["shutdown"]["exit_code"] in (0, -15) and not r["shutdown"]["killed"], detail
     rec = r["recording"]
     assert rec["complete"] and rec["rows_read"] >= rec["rows_reported"] > 0 and rec["seq_gaps"] == 0, detail
+    assert rec["segments"] >= 2 and rec["duplicates"] == 0 and rec["recording_ids"] == 1, detail
+    assert all(f["blueprints"] and f["static_geometry"] for f in rec["segment_files"]), detail
+    assert sum(f["rows"] for f in rec["segment_files"]) == rec["rows_read"], detail
     assert r.get("service_dir_removed")
     assert "OK" in format_report(r) or r["failures"], detail
 
@@ -76,3 +80,36 @@ def test_soak_refuses_unbounded_runs():
     proc = subprocess.run([sys.executable, "-m", "service.cli", "soak", "--minutes", "0"],
                           capture_output=True, text=True, timeout=60)
     assert proc.returncode == 2 and "--minutes" in proc.stderr
+
+
+def _segmented_recording(tmp_path, groups):
+    """A recording of `groups` snapshots per segment, rotated with `rotate()`."""
+    from service.recorder import RerunRecorder
+    from twin.engine import Twin
+
+    twin = Twin("6208", bearing_id="default")
+    rec = RerunRecorder(tmp_path / "soak.rrd", flush_interval_s=1e6)
+    rec.add_twin_from(twin)
+    for i, g in enumerate(groups):
+        if i:
+            rec.rotate()
+        for _ in range(g):
+            twin.advance(0.002)
+            rec.publish(twin.snapshot())
+    rec.close()
+    return rec
+
+
+def test_recording_check_reads_every_segment(tmp_path):
+    pytest.importorskip("rerun")
+    from service.soak import _check_recording
+
+    rec = _segmented_recording(tmp_path, (4, 6, 5))
+    r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None)
+    assert r["error"] is None and r["complete"], r
+    assert r["segments"] == 3 and [f["rows"] for f in r["segment_files"]] == [4, 6, 5]
+    assert r["rows_read"] == 15 and r["seq_gaps"] == 0 and r["duplicates"] == 0 and r["recording_ids"] == 1
+    # a lost segment in the middle: a gap, incomplete
+    rec.segments[1].rename(tmp_path / "soak-0001.rrd.bak")
+    r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None)
+    assert r["segments"] == 1 and not r["complete"]

@@ -12,10 +12,13 @@ import pytest
 
 from service.recorder import (
     RerunRecorder,
+    _reader,
     describe_recording,
     read_column,
     read_index,
     read_recording,
+    recording_segments,
+    segment_path,
 )
 from twin.engine import Twin
 
@@ -330,3 +333,217 @@ def test_spawn_viewer_headless_falls_back_to_file(tmp_path, twin_a, monkeypatch,
     rec2.close()
     assert read_recording(tmp_path / "headless.rrd")["bearing/a/balls"] == 3
     assert read_recording(tmp_path / "noviewer.rrd")["bearing/a/balls"] == 3
+
+
+# ---- segments (rotation of the main file) ------------------------------------------------------
+# The rotation is checked after each send; `flush()` sends, waits until the file holds it, then
+# rotates if due, so with tiny thresholds every flush that wrote rows closes a segment: the number
+# of segments does not depend on timing (the worker never sends: flush_interval_s is huge).
+GROUPS = (7, 13, 1, 19)     # snapshots per segment (sum = N)
+
+
+def _segmented(path, twin, **kw) -> RerunRecorder:
+    return _recorder(path, twin, flush_interval_s=1e6, **kw)
+
+
+def _publish_in_groups(rec, snaps, groups=GROUPS) -> None:
+    assert sum(groups) == len(snaps)
+    i = 0
+    for g in groups:
+        for s in snaps[i:i + g]:
+            rec.publish(s)
+        i += g
+        rec.flush()
+
+
+def _assert_segments_complete(segs, snaps, groups=GROUPS) -> None:
+    """Every segment is a complete recording on its own (one recording id, the static geometry,
+    the series styles, a blueprint) holding exactly its group of rows; together they hold every
+    row once."""
+    assert [p.name for p in segs[1:]] == [f"run-{i:04d}.rrd" for i in range(1, len(segs))]
+    ids = set()
+    start = 0
+    for seg, g in zip(segs, groups, strict=True):
+        info = describe_recording(seg)
+        ids.add((info["application_id"], info["recording_id"]))
+        assert info["blueprints"] >= 1, seg
+        ent = info["entities"]
+        assert ent["bearing/a/geometry/inner_raceway"]["static_rows"] == 1, seg
+        assert ent["bearing/a/friction_torque_n_m"]["static_rows"] >= 1, seg       # series style
+        assert list(read_index(seg, "bearing/a/balls")) == [s.seq for s in snaps[start:start + g]], seg
+        _assert_tree(read_recording(seg), "a", snaps[start:start + g])
+        start += g
+    assert len(ids) == 1
+    # across the boundaries: per entity, the rows of all segments = the snapshots published
+    rows = read_recording(segs)
+    _assert_tree(rows, "a", snaps)
+    assert list(read_index(segs, "bearing/a/friction_torque_n_m")) == [s.seq for s in snaps]
+    assert read_column(segs, "bearing/a/friction_torque_n_m", "sim_time") == [round(s.time_s * 1e9) for s in snaps]
+    assert describe_recording(segs)["segments"] == len(segs)
+
+
+@pytest.mark.parametrize("footer", [False, True], ids=["no-footer", "footer"])
+def test_rotation_by_size_loses_no_row(tmp_path, twin_a, footer):
+    twin, snaps = twin_a
+    path = tmp_path / "run.rrd"
+    rec = _segmented(path, twin, segment_bytes=1, write_footer=footer)
+    _publish_in_groups(rec, snaps[:sum(GROUPS[:-1])], GROUPS[:-1])   # three segments closed by flush
+    assert rec.segments == [segment_path(path, i) for i in range(4)]
+    assert rec.current_path == segment_path(path, 3)
+    for s in snaps[sum(GROUPS[:-1]):]:
+        rec.publish(s)
+    rec.close()              # the shutdown path: drains, sends and closes the open segment
+    assert rec.current_path is None and rec.segments == recording_segments(path)
+    assert rec.rows_logged == N and rec.dropped == 0 and rec.errors == 0
+    segs = recording_segments(path)
+    assert len(segs) == 4
+    _assert_segments_complete(segs, snaps)
+    for seg in segs:
+        if footer:      # the footer (manifest) is written when a segment is closed: it is, each one
+            _reader(seg).store()
+        else:
+            with pytest.raises(RuntimeError, match="footer"):
+                _reader(seg).store()
+
+
+def test_rotation_by_age_and_explicit(tmp_path, twin_a):
+    twin, snaps = twin_a
+    path = tmp_path / "run.rrd"
+    rec = _segmented(path, twin, segment_s=1e-9)       # due as soon as a segment holds a row
+    _publish_in_groups(rec, snaps[:20], (7, 13))
+    assert len(rec.segments) == 3
+    rec.flush()                                     # no row since the rotation: no empty segment
+    assert len(rec.segments) == 3
+    rec.close()
+    segs = recording_segments(path)
+    assert len(segs) == 3 and read_recording(segs[-1]).get("bearing/a/balls", 0) == 0
+    _assert_segments_complete(segs[:2], snaps[:20], (7, 13))
+
+    rec = _segmented(tmp_path / "x.rrd", twin)             # no thresholds: rotates on request only
+    for s in snaps[:5]:
+        rec.publish(s)
+    rec.flush()
+    assert rec.segments == [tmp_path / "x.rrd"]
+    assert rec.rotate() == tmp_path / "x-0001.rrd"
+    with pytest.raises(ValueError):
+        rec.start_file(tmp_path / "x-0001.rrd")       # a segment is not a free file
+    for s in snaps[5:9]:
+        rec.publish(s)
+    rec.close()
+    assert rec.rotate() is None
+    assert [read_recording(p)["bearing/a/friction_torque_n_m"] for p in recording_segments(tmp_path / "x.rrd")] == [5, 4]
+
+
+def test_rotation_happens_in_the_worker(tmp_path, twin_a):
+    """Without flush(): the worker sends every flush_interval_s and rotates when due."""
+    twin, snaps = twin_a
+    path = tmp_path / "run.rrd"
+    rec = _recorder(path, twin, flush_interval_s=0.01, segment_bytes=1)
+    for s in snaps[:10]:
+        rec.publish(s)
+    deadline = time.monotonic() + 30.0        # a liveness bound, not a performance figure
+    while len(rec.segments) < 2 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    for s in snaps[10:]:
+        rec.publish(s)
+    rec.close()
+    segs = recording_segments(path)
+    assert len(segs) >= 2 and rec.rows_logged == N
+    _assert_tree(read_recording(segs), "a", snaps)
+    assert list(read_index(segs, "bearing/a/balls")) == [s.seq for s in snaps]
+
+
+def test_segment_names_and_stale_segments(tmp_path, twin_a):
+    twin, snaps = twin_a
+    path = tmp_path / "run.rrd"
+    assert segment_path(path, 0) == path and segment_path(path, 12) == tmp_path / "run-0012.rrd"
+    assert recording_segments(path) == []
+    # with rotation on, segments of an earlier, longer recording to the same name are removed
+    # (run.rrd itself is overwritten), other files are left alone; without rotation nothing is
+    for name in ("run-0001.rrd", "run-0002.rrd", "run-0003.rrd", "run-x.rrd", "run-0001.txt", "other-0001.rrd"):
+        (tmp_path / name).write_bytes(b"old")
+    _segmented(path, twin).close()
+    assert (tmp_path / "run-0002.rrd").exists()
+    rec = _segmented(path, twin, segment_bytes=1)
+    assert not (tmp_path / "run-0002.rrd").exists() and not (tmp_path / "run-0003.rrd").exists()
+    assert all((tmp_path / n).exists() for n in ("run-x.rrd", "run-0001.txt", "other-0001.rrd"))
+    _publish_in_groups(rec, snaps[:10], (10,))
+    rec.close()
+    assert recording_segments(path) == [path, tmp_path / "run-0001.rrd"]
+    # a missing number ends the list
+    (tmp_path / "run-0003.rrd").write_bytes(b"x")
+    assert recording_segments(path) == [path, tmp_path / "run-0001.rrd"]
+    with pytest.raises(ValueError):
+        RerunRecorder(path, segment_s=-1.0)
+    with pytest.raises(ValueError):
+        RerunRecorder(path, segment_bytes=-5)
+
+
+def test_service_settings_reach_the_recorder(tmp_path, monkeypatch):
+    from service.settings import ServiceSettings
+    from service.wiring import open_recorder
+
+    s = ServiceSettings(record=tmp_path / "svc.rrd", enable_zenoh=False)
+    assert s.record_segment_s == 600.0 and s.record_segment_mb == 1000.0 and s.record_footer is False
+    rec = open_recorder(s)
+    try:
+        assert rec.segment_s == 600.0 and rec.segment_bytes == 1_000_000_000 and rec.write_footer is False
+        assert rec.flush_interval_s == 0.1
+    finally:
+        rec.close()
+    monkeypatch.setenv("BEARING_TWIN_RECORD_SEGMENT_S", "0")
+    monkeypatch.setenv("BEARING_TWIN_RECORD_SEGMENT_MB", "0.5")
+    monkeypatch.setenv("BEARING_TWIN_RECORD_FOOTER", "true")
+    s = ServiceSettings(record=tmp_path / "svc2.rrd", enable_zenoh=False)
+    rec = open_recorder(s)
+    try:
+        assert rec.segment_s is None and rec.segment_bytes == 500_000 and rec.write_footer is True
+    finally:
+        rec.close()
+
+
+def _threads() -> int:
+    import os
+
+    return len(os.listdir("/proc/self/task"))
+
+
+def test_rotation_keeps_one_stream_and_closes_the_old_segment_at_once(tmp_path, twin_a):
+    """rerun-sdk 0.41 never frees a RecordingStream (its threads keep running): the rotation
+    re-points the same stream (and the same blueprint stream) at the next file, so rotating adds
+    no thread; and the segment it leaves is closed right away (its footer is written)."""
+    pytest.importorskip("rerun")
+    import os
+
+    if not os.path.isdir("/proc/self/task"):
+        pytest.skip("counts threads in /proc")
+    twin, snaps = twin_a
+    path = tmp_path / "run.rrd"
+    rec = _segmented(path, twin, segment_bytes=1, write_footer=True)
+    rec.publish(snaps[0])
+    rec.flush()                                   # first rotation: blueprint stream created
+    before = _threads()
+    for i in range(1, 31):
+        rec.publish(snaps[i % N])
+        rec.flush()
+        _reader(rec.segments[-2]).store()         # the segment just left is complete (footer)
+    assert len(rec.segments) == 32
+    assert _threads() - before <= 1
+    rec.close()
+    assert read_recording(recording_segments(path))["bearing/a/balls"] == 31
+
+
+def test_a_failed_rotation_keeps_writing_the_open_segment(tmp_path, twin_a):
+    twin, snaps = twin_a
+    path = tmp_path / "run.rrd"
+    (tmp_path / "run-0001.rrd").mkdir()           # the next segment cannot be created
+    rec = _segmented(path, twin)
+    for s in snaps[:5]:
+        rec.publish(s)
+    assert rec.rotate() is None and rec.errors == 1
+    assert rec.segments == [path] and rec.current_path == path
+    for s in snaps[5:12]:
+        rec.publish(s)
+    rec.close()
+    assert read_recording(recording_segments(path))["bearing/a/friction_torque_n_m"] == 12
+    assert list(read_index(path, "bearing/a/balls")) == [s.seq for s in snaps[:12]]
