@@ -550,6 +550,7 @@ class RerunRecorder:
         self._segments.append(path)
         for tw in self._twins.values():             # the new segment is complete on its own
             self._send_static(out, tw)
+            tw.last_status = tw.last_discharge = None  # its first rows log the status and risk again
         self._send_blueprint([out])
         log.info("rerun: segment %s closed (%d snapshots), recording into %s", old_path, old_rows, path)
         return path

@@ -316,8 +316,11 @@ class TwinService:
 
     def start_recording(self, entry: TwinEntry, path: str | None) -> Path:
         target = self.resolve_recording_path(entry.id, path)
-        if self.settings.recording_path is not None and target.resolve() == Path(self.settings.recording_path).resolve():
-            raise InputError.one("path", f"{str(target)!r} is the service-wide recording")
+        if self.settings.recording_path is not None:
+            main = Path(self.settings.recording_path).resolve()
+            t = target.resolve()
+            if t == main or (t.parent == main.parent and re.fullmatch(re.escape(main.stem) + r"-\d{4,}\.rrd", t.name)):
+                raise InputError.one("path", f"{str(target)!r} is the service-wide recording or one of its segments")
         recorder_cls = _recorder_class()
         with self._recording_lock:
             self.stop_recording(entry)

@@ -146,6 +146,9 @@ def test_sigterm_closes_the_open_segment_of_a_rotating_recording(hostile, tmp_pa
     try:
         with httpx.Client(base_url=svc.url, timeout=30.0) as c:
             hostile.wait_for(lambda: len(recording_segments(rrd)), lambda n: n >= 3, timeout=60)
+            # a per-twin recording may not take the name of a future segment of the service-wide one
+            clash = c.post("/v1/bearings/default/recording", json={"action": "start", "path": "rot-0042.rrd"})
+            assert clash.status_code == 422 and clash.json()["detail"][0]["field"] == "path", clash.text
             rows_before = c.get("/health").json()["recording_rows"]
         svc.signal(signal.SIGTERM, timeout=EXIT_BOUND_S)
         assert svc.proc.returncode in (0, -signal.SIGTERM), svc.text
@@ -159,6 +162,7 @@ def test_sigterm_closes_the_open_segment_of_a_rotating_recording(hostile, tmp_pa
         info = describe_recording(seg)
         ids.add(info["recording_id"])
         assert info["blueprints"] >= 1 and "bearing/default/geometry/inner_raceway" in info["entities"], seg
+        assert "bearing/default/status" in info["entities"], seg   # each segment logs the status again
         _reader(seg).store()        # footer on: every segment, the last one too, was closed properly
     assert len(ids) == 1
     rows = read_recording(segs)
