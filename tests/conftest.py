@@ -1,1 +1,26 @@
 """Shared fixtures. Physics tests cite the seed equation, table or figure they reproduce."""
+
+import importlib.util
+from pathlib import Path
+
+import pytest
+
+
+def _load_support():
+    # --import-mode=importlib and no tests/__init__.py: tests/support.py is not importable by
+    # name from test modules, so it is loaded by path here and shared as a fixture
+    spec = importlib.util.spec_from_file_location("bearing_twin_test_support",
+                                                  Path(__file__).with_name("support.py"))
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+_SUPPORT = _load_support()
+
+
+@pytest.fixture(scope="session")
+def support():
+    """tests/support.py: `Peer` (zenoh test peer), `ThreadServer` (uvicorn in a thread),
+    `wait_for` (bounded polling), `free_port`, `free_endpoint`, `strict_loads`."""
+    return _SUPPORT

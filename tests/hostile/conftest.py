@@ -1,11 +1,11 @@
-"""Helpers of the hostile-input, fault and long-run tests (issue 6): a uvicorn server in a thread
-and `bearing-twin serve` as a subprocess, both on 127.0.0.1 free ports; zenoh peers with
-multicast scouting off. Every wait is bounded. Exposed as fixtures (pytest runs with
---import-mode=importlib, so test modules do not import each other)."""
+"""Helpers of the hostile-input, fault and long-run tests (issue 6): `bearing-twin serve` as a
+subprocess on 127.0.0.1 free ports, plus the shared uvicorn-in-a-thread server and zenoh peer
+(multicast scouting off) of tests/support.py. Every wait is bounded. Exposed as fixtures (pytest
+runs with --import-mode=importlib, so test modules do not import each other)."""
 
 from __future__ import annotations
 
-import json
+import functools
 import os
 import queue
 import re
@@ -28,60 +28,6 @@ def free_port() -> int:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
         s.bind(("127.0.0.1", 0))
         return s.getsockname()[1]
-
-
-def strict_loads(payload) -> object:
-    """json.loads that fails on NaN / Infinity literals."""
-    def reject(name):
-        raise AssertionError(f"JSON carries {name}")
-    return json.loads(payload, parse_constant=reject)
-
-
-def wait_for(fetch, predicate, timeout=WAIT_S, interval=0.02):
-    deadline = time.monotonic() + timeout
-    while True:
-        value = fetch()
-        if predicate(value):
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"condition not met within {timeout} s; last value {value!r}")
-        time.sleep(interval)
-
-
-class ThreadServer:
-    """uvicorn in a thread on 127.0.0.1, port 0 (read back); `.app` is the FastAPI app."""
-
-    def __init__(self, settings):
-        import uvicorn
-
-        from service.app import create_app
-
-        self.app = create_app(settings)
-        config = uvicorn.Config(self.app, host="127.0.0.1", port=0, log_level="warning",
-                                lifespan="on", timeout_graceful_shutdown=2)
-        self.server = uvicorn.Server(config)
-        self.thread = threading.Thread(target=self.server.run, daemon=True)
-        self.url = None
-
-    @property
-    def service(self):
-        return self.app.state.service
-
-    def __enter__(self) -> ThreadServer:
-        self.thread.start()
-        deadline = time.monotonic() + 90.0
-        while not self.server.started:
-            if not self.thread.is_alive() or time.monotonic() > deadline:
-                raise RuntimeError("uvicorn did not start")
-            time.sleep(0.02)
-        port = self.server.servers[0].sockets[0].getsockname()[1]
-        self.url = f"http://127.0.0.1:{port}"
-        return self
-
-    def __exit__(self, *exc):
-        self.server.should_exit = True
-        self.thread.join(20.0)
-        assert not self.thread.is_alive(), "uvicorn did not stop"
 
 
 class ServeProcess:
@@ -143,64 +89,15 @@ class ServeProcess:
             self.proc.wait(15)
 
 
-class Peer:
-    """A zenoh peer connected to one endpoint, multicast scouting off."""
-
-    def __init__(self, endpoint: str):
-        import zenoh
-
-        from service.bus import make_config
-
-        self.session = zenoh.open(make_config([], [endpoint], "peer"))
-        self.inbox: queue.Queue = queue.Queue()
-        self._subs = []
-
-    def subscribe(self, keyexpr: str):
-        def cb(sample):
-            self.inbox.put((str(sample.key_expr), sample.payload.to_bytes()))
-        self._subs.append(self.session.declare_subscriber(keyexpr, cb))
-
-    def wait_for(self, predicate, timeout_s: float = WAIT_S):
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            try:
-                item = self.inbox.get(timeout=0.1)
-            except queue.Empty:
-                continue
-            if predicate(item):
-                return item
-        raise AssertionError("timed out waiting for a zenoh message")
-
-    def result_after(self, key: str, payload, bearing_id: str = "default", timeout_s: float = WAIT_S) -> dict:
-        """Put a setpoint and return the next message on its result key."""
-        self.drain()
-        self.session.put(key, payload)
-        _, data = self.wait_for(lambda item: item[0] == f"bearing/{bearing_id}/setpoint/result", timeout_s)
-        return strict_loads(data)
-
-    def drain(self) -> None:
-        while True:
-            try:
-                self.inbox.get_nowait()
-            except queue.Empty:
-                return
-
-    def close(self):
-        for sub in self._subs:
-            try:
-                sub.undeclare()
-            except Exception:
-                pass
-        self.session.close()
-
-
 @pytest.fixture(scope="session")
-def hostile():
-    """The helpers as one namespace (fixtures cannot be imported across test modules here)."""
+def hostile(support):
+    """The helpers as one namespace (fixtures cannot be imported across test modules here);
+    `ThreadServer`, `Peer`, `strict_loads` and `wait_for` are the shared ones of tests/support.py."""
     class H:
         pass
     h = H()
     h.REPO, h.SCENARIOS, h.WAIT_S = REPO, SCENARIOS, WAIT_S
-    h.free_port, h.strict_loads, h.wait_for = free_port, strict_loads, wait_for
-    h.ThreadServer, h.ServeProcess, h.Peer = ThreadServer, ServeProcess, Peer
+    h.free_port, h.strict_loads = free_port, support.strict_loads
+    h.wait_for = functools.partial(support.wait_for, timeout=WAIT_S)
+    h.ThreadServer, h.ServeProcess, h.Peer = support.ThreadServer, ServeProcess, support.Peer
     return h

@@ -285,7 +285,7 @@ def test_nasty_payloads_through_a_real_zenoh_session(hostile):
             states = []
             deadline = time.monotonic() + 30
             while len(states) < 5 and time.monotonic() < deadline:
-                key, data = peer.wait_for(lambda item: True)
+                key, _, data = peer.wait_for(lambda item: True)
                 if key == "bearing/default/state":
                     states.append(hostile.strict_loads(data))
             assert len(states) >= 5 and states[-1]["seq"] > states[0]["seq"]

@@ -16,7 +16,6 @@ import pytest
 zenoh = pytest.importorskip("zenoh")
 pytest.importorskip("rerun")
 
-from service.bus import make_config
 from service.recorder import (
     _reader,
     describe_recording,
@@ -45,18 +44,15 @@ def test_signal_flushes_recordings_and_closes_zenoh(hostile, tmp_path, sig):
         # the service said where it binds and that a token is required
         assert f"HTTP on http://127.0.0.1:{svc.port} (loopback only" in svc.text
         assert "access: bearer token required" in svc.text
-        peer_session = zenoh.open(make_config([], [svc.zenoh_endpoint], "peer"))
-        peer = peer_session
-        alive_events = []
-        sub = peer_session.liveliness().declare_subscriber(
-            "bearing/*/alive", lambda s: alive_events.append((str(s.key_expr), s.kind)), history=True)
+        peer = hostile.Peer(svc.zenoh_endpoint)
+        peer.subscribe("bearing/*/alive", liveliness=True)
         with httpx.Client(base_url=svc.url, timeout=30.0) as c:
             assert c.post("/v1/bearings/default/recording", json={"action": "start", "path": "clip.rrd"},
                           headers=AUTH).status_code == 200
             assert c.put("/v1/bearings/default/setpoint", json={"radial_load_n": 4000.0}, headers=AUTH).status_code == 200
             hostile.wait_for(lambda: c.get("/health").json(), lambda h: h["recording_rows"] >= 20, timeout=60)
             rows_before = c.get("/health").json()["recording_rows"]
-        hostile.wait_for(lambda: list(alive_events), lambda ev: any(k == "bearing/default/alive" for k, _ in ev))
+        peer.wait_for(lambda item: item.key == "bearing/default/alive")
 
         took = svc.signal(sig, timeout=EXIT_BOUND_S)
         # uvicorn re-raises the signal after its graceful shutdown: SIGTERM ends the process
@@ -65,10 +61,8 @@ def test_signal_flushes_recordings_and_closes_zenoh(hostile, tmp_path, sig):
         log = svc.text
         assert "Application shutdown complete" in log and "Traceback" not in log, log
         # zenoh was closed properly: the twin's liveliness token was withdrawn
-        hostile.wait_for(lambda: list(alive_events),
-                         lambda ev: any(k == "bearing/default/alive" and kind == zenoh.SampleKind.DELETE
-                                        for k, kind in ev), timeout=10)
-        sub.undeclare()
+        peer.wait_for(lambda item: item.key == "bearing/default/alive" and item.kind == zenoh.SampleKind.DELETE,
+                      timeout_s=10)
     finally:
         if peer is not None:
             peer.close()
@@ -119,7 +113,7 @@ def test_kill_9_keeps_closed_recordings_and_restarts_on_the_same_ports(hostile, 
         peer = hostile.Peer(endpoint)
         try:
             peer.subscribe("bearing/default/state")
-            _, data = peer.wait_for(lambda item: item[0] == "bearing/default/state", timeout_s=60)
+            _, _, data = peer.wait_for(lambda item: item[0] == "bearing/default/state", timeout_s=60)
             state = hostile.strict_loads(data)
             assert state["restarts"] == 0 and state["status"] == "ok"
         finally:

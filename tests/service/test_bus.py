@@ -8,7 +8,6 @@ from __future__ import annotations
 import io
 import json
 import queue
-import socket
 import threading
 import time
 
@@ -22,12 +21,6 @@ from twin.engine import Twin
 from twin.setpoint import SetpointUpdate
 
 WAIT_S = 10.0
-
-
-def free_endpoint() -> str:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{s.getsockname()[1]}"
 
 
 def reject(name: str):
@@ -45,47 +38,9 @@ def twin():
     return tw
 
 
-class Client:
-    """A separate peer session (another process in real life) connected to the bus."""
-
-    def __init__(self, connect: list[str]):
-        self.session = zenoh.open(make_config([], connect, "peer"))
-        self.inbox: queue.Queue = queue.Queue()
-        self._subs = []
-
-    def subscribe(self, keyexpr: str, liveliness: bool = False):
-        def cb(sample):
-            self.inbox.put((str(sample.key_expr), sample.kind, sample.payload.to_bytes()))
-        if liveliness:
-            sub = self.session.liveliness().declare_subscriber(keyexpr, cb, history=True)
-        else:
-            sub = self.session.declare_subscriber(keyexpr, cb)
-        self._subs.append(sub)  # keep a reference
-        return sub
-
-    def wait_for(self, predicate, timeout_s: float = WAIT_S, poke=None):
-        """First (key, kind, payload) satisfying predicate; `poke()` is called while waiting."""
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            if poke is not None:
-                poke()
-            try:
-                item = self.inbox.get(timeout=0.1)
-            except queue.Empty:
-                continue
-            if predicate(item):
-                return item
-        raise AssertionError("timed out waiting for a zenoh message")
-
-    def close(self):
-        for sub in self._subs:
-            sub.undeclare()
-        self.session.close()
-
-
 @pytest.fixture
-def endpoint():
-    return free_endpoint()
+def endpoint(support):
+    return support.free_endpoint()
 
 
 @pytest.fixture
@@ -96,8 +51,9 @@ def bus(endpoint):
 
 
 @pytest.fixture
-def client(endpoint, bus):
-    c = Client([endpoint])
+def client(endpoint, bus, support):
+    """A separate peer session (another process in real life) connected to the bus."""
+    c = support.Peer(endpoint, timeout_s=WAIT_S)
     yield c
     c.close()
 
@@ -190,17 +146,10 @@ def test_setpoints_are_applied_and_refusals_reported(bus, client, twin):
     pub = client.session.declare_publisher("bearing/t1/setpoint")
 
     def put_and_wait(payload: bytes) -> dict:
-        while not client.inbox.empty():
-            client.inbox.get_nowait()
-        deadline = time.monotonic() + WAIT_S
-        while time.monotonic() < deadline:  # the first put may precede route discovery
-            pub.put(payload)
-            try:
-                _, _, data = client.inbox.get(timeout=0.5)
-                return loads(data)
-            except queue.Empty:
-                continue
-        raise AssertionError("no setpoint result")
+        client.drain()
+        # put again every 0.5 s until a result arrives: the first put may precede route discovery
+        _, _, data = client.wait_for(lambda item: True, poke=lambda: pub.put(payload), poke_every_s=0.5)
+        return loads(data)
 
     result = put_and_wait(b'{"shaft_speed_rad_s": 300.0}')
     assert result["accepted"] is True and result["bearing_id"] == "t1"
@@ -274,9 +223,9 @@ def test_liveliness_token_follows_attach_and_detach(bus, client):
     assert kind == zenoh.SampleKind.PUT
 
 
-def test_closing_the_bus_withdraws_every_token(endpoint, twin):
+def test_closing_the_bus_withdraws_every_token(endpoint, twin, support):
     bus = ZenohBus(listen=[endpoint], connect=[])
-    client = Client([endpoint])
+    client = support.Peer(endpoint, timeout_s=WAIT_S)
     try:
         client.subscribe("bearing/*/alive", liveliness=True)
         for name in ("a", "b"):
@@ -328,8 +277,8 @@ def test_endpoint_forms_that_are_accepted():
 
 
 # ---- (e) monitor -----------------------------------------------------------------------------
-def test_monitor_sees_twins_of_two_services(endpoint, twin):
-    endpoint2 = free_endpoint()
+def test_monitor_sees_twins_of_two_services(endpoint, twin, support):
+    endpoint2 = support.free_endpoint()
     bus1 = ZenohBus(listen=[endpoint], connect=[])
     bus2 = ZenohBus(listen=[endpoint2], connect=[endpoint])  # a second service, joined to the first
     stop = threading.Event()

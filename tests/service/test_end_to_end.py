@@ -24,7 +24,6 @@ zenoh = pytest.importorskip("zenoh")
 pytest.importorskip("rerun")
 httpx = pytest.importorskip("httpx")
 
-from service.bus import make_config
 from twin.snapshot import Snapshot
 
 REPO = Path(__file__).resolve().parents[2]
@@ -98,40 +97,6 @@ class Service:
             self.proc.wait(10)
 
 
-class Peer:
-    """A zenoh peer (another process in real life) connected to the service, multicast off."""
-
-    def __init__(self, endpoint: str):
-        self.session = zenoh.open(make_config([], [endpoint], "peer"))
-        self.inbox: queue.Queue = queue.Queue()
-        self._subs = []
-
-    def subscribe(self, keyexpr: str, liveliness: bool = False):
-        def cb(sample):
-            self.inbox.put((str(sample.key_expr), sample.kind, sample.payload.to_bytes()))
-        if liveliness:
-            sub = self.session.liveliness().declare_subscriber(keyexpr, cb, history=True)
-        else:
-            sub = self.session.declare_subscriber(keyexpr, cb)
-        self._subs.append(sub)
-
-    def wait_for(self, predicate, timeout_s: float = WAIT_S):
-        deadline = time.monotonic() + timeout_s
-        while time.monotonic() < deadline:
-            try:
-                item = self.inbox.get(timeout=0.1)
-            except queue.Empty:
-                continue
-            if predicate(item):
-                return item
-        raise AssertionError("timed out waiting for a zenoh message")
-
-    def close(self):
-        for sub in self._subs:
-            sub.undeclare()
-        self.session.close()
-
-
 @pytest.fixture
 def service(tmp_path):
     svc = Service(tmp_path)
@@ -139,7 +104,7 @@ def service(tmp_path):
     svc.kill()
 
 
-def state_where(peer: Peer, predicate, bearing_id="default"):
+def state_where(peer, predicate, bearing_id="default"):
     key = f"bearing/{bearing_id}/state"
 
     def match(item):
@@ -148,8 +113,8 @@ def state_where(peer: Peer, predicate, bearing_id="default"):
     return strict_loads(peer.wait_for(match)[2])
 
 
-def test_serve_http_zenoh_rerun_sigterm(service):
-    peer = Peer(service.zenoh_endpoint)
+def test_serve_http_zenoh_rerun_sigterm(service, support):
+    peer = support.Peer(service.zenoh_endpoint, timeout_s=WAIT_S)  # multicast off
     http = httpx.Client(base_url=service.url, timeout=30.0)
     try:
         peer.subscribe("bearing/**")

@@ -3,48 +3,21 @@ and the service-wide recording disabled; every wait is bounded."""
 
 from __future__ import annotations
 
+import functools
 import importlib.util
 import json
 import math
-import threading
 import time
 from pathlib import Path
 
 import httpx
 import pytest
-import uvicorn
 
-from service.app import create_app
 from service.settings import ServiceSettings
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 HAVE_RERUN = importlib.util.find_spec("rerun") is not None
 WAIT_S = 20.0
-
-
-class Server:
-    """uvicorn in a thread, bound to 127.0.0.1 on a free port (port 0, read back)."""
-
-    def __init__(self, settings: ServiceSettings):
-        config = uvicorn.Config(create_app(settings), host="127.0.0.1", port=0, log_level="warning",
-                                lifespan="on", timeout_graceful_shutdown=2)
-        self.server = uvicorn.Server(config)
-        self.thread = threading.Thread(target=self.server.run, daemon=True)
-
-    def __enter__(self) -> str:
-        self.thread.start()
-        deadline = time.monotonic() + 60.0
-        while not self.server.started:
-            if not self.thread.is_alive() or time.monotonic() > deadline:
-                raise RuntimeError("uvicorn did not start")
-            time.sleep(0.02)
-        port = self.server.servers[0].sockets[0].getsockname()[1]
-        return f"http://127.0.0.1:{port}"
-
-    def __exit__(self, *exc):
-        self.server.should_exit = True
-        self.thread.join(15.0)
-        assert not self.thread.is_alive(), "uvicorn did not stop"
 
 
 @pytest.fixture(scope="module")
@@ -53,22 +26,18 @@ def recordings(tmp_path_factory):
 
 
 @pytest.fixture(scope="module")
-def client(recordings):
+def client(recordings, support):
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, scenario_dir=SCENARIOS,
                                record=recordings / "service.rrd", max_twins=4)
-    with Server(settings) as base_url, httpx.Client(base_url=base_url, timeout=30.0) as c:
+    with support.ThreadServer(settings, start_timeout_s=60.0, stop_timeout_s=15.0) as srv, \
+            httpx.Client(base_url=srv.url, timeout=30.0) as c:
         yield c
 
 
-def wait_for(fetch, predicate, timeout=WAIT_S):
-    deadline = time.monotonic() + timeout
-    while True:
-        value = fetch()
-        if predicate(value):
-            return value
-        if time.monotonic() > deadline:
-            raise AssertionError(f"condition not met within {timeout} s; last value {value!r}")
-        time.sleep(0.02)
+@pytest.fixture(scope="module")
+def wait_for(support):
+    """support.wait_for(fetch, predicate, timeout=WAIT_S): poll until predicate(fetch()), bounded."""
+    return functools.partial(support.wait_for, timeout=WAIT_S)
 
 
 def detail(response) -> list[dict]:
@@ -91,7 +60,7 @@ def test_health(client):
     assert tw["running"] and tw["mode"] == "real_time"
 
 
-def test_state_is_the_contract(client):
+def test_state_is_the_contract(client, wait_for):
     state = wait_for(lambda: client.get("/v1/bearings/default/state"), lambda r: r.status_code == 200)
     text = state.text
     json.loads(text, parse_constant=lambda c: pytest.fail(f"JSON carries {c}"))
@@ -107,7 +76,7 @@ def test_state_is_the_contract(client):
     assert later["time_s"] > s["time_s"]
 
 
-def test_put_setpoint_shows_up_in_state(client):
+def test_put_setpoint_shows_up_in_state(client, wait_for):
     r = client.put("/v1/bearings/default/setpoint", json={"radial_load_n": 4200.0})
     assert r.status_code == 200, r.text
     body = r.json()
@@ -176,7 +145,7 @@ def test_unknown_twin_is_404(client):
         assert err["field"] == "bearing_id" and "default" in err["allowed"]
 
 
-def test_create_two_twins_duplicate_and_delete(client):
+def test_create_two_twins_duplicate_and_delete(client, wait_for):
     r = client.post("/v1/bearings", json={"id": "pump-7208", "designation": "7208",
                                           "diametral_clearance_m": 5e-6, "lubricant": "ISO VG 68",
                                           "setpoint": {"shaft_speed_rad_s": 300.0, "axial_load_n": 1000.0}})
@@ -227,7 +196,7 @@ def test_invalid_creation_is_422(client, body, field):
     assert detail(r)[0]["field"] == field
 
 
-def test_ev_twin_with_shear_and_current_heating(client):
+def test_ev_twin_with_shear_and_current_heating(client, wait_for):
     # seed 003: a 6200 created with shear heating on, driven at 20 000 rpm and 10 A, publishes the
     # inlet heating and a thinner film than the isothermal film (factor < 1)
     r = client.post("/v1/bearings", json={
@@ -251,7 +220,7 @@ def test_ev_twin_with_shear_and_current_heating(client):
         client.delete("/v1/bearings/ev")
 
 
-def test_scenarios(client):
+def test_scenarios(client, wait_for):
     names = client.get("/v1/scenarios").json()["scenarios"]
     assert "seed000_startup_steady_slowdown" in names and "seed000_clearance_sweep" in names
     r = client.post("/v1/bearings", json={"id": "scn"})
