@@ -54,6 +54,18 @@ memory stays flat (the file is a valid RRD stream: the viewer and `RrdReader.str
 `rerun rrd optimize` adds the footer afterwards); with the footer, segments bound the memory to
 that of one segment (freed when it closes).
 
+Freeing streams. rerun-sdk 0.41 keeps every `RecordingStream` (and its 2 threads, ~1-2 MB) in
+a native list until `rerun_bindings.flush_and_cleanup_orphaned_recordings()` runs (rerun issue
+#2116; `rr.init` calls it, nothing else does), so a stream per output would leak on a service
+where clips are started and stopped for weeks. A stream cannot be re-pointed at another
+recording id (the id is fixed at creation), so clips do not share pooled streams: two clips
+with one id would merge into one recording in the viewer. Instead every stream is made through
+a `RerunStreams` (one per service, or one per recorder) and, once its file is closed (flushed,
+`disconnect()` writes the footer) and the recorder has dropped it, `RerunStreams.reclaim()`
+runs that cleanup: the stream's threads are joined and its memory freed. The cleanup flushes
+every stream of the process (blocking) and clears rerun's global data recording (unused here).
+The main file's stream still survives its rotations (`save()` to the next segment).
+
 rerun-sdk 0.41 notes: an explicit `rr.RecordingStream` per output; `flush()` then `disconnect()`
 before the file is read back; read it with `read_recording` (`rerun.chunk.RrdReader`).
 """
@@ -78,8 +90,14 @@ from pathlib import Path
 from typing import Any, Self
 
 import numpy as np
-import rerun as rr
-import rerun.blueprint as rrb
+
+# The service writes footerless segments on purpose (module doc: the footer grows in memory until
+# the file closes); rerun warns about that once per file. Quiet that one target unless the user
+# set RUST_LOG themselves.
+os.environ.setdefault("RUST_LOG", "warn,re_log_encoding::rrd::file_sink=error")
+
+import rerun as rr  # noqa: E402 - after the RUST_LOG default
+import rerun.blueprint as rrb  # noqa: E402
 
 log = logging.getLogger(__name__)
 
@@ -233,9 +251,79 @@ def _extract(snapshot, positions_m: np.ndarray | None) -> _Row:
                 positions_m=positions_m)
 
 
+class RerunStreams:
+    """Makes the rerun streams of one or more recorders and frees those they have dropped.
+
+    rerun-sdk 0.41 never frees a `RecordingStream` by itself (rerun issue #2116): the bindings
+    keep each one, with its batcher threads, in a native list. `reclaim()` calls the bindings'
+    `flush_and_cleanup_orphaned_recordings()` (what `rr.init` does), which flushes every stream
+    of the process and drops those nothing else refers to (their files must be closed first:
+    `flush()` + `disconnect()`). A `TwinService` owns one for all its recorders; a recorder made
+    without one makes its own.
+
+    Creation and reclaim are serialised by one lock, and must be: rerun's `new_recording` /
+    `new_blueprint` hold the GIL while they wait for the native list the cleanup holds while it
+    flushes, and a flush can wait for the GIL (releasing numpy buffers): a stream created on
+    another thread during a reclaim deadlocks. So every stream of the recorders sharing one
+    `RerunStreams` is made through it, on the caller's thread (constructor, `start_file`), never
+    on a worker; recorders on several threads of one process should share one `RerunStreams`."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self.created = 0           # streams made (recordings and blueprints)
+        self.reclaims = 0          # successful cleanups
+        self.reclaim_errors = 0
+        self._warned = False
+
+    def new_recording(self, application_id: str, recording_id: str) -> rr.RecordingStream:
+        with self._lock:
+            self.created += 1
+            return rr.RecordingStream(application_id, recording_id=recording_id)
+
+    def new_blueprint(self, application_id: str) -> rr.RecordingStream:
+        import rerun_bindings
+
+        with self._lock:
+            self.created += 1
+            return rr.RecordingStream._from_native(rerun_bindings.new_blueprint(
+                application_id=application_id, make_default=False, make_thread_default=False,
+                default_enabled=True))
+
+    def send_blueprint(self, blueprint: rrb.Blueprint, recording: rr.RecordingStream) -> None:
+        """rerun's own `send_blueprint` (it makes a blueprint stream per call) under the lock."""
+        with self._lock:
+            self.created += 1
+            recording.send_blueprint(blueprint, make_active=True, make_default=True)
+
+    def reclaim(self) -> bool:
+        """Free the streams no recorder refers to any more (threads joined, memory released);
+        False (logged once) when the bindings lack the cleanup or it failed (e.g. a sink that
+        cannot flush): those streams are then kept, as rerun-sdk would anyway."""
+        try:
+            import rerun_bindings
+
+            cleanup = rerun_bindings.flush_and_cleanup_orphaned_recordings
+        except (ImportError, AttributeError) as exc:
+            return self._failed(exc)
+        try:
+            with self._lock:
+                cleanup()
+        except Exception as exc:  # noqa: BLE001 - a failed cleanup only keeps the streams
+            return self._failed(exc)
+        self.reclaims += 1
+        return True
+
+    def _failed(self, exc: BaseException) -> bool:
+        self.reclaim_errors += 1
+        if not self._warned:
+            self._warned = True
+            log.warning("rerun: could not free closed recording streams (%s): they stay in memory", exc)
+        return False
+
+
 @dataclass
 class _Output:
-    stream: rr.RecordingStream
+    stream: rr.RecordingStream | None
     path: Path | None
     viewer: bool = False
     opened_at: float = field(default_factory=time.monotonic)   # monotonic [s]
@@ -252,10 +340,27 @@ class _BlueprintSender:
     with its throw-away stream). Uses rerun internals (`rerun_bindings.new_blueprint`,
     `Blueprint._log_to_stream`): if they are missing, falls back to `send_blueprint`."""
 
-    def __init__(self, application_id: str):
+    def __init__(self, application_id: str, streams: RerunStreams):
         self.application_id = application_id
+        self._streams = streams
         self._stream: rr.RecordingStream | None = None
         self._fallback = False
+        try:     # made now, on the caller's thread (see `RerunStreams`), not on the worker
+            self._stream = streams.new_blueprint(application_id)
+        except (ImportError, AttributeError, TypeError) as exc:
+            self._fallback = True
+            log.warning("rerun: blueprint stream reuse unavailable (%s): using send_blueprint", exc)
+
+    def close(self) -> None:
+        """Drop the blueprint stream (freed by the next `RerunStreams.reclaim`). Its in-memory
+        sink holds the stream itself (a reference cycle in rerun-sdk 0.41): `disconnect()`
+        replaces that sink first, or the stream could never be freed."""
+        stream, self._stream = self._stream, None
+        if stream is not None:
+            try:
+                stream.disconnect()
+            except Exception as exc:  # noqa: BLE001 - only keeps the stream alive
+                log.warning("rerun: disconnect of the blueprint stream failed: %s", exc)
 
     def send(self, blueprint: rrb.Blueprint, recording: rr.RecordingStream) -> None:
         if not self._fallback:
@@ -263,9 +368,7 @@ class _BlueprintSender:
                 import rerun_bindings
 
                 if self._stream is None:
-                    self._stream = rr.RecordingStream._from_native(rerun_bindings.new_blueprint(
-                        application_id=self.application_id, make_default=False, make_thread_default=False,
-                        default_enabled=True))
+                    raise AttributeError("the blueprint stream is closed")
                 storage = self._stream.memory_recording().storage
                 self._stream.set_time("blueprint", sequence=0)
                 blueprint.to_blueprint()._log_to_stream(self._stream)
@@ -274,7 +377,7 @@ class _BlueprintSender:
             except (ImportError, AttributeError, TypeError) as exc:
                 self._fallback = True
                 log.warning("rerun: blueprint stream reuse unavailable (%s): using send_blueprint", exc)
-        recording.send_blueprint(blueprint, make_active=True, make_default=True)
+        self._streams.send_blueprint(blueprint, recording)
 
 
 def segment_path(path: str | Path, index: int) -> Path:
@@ -333,11 +436,13 @@ class RerunRecorder:
                  queue_size: int = 256, viewer_port: int = 9876,
                  series_window_s: float | None = 5.0, min_interval_s: float = 0.0,
                  segment_s: float | None = None, segment_bytes: int | None = None,
-                 write_footer: bool = True):
+                 write_footer: bool = True, streams: RerunStreams | None = None):
         """`segment_s` [s of wall time] / `segment_bytes` [bytes]: rotate the main file once its
         open segment is that old / that large (None or 0 = never; see the module doc).
         `write_footer`: end every file (segments, `start_file` files) with rerun's footer (chunk
-        manifest); False keeps the memory flat on long runs (module doc)."""
+        manifest); False keeps the memory flat on long runs (module doc).
+        `streams`: makes and frees this recorder's rerun streams (shared by the recorders of a
+        service); by default the recorder has its own."""
         if not (flush_interval_s > 0.0 and math.isfinite(flush_interval_s)):
             raise ValueError(f"flush_interval_s = {flush_interval_s!r}: must be finite and > 0")
         if queue_size < 1:
@@ -356,6 +461,7 @@ class RerunRecorder:
         self.series_window_s = series_window_s
         self.viewer_port = viewer_port
         self.min_interval_s = float(min_interval_s)
+        self._streams = streams if streams is not None else RerunStreams()
 
         self._queue: deque = deque()
         self._qlock = threading.Lock()
@@ -375,7 +481,7 @@ class RerunRecorder:
         self._blueprint_dirty = False   # (re)sent by the next send, once for many add_twin calls
         self._segments: list[Path] = []
         self._rotation_failed_at: float | None = None
-        self._blueprints = _BlueprintSender(application_id)
+        self._blueprints = _BlueprintSender(application_id, self._streams)
 
         self.path = Path(path) if path is not None else None
         self._viewer = self._open_viewer(spawn_viewer)
@@ -390,7 +496,7 @@ class RerunRecorder:
 
     # ---- outputs ----------------------------------------------------------------------------
     def _new_stream(self) -> rr.RecordingStream:
-        return rr.RecordingStream(self.application_id, recording_id=self.recording_id)
+        return self._streams.new_recording(self.application_id, self.recording_id)
 
     def _open_viewer(self, spawn_viewer: bool) -> _Output | None:
         """A stream to a spawned viewer (its own stream: the file segments rotate, the viewer's
@@ -446,11 +552,13 @@ class RerunRecorder:
             out.stream.disconnect()
         except Exception as exc:  # noqa: BLE001
             log.warning("rerun: disconnect of %s failed: %s", out.path or "viewer", exc)
+        out.stream = None       # the file is closed: the stream can be freed (`RerunStreams.reclaim`)
 
     def start_file(self, path: str | Path) -> Path:
         """Start recording into a further .rrd file while running (static geometry and blueprint
         first, then every snapshot published from now on). Replaces (and completes) a file started
-        earlier with `start_file`. Returns the path."""
+        earlier with `start_file`. Returns the path. The file gets a new stream (with the
+        recorder's recording id), freed again when the file is stopped."""
         path = Path(path)
         if self._closed:
             raise RuntimeError("recorder is closed")
@@ -459,13 +567,16 @@ class RerunRecorder:
         with self._io_lock:
             self._drain_locked()
             self._send_locked()        # rows published before start_file go to the old outputs only
-            if self._extra is not None:
+            replaced = self._extra is not None
+            if replaced:
                 self._stop_file_locked()
             out = self._open_file(path)
             for tw in self._twins.values():
                 self._send_static(out, tw)
             self._send_blueprint([out])         # the others get theirs at the next send if due
             self._extra = out
+        if replaced:
+            self._streams.reclaim()
         return path
 
     def stop_file(self) -> Path | None:
@@ -476,7 +587,9 @@ class RerunRecorder:
                 return None
             self._drain_locked()
             self._send_locked()
-            return self._stop_file_locked()
+            path = self._stop_file_locked()
+        self._streams.reclaim()             # outside the lock: it flushes every stream
+        return path
 
     def _stop_file_locked(self) -> Path | None:
         out, self._extra = self._extra, None
@@ -785,6 +898,8 @@ class RerunRecorder:
             self._viewer = None
             self._primary = None
             self._extra = None
+            self._blueprints.close()
+        self._streams.reclaim()             # free this recorder's streams (module doc)
 
     def __enter__(self) -> Self:
         return self

@@ -10,6 +10,11 @@ HTTP layer and the tests that disable them never import zenoh or rerun):
                 -> per-twin recordings closed -> service recording closed (drained, flushed)
                 -> zenoh session closed
 
+Every recorder of the service makes its rerun streams through one `service.recorder.RerunStreams`
+owned by the `TwinService` (`rerun_streams()`): a per-twin recording gets a new recorder (its
+own recording id) per start, and its streams are freed when it stops (rerun-sdk 0.41 would keep
+them, and their threads, forever: see the recorder's module doc).
+
 A setpoint arriving over zenoh goes through `TwinRunner.submit_setpoint_json`, which uses the
 same validation as HTTP (`service.schemas.parse_setpoint` + the bearing's limits).
 """
@@ -75,12 +80,15 @@ def _recorder_class():
     return RerunRecorder
 
 
-def open_recorder(settings: ServiceSettings):
-    """The service-wide rerun recorder, or None when recording (and the viewer) are off."""
+def open_recorder(settings: ServiceSettings, streams: Any = None):
+    """The service-wide rerun recorder, or None when recording (and the viewer) are off.
+    `streams`: the service's `RerunStreams`, shared with the per-twin recordings (stream creation
+    and reclaim must not run concurrently, see `service.recorder.RerunStreams`)."""
     path = settings.recording_path
     if path is None and not settings.spawn_viewer:
         return None
-    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer, **recorder_options(settings))
+    extra = {} if streams is None else {"streams": streams}
+    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer, **recorder_options(settings), **extra)
 
 
 def recorder_options(settings: ServiceSettings) -> dict:
@@ -126,6 +134,17 @@ class TwinService:
         self._recording_lock = threading.RLock()
         self._lock = threading.RLock()
         self._closed = False
+        self._rerun_streams = None          # service.recorder.RerunStreams, made on first use
+
+    def rerun_streams(self):
+        """The `RerunStreams` that makes and frees every rerun stream of this service."""
+        with self._lock:
+            if self._rerun_streams is None:
+                _recorder_class()
+                from service.recorder import RerunStreams
+
+                self._rerun_streams = RerunStreams()
+            return self._rerun_streams
 
     # ---- life cycle ------------------------------------------------------------------------
     def open(self, *, default_twin: bool = True) -> TwinService:
@@ -134,7 +153,8 @@ class TwinService:
             sys.setswitchinterval(self.settings.gil_switch_interval_s)  # process-wide, see settings
         try:
             self.bus = open_bus(self.settings)
-            self.recorder = open_recorder(self.settings)
+            if self.settings.recording_path is not None or self.settings.spawn_viewer:
+                self.recorder = open_recorder(self.settings, self.rerun_streams())
             if default_twin and self.settings.start_twin:
                 self.create_twin(BearingCreate(id=self.settings.twin_id, designation=self.settings.bearing))
         except BaseException:
@@ -322,13 +342,15 @@ class TwinService:
             if t == main or (t.parent == main.parent and re.fullmatch(re.escape(main.stem) + r"-\d{4,}\.rrd", t.name)):
                 raise InputError.one("path", f"{str(target)!r} is the service-wide recording or one of its segments")
         recorder_cls = _recorder_class()
+        streams = self.rerun_streams()
         with self._recording_lock:
             self.stop_recording(entry)
             if target.exists() and not target.is_file():
                 raise InputError.one("path", f"{str(target)!r} exists and is not a file")
             try:
-                rec = recorder_cls(target, **recorder_options(self.settings))
+                rec = recorder_cls(target, **recorder_options(self.settings), streams=streams)
             except (OSError, RuntimeError, ValueError) as exc:   # e.g. a folder that is a file
+                streams.reclaim()            # the stream made for the file that failed
                 raise InputError.one("path", f"cannot record to {str(target)!r}: "
                                      f"{' '.join(str(exc).split())[:200]}") from None
             rec.add_twin_from(entry.twin)
@@ -337,7 +359,8 @@ class TwinService:
         return target
 
     def stop_recording(self, entry: TwinEntry) -> tuple[Path | None, int]:
-        """Finish the twin's own recording (flushed, complete); returns (path, rows written)."""
+        """Finish the twin's own recording (flushed, complete; its rerun streams freed);
+        returns (path, rows written)."""
         with self._recording_lock:
             rec, path = entry.recording, entry.recording_path
             if rec is None:

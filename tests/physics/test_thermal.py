@@ -7,8 +7,7 @@ import pytest
 from twin import catalog, studies
 from twin.engine import Twin
 from twin.physics import thermal, viscosity
-from twin.setpoint import Setpoint
-from twin.spec import BearingSpec, Thermal
+from twin.spec import Thermal
 
 
 def test_roelands_temperature_law_by_hand():
