@@ -36,7 +36,7 @@ def _plt():
 
 def _fig_reduction(out: Path) -> tuple[str, list]:
     """Seed 003 Figs. 2/4 at 2.496 m/s: solver table vs the loop's law."""
-    table = tcal._table()
+    table = tcal.load_table()
     inputs = table["provenance"]["inputs"]
     th = Thermal()
     u = prm.DEFAULT_ENTRAINMENT_SPEED_M_S

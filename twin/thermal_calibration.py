@@ -20,16 +20,13 @@ Run `python -m twin.thermal_calibration` to print the fit and its residuals.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
+from twin.ehl_solver.calibration import load_table
 from twin.physics.thermal import inlet_shear_heating_temperature_rise_k, thermal_film_factor
-
-TABLE_PATH = Path(__file__).parent / "ehl_solver" / "film_reduction_table.json"
 
 
 @dataclass(frozen=True)
@@ -41,10 +38,6 @@ class ReducedOrderFit:
     rms_ln_error: float           # rms of ln(h_law / h_solver) over the cells [-]
     max_reduction_error: float    # max |reduction_law - reduction_solver| (fractions of h_iso) [-]
     cells: int
-
-
-def _table(path: Path | str | None = None) -> dict:
-    return json.loads(Path(path or TABLE_PATH).read_text())
 
 
 def law_factor(current_rise_k: float, entrainment_speed_m_s: float, inputs: dict,
@@ -65,11 +58,11 @@ def _cells(table: dict):
                 yield table["current_temperature_rise_k"][i][j], u, table["h_min_factor"][i][j]
 
 
-def fit_reduced_order_law(path: Path | str | None = None) -> ReducedOrderFit:
+def fit_reduced_order_law(path: str | None = None) -> ReducedOrderFit:
     """Least-squares fit of (c_T, c_s) to the solver's converged, non-extrapolated cells."""
     from scipy.optimize import least_squares
 
-    table = _table(path)
+    table = load_table(path)
     inputs = table["provenance"]["inputs"]
     cells = list(_cells(table))
 

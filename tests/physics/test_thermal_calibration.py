@@ -35,7 +35,7 @@ def test_reduction_band_at_fig2_currents_and_its_rise_with_current():
     # seed 003 Fig. 2/4: 57.6-84.8 % reduction of the minimum film at 20-30 A, rising with
     # current, at the Appendix 2 contact (default speed 2.496 m/s, 40 degC) through the law the
     # real-time loop runs. Tolerance: 2 points at the band's edges (the law vs the solver).
-    table = tc._table()
+    table = tc.load_table()
     inputs = table["provenance"]["inputs"]
     th = Thermal()
     reductions = []

@@ -38,6 +38,7 @@ from numba import njit
 
 from twin.ehl_solver import params as prm
 from twin.jit import JIT
+from twin.physics.thermal import hamrock_dowson_temperature_film_ratio
 
 TABLE_PATH = Path(__file__).with_name("film_reduction_table.json")
 SCHEMA = "bearing-twin/ehl-film-reduction/1"
@@ -101,20 +102,16 @@ def anchor_bearing_resistance(*, target_reduction: float = SEED_REDUCTION_BAND[1
 
 
 def hd_temperature_film_ratio(temperature_rise_k: float, base_temperature_c: float = prm.BASE_TEMPERATURE_C,
-                              eta0_pa_s: float | None = None, alpha_pa_inv: float = prm.ALPHA_PA_INV,
-                              beta_k_inv: float | None = None) -> float:
-    """g(T) = (eta(T)/eta0)^0.68 (alpha*(T)/alpha)^0.49: the Hamrock-Dowson film ratio for a uniform
-    temperature rise of the inlet, with Roelands (seed 003 eq. 3) at ambient pressure:
-    ln(eta/eta0) = (ln eta0 + 9.67)(f - 1), alpha* = alpha f, f = ((T - 138)/(T_i - 138))^-S0."""
+                              eta0_pa_s: float | None = None, beta_k_inv: float | None = None) -> float:
+    """g(T) = (eta(T)/eta0)^0.68 (alpha*(T)/alpha)^0.49 of a uniform inlet temperature rise
+    (twin.physics.thermal.hamrock_dowson_temperature_film_ratio, Roelands' eq. 3 at ambient
+    pressure) for the solver's oil at base_temperature_c unless eta0 / beta are given."""
     if eta0_pa_s is None:
         eta0_pa_s = prm.oil_viscosity_pa_s(base_temperature_c)
     if beta_k_inv is None:
         beta_k_inv = prm.oil_temperature_viscosity_coefficient(base_temperature_c)
-    ti = base_temperature_c + 273.15
-    a = math.log(eta0_pa_s) + 9.67
-    s0 = beta_k_inv * (ti - 138.0) / a
-    f = ((ti + temperature_rise_k - 138.0) / (ti - 138.0)) ** (-s0)
-    return math.exp(0.68 * a * (f - 1.0)) * f ** 0.49
+    return hamrock_dowson_temperature_film_ratio(temperature_rise_k, eta0_pa_s, base_temperature_c + 273.15,
+                                                 beta_k_inv)
 
 
 def generate_table(currents_a=DEFAULT_CURRENTS_A, speeds_m_s=DEFAULT_SPEEDS_M_S, *,
