@@ -11,10 +11,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from twin import catalog
 from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.setpoint import Setpoint
-from twin.spec import ModelOptions
+from twin.spec import BearingSpec, ModelOptions, Thermal
 
 SETTLE_S = 0.005
 
@@ -132,9 +133,6 @@ def ev_operating_point(shaft_current_a: float, shaft_speed_rpm: float, *, oil_te
                        radial_load_n: float = EV_RADIAL_LOAD_N, settle_s: float = EV_SETTLE_S):
     """Seed 003's EV case on the 6200 twin (seed-000 oil, shear and current heating on unless
     told otherwise): warm start at the operating point, settle, return (EVSample, snapshot)."""
-    from twin import catalog
-    from twin.spec import BearingSpec, Thermal
-
     fields = {"shear_heating": shear_heating}
     if equivalent_resistance_ohm is not None:
         fields["equivalent_resistance_ohm"] = equivalent_resistance_ohm
