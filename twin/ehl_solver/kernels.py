@@ -152,6 +152,22 @@ def _wedge(rho, h, i, j, rx1, w):
 
 
 @njit(**JIT)
+def _faces(eps, i, j):
+    """eps at the four half nodes around node (i, j): (x-, x+, y-, y+), by _half."""
+    e = eps[i, j]
+    return _half(eps[i - 1, j], e), _half(eps[i + 1, j], e), _half(eps[i, j - 1], e), _half(eps[i, j + 1], e)
+
+
+@njit(**JIT)
+def _operator(p, h, rho, i, j, exm, exp_, eym, eyp, rx2, ry2, rx1, w):
+    """L(P) at node (i, j): the discrete Reynolds operator of seed 003 eq. 1 (Poiseuille terms
+    with the face coefficients minus the wedge term)."""
+    return ((exm * (p[i - 1, j] - p[i, j]) + exp_ * (p[i + 1, j] - p[i, j])) * rx2
+            + (eym * (p[i, j - 1] - p[i, j]) + eyp * (p[i, j + 1] - p[i, j])) * ry2
+            - _wedge(rho, h, i, j, rx1, w))
+
+
+@njit(**JIT)
 def residual(p, h, rho, eps, f, hx, hy, kappa2, xi0, r):
     """r = f - L(P) on interior nodes (0 on the boundary); returns sum |r| over nodes with P > 0."""
     nx, ny = p.shape
@@ -167,14 +183,9 @@ def residual(p, h, rho, eps, f, hx, hy, kappa2, xi0, r):
         r[nx - 1, j] = 0.0
     for i in range(1, nx - 1):
         for j in range(1, ny - 1):
-            exm = _half(eps[i - 1, j], eps[i, j])
-            exp_ = _half(eps[i + 1, j], eps[i, j])
-            eym = _half(eps[i, j - 1], eps[i, j])
-            eyp = _half(eps[i, j + 1], eps[i, j])
+            exm, exp_, eym, eyp = _faces(eps, i, j)
             w = wedge_weight(eps[i, j], rx2, xi0, i)
-            lp = ((exm * (p[i - 1, j] - p[i, j]) + exp_ * (p[i + 1, j] - p[i, j])) * rx2
-                  + (eym * (p[i, j - 1] - p[i, j]) + eyp * (p[i, j + 1] - p[i, j])) * ry2
-                  - _wedge(rho, h, i, j, rx1, w))
+            lp = _operator(p, h, rho, i, j, exm, exp_, eym, eyp, rx2, ry2, rx1, w)
             r[i, j] = f[i, j] - lp
             if p[i, j] > 0.0:
                 total += abs(r[i, j])
@@ -287,14 +298,9 @@ def relax_gs(p, h, rho, eps, f, hx, hy, kappa2, kc, kind, xi0, omega, max_step, 
                 rhs[row] = 0.0
                 continue
             any_gs = True
-            exm = _half(eps[i - 1, j], eps[i, j])
-            exp_ = _half(eps[i + 1, j], eps[i, j])
-            eym = _half(eps[i, j - 1], eps[i, j])
-            eyp = _half(eps[i, j + 1], eps[i, j])
+            exm, exp_, eym, eyp = _faces(eps, i, j)
             w = wedge_weight(eps[i, j], rx2, xi0, i)
-            lp = ((exm * (p[i - 1, j] - p[i, j]) + exp_ * (p[i + 1, j] - p[i, j])) * rx2
-                  + (eym * (p[i, j - 1] - p[i, j]) + eyp * (p[i, j + 1] - p[i, j])) * ry2
-                  - _wedge(rho, h, i, j, rx1, w))
+            lp = _operator(p, h, rho, i, j, exm, exp_, eym, eyp, rx2, ry2, rx1, w)
             rhs[row] = f[i, j] - lp
             for o in range(-2, 3):
                 k = i + o
@@ -378,15 +384,10 @@ def relax_jd(p, h, rho, eps, f, hx, hy, kappa2, kc, kind, xi0, omega, max_step, 
                 rhs[row] = 0.0
                 continue
             any_jd = True
-            exm = _half(eps[i - 1, j], eps[i, j])
-            exp_ = _half(eps[i + 1, j], eps[i, j])
-            eym = _half(eps[i, j - 1], eps[i, j])
-            eyp = _half(eps[i, j + 1], eps[i, j])
+            exm, exp_, eym, eyp = _faces(eps, i, j)
             s = (exm + exp_) * rx2 + (eym + eyp) * ry2
             w = wedge_weight(eps[i, j], rx2, xi0, i)
-            lp = ((exm * (p[i - 1, j] - p[i, j]) + exp_ * (p[i + 1, j] - p[i, j])) * rx2
-                  + (eym * (p[i, j - 1] - p[i, j]) + eyp * (p[i, j + 1] - p[i, j])) * ry2
-                  - _wedge(rho, h, i, j, rx1, w))
+            lp = _operator(p, h, rho, i, j, exm, exp_, eym, eyp, rx2, ry2, rx1, w)
             rhs[row] = f[i, j] - lp
             for o in range(-2, 3):
                 k = i + o
@@ -451,10 +452,7 @@ def natural_residual(p, h, rho, eps, r, hx, hy, kappa2, kc, xi0):
     total = 0.0
     for i in range(1, nx - 1):
         for j in range(1, ny - 1):
-            exm = _half(eps[i - 1, j], eps[i, j])
-            exp_ = _half(eps[i + 1, j], eps[i, j])
-            eym = _half(eps[i, j - 1], eps[i, j])
-            eyp = _half(eps[i, j + 1], eps[i, j])
+            exm, exp_, eym, eyp = _faces(eps, i, j)
             w = wedge_weight(eps[i, j], rx2, xi0, i)
             d = (-(exm + exp_) * rx2 - (eym + eyp) * ry2
                  - ((1.0 + 0.5 * w) * rho[i, j] * kc[0, 0] - (1.0 + w) * rho[i - 1, j] * kc[1, 0]
