@@ -212,6 +212,8 @@ class Twin:
         """Feed the life monitor the current conditions (it re-evaluates every refresh_s of
         simulated time): setpoint loads, the ramped shaft speed, the kinematic viscosity of the
         film inlet (oil temperature plus the inlet's current and shear heating) and the contacts."""
+        if not (force or self.life_monitor.due(self.time_s)):
+            return
         sp = self._setpoint
         rise = getattr(self, "_current_heating_k", 0.0) + getattr(self, "_shear_heating_k", 0.0)
         rho = density_kg_m3(self.model.spec.lubricant.density_15c_kg_m3, sp.oil_temperature_c + rise)

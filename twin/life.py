@@ -604,15 +604,18 @@ class LifeMonitor:
         self._contact_life_h = math.inf
         self._last_eval_s: float | None = None
 
+    def due(self, time_s: float) -> bool:
+        """Whether `update` would re-evaluate at `time_s` (refresh_s passed, or a new clock)."""
+        last = self._last_eval_s
+        return self.ratings is not None and (last is None or not last <= time_s < last + self.settings.refresh_s)
+
     def update(self, time_s: float, shaft_speed_rad_s: float, radial_load_n: float, axial_load_n: float,
                kinematic_viscosity_m2_s: float, contacts: np.ndarray, force: bool = False) -> None:
         """Re-evaluate if `refresh_s` has passed (or `force`), and restart the damage interval at
         the new rate."""
-        if self.ratings is None:
+        if self.ratings is None or not (force or self.due(time_s)):
             return
         last = self._last_eval_s
-        if not force and last is not None and last <= time_s < last + self.settings.refresh_s:
-            return
         try:
             self._iso = iso_life(self.spec, self.ratings, self.settings, radial_load_n, axial_load_n,
                                  shaft_speed_rad_s, kinematic_viscosity_m2_s)
