@@ -1,4 +1,4 @@
-"""`bearing-twin` command line: simulate, bench, report, serve, scenario, bench-service, monitor, soak.
+"""`bearing-twin` command line: simulate, bench, report, serve, scenario, bench-service, monitor, soak, life.
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -174,6 +174,9 @@ def build_parser() -> argparse.ArgumentParser:
     from service.ehl_cli import add_ehl_command
 
     add_ehl_command(sub)
+    from service.life_cli import add_life_command
+
+    add_life_command(sub)
     return parser
 
 

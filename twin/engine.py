@@ -20,10 +20,11 @@ from twin.kernels.tribology import T_HMIN_EXP_EU
 from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k,
                                   inlet_shear_heating_temperature_rise_k, roelands_temperature_viscosity_pa_s,
                                   thermal_film_factor)
-from twin.physics.viscosity import dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
+from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.setpoint import Setpoint, SetpointUpdate, check_limits
 from twin.electrical import bearing_network
-from twin.snapshot import BallState, ContactState, SetpointState, Snapshot
+from twin.life import LifeMonitor, LifeSettings
+from twin.snapshot import BallState, ContactState, LifeState, SetpointState, Snapshot
 from twin.snapshot import ElectricalState as ElectricalSnapshot
 from twin.spec import BearingSpec, ModelOptions
 from twin.state import TwinState, make_state
@@ -39,6 +40,19 @@ def _finite_or_none(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
+def setpoint_limits(model: BearingModel) -> dict[str, tuple[float, float]]:
+    """Allowed (low, high) of each setpoint field for this bearing model."""
+    axial_low = 0.0 if model.spec.kind == "angular_contact" else -model.max_axial_load_n
+    return {
+        "shaft_speed_rad_s": (0.0, model.max_shaft_speed_rad_s),
+        "radial_load_n": (0.0, model.max_radial_load_n),
+        "axial_load_n": (axial_low, model.max_axial_load_n),
+        "oil_temperature_c": (-30.0, 150.0),
+        "shaft_current_a": (0.0, 100.0),
+        "shaft_voltage_v": (0.0, 1000.0),
+    }
+
+
 class Twin:
     """A running bearing twin.
 
@@ -50,7 +64,8 @@ class Twin:
 
     def __init__(self, bearing: str | BearingSpec = "6208", *, options: ModelOptions | None = None,
                  setpoint: Setpoint | None = None, bearing_id: str = "default",
-                 diametral_clearance_m: float | None = None, warm: bool = True):
+                 diametral_clearance_m: float | None = None, warm: bool = True,
+                 life: LifeSettings | None = None):
         spec = bearing if isinstance(bearing, BearingSpec) else catalog.bearing(bearing)
         if diametral_clearance_m is not None:
             mounting = spec.mounting.model_copy(update={"diametral_clearance_m": diametral_clearance_m})
@@ -58,6 +73,7 @@ class Twin:
         self.bearing_id = bearing_id
         self.model: BearingModel = make_model(spec, options)
         self.state: TwinState = make_state(self.model)
+        self.life_monitor = LifeMonitor(self.model, life)  # rating life and damage (twin.life)
         self._setpoint_vector = np.zeros(L.N_SETPOINT)
         self._setpoint = Setpoint()
         self.seq = 0
@@ -81,16 +97,7 @@ class Twin:
     @property
     def limits(self) -> dict[str, tuple[float, float]]:
         """Allowed (low, high) of each setpoint field for this bearing."""
-        m = self.model
-        axial_low = 0.0 if m.spec.kind == "angular_contact" else -m.max_axial_load_n
-        return {
-            "shaft_speed_rad_s": (0.0, m.max_shaft_speed_rad_s),
-            "radial_load_n": (0.0, m.max_radial_load_n),
-            "axial_load_n": (axial_low, m.max_axial_load_n),
-            "oil_temperature_c": (-30.0, 150.0),
-            "shaft_current_a": (0.0, 100.0),
-            "shaft_voltage_v": (0.0, 1000.0),
-        }
+        return setpoint_limits(self.model)
 
     @property
     def setpoint(self) -> Setpoint:
@@ -198,6 +205,21 @@ class Twin:
         self.state.scalars[L.X_TIME] = t
         m = self.model
         evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
+        self._update_life(force=True)
+
+    # ---- rating life (twin.life) --------------------------------------------------------------
+    def _update_life(self, force: bool = False) -> None:
+        """Feed the life monitor the current conditions (it re-evaluates every refresh_s of
+        simulated time): setpoint loads, the ramped shaft speed, the kinematic viscosity of the
+        film inlet (oil temperature plus the inlet's current and shear heating) and the contacts."""
+        if not (force or self.life_monitor.due(self.time_s)):
+            return
+        sp = self._setpoint
+        rise = getattr(self, "_current_heating_k", 0.0) + getattr(self, "_shear_heating_k", 0.0)
+        rho = density_kg_m3(self.model.spec.lubricant.density_15c_kg_m3, sp.oil_temperature_c + rise)
+        self.life_monitor.update(self.time_s, float(self.state.scalars[L.X_SHAFT_SPEED]), sp.radial_load_n,
+                                 sp.axial_load_n, self._inlet_viscosity_pa_s / rho, self.state.contacts,
+                                 force=force)
 
     def _frame(self, n: int) -> int:
         self._update_inlet_viscosity()
@@ -213,6 +235,7 @@ class Twin:
             self._recover(status)
         else:
             self._last_good_time_s = self.time_s
+            self._update_life()
         return done
 
     def _recover(self, status: int) -> None:
@@ -329,4 +352,9 @@ class Twin:
                 current_temperature_rise_k=float(self._current_heating_k),
                 shear_temperature_rise_k=float(self._shear_heating_k),
                 film_thermal_factor=float(self._film_thermal_factor)),
-            balls=balls)
+            balls=balls,
+            life=self._life_state())
+
+    def _life_state(self) -> LifeState | None:
+        block = self.life_monitor.block(self.time_s)
+        return None if block is None else LifeState(**block)

@@ -69,6 +69,30 @@ class ElectricalState(BaseModel):
     film_thermal_factor: float = Field(default=1.0, description="Film thickness / isothermal film thickness from the heating (1: none) [-].")
 
 
+class LifeState(BaseModel):
+    """Rating life at the current conditions and the damage accumulated so far (twin.life:
+    ISO 281:2007 and a Lundberg-Palmgren life from the twin's own contact loads). Null where a
+    value is undefined or unbounded (e.g. at rest the life is unbounded and kappa undefined);
+    `reason` says why."""
+
+    model_config = _FROZEN
+    kappa: float | None = Field(default=None, description="Viscosity ratio nu / nu1 of ISO 281:2007 clause 9.3 [-]; null at rest.")
+    a_iso: float | None = Field(default=None, description="Life modification factor a_ISO (ISO 281:2007 clause 9.3, <= 50) [-]; null at rest or for kappa < 0.1.")
+    l10_h: float | None = Field(default=None, description="Basic rating life L10 = (C/P)^3 at the current shaft speed [h]; null when unbounded.")
+    l10m_h: float | None = Field(default=None, description="Modified rating life a_ISO L10 (90 % reliability) [h]; null when unbounded or not applicable.")
+    l10_contact_loads_h: float | None = Field(default=None, description="Lundberg-Palmgren life from the twin's ball loads (ISO/TS 16281 spirit), running mean over the ball passages [h]; null when unbounded.")
+    damage_fraction: float = Field(default=0.0, description="Palmgren-Miner damage accumulated along the twin's history [-] (1 = life used up).")
+    damage_rate_per_s: float = Field(default=0.0, description="Fraction of life used per second at the current conditions [1/s].")
+    remaining_life_h: float | None = Field(default=None, description="(1 - damage) x the damage basis life at the current conditions [h]; null when unbounded.")
+    dynamic_load_rating_n: float | None = Field(default=None, description="Basic dynamic load rating C used [N].")
+    equivalent_load_n: float | None = Field(default=None, description="Equivalent dynamic load P = X Fr + Y Fa (ISO 281 Table 3) [N].")
+    contamination_factor: float | None = Field(default=None, description="Contamination factor e_C (ISO 281:2007 Table 13 / Annex A) [-].")
+    viscosity_m2_s: float | None = Field(default=None, description="Kinematic viscosity of the oil at the film inlet, nu [m^2/s].")
+    rated_viscosity_m2_s: float | None = Field(default=None, description="Rated viscosity nu1 of ISO 281:2007 clause 9.3 [m^2/s]; null at rest.")
+    damage_basis: Literal["iso_281", "contact_loads"] | None = Field(default=None, description="Life the damage accrues against.")
+    reason: str | None = Field(default=None, description="Why values are null, or a caveat; null when there is none.")
+
+
 class SetpointState(BaseModel):
     """The setpoint in force."""
 
@@ -102,6 +126,7 @@ class Snapshot(BaseModel):
     viscosity_pa_s: float = Field(description="Inlet viscosity: the oil at the oil temperature plus the inlet's current and shear heating (Roelands, seed 003 eq. 3) [Pa s].")
     electrical: ElectricalState
     balls: tuple[BallState, ...]
+    life: LifeState | None = Field(default=None, description="Rating life and accumulated damage (twin.life); null before the first evaluation.")
 
     def to_json(self) -> str:
         """JSON text with the contract's field names."""

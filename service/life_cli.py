@@ -1,0 +1,70 @@
+"""`bearing-twin life`: ISO 281 rating life and the contact-load life of a catalogue bearing at
+one steady operating point (twin.life.rate_operating_point)."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+
+_CONTAMINATION = ("extreme_cleanliness", "high_cleanliness", "normal_cleanliness",
+                  "slight_to_typical_contamination", "severe_contamination", "very_severe_contamination")
+
+
+def add_life_command(sub) -> None:
+    """Register `life` on the `bearing-twin` subparsers."""
+    p = sub.add_parser(
+        "life", help="rating life: ISO 281 L10 / L10m (a_ISO, kappa) and the Lundberg-Palmgren life from the "
+        "ball loads of the quasi-static equilibrium",
+        description="ISO 281:2007 basic and modified rating life of a catalogue bearing at one steady operating "
+        "point, and the life from the contact loads (Lundberg-Palmgren per raceway, ISO/TS 16281 spirit) of the "
+        "twin's quasi-static equilibrium (a short DEM run where the equilibrium does not converge).")
+    p.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    p.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
+    p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
+    p.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
+    p.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC]")
+    p.add_argument("--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload")
+    p.add_argument("--contamination", choices=_CONTAMINATION, default="normal_cleanliness",
+                   help="contamination level (ISO 281 Table 13 / Annex A, oil; default normal_cleanliness)")
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+    p.set_defaults(func=_cmd_life)
+
+
+def _fmt(value, spec: str = "{:.4g}") -> str:
+    return "-" if value is None else spec.format(value)
+
+
+def _cmd_life(args: argparse.Namespace) -> int:
+    from pydantic import ValidationError
+
+    from twin.life import LifeSettings, rate_operating_point
+    from twin.setpoint import SetpointError
+
+    try:
+        result = rate_operating_point(args.bearing, args.radial_load, args.axial_load, args.speed,
+                                      oil_temperature_c=args.oil_temperature, diametral_clearance_m=args.clearance,
+                                      settings=LifeSettings(contamination=args.contamination))
+    except ValidationError as exc:
+        msg = "; ".join(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" for e in exc.errors())
+        print(f"error: {msg}", file=sys.stderr)
+        return 2
+    except (SetpointError, ValueError) as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if args.json:
+        print(json.dumps(result, allow_nan=False))
+        return 0
+    r = result
+    print(f"{r['bearing']} ({r['kind']}, {r['nominal_contact_angle_deg']:g} deg) at Fr = {r['radial_load_n']:g} N, "
+          f"Fa = {r['axial_load_n']:g} N, {r['shaft_speed_rad_s']:g} rad/s, oil {r['oil_temperature_c']:g} degC")
+    print(f"  C = {r['dynamic_load_rating_n']:.0f} N, C0 = {r['static_load_rating_n']:.0f} N, "
+          f"Pu = {r['fatigue_load_limit_n']:.0f} N ({r['ratings_source']})")
+    print(f"  P = {r['x_factor']:g} Fr + {r['y_factor']:g} Fa = {r['equivalent_load_n']:.0f} N (e = {r['e_factor']:g})")
+    print(f"  kappa = {_fmt(r['kappa'])}, e_C = {r['contamination_factor']:.3g}, a_ISO = {_fmt(r['a_iso'])}")
+    print(f"  L10 = {_fmt(r['l10_h'], '{:.0f}')} h, L10m = {_fmt(r['l10m_h'], '{:.0f}')} h, "
+          f"contact-load life = {_fmt(r['l10_contact_loads_h'], '{:.0f}')} h")
+    print(f"  contact loads from: {r['contact_loads_from']}")
+    if r["reason"]:
+        print(f"  note: {r['reason']}")
+    return 0
