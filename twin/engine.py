@@ -197,7 +197,7 @@ class Twin:
             warm_start(self.model, self.state, speed, 0.0, 0.0)
         self.state.scalars[L.X_TIME] = t
         m = self.model
-        evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
+        evaluate(m.params, m.angle_table, self._setpoint_vector, *self.state.kernel_args())
 
     def _frame(self, n: int) -> int:
         self._update_inlet_viscosity()
@@ -205,7 +205,7 @@ class Twin:
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
         m = self.model
-        status, done = step_n(m.params, m.race_tribology, self._setpoint_vector,
+        status, done = step_n(m.params, m.angle_table, self._setpoint_vector,
                               *s.kernel_args(), n)
         if s.scalars[L.X_TORQUE_COUNT] > 0:
             self._last_torque_n_m = s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT]
