@@ -72,10 +72,14 @@ class Twin:
 
     def default_setpoint(self) -> Setpoint:
         """Seed 000's operating point (500 rad/s, 3000 N, 40 degC) where the bearing can hold it;
-        for a small bearing the radial load is a quarter of what it can hold."""
+        for a small bearing the radial load is a quarter of what it can hold. An angular-contact
+        bearing also gets an equal axial load (seed 004's Fr = Fa): a single row cannot carry a
+        radial load without an axial reaction (its inner ring would slide out axially)."""
         m = self.model
+        radial = min(3000.0, round(0.25 * m.max_radial_load_n))
+        axial = min(radial, round(0.25 * m.max_axial_load_n)) if m.spec.kind == "angular_contact" else 0.0
         return Setpoint(shaft_speed_rad_s=min(500.0, 0.5 * m.max_shaft_speed_rad_s),
-                        radial_load_n=min(3000.0, round(0.25 * m.max_radial_load_n)))
+                        radial_load_n=radial, axial_load_n=axial)
 
     # ---- setpoint ---------------------------------------------------------------------------
     @property
