@@ -49,9 +49,10 @@ SPIN_CREEP_FACTOR = 1.3
 ELECTRICAL_EVERY = 10
 
 
-@njit(**JIT)
+@njit(inline="always", **JIT)
 def _at_angle(table, r, i, f, col):
-    """Column `col` of race r's contact-angle table, linear between rows i and i + 1 (weight f)."""
+    """Column `col` of race r's contact-angle table, linear between rows i and i + 1 (weight f).
+    Inlined at numba level: 18 calls per contact refresh would otherwise each pass the table."""
     lo = table[r, i, col]
     return lo + f * (table[r, i + 1, col] - lo)
 
@@ -169,7 +170,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             ab = math.sqrt(tri[5] * tri[6])
             spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
                            + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
-            relax = u / ab + kt * spin_rel * ab / (SPIN_CREEP_FACTOR * tri[4] * q_el)
+            relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * tri[4] * q_el, 1e-12)
             w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
             w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
                                   + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
