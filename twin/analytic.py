@@ -3,15 +3,21 @@
 Load distribution of a rigidly supported radial ball bearing (seed 000 Appendix A, after Harris
 [45]): delta_psi = delta_r cos(psi) - Pd/2 (eq. A1), Q = K_eff delta^1.5 with the inner and
 outer Hertz contacts in series, Stribeck's Qmax = Fr / (Z Jr(eps)) (eq. A3).
+
+Jones' quasi-static solution for combined radial and axial load (and clearance or preload) of
+angular-contact and deep-groove ball bearings, with the centrifugal force of the balls and the
+exact Hertz constants at each contact's own angle (`jones_equilibrium`).
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy import integrate, optimize
 
+from twin import model as model_lib
 from twin.kernels import layout as L
 from twin.model import BearingModel
 
@@ -94,3 +100,169 @@ def qmax_continuous_n(model: BearingModel, radial_load_n: float, clearance_m: fl
     delta_r = optimize.brentq(fr_of, lo, 1e-3, xtol=1e-15)
     eps = load_parameter_epsilon(delta_r, clearance_m)
     return k * (delta_r - 0.5 * clearance_m) ** 1.5, eps
+
+
+# ---- Jones quasi-static solution of angular-contact and deep-groove ball bearings ---------------
+
+@dataclass(frozen=True)
+class JonesSolution:
+    """Quasi-static equilibrium of the inner ring and every ball (Jones 1960; Harris & Kotzalas,
+    Rolling Bearing Analysis, 5th ed., vol. 2, ch. 3 "Distribution of internal loading in high
+    speed bearings", and vol. 1 ch. 7-8 for the static case).
+
+    ring_displacement_m: inner-ring shift (x along Fr, y, z along Fa) [m]; azimuths_rad: ball
+    azimuths [rad]; inner_load_n / outer_load_n [N]; inner_angle_rad / outer_angle_rad: contact
+    angles, the angle between the contact normal and the radial plane, positive in the bearing's
+    nominal sense [rad]; ball_axial_m / ball_radial_m: ball-centre positions (z, distance from the
+    axis) [m]; centrifugal_force_n [N]; epsilon: the load parameter (1 + delta_a tan(alpha0) /
+    delta_r) / 2 of seed 004 section 3.1 (Harris) with the nominal angle alpha0 [-]; converged."""
+
+    ring_displacement_m: np.ndarray
+    azimuths_rad: np.ndarray
+    inner_load_n: np.ndarray
+    outer_load_n: np.ndarray
+    inner_angle_rad: np.ndarray
+    outer_angle_rad: np.ndarray
+    ball_axial_m: np.ndarray
+    ball_radial_m: np.ndarray
+    centrifugal_force_n: float
+    epsilon: float
+    converged: bool
+
+    @property
+    def qmax_n(self) -> float:
+        """Largest inner-contact load [N]."""
+        return float(self.inner_load_n.max())
+
+
+class _Geometry:
+    """Groove-curvature centres of one bearing in a ball's (z, rho) plane and the exact Hertz
+    stiffness of each race at any contact angle (twin.model.contact_constants)."""
+
+    def __init__(self, model: BearingModel):
+        race = model.race_params
+        self.model = model
+        self.rb = model.ball_radius_m
+        self.inner_centre = np.array([race[0, L.R_GROOVE_CENTRE_Z], race[0, L.R_GROOVE_CENTRE_RADIUS]])
+        self.outer_centre = np.array([race[1, L.R_GROOVE_CENTRE_Z], race[1, L.R_GROOVE_CENTRE_RADIUS]])
+        self.inner_free = race[0, L.R_GROOVE_RADIUS] - self.rb
+        self.outer_free = race[1, L.R_GROOVE_RADIUS] - self.rb
+        self.e_prime = float(model.params[L.P_E_PRIME])
+
+    def stiffness(self, race: int, sin_alpha: float) -> float:
+        """Exact Hertz K [N/m^1.5] of race `race` at |sin(alpha)|."""
+        return model_lib.contact_constants(self.model.spec, race == 0, min(abs(sin_alpha), 0.999),
+                                           self.e_prime)["stiffness_n_m15"]
+
+
+def _ball_forces(geo: _Geometry, ball: np.ndarray, inner_centre: np.ndarray, m_omega2: float):
+    """Net force on a ball at `ball` (z, rho) [N] and its two contacts (Q [N], unit normal);
+    m_omega2 = m omega_c^2 [N/m] makes the centrifugal force m omega_c^2 rho."""
+    to_inner = inner_centre - ball
+    d_i = float(np.hypot(*to_inner))
+    n_i = to_inner / d_i                      # ball -> inner groove centre
+    from_outer = ball - geo.outer_centre
+    d_o = float(np.hypot(*from_outer))
+    n_o = from_outer / d_o                    # outer groove centre -> ball
+    delta_i = d_i - geo.inner_free
+    delta_o = d_o - geo.outer_free
+    q_i = geo.stiffness(0, n_i[0]) * delta_i ** 1.5 if delta_i > 0.0 else 0.0
+    q_o = geo.stiffness(1, n_o[0]) * delta_o ** 1.5 if delta_o > 0.0 else 0.0
+    force = q_i * n_i - q_o * n_o + np.array([0.0, m_omega2 * ball[1]])
+    return force, q_i, n_i, q_o, n_o
+
+
+def _solve_ball(geo: _Geometry, inner_centre: np.ndarray, m_omega2: float, scale: float):
+    """Equilibrium position (z, rho) of one ball between the displaced inner groove centre and
+    the fixed outer one: Qi n_i - Qo n_o + Fc e_rho = 0 (Harris vol. 2 eqs. 3.x, no gyroscopic
+    moment). A ball that the inner race does not reach rests in the bottom of the outer groove."""
+    k_o0 = geo.stiffness(1, 0.0)
+    fc = m_omega2 * (geo.outer_centre[1] + geo.outer_free)
+    rest = geo.outer_centre + np.array([0.0, geo.outer_free + (fc / k_o0) ** (2.0 / 3.0)])
+    if np.hypot(*(inner_centre - rest)) <= geo.inner_free:
+        return rest
+    axis = inner_centre - geo.outer_centre
+    span = float(np.hypot(*axis))
+    overlap = max(span - geo.inner_free - geo.outer_free, 0.0)
+    guess = geo.outer_centre + axis / span * (geo.outer_free + 0.5 * overlap)
+
+    def residual(x_um):
+        return _ball_forces(geo, x_um * 1e-6, inner_centre, m_omega2)[0] / scale
+
+    sol = optimize.root(residual, guess * 1e6, method="hybr", options={"xtol": 1e-13})
+    if np.max(np.abs(residual(sol.x))) > 1e-10:
+        sol = optimize.root(residual, sol.x, method="lm", options={"xtol": 1e-15, "ftol": 1e-15})
+    return sol.x * 1e-6
+
+
+def jones_equilibrium(model: BearingModel, radial_load_n: float, axial_load_n: float,
+                      shaft_speed_rad_s: float = 0.0, azimuths_rad=None,
+                      centrifugal: bool = True, initial_displacement_m=None) -> JonesSolution:
+    """Jones' quasi-static solution (Jones 1960, "A general theory for elastically constrained
+    ball and radial roller bearings under arbitrary load and speed conditions", J. Basic Eng. 82;
+    Harris & Kotzalas vol. 2 ch. 3) for the model's bearing: rigid rings, the inner ring displaced
+    (delta_x, delta_y, delta_z) without tilt (as in the twin), each ball in equilibrium between its
+    inner and outer contacts and its centrifugal force m omega_c^2 rho (omega_c the cage speed of
+    the rolling kinematics), each contact Q = K(alpha) delta^1.5 with the EXACT Hertz constants of
+    its own contact angle. Gyroscopic moments and friction are neglected (Jones' "outer raceway
+    control" moment is small at the twin's speeds). Works for deep-groove bearings too (nominal
+    angle 0, with clearance or preload through the model's mounting).
+
+    azimuths_rad: the balls' azimuths (default evenly spaced from 0); radial load along +x,
+    axial load along +z on the inner ring [N]."""
+    z = model.ball_count
+    psi = (np.asarray(azimuths_rad, dtype=float) if azimuths_rad is not None
+           else 2.0 * math.pi * np.arange(z) / z)
+    geo = _Geometry(model)
+    mass = float(model.params[L.P_BALL_MASS])
+    omega_c = model.cage_speed_rad_s(shaft_speed_rad_s) if centrifugal else 0.0
+    scale = max(abs(radial_load_n), abs(axial_load_n), 1.0)
+    c, s = np.cos(psi), np.sin(psi)
+
+    m_omega2 = mass * omega_c ** 2
+
+    def solve_balls(shift):
+        out = []
+        for j in range(z):
+            centre = geo.inner_centre + np.array([shift[2], shift[0] * c[j] + shift[1] * s[j]])
+            out.append((centre, _solve_ball(geo, centre, m_omega2, scale)))
+        return out
+
+    def ring_residual(shift_um):
+        shift = shift_um * 1e-6
+        force = np.array([radial_load_n, 0.0, axial_load_n])
+        for j, (centre, ball) in enumerate(solve_balls(shift)):
+            _, q_i, n_i, _, _ = _ball_forces(geo, ball, centre, m_omega2)
+            force[0] -= q_i * n_i[1] * c[j]
+            force[1] -= q_i * n_i[1] * s[j]
+            force[2] -= q_i * n_i[0]
+        return force / scale
+
+    if initial_displacement_m is None:
+        k_eff = series_stiffness_n_m15(geo.stiffness(0, math.sin(model.contact_angle_rad)),
+                                       geo.stiffness(1, math.sin(model.contact_angle_rad)))
+        sa, ca = math.sin(model.contact_angle_rad), math.cos(model.contact_angle_rad)
+        pd = model.spec.mounting.diametral_clearance_m
+        dr = (max(radial_load_n, 1.0) / (z * 0.2288 * k_eff)) ** (2 / 3) / max(ca, 0.2) + 0.5 * max(pd, 0.0)
+        da = (axial_load_n / (z * k_eff * sa)) ** (2 / 3) / sa if (sa > 0.05 and axial_load_n > 0) else 0.0
+        initial_displacement_m = np.array([dr, 0.0, da])
+    x0 = np.asarray(initial_displacement_m, dtype=float) * 1e6
+    sol = optimize.root(ring_residual, x0, method="hybr", options={"xtol": 1e-12})
+    if np.max(np.abs(ring_residual(sol.x))) > 1e-9:
+        sol = optimize.root(ring_residual, sol.x, method="lm", options={"xtol": 1e-15, "ftol": 1e-15})
+    converged = bool(np.max(np.abs(ring_residual(sol.x))) <= 1e-8)
+    shift = sol.x * 1e-6
+    q_in, q_out, a_in, a_out, zb, rho = (np.zeros(z) for _ in range(6))
+    for j, (centre, ball) in enumerate(solve_balls(shift)):
+        _, q_i, n_i, q_o, n_o = _ball_forces(geo, ball, centre, m_omega2)
+        q_in[j], q_out[j] = q_i, q_o
+        a_in[j] = math.atan2(n_i[0], n_i[1])
+        a_out[j] = math.atan2(n_o[0], n_o[1])
+        zb[j], rho[j] = ball
+    delta_r = float(math.hypot(shift[0], shift[1]))
+    tan_a = math.tan(model.contact_angle_rad)
+    eps = 0.5 * (1.0 + shift[2] * tan_a / delta_r) if delta_r > 0.0 else math.inf
+    return JonesSolution(ring_displacement_m=shift, azimuths_rad=psi, inner_load_n=q_in,
+                         outer_load_n=q_out, inner_angle_rad=a_in, outer_angle_rad=a_out,
+                         ball_axial_m=zb, ball_radial_m=rho, centrifugal_force_n=float(m_omega2 * model.pitch_radius_m),
+                         epsilon=eps, converged=converged)

@@ -88,10 +88,14 @@ class Twin:
 
     def default_setpoint(self) -> Setpoint:
         """Seed 000's operating point (500 rad/s, 3000 N, 40 degC) where the bearing can hold it;
-        for a small bearing the radial load is a quarter of what it can hold."""
+        for a small bearing the radial load is a quarter of what it can hold. An angular-contact
+        bearing also gets an equal axial load (seed 004's Fr = Fa): a single row cannot carry a
+        radial load without an axial reaction (its inner ring would slide out axially)."""
         m = self.model
+        radial = min(3000.0, round(0.25 * m.max_radial_load_n))
+        axial = min(radial, round(0.25 * m.max_axial_load_n)) if m.spec.kind == "angular_contact" else 0.0
         return Setpoint(shaft_speed_rad_s=min(500.0, 0.5 * m.max_shaft_speed_rad_s),
-                        radial_load_n=min(3000.0, round(0.25 * m.max_radial_load_n)))
+                        radial_load_n=radial, axial_load_n=axial)
 
     # ---- setpoint ---------------------------------------------------------------------------
     @property
@@ -204,7 +208,7 @@ class Twin:
             warm_start(self.model, self.state, speed, 0.0, 0.0)
         self.state.scalars[L.X_TIME] = t
         m = self.model
-        evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
+        evaluate(m.params, m.angle_table, self._setpoint_vector, *self.state.kernel_args())
         self._update_life(force=True)
 
     # ---- rating life (twin.life) --------------------------------------------------------------
@@ -227,7 +231,7 @@ class Twin:
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
         m = self.model
-        status, done = step_n(m.params, m.race_tribology, self._setpoint_vector,
+        status, done = step_n(m.params, m.angle_table, self._setpoint_vector,
                               *s.kernel_args(), n)
         if s.scalars[L.X_TORQUE_COUNT] > 0:
             self._last_torque_n_m = s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT]

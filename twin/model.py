@@ -1,7 +1,13 @@
 """Compile a `BearingSpec` once into an immutable `BearingModel` (MuJoCo's mjModel role).
 
-Every derived constant the kernels need lives in two read-only float64 arrays (`params`, indexed
-by `twin.kernels.layout.P_*`, and `race_params[r]`, r = 0 inner, 1 outer, indexed by `R_*`).
+Every derived constant the kernels need lives in read-only float64 arrays: `params` (indexed by
+`twin.kernels.layout.P_*`), `race_params[r]` (r = 0 inner, 1 outer, indexed by `R_*`, at the
+nominal contact angle) and `angle_table[r, i, :]` (`A_*`: Hertz stiffness and the tribology
+coefficients of race r at sin(alpha) = i * ANGLE_STEP). The Hertz constants (ellipticity and the
+complete elliptic integrals) are solved exactly for every one of these geometries
+(`twin.physics.hertz.elliptic_constants`); the rolling-direction radius Rx of a contact follows
+its contact angle (Meusnier: the raceway's rolling radius is the distance from the contact to the
+bearing axis along the normal), Ry is the groove's.
 """
 
 from __future__ import annotations
@@ -12,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin.kernels import layout as L
-from twin.kernels.tribology import tribology_coefficients
+from twin.kernels.tribology import N_TRIBOLOGY, tribology_coefficients
 from twin.physics import hertz
 from twin.spec import BearingSpec, ModelOptions
 
@@ -32,6 +38,7 @@ class BearingModel:
     params: np.ndarray
     race_params: np.ndarray
     race_tribology: np.ndarray
+    angle_table: np.ndarray
     ball_count: int
     pitch_radius_m: float
     contact_angle_rad: float
@@ -39,6 +46,14 @@ class BearingModel:
     max_radial_load_n: float
     max_axial_load_n: float
     max_shaft_speed_rad_s: float
+
+    def stiffness_at(self, race: int, sin_alpha: float) -> float:
+        """Hertz K [N/m^1.5] of race `race` (0 inner, 1 outer) at contact angle alpha, interpolated
+        in the angle table exactly as the kernel does."""
+        x = min(abs(sin_alpha), L.ANGLE_MAX_SIN) * L.ANGLE_INV_STEP
+        i = min(int(x), L.ANGLE_POINTS - 2)
+        lo = float(self.angle_table[race, i, L.A_STIFFNESS])
+        return lo + (x - i) * (float(self.angle_table[race, i + 1, L.A_STIFFNESS]) - lo)
 
     @property
     def dt_s(self) -> float:
@@ -75,6 +90,40 @@ class BearingModel:
         return abs(wc) * self.pitch_radius_m / self.ball_radius_m
 
 
+def raceway_radii_m(spec: BearingSpec, inner: bool, sin_alpha: float) -> tuple[float, float]:
+    """(Rx, Ry) [m] of a ball-raceway contact at contact angle alpha (|sin alpha| given):
+    Rx = Rb r / (r +- Rb) with the raceway's rolling radius r = (dm/2 -+ Rb cos alpha) / cos alpha
+    (seed 000 eq. 2 and Fig. 3 at alpha = 0; Harris & Kotzalas, Rolling Bearing Analysis, ch. 2,
+    for alpha > 0), Ry = Rb Rg / (Rg - Rb) of the groove radius Rg."""
+    g = spec.geometry
+    rb = g.ball_radius_m
+    pitch = g.pitch_radius_m
+    cos_a = math.sqrt(max(1.0 - sin_alpha * sin_alpha, 0.0))
+    if inner:
+        rx = hertz.convex_radius_m(rb, (pitch - rb * cos_a) / cos_a)
+        groove = g.inner_groove_radius_m
+    else:
+        rx = hertz.concave_radius_m(rb, (pitch + rb * cos_a) / cos_a)
+        groove = g.outer_groove_radius_m
+    return rx, hertz.concave_radius_m(rb, groove)
+
+
+def contact_constants(spec: BearingSpec, inner: bool, sin_alpha: float, e_prime: float) -> dict:
+    """Exact Hertz constants of one race at contact angle alpha: Rx, Ry [m], ellipticity k,
+    Fbar, Ebar [-], stiffness K [N/m^1.5], semi-axis coefficients a/Q^(1/3), b/Q^(1/3) [m/N^(1/3)]."""
+    rx, ry = raceway_radii_m(spec, inner, sin_alpha)
+    c = hertz.elliptic_constants(rx, ry)
+    r = hertz.curvature_sum_radius_m(rx, ry)
+    return {
+        "rx_m": rx, "ry_m": ry, "ellipticity": c.ellipticity, "first_kind": c.first_kind,
+        "second_kind": c.second_kind,
+        "stiffness_n_m15": hertz.stiffness_from_constants(c.ellipticity, c.first_kind, c.second_kind, r, e_prime),
+        # semi-axes grow as Q^(1/3): the law at Q = 1 N is the coefficient
+        "semi_major_coef": hertz.semi_major_from_constants(1.0, c.ellipticity, c.second_kind, r, e_prime),
+        "semi_minor_coef": hertz.semi_minor_from_constants(1.0, c.ellipticity, c.second_kind, r, e_prime),
+    }
+
+
 def _race_row(spec: BearingSpec, inner: bool, alpha: float, e_prime: float) -> np.ndarray:
     g = spec.geometry
     rb = g.ball_radius_m
@@ -85,25 +134,50 @@ def _race_row(spec: BearingSpec, inner: bool, alpha: float, e_prime: float) -> n
     if inner:
         row[L.R_GROOVE_CENTRE_RADIUS] = pitch + offset * math.cos(alpha)
         row[L.R_GROOVE_CENTRE_Z] = offset * math.sin(alpha)
-        r2x = (pitch - rb * math.cos(alpha)) / math.cos(alpha)
-        rx = hertz.convex_radius_m(rb, r2x)
     else:
         row[L.R_GROOVE_CENTRE_RADIUS] = (pitch - offset * math.cos(alpha)
                                          + 0.5 * spec.mounting.diametral_clearance_m)
         row[L.R_GROOVE_CENTRE_Z] = -offset * math.sin(alpha)
-        r2x = (pitch + rb * math.cos(alpha)) / math.cos(alpha)
-        rx = hertz.concave_radius_m(rb, r2x)
-    ry = hertz.concave_radius_m(rb, groove)
-    k = hertz.ellipticity(rx, ry)
+    c = contact_constants(spec, inner, math.sin(alpha), e_prime)
     row[L.R_GROOVE_RADIUS] = groove
-    row[L.R_STIFFNESS] = hertz.raceway_stiffness_n_m15(rx, ry, e_prime)
-    row[L.R_RX] = rx
-    row[L.R_RY] = ry
-    row[L.R_K_ELLIPTICITY] = k
-    # semi-axes grow as Q^(1/3): the law at Q = 1 N is the coefficient
-    row[L.R_SEMI_MAJOR_COEF] = hertz.semi_major_axis_m(1.0, rx, ry, e_prime)
-    row[L.R_SEMI_MINOR_COEF] = hertz.semi_minor_axis_m(1.0, rx, ry, e_prime)
+    row[L.R_STIFFNESS] = c["stiffness_n_m15"]
+    row[L.R_RX] = c["rx_m"]
+    row[L.R_RY] = c["ry_m"]
+    row[L.R_K_ELLIPTICITY] = c["ellipticity"]
+    row[L.R_SEMI_MAJOR_COEF] = c["semi_major_coef"]
+    row[L.R_SEMI_MINOR_COEF] = c["semi_minor_coef"]
     return row
+
+
+def _tribology_row(spec: BearingSpec, options: ModelOptions, inner: bool, sin_alpha: float,
+                   e_prime: float, g_param: float) -> tuple[float, np.ndarray]:
+    """(K [N/m^1.5], tribology coefficients) of one race at |sin(alpha)| = sin_alpha."""
+    c = contact_constants(spec, inner, sin_alpha, e_prime)
+    tri = tribology_coefficients(c["rx_m"], c["ry_m"], c["ellipticity"], e_prime, g_param,
+                                 spec.geometry.ball_radius_m, c["semi_major_coef"],
+                                 c["semi_minor_coef"], options.film_formula)
+    return c["stiffness_n_m15"], tri
+
+
+def make_angle_table(spec: BearingSpec, options: ModelOptions, e_prime: float, g_param: float) -> np.ndarray:
+    """angle_table[r, i, :]: `A_STIFFNESS` and the tribology coefficients (from `A_TRIBOLOGY`) of
+    race r at sin(alpha) = i * ANGLE_STEP, i = 0 .. ANGLE_POINTS - 1 (exact Hertz constants)."""
+    table = np.zeros((2, L.ANGLE_POINTS, L.A_TRIBOLOGY + N_TRIBOLOGY))
+    for r in range(2):
+        for i in range(L.ANGLE_POINTS):
+            k, tri = _tribology_row(spec, options, r == 0, i * L.ANGLE_STEP, e_prime, g_param)
+            table[r, i, L.A_STIFFNESS] = k
+            table[r, i, L.A_TRIBOLOGY:] = tri
+    return table
+
+
+def interpolate_angle_table(table: np.ndarray, race: int, sin_alpha: float) -> np.ndarray:
+    """The row of `table` for race `race` at |sin(alpha)|, linear between grid points exactly as
+    the kernel's tribology refresh does (`twin.kernels.step`); clamped to the grid."""
+    x = min(abs(sin_alpha), L.ANGLE_MAX_SIN) * L.ANGLE_INV_STEP
+    i = min(int(x), L.ANGLE_POINTS - 2)
+    f = x - i
+    return table[race, i] + f * (table[race, i + 1] - table[race, i])
 
 
 def _load_at_pressure(row: np.ndarray, pressure_pa: float) -> float:
@@ -174,11 +248,12 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
                                p[L.P_G_PARAM], rb, race[r, L.R_SEMI_MAJOR_COEF],
                                race[r, L.R_SEMI_MINOR_COEF], options.film_formula)
         for r in range(2)])
-    for a in (p, race, tribology):
+    angle_table = make_angle_table(spec, options, e_prime, p[L.P_G_PARAM])
+    for a in (p, race, tribology, angle_table):
         a.setflags(write=False)
     return BearingModel(
         spec=spec, options=options, params=p, race_params=race,
-        race_tribology=tribology,
+        race_tribology=tribology, angle_table=angle_table,
         ball_count=z, pitch_radius_m=pitch,
         contact_angle_rad=alpha, inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),
         max_radial_load_n=float(max_radial), max_axial_load_n=float(max_axial),

@@ -1,6 +1,8 @@
 """Warm start: quasi-static equilibrium of the inner ring and every ball (normal Hertz contacts,
 applied loads, centrifugal force of the orbit) with rolling kinematics, so a new twin is in
-steady state within a few milliseconds of simulated time instead of hundreds."""
+steady state within a few milliseconds of simulated time instead of hundreds. Each contact's
+Hertz stiffness is taken at its own contact angle from the model's angle table, as the kernel
+does, and written to the contact lanes, so the first step starts from the same equilibrium."""
 
 from __future__ import annotations
 
@@ -36,7 +38,7 @@ def _equilibrium_residual(x_um, model: BearingModel, azimuths, fr, fa, cage_spee
             delta, nx, ny, nz = groove_penetration(rel[0], rel[1], rel[2], race[r, L.R_GROOVE_CENTRE_RADIUS],
                                                    race[r, L.R_GROOVE_CENTRE_Z], race[r, L.R_GROOVE_RADIUS], rb)
             if delta > 0.0:
-                q = race[r, L.R_STIFFNESS] * delta ** 1.5
+                q = model.stiffness_at(r, nz) * delta ** 1.5
                 f = -q * np.array([nx, ny, nz])
                 fball += f
                 if r == 0:
@@ -102,7 +104,6 @@ def warm_start(model: BearingModel, state: TwinState, shaft_speed_rad_s: float, 
     azimuths = cage_angle_rad + 2.0 * math.pi * np.arange(z) / z
     ring, d_rho, zb, ok = solve_equilibrium(model, azimuths, radial_load_n, axial_load_n, cage_speed)
     rb = model.ball_radius_m
-    alpha = model.contact_angle_rad
     state.scalars[:] = 0.0
     state.scalars[L.X_SHAFT_SPEED] = shaft_speed_rad_s
     state.scalars[L.X_CAGE_ANGLE] = cage_angle_rad
@@ -110,14 +111,24 @@ def warm_start(model: BearingModel, state: TwinState, shaft_speed_rad_s: float, 
     state.ring_position_m[:] = ring
     state.ring_velocity_m_s[:] = 0.0
     state.clear_contacts()
+    rows = state.lanes.reshape(L.N_ROWS, L.CW)
+    race = model.race_params
     for j in range(z):
         c, s = math.cos(azimuths[j]), math.sin(azimuths[j])
         rho = model.pitch_radius_m + d_rho[j]
-        state.ball_position_m[j] = (rho * c, rho * s, zb[j])
+        ball = np.array([rho * c, rho * s, zb[j]])
+        state.ball_position_m[j] = ball
+        normals = []
+        for r, centre in ((0, ring), (1, np.zeros(3))):
+            rel = ball - centre
+            _, nx, ny, nz = groove_penetration(rel[0], rel[1], rel[2], race[r, L.R_GROOVE_CENTRE_RADIUS],
+                                               race[r, L.R_GROOVE_CENTRE_Z], race[r, L.R_GROOVE_RADIUS], rb)
+            rows[L.M_STIFFNESS, 2 * j + r] = model.stiffness_at(r, nz)
+            normals.append(np.array([nx, ny, nz]))
         e_t = np.array([-s, c, 0.0])
         speed = cage_speed * rho
         state.ball_velocity_m_s[j] = speed * e_t
-        # no slip at the outer contact: omega_b = -(V / Rb) (n_o x e_t), n_o the outer normal
-        n_o = np.array([math.cos(alpha) * c, math.cos(alpha) * s, math.sin(alpha)])
-        state.ball_angular_velocity_rad_s[j] = -(speed / rb) * np.cross(n_o, e_t)
+        # no slip at the outer contact: omega_b = -(V / Rb) (n_o x e_t), n_o the outer normal at
+        # the equilibrium position (the contact angle the ball actually has)
+        state.ball_angular_velocity_rad_s[j] = -(speed / rb) * np.cross(normals[1], e_t)
     return ok

@@ -65,13 +65,15 @@ def test_clearance_and_preload_move_it_the_way_the_literature_says():
     """Harris & Kotzalas (Rolling Bearing Analysis, fatigue life against clearance): life falls
     as the diametral clearance grows beyond 0, peaks at a slightly negative clearance (light
     preload: more balls share the load) and falls steeply under heavy preload. Measured on the
-    6208 at 3000 N: L/L(0) = 0.98 (+2 um), 0.945 (+5 um), 0.875 (+12.6 um), 0.775 (+25 um);
-    1.02 (-2 um), 1.06 (-5 um), 1.10 (-10 um); 0.90 (-20 um), 0.37 (-30 um)."""
+    6208 at 3000 N with the exact Hertz constants: L/L(0) = 0.981 (+2 um), 0.954 (+5 um),
+    0.894 (+12.6 um), 0.808 (+25 um); 1.019 (-2 um), 1.047 (-5 um), 1.086 (-10 um); 1.054 (-20 um),
+    0.595 (-30 um), 0.27 (-40 um). (With the 32 % too stiff Brewe-Hamrock reading the same preload
+    gave 0.37 at -30 um: softer contacts carry less preload load, so the fall starts later.)"""
     l0 = _life(0.0)
     ratio = {pd: _life(pd * 1e-6) / l0 for pd in (12.6, 25.0, -5.0, -10.0, -30.0)}
     assert ratio[25.0] < ratio[12.6] < 0.95
     assert ratio[-5.0] > 1.0 and ratio[-10.0] > 1.0
-    assert ratio[-30.0] < 0.5
+    assert ratio[-30.0] < 0.7 and _life(-40e-6) / l0 < 0.4
     # ISO 281's L10 sees none of it: it depends on C and P only
     assert life.basic_rating_life_mrev(32500.0, FR) == life.basic_rating_life_mrev(32500.0, FR)
 

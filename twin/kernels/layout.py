@@ -137,10 +137,24 @@ O_EZ = 55
 O_SX = 56     # slip velocity ball minus ring, tangential [m/s]
 O_SY = 57
 O_SZ = 58
-N_ROWS = 59
+# tangential spring relaxation (refreshed with the tribology): xi <- decay xi + v_slip dt
+C_XI_DECAY = 59  # 1 / (1 + u dt / L), L = sqrt(a b) the contact's relaxation length [-]
+N_ROWS = 60
 
 # ---- kernel status codes ----------------------------------------------------------------------
 STATUS_OK = 0
 STATUS_NOT_FINITE = 1
 STATUS_PENETRATION = 2
 STATUS_NAMES = ("ok", "diverged: non-finite state", "overloaded: excessive contact penetration")
+
+# ---- contact-angle tables (twin.model: angle_table[r, i, :], r = 0 inner, 1 outer) ---------------
+# Row i holds the Hertz and film constants of race r at sin(contact angle) = i * ANGLE_STEP
+# (0 .. sin 60 deg), computed exactly at compile time; the tribology refresh interpolates them
+# linearly at each contact's current |sin(alpha)| = |n_z| (tests/physics/test_contact_angle_table.py
+# proves the grid).
+ANGLE_POINTS = 49                      # grid points
+ANGLE_MAX_SIN = 0.8660254037844386     # sin(60 deg): the last grid point
+ANGLE_STEP = ANGLE_MAX_SIN / (ANGLE_POINTS - 1)
+ANGLE_INV_STEP = 1.0 / ANGLE_STEP
+A_STIFFNESS = 0    # Hertz K [N/m^1.5]
+A_TRIBOLOGY = 1    # first of the N_TRIBOLOGY coefficients of twin.kernels.tribology (T_* + 1)

@@ -12,10 +12,11 @@ from numba import njit
 from twin.jit import JIT
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
-    C_CAPACITANCE, C_ENTRAINMENT, C_FLUID_DAMPING, C_RESISTANCE, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
+    A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, G_NZ,
+    C_CAPACITANCE, C_ENTRAINMENT, C_XI_DECAY, C_FLUID_DAMPING, C_RESISTANCE, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
     C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT, C_SRR,
     C_TANGENT_DAMPING, CW, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
-    K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, N_CACHED,
+    G_NX, G_NY, K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, N_CACHED,
     O_EX, O_EY, O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ,
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
@@ -35,11 +36,25 @@ from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribo
 # damper stiff enough to destabilise the explicit integration (seen at 1 rad/s).
 ROLLING_REGULARISATION_SPEED = 0.01
 
+# Linearising the fully sliding Coulomb traction mu p v/|v| of a spinning Hertz ellipse about pure
+# spin (relative spin w_s) gives a force -(mu Q / (|w_s| sqrt(a b))) M v for a small extra slip v,
+# with M = 3 pi / 8 for a circle and 1.18-1.38 across the major axis for k = 1..15 (0.4-1.2 along
+# the minor axis): the twin uses one M (tests/physics/test_spin_creep.py integrates it).
+SPIN_CREEP_FACTOR = 1.3
+
 # The contacts' parallel RC is refreshed every ELECTRICAL_EVERY tribology refreshes (100 us at
 # dt = 1 us): it only feeds the network evaluated between frames (1 ms) and the 10 ms
 # electro-thermal coupling, and refreshing it every 10 us cost ~90 ns per step (10 % of the
 # budget). A contact that has just closed gets its RC at once.
 ELECTRICAL_EVERY = 10
+
+
+@njit(inline="always", **JIT)
+def _at_angle(table, r, i, f, col):
+    """Column `col` of race r's contact-angle table, linear between rows i and i + 1 (weight f).
+    Inlined at numba level: 18 calls per contact refresh would otherwise each pass the table."""
+    lo = table[r, i, col]
+    return lo + f * (table[r, i + 1, col] - lo)
 
 
 @njit(**JIT)
@@ -51,7 +66,9 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     Ball-raceway contacts: gather the kinematics into the lanes of `w`, one vectorised geometry
     pass, one vectorised force pass, then per ball: sum the forces, refresh the tribology of
     loaded contacts when `tribology_now` (or when a contact closes), clear opened contacts.
-    Returns a status code."""
+    The refresh takes each contact's Hertz stiffness (its lane M_STIFFNESS, read by the next
+    geometry pass) and film constants at its current contact angle from the model's angle table
+    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|). Returns a status code."""
     z = bx.shape[0]
     nc = 2 * z
     rb = p[P_BALL_RADIUS]
@@ -114,15 +131,26 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         w[C_LOAD * CW + c] = q_el
         if tribology_now or w[C_LAMBDA * CW + c] < 0.0:
             r = c & 1
+            # Hertz and film constants at the contact's current angle (angle table row i, i + 1)
+            xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
+            ia = min(int(xa), ANGLE_POINTS - 2)
+            fa = xa - ia
+            w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
             ex = w[O_EX * CW + c]
             ey = w[O_EY * CW + c]
             ez = w[O_EZ * CW + c]
             u2 = ex * ex + ey * ey + ez * ez
             u = math.sqrt(u2)
+            t = A_TRIBOLOGY
             tri = contact_tribology(
-                q_el, u, eta, roughness, tr[r, 0], tr[r, 1], tr[r, 2], tr[r, 3], tr[r, 4],
-                tr[r, 5], tr[r, 6], tr[r, 7], tr[r, 8], tr[r, 9], tr[r, 10], tr[r, 11],
-                tr[r, 12], tr[r, 13], tr[r, 14], friction_model, rolling_on)
+                q_el, u, eta, roughness, _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
+                _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
+                _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
+                _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
+                _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
+                _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
+                _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
+                _at_angle(tr, r, ia, fa, t + 14), friction_model, rolling_on)
             w[C_H_MIN * CW + c] = tri[0]
             w[C_H_C * CW + c] = tri[1]
             w[C_LAMBDA * CW + c] = tri[2]
@@ -137,13 +165,21 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
             w[C_TANGENT_DAMPING * CW + c] = ct_ratio * 2.0 * math.sqrt(kt * tangent_mass)
             w[C_ENTRAINMENT * CW + c] = u
+            # tangential spring relaxation (contacts.raceway_forces): by rolling over L = sqrt(a b)
+            # and by the spin sliding of the contact, kt |w_spin| sqrt(a b) / (1.3 mu Q)
+            ab = math.sqrt(tri[5] * tri[6])
+            spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
+                           + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
+            relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * tri[4] * q_el, 1e-12)
+            w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
             w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
                                   + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
             if not (electrical_now or w[C_CAPACITANCE * CW + c] == 0.0):
                 continue  # the RC keeps its last value between electrical refreshes
             if tri[1] > 0.0:
                 res_ohm, cap_f = contact_electrical(
-                    q_el, tri[2], tri[1], tri[5], tri[6], tr[r, T_RX], tr[r, T_RY],
+                    q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
+                    _at_angle(tr, r, ia, fa, t + T_RY),
                     p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT], p[P_ASPERITY_RESISTANCE],
                     p[P_OIL_RESISTIVITY])
             else:  # no film (no entrainment): metallic contact, no dielectric
