@@ -29,10 +29,10 @@ from twin.spec import BearingSpec, ModelOptions
 from twin.state import TwinState, make_state
 from twin.warmstart import warm_start
 
-FRAME_STEPS = 1000  # steps per compiled call (1 ms of simulated time at dt = 1 us)
+FRAME_S = 1e-3  # simulated time per compiled call [s] (1000 steps at dt = 1 us)
 RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
 MIN_FILM_THERMAL_FACTOR = 1e-4  # floor of the thermal film factor [-]
-COUPLING_FRAMES = 10  # electro-thermal coupling refreshed every 10 frames (10 ms at 1 ms frames)
+COUPLING_PERIOD_S = 0.01  # electro-thermal coupling refreshed every 10 ms of simulated time [s]
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -111,19 +111,20 @@ class Twin:
         return new
 
     # ---- electro-thermal coupling (seed 003) ------------------------------------------------
-    def _update_inlet_viscosity(self, force: bool = False) -> None:
+    def _update_inlet_viscosity(self, force: bool = False, elapsed_s: float = 0.0) -> None:
         """Electro-thermal film loss (seed 003): the inlet is heated by the current discharge of the
         race track (eq. 10, with the bearing's equivalent resistance) and by shear (eq. 6 at the
         inlet); the film the loop computes is the isothermal film at the oil temperature times
         the thermal film factor g(dT)^c_T calibrated against the thermal EHL solver
         (twin.thermal_calibration). The factor enters the kernel through the one viscosity it
         reads: eta_film = eta_oil * factor^(1 / n_u), n_u the film law's exponent of (eta u), so
-        film, Lambda, regime, mu and fluid damping all follow. Recomputed every COUPLING_FRAMES
-        frames (the drivers change slowly)."""
-        self._frames_since_coupling = getattr(self, "_frames_since_coupling", 0) + 1
-        if not force and self._frames_since_coupling < COUPLING_FRAMES:
+        film, Lambda, regime, mu and fluid damping all follow. Recomputed at the start of the frame
+        that completes COUPLING_PERIOD_S of simulated time (`elapsed_s`: the frame's length; the
+        drivers change slowly), whatever the step."""
+        self._since_coupling_s = getattr(self, "_since_coupling_s", 0.0) + elapsed_s
+        if not force and self._since_coupling_s < COUPLING_PERIOD_S - 0.5 * self.model.dt_s:
             return
-        self._frames_since_coupling = 0
+        self._since_coupling_s = 0.0
         sp = self._setpoint
         th = self.model.spec.thermal
         have_state = hasattr(self, "state")
@@ -200,7 +201,7 @@ class Twin:
         evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
 
     def _frame(self, n: int) -> int:
-        self._update_inlet_viscosity()
+        self._update_inlet_viscosity(elapsed_s=n * self.model.dt_s)
         s = self.state
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
@@ -235,9 +236,10 @@ class Twin:
         self.state.scalars[L.X_TIME] = t
         self.reset(keep_time=True)
 
-    def advance(self, seconds: float, frame_steps: int = FRAME_STEPS, *,
+    def advance(self, seconds: float, frame_steps: int | None = None, *,
                 max_restarts: int | None = None) -> int:
-        """Integrate `seconds` of simulated time in frames of `frame_steps` steps.
+        """Integrate `seconds` of simulated time (a whole number of steps, the nearest) in frames of
+        `frame_steps` steps (default: FRAME_S of simulated time).
 
         A state the kernel cannot hold at the setpoint in force fails again right after its warm
         restart, i.e. at nearly every step (each restart costs a warm start): `max_restarts`
@@ -246,6 +248,8 @@ class Twin:
         if not (math.isfinite(seconds) and seconds >= 0.0):
             raise ValueError(f"seconds = {seconds!r}: must be finite and >= 0")
         remaining = int(round(seconds / self.model.dt_s))
+        if frame_steps is None:
+            frame_steps = max(1, int(round(FRAME_S / self.model.dt_s)))
         first = self.restarts
         while remaining > 0:
             n = min(frame_steps, remaining)

@@ -8,11 +8,13 @@ import pytest
 
 from twin.engine import Twin
 from twin.setpoint import Setpoint
+from twin.spec import ModelOptions
 
 
 @pytest.fixture(scope="module")
-def combined():
-    twin = Twin("7208", setpoint=Setpoint(shaft_speed_rad_s=500.0, radial_load_n=3000.0, axial_load_n=3000.0))
+def combined(time_step):
+    twin = Twin("7208", options=ModelOptions(time_step_s=time_step),
+                setpoint=Setpoint(shaft_speed_rad_s=500.0, radial_load_n=3000.0, axial_load_n=3000.0))
     twin.advance(0.02)
     return twin, twin.snapshot()
 
