@@ -68,7 +68,7 @@ def central_difference_critical_step_s(omega_rad_s: float, damping_ratio: float)
     if omega_rad_s <= 0.0:
         return math.inf
     z = max(damping_ratio, 0.0)
-    return 2.0 / omega_rad_s * (math.sqrt(1.0 + z * z) - z)
+    return float(2.0 / omega_rad_s * (math.sqrt(1.0 + z * z) - z))
 
 
 def hertz_tangent_stiffness_n_m(stiffness_n_m15: float, load_n: float) -> float:

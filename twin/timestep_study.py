@@ -278,7 +278,8 @@ def summary(rows: list[dict], step: str = "auto") -> dict[str, float]:
     """Largest deviation of each quantity over the rows of one step label."""
     out = {}
     for q in QUANTITIES:
-        values = [r["deviation"][q] for r in rows if r["step"] == step and not math.isnan(r["deviation"][q])]
+        values = [r["deviation"][q] for r in rows if r["step"] == step and r["deviation"][q] is not None
+                  and not math.isnan(r["deviation"][q])]
         out[q] = max(values) if values else math.nan
     return out
 
@@ -288,8 +289,10 @@ _HEAD = ("ball_load", "lambda", "h_min", "mu", "cage_speed", "ball_spin", "ball_
 _TITLE = ("load", "Lambda", "h_min", "mu", "cage", "spin", "orbit", "torque", "C", "heating")
 
 
-def _pct(x: float) -> str:
-    return "-" if math.isnan(x) else ("inf" if math.isinf(x) else f"{100.0 * x:.3f}")
+def _pct(x: float | None) -> str:
+    if x is None or math.isnan(x):
+        return "-"
+    return "inf" if math.isinf(x) else f"{100.0 * x:.3f}"
 
 
 def markdown_table(rows: list[dict]) -> str:
