@@ -199,6 +199,11 @@ class Twin:
         self.state.scalars[L.X_TIME] = t
         m = self.model
         evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
+        if self._setpoint.shaft_current_a > 0.0 or m.spec.thermal.shear_heating:
+            # the inlet heating of the warm state (loaded balls, entrainment), not of the state
+            # before it (no loaded ball: the current heating at its cap for the first 10 ms)
+            self._update_inlet_viscosity(force=True)
+            evaluate(m.params, m.race_tribology, self._setpoint_vector, *self.state.kernel_args())
 
     def _frame(self, n: int) -> int:
         self._update_inlet_viscosity(elapsed_s=n * self.model.dt_s)
