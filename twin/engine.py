@@ -158,6 +158,32 @@ class Twin:
         loaded = c[L.C_LOAD, 0::2] > 0.0
         return float(np.mean(np.abs(u[loaded] if loaded.any() else u)))
 
+    def loaded_zone_ball_count(self) -> float:
+        """Balls in the inner race's loaded zone (K of seed 003 eq. 10) as the zone's arc in ball
+        pitches: the mean number of loaded balls over a ball pass. The count at an instant jumps
+        by one whenever a ball crosses an edge of the zone, and sampled every 10 ms by the
+        electro-thermal coupling it made the heating a step function of the state (at 1700 rad/s
+        and 20 A: 6.5 or 8.1 K, 25 % apart, by when a sample fell). The edges are interpolated
+        between neighbouring balls on their inner approach (G_DELTA, < 0: gap)."""
+        z = self.model.ball_count
+        delta = self.state.contacts[L.G_DELTA, 0::2]
+        loaded = delta > 0.0
+        if loaded.all() or not loaded.any():
+            return float(z) if loaded.all() else 0.0
+        order = np.argsort(self.ball_azimuths_rad())
+        az = self.ball_azimuths_rad()[order]
+        d = delta[order]
+        arc = 0.0
+        for j in range(z):
+            k = (j + 1) % z
+            gap = (az[k] - az[j]) % (2.0 * math.pi)
+            if d[j] > 0.0 and d[k] > 0.0:
+                arc += gap
+            elif d[j] > 0.0 or d[k] > 0.0:  # one edge of the zone lies between the two balls
+                inside = d[j] if d[j] > 0.0 else d[k]
+                arc += gap * inside / (abs(d[j]) + abs(d[k]))
+        return arc * z / (2.0 * math.pi)
+
     def current_heating_k(self) -> float:
         """Race-track temperature rise from the shaft current (seed 003 eq. 10) [K]."""
         sp = self._setpoint
@@ -167,7 +193,7 @@ class Twin:
         if r_b is None:
             net = self.electrical()
             r_b = net.impedance_ohm * math.cos(net.phase_rad)
-        loaded = int(np.count_nonzero(self.state.contacts[L.C_LOAD, 0::2] > 0.0))
+        loaded = self.loaded_zone_ball_count()
         return min(MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k(
             sp.shaft_current_a, r_b, 2.0 * m.pitch_radius_m, 2.0 * m.ball_radius_m, loaded,
             float(self.state.scalars[L.X_SHAFT_SPEED]) / (2.0 * math.pi), th.crater_depth_m,
