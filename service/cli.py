@@ -1,4 +1,5 @@
-"""`bearing-twin` command line: simulate, bench, report, serve, scenario, bench-service, monitor, soak, life.
+"""`bearing-twin` command line: simulate, bench, timestep-study, report, serve, scenario, bench-service, monitor,
+soak, life.
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -15,6 +16,15 @@ def _positive_float(text: str) -> float:
     if not value > 0:
         raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
     return value
+
+
+def _time_step(text: str) -> float | str:
+    from twin.timestep import parse_time_step
+
+    try:
+        return parse_time_step(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
@@ -72,16 +82,23 @@ def _print_table(snap) -> None:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from twin.bench import run_engine_benchmark
 
-    result = run_engine_benchmark(seconds=args.seconds, repeats=args.repeats)
-    if args.json:
-        print(json.dumps(result))
-    else:
-        print(f"{result['bearing']} at {result['radial_load_n']:.0f} N, {result['shaft_speed_rad_s']:.0f} rad/s, "
-              f"dt = {result['time_step_s'] * 1e6:.1f} us, full model ({result['shaft_current_a']:g} A shaft current, "
-              f"shear heating {'on' if result['shear_heating'] else 'off'})")
-        print(f"  real-time factor (best of {result['repeats']}): {result['real_time_factor']:.3f}")
-        print(f"  real-time factor (median): {result['real_time_factor_median']:.3f}")
-        print(f"  ns per step (best): {result['ns_per_step']:.0f}")
+    from twin.bench import summary_text
+
+    try:
+        result = run_engine_benchmark(seconds=args.seconds, repeats=args.repeats)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(json.dumps(result) if args.json else summary_text(result))
+    return 0
+
+
+def _cmd_timestep_study(args: argparse.Namespace) -> int:
+    from twin import timestep_study
+
+    result = timestep_study.run_all(quick=args.quick, progress=lambda case, step: print(
+        f"{case.id}: {step}", file=sys.stderr, flush=True))
+    print(timestep_study.as_json(result) if args.json else timestep_study.markdown(result))
     return 0
 
 
@@ -97,16 +114,22 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC]")
     sim.add_argument("--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload")
     sim.add_argument("--duration", type=float, default=0.05, help="simulated time [s]")
-    sim.add_argument("--dt", type=float, default=1e-6, help="time step [s]")
+    sim.add_argument("--dt", type=_time_step, default="auto",
+                     help="time step [s] or 'auto' (default: from the critical step, twin.timestep)")
     sim.add_argument("--film-formula", choices=["hamrock_dowson", "masjedi_khonsari"], default="hamrock_dowson")
     sim.add_argument("--json", action="store_true", help="print the snapshot as JSON")
     sim.set_defaults(func=_cmd_simulate)
 
-    bench = sub.add_parser("bench", help="engine speed: real-time factor and ns per step (6208, 3000 N, 500 rad/s)")
+    bench = sub.add_parser("bench", help="engine speed: real-time factor at the default step and at 1 us, "
+                           "further cases, per-pass timing")
     bench.add_argument("--seconds", type=_positive_float, default=0.2, help="simulated seconds per repeat")
-    bench.add_argument("--repeats", type=int, default=5, help="repeats (best and median reported)")
+    bench.add_argument("--repeats", type=int, default=5, help="repeats, at least 5 (best and median reported)")
     bench.add_argument("--json", action="store_true")
     bench.set_defaults(func=_cmd_bench)
+    study = sub.add_parser("timestep-study", help="the auto time step against 1 us over the operating envelope")
+    study.add_argument("--quick", action="store_true", help="a subset of the cases (the test suite's)")
+    study.add_argument("--json", action="store_true")
+    study.set_defaults(func=_cmd_timestep_study)
     report = sub.add_parser("report", help="validation report against the seeds (Markdown + PNG plots)")
     report.add_argument("--out", default="reports", help="output directory (default reports/)")
     report.add_argument("--quick", action="store_true", help="fewer points and shorter runs")

@@ -24,3 +24,10 @@ def support():
     """tests/support.py: `Peer` (zenoh test peer), `ThreadServer` (uvicorn in a thread),
     `wait_for` (bounded polling), `free_port`, `free_endpoint`, `strict_loads`."""
     return _SUPPORT
+
+
+@pytest.fixture(scope="session", params=("auto", 1e-6), ids=("dt_auto", "dt_1us"))
+def time_step(request):
+    """ModelOptions.time_step_s of the seed checks: each runs at the auto step (the default,
+    twin.timestep) and at seed 000's 1 us (issue 13)."""
+    return request.param

@@ -17,9 +17,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from twin import timestep
 from twin.kernels import layout as L
 from twin.kernels.tribology import N_TRIBOLOGY, tribology_coefficients
 from twin.physics import hertz
+from twin.physics.viscosity import dynamic_viscosity_pa_s
 from twin.spec import BearingSpec, ModelOptions
 
 # ISO 76 static limit for ball bearings: 4.2 GPa; the model refuses loads whose analytic maximum
@@ -46,6 +48,7 @@ class BearingModel:
     max_radial_load_n: float
     max_axial_load_n: float
     max_shaft_speed_rad_s: float
+    time_step: timestep.CriticalTimeStep | None = None  # critical step of the scheme (twin.timestep)
 
     def stiffness_at(self, race: int, sin_alpha: float) -> float:
         """Hertz K [N/m^1.5] of race `race` (0 inner, 1 outer) at contact angle alpha, interpolated
@@ -205,7 +208,6 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     contact_distance = min(rb + g.cage_element_radius_m, half_chord - 20e-6)
 
     p = np.zeros(L.N_PARAMS)
-    p[L.P_DT] = options.time_step_s
     p[L.P_BALL_RADIUS] = rb
     p[L.P_BALL_MASS] = ball_mass
     p[L.P_BALL_INERTIA] = ball_inertia
@@ -225,7 +227,6 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_RAMP] = options.speed_ramp_rad_s2
     p[L.P_FILM_FORMULA] = 0.0 if options.film_formula == "hamrock_dowson" else 1.0
     p[L.P_FRICTION_MODEL] = 0.0 if options.friction_model == "stribeck_line" else 1.0
-    p[L.P_SUBSTEPS] = options.tribology_substeps
     p[L.P_ROLLING] = 1.0 if options.rolling_resistance else 0.0
     p[L.P_BALL_REDUCED_TANGENT_MASS] = ball_mass / (1.0 + ball_mass * rb * rb / ball_inertia)
     p[L.P_MAX_PENETRATION] = 0.01 * rb
@@ -249,6 +250,13 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
                                race[r, L.R_SEMI_MINOR_COEF], options.film_formula)
         for r in range(2)])
     angle_table = make_angle_table(spec, options, e_prime, p[L.P_G_PARAM])
+    # the step: the number asked for, or the auto step from the stiffest element at the static
+    # capacity q_limit (twin.timestep); the tribology sub-rate is a period, as steps of this dt
+    critical = timestep.estimate(
+        p, race, tribology, q_limit,
+        dynamic_viscosity_pa_s(spec.lubricant, timestep.REFERENCE_OIL_TEMPERATURE_C), z)
+    p[L.P_DT] = timestep.resolve_time_step_s(options.time_step_s, critical)
+    p[L.P_SUBSTEPS] = timestep.steps_per_period(options.tribology_period_s, p[L.P_DT])
     for a in (p, race, tribology, angle_table):
         a.setflags(write=False)
     return BearingModel(
@@ -257,4 +265,4 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
         ball_count=z, pitch_radius_m=pitch,
         contact_angle_rad=alpha, inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),
         max_radial_load_n=float(max_radial), max_axial_load_n=float(max_axial),
-        max_shaft_speed_rad_s=float(max_speed))
+        max_shaft_speed_rad_s=float(max_speed), time_step=critical)

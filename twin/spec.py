@@ -10,7 +10,10 @@ from __future__ import annotations
 import math
 from typing import Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
+
+# the range of an explicit ModelOptions.time_step_s [s] (twin.timestep.TIME_STEP_RANGE_S)
+TIME_STEP_RANGE_S = (1e-8, 2e-5)
 
 _FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
@@ -239,13 +242,19 @@ class ModelOptions(BaseModel):
 
     model_config = _FROZEN
 
-    time_step_s: float = Field(default=1e-6, ge=1e-8, le=5e-6, description="Integration step dt [s] (seed 000: 1 us).")
+    time_step_s: float | Literal["auto"] = Field(
+        default="auto",
+        description="Integration step dt [s], or 'auto' (default): 0.8 x the critical step of the explicit "
+        "scheme at the bearing's static capacity, a divisor of 1 ms (twin.timestep; about 3.2 us for the "
+        "6208). Seed 000 uses 1 us. A number must lie in [1e-08, 2e-05] s.")
     film_formula: Literal["hamrock_dowson", "masjedi_khonsari"] = Field(
         default="hamrock_dowson", description="Minimum film formula: seed 000 eq. 6 or seed 004 eq. 6.")
     friction_model: Literal["stribeck_line", "asperity_share"] = Field(
         default="stribeck_line", description="mu(Lambda): seed 000 section 2.3 or seed 001 eq. A2.")
-    tribology_substeps: int = Field(
-        default=10, ge=1, le=10, description="Film/Lambda/mu/damping refreshed every this many steps (<= 10 us at 1 us).")
+    tribology_period_s: float = Field(
+        default=1e-5, ge=1e-7, le=1e-4,
+        description="Film/Lambda/mu/damping refreshed every this period [s], a whole number of steps (the "
+        "nearest, at least 1; 10 steps at dt = 1 us); the contacts' RC every 10 refreshes (100 us).")
     tangential_stiffness_ratio: float = Field(
         default=0.8, ge=2.0 / 3.0, le=1.0, description="Kt/Kn [-] (seed 000 section 2.1: [2/3, 1]).")
     tangential_damping_ratio: float = Field(
@@ -256,3 +265,19 @@ class ModelOptions(BaseModel):
     speed_ramp_rad_s2: float = Field(
         default=5000.0, gt=0.0, le=1e6, description="Shaft acceleration limit towards the speed setpoint [rad/s^2].")
     rolling_resistance: bool = Field(default=True, description="Apply seed 001 rolling force and moments.")
+
+    @field_validator("time_step_s", mode="before")
+    @classmethod
+    def _time_step(cls, value):
+        low, high = TIME_STEP_RANGE_S
+        if isinstance(value, str) and value.strip().lower() == "auto":
+            return "auto"
+        try:
+            number = float(value)
+        except (TypeError, ValueError):
+            raise ValueError(f"time_step_s = {value!r}: must be 'auto' or a number of seconds in "
+                             f"[{low:g}, {high:g}] s") from None
+        if isinstance(value, bool) or not (low <= number <= high):
+            raise ValueError(f"time_step_s = {value!r}: must be 'auto' or a number of seconds in "
+                             f"[{low:g}, {high:g}] s")
+        return number

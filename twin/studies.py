@@ -130,7 +130,8 @@ class EVSample:
 
 def ev_operating_point(shaft_current_a: float, shaft_speed_rpm: float, *, oil_temperature_c: float = 40.0,
                        equivalent_resistance_ohm: float | None = None, shear_heating: bool = True,
-                       radial_load_n: float = EV_RADIAL_LOAD_N, settle_s: float = EV_SETTLE_S):
+                       radial_load_n: float = EV_RADIAL_LOAD_N, settle_s: float = EV_SETTLE_S,
+                       options: ModelOptions | None = None):
     """Seed 003's EV case on the 6200 twin (seed-000 oil, shear and current heating on unless
     told otherwise): warm start at the operating point, settle, return (EVSample, snapshot)."""
     fields = {"shear_heating": shear_heating}
@@ -138,7 +139,7 @@ def ev_operating_point(shaft_current_a: float, shaft_speed_rpm: float, *, oil_te
         fields["equivalent_resistance_ohm"] = equivalent_resistance_ohm
     base = catalog.bearing(EV_BEARING)
     spec = BearingSpec.model_validate({**base.model_dump(), "thermal": Thermal(**fields).model_dump()})
-    twin = Twin(spec, setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rpm * math.pi / 30.0,
+    twin = Twin(spec, options=options, setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rpm * math.pi / 30.0,
                                         radial_load_n=radial_load_n, shaft_current_a=shaft_current_a,
                                         oil_temperature_c=oil_temperature_c))
     twin.advance(settle_s)

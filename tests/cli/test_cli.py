@@ -48,3 +48,5 @@ def test_report_quick(tmp_path):
     # the EV section (seed 003): Figs. 2/4 band, Fig. 7's thickest-film speed rising with current
     assert "## EV motor bearing under shaft current (seed 003)" in text
     assert "57.6-84.8 %" in text and "speed of the thickest film" in text
+    # issue 13: the time-step study's table
+    assert "## Time step: the auto step against 1 us" in text and "| 6208-serve | auto |" in text

@@ -13,8 +13,9 @@ EDGE = 0.02  # Table 3's band edges are rounded: a value within 2 % of an edge c
 
 
 @pytest.fixture(scope="module")
-def speed_sweep():
-    return [studies.sample_at_azimuth_zero(w) for w in SPEEDS]
+def speed_sweep(time_step):
+    options = ModelOptions(time_step_s=time_step)
+    return [studies.sample_at_azimuth_zero(w, options=options) for w in SPEEDS]
 
 
 def _inside(value, low, high):
@@ -45,19 +46,20 @@ def test_speed_slope_is_0_68(speed_sweep):
     assert slope == pytest.approx(0.68, abs=0.03)
 
 
-def test_load_slope_is_minus_0_073():
+def test_load_slope_is_minus_0_073(time_step):
     # seed 000 section 3.1, Fig. 9b: ln Lambda_out against ln Qmax, Fr = 750-7500 N, slope -0.0727
-    samples = [studies.sample_at_azimuth_zero(500.0, fr) for fr in (750, 1500, 3000, 4500, 6000, 7500)]
+    options = ModelOptions(time_step_s=time_step)
+    samples = [studies.sample_at_azimuth_zero(500.0, fr, options=options) for fr in (750, 1500, 3000, 4500, 6000, 7500)]
     slope = studies.log_slope([s.load_outer_n for s in samples], [s.lambda_outer for s in samples])
     assert slope == pytest.approx(-0.073, abs=0.01)
     # and Fr against Qmax has a slope close to 1 (eq. A3)
     assert studies.log_slope([s.load_inner_n for s in samples], [s.radial_load_n for s in samples]) == pytest.approx(1.0, abs=0.05)
 
 
-def test_fig_8_outer_lambda_over_a_cage_revolution():
+def test_fig_8_outer_lambda_over_a_cage_revolution(time_step):
     # seed 000 Fig. 8b: at 500 rad/s and 3000 N the outer Lambda goes from ~2.15 (loaded, psi = 0)
     # to ~3 (unloaded zone, centrifugal load only): mixed regime everywhere in steady state
-    rev = studies.lambda_over_revolution(500.0, 3000.0, samples=200)
+    rev = studies.lambda_over_revolution(500.0, 3000.0, samples=200, options=ModelOptions(time_step_s=time_step))
     lam = rev["lambda_outer"]
     assert np.all(np.isfinite(lam))  # the outer contact never opens (centrifugal force)
     assert lam.min() == pytest.approx(2.1, abs=0.1)
@@ -68,10 +70,10 @@ def test_fig_8_outer_lambda_over_a_cage_revolution():
     assert lam[unloaded].min() > 2.9
 
 
-def test_masjedi_khonsari_option_speed_slope():
+def test_masjedi_khonsari_option_speed_slope(time_step):
     # seed 004 eq. 6 and Fig. 7f: with Masjedi-Khonsari the slope is 0.711 k^-0.023 (0.7105 in the
     # seed's twin); k = 9.2 inner -> 0.677
-    opts = ModelOptions(film_formula="masjedi_khonsari")
+    opts = ModelOptions(film_formula="masjedi_khonsari", time_step_s=time_step)
     samples = [studies.sample_at_azimuth_zero(w, options=opts) for w in (300, 700, 1100, 1500)]
     slope = studies.log_slope([s.shaft_speed_rad_s for s in samples], [s.lambda_inner for s in samples])
     k_inner = (163.8 / 4.990) ** (2 / math.pi)

@@ -8,11 +8,12 @@ from pydantic import ValidationError
 from twin import catalog
 from twin.engine import Twin
 from twin.setpoint import Setpoint, SetpointError
-from twin.spec import BearingSpec, Geometry
+from twin.spec import BearingSpec, Geometry, ModelOptions
 
 
-def test_one_second_at_1700_rad_s_and_7500_n():
-    twin = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=1700.0, radial_load_n=7500.0))
+def test_one_second_at_1700_rad_s_and_7500_n(time_step):
+    twin = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=1700.0, radial_load_n=7500.0),
+                options=ModelOptions(time_step_s=time_step))
     worst = 0.0
     for _ in range(20):
         twin.advance(0.05)
@@ -75,14 +76,15 @@ def test_unknown_designation_and_bad_clearance():
         catalog.bearing("6208", diametral_clearance_m=-1e-3)
 
 
-def test_every_catalog_bearing_builds_and_runs():
+def test_every_catalog_bearing_builds_and_runs(time_step):
     for name in catalog.designations():
         spec = catalog.bearing(name)
         assert isinstance(spec, BearingSpec)
         # an angular-contact bearing needs an axial load to seat its balls (a single row cannot
         # carry a pure radial load without an axial reaction)
         twin = Twin(name, setpoint=Setpoint(shaft_speed_rad_s=300.0, radial_load_n=1000.0,
-                                            axial_load_n=500.0 if name.startswith("7208") else 0.0))
+                                            axial_load_n=500.0 if name.startswith("7208") else 0.0),
+                    options=ModelOptions(time_step_s=time_step))
         twin.advance(0.002)
         assert twin.snapshot().status == "ok", name
 

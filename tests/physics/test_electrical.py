@@ -15,7 +15,7 @@ from twin.kernels import layout as L
 from twin.kernels.tribology import contact_electrical
 from twin.physics import electrical as el
 from twin.setpoint import Setpoint
-from twin.spec import Electrical
+from twin.spec import Electrical, ModelOptions
 
 EPS0 = 8.8541878128e-12
 RX, RY = 4.99e-3, 163.8e-3  # 6208 inner contact
@@ -97,20 +97,22 @@ def test_network_identities():
     assert math.isinf(net.ball_resistance_ohm[1])
 
 
-def test_6208_bearing_capacitance_tens_to_hundreds_of_pf_falling_with_speed():
+def test_6208_bearing_capacitance_tens_to_hundreds_of_pf_falling_with_speed(time_step):
     caps = []
     for w in (300.0, 900.0, 1500.0):
-        twin = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=w, radial_load_n=3000.0))
+        twin = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=w, radial_load_n=3000.0),
+                    options=ModelOptions(time_step_s=time_step))
         twin.advance(0.003)
         caps.append(twin.snapshot().electrical.capacitance_f)
     assert all(20e-12 < c < 900e-12 for c in caps)
     assert caps[0] > caps[1] > caps[2]
 
 
-def test_boundary_bearing_is_resistive_full_film_bearing_capacitive():
-    slow = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=20.0, radial_load_n=3000.0))
+def test_boundary_bearing_is_resistive_full_film_bearing_capacitive(time_step):
+    options = ModelOptions(time_step_s=time_step)
+    slow = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=20.0, radial_load_n=3000.0), options=options)
     slow.advance(0.003)
-    fast = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=1700.0, radial_load_n=1000.0))
+    fast = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=1700.0, radial_load_n=1000.0), options=options)
     fast.advance(0.003)
     assert abs(slow.snapshot().electrical.phase_rad) < 0.1          # resistive
     assert fast.snapshot().electrical.phase_rad < -1.4              # capacitive

@@ -7,7 +7,7 @@ import pytest
 from twin import catalog, studies
 from twin.engine import Twin
 from twin.physics import thermal, viscosity
-from twin.spec import Thermal
+from twin.spec import ModelOptions, Thermal
 
 
 def test_roelands_temperature_law_by_hand():
@@ -44,20 +44,23 @@ def test_shear_heating_eq6_by_hand():
     assert math.isinf(thermal.shear_heating_temperature_rise_k(50.0, ti, ap, 5e-6, 3e9, b, eta, k))
 
 
-def _ev_twin(current_a, temperature_c=40.0, resistance_ohm=None, rpm=20000.0, shear_heating=True):
+def _ev_twin(current_a, temperature_c=40.0, resistance_ohm=None, rpm=20000.0, shear_heating=True, time_step="auto"):
     """The 6200 EV twin of seed 003 (shear and current heating on), settled for 20 ms."""
     sample, snap = studies.ev_operating_point(current_a, rpm, oil_temperature_c=temperature_c,
-                                              equivalent_resistance_ohm=resistance_ohm, shear_heating=shear_heating)
+                                              equivalent_resistance_ohm=resistance_ohm, shear_heating=shear_heating,
+                                              options=ModelOptions(time_step_s=time_step))
     return sample.h_min_inner_m, snap
 
 
-def test_film_falls_with_current_base_temperature_and_resistance():
+def test_film_falls_with_current_base_temperature_and_resistance(time_step):
     # seed 003 Figs. 4, 8 and 10 trends, through the film of the real-time loop
-    h = [_ev_twin(i)[0] for i in (0.0, 10.0, 20.0)]
+    h = [_ev_twin(i, time_step=time_step)[0] for i in (0.0, 10.0, 20.0)]
     assert h[0] > h[1] > h[2]
-    assert _ev_twin(10.0, temperature_c=80.0)[0] < _ev_twin(10.0, temperature_c=40.0)[0]
-    assert _ev_twin(10.0, resistance_ohm=5.6e-4)[0] < _ev_twin(10.0, resistance_ohm=2.92e-4)[0]
-    _, snap = _ev_twin(10.0)
+    dt = time_step
+    assert _ev_twin(10.0, temperature_c=80.0, time_step=dt)[0] < _ev_twin(10.0, temperature_c=40.0, time_step=dt)[0]
+    assert (_ev_twin(10.0, resistance_ohm=5.6e-4, time_step=dt)[0]
+            < _ev_twin(10.0, resistance_ohm=2.92e-4, time_step=dt)[0])
+    _, snap = _ev_twin(10.0, time_step=time_step)
     e = snap.electrical
     assert e.current_temperature_rise_k > 0 and e.shear_temperature_rise_k > 0
     assert e.contact_temperature_rise_k == pytest.approx(e.current_temperature_rise_k + e.shear_temperature_rise_k)
@@ -65,10 +68,10 @@ def test_film_falls_with_current_base_temperature_and_resistance():
     assert snap.viscosity_pa_s < viscosity.dynamic_viscosity_pa_s(catalog.lubricant(), 40.0)
 
 
-def test_loop_film_is_the_isothermal_film_times_the_thermal_factor():
+def test_loop_film_is_the_isothermal_film_times_the_thermal_factor(time_step):
     # the loop runs the law of twin.physics.thermal: same contact, same kinematics, heating off/on
-    h_iso, snap_iso = _ev_twin(0.0, shear_heating=False)
-    h_hot, snap_hot = _ev_twin(10.0)
+    h_iso, snap_iso = _ev_twin(0.0, shear_heating=False, time_step=time_step)
+    h_hot, snap_hot = _ev_twin(10.0, time_step=time_step)
     e = snap_hot.electrical
     twin_theta0 = 40.0 + 273.15
     eta0 = viscosity.dynamic_viscosity_pa_s(catalog.lubricant(), 40.0)
@@ -81,14 +84,14 @@ def test_loop_film_is_the_isothermal_film_times_the_thermal_factor():
     assert h_hot / h_iso == pytest.approx(factor, rel=0.02)
 
 
-def test_thickest_film_speed_rises_with_current_fig7():
+def test_thickest_film_speed_rises_with_current_fig7(time_step):
     # seed 003 Fig. 7: without current the film first grows with speed (entrainment) and then
     # falls (shear heating); "as the current increases, the rotational speed required to attain
     # the thickest film thickness increases". Real-time loop, 6200 EV twin, 200 N, 40 degC.
     rpms = (2000.0, 5000.0, 10000.0, 20000.0, 30000.0, 50000.0)
     thickest = {}
     for current in (0.0, 10.0, 20.0):
-        films = [_ev_twin(current, rpm=rpm)[0] for rpm in rpms]
+        films = [_ev_twin(current, rpm=rpm, time_step=time_step)[0] for rpm in rpms]
         k = max(range(len(rpms)), key=films.__getitem__)
         assert 0 < k < len(rpms) - 1 or current > 0.0, f"{current} A: no interior maximum {films}"
         thickest[current] = rpms[k]
