@@ -241,14 +241,15 @@ def defect_row(defect, geometry) -> np.ndarray:
 def edge_drop_m(inside_m, edge_radius_m, relative_radius_m):
     """Drop [m] of a body of relative radius R allowed by one straight edge at distance `inside_m`
     (> 0: the contact is inside the pit) with a rounded edge of radius r_e (module docstring):
-    0 for inside <= -r_e, else R + r_e - sqrt((R + r_e)^2 - (inside + r_e)^2), R + r_e at most."""
+    0 for inside <= -r_e, else R + r_e - sqrt((R + r_e)^2 - (inside + r_e)^2); unlimited (inf)
+    once inside + r_e >= R + r_e (the body fits in the pit: only the depth stops it)."""
     if inside_m <= -edge_radius_m:
         return 0.0
     r = relative_radius_m + edge_radius_m
     t = inside_m + edge_radius_m
     if t >= r:
-        return r
-    return r - math.sqrt(r * r - t * t)
+        return math.inf
+    return t * t / (r + math.sqrt(r * r - t * t))  # = r - sqrt(r^2 - t^2), without cancellation
 
 
 @njit(**JIT)
@@ -264,10 +265,7 @@ def pit_drop_m(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx
 @njit(**JIT)
 def wrap_angle(a):
     """Angle wrapped into (-pi, pi] [rad]."""
-    a = math.fmod(a + math.pi, 2.0 * math.pi)
-    if a <= 0.0:
-        a += 2.0 * math.pi
-    return a - math.pi
+    return a - 2.0 * math.pi * math.ceil((a - math.pi) / (2.0 * math.pi))
 
 
 @njit(**JIT)
