@@ -103,3 +103,29 @@ def test_sensor_noise_has_the_stated_density():
     again = np.array([add_sensor_noise(0.0, sigma) for _ in range(100)])
     assert np.array_equal(again, y[:100])
     assert add_sensor_noise(1.5, 0.0) == 1.5
+
+
+def test_sensor_push_fills_a_ring_the_reader_drains():
+    """sensor_push = decimator + noise + ring: the samples read back in order equal the block
+    decimation; a reader that falls more than a ring behind is told how many it lost."""
+    from twin.vibration.signal import read_ring, sensor_push
+
+    d = design_decimator(8 * F_OUT, F_OUT)
+    x = np.random.default_rng(1).standard_normal(8 * 700)
+    ref = np.zeros(800)
+    k = decimate_block(d.phases, d.new_state(), x, ref)
+    state = d.new_state()
+    ring = np.zeros(256)
+    ring_state = np.zeros(1)
+    got, cursor = [], 0
+    for i, xi in enumerate(x):
+        sensor_push(d.phases, state, xi, 0.0, ring, ring_state)
+        if i % 1000 == 999:  # a reader between frames
+            new, cursor, lost = read_ring(ring, ring_state, cursor)
+            assert lost == 0
+            got.append(new)
+    new, cursor, lost = read_ring(ring, ring_state, cursor)
+    got.append(new)
+    assert np.array_equal(np.concatenate(got), ref[:k]) and cursor == k == 700
+    new, cursor, lost = read_ring(ring, ring_state, 0)  # a reader 700 behind a 256 ring
+    assert lost == 700 - 256 and np.array_equal(new, ref[700 - 256:700])

@@ -186,3 +186,35 @@ def add_sensor_noise(y, sigma):
     if sigma > 0.0:
         return y + sigma * np.random.standard_normal()
     return y
+
+
+# ---- the sensor as the kernel sees it: decimator + noise + a ring of output samples ---------------
+RS_WRITTEN = 0    # ring state: output samples written since reset (the reader's cursor is its own)
+N_RS_HEADER = 1
+
+
+@njit(**JIT)
+def sensor_push(phases, dec_state, a_m_s2, sigma, ring, ring_state):
+    """One DEM step of the accelerometer (the one call the kernel makes per step): push the sensed
+    acceleration a [m/s^2] into the decimator; when an output sample completes, add the sensor
+    noise (sigma [m/s^2], `noise_sigma`) and write it into `ring` (1-D, float32 or float64, written
+    modulo its length) at ring_state[RS_WRITTEN], which then counts up. Returns True when a sample
+    was written."""
+    ready, y = decimator_push(phases, dec_state, a_m_s2)
+    if ready:
+        k = int(ring_state[RS_WRITTEN])
+        ring[k % ring.shape[0]] = add_sensor_noise(y, sigma)
+        ring_state[RS_WRITTEN] = k + 1
+    return ready
+
+
+def read_ring(ring: np.ndarray, ring_state: np.ndarray, cursor: int) -> tuple[np.ndarray, int, int]:
+    """Samples written since `cursor` (a count of samples, the reader's own): (samples in order,
+    new cursor, samples lost because the ring wrapped over them before they were read). Python,
+    between frames."""
+    written = int(ring_state[RS_WRITTEN])
+    size = ring.shape[0]
+    lost = max(0, written - cursor - size)
+    start = cursor + lost
+    idx = np.arange(start, written) % size
+    return ring[idx].copy(), written, lost
