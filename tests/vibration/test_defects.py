@@ -151,7 +151,7 @@ def _drop(row, race, ball, azimuth, shaft_angle=0.0, nz=0.0, q=(1.0, 0.0, 0.0, 0
     nx, ny = sign * math.cos(azimuth), sign * math.sin(azimuth)
     rx = RX_OUT if race == 1 else RX_IN
     ry = RY_OUT if race == 1 else RY_IN
-    return contact_defect_drop_m(row, race, ball, px, py, nz, w[0], w[1], w[2], nx, ny, shaft_angle,
+    return contact_defect_drop_m(row, race, ball, px, py, nx, ny, nz, w[0], w[1], w[2], shaft_angle,
                                  q[0], q[1], q[2], q[3], RB, r, G.outer_groove_radius_m, rx, ry)
 
 
@@ -231,9 +231,9 @@ def _roll_ball(row, n, dt, w_cage, w_ball, pitch, rb, ro, ri, rg, rx_o, ry_o, rx
         phi = w_cage * (k * dt)
         c, s = math.cos(phi), math.sin(phi)
         px, py = pitch * c, pitch * s
-        hits[k, 1] = contact_defect_drop_m(row, 1, 0, px, py, 0.0, 0.0, 0.0, w_ball, c, s, 0.0,
+        hits[k, 1] = contact_defect_drop_m(row, 1, 0, px, py, c, s, 0.0, 0.0, 0.0, w_ball, 0.0,
                                            q[0], q[1], q[2], q[3], rb, ro, rg, rx_o, ry_o)
-        hits[k, 0] = contact_defect_drop_m(row, 0, 0, px, py, 0.0, 0.0, 0.0, w_ball, -c, -s, 0.0,
+        hits[k, 0] = contact_defect_drop_m(row, 0, 0, px, py, -c, -s, 0.0, 0.0, 0.0, w_ball, 0.0,
                                            q[0], q[1], q[2], q[3], rb, ri, rg, rx_i, ry_i)
         quat_integrate(q, 0.0, 0.0, w_ball, dt)
 

@@ -269,7 +269,7 @@ def wrap_angle(a):
 
 
 @njit(**JIT)
-def contact_defect_drop_m(d, race, ball, px, py, nz, wx, wy, wz, nx, ny, shaft_angle,
+def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_angle,
                           qw, qx, qy, qz, rb, race_radius, groove_radius, rx, ry):
     """Extra radial clearance [m] that the defect row `d` (D_* layout) opens at the contact of
     ball `ball` with race `race` (0 inner, 1 outer): the kernel subtracts it from the contact's
