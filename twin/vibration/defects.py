@@ -1,0 +1,362 @@
+"""Local defects: outer-race spall, inner-race spall, ball defect; the extra clearance they open
+at a ball-raceway contact; unit quaternions for the ball orientation.
+
+Defect geometry (every defect is a pit with straight edges): `width_m` along the rolling
+direction, `length_m` across it, `depth_m`, and an edge radius (0 = sharp). Outer spall at a fixed
+azimuth; inner spall at an angle fixed on the rotating inner ring; ball defect at a point fixed on
+the ball, given in ball body coordinates.
+
+Depth profile (`pit_drop_m`). A ball over a pit cannot follow its bottom: it drops until it
+touches an edge, so the extra radial clearance is (Sawalhi & Randall 2008, "Simulating gear and
+bearing interactions in the presence of faults, Part I", MSSP 22(8), sec. 4.1 (localised faults,
+their eq. for the additional displacement of a ball over a spall); Harsha 2005, "Nonlinear
+dynamic analysis of an unbalanced rotor supported by roller bearing", Chaos Solitons Fractals 26,
+defect as an extra deflection term)
+
+    h_eff(s) = min(depth, R - sqrt(R^2 - a^2)),  a = distance from the contact to the nearer edge,
+
+with R the ball radius for a flat raceway (at the spall centre a = w/2: the brief's h_eff =
+min(depth, Rb - sqrt(Rb^2 - (w/2)^2))). Generalised here, second order in a/R, to curved bodies
+by the relative radius of curvature of the contact in that direction (Harris' curvature sum;
+the engine's R_RX along the rolling direction, R_RY across): a pit on a concave outer race lets
+the ball drop by ~a^2/2 (1/Rb - 1/Ro), on the convex inner race by ~a^2/2 (1/Rb + 1/Ri); across
+the conforming groove (1/Rb - 1/Rg) the drop is small, so a spall must be long across the track
+for the ball to fall in. The relative curvature is symmetric in the two bodies, so the same law
+holds for a pit on the ball. A rounded edge of radius r_e is a quarter circle tangent to the
+surface and the wall: the contact distance R + r_e from the edge's centre gives
+h = R + r_e - sqrt((R + r_e)^2 - (a + r_e)^2) for a > -r_e (0 before the rounding starts).
+The engine subtracts h_eff from the contact deflection (an extra radial clearance): entering the
+pit the ball unloads, at the exit edge the clearance closes over a short distance and the ball
+strikes it; the contact normal is not tilted by the edge (as in Sawalhi & Randall).
+
+Ball orientation: a unit quaternion q = (w, x, y, z) per ball maps body to world coordinates;
+with the world-frame angular velocity omega (the engine's) q' = 1/2 omega (x) q (Hamilton
+product; with a body-frame omega_b it is q' = 1/2 q (x) omega_b), integrated exactly for omega
+constant over the step, q <- exp(omega dt / 2) (x) q, and renormalised (Shoemake 1985; any
+rigid-body text).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Annotated, Literal, Union
+
+import numpy as np
+from numba import njit
+from pydantic import BaseModel, ConfigDict, Field, TypeAdapter, ValidationInfo, model_validator
+
+from twin.jit import JIT
+
+_FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+# ---- defect row layout (one float64 row per active defect; `defect_row` builds it) ---------------
+D_KIND = 0          # KIND_*
+D_ANGLE = 1         # outer: azimuth [rad]; inner: angle on the ring from its reference mark [rad]
+D_BALL = 2          # ball index (ball defect)
+D_BODY_X = 3        # ball defect centre, unit vector in ball body coordinates
+D_BODY_Y = 4
+D_BODY_Z = 5
+D_HALF_WIDTH = 6    # half width along the rolling direction [m]
+D_HALF_LENGTH = 7   # half length across it [m]
+D_DEPTH = 8         # [m]
+D_EDGE_RADIUS = 9   # [m], 0 = sharp
+D_CENTRE_NZ = 10    # race spall: axial component of the contact normal at the spall's centre line
+N_DEFECT_PARAMS = 11
+
+KIND_NONE = 0
+KIND_OUTER = 1
+KIND_INNER = 2
+KIND_BALL = 3
+
+RACE_INNER = 0
+RACE_OUTER = 1
+
+
+class _Pit(BaseModel):
+    model_config = _FROZEN
+
+    width_m: float = Field(gt=0.0, le=0.05, description="Size along the rolling direction [m].")
+    length_m: float = Field(gt=0.0, le=0.05, description="Size across the rolling direction [m].")
+    depth_m: float = Field(gt=0.0, le=0.01, description="Depth [m].")
+    edge_radius_m: float = Field(default=0.0, ge=0.0, le=0.01,
+                                 description="Radius of the rounded edges [m]; 0 = sharp edges.")
+
+    @model_validator(mode="after")
+    def _edges(self) -> "_Pit":
+        half = 0.5 * min(self.width_m, self.length_m)
+        if self.edge_radius_m > half:
+            raise ValueError(f"edge_radius_m = {self.edge_radius_m:g} m: must be in [0, {half:g}] m "
+                             "(half the smaller of width_m and length_m)")
+        return self
+
+
+class OuterRaceSpall(_Pit):
+    """Spall on the stationary outer race at a fixed azimuth."""
+
+    kind: Literal["outer"] = "outer"
+    azimuth_deg: float = Field(default=0.0, ge=0.0, lt=360.0,
+                               description="Azimuth of the spall centre [deg] from +x (load direction) about +z.")
+
+    @model_validator(mode="after")
+    def _fits(self, info: ValidationInfo) -> "OuterRaceSpall":
+        _check_race(self, info, outer=True)
+        return self
+
+
+class InnerRaceSpall(_Pit):
+    """Spall on the rotating inner race at an angle fixed on the ring."""
+
+    kind: Literal["inner"] = "inner"
+    ring_angle_deg: float = Field(
+        default=0.0, ge=0.0, lt=360.0,
+        description="Angle of the spall centre on the inner ring [deg] from the ring's reference mark (the mark "
+        "is at azimuth 0 when the shaft angle is 0), about +z.")
+
+    @model_validator(mode="after")
+    def _fits(self, info: ValidationInfo) -> "InnerRaceSpall":
+        _check_race(self, info, outer=False)
+        return self
+
+
+class BallDefect(_Pit):
+    """Pit on one ball at a point fixed on the ball (ball body coordinates: the world axes at the
+    moment the defect is injected)."""
+
+    kind: Literal["ball"] = "ball"
+    ball_index: int = Field(default=0, ge=0, le=15, description="Which ball [-], 0 .. ball_count - 1.")
+    colatitude_deg: float = Field(default=90.0, ge=0.0, le=180.0,
+                                  description="Polar angle of the defect centre from the body +z axis [deg].")
+    longitude_deg: float = Field(default=0.0, ge=0.0, lt=360.0,
+                                 description="Azimuth of the defect centre about the body +z axis from body +x [deg].")
+
+    @property
+    def body_point(self) -> tuple[float, float, float]:
+        """Unit vector to the defect centre in ball body coordinates."""
+        t, p = math.radians(self.colatitude_deg), math.radians(self.longitude_deg)
+        return (math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t))
+
+    @model_validator(mode="after")
+    def _fits(self, info: ValidationInfo) -> "BallDefect":
+        geometry = _geometry(info)
+        if geometry is None:
+            return self
+        rb = geometry.ball_radius_m
+        if self.ball_index >= geometry.ball_count:
+            raise ValueError(f"ball_index = {self.ball_index}: must be in [0, {geometry.ball_count - 1}] "
+                             f"(the bearing has {geometry.ball_count} balls)")
+        for name in ("width_m", "length_m"):
+            value = getattr(self, name)
+            if value > rb:
+                raise ValueError(f"{name} = {value:g} m: must be in (0, {rb:g}] m for a local ball defect "
+                                 "(at most the ball radius)")
+        _check_depth(self, rb)
+        return self
+
+
+Defect = Annotated[Union[OuterRaceSpall, InnerRaceSpall, BallDefect], Field(discriminator="kind")]
+_DEFECT = TypeAdapter(Defect)
+_DEFECTS = TypeAdapter(list[Defect])
+
+
+def _geometry(info: ValidationInfo):
+    ctx = info.context if info is not None else None
+    return ctx.get("geometry") if isinstance(ctx, dict) else None
+
+
+def _check_depth(pit: _Pit, rb: float) -> None:
+    limit = 0.5 * rb
+    if pit.depth_m > limit:
+        raise ValueError(f"depth_m = {pit.depth_m:g} m: must be in (0, {limit:g}] m (a quarter of the ball "
+                         "diameter: beyond it the defect is no longer a local pit under a ball)")
+
+
+def race_limits(geometry, outer: bool) -> dict[str, float]:
+    """Largest spall on a raceway of this bearing [m]:
+
+    - width_m (along the rolling direction) <= the ball spacing on the raceway, 2 pi R / Z (R the
+      raceway radius at the contact): a local defect holds at most one ball; longer is an extended
+      (distributed) fault;
+    - length_m (across) <= the groove arc the ball can touch, 2 Rg asin(Rb / Rg);
+    - depth_m <= Rb / 2."""
+    rb = geometry.ball_radius_m
+    radius = geometry.outer_raceway_radius_m if outer else geometry.inner_raceway_radius_m
+    rg = geometry.outer_groove_radius_m if outer else geometry.inner_groove_radius_m
+    return {"width_m": 2.0 * math.pi * radius / geometry.ball_count,
+            "length_m": 2.0 * rg * math.asin(min(rb / rg, 1.0)),
+            "depth_m": 0.5 * rb}
+
+
+def _check_race(pit: _Pit, info: ValidationInfo, outer: bool) -> None:
+    geometry = _geometry(info)
+    if geometry is None:
+        return
+    lim = race_limits(geometry, outer)
+    race = "outer" if outer else "inner"
+    why = {"width_m": f"the ball spacing on the {race} raceway, 2 pi R / Z",
+           "length_m": f"the {race} groove arc the ball can touch, 2 Rg asin(Rb / Rg)"}
+    for name, reason in why.items():
+        value = getattr(pit, name)
+        if value > lim[name]:
+            raise ValueError(f"{name} = {value:g} m: must be in (0, {lim[name]:g}] m for this bearing ({reason})")
+    _check_depth(pit, geometry.ball_radius_m)
+
+
+def validate_defect(data, geometry):
+    """A defect from plain data (dict with `kind` = outer | inner | ball), checked against the
+    bearing's `twin.spec.Geometry`. Raises pydantic.ValidationError whose message names the field
+    and its allowed range for this bearing (a spall larger than the raceway, a negative depth)."""
+    return _DEFECT.validate_python(data, context={"geometry": geometry})
+
+
+def validate_defects(data, geometry) -> list:
+    """`validate_defect` for a list (error locations carry the list index)."""
+    return _DEFECTS.validate_python(data, context={"geometry": geometry})
+
+
+def defect_row(defect, geometry) -> np.ndarray:
+    """The float64 row (D_* layout) the numba functions read for one defect of this bearing."""
+    row = np.zeros(N_DEFECT_PARAMS)
+    row[D_HALF_WIDTH] = 0.5 * defect.width_m
+    row[D_HALF_LENGTH] = 0.5 * defect.length_m
+    row[D_DEPTH] = defect.depth_m
+    row[D_EDGE_RADIUS] = defect.edge_radius_m
+    sin_a = math.sin(math.radians(geometry.nominal_contact_angle_deg))
+    if defect.kind == "outer":
+        row[D_KIND] = KIND_OUTER
+        row[D_ANGLE] = math.radians(defect.azimuth_deg)
+        row[D_CENTRE_NZ] = sin_a       # outer normal (groove centre -> ball) points up under +z load
+    elif defect.kind == "inner":
+        row[D_KIND] = KIND_INNER
+        row[D_ANGLE] = math.radians(defect.ring_angle_deg)
+        row[D_CENTRE_NZ] = -sin_a
+    else:
+        row[D_KIND] = KIND_BALL
+        row[D_BALL] = defect.ball_index
+        row[D_BODY_X:D_BODY_Z + 1] = defect.body_point
+    return row
+
+
+# ---- depth profile -----------------------------------------------------------------------------
+@njit(**JIT)
+def edge_drop_m(inside_m, edge_radius_m, relative_radius_m):
+    """Drop [m] of a body of relative radius R allowed by one straight edge at distance `inside_m`
+    (> 0: the contact is inside the pit) with a rounded edge of radius r_e (module docstring):
+    0 for inside <= -r_e, else R + r_e - sqrt((R + r_e)^2 - (inside + r_e)^2); unlimited (inf)
+    once inside + r_e >= R + r_e (the body fits in the pit: only the depth stops it)."""
+    if inside_m <= -edge_radius_m:
+        return 0.0
+    r = relative_radius_m + edge_radius_m
+    t = inside_m + edge_radius_m
+    if t >= r:
+        return math.inf
+    return t * t / (r + math.sqrt(r * r - t * t))  # = r - sqrt(r^2 - t^2), without cancellation
+
+
+@njit(**JIT)
+def pit_drop_m(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, ry_m):
+    """Extra radial clearance [m] a pit opens at a contact whose centre is at (u, v) [m] from the
+    pit centre (u along the rolling direction, v across): min(depth, drop allowed by the nearer
+    edge along (relative radius rx) and across (ry)), >= 0 (module docstring)."""
+    along = edge_drop_m(half_width_m - abs(u_m), edge_radius_m, rx_m)
+    across = edge_drop_m(half_length_m - abs(v_m), edge_radius_m, ry_m)
+    return max(0.0, min(depth_m, along, across))
+
+
+@njit(**JIT)
+def wrap_angle(a):
+    """Angle wrapped into (-pi, pi] [rad]."""
+    return a - 2.0 * math.pi * math.ceil((a - math.pi) / (2.0 * math.pi))
+
+
+@njit(**JIT)
+def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_angle,
+                          qw, qx, qy, qz, rb, race_radius, groove_radius, rx, ry):
+    """Extra radial clearance [m] that the defect row `d` (D_* layout) opens at the contact of
+    ball `ball` with race `race` (0 inner, 1 outer): the kernel subtracts it from the contact's
+    deflection.
+
+    (px, py): ball centre relative to the ring centre [m]; (nx, ny, nz): unit contact normal,
+    groove-curvature centre -> ball centre (the contact point is at ball centre + Rb n);
+    (wx, wy, wz): ball angular velocity, world frame [rad/s]; shaft_angle [rad]; q the ball's
+    orientation quaternion; rb ball radius, race_radius raceway radius at the contact, groove_radius,
+    and rx, ry the contact's relative radii of curvature along / across the rolling direction [m].
+
+    Race spall: u = race_radius wrap(ball azimuth - spall azimuth) (inner: spall azimuth = shaft
+    angle + ring angle), v = groove_radius (asin nz - asin nz_centre). Ball defect: the defect
+    centre p = q body q* in the world; u, v = Rb p.t, Rb p.b with t = (omega x n)/|omega x n| the
+    rolling direction of the ball surface at the contact and b = n x t; zero when p.n <= 0."""
+    kind = int(d[D_KIND])
+    if kind == KIND_OUTER or kind == KIND_INNER:
+        if (kind == KIND_OUTER) != (race == RACE_OUTER):
+            return 0.0
+        centre = d[D_ANGLE] + (shaft_angle if kind == KIND_INNER else 0.0)
+        u = race_radius * wrap_angle(math.atan2(py, px) - centre)
+        v = groove_radius * (math.asin(min(1.0, max(-1.0, nz))) - math.asin(d[D_CENTRE_NZ]))
+        return pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, ry)
+    if kind == KIND_BALL and ball == int(d[D_BALL]):
+        ex, ey, ez = quat_rotate(qw, qx, qy, qz, d[D_BODY_X], d[D_BODY_Y], d[D_BODY_Z])
+        cos_n = ex * nx + ey * ny + ez * nz
+        if cos_n <= 0.0:
+            return 0.0
+        tx = wy * nz - wz * ny
+        ty = wz * nx - wx * nz
+        tz = wx * ny - wy * nx
+        tn = math.sqrt(tx * tx + ty * ty + tz * tz)
+        if tn > 0.0:
+            tx /= tn
+            ty /= tn
+            tz /= tn
+            bx = ny * tz - nz * ty
+            by = nz * tx - nx * tz
+            bz = nx * ty - ny * tx
+            u = rb * (ex * tx + ey * ty + ez * tz)
+            v = rb * (ex * bx + ey * by + ez * bz)
+        else:  # ball not spinning: no rolling direction, measure the distance both ways
+            dist = rb * math.sqrt(max(0.0, 1.0 - cos_n * cos_n))
+            u = dist
+            v = dist
+        return pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, ry)
+    return 0.0
+
+
+# ---- unit quaternions (w, x, y, z), body -> world ---------------------------------------------------
+@njit(**JIT)
+def quat_multiply(aw, ax, ay, az, bw, bx, by, bz):
+    """Hamilton product a (x) b."""
+    return (aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw)
+
+
+@njit(**JIT)
+def quat_rotate(qw, qx, qy, qz, vx, vy, vz):
+    """q v q* for a unit quaternion: a body vector in world coordinates (t = 2 q_v x v,
+    v' = v + w t + q_v x t)."""
+    tx = 2.0 * (qy * vz - qz * vy)
+    ty = 2.0 * (qz * vx - qx * vz)
+    tz = 2.0 * (qx * vy - qy * vx)
+    return (vx + qw * tx + (qy * tz - qz * ty),
+            vy + qw * ty + (qz * tx - qx * tz),
+            vz + qw * tz + (qx * ty - qy * tx))
+
+
+@njit(**JIT)
+def quat_integrate(q, wx, wy, wz, dt):
+    """Advance the unit quaternion q (array of 4, in place) by a world-frame angular velocity
+    (wx, wy, wz) [rad/s] held over dt [s]: q <- exp(omega dt / 2) (x) q (exact for constant omega,
+    the solution of q' = 1/2 omega (x) q), then renormalised."""
+    w = math.sqrt(wx * wx + wy * wy + wz * wz)
+    half = 0.5 * w * dt
+    if half > 1e-12:
+        s = math.sin(half) / w
+        dw = math.cos(half)
+    else:
+        s = 0.5 * dt
+        dw = 1.0
+    rw, rx, ry, rz = quat_multiply(dw, s * wx, s * wy, s * wz, q[0], q[1], q[2], q[3])
+    n = math.sqrt(rw * rw + rx * rx + ry * ry + rz * rz)
+    q[0] = rw / n
+    q[1] = rx / n
+    q[2] = ry / n
+    q[3] = rz / n
