@@ -54,8 +54,8 @@ def test_6208_agrees_with_the_engine_helper():
 def test_angular_contact_frequencies_follow_the_loaded_angle():
     """7208: a larger loaded contact angle lowers gamma = D cos(alpha)/d_m: BPFO, FTF and BSF
     (1 - gamma^2) rise, BPFI falls; at 40 deg BPFO = Z f_s / 2 (1 - D cos 40 / d_m) exactly."""
-    g = catalog.bearing("7208").geometry
-    f15 = bearing_defect_frequencies(g, 500.0)  # nominal 15 deg
+    g = catalog.bearing("7208C").geometry
+    f15 = bearing_defect_frequencies(g, 500.0)  # 7208C: nominal 15 deg
     f40 = bearing_defect_frequencies(g, 500.0, math.radians(40.0))
     assert f40.bpfo_hz > f15.bpfo_hz and f40.ftf_hz > f15.ftf_hz and f40.bsf_hz > f15.bsf_hz
     assert f40.bpfi_hz < f15.bpfi_hz
