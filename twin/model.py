@@ -12,8 +12,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin.kernels import layout as L
-from twin.kernels.tribology import tribology_coefficients
+from twin.kernels.tribology import T_PIVOT, tribology_coefficients
 from twin.physics import hertz
+from twin.physics.traction import deformed_surface_radius_m, hertz_strip_table
 from twin.spec import BearingSpec, ModelOptions
 
 # ISO 76 static limit for ball bearings: 4.2 GPa; the model refuses loads whose analytic maximum
@@ -150,7 +151,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_ALPHA_E] = options.restitution_coefficient_s_m
     p[L.P_RAMP] = options.speed_ramp_rad_s2
     p[L.P_FILM_FORMULA] = 0.0 if options.film_formula == "hamrock_dowson" else 1.0
-    p[L.P_FRICTION_MODEL] = 0.0 if options.friction_model == "stribeck_line" else 1.0
+    p[L.P_FRICTION_MODEL] = {"stribeck_line": 0.0, "asperity_share": 1.0, "ellipse_traction": 2.0}[options.friction_model]
     p[L.P_SUBSTEPS] = options.tribology_substeps
     p[L.P_ROLLING] = 1.0 if options.rolling_resistance else 0.0
     p[L.P_BALL_REDUCED_TANGENT_MASS] = ball_mass / (1.0 + ball_mass * rb * rb / ball_inertia)
@@ -160,6 +161,16 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_GAP_LIMIT] = el.outer_gap_limit_m
     p[L.P_ASPERITY_RESISTANCE] = el.metallic_contact_resistance_ohm
     p[L.P_OIL_RESISTIVITY] = el.oil_resistivity_ohm_m
+    p[L.P_TRACTION_STRIPS] = options.traction_strips
+    p[L.P_TRACTION_EVERY] = options.traction_every
+    p[L.P_EYRING_STRESS] = spec.lubricant.eyring_stress_pa
+    p[L.P_LIMITING_SHEAR] = spec.lubricant.limiting_shear_coefficient
+    p[L.P_PRESSURE_VISCOSITY] = spec.lubricant.pressure_viscosity_pa_inv
+    p[L.P_ASPERITY_SLIP] = options.asperity_regularisation_slip_m_s
+    p[L.P_DEFORMED_RADIUS] = deformed_surface_radius_m(rb, g.inner_groove_radius_m)
+    p[L.P_DEFORMED_RADIUS + 1] = deformed_surface_radius_m(rb, g.outer_groove_radius_m)
+    strips = hertz_strip_table(options.traction_strips)
+    p[L.P_STRIP_TABLE:L.P_STRIP_TABLE + strips.size] = strips.ravel()
 
     race = np.stack([_race_row(spec, True, alpha, e_prime), _race_row(spec, False, alpha, e_prime)])
     # load limits: analytic Qmax = Fr / (Z Jr), Jr(0.5) = 0.2288 (seed 000 eq. A3)
@@ -174,6 +185,8 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
                                p[L.P_G_PARAM], rb, race[r, L.R_SEMI_MAJOR_COEF],
                                race[r, L.R_SEMI_MINOR_COEF], options.film_formula)
         for r in range(2)])
+    if options.friction_model == "ellipse_traction":
+        tribology[:, T_PIVOT] = 0.0  # the strips' spin moment replaces seed 001's eq. 11
     for a in (p, race, tribology):
         a.setflags(write=False)
     return BearingModel(

@@ -24,7 +24,9 @@ class ContactState(BaseModel):
     lambda_: float | None = Field(alias="lambda", serialization_alias="lambda",
                                   description="Film parameter Lambda = h_min / (1.25 sqrt(s1^2 + s2^2)) [-]; null without contact.")
     regime: Regime = Field(description="Lubrication regime (seed 000 Table 2).")
-    mu: float = Field(description="Sliding friction coefficient [-] (0 without contact).")
+    mu: float = Field(description="Effective friction coefficient |F_t| / Q: net tangential force over normal load of the "
+                      "contact, the traction integrated over its ellipse (with the centre-point friction options: "
+                      "their Coulomb coefficient) [-] (0 without contact).")
     entrainment_speed_m_s: float = Field(description="Mean surface speed relative to the contact [m/s].")
     slide_roll_ratio: float = Field(description="Sliding / entrainment speed, signed [-].")
     contact_angle_rad: float = Field(description="Angle of the contact normal to the radial plane [rad].")

@@ -116,6 +116,14 @@ class Lubricant(BaseModel):
     density_15c_kg_m3: float = Field(default=870.0, gt=500.0, le=2000.0, description="Density at 15 degC [kg/m^3].")
     pressure_viscosity_pa_inv: float = Field(
         default=2.3e-8, gt=0.0, le=1e-7, description="Pressure-viscosity coefficient xi [1/Pa] (seed 000: 2.3e-8).")
+    eyring_stress_pa: float = Field(
+        default=5e6, gt=1e5, le=1e8,
+        description="Eyring stress tau0 of the film's shear thinning [Pa] (Johnson and Tevaarwerk 1977, Proc. R. Soc. "
+        "Lond. A 356: a few MPa for mineral oils; Evans and Johnson 1986 report 2-10 MPa).")
+    limiting_shear_coefficient: float = Field(
+        default=0.06, gt=0.0, le=0.2,
+        description="gamma = limiting shear stress / pressure of the film [-] (Bair and Winer 1979, J. Lubr. Technol. "
+        "101: 0.05-0.08 for mineral oils; the middle of that range).")
 
     @model_validator(mode="after")
     def _order(self) -> "Lubricant":
@@ -193,16 +201,14 @@ class Thermal(BaseModel):
         default=True, description="Feed the current-discharge heating (seed 003 eq. 10) back into the film.")
     shear_heating: bool = Field(
         default=False,
-        description="Feed the inlet shear heating (seed 003 eq. 6 at the inlet) back into the film. Off by default: "
-        "seed 000, which validates the 6208 twin (Table 3, Fig. 8), is isothermal; the EV preset turns it on.")
+        description="Reduce the film by the inlet shear heating of a rolling contact, the Murch-Wilson factor "
+        "phi_T = 3.94 / (3.94 + L^0.62), L = beta eta u^2 / k' (Murch and Wilson 1975; twin.physics.thermal). Off by "
+        "default: seed 000, which validates the 6208 twin (Table 3, Fig. 8), is isothermal; the EV preset turns it on.")
     film_temperature_exponent: float = Field(
-        default=1.46, gt=0.0, le=5.0,
-        description="c_T of the loop's thermal film law h/h_iso = g(dT)^c_T [-], fitted to the thermal EHL solver "
-        "(twin.thermal_calibration, 33 solver cells of seed 003 Appendix 2, max error 3.8 points of reduction).")
-    inlet_shear_heating_factor: float = Field(
-        default=1.50, ge=0.0, le=20.0,
-        description="c_s of the inlet shear heating dT = c_s 2 eta u^2 / k' (seed 003 eq. 6 at p -> 0) [-], fitted "
-        "with film_temperature_exponent (twin.thermal_calibration).")
+        default=1.38, gt=0.0, le=5.0,
+        description="c_T of the loop's current-heating film law h/h_iso = g(dT)^c_T [-], fitted to the current heating "
+        "of the thermal EHL solver (twin.thermal_calibration: the solver's film with current over its film without, "
+        "28 cells of seed 003 Appendix 2, rms 13 % in ln h, max error 6.4 points of reduction).")
 
 
 class Mounting(BaseModel):
@@ -242,8 +248,23 @@ class ModelOptions(BaseModel):
     time_step_s: float = Field(default=1e-6, ge=1e-8, le=5e-6, description="Integration step dt [s] (seed 000: 1 us).")
     film_formula: Literal["hamrock_dowson", "masjedi_khonsari"] = Field(
         default="hamrock_dowson", description="Minimum film formula: seed 000 eq. 6 or seed 004 eq. 6.")
-    friction_model: Literal["stribeck_line", "asperity_share"] = Field(
-        default="stribeck_line", description="mu(Lambda): seed 000 section 2.3 or seed 001 eq. A2.")
+    friction_model: Literal["ellipse_traction", "stribeck_line", "asperity_share"] = Field(
+        default="ellipse_traction",
+        description="Tangential friction of the ball-raceway contacts: 'ellipse_traction' integrates the traction over "
+        "strips of the contact ellipse (differential and spin slip; seed 000 mu(Lambda) x seed 001 eq. A2 asperity "
+        "share + Eyring / limiting-shear film; twin.kernels.traction); 'stribeck_line' (seed 000 section 2.3) and "
+        "'asperity_share' (seed 001 eq. A1-A2) are the former centre-point Coulomb laws.")
+    traction_strips: int = Field(
+        default=12, ge=2, le=32,
+        description="Strips across the major axis of each contact ellipse (ellipse_traction) [-]; 12 is converged "
+        "(tests/kernels/test_traction.py).")
+    traction_every: int = Field(
+        default=5, ge=1, le=10,
+        description="Tribology refreshes between two strip integrations (ellipse_traction) [-]; 5 (50 us at 1 us and "
+        "10 substeps) is converged (tests/kernels/test_traction.py).")
+    asperity_regularisation_slip_m_s: float = Field(
+        default=1e-3, gt=0.0, le=0.1,
+        description="Slip over which the asperity (Coulomb) friction develops in ellipse_traction [m/s].")
     tribology_substeps: int = Field(
         default=10, ge=1, le=10, description="Film/Lambda/mu/damping refreshed every this many steps (<= 10 us at 1 us).")
     tangential_stiffness_ratio: float = Field(

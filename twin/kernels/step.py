@@ -21,11 +21,12 @@ from twin.kernels.layout import (
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
     P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
-    P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
+    P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
 )
+from twin.kernels.traction import apply_traction_moments, ellipse_traction
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 
 
@@ -41,10 +42,12 @@ ROLLING_REGULARISATION_SPEED = 0.01
 # budget). A contact that has just closed gets its RC at once.
 ELECTRICAL_EVERY = 10
 
+FRICTION_ELLIPSE = 2  # P_FRICTION_MODEL code of the friction over the contact ellipse
+
 
 @njit(**JIT)
 def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                          tribology_now, electrical_now):
+                          tribology_now, electrical_now, traction_now):
     """Forces and torques of every contact at the current positions -> accelerations of the
     balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
 
@@ -127,7 +130,8 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             w[C_H_C * CW + c] = tri[1]
             w[C_LAMBDA * CW + c] = tri[2]
             w[C_REGIME * CW + c] = tri[3]
-            w[C_MU * CW + c] = tri[4]
+            if friction_model != FRICTION_ELLIPSE or w[C_MU * CW + c] == 0.0:
+                w[C_MU * CW + c] = tri[4]  # ellipse friction: its capacity (ellipse_traction) once solved
             w[C_SEMI_MAJOR * CW + c] = tri[5]
             w[C_SEMI_MINOR * CW + c] = tri[6]
             w[C_FLUID_DAMPING * CW + c] = tri[7]
@@ -151,6 +155,10 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             w[C_RESISTANCE * CW + c] = res_ohm
             w[C_CAPACITANCE * CW + c] = cap_f
     scal[X_MAX_PENETRATION] = max_pen
+    if friction_model == FRICTION_ELLIPSE:  # friction over the contact ellipse (twin.kernels.traction)
+        if traction_now:
+            ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
+        apply_traction_moments(w, nc)
     ring_fx = 0.0
     ring_fy = 0.0
     ring_fz = 0.0
@@ -230,6 +238,7 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
     half = 0.5 * dt
     cage_inertia = p[P_CAGE_INERTIA]
     substeps = int(p[P_SUBSTEPS])
+    traction_every = max(int(p[P_TRACTION_EVERY]), 1)
     ramp = p[P_RAMP] * dt
     # leapfrog form of velocity-Verlet: the closing half kick of one step and the opening half
     # kick of the next are one full kick; the state holds full-step velocities between frames
@@ -259,7 +268,8 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
         scal[X_STEP] = step + 1
         status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w,
                                        cage_load, step % substeps == 0,
-                                       step % (substeps * ELECTRICAL_EVERY) == 0)
+                                       step % (substeps * ELECTRICAL_EVERY) == 0,
+                                       step % (substeps * traction_every) == 0)  # a tribology step
         scal[X_TORQUE_SUM] += scal[X_DRIVE_TORQUE]
         scal[X_TORQUE_COUNT] += 1.0
         done = it + 1
@@ -280,4 +290,4 @@ def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load):
     """Contact forces, tribology and accelerations at the current state without advancing time
     (used after a warm start). Returns the status."""
     return compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                                 True, True)
+                                 True, True, True)
