@@ -28,9 +28,10 @@ differential slip, the n part the spin (pivoting) moment, which replaces seed 00
 spin moment is applied every step from its value and slope at the solution, clipped to the
 all-sliding value, so that it follows the spin rate without a sign chatter.
 
-Cost: the strip solve (a few exponentials per strip) runs every `P_TRACTION_EVERY` tribology
-refreshes; the convergence of that sub-rate and of the strip count is shown in
-tests/kernels/test_traction.py. No allocation: the per-strip values of the contact being solved
+Cost: the strip solve (a few exponentials per strip pair, one to three Newton passes from the
+last solution) runs every `P_TRACTION_EVERY` tribology refreshes (100 us): the torque moves by
+under 0.02 % against a solve every 10 us (tests/physics/test_friction_torque.py), and 12 strips
+hold the moments within 0.5 % of 32 (tests/kernels/test_traction.py). No allocation: the per-strip values of the contact being solved
 live in scratch rows of the lane array.
 """
 
