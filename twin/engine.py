@@ -343,6 +343,7 @@ class Twin:
             viscosity_pa_s=float(self._inlet_viscosity_pa_s),
             electrical=ElectricalSnapshot(
                 resistance_ohm=_finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,
+                capacitance_reason=net.capacitance_reason,
                 impedance_ohm=net.impedance_ohm, phase_rad=net.phase_rad,
                 frequency_hz=net.frequency_hz, shaft_voltage_v=net.shaft_voltage_v,
                 shaft_current_a=net.shaft_current_a, max_film_field_v_m=net.max_film_field_v_m,

@@ -55,7 +55,11 @@ class ElectricalState(BaseModel):
 
     model_config = _FROZEN
     resistance_ohm: float | None = Field(description="Equivalent parallel resistance 1/Re(Y) at the frequency [ohm]; null: no conduction.")
-    capacitance_f: float = Field(description="Equivalent parallel capacitance Im(Y)/omega [F].")
+    capacitance_f: float | None = Field(
+        description="Equivalent parallel capacitance Im(Y)/omega [F], published where the network is capacitive (impedance "
+        "phase at or below -45 deg); null otherwise, with capacitance_reason.")
+    capacitance_reason: str | None = Field(
+        default=None, description="Why capacitance_f is null (the network is resistive); null when it is published.")
     impedance_ohm: float = Field(description="Impedance magnitude at the frequency [ohm].")
     phase_rad: float = Field(description="Impedance phase [rad]: -pi/2 capacitive, 0 resistive.")
     frequency_hz: float = Field(description="Frequency of the impedance [Hz].")

@@ -38,6 +38,15 @@ class Geometry(BaseModel):
         default=0.0, ge=0.0, le=45.0,
         description="Unloaded contact angle [deg]: 0 for deep-groove, e.g. 40 for a 7208 B.")
     cage_mass_kg: float = Field(default=0.02, gt=0.0, le=100.0, description="Cage mass [kg].")
+    ring_width_m: float | None = Field(
+        default=None, gt=0.0, le=1.0,
+        description="Ring width B [m] (ISO 15 boundary dimension), for the capacitance of the rings' lands; null: "
+        "the lands are left out of the bearing capacitance.")
+    shoulder_depth_m: float | None = Field(
+        default=None, gt=0.0, le=0.05,
+        description="Depth of the groove below the ring's land (shoulder height) [m], for the capacitance of the gap "
+        "around the contacts; null: 0.18 ball diameters, a typical deep-groove proportion (an assumption: between "
+        "0.15 and 0.22 the contact capacitance moves by under 3 %, tests/physics/test_electrical.py).")
 
     @model_validator(mode="after")
     def _fits(self) -> "Geometry":
@@ -133,7 +142,9 @@ class Lubricant(BaseModel):
 
 
 class Electrical(BaseModel):
-    """Electrical properties of the lubricated contacts and their calibration constants.
+    """Electrical properties of the lubricated contacts and their calibration constants. The
+    capacitances of the geometry (the gap around each contact, the rings' lands) are integrated
+    from the bearing's geometry when the model is compiled (twin.model, twin.physics.electrical).
 
     Defaults: mineral oil eps_r 2.2 and 1e10 ohm m (Prashad, Tribology in electrical
     environments, 2005, ch. 1-2); a fully metallic Hertz contact of ~0.1 ohm (Holm constriction of
@@ -152,12 +163,6 @@ class Electrical(BaseModel):
     metallic_contact_resistance_ohm: float = Field(
         default=0.1, gt=0.0, le=1e6,
         description="Resistance of one contact with all its load on asperities (Lambda -> 0) [ohm].")
-    outer_gap_limit_m: float = Field(
-        default=50e-6, gt=0.0, le=1e-3,
-        description="The outer-zone capacitance is integrated until the oil gap has grown by this much [m].")
-    rest_capacitance_f: float = Field(
-        default=20e-12, ge=0.0, le=1e-6,
-        description="Capacitance of the rest of the bearing (rings through cage and air/oil) [F].")
     frequency_hz: float = Field(
         default=10e3, gt=0.0, le=1e8, description="Frequency of the reported impedance [Hz].")
     breakdown_field_v_m: float = Field(

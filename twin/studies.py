@@ -123,7 +123,7 @@ class EVSample:
     current_temperature_rise_k: float
     shear_temperature_rise_k: float
     film_thermal_factor: float
-    bearing_capacitance_f: float
+    bearing_capacitance_f: float | None   # None where the network is not capacitive
     current_density_a_m2: float
     discharge_risk: str
 

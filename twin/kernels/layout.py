@@ -26,7 +26,7 @@ P_ROLLING = 20             # 1: seed 001 rolling resistance on
 P_BALL_REDUCED_TANGENT_MASS = 21  # m / (1 + m Rb^2 / I) [kg]
 P_MAX_PENETRATION = 22     # status threshold [m]
 P_OIL_PERMITTIVITY = 23    # relative permittivity of the oil at ambient pressure [-]
-P_GAP_LIMIT = 24           # outer-zone capacitance integration limit [m]
+P_GAP_LIMIT = 24           # gap limit of the outer-zone capacitance, inner race [m] (outer: P_GAP_LIMIT_OUTER)
 P_ASPERITY_RESISTANCE = 25 # resistance of a fully metallic contact [ohm]
 P_OIL_RESISTIVITY = 26     # [ohm m]
 # friction over the contact ellipse (twin.kernels.traction; issue 11 item 3)
@@ -37,7 +37,8 @@ P_LIMITING_SHEAR = 30      # gamma = tau_L / p [-]
 P_PRESSURE_VISCOSITY = 31  # Barus alpha [1/Pa]
 P_ASPERITY_SLIP = 32       # regularisation slip of the asperity friction [m/s]
 P_DEFORMED_RADIUS = 33     # contact-surface radius across the groove, inner (33) and outer (34) [m]
-P_STRIP_TABLE = 35         # MAX_STRIPS rows of 4: mean t, mean t^2, load share, mean pressure / p_h
+P_GAP_LIMIT_OUTER = 35     # gap limit of the outer-zone capacitance, outer race [m]
+P_STRIP_TABLE = 36         # MAX_STRIPS rows of 4: mean t, mean t^2, load share, mean pressure / p_h
 MAX_STRIPS = 32
 N_PARAMS = P_STRIP_TABLE + 4 * MAX_STRIPS
 

@@ -20,7 +20,7 @@ from twin.kernels.layout import (
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
-    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
+    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
     P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
@@ -148,7 +148,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             if tri[1] > 0.0:
                 res_ohm, cap_f = contact_electrical(
                     q_el, tri[2], tri[1], tri[5], tri[6], tr[r, T_RX], tr[r, T_RY],
-                    p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT], p[P_ASPERITY_RESISTANCE],
+                    p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER], p[P_ASPERITY_RESISTANCE],
                     p[P_OIL_RESISTIVITY])
             else:  # no film (no entrainment): metallic contact, no dielectric
                 res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
