@@ -9,7 +9,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 
 from twin import catalog, skf_friction, studies
 from twin.physics import viscosity

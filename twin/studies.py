@@ -162,7 +162,7 @@ TORQUE_BALL_PASSAGES = 3
 
 
 def mean_friction_torque_n_m(shaft_speed_rad_s: float, radial_load_n: float, *, designation: str = "6208",
-                             shear_heating: bool = False, oil_temperature_c: float = 40.0,
+                             axial_load_n: float = 0.0, shear_heating: bool = False, oil_temperature_c: float = 40.0,
                              options: ModelOptions | None = None, settle_s: float = TORQUE_SETTLE_S,
                              passages: int = TORQUE_BALL_PASSAGES) -> tuple[float, Twin]:
     """Shaft torque [N m] averaged over whole ball passages (`passages` ball pitches of the cage,
@@ -172,7 +172,7 @@ def mean_friction_torque_n_m(shaft_speed_rad_s: float, radial_load_n: float, *, 
     spec = BearingSpec.model_validate({**base.model_dump(),
                                        "thermal": Thermal(shear_heating=shear_heating).model_dump()})
     twin = Twin(spec, options=options, setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s,
-                                                         radial_load_n=radial_load_n,
+                                                         radial_load_n=radial_load_n, axial_load_n=axial_load_n,
                                                          oil_temperature_c=oil_temperature_c))
     twin.advance(settle_s)
     pitch = 2.0 * math.pi / twin.model.ball_count / max(twin.model.cage_speed_rad_s(shaft_speed_rad_s), 1e-3)

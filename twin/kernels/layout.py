@@ -155,6 +155,9 @@ E_SPIN_MOMENT = 61   # moment along n at the spin rate E_SPIN_RATE [N m]
 E_SPIN_SLOPE = 62    # d(moment along n) / d(spin rate) [N m s]
 E_SPIN_RATE = 63     # relative spin rate (ball minus ring) about n at the solution [rad/s]
 E_SPIN_CAP = 64      # largest moment along n (every strip sliding) [N m]
+E_M2X = 71           # E_MOMENT_T2 t2 in the world frame at the last solve [N m]
+E_M2Y = 72
+E_M2Z = 73
 # per-strip scratch of the contact being solved (lanes 0..MAX_STRIPS-1)
 E_SCRATCH_O = 65     # slip offset o_k of strip k [m/s]
 E_SCRATCH_SE = 66    # Eyring slip scale h tau0 / eta(p_k) [m/s]
@@ -162,7 +165,7 @@ E_SCRATCH_SSAT = 67  # slip at which strip k reaches the limiting shear stress [
 E_SCRATCH_EY = 68    # Eyring force coefficient (1 - Qa/Q) A_k tau0 [N]
 E_SCRATCH_SPREAD = 69  # half the spread of the slip across strip k [m/s]
 E_SCRATCH_SIGNED_HALF = 70  # half-width of strip k in t, signed like ds/dt across it [-]
-N_ROWS = 71
+N_ROWS = 74
 
 # ---- kernel status codes ----------------------------------------------------------------------
 STATUS_OK = 0
