@@ -44,7 +44,7 @@ def _fig_reduction(out: Path) -> tuple[str, list]:
     rows = []
     for i, current in enumerate(table["currents_a"]):
         rise = prm.current_temperature_rise_k(current, u, th.equivalent_resistance_ohm)
-        law = tcal.law_factor(rise, u, inputs, th.film_temperature_exponent, th.inlet_shear_heating_factor)
+        law = tcal.law_factor(rise, u, inputs, th.film_temperature_exponent)
         rows.append((current, rise, 1.0 - table["h_min_factor"][i][j], 1.0 - law))
     plt = _plt()
     fig, ax = plt.subplots(figsize=(7, 4))
@@ -147,10 +147,11 @@ def write_ev_section(out: Path, quick: bool = False, progress=None) -> list[str]
     md = ["## EV motor bearing under shaft current (seed 003)\n",
           "The real-time loop heats the inlet by the current discharge of the race track (seed 003 eq. 10, "
           f"R_b = {th.equivalent_resistance_ohm:g} ohm and H_c = {th.crater_depth_m:g} m, the EHL solver's anchored "
-          "reading of Appendix 2) and by shear (eq. 6 at the inlet, self-consistent with Roelands' eq. 3), and "
-          "multiplies the isothermal film by g(dT)^c_T; c_T = "
-          f"{th.film_temperature_exponent:g} and c_s = {th.inlet_shear_heating_factor:g} are fitted to the thermal "
-          "EHL solver (`python -m twin.thermal_calibration`).\n",
+          "reading of Appendix 2) and multiplies the isothermal film by g(dT)^c_T, c_T = "
+          f"{th.film_temperature_exponent:g} fitted to the current heating of the thermal EHL solver "
+          "(`python -m twin.thermal_calibration`); the inlet's shear heating multiplies it by the Murch-Wilson factor "
+          "3.94 / (3.94 + L^0.62), L = beta eta u^2 / k' (an established rolling-contact inlet law; seed 003's eq. 6 "
+          "is a Hertz-zone temperature).\n",
           "### Film reduction against current (seed 003 Figs. 2 and 4)\n", f"![reduction]({red_png})\n",
           "| current [A] | eq. 10 rise [K] | solver reduction | loop-law reduction |", "|---|---|---|---|"]
     md += [f"| {c:g} | {t:.1f} | {100 * a:.1f} % | {100 * b:.1f} % |" for c, t, a, b in red_rows]
@@ -160,8 +161,11 @@ def write_ev_section(out: Path, quick: bool = False, progress=None) -> list[str]
            "| current [A] | speed of the thickest film [rpm] |", "|---|---|"]
     md += [f"| {c:g} | {sp['thickest'][c]:,.0f} |" for c in CURRENTS_A]
     md += ["\nSeed 003: 'as the current increases, the rotational speed required to attain the thickest film "
-           "increases'. The 6200's entrainment speed is about 6 times seed 003's for the same rpm (seed 003 maps "
-           "10 000 rpm to 0.832 m/s), so the twin's shear heating takes over at lower rpm than the seed's.\n",
+           "increases'; 'higher currents require higher shaft speeds to achieve film formation'. With the "
+           "Murch-Wilson inlet law the film without current keeps growing up to the 6200's speed limit (its maximum, "
+           "at L = 12, lies near 31 m/s, above 60 000 rpm), so the thickest film sits at the top of the sweep; the "
+           "speed at which the film with current reaches half the film without current rises with the current. "
+           "Seed 003's interior maximum without current came from its eq. 6 applied at the inlet.\n",
            "### Base temperature and bearing resistance (seed 003 Figs. 8 and 10), 20 000 rpm\n",
            f"![temperature and resistance]({tr_png})\n",
            "| oil temperature [degC] | current [A] | h_min [nm] |", "|---|---|---|"]
@@ -173,7 +177,8 @@ def write_ev_section(out: Path, quick: bool = False, progress=None) -> list[str]
            "| current [A] | rpm | C_bearing [pF] | current density [A/mm^2] | discharge risk |", "|---|---|---|---|---|"]
     for c in CURRENTS_A[1:]:
         for s in at20[c][:: max(1, len(rpms) // 3)]:
-            md.append(f"| {c:g} | {s.shaft_speed_rpm:,.0f} | {1e12 * s.bearing_capacitance_f:.0f} | "
+            cap = "-" if s.bearing_capacitance_f is None else f"{1e12 * s.bearing_capacitance_f:.0f}"
+            md.append(f"| {c:g} | {s.shaft_speed_rpm:,.0f} | {cap} | "
                       f"{1e-6 * s.current_density_a_m2:.2f} | {s.discharge_risk} |")
     md.append("")
     return md

@@ -41,6 +41,10 @@ _DEEP_GROOVE_MM = {
 
 _POCKET_CLEARANCE_M = 30e-6
 
+# ISO 15 ring width B [mm] of the dimension series 02 (62xx, 72xx): the rings' lands' capacitance
+_RING_WIDTH_MM = {"6200": 9.0, "6201": 10.0, "6202": 11.0, "6203": 12.0, "6204": 14.0, "6205": 15.0,
+                  "6206": 16.0, "6207": 17.0, "6208": 18.0, "6209": 19.0, "6210": 20.0, "7208": 18.0}
+
 # ISO 3448 grade (nu_40 in mm^2/s) -> nu_100 [mm^2/s] of a VI ~ 100 mineral oil (ASTM D2270 table)
 _ISO_VG_NU100_MM2_S = {10: 2.6, 15: 3.3, 22: 4.2, 32: 5.4, 46: 6.8, 68: 8.7, 100: 11.1,
                        150: 14.5, 220: 18.8, 320: 24.0, 460: 30.5}
@@ -96,6 +100,9 @@ def bearing(designation: str = "6208", *, diametral_clearance_m: float = 0.0,
         geometry, kind = _deep_groove(*_DEEP_GROOVE_MM[key]), "deep_groove"
     else:
         raise ValueError(f"designation: unknown bearing {designation!r}; known: {', '.join(designations())}")
+    width = _RING_WIDTH_MM.get(key[:4])
+    if width is not None and geometry.ring_width_m is None:
+        geometry = geometry.model_copy(update={"ring_width_m": width * 1e-3})
     mounting = Mounting(diametral_clearance_m=diametral_clearance_m)
     return BearingSpec(designation=key, kind=kind, geometry=geometry, mounting=mounting,
                        lubricant=lubricant or Lubricant(), **spec_fields)

@@ -2,8 +2,16 @@
 kernel (seed 000 end of section 2.2, seed 004 conclusion).
 
 Per ball the inner and outer contacts are in series; the balls are in parallel, with the rest of
-the bearing's capacitance beside them. Open contacts (unloaded balls) are pure capacitors across
-their gap. Evaluated between frames (numpy), never in the hot loop.
+the bearing (the rings' lands facing each other across the oil-filled annulus, a coaxial
+capacitor of the geometry, twin.model) beside them. Open contacts (an unloaded ball off its
+raceway) are pure capacitors across the gap the dynamics gives them, integrated over the exact
+ball-groove geometry (twin.physics.electrical: the paraboloid law with the geometric gap limit);
+an unloaded ball's other contact, pressed by its centrifugal load, has its own film from the film
+formula like any loaded contact. Evaluated between frames (numpy), never in the hot loop.
+
+The bearing is published as a capacitance only where the network is capacitive (impedance phase
+at or below -45 deg, CAPACITIVE_PHASE_RAD): above it the asperity contacts' conduction dominates
+and Im(Y)/omega is not a capacitance of anything (the impedance and phase always are).
 """
 
 from __future__ import annotations
@@ -18,6 +26,7 @@ from twin.model import BearingModel
 from twin.physics.electrical import outer_zone_capacitance_f
 
 _MIN_GAP_M = 1e-9
+CAPACITIVE_PHASE_RAD = -math.pi / 4.0  # the network is capacitive at or below this impedance phase
 
 
 @dataclass(frozen=True)
@@ -29,7 +38,8 @@ class ElectricalState:
     ball_resistance_ohm: np.ndarray      # (Z,) series R_in + R_out, inf if either is open
     ball_capacitance_f: np.ndarray       # (Z,) series C_in C_out / (C_in + C_out)
     resistance_ohm: float                # 1 / Re(Y) at the frequency (inf: no conduction)
-    capacitance_f: float                 # Im(Y) / omega
+    capacitance_f: float | None          # Im(Y) / omega where the network is capacitive, else None
+    capacitance_reason: str | None       # why capacitance_f is None (None when it is published)
     impedance_ohm: float                 # |Z|
     phase_rad: float                     # arg Z (-pi/2: capacitive, 0: resistive)
     frequency_hz: float
@@ -45,7 +55,7 @@ def _open_contact_capacitance(model: BearingModel, r: int, gap_m: np.ndarray) ->
     el = model.spec.electrical
     rx, ry = model.race_params[r, L.R_RX], model.race_params[r, L.R_RY]
     return np.array([outer_zone_capacitance_f(el.oil_relative_permittivity, rx, ry, max(g, _MIN_GAP_M),
-                                              el.outer_gap_limit_m) for g in gap_m])
+                                              model.gap_limit_m[r]) for g in gap_m])
 
 
 def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: float,
@@ -69,7 +79,7 @@ def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: 
         z_c = 1.0 / y_c
         z_ball = z_c[0::2] + z_c[1::2]
         y_ball = 1.0 / z_ball
-    y = complex(np.sum(y_ball)) + 1j * omega * el.rest_capacitance_f
+    y = complex(np.sum(y_ball)) + 1j * omega * model.rest_capacitance_f
     z_total = 1.0 / y
     r_ball = r_c[0::2] + r_c[1::2]
     c_in, c_out = c_c[0::2], c_c[1::2]
@@ -92,10 +102,18 @@ def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: 
     max_field = float(np.max(field)) if field.size else 0.0
     max_density = float(np.max(density)) if density.size else 0.0
     risk, reason = _risk(el, max_field, max_density, voltage, current)
+    phase = math.atan2(z_total.imag, z_total.real)
+    capacitance, capacitance_reason = y.imag / omega, None
+    if phase > CAPACITIVE_PHASE_RAD:
+        capacitance = None
+        capacitance_reason = (f"not capacitive: impedance phase {math.degrees(phase):.1f} deg above -45 deg at "
+                              f"{el.frequency_hz:g} Hz (conduction through asperity contacts dominates); "
+                              f"|Z| = {abs(z_total):.4g} ohm")
     return ElectricalState(
         contact_resistance_ohm=r_c, contact_capacitance_f=c_c, ball_resistance_ohm=r_ball,
         ball_capacitance_f=c_ball, resistance_ohm=(1.0 / y.real) if y.real > 0 else math.inf,
-        capacitance_f=y.imag / omega, impedance_ohm=abs(z_total), phase_rad=math.atan2(z_total.imag, z_total.real),
+        capacitance_f=capacitance, capacitance_reason=capacitance_reason, impedance_ohm=abs(z_total),
+        phase_rad=phase,
         frequency_hz=el.frequency_hz, shaft_voltage_v=voltage, shaft_current_a=current,
         max_film_field_v_m=max_field, current_density_a_m2=max_density, discharge_risk=risk,
         reason=reason)

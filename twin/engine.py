@@ -18,8 +18,10 @@ from twin.physics.friction import REGIME_NAMES
 from twin.physics.hertz import max_pressure_pa
 from twin.kernels.tribology import T_HMIN_EXP_EU
 from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k,
-                                  inlet_shear_heating_temperature_rise_k, roelands_temperature_viscosity_pa_s,
-                                  thermal_film_factor)
+                                  equivalent_inlet_temperature_rise_k, murch_wilson_thermal_factor,
+                                  roelands_temperature_viscosity_coefficient_k_inv,
+                                  roelands_temperature_viscosity_pa_s, thermal_film_factor,
+                                  thermal_loading_parameter)
 from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.setpoint import Setpoint, SetpointUpdate, check_limits
 from twin.electrical import bearing_network
@@ -72,6 +74,7 @@ class Twin:
             spec = BearingSpec.model_validate({**spec.model_dump(), "mounting": mounting.model_dump()})
         self.bearing_id = bearing_id
         self.model: BearingModel = make_model(spec, options)
+        self._effective_mu = self.model.options.friction_model == "ellipse_traction"
         self.state: TwinState = make_state(self.model)
         self.life_monitor = LifeMonitor(self.model, life)  # rating life and damage (twin.life)
         self._setpoint_vector = np.zeros(L.N_SETPOINT)
@@ -123,15 +126,17 @@ class Twin:
 
     # ---- electro-thermal coupling (seed 003) ------------------------------------------------
     def _update_inlet_viscosity(self, force: bool = False, elapsed_s: float = 0.0) -> None:
-        """Electro-thermal film loss (seed 003): the inlet is heated by the current discharge of the
-        race track (eq. 10, with the bearing's equivalent resistance) and by shear (eq. 6 at the
-        inlet); the film the loop computes is the isothermal film at the oil temperature times
-        the thermal film factor g(dT)^c_T calibrated against the thermal EHL solver
-        (twin.thermal_calibration). The factor enters the kernel through the one viscosity it
-        reads: eta_film = eta_oil * factor^(1 / n_u), n_u the film law's exponent of (eta u), so
-        film, Lambda, regime, mu and fluid damping all follow. Recomputed at the start of the frame
-        that completes COUPLING_PERIOD_S of simulated time (`elapsed_s`: the frame's length; the
-        drivers change slowly), whatever the step."""
+        """Thermal film loss at the inlet, where the film is formed: the current discharge of the
+        race track heats it (seed 003 eq. 10, with the bearing's equivalent resistance) and the
+        film falls by g(dT)^c_T, calibrated against the thermal EHL solver's current heating
+        (twin.thermal_calibration); the back-flow shear of the inlet (Thermal.shear_heating)
+        reduces it further by the Murch-Wilson factor phi_T = 3.94 / (3.94 + L^0.62),
+        L = beta eta u^2 / k_f at the current-heated inlet (twin.physics.thermal). The film the
+        loop computes is the isothermal film at the oil temperature times both factors; they
+        enter the kernel through the one viscosity it reads: eta_film = eta_oil * factor^(1 / n_u),
+        n_u the film law's exponent of (eta u), so film, Lambda, regime, mu, fluid damping and the
+        rolling resistance all follow. Recomputed at the start of the frame that completes COUPLING_PERIOD_S of simulated
+        time (`elapsed_s`: the frame's length; the drivers change slowly), whatever the step."""
         self._since_coupling_s = getattr(self, "_since_coupling_s", 0.0) + elapsed_s
         if not force and self._since_coupling_s < COUPLING_PERIOD_S - 0.5 * self.model.dt_s:
             return
@@ -144,17 +149,25 @@ class Twin:
             current_rise = self.current_heating_k()
         theta0 = sp.oil_temperature_c + 273.15
         eta0, beta = self._oil_viscosity_pa_s, self._oil_beta_k_inv
+        current_factor = 1.0
+        if current_rise > 0.0:
+            current_factor = thermal_film_factor(current_rise, eta0, theta0, beta, th.film_temperature_exponent)
+        shear_factor = 1.0
         shear_rise = 0.0
         if th.shear_heating and have_state:
-            shear_rise = inlet_shear_heating_temperature_rise_k(
-                self.mean_entrainment_speed_m_s(), eta0, theta0, beta, th.oil_thermal_conductivity_w_m_k,
-                other_rise_k=current_rise, shear_factor=th.inlet_shear_heating_factor)
+            theta_c = theta0 + current_rise  # the shear heats an inlet the current has heated
+            eta_c = roelands_temperature_viscosity_pa_s(eta0, theta0, theta_c, beta)
+            beta_c = roelands_temperature_viscosity_coefficient_k_inv(eta0, theta0, theta_c, beta)
+            loading = thermal_loading_parameter(beta_c, eta_c, self.mean_entrainment_speed_m_s(),
+                                                th.oil_thermal_conductivity_w_m_k)
+            shear_factor = murch_wilson_thermal_factor(loading)
+            shear_rise = equivalent_inlet_temperature_rise_k(shear_factor, eta_c, theta_c, beta_c)
         rise = current_rise + shear_rise
-        factor = 1.0
-        if rise > 0.0:  # floored: below 1e-4 of the isothermal film there is no film to speak of
-            factor = max(MIN_FILM_THERMAL_FACTOR, thermal_film_factor(rise, eta0, theta0, beta, th.film_temperature_exponent))
+        # floored: below 1e-4 of the isothermal film there is no film to speak of
+        factor = max(MIN_FILM_THERMAL_FACTOR, current_factor * shear_factor)
         self._current_heating_k = current_rise
         self._shear_heating_k = shear_rise
+        self._shear_film_factor = shear_factor
         self._film_thermal_factor = factor
         self._inlet_viscosity_pa_s = (roelands_temperature_viscosity_pa_s(eta0, theta0, theta0 + rise, beta)
                                       if rise > 0.0 else eta0)
@@ -336,7 +349,7 @@ class Twin:
             h_min_m=_finite_or_none(c[L.C_H_MIN]) if loaded else None,
             h_c_m=_finite_or_none(c[L.C_H_C]) if loaded else None,
             **{"lambda": _finite_or_none(c[L.C_LAMBDA]) if loaded else None},
-            regime=regime, mu=float(c[L.C_MU]) if loaded else 0.0,
+            regime=regime, mu=self._contact_mu(c) if loaded else 0.0,
             entrainment_speed_m_s=float(c[L.C_ENTRAINMENT]) if loaded else 0.0,
             slide_roll_ratio=float(c[L.C_SRR]) if loaded else 0.0,
             contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.G_NZ])))) if loaded else 0.0,
@@ -344,6 +357,15 @@ class Twin:
             resistance_ohm=_finite_or_none(net.contact_resistance_ohm[2 * j + r]),
             capacitance_f=float(net.contact_capacitance_f[2 * j + r]),
         )
+
+    def _contact_mu(self, c: np.ndarray) -> float:
+        """Published mu of one contact's lane column: with the ellipse friction the effective
+        coefficient |F_t| / Q (the tangential spring's elastic force, which the strips transmit,
+        over the normal load); with the centre-point laws their Coulomb coefficient."""
+        if not self._effective_mu:
+            return float(c[L.C_MU])
+        kt = self.model.options.tangential_stiffness_ratio * 1.5 * c[L.M_STIFFNESS] * c[L.G_SQRT_DELTA]
+        return float(kt * math.sqrt(c[L.T_XI0] ** 2 + c[L.T_XI1] ** 2 + c[L.T_XI2] ** 2) / c[L.C_LOAD])
 
     def electrical(self):
         """The bearing's electrical network at the current state (twin.electrical)."""
@@ -382,6 +404,7 @@ class Twin:
             viscosity_pa_s=float(self._inlet_viscosity_pa_s),
             electrical=ElectricalSnapshot(
                 resistance_ohm=_finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,
+                capacitance_reason=net.capacitance_reason,
                 impedance_ohm=net.impedance_ohm, phase_rad=net.phase_rad,
                 frequency_hz=net.frequency_hz, shaft_voltage_v=net.shaft_voltage_v,
                 shaft_current_a=net.shaft_current_a, max_film_field_v_m=net.max_film_field_v_m,

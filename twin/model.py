@@ -14,13 +14,17 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
 from twin import timestep
 from twin.kernels import layout as L
-from twin.kernels.tribology import N_TRIBOLOGY, tribology_coefficients
+from twin.kernels.tribology import N_TRIBOLOGY, T_PIVOT, tribology_coefficients
 from twin.physics import hertz
+from twin.physics.electrical import (ball_raceway_gap_integral_m, coaxial_capacitance_f,
+                                     equivalent_gap_limit_m)
+from twin.physics.traction import deformed_surface_radius_m, hertz_strip_table
 from twin.physics.viscosity import dynamic_viscosity_pa_s
 from twin.spec import BearingSpec, ModelOptions
 
@@ -29,6 +33,8 @@ from twin.spec import BearingSpec, ModelOptions
 # rating C0 of the bearing: 21 kN radial for the 6208 of seed 000, SKF lists 19 kN).
 STATIC_PRESSURE_LIMIT_PA = 4.2e9
 MODEL_PRESSURE_FACTOR = 1.0
+DEFAULT_SHOULDER_DEPTH_RATIO = 0.18  # groove depth / ball diameter when the geometry gives none
+GAP_LIMIT_REFERENCE_GAP_M = 1e-6     # central gap at which the exact gap integral is matched
 
 
 @dataclass(frozen=True)
@@ -49,6 +55,9 @@ class BearingModel:
     max_axial_load_n: float
     max_shaft_speed_rad_s: float
     time_step: timestep.CriticalTimeStep | None = None  # critical step of the scheme (twin.timestep)
+
+    gap_limit_m: tuple[float, float] = (50e-6, 50e-6)   # inner, outer: geometric gap limit of the contact capacitance
+    rest_capacitance_f: float = 0.0                     # the rings' lands across the oil-filled annulus [F]
 
     def stiffness_at(self, race: int, sin_alpha: float) -> float:
         """Hertz K [N/m^1.5] of race `race` (0 inner, 1 outer) at contact angle alpha, interpolated
@@ -183,6 +192,33 @@ def interpolate_angle_table(table: np.ndarray, race: int, sin_alpha: float) -> n
     return table[race, i] + f * (table[race, i + 1] - table[race, i])
 
 
+@lru_cache(maxsize=64)
+def _geometry_capacitance(rb: float, inner_groove: float, outer_groove: float, pitch: float, alpha: float,
+                          shoulder: float, width: float | None, permittivity: float,
+                          rx_in: float, ry_in: float, rx_out: float, ry_out: float) -> tuple[float, float, float]:
+    """(gap limit inner [m], gap limit outer [m], rest capacitance [F]) from the geometry: the exact
+    ball-groove gap integral matched at 1 um by the paraboloid law's gap limit
+    (twin.physics.electrical.equivalent_gap_limit_m), and the rings' lands as a coaxial capacitor
+    filled with oil over the width where both rings are lands."""
+    limits = []
+    lands = []
+    half_widths = []
+    for inner, groove, rx, ry in ((True, inner_groove, rx_in, ry_in), (False, outer_groove, rx_out, ry_out)):
+        offset = groove - rb
+        centre = pitch + offset * math.cos(alpha) if inner else pitch - offset * math.cos(alpha)
+        land = centre - groove + shoulder if inner else centre + groove - shoulder
+        integral = ball_raceway_gap_integral_m(rb, groove, centre, alpha, inner, land, width,
+                                               GAP_LIMIT_REFERENCE_GAP_M)
+        limits.append(equivalent_gap_limit_m(integral, rx, ry, GAP_LIMIT_REFERENCE_GAP_M))
+        lands.append(land)
+        reach = groove * groove - (centre - land) ** 2
+        half_widths.append(offset * math.sin(alpha) + math.sqrt(max(reach, 0.0)))
+    rest = 0.0
+    if width is not None:
+        rest = coaxial_capacitance_f(permittivity, width - 2.0 * max(half_widths), lands[0], lands[1])
+    return limits[0], limits[1], rest
+
+
 def _load_at_pressure(row: np.ndarray, pressure_pa: float) -> float:
     """Ball load [N] at which the Hertz maximum pressure of this race reaches pressure_pa."""
     # p = 3 Q / (2 pi a b), a b = ca cb Q^(2/3) -> Q^(1/3) = 2 pi ca cb p / 3
@@ -226,17 +262,33 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_ALPHA_E] = options.restitution_coefficient_s_m
     p[L.P_RAMP] = options.speed_ramp_rad_s2
     p[L.P_FILM_FORMULA] = 0.0 if options.film_formula == "hamrock_dowson" else 1.0
-    p[L.P_FRICTION_MODEL] = 0.0 if options.friction_model == "stribeck_line" else 1.0
+    p[L.P_FRICTION_MODEL] = {"stribeck_line": 0.0, "asperity_share": 1.0, "ellipse_traction": 2.0}[options.friction_model]
     p[L.P_ROLLING] = 1.0 if options.rolling_resistance else 0.0
     p[L.P_BALL_REDUCED_TANGENT_MASS] = ball_mass / (1.0 + ball_mass * rb * rb / ball_inertia)
     p[L.P_MAX_PENETRATION] = 0.01 * rb
     el = spec.electrical
     p[L.P_OIL_PERMITTIVITY] = el.oil_relative_permittivity
-    p[L.P_GAP_LIMIT] = el.outer_gap_limit_m
     p[L.P_ASPERITY_RESISTANCE] = el.metallic_contact_resistance_ohm
     p[L.P_OIL_RESISTIVITY] = el.oil_resistivity_ohm_m
+    p[L.P_TRACTION_STRIPS] = options.traction_strips
+    p[L.P_TRACTION_EVERY] = options.traction_every
+    p[L.P_EYRING_STRESS] = spec.lubricant.eyring_stress_pa
+    p[L.P_LIMITING_SHEAR] = spec.lubricant.limiting_shear_coefficient
+    p[L.P_PRESSURE_VISCOSITY] = spec.lubricant.pressure_viscosity_pa_inv
+    p[L.P_ASPERITY_SLIP] = options.asperity_regularisation_slip_m_s
+    p[L.P_DEFORMED_RADIUS] = deformed_surface_radius_m(rb, g.inner_groove_radius_m)
+    p[L.P_DEFORMED_RADIUS + 1] = deformed_surface_radius_m(rb, g.outer_groove_radius_m)
+    strips = hertz_strip_table(options.traction_strips)
+    p[L.P_STRIP_TABLE:L.P_STRIP_TABLE + strips.size] = strips.ravel()
 
     race = np.stack([_race_row(spec, True, alpha, e_prime), _race_row(spec, False, alpha, e_prime)])
+    shoulder = g.shoulder_depth_m if g.shoulder_depth_m is not None else DEFAULT_SHOULDER_DEPTH_RATIO * 2.0 * rb
+    gap_in, gap_out, rest = _geometry_capacitance(
+        rb, g.inner_groove_radius_m, g.outer_groove_radius_m, pitch, alpha, shoulder, g.ring_width_m,
+        el.oil_relative_permittivity, float(race[0, L.R_RX]), float(race[0, L.R_RY]), float(race[1, L.R_RX]),
+        float(race[1, L.R_RY]))
+    p[L.P_GAP_LIMIT] = gap_in
+    p[L.P_GAP_LIMIT_OUTER] = gap_out
     # load limits: analytic Qmax = Fr / (Z Jr), Jr(0.5) = 0.2288 (seed 000 eq. A3)
     q_limit = min(_load_at_pressure(race[0], MODEL_PRESSURE_FACTOR * STATIC_PRESSURE_LIMIT_PA),
                   _load_at_pressure(race[1], MODEL_PRESSURE_FACTOR * STATIC_PRESSURE_LIMIT_PA))
@@ -257,6 +309,10 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
         dynamic_viscosity_pa_s(spec.lubricant, timestep.REFERENCE_OIL_TEMPERATURE_C), z)
     p[L.P_DT] = timestep.resolve_time_step_s(options.time_step_s, critical)
     p[L.P_SUBSTEPS] = timestep.steps_per_period(options.tribology_period_s, p[L.P_DT])
+    if options.friction_model == "ellipse_traction":
+        # the strips' spin moment replaces seed 001's eq. 11, at every contact angle
+        tribology[:, T_PIVOT] = 0.0
+        angle_table[:, :, L.A_TRIBOLOGY + T_PIVOT] = 0.0
     for a in (p, race, tribology, angle_table):
         a.setflags(write=False)
     return BearingModel(
@@ -265,4 +321,5 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
         ball_count=z, pitch_radius_m=pitch,
         contact_angle_rad=alpha, inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),
         max_radial_load_n=float(max_radial), max_axial_load_n=float(max_axial),
-        max_shaft_speed_rad_s=float(max_speed), time_step=critical)
+        max_shaft_speed_rad_s=float(max_speed), time_step=critical, gap_limit_m=(gap_in, gap_out),
+        rest_capacitance_f=rest)

@@ -24,7 +24,9 @@ class ContactState(BaseModel):
     lambda_: float | None = Field(alias="lambda", serialization_alias="lambda",
                                   description="Film parameter Lambda = h_min / (1.25 sqrt(s1^2 + s2^2)) [-]; null without contact.")
     regime: Regime = Field(description="Lubrication regime (seed 000 Table 2).")
-    mu: float = Field(description="Sliding friction coefficient [-] (0 without contact).")
+    mu: float = Field(description="Effective friction coefficient |F_t| / Q: net tangential force over normal load of the "
+                      "contact, the traction integrated over its ellipse (with the centre-point friction options: "
+                      "their Coulomb coefficient) [-] (0 without contact).")
     entrainment_speed_m_s: float = Field(description="Mean surface speed relative to the contact [m/s].")
     slide_roll_ratio: float = Field(description="Sliding / entrainment speed, signed [-].")
     contact_angle_rad: float = Field(description="Angle of the contact normal to the radial plane [rad].")
@@ -53,7 +55,11 @@ class ElectricalState(BaseModel):
 
     model_config = _FROZEN
     resistance_ohm: float | None = Field(description="Equivalent parallel resistance 1/Re(Y) at the frequency [ohm]; null: no conduction.")
-    capacitance_f: float = Field(description="Equivalent parallel capacitance Im(Y)/omega [F].")
+    capacitance_f: float | None = Field(
+        description="Equivalent parallel capacitance Im(Y)/omega [F], published where the network is capacitive (impedance "
+        "phase at or below -45 deg); null otherwise, with capacitance_reason.")
+    capacitance_reason: str | None = Field(
+        default=None, description="Why capacitance_f is null (the network is resistive); null when it is published.")
     impedance_ohm: float = Field(description="Impedance magnitude at the frequency [ohm].")
     phase_rad: float = Field(description="Impedance phase [rad]: -pi/2 capacitive, 0 resistive.")
     frequency_hz: float = Field(description="Frequency of the impedance [Hz].")

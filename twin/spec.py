@@ -41,6 +41,15 @@ class Geometry(BaseModel):
         default=0.0, ge=0.0, le=45.0,
         description="Unloaded contact angle [deg]: 0 for deep-groove, e.g. 40 for a 7208 B.")
     cage_mass_kg: float = Field(default=0.02, gt=0.0, le=100.0, description="Cage mass [kg].")
+    ring_width_m: float | None = Field(
+        default=None, gt=0.0, le=1.0,
+        description="Ring width B [m] (ISO 15 boundary dimension), for the capacitance of the rings' lands; null: "
+        "the lands are left out of the bearing capacitance.")
+    shoulder_depth_m: float | None = Field(
+        default=None, gt=0.0, le=0.05,
+        description="Depth of the groove below the ring's land (shoulder height) [m], for the capacitance of the gap "
+        "around the contacts; null: 0.18 ball diameters, a typical deep-groove proportion (an assumption: between "
+        "0.15 and 0.22 the contact capacitance moves by under 3 %, tests/physics/test_electrical.py).")
 
     @model_validator(mode="after")
     def _fits(self) -> "Geometry":
@@ -119,6 +128,14 @@ class Lubricant(BaseModel):
     density_15c_kg_m3: float = Field(default=870.0, gt=500.0, le=2000.0, description="Density at 15 degC [kg/m^3].")
     pressure_viscosity_pa_inv: float = Field(
         default=2.3e-8, gt=0.0, le=1e-7, description="Pressure-viscosity coefficient xi [1/Pa] (seed 000: 2.3e-8).")
+    eyring_stress_pa: float = Field(
+        default=5e6, gt=1e5, le=1e8,
+        description="Eyring stress tau0 of the film's shear thinning [Pa] (Johnson and Tevaarwerk 1977, Proc. R. Soc. "
+        "Lond. A 356: a few MPa for mineral oils; Evans and Johnson 1986 report 2-10 MPa).")
+    limiting_shear_coefficient: float = Field(
+        default=0.06, gt=0.0, le=0.2,
+        description="gamma = limiting shear stress / pressure of the film [-] (Bair and Winer 1979, J. Lubr. Technol. "
+        "101: 0.05-0.08 for mineral oils; the middle of that range).")
 
     @model_validator(mode="after")
     def _order(self) -> "Lubricant":
@@ -128,7 +145,9 @@ class Lubricant(BaseModel):
 
 
 class Electrical(BaseModel):
-    """Electrical properties of the lubricated contacts and their calibration constants.
+    """Electrical properties of the lubricated contacts and their calibration constants. The
+    capacitances of the geometry (the gap around each contact, the rings' lands) are integrated
+    from the bearing's geometry when the model is compiled (twin.model, twin.physics.electrical).
 
     Defaults: mineral oil eps_r 2.2 and 1e10 ohm m (Prashad, Tribology in electrical
     environments, 2005, ch. 1-2); a fully metallic Hertz contact of ~0.1 ohm (Holm constriction of
@@ -147,12 +166,6 @@ class Electrical(BaseModel):
     metallic_contact_resistance_ohm: float = Field(
         default=0.1, gt=0.0, le=1e6,
         description="Resistance of one contact with all its load on asperities (Lambda -> 0) [ohm].")
-    outer_gap_limit_m: float = Field(
-        default=50e-6, gt=0.0, le=1e-3,
-        description="The outer-zone capacitance is integrated until the oil gap has grown by this much [m].")
-    rest_capacitance_f: float = Field(
-        default=20e-12, ge=0.0, le=1e-6,
-        description="Capacitance of the rest of the bearing (rings through cage and air/oil) [F].")
     frequency_hz: float = Field(
         default=10e3, gt=0.0, le=1e8, description="Frequency of the reported impedance [Hz].")
     breakdown_field_v_m: float = Field(
@@ -196,16 +209,14 @@ class Thermal(BaseModel):
         default=True, description="Feed the current-discharge heating (seed 003 eq. 10) back into the film.")
     shear_heating: bool = Field(
         default=False,
-        description="Feed the inlet shear heating (seed 003 eq. 6 at the inlet) back into the film. Off by default: "
-        "seed 000, which validates the 6208 twin (Table 3, Fig. 8), is isothermal; the EV preset turns it on.")
+        description="Reduce the film by the inlet shear heating of a rolling contact, the Murch-Wilson factor "
+        "phi_T = 3.94 / (3.94 + L^0.62), L = beta eta u^2 / k' (Murch and Wilson 1975; twin.physics.thermal). Off by "
+        "default: seed 000, which validates the 6208 twin (Table 3, Fig. 8), is isothermal; the EV preset turns it on.")
     film_temperature_exponent: float = Field(
-        default=1.46, gt=0.0, le=5.0,
-        description="c_T of the loop's thermal film law h/h_iso = g(dT)^c_T [-], fitted to the thermal EHL solver "
-        "(twin.thermal_calibration, 33 solver cells of seed 003 Appendix 2, max error 3.8 points of reduction).")
-    inlet_shear_heating_factor: float = Field(
-        default=1.50, ge=0.0, le=20.0,
-        description="c_s of the inlet shear heating dT = c_s 2 eta u^2 / k' (seed 003 eq. 6 at p -> 0) [-], fitted "
-        "with film_temperature_exponent (twin.thermal_calibration).")
+        default=1.38, gt=0.0, le=5.0,
+        description="c_T of the loop's current-heating film law h/h_iso = g(dT)^c_T [-], fitted to the current heating "
+        "of the thermal EHL solver (twin.thermal_calibration: the solver's film with current over its film without, "
+        "28 cells of seed 003 Appendix 2, rms 13 % in ln h, max error 6.4 points of reduction).")
 
 
 class Mounting(BaseModel):
@@ -249,8 +260,24 @@ class ModelOptions(BaseModel):
         "6208). Seed 000 uses 1 us. A number must lie in [1e-08, 2e-05] s.")
     film_formula: Literal["hamrock_dowson", "masjedi_khonsari"] = Field(
         default="hamrock_dowson", description="Minimum film formula: seed 000 eq. 6 or seed 004 eq. 6.")
-    friction_model: Literal["stribeck_line", "asperity_share"] = Field(
-        default="stribeck_line", description="mu(Lambda): seed 000 section 2.3 or seed 001 eq. A2.")
+    friction_model: Literal["ellipse_traction", "stribeck_line", "asperity_share"] = Field(
+        default="ellipse_traction",
+        description="Tangential friction of the ball-raceway contacts: 'ellipse_traction' integrates the traction over "
+        "strips of the contact ellipse (differential and spin slip; seed 000 mu(Lambda) x seed 001 eq. A2 asperity "
+        "share + Eyring / limiting-shear film; twin.kernels.traction); 'stribeck_line' (seed 000 section 2.3) and "
+        "'asperity_share' (seed 001 eq. A1-A2) are the former centre-point Coulomb laws.")
+    traction_strips: int = Field(
+        default=12, ge=2, le=32,
+        description="Strips across the major axis of each contact ellipse (ellipse_traction) [-]; 12: moments within 0.5 % "
+        "(spin moment 2 %) of 32 strips (tests/kernels/test_traction.py).")
+    traction_every: int = Field(
+        default=20, ge=1, le=100,
+        description="Tribology refreshes between two strip integrations (ellipse_traction) [-]; 20 (200 us at 1 us and "
+        "10 substeps): the torque moves by under 0.04 % from a solve every 10 us up to every 500 us (6208, 100-1700 "
+        "rad/s, 750-7500 N), the 7208's spin moments by under 2 % at 200 us (tests/physics/test_friction_torque.py).")
+    asperity_regularisation_slip_m_s: float = Field(
+        default=1e-3, gt=0.0, le=0.1,
+        description="Slip over which the asperity (Coulomb) friction develops in ellipse_traction [m/s].")
     tribology_period_s: float = Field(
         default=1e-5, ge=1e-7, le=1e-4,
         description="Film/Lambda/mu/damping refreshed every this period [s], a whole number of steps (the "

@@ -123,7 +123,7 @@ class EVSample:
     current_temperature_rise_k: float
     shear_temperature_rise_k: float
     film_thermal_factor: float
-    bearing_capacitance_f: float
+    bearing_capacitance_f: float | None   # None where the network is not capacitive
     current_density_a_m2: float
     discharge_risk: str
 
@@ -155,3 +155,29 @@ def ev_operating_point(shaft_current_a: float, shaft_speed_rpm: float, *, oil_te
         bearing_capacitance_f=e.capacitance_f, current_density_a_m2=e.current_density_a_m2,
         discharge_risk=e.discharge_risk)
     return sample, snap
+
+
+# ---- friction torque (issue 11 item 3; the SKF comparison of `bearing-twin report`) ----------
+TORQUE_SETTLE_S = 0.015
+TORQUE_BALL_PASSAGES = 3
+
+
+def mean_friction_torque_n_m(shaft_speed_rad_s: float, radial_load_n: float, *, designation: str = "6208",
+                             axial_load_n: float = 0.0, shear_heating: bool = False, oil_temperature_c: float = 40.0,
+                             options: ModelOptions | None = None, settle_s: float = TORQUE_SETTLE_S,
+                             passages: int = TORQUE_BALL_PASSAGES) -> tuple[float, Twin]:
+    """Shaft torque [N m] averaged over whole ball passages (`passages` ball pitches of the cage,
+    at least 10 ms) after `settle_s` from the warm start, and the twin. `shear_heating` turns the
+    Murch-Wilson inlet heating on (Thermal.shear_heating)."""
+    base = catalog.bearing(designation)
+    spec = BearingSpec.model_validate({**base.model_dump(),
+                                       "thermal": Thermal(shear_heating=shear_heating).model_dump()})
+    twin = Twin(spec, options=options, setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s,
+                                                         radial_load_n=radial_load_n, axial_load_n=axial_load_n,
+                                                         oil_temperature_c=oil_temperature_c))
+    twin.advance(settle_s)
+    pitch = 2.0 * math.pi / twin.model.ball_count / max(twin.model.cage_speed_rad_s(shaft_speed_rad_s), 1e-3)
+    window = max(passages * pitch, 0.01)
+    steps = int(round(window / twin.model.dt_s))
+    twin.advance(steps * twin.model.dt_s, frame_steps=steps)  # one frame: its mean torque
+    return float(twin.snapshot().friction_torque_n_m), twin

@@ -2,12 +2,14 @@
 
 import math
 
+import numpy as np
 import pytest
 
 from twin import catalog, studies
 from twin.engine import Twin
 from twin.physics import thermal, viscosity
-from twin.spec import ModelOptions, Thermal
+from twin.setpoint import Setpoint
+from twin.spec import BearingSpec, ModelOptions, Thermal
 
 
 def test_roelands_temperature_law_by_hand():
@@ -68,37 +70,52 @@ def test_film_falls_with_current_base_temperature_and_resistance(time_step):
     assert snap.viscosity_pa_s < viscosity.dynamic_viscosity_pa_s(catalog.lubricant(), 40.0)
 
 
-def test_loop_film_is_the_isothermal_film_times_the_thermal_factor(time_step):
-    # the loop runs the law of twin.physics.thermal: same contact, same kinematics, heating off/on
-    h_iso, snap_iso = _ev_twin(0.0, shear_heating=False, time_step=time_step)
-    h_hot, snap_hot = _ev_twin(10.0, time_step=time_step)
+def test_loop_film_is_the_isothermal_film_times_the_thermal_factor():
+    # the loop runs the laws of twin.physics.thermal: same contact, same kinematics, heating off/on;
+    # factor = g(dT_current)^c_T x Murch-Wilson(L at the current-heated inlet)
+    h_iso, snap_iso = _ev_twin(0.0, shear_heating=False)
+    h_hot, snap_hot = _ev_twin(10.0)
     e = snap_hot.electrical
-    twin_theta0 = 40.0 + 273.15
+    theta0 = 40.0 + 273.15
     eta0 = viscosity.dynamic_viscosity_pa_s(catalog.lubricant(), 40.0)
     beta = viscosity.temperature_viscosity_coefficient_k_inv(catalog.lubricant(), 40.0)
-    factor = thermal.thermal_film_factor(e.contact_temperature_rise_k, eta0, twin_theta0, beta, Thermal().film_temperature_exponent)
-    assert e.film_thermal_factor == pytest.approx(factor, rel=1e-9)
+    current = thermal.thermal_film_factor(e.current_temperature_rise_k, eta0, theta0, beta,
+                                          Thermal().film_temperature_exponent)
+    theta_c = theta0 + e.current_temperature_rise_k
+    u = np.mean([b.inner.entrainment_speed_m_s for b in snap_hot.balls if b.inner.load_n > 0.0])
+    loading = thermal.thermal_loading_parameter(
+        thermal.roelands_temperature_viscosity_coefficient_k_inv(eta0, theta0, theta_c, beta),
+        thermal.roelands_temperature_viscosity_pa_s(eta0, theta0, theta_c, beta), u, Thermal().oil_thermal_conductivity_w_m_k)
+    # the loop's speed is the one of its last coupling (<= 10 ms before the snapshot): 1 %
+    assert e.film_thermal_factor == pytest.approx(current * thermal.murch_wilson_thermal_factor(loading), rel=0.01)
     assert snap_iso.electrical.film_thermal_factor == 1.0
     # same warm start and speed: the film differs by the factor (load and entrainment agree to
     # better than 1 %, so the film ratio matches the factor within 2 %)
-    assert h_hot / h_iso == pytest.approx(factor, rel=0.02)
+    assert h_hot / h_iso == pytest.approx(e.film_thermal_factor, rel=0.02)
 
 
-def test_thickest_film_speed_rises_with_current_fig7(time_step):
-    # seed 003 Fig. 7: without current the film first grows with speed (entrainment) and then
-    # falls (shear heating); "as the current increases, the rotational speed required to attain
-    # the thickest film thickness increases". Real-time loop, 6200 EV twin, 200 N, 40 degC.
-    rpms = (2000.0, 5000.0, 10000.0, 20000.0, 30000.0, 50000.0)
-    thickest = {}
-    for current in (0.0, 10.0, 20.0):
-        films = [_ev_twin(current, rpm=rpm, time_step=time_step)[0] for rpm in rpms]
-        k = max(range(len(rpms)), key=films.__getitem__)
-        assert 0 < k < len(rpms) - 1 or current > 0.0, f"{current} A: no interior maximum {films}"
-        thickest[current] = rpms[k]
-        # "higher currents require higher shaft speeds to achieve film formation"
-        if current > 0.0:
-            assert films[0] < 0.1 * max(films)
-    assert thickest[0.0] < thickest[10.0] < thickest[20.0], thickest
+def test_higher_currents_need_higher_speeds_to_form_a_film_fig7():
+    # seed 003 Fig. 7: "higher currents require higher shaft speeds to achieve film formation".
+    # Real-time loop, 6200 EV twin, 200 N, 40 degC, current + inlet shear heating: the speed at
+    # which the film with current first reaches half the film without current rises with the
+    # current (measured: 20 000 rpm at 10 A, 30 000 rpm at 20 A, above 50 000 rpm at 30 A).
+    # Not reproduced, with the reason: seed 003's interior maximum of the film without current
+    # (Fig. 7) came from its eq. 6 applied at the inlet; with the Murch-Wilson inlet law the
+    # 6200's film keeps growing up to its speed limit (L = 12, where phi_T = 3.94 / (3.94 + L^0.62)
+    # turns the film down, is reached at about 31 m/s, above 60 000 rpm), only flattening:
+    # 30 000 -> 50 000 rpm adds 11 % instead of the isothermal 42 %.
+    rpms = (5000.0, 10000.0, 20000.0, 30000.0, 50000.0)
+    films = {current: [_ev_twin(current, rpm=rpm)[0] for rpm in rpms] for current in (0.0, 10.0, 20.0)}
+    ratio_speed = (rpms[-1] / rpms[-2]) ** 0.68
+    assert films[0.0] == sorted(films[0.0])
+    assert films[0.0][-1] / films[0.0][-2] < 0.85 * ratio_speed
+    first = {}
+    for current in (10.0, 20.0):
+        ratios = [h / h0 for h, h0 in zip(films[current], films[0.0])]
+        assert all(r < 1.0 for r in ratios)
+        assert ratios == sorted(ratios)  # the current heating fades with speed (eq. 10: 1 / f_s)
+        first[current] = next(rpm for rpm, r in zip(rpms, ratios) if r >= 0.5)
+    assert first[10.0] < first[20.0], first
 
 
 def test_shear_heating_is_off_by_default_for_the_isothermal_seed000_twin():
@@ -109,15 +126,51 @@ def test_shear_heating_is_off_by_default_for_the_isothermal_seed000_twin():
     assert e.shear_temperature_rise_k == 0.0 and e.film_thermal_factor == 1.0
 
 
-def test_inlet_shear_heating_is_self_consistent_eq6():
-    # seed 003 eq. 6 at p -> 0: dT = c_s 2 eta(T0 + dT) u^2 / k'
-    eta0, t0, beta, k = 0.04, 313.15, 0.047, 0.145
-    for u in (1.0, 4.0, 15.0):
-        dt = thermal.inlet_shear_heating_temperature_rise_k(u, eta0, t0, beta, k, shear_factor=1.5)
-        eta = thermal.roelands_temperature_viscosity_pa_s(eta0, t0, t0 + dt, beta)
-        assert dt == pytest.approx(1.5 * 2 * eta * u * u / k, rel=1e-4, abs=1e-4)
-    # cold limit: 2 eta0 u^2 / k' (no viscosity drop)
-    assert thermal.inlet_shear_heating_temperature_rise_k(0.1, eta0, t0, beta, k) == pytest.approx(2 * eta0 * 0.01 / k, rel=1e-3)
-    # a prior (current) heating thins the oil and lowers the shear heating
-    assert (thermal.inlet_shear_heating_temperature_rise_k(4.0, eta0, t0, beta, k, other_rise_k=30.0)
-            < thermal.inlet_shear_heating_temperature_rise_k(4.0, eta0, t0, beta, k))
+def test_inlet_shear_heating_laws_by_hand_and_cross_check():
+    # Murch and Wilson 1975: phi_T = 3.94 / (3.94 + L^0.62); Gupta et al. 1992:
+    # [1 - 13.2 (p_h/E') L^0.42] / [1 + 0.213 (1 + 2.23 SRR^0.83) L^0.64]; L = beta eta0 u^2 / k_f
+    lam = thermal.thermal_loading_parameter(0.047, 0.04, 7.25, 0.145)
+    assert lam == pytest.approx(0.047 * 0.04 * 7.25 ** 2 / 0.145, rel=1e-12)
+    assert thermal.murch_wilson_thermal_factor(lam) == pytest.approx(3.94 / (3.94 + lam ** 0.62), rel=1e-12)
+    assert thermal.gupta_thermal_factor(lam, 0.01, 0.2) == pytest.approx(
+        (1 - 13.2 * 0.01 * lam ** 0.42) / (1 + 0.213 * (1 + 2.23 * 0.2 ** 0.83) * lam ** 0.64), rel=1e-12)
+    assert thermal.murch_wilson_thermal_factor(0.0) == 1.0 and thermal.gupta_thermal_factor(0.0, 0.01) == 1.0
+    # the two published laws agree within 0.12 for the 6208's rolling speeds (1.45-24.6 m/s,
+    # p_h = 2 GPa, pure rolling); Gupta's is the lower (measured 0.02 at 1.45 m/s, 0.12 at 24.6 m/s)
+    for u in (1.45, 7.24, 14.5, 24.6):
+        lam = thermal.thermal_loading_parameter(0.047, 0.04, u, 0.145)
+        mw = thermal.murch_wilson_thermal_factor(lam)
+        gu = thermal.gupta_thermal_factor(lam, 2.0e9 / 2.307e11)
+        assert 0.0 <= mw - gu <= 0.12, (u, mw, gu)
+    # the equivalent inlet temperature rise reproduces the factor through the Hamrock-Dowson ratio
+    rise = thermal.equivalent_inlet_temperature_rise_k(0.8, 0.04, 313.15, 0.047)
+    assert thermal.hamrock_dowson_temperature_film_ratio(rise, 0.04, 313.15, 0.047) == pytest.approx(0.8, rel=1e-5)
+    # Roelands' temperature-viscosity coefficient is beta at theta0 and falls as the oil heats
+    assert thermal.roelands_temperature_viscosity_coefficient_k_inv(0.04, 313.15, 313.15, 0.047) == pytest.approx(0.047)
+    assert thermal.roelands_temperature_viscosity_coefficient_k_inv(0.04, 313.15, 353.15, 0.047) < 0.047
+
+
+@pytest.mark.parametrize("speed, band", [(100.0, (0.95, 1.0)), (500.0, (0.8, 0.95)), (1000.0, (0.6, 0.85)),
+                                         (1700.0, (0.5, 0.8))])
+def test_6208_film_factor_follows_murch_wilson(speed, band):
+    # issue 11: with inlet heating on, the loop's film factor within the cited law's value +-5 %
+    # across 100-1700 rad/s (6208, 3000 N, seed oil at 40 degC), and in the range established
+    # inlet laws give (0.8-0.95 at 500 rad/s, 0.5-0.8 at 1700 rad/s; eq. 6 at the inlet gave
+    # 0.41 / 0.10). Measured 0.974 / 0.833 / 0.679 / 0.523. The film itself: heated / isothermal.
+    base = catalog.bearing("6208")
+    hot = BearingSpec.model_validate({**base.model_dump(), "thermal": Thermal(shear_heating=True).model_dump()})
+    films = []
+    for spec in (base, hot):
+        twin = Twin(spec, setpoint=Setpoint(shaft_speed_rad_s=speed, radial_load_n=3000.0))
+        twin.advance(0.012)
+        snap = twin.snapshot()
+        ball = min(snap.balls, key=lambda b: abs(b.azimuth_rad))
+        films.append(ball.inner.h_min_m)
+    lub = base.lubricant
+    law = thermal.murch_wilson_thermal_factor(thermal.thermal_loading_parameter(
+        viscosity.temperature_viscosity_coefficient_k_inv(lub, 40.0), viscosity.dynamic_viscosity_pa_s(lub, 40.0),
+        twin.mean_entrainment_speed_m_s(), Thermal().oil_thermal_conductivity_w_m_k))
+    factor = snap.electrical.film_thermal_factor
+    assert factor == pytest.approx(law, rel=0.05)
+    assert films[1] / films[0] == pytest.approx(law, rel=0.05)
+    assert band[0] <= factor <= band[1]

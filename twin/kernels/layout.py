@@ -26,10 +26,21 @@ P_ROLLING = 20             # 1: seed 001 rolling resistance on
 P_BALL_REDUCED_TANGENT_MASS = 21  # m / (1 + m Rb^2 / I) [kg]
 P_MAX_PENETRATION = 22     # status threshold [m]
 P_OIL_PERMITTIVITY = 23    # relative permittivity of the oil at ambient pressure [-]
-P_GAP_LIMIT = 24           # outer-zone capacitance integration limit [m]
+P_GAP_LIMIT = 24           # gap limit of the outer-zone capacitance, inner race [m] (outer: P_GAP_LIMIT_OUTER)
 P_ASPERITY_RESISTANCE = 25 # resistance of a fully metallic contact [ohm]
 P_OIL_RESISTIVITY = 26     # [ohm m]
-N_PARAMS = 27
+# friction over the contact ellipse (twin.kernels.traction; issue 11 item 3)
+P_TRACTION_STRIPS = 27     # strips across the major axis [-]
+P_TRACTION_EVERY = 28      # tribology refreshes between two strip integrations [-]
+P_EYRING_STRESS = 29       # tau0 [Pa]
+P_LIMITING_SHEAR = 30      # gamma = tau_L / p [-]
+P_PRESSURE_VISCOSITY = 31  # Barus alpha [1/Pa]
+P_ASPERITY_SLIP = 32       # regularisation slip of the asperity friction [m/s]
+P_DEFORMED_RADIUS = 33     # contact-surface radius across the groove, inner (33) and outer (34) [m]
+P_GAP_LIMIT_OUTER = 35     # gap limit of the outer-zone capacitance, outer race [m]
+P_STRIP_TABLE = 36         # MAX_STRIPS rows of 4: mean t, mean t^2, load share, mean pressure / p_h
+MAX_STRIPS = 32
+N_PARAMS = P_STRIP_TABLE + 4 * MAX_STRIPS
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]
@@ -139,7 +150,24 @@ O_SY = 57
 O_SZ = 58
 # tangential spring relaxation (refreshed with the tribology): xi <- decay xi + v_slip dt
 C_XI_DECAY = 59  # 1 / (1 + u dt / L), L = sqrt(a b) the contact's relaxation length [-]
-N_ROWS = 60
+# friction over the contact ellipse (twin.kernels.traction), refreshed with the strip integration
+E_SLIP = 60          # centre slip s0 of the last strip solution (warm start) [m/s]
+E_MOMENT_T2 = 61     # moment of the traction about the contact centre along t2 = n x t1 [N m]
+E_SPIN_MOMENT = 62   # moment along n at the spin rate E_SPIN_RATE [N m]
+E_SPIN_SLOPE = 63    # d(moment along n) / d(spin rate) [N m s]
+E_SPIN_RATE = 64     # relative spin rate (ball minus ring) about n at the solution [rad/s]
+E_SPIN_CAP = 65      # largest moment along n (every strip sliding) [N m]
+E_M2X = 72           # E_MOMENT_T2 t2 in the world frame at the last solve [N m]
+E_M2Y = 73
+E_M2Z = 74
+# per-strip scratch of the contact being solved (lanes 0..MAX_STRIPS-1)
+E_SCRATCH_O = 66     # slip offset o_k of strip k [m/s]
+E_SCRATCH_SE = 67    # Eyring slip scale h tau0 / eta(p_k) [m/s]
+E_SCRATCH_SSAT = 68  # slip at which strip k reaches the limiting shear stress [m/s]
+E_SCRATCH_EY = 69    # Eyring force coefficient (1 - Qa/Q) A_k tau0 [N]
+E_SCRATCH_SPREAD = 70  # half the spread of the slip across strip k [m/s]
+E_SCRATCH_SIGNED_HALF = 71  # half-width of strip k in t, signed like ds/dt across it [-]
+N_ROWS = 75
 
 # ---- kernel status codes ----------------------------------------------------------------------
 STATUS_OK = 0

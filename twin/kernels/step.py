@@ -21,12 +21,13 @@ from twin.kernels.layout import (
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
-    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
-    P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
+    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
+    P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
 )
+from twin.kernels.traction import apply_traction_moments, ellipse_traction
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 
 
@@ -48,6 +49,8 @@ SPIN_CREEP_FACTOR = 1.3
 # budget). A contact that has just closed gets its RC at once.
 ELECTRICAL_EVERY = 10
 
+FRICTION_ELLIPSE = 2  # P_FRICTION_MODEL code of the friction over the contact ellipse
+
 
 @njit(inline="always", **JIT)
 def _at_angle(table, r, i, f, col):
@@ -59,7 +62,7 @@ def _at_angle(table, r, i, f, col):
 
 @njit(**JIT)
 def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                          tribology_now, electrical_now):
+                          tribology_now, electrical_now, traction_now):
     """Forces and torques of every contact at the current positions -> accelerations of the
     balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
 
@@ -155,7 +158,8 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             w[C_H_C * CW + c] = tri[1]
             w[C_LAMBDA * CW + c] = tri[2]
             w[C_REGIME * CW + c] = tri[3]
-            w[C_MU * CW + c] = tri[4]
+            if friction_model != FRICTION_ELLIPSE or w[C_MU * CW + c] == 0.0:
+                w[C_MU * CW + c] = tri[4]  # ellipse friction: its capacity (ellipse_traction) once solved
             w[C_SEMI_MAJOR * CW + c] = tri[5]
             w[C_SEMI_MINOR * CW + c] = tri[6]
             w[C_FLUID_DAMPING * CW + c] = tri[7]
@@ -180,13 +184,17 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
                 res_ohm, cap_f = contact_electrical(
                     q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
                     _at_angle(tr, r, ia, fa, t + T_RY),
-                    p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT], p[P_ASPERITY_RESISTANCE],
+                    p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER], p[P_ASPERITY_RESISTANCE],
                     p[P_OIL_RESISTIVITY])
             else:  # no film (no entrainment): metallic contact, no dielectric
                 res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
             w[C_RESISTANCE * CW + c] = res_ohm
             w[C_CAPACITANCE * CW + c] = cap_f
     scal[X_MAX_PENETRATION] = max_pen
+    if friction_model == FRICTION_ELLIPSE:  # friction over the contact ellipse (twin.kernels.traction)
+        if traction_now:
+            ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
+        apply_traction_moments(w, nc)
     ring_fx = 0.0
     ring_fy = 0.0
     ring_fz = 0.0
@@ -266,6 +274,7 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
     half = 0.5 * dt
     cage_inertia = p[P_CAGE_INERTIA]
     substeps = int(p[P_SUBSTEPS])
+    traction_every = max(int(p[P_TRACTION_EVERY]), 1)
     ramp = p[P_RAMP] * dt
     # leapfrog form of velocity-Verlet: the closing half kick of one step and the opening half
     # kick of the next are one full kick; the state holds full-step velocities between frames
@@ -309,7 +318,8 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
             bw[j, 1] = st * wx + ct * bw[j, 1]
         status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w,
                                        cage_load, step % substeps == 0,
-                                       step % (substeps * ELECTRICAL_EVERY) == 0)
+                                       step % (substeps * ELECTRICAL_EVERY) == 0,
+                                       step % (substeps * traction_every) == 0)  # a tribology step
         for j in range(z):
             vx = bv[j, 0]
             bv[j, 0] = ct * vx + st * bv[j, 1]
@@ -337,4 +347,4 @@ def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load):
     """Contact forces, tribology and accelerations at the current state without advancing time
     (used after a warm start). Returns the status."""
     return compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                                 True, True)
+                                 True, True, True)

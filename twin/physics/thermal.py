@@ -1,4 +1,5 @@
-"""Electro-thermal laws of seed 003 (EV motor bearing under current discharge).
+"""Electro-thermal laws of seed 003 (EV motor bearing under current discharge) and the inlet
+shear-heating reduction of rolling contacts (Murch and Wilson 1975, Gupta et al. 1992).
 
 Plain Python scalars (evaluated between frames, not in the hot loop), SI units, temperatures in K
 unless the name says degC.
@@ -76,43 +77,80 @@ def hamrock_dowson_temperature_film_ratio(temperature_rise_k: float, eta0_pa_s: 
     return math.exp(0.68 * lnk * (f - 1.0)) * f ** 0.49
 
 
-def inlet_shear_heating_temperature_rise_k(entrainment_speed_m_s: float, eta0_pa_s: float, theta0_k: float,
-                                           beta_k_inv: float, conductivity_w_m_k: float,
-                                           other_rise_k: float = 0.0, shear_factor: float = 1.0,
-                                           max_rise_k: float = 500.0) -> float:
-    """Shear-heating temperature rise of the inlet, where the film is formed: seed 003 eq. 6 at
-    the inlet (p -> 0: the compression term vanishes and eq. 6 reduces to dT = 2 eta u^2 / k'),
-    with eta the Roelands viscosity (eq. 3) at the heated inlet temperature theta0 + other_rise +
-    dT (self-consistent: a hotter oil shears with less heat), times `shear_factor` (calibrated
-    against the full EHL solver, twin.thermal_calibration). Solved by bisection (the right-hand
-    side falls as dT rises, so the root is unique) [K]."""
-    u = entrainment_speed_m_s
-    if u <= 0.0 or shear_factor <= 0.0:
+def roelands_temperature_viscosity_coefficient_k_inv(eta0_pa_s: float, theta0_k: float, theta_k: float,
+                                                      beta_k_inv: float) -> float:
+    """beta(theta) = -d ln(eta) / d theta of Roelands' law at ambient pressure (seed 003 eq. 3,
+    roelands_temperature_viscosity_pa_s) [1/K]: lnk S0 ((theta - 138)/(theta0 - 138))^(-S0 - 1) /
+    (theta0 - 138), equal to beta_k_inv at theta0."""
+    lnk = math.log(eta0_pa_s) + ROELANDS_LN_ETA_INF
+    s0 = beta_k_inv * (theta0_k - ROELANDS_T_K) / lnk
+    ratio = (theta_k - ROELANDS_T_K) / (theta0_k - ROELANDS_T_K)
+    return lnk * s0 * ratio ** (-s0 - 1.0) / (theta0_k - ROELANDS_T_K)
+
+
+def thermal_loading_parameter(beta_k_inv: float, viscosity_pa_s: float, entrainment_speed_m_s: float,
+                              conductivity_w_m_k: float) -> float:
+    """L = beta eta0 u^2 / k_f [-], the thermal loading of the inlet of a rolling contact: the
+    shear heat of the back-flow in the inlet (~ eta u^2) against conduction (k_f), weighted by
+    the viscosity's temperature sensitivity beta = -d ln(eta)/dT (Murch and Wilson 1975; Gupta
+    et al. 1992). u is the rolling (entrainment) speed."""
+    u = max(entrainment_speed_m_s, 0.0)
+    return beta_k_inv * viscosity_pa_s * u * u / conductivity_w_m_k
+
+
+def murch_wilson_thermal_factor(thermal_loading: float) -> float:
+    """phi_T = 3.94 / (3.94 + L^0.62) [-]: ratio of the film thickness of a rolling contact with
+    inlet shear heating to the isothermal one (Murch and Wilson 1975, 'A thermal
+    elastohydrodynamic inlet zone analysis', J. Lubr. Technol. 97(2), 212-216; as quoted by
+    Hamrock, Schmid and Jacobson, Fundamentals of Machine Elements, and in the review of Marian
+    et al., Lubricants 8 (2020) 95). The loop's inlet-heating law."""
+    if not (thermal_loading > 0.0):
+        return 1.0
+    return 3.94 / (3.94 + thermal_loading ** 0.62)
+
+
+def gupta_thermal_factor(thermal_loading: float, max_pressure_over_e_prime: float,
+                         slide_roll_ratio: float = 0.0) -> float:
+    """phi_T = [1 - 13.2 (p_h/E') L^0.42] / [1 + 0.213 (1 + 2.23 SRR^0.83) L^0.64] [-]: the inlet
+    thermal reduction factor of Gupta, Cheng, Zhu, Forster and Schrand 1992 ('Viscoelastic
+    effects in MIL-L-7808-type lubricant, Part I', Tribol. Trans. 35, 269-274; as quoted by
+    Harris and Kotzalas, Advanced Concepts of Bearing Technology, 2007), with the slide-to-roll
+    ratio SRR. The cross-check of murch_wilson_thermal_factor; floored at 0."""
+    if not (thermal_loading > 0.0):
+        return 1.0
+    srr = abs(slide_roll_ratio)
+    num = 1.0 - 13.2 * max_pressure_over_e_prime * thermal_loading ** 0.42
+    den = 1.0 + 0.213 * (1.0 + 2.23 * srr ** 0.83) * thermal_loading ** 0.64
+    return max(num, 0.0) / den
+
+
+def equivalent_inlet_temperature_rise_k(film_factor: float, eta0_pa_s: float, theta0_k: float,
+                                        beta_k_inv: float, max_rise_k: float = 500.0) -> float:
+    """The uniform inlet temperature rise dT whose Hamrock-Dowson film ratio g(dT)
+    (hamrock_dowson_temperature_film_ratio) equals `film_factor` [K]: the temperature the
+    isothermal film formula would need at the inlet to give the same film (bisection; g falls
+    monotonically with dT). 0 for a factor >= 1."""
+    if film_factor >= 1.0:
         return 0.0
-    coef = 2.0 * shear_factor * u * u / conductivity_w_m_k
-
-    def excess(rise: float) -> float:
-        eta = roelands_temperature_viscosity_pa_s(eta0_pa_s, theta0_k, theta0_k + other_rise_k + rise, beta_k_inv)
-        return coef * eta - rise
-
     lo, hi = 0.0, max_rise_k
-    if excess(hi) > 0.0:
+    if hamrock_dowson_temperature_film_ratio(hi, eta0_pa_s, theta0_k, beta_k_inv) > film_factor:
         return max_rise_k
-    for _ in range(60):
+    for _ in range(80):
         mid = 0.5 * (lo + hi)
-        if excess(mid) > 0.0:
+        if hamrock_dowson_temperature_film_ratio(mid, eta0_pa_s, theta0_k, beta_k_inv) > film_factor:
             lo = mid
         else:
             hi = mid
-        if hi - lo < 1e-4:
+        if hi - lo < 1e-6:
             break
     return 0.5 * (lo + hi)
 
 
 def thermal_film_factor(temperature_rise_k: float, eta0_pa_s: float, theta0_k: float, beta_k_inv: float,
                         temperature_exponent: float) -> float:
-    """Film-reduction factor h(heated inlet) / h(isothermal) = g(dT)^c: the Hamrock-Dowson film
-    ratio of a uniform inlet temperature rise (hamrock_dowson_temperature_film_ratio) raised to
-    the exponent c that the full thermal EHL solver of seed 003 gives (twin.thermal_calibration:
-    the solver's films fall faster with temperature than the isothermal formula's, c > 1)."""
+    """Film-reduction factor of the current heating, h(heated inlet) / h(isothermal) = g(dT)^c:
+    the Hamrock-Dowson film ratio of a uniform inlet temperature rise
+    (hamrock_dowson_temperature_film_ratio) raised to the exponent c that the full thermal EHL
+    solver of seed 003 gives for its current heating (twin.thermal_calibration: the solver's
+    films fall faster with temperature than the isothermal formula's, c > 1)."""
     return hamrock_dowson_temperature_film_ratio(temperature_rise_k, eta0_pa_s, theta0_k, beta_k_inv) ** temperature_exponent

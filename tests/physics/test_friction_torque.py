@@ -1,0 +1,89 @@
+"""The bearing's friction torque with the friction over the contact ellipse against the SKF model
+for the frictional moment (an independent, public catalogue formula, twin.skf_friction)."""
+
+import numpy as np
+import pytest
+
+from twin import catalog, skf_friction, studies
+from twin.physics import viscosity
+from twin.kernels import layout as L
+from twin.spec import ModelOptions
+
+LOADS_N = (750.0, 1500.0, 3000.0, 7500.0)
+
+
+def _nu_mm2_s(temperature_c=40.0):
+    lub = catalog.lubricant()
+    return viscosity.kinematic_viscosity_m2_s(lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s,
+                                              temperature_c) * 1e6
+
+
+@pytest.fixture(scope="module")
+def sweep():
+    return {f: studies.mean_friction_torque_n_m(500.0, f)[0] for f in LOADS_N}
+
+
+def test_torque_rises_with_load_like_published_models(sweep):
+    # issue 11: published bearing friction models give about Fr^0.8 at 500 rad/s (SKF: M_rr ~ Fr^0.54,
+    # M_sl ~ Fr^(5/3); its slope over 750-7500 N here is 0.78); the centre-point friction gave
+    # 0.40. The differential (Heathcote) slip over the ellipse supplies the missing sliding part.
+    slope = studies.log_slope(list(sweep), list(sweep.values()))
+    skf = [skf_friction.frictional_moment("6208", 40.0, 80.0, f, 500.0, _nu_mm2_s(), inlet_shear=False).total_n_m
+           for f in LOADS_N]
+    skf_slope = studies.log_slope(LOADS_N, skf)
+    assert 0.6 <= slope <= 1.0, (slope, sweep)
+    assert 0.7 <= skf_slope <= 0.9
+
+
+def test_torque_within_a_factor_1_5_of_the_skf_model(sweep):
+    # SKF catalogue model (M_seal = M_drag = 0: open bearing, no oil bath) at 3000 N, 500 rad/s,
+    # the seed oil at 40 degC (46.7 mm^2/s): isothermal twin against phi_ish = 1, and the twin with
+    # the inlet shear heating on against phi_ish of the catalogue
+    nu = _nu_mm2_s()
+    iso = skf_friction.frictional_moment("6208", 40.0, 80.0, 3000.0, 500.0, nu, inlet_shear=False)
+    hot = skf_friction.frictional_moment("6208", 40.0, 80.0, 3000.0, 500.0, nu)
+    twin_hot, _ = studies.mean_friction_torque_n_m(500.0, 3000.0, shear_heating=True)
+    assert 1 / 1.5 <= sweep[3000.0] / iso.total_n_m <= 1.5, (sweep[3000.0], iso)
+    assert 1 / 1.5 <= twin_hot / hot.total_n_m <= 1.5, (twin_hot, hot)
+
+
+def test_traction_sub_rate_is_converged():
+    # numerical choice: the strip integration every traction_every = 20 tribology refreshes
+    # (200 us). Measured (6208; 3000 N / 500 rad/s, 750 N / 1700 rad/s, 7500 N / 100 rad/s): the
+    # torque with a solve every 10 us, 100 us, 200 us and 500 us agrees within 0.04 %; on the
+    # 7208 (Fr = Fa = 3000 N, spin 50-80 rad/s) the spin moments at 200 us are within 2 % of
+    # every 10 us (5-8 % at 500 us) and the torque within 0.05 %. Bounded here at 0.5 % / 5 %.
+    fast, _ = studies.mean_friction_torque_n_m(500.0, 3000.0, options=ModelOptions(traction_every=1))
+    default, _ = studies.mean_friction_torque_n_m(500.0, 3000.0)
+    assert ModelOptions().traction_every == 20
+    assert default == pytest.approx(fast, rel=0.005)
+    spins = []
+    for every in (1, 20):
+        torque, twin = studies.mean_friction_torque_n_m(500.0, 3000.0, designation="7208",
+                                                        options=ModelOptions(traction_every=every),
+                                                        axial_load_n=3000.0)
+        c = twin.state.contacts
+        loaded = c[L.C_LOAD] > 100.0
+        spins.append((torque, c[L.E_SPIN_MOMENT][loaded]))
+    assert spins[1][0] == pytest.approx(spins[0][0], rel=0.005)
+    np.testing.assert_allclose(spins[1][1], spins[0][1], rtol=0.05)
+    assert np.all(np.abs(spins[0][1]) > 1e-3)  # the angular-contact balls spin: the moment matters
+
+
+def test_skf_model_by_hand():
+    # SKF catalogue: 6208 (d 40, D 80 mm, series 62: R1 3.9e-7, S1 3.23e-3), 3000 N, 4775 r/min,
+    # nu 46.7 mm^2/s; hand evaluation of each factor
+    n = 500.0 * 30 / np.pi
+    dm, nu = 60.0, 46.736
+    g_rr = 3.9e-7 * dm ** 1.96 * 3000.0 ** 0.54
+    g_sl = 3.23e-3 * dm ** -0.26 * 3000.0 ** (5 / 3)
+    phi_ish = 1 / (1 + 1.84e-9 * (n * dm) ** 1.28 * nu ** 0.64)
+    phi_rs = np.exp(-3e-8 * nu * n * 120.0 * np.sqrt(3.1 / 80.0))
+    phi_bl = np.exp(-2.6e-8 * (n * nu) ** 1.4 * dm)
+    mu_sl = phi_bl * 0.15 + (1 - phi_bl) * 0.05
+    hand = (phi_ish * phi_rs * g_rr * (nu * n) ** 0.6 + g_sl * mu_sl) * 1e-3
+    m = skf_friction.frictional_moment("6208", 40.0, 80.0, 3000.0, 500.0, nu)
+    assert m.total_n_m == pytest.approx(hand, rel=1e-12)
+    assert m.total_n_m == pytest.approx(0.1376, rel=2e-3)
+    with pytest.raises(ValueError, match="designation"):
+        skf_friction.frictional_moment("7208", 40.0, 80.0, 3000.0, 500.0, nu)
