@@ -16,7 +16,7 @@ own recording id) per start, and its streams are freed when it stops (rerun-sdk 
 them, and their threads, forever: see the recorder's module doc).
 
 A setpoint arriving over zenoh goes through `TwinRunner.submit_setpoint_json`, which uses the
-same validation as HTTP (`service.schemas.parse_setpoint` + the bearing's limits).
+same validation as HTTP (`service.api.schemas.parse_setpoint` + the bearing's limits).
 """
 
 from __future__ import annotations
@@ -34,8 +34,8 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from service.runner import TwinRunner
-from service.schemas import (
+from service.core.runner import TwinRunner
+from service.api.schemas import (
     BearingCreate,
     FieldError,
     InputError,
@@ -64,7 +64,7 @@ def open_bus(settings: ServiceSettings):
     if not settings.enable_zenoh:
         return None
     try:
-        from service.bus import ZenohBus
+        from service.bus.zenoh_bus import ZenohBus
     except ImportError as exc:
         raise WiringError(f"zenoh is enabled but service.bus cannot be imported ({exc}); "
                           "install eclipse-zenoh or run with --no-zenoh") from exc

@@ -22,7 +22,7 @@ from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_tempera
                                   thermal_film_factor)
 from twin.physics.viscosity import dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.setpoint import Setpoint, SetpointUpdate, check_limits
-from twin.electrical import bearing_network
+from twin.electrical_network import bearing_network
 from twin.snapshot import BallState, ContactState, SetpointState, Snapshot
 from twin.snapshot import ElectricalState as ElectricalSnapshot
 from twin.spec import BearingSpec, ModelOptions
@@ -116,7 +116,7 @@ class Twin:
         race track (eq. 10, with the bearing's equivalent resistance) and by shear (eq. 6 at the
         inlet); the film the loop computes is the isothermal film at the oil temperature times
         the thermal film factor g(dT)^c_T calibrated against the thermal EHL solver
-        (twin.thermal_calibration). The factor enters the kernel through the one viscosity it
+        (twin.validation.thermal_law_fit). The factor enters the kernel through the one viscosity it
         reads: eta_film = eta_oil * factor^(1 / n_u), n_u the film law's exponent of (eta u), so
         film, Lambda, regime, mu and fluid damping all follow. Recomputed every COUPLING_FRAMES
         frames (the drivers change slowly)."""
@@ -284,7 +284,7 @@ class Twin:
         )
 
     def electrical(self):
-        """The bearing's electrical network at the current state (twin.electrical)."""
+        """The bearing's electrical network at the current state (twin.electrical_network)."""
         sp = self._setpoint
         return bearing_network(self.model, self.state.contacts, sp.shaft_voltage_v, sp.shaft_current_a)
 

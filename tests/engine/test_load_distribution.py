@@ -2,7 +2,7 @@
 
 The DEM is started at 1500 N and the load is stepped to 3000 N, so the dynamics (not the warm
 start) must find the equilibrium. The reference is the Hertz equilibrium of the rigid rings for
-the balls' actual azimuths (`twin.analytic.radial_equilibrium`) with the same contact law.
+the balls' actual azimuths (`twin.validation.analytic.radial_equilibrium`) with the same contact law.
 
 Load parameter eps: the seed prints 0.685 / 0.5 / 0.4 for Pd = -12.6 / 0 / +12.6 um; those follow
 from its eq. 2 as printed, which lacks the 1/(1 - nu) factor (30 % too soft). With the DESIGN.md
@@ -12,7 +12,7 @@ constant the Hertz equilibrium gives 0.745 / 0.5 / 0.388, which the test asserts
 import numpy as np
 import pytest
 
-from twin import analytic
+from twin.validation import analytic
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 

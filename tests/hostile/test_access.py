@@ -10,8 +10,8 @@ import json
 import httpx
 import pytest
 
-from service.runner import TwinRunner
-from service.security import bearer_token, token_matches
+from service.core.runner import TwinRunner
+from service.core.admission import bearer_token, token_matches
 from service.settings import ServiceSettings
 
 TOKEN = "s3cret-Token_for.tests"

@@ -17,7 +17,7 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from service.runner import TwinRunner
+from service.core.runner import TwinRunner
 from service.settings import ServiceSettings
 
 CAP = 4096

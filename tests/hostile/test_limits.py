@@ -11,8 +11,8 @@ import time
 import httpx
 import pytest
 
-from service.runner import TwinRunner
-from service.security import TokenBucket
+from service.core.runner import TwinRunner
+from service.core.admission import TokenBucket
 from service.settings import ServiceSettings
 
 RATE, BURST, CAP = 5.0, 10, 2048

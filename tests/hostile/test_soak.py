@@ -13,7 +13,7 @@ import sys
 import pytest
 
 from service.settings import ServiceSettings
-from service.soak import SoakConfig, _memory, format_report, run_soak
+from service.tools.soak import SoakConfig, _memory, format_report, run_soak
 
 
 def test_soak_short_run_with_its_own_service(hostile, tmp_path):
@@ -102,7 +102,7 @@ def _segmented_recording(tmp_path, groups):
 
 def test_recording_check_reads_every_segment(tmp_path):
     pytest.importorskip("rerun")
-    from service.soak import _check_recording
+    from service.tools.soak import _check_recording
 
     rec = _segmented_recording(tmp_path, (4, 6, 5))
     r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None)

@@ -9,7 +9,7 @@ import pytest
 from pydantic import ValidationError
 
 from twin import catalog
-from twin.electrical import bearing_network
+from twin.electrical_network import bearing_network
 from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.kernels.tribology import contact_electrical

@@ -22,7 +22,7 @@ from twin.physics.rolling import (
     sliding_friction_coefficient_asperity_share,
     speed_parameter_u,
 )
-from twin.physics.thrust_bearing_seed001 import (
+from twin.validation.thrust_bearing_seed001 import (
     TABLE_1_D3MM_Q0633N,
     TABLE_2_D635MM_Q0125N,
     ball_race_geometry,

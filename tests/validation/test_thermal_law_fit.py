@@ -2,7 +2,7 @@
 
 import pytest
 
-from twin import thermal_calibration as tc
+from twin.validation import thermal_law_fit as tc
 from twin.ehl_solver import params as prm
 from twin.spec import Thermal
 

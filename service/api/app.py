@@ -23,14 +23,14 @@ from pydantic import ValidationError
 from starlette.concurrency import run_in_threadpool
 from starlette.exceptions import HTTPException as StarletteHTTPException
 
-from service.scenarios import (
+from service.core.scenarios import (
     ScenarioError,
     find_scenario,
     list_scenarios,
     load_scenario,
     scenario_from_dict,
 )
-from service.schemas import (
+from service.api.schemas import (
     BearingCreate,
     BearingInfo,
     ErrorResponse,
@@ -48,7 +48,7 @@ from service.schemas import (
     parse_setpoint,
     setpoint_error,
 )
-from service.security import HardeningMiddleware
+from service.core.admission import HardeningMiddleware
 from service.settings import ServiceSettings
 from service.wiring import TwinEntry, TwinService
 from twin.setpoint import SetpointError, SetpointUpdate

@@ -15,7 +15,7 @@ import pytest
 
 from service.settings import ServiceSettings
 
-SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 HAVE_RERUN = importlib.util.find_spec("rerun") is not None
 WAIT_S = 20.0
 

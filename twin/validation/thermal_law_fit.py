@@ -15,7 +15,7 @@ constants are the defaults of twin.spec.Thermal (`film_temperature_exponent`,
 `inlet_shear_heating_factor`); tests/physics/test_thermal_calibration.py refits and pins them,
 so a regenerated table cannot silently disagree with the loop.
 
-Run `python -m twin.thermal_calibration` to print the fit and its residuals.
+Run `python -m twin.validation.thermal_law_fit` to print the fit and its residuals.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from twin.ehl_solver.calibration import load_table
+from twin.ehl_solver.film_reduction import load_table
 from twin.physics.thermal import inlet_shear_heating_temperature_rise_k, thermal_film_factor
 
 

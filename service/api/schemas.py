@@ -125,7 +125,7 @@ def _field_bounds() -> dict[str, tuple[Any, Any]]:
     pydantic error names only the bound that was crossed)."""
     global _BOUNDS
     if _BOUNDS is None:
-        from service.scenarios import Scenario, ScenarioRun, ScenarioStep
+        from service.core.scenarios import Scenario, ScenarioRun, ScenarioStep
 
         bounds: dict[str, tuple[Any, Any]] = {}
         for model in (SetpointUpdate, BearingCreate, RecordingRequest, ScenarioRequest, Scenario,

@@ -10,7 +10,7 @@ inputs (exit code 1 when the solver did not converge: the numbers are then not a
 `calibrate` regenerates the film-reduction table shipped with twin.ehl_solver; `bench` times
 the isothermal solve at the default speed (default 129 x 129, the solver's speed figure).
 
-service/cli.py registers this with `add_ehl_command(sub)`; `python -m service.ehl_cli ehl ...`
+service/cli.py registers this with `add_ehl_command(sub)`; `python -m service.tools.ehl_cli ehl ...`
 runs it on its own.
 """
 
@@ -187,11 +187,11 @@ def _cmd_solve(args: argparse.Namespace) -> int:
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
-    from twin.ehl_solver import calibration
+    from twin.ehl_solver import film_reduction as calibration
 
     out = args.out or str(calibration.TABLE_PATH)
     grid = args.grid or calibration.CALIBRATION_GRID
-    prog = "python -m service.ehl_cli" if sys.argv and sys.argv[0].endswith("ehl_cli.py") else "bearing-twin"
+    prog = "python -m service.tools.ehl_cli" if sys.argv and sys.argv[0].endswith("ehl_cli.py") else "bearing-twin"
     command = f"{prog} ehl calibrate" + (f" --out {args.out}" if args.out else "") + \
         (f" --grid {args.grid}" if args.grid else "") + (" --anchor" if args.anchor else "")
 

@@ -10,11 +10,11 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
-from twin import studies
-from twin.bench import run_engine_benchmark
+from twin.validation import studies
+from twin.validation.bench import run_engine_benchmark
 from twin.engine import Twin
 from twin.kernels import layout as L
-from twin.physics import thrust_bearing_seed001 as s001
+from twin.validation import thrust_bearing_seed001 as s001
 from twin.setpoint import Setpoint
 from twin.spec import ModelOptions
 
@@ -192,8 +192,8 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
     """Run every study (with a progress bar) and write `report.md` and PNGs into out_dir."""
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
-    from service import report_ev
-    from service.report_ehl import write_ehl_section
+    from service.reports import ev as report_ev
+    from service.reports.ehl import write_ehl_section
 
     total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 5 + report_ev.study_count(quick)
     with tqdm(total=total, desc="bearing-twin report", unit="study") as progress:

@@ -15,8 +15,8 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
-from service.bus import ZenohBus, make_config, wait_until
-from service.monitor import add_monitor_command, run_monitor
+from service.bus.zenoh_bus import ZenohBus, make_config, wait_until
+from service.tools.monitor import add_monitor_command, run_monitor
 from twin.engine import Twin
 from twin.setpoint import SetpointUpdate
 

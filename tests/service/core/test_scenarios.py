@@ -10,7 +10,7 @@ import pytest
 import yaml
 
 from service.cli import main
-from service.scenarios import (
+from service.core.scenarios import (
     ScenarioError,
     ScenarioExecutor,
     future_setpoint_fields,
@@ -21,7 +21,7 @@ from service.scenarios import (
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 
-SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+SCENARIOS = Path(__file__).resolve().parents[3] / "scenarios"
 HAVE_RERUN = importlib.util.find_spec("rerun") is not None
 
 

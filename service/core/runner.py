@@ -49,7 +49,7 @@ field alone rose) is remembered: from then on this twin refuses it, and anything
 submission (422 naming the field). No NaN reaches a snapshot: `Snapshot` refuses non-finite
 numbers, and a frame that fails is restarted before the next snapshot is taken.
 
-Access and limits (service.security). `submit_setpoint_json` (zenoh) refuses payloads larger than
+Access and limits (service.core.admission). `submit_setpoint_json` (zenoh) refuses payloads larger than
 `max_payload_bytes`, payloads without the configured `token` field (it is removed before
 validation), and setpoints beyond the twin's rate (`admit_setpoint`, a token bucket shared with
 HTTP); each refusal carries a `status` (401, 413, 422, 429) like the HTTP answer would.
@@ -66,16 +66,16 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
-from service.scenarios import ResolvedRun, ScenarioExecutor
-from service.schemas import (
+from service.core.scenarios import ResolvedRun, ScenarioExecutor
+from service.api.schemas import (
     FieldError,
     InputError,
     parse_setpoint,
     parse_setpoint_json,
     setpoint_error,
 )
-from service.security import TokenBucket, token_matches
-from service.sinks import SnapshotSink
+from service.core.admission import TokenBucket, token_matches
+from service.core.sinks import SnapshotSink
 from twin.engine import Twin
 from twin.setpoint import _UNITS as SETPOINT_UNITS
 from twin.setpoint import Setpoint, SetpointError, SetpointUpdate, check_limits

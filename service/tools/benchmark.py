@@ -45,7 +45,7 @@ def run_service_benchmark(seconds: float = 10.0, rate_hz: float = 20.0, bearing:
     import httpx
     import uvicorn
 
-    from service.app import create_app
+    from service.api.app import create_app
     from service.settings import ServiceSettings
 
     endpoint = f"tcp/127.0.0.1:{_free_port()}"
@@ -69,7 +69,7 @@ def run_service_benchmark(seconds: float = 10.0, rate_hz: float = 20.0, bearing:
         if zenoh_on:
             import zenoh
 
-            from service.bus import make_config
+            from service.bus.zenoh_bus import make_config
 
             session = zenoh.open(make_config([], [endpoint], "peer"))
 

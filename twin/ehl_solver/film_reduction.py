@@ -20,7 +20,7 @@ flagged `extrapolated`: ln f(I, u) = ln f(0, u) + c(u) ln g(T_obn), g the Hamroc
 ratio (eta(T)/eta0)^0.68 (alpha*(T)/alpha)^0.49 of Roelands at ambient pressure and c(u) fitted
 on the converged cells of the same speed.
 
-Regenerate: `bearing-twin ehl calibrate` (or `python -m twin.ehl_solver.calibration`).
+Regenerate: `bearing-twin ehl calibrate` (or `python -m twin.ehl_solver.film_reduction`).
 """
 
 from __future__ import annotations
@@ -182,7 +182,7 @@ def generate_table(currents_a=DEFAULT_CURRENTS_A, speeds_m_s=DEFAULT_SPEEDS_M_S,
         "hamrock_dowson_h_min_m": hd_min,
         "provenance": {
             "generated_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
-            "command": command or "python -m twin.ehl_solver.calibration",
+            "command": command or "python -m twin.ehl_solver.film_reduction",
             "solver": "twin.ehl_solver.solve_point_contact (FAS multigrid, seed 003 eqs. 1-11)",
             "grid": grid,
             "python": sys.version.split()[0], "numpy": np.__version__, "platform": platform.platform(),
@@ -314,7 +314,7 @@ def main(argv: list[str] | None = None) -> int:
                         help="re-anchor R_b (84.8 %% at 30 A, default speed) before the table")
     args = parser.parse_args(argv)
     return run_calibration(args.out, grid=args.grid, anchor=args.anchor,
-                           command="python -m twin.ehl_solver.calibration " + " ".join(argv or sys.argv[1:]))
+                           command="python -m twin.ehl_solver.film_reduction " + " ".join(argv or sys.argv[1:]))
 
 
 def run_calibration(out, *, grid: int = CALIBRATION_GRID, anchor: bool = False, command: str | None = None,

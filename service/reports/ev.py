@@ -3,7 +3,7 @@ film loss beside the thermal EHL solver and the seed's figures.
 
 - Fig. 2/4: film reduction against current at the Appendix 2 contact: the solver's shipped
   table (twin/ehl_solver/film_reduction_table.json) and the loop's calibrated law
-  (twin.thermal_calibration) with the 57.6-84.8 % band;
+  (twin.validation.thermal_law_fit) with the 57.6-84.8 % band;
 - Fig. 7: minimum film against shaft speed at 0-30 A on the 6200 EV twin (the loop itself), with
   the speed of the thickest film;
 - Figs. 8 and 10: film against base temperature and against the equivalent bearing resistance;
@@ -16,8 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from twin import studies
-from twin import thermal_calibration as tcal
+from twin.validation import studies
+from twin.validation import thermal_law_fit as tcal
 from twin.ehl_solver import params as prm
 from twin.spec import Thermal
 
@@ -50,7 +50,7 @@ def _fig_reduction(out: Path) -> tuple[str, list]:
     fig, ax = plt.subplots(figsize=(7, 4))
     c = [r[0] for r in rows]
     ax.plot(c, [100 * r[2] for r in rows], "o-", label="thermal EHL solver (seed 003 eqs. 1-11), 257 x 257")
-    ax.plot(c, [100 * r[3] for r in rows], "s--", label="real-time loop's law (twin.thermal_calibration)")
+    ax.plot(c, [100 * r[3] for r in rows], "s--", label="real-time loop's law (twin.validation.thermal_law_fit)")
     ax.axhspan(100 * BAND[0], 100 * BAND[1], color="orange", alpha=0.15, label="seed 003 Fig. 2 band 57.6-84.8 %")
     ax.set(xlabel="shaft current [A]", ylabel="minimum-film reduction [%]",
            title=f"Appendix 2 contact, {u} m/s (30 000 rpm), 40 degC, R_b = {th.equivalent_resistance_ohm:g} ohm")
@@ -150,7 +150,7 @@ def write_ev_section(out: Path, quick: bool = False, progress=None) -> list[str]
           "reading of Appendix 2) and by shear (eq. 6 at the inlet, self-consistent with Roelands' eq. 3), and "
           "multiplies the isothermal film by g(dT)^c_T; c_T = "
           f"{th.film_temperature_exponent:g} and c_s = {th.inlet_shear_heating_factor:g} are fitted to the thermal "
-          "EHL solver (`python -m twin.thermal_calibration`).\n",
+          "EHL solver (`python -m twin.validation.thermal_law_fit`).\n",
           "### Film reduction against current (seed 003 Figs. 2 and 4)\n", f"![reduction]({red_png})\n",
           "| current [A] | eq. 10 rise [K] | solver reduction | loop-law reduction |", "|---|---|---|---|"]
     md += [f"| {c:g} | {t:.1f} | {100 * a:.1f} % | {100 * b:.1f} % |" for c, t, a, b in red_rows]

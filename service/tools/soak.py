@@ -189,7 +189,7 @@ class _Stream:
     def __init__(self, endpoint: str, bearing_id: str):
         import zenoh
 
-        from service.bus import make_config
+        from service.bus.zenoh_bus import make_config
 
         self.session = zenoh.open(make_config([], [endpoint], "peer"))
         self.bearing_id = bearing_id

@@ -21,8 +21,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from service.runner import ScenarioHandle, TwinRunner
-from service.scenarios import ResolvedRun, Scenario
+from service.core.runner import ScenarioHandle, TwinRunner
+from service.core.scenarios import ResolvedRun, Scenario
 from twin import catalog
 from twin.engine import Twin
 from twin.snapshot import Snapshot

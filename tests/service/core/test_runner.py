@@ -10,9 +10,9 @@ import time
 
 import pytest
 
-from service.runner import TwinRunner
-from service.scenarios import ScenarioError, scenario_from_dict
-from service.schemas import InputError
+from service.core.runner import TwinRunner
+from service.core.scenarios import ScenarioError, scenario_from_dict
+from service.api.schemas import InputError
 from twin.engine import Twin
 
 WAIT_S = 30.0

@@ -166,7 +166,7 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
     from rich.console import Console
     from rich.live import Live
 
-    from service.bus import make_config
+    from service.bus.zenoh_bus import make_config
 
     connect = list(connect or [])
     listen = list(listen or [])
