@@ -50,7 +50,7 @@ from service.api.schemas import (
 )
 from service.core.admission import HardeningMiddleware
 from service.settings import ServiceSettings
-from service.wiring import TwinEntry, TwinService
+from service.core.registry import TwinEntry, TwinService
 from twin.setpoint import SetpointError, SetpointUpdate
 from twin.snapshot import SetpointState, Snapshot
 
