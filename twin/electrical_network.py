@@ -21,7 +21,7 @@ _MIN_GAP_M = 1e-9
 
 
 @dataclass(frozen=True)
-class ElectricalState:
+class ElectricalNetwork:
     """Network values and indicators (SI)."""
 
     contact_resistance_ohm: np.ndarray   # (2Z,), inf for open contacts
@@ -49,7 +49,7 @@ def _open_contact_capacitance(model: BearingModel, r: int, gap_m: np.ndarray) ->
 
 
 def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: float,
-                    shaft_current_a: float) -> ElectricalState:
+                    shaft_current_a: float) -> ElectricalNetwork:
     """Evaluate the network for the contact rows `contacts` (TwinState.contacts view)."""
     el = model.spec.electrical
     z = model.ball_count
@@ -92,7 +92,7 @@ def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: 
     max_field = float(np.max(field)) if field.size else 0.0
     max_density = float(np.max(density)) if density.size else 0.0
     risk, reason = _risk(el, max_field, max_density, voltage, current)
-    return ElectricalState(
+    return ElectricalNetwork(
         contact_resistance_ohm=r_c, contact_capacitance_f=c_c, ball_resistance_ohm=r_ball,
         ball_capacitance_f=c_ball, resistance_ohm=(1.0 / y.real) if y.real > 0 else math.inf,
         capacitance_f=y.imag / omega, impedance_ohm=abs(z_total), phase_rad=math.atan2(z_total.imag, z_total.real),
