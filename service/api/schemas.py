@@ -1,181 +1,32 @@
-"""HTTP request/response models and the ONE validation path for setpoints (HTTP and zenoh).
-
-Every field's description carries its unit in brackets ("[rad/s]", "[-]" for counts and
-dimensionless numbers, "[text]" for names). The state snapshot itself is `twin.snapshot.Snapshot`.
+"""HTTP request and response models. Every field's description carries its unit in brackets
+("[rad/s]", "[-]" for counts and dimensionless numbers, "[text]" for names). The setpoint is
+`twin.setpoint` (Setpoint, SetpointUpdate), the state snapshot `twin.snapshot.Snapshot`: the
+HTTP layer has no vocabulary of its own.
 """
 
 from __future__ import annotations
 
-import json
-import math
+from functools import cache
 from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field
 
-from twin.setpoint import _UNITS as SETPOINT_UNITS
-from twin.setpoint import SetpointError, SetpointUpdate
-from twin.snapshot import SetpointState
+from service.core.errors import FieldError, InputError
+from service.core.registry import ID_PATTERN
+from twin.setpoint import Setpoint, SetpointUpdate
 from twin.spec import Thermal
 
-ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
+__all__ = ["BearingCreate", "BearingInfo", "ErrorResponse", "FieldError", "Health", "InputError",
+           "RecordingRequest", "RecordingStatus", "ScenarioAccepted", "ScenarioList", "ScenarioRequest",
+           "ScenarioStatus", "SetpointResponse", "TwinHealth", "request_bounds"]
+
 _STRICT = ConfigDict(extra="forbid", allow_inf_nan=False)
-
-
-# ---- errors -----------------------------------------------------------------------------------
-class FieldError(BaseModel):
-    """One thing wrong with a request."""
-
-    field: str | None = Field(description="Where: the field name or path (e.g. 'radial_load_n', 'steps[2].at_s'); null when the request as a whole is wrong [text].")
-    message: str = Field(description="What is wrong, with the allowed range and unit when there is one [text].")
-    allowed: list[Any] | None = Field(default=None, description="Allowed [low, high] in the field's unit, or the allowed names; null when not applicable [field unit].")
 
 
 class ErrorResponse(BaseModel):
     """Body of every 4xx/5xx answer."""
 
     detail: list[FieldError] = Field(description="The problems found [list].")
-
-
-class InputError(Exception):
-    """Bad input: carries the FieldErrors and the HTTP status to answer with."""
-
-    def __init__(self, errors: list[FieldError], status_code: int = 422):
-        self.errors, self.status_code = errors, status_code
-        super().__init__("; ".join(f"{e.field}: {e.message}" if e.field else e.message for e in errors))
-
-    @classmethod
-    def one(cls, field: str | None, message: str, allowed: list | None = None,
-            status_code: int = 422) -> InputError:
-        return cls([FieldError(field=field, message=message, allowed=allowed)], status_code)
-
-
-def _loc_text(loc: tuple | list, skip: tuple[str, ...] = ("body",)) -> str | None:
-    parts = list(loc)
-    while parts and parts[0] in skip:
-        parts.pop(0)
-    out = ""
-    for part in parts:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += ("." if out else "") + str(part)
-    return out or None
-
-
-def field_errors(errors: list[dict], limits: dict[str, tuple[float, float]] | None = None) -> list[FieldError]:
-    """pydantic error dicts -> FieldErrors naming the field and, for setpoint fields, the twin's
-    allowed range (the bearing's limits) or else the schema's bounds. Never echoes the input
-    (it may hold NaN, which JSON cannot carry)."""
-    out = []
-    for e in errors:
-        loc = tuple(e.get("loc", ()))
-        field = _loc_text(loc)
-        leaf = str(loc[-1]) if loc else None
-        msg = str(e.get("msg", "invalid")).removeprefix("Value error, ")
-        ctx = e.get("ctx") or {}
-        allowed = None
-        if limits and leaf in limits:
-            low, high = limits[leaf]
-            allowed = [low, high]
-            unit = SETPOINT_UNITS.get(leaf, "")
-            msg = f"{msg}; allowed range [{low:g}, {high:g}] {unit} for this bearing"
-        else:
-            low = ctx.get("ge", ctx.get("gt"))
-            high = ctx.get("le", ctx.get("lt"))
-            if low is not None or high is not None:
-                known = _field_bounds().get(leaf or "")
-                if known is not None:
-                    low = known[0] if low is None else low
-                    high = known[1] if high is None else high
-                allowed = [_jsonable(low), _jsonable(high)]
-                unit = unit_of(leaf or "")
-                msg = f"{msg}; allowed range [{_fmt(low)}, {_fmt(high)}]{' ' + unit if unit else ''}"
-        if e.get("type") == "extra_forbidden" and leaf is not None:
-            msg = f"unknown field {leaf!r}"
-            if limits:
-                allowed = sorted(limits)
-        if e.get("type") == "json_invalid":
-            field = None
-            msg = f"body is not valid JSON: {ctx.get('error', msg)}"
-        out.append(FieldError(field=field, message=msg, allowed=allowed))
-    return out
-
-
-_UNIT_SUFFIXES = (("_rad_s", "rad/s"), ("_m2_s", "m^2/s"), ("_pa_s", "Pa s"), ("_hz", "Hz"),
-                  ("_n", "N"), ("_m", "m"), ("_c", "degC"), ("_s", "s"), ("_a", "A"), ("_v", "V"))
-
-
-def unit_of(field: str) -> str:
-    """The unit a field name carries in its suffix ('radial_load_n' -> 'N'), '' if none."""
-    for suffix, unit in _UNIT_SUFFIXES:
-        if field.endswith(suffix):
-            return unit
-    return ""
-
-
-def _fmt(value: Any) -> str:
-    return "-inf" if value is None else (f"{value:g}" if isinstance(value, (int, float)) else str(value))
-
-
-_BOUNDS: dict[str, tuple[Any, Any]] | None = None
-
-
-def _field_bounds() -> dict[str, tuple[Any, Any]]:
-    """field name -> (low, high) declared on the request models (both sides of a range, since a
-    pydantic error names only the bound that was crossed)."""
-    global _BOUNDS
-    if _BOUNDS is None:
-        from service.core.scenarios import Scenario, ScenarioRun, ScenarioStep
-
-        bounds: dict[str, tuple[Any, Any]] = {}
-        for model in (SetpointUpdate, BearingCreate, RecordingRequest, ScenarioRequest, Scenario,
-                      ScenarioRun, ScenarioStep):
-            for name, info in model.model_fields.items():
-                low = high = None
-                for m in info.metadata:
-                    low = getattr(m, "ge", getattr(m, "gt", low)) if low is None else low
-                    high = getattr(m, "le", getattr(m, "lt", high)) if high is None else high
-                if (low is not None or high is not None) and name not in bounds:
-                    bounds[name] = (low, high)
-        _BOUNDS = bounds
-    return _BOUNDS
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, float) and not math.isfinite(value):
-        return None
-    if isinstance(value, (int, float, str)) or value is None:
-        return value
-    return str(value)
-
-
-def setpoint_error(exc: SetpointError) -> FieldError:
-    return FieldError(field=exc.field, message=str(exc), allowed=[exc.low, exc.high])
-
-
-def parse_setpoint(data: Any, limits: dict[str, tuple[float, float]]) -> SetpointUpdate:
-    """Validate a parsed setpoint body (dict) with SetpointUpdate; raises InputError naming the
-    field and the bearing's range. The bearing limits themselves are checked by the runner on the
-    merged setpoint (TwinRunner.submit)."""
-    if isinstance(data, SetpointUpdate):
-        return data
-    if not isinstance(data, dict):
-        raise InputError.one(None, f"a setpoint is a JSON object of fields {sorted(limits)}, got "
-                             f"{type(data).__name__}", sorted(limits))
-    try:
-        return SetpointUpdate.model_validate(data)
-    except ValidationError as exc:
-        raise InputError(field_errors(exc.errors(), limits)) from None
-
-
-def parse_setpoint_json(payload: bytes | str, limits: dict[str, tuple[float, float]]) -> SetpointUpdate:
-    """Same as parse_setpoint for raw JSON text (zenoh). NaN/Infinity literals parse and are then
-    refused by field (SetpointUpdate forbids non-finite numbers)."""
-    try:
-        data = json.loads(payload)
-    except (ValueError, UnicodeDecodeError) as exc:
-        raise InputError.one(None, f"payload is not valid JSON: {exc}") from None
-    return parse_setpoint(data, limits)
 
 
 # ---- bearings -----------------------------------------------------------------------------------
@@ -216,7 +67,7 @@ class BearingInfo(BaseModel):
     mode: Literal["real_time", "fast"] = Field(description="Pacing: real_time (paced to the wall clock) or fast [text].")
     running: bool = Field(description="Whether the runner thread is alive [bool].")
     time_s: float = Field(description="Simulated time of the latest snapshot [s].")
-    setpoint: SetpointState = Field(description="The setpoint in force or pending (latest accepted) [fields with units].")
+    setpoint: Setpoint = Field(description="The setpoint in force or pending (latest accepted) [fields with units].")
     limits: dict[str, tuple[float, float]] = Field(description="Allowed [low, high] of each setpoint field for this bearing, in the unit its name carries (shaft_speed_rad_s in rad/s, ...) [field unit].")
     scenario: ScenarioStatus | None = Field(default=None, description="Current or last scenario [object].")
     state_url: str = Field(description="Where to GET the latest snapshot [URL path].")
@@ -228,7 +79,7 @@ class SetpointResponse(BaseModel):
     """The setpoint after a PUT: applied at the runner's next frame (<= one frame later)."""
 
     bearing_id: str = Field(description="Twin name [text].")
-    setpoint: SetpointState = Field(description="The complete setpoint now in force for the next frame [fields with units].")
+    setpoint: Setpoint = Field(description="The complete setpoint now in force for the next frame [fields with units].")
     frame_s: float = Field(description="Frame length: the update applies at the next frame boundary [s of simulated time].")
 
 
@@ -302,7 +153,7 @@ class TwinHealth(BaseModel):
     setpoints_refused: int = Field(default=0, description="zenoh setpoints refused (token, size, rate, validation) [-].")
     setpoints_rate_limited: int = Field(default=0, description="Setpoints refused by the rate limit, HTTP 429 and zenoh [-].")
     fallbacks: int = Field(default=0, description="Times the twin could not hold its setpoint and was warm-restarted at the last safe one [-].")
-    last_safe_setpoint: SetpointState | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")
+    last_safe_setpoint: Setpoint | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")
 
 
 class Health(BaseModel):
@@ -317,3 +168,21 @@ class Health(BaseModel):
     recording_rows: int = Field(default=0, description="Snapshots written to the service-wide recording [-].")
     pid: int | None = Field(default=None, description="Process id of the service [-] (for soak tests and monitoring).")
     rss_bytes: int | None = Field(default=None, description="Resident memory of the service process [bytes]; null where /proc is unavailable.")
+
+
+@cache
+def request_bounds() -> dict[str, tuple[Any, Any]]:
+    """field name -> (low, high) declared on the request models (both sides of a range, since a
+    pydantic error names only the bound that was crossed)."""
+    from service.core.scenarios import Scenario, ScenarioRun, ScenarioStep
+
+    bounds: dict[str, tuple[Any, Any]] = {}
+    for model in (BearingCreate, RecordingRequest, ScenarioRequest, Scenario, ScenarioRun, ScenarioStep, Thermal):
+        for name, info in model.model_fields.items():
+            low = high = None
+            for m in info.metadata:
+                low = getattr(m, "ge", getattr(m, "gt", low)) if low is None else low
+                high = getattr(m, "le", getattr(m, "lt", high)) if high is None else high
+            if (low is not None or high is not None) and name not in bounds:
+                bounds[name] = (low, high)
+    return bounds

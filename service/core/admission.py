@@ -1,41 +1,25 @@
-"""Access and abuse limits of the service: bearer token, setpoint rate, request body size.
+"""The admission gate: ONE check of who may send setpoints and how many, for every transport.
 
 * `token_matches(given, expected)`: constant-time comparison (hmac.compare_digest on UTF-8
   bytes), so the time an answer takes does not tell how much of a guessed token was right.
-* `TokenBucket`: the per-twin setpoint rate limit (sustained `rate_hz`, bursts of `burst`),
-  shared by HTTP and zenoh (`TwinRunner.admit_setpoint`).
-* `HardeningMiddleware`: a pure ASGI middleware in front of the FastAPI app. For each HTTP
-  request, in this order:
+* `TokenBucket`: a rate limit (sustained `rate_hz`, bursts of `burst`).
+* `AdmissionGate`: the service's token, body/payload size cap and per-twin setpoint rate (one
+  token bucket per twin, shared by HTTP and zenoh). Each check returns None (admitted) or a
+  `Refusal` with the status the transport answers with (401, 413, 429), the field and a
+  message; the HTTP layer turns it into its error answer (service.api.deps), the zenoh intake
+  into a refusal on the result key (service.core.intake).
 
-  1. token: when a token is configured, POST/PUT/PATCH/DELETE (and every method other than
-     GET/HEAD/OPTIONS) need `Authorization: Bearer <token>`; GET/HEAD too when
-     `read_requires_token` (GET /health stays open: it is the liveness probe). 401 otherwise,
-     with `WWW-Authenticate: Bearer`.
-  2. size: a `Content-Length` above `max_body_bytes` -> 413 at once (nothing is read); a
-     malformed one -> 400.
-  3. rate: `PUT /v1/bearings/{id}/setpoint` takes one token from that twin's bucket -> 429 with
-     `Retry-After` (whole seconds) when empty. Answered here, before the body is read or a
-     worker thread is taken, so a burst of setpoints cannot starve reads.
-  4. body: a body without Content-Length (chunked) is read here while counting; above the cap
-     -> 413, else it is handed to the app unchanged.
-
-Every refusal has the service's error body {"detail": [{"field", "message", "allowed"}]}.
+No transport here: no fastapi, no zenoh.
 """
 
 from __future__ import annotations
 
 import hmac
-import json
 import math
-import re
 import threading
 import time
-from collections.abc import Awaitable, Callable
-from typing import Any
-
-_SETPOINT_PATH = re.compile(r"^/v1/bearings/([^/]+)/setpoint/?$")
-_READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
-_OPEN_PATHS = frozenset({"/health"})
+from collections.abc import Callable
+from dataclasses import dataclass
 
 
 def token_matches(given: str | bytes | None, expected: str | None) -> bool:
@@ -90,138 +74,87 @@ class TokenBucket:
             return False, (1.0 - self._tokens) / self.rate_hz
 
 
-def error_body(message: str, field: str | None = None, allowed: list | None = None) -> bytes:
-    return json.dumps({"detail": [{"field": field, "message": message, "allowed": allowed}]}).encode()
+@dataclass(frozen=True)
+class Refusal:
+    """Why the gate refused: the status to answer with, the field at fault and a message."""
+
+    status: int                       # 401, 413 or 429
+    field: str | None
+    message: str
+    allowed: list | None = None
+    retry_after_s: float | None = None   # 429: when a setpoint will be admitted again [s]
 
 
-class HardeningMiddleware:
-    """See the module docstring. `get_service()` returns the running TwinService (or None)."""
+class AdmissionGate:
+    """Token, size and per-twin setpoint rate for every transport (see the module docstring).
 
-    def __init__(self, app, *, token: str | None, read_requires_token: bool, max_body_bytes: int,
-                 get_service: Callable[[], Any]):
-        self.app = app
+    `token` None: no authentication. `setpoint_rate_hz` None or 0: no rate limit.
+    `max_payload_bytes` None: no size cap."""
+
+    def __init__(self, *, token: str | None = None, setpoint_rate_hz: float | None = None,
+                 setpoint_burst: int = 100, max_payload_bytes: int | None = None,
+                 clock: Callable[[], float] = time.monotonic):
         self.token = token
-        self.read_requires_token = bool(read_requires_token)
-        self.max_body_bytes = int(max_body_bytes)
-        self.get_service = get_service
+        self.setpoint_rate_hz = float(setpoint_rate_hz) if setpoint_rate_hz else None
+        self.setpoint_burst = int(setpoint_burst)
+        if self.setpoint_rate_hz is not None:
+            TokenBucket(self.setpoint_rate_hz, self.setpoint_burst)   # ValueError on bad settings
+        self.max_payload_bytes = max_payload_bytes
+        self._clock = clock
+        self._buckets: dict[str, TokenBucket] = {}
+        self._lock = threading.Lock()
         self.unauthorized = 0
         self.too_large = 0
-        self.rate_limited = 0
 
-    async def __call__(self, scope, receive, send) -> None:
-        if scope["type"] != "http":
-            await self.app(scope, receive, send)
-            return
-        method = scope.get("method", "GET").upper()
-        path = scope.get("path", "")
-        headers = _headers(scope)
+    @property
+    def requires_token(self) -> bool:
+        return self.token is not None
 
-        # 1. token
-        if self.token is not None and self._needs_token(method, path):
-            given = bearer_token(headers.get(b"authorization"))
-            if not token_matches(given, self.token):
-                self.unauthorized += 1
-                message = ("missing bearer token: send 'Authorization: Bearer <token>'"
-                           if given is None else "invalid bearer token")
-                await _answer(send, 401, error_body(message, "Authorization"),
-                              [(b"www-authenticate", b'Bearer realm="bearing-twin"')])
-                return
-
-        # 2. declared size
-        length = headers.get(b"content-length")
-        if length is not None:
-            try:
-                declared = int(length)
-                if declared < 0:
-                    raise ValueError
-            except ValueError:
-                await _answer(send, 400, error_body("malformed Content-Length header", "Content-Length"))
-                return
-            if declared > self.max_body_bytes:
-                self.too_large += 1
-                await _answer(send, 413, error_body(
-                    f"request body of {declared} bytes is larger than the limit of "
-                    f"{self.max_body_bytes} bytes", "body", [0, self.max_body_bytes]))
-                return
-
-        # 3. setpoint rate, per twin
-        if method == "PUT":
-            m = _SETPOINT_PATH.match(path)
-            if m is not None:
-                refused = self._rate_limit(m.group(1))
-                if refused is not None:
-                    self.rate_limited += 1
-                    await _answer(send, 429, error_body(
-                        f"too many setpoints for twin {m.group(1)!r}: at most "
-                        f"{refused[1]:g} per second (bursts of {refused[2]}); retry after "
-                        f"{refused[0]:.3f} s", None),
-                        [(b"retry-after", str(max(1, math.ceil(refused[0]))).encode())])
-                    return
-
-        # 4. body without a declared length (chunked): read it while counting
-        if length is None and (b"transfer-encoding" in headers or method not in _READ_METHODS):
-            body, more, disconnected = bytearray(), True, False
-            while more:
-                message = await receive()
-                if message["type"] == "http.disconnect":
-                    disconnected = True
-                    break
-                body += message.get("body", b"")
-                more = message.get("more_body", False)
-                if len(body) > self.max_body_bytes:
-                    self.too_large += 1
-                    await _answer(send, 413, error_body(
-                        f"request body is larger than the limit of {self.max_body_bytes} bytes",
-                        "body", [0, self.max_body_bytes]))
-                    return
-            if disconnected:
-                return
-            receive = _replay(bytes(body), receive)
-        await self.app(scope, receive, send)
-
-    def _needs_token(self, method: str, path: str) -> bool:
-        if method not in _READ_METHODS:
-            return True
-        return self.read_requires_token and path not in _OPEN_PATHS
-
-    def _rate_limit(self, bearing_id: str) -> tuple[float, float, int] | None:
-        """None when admitted, else (retry after [s], rate [1/s], burst)."""
-        try:
-            service = self.get_service()
-            entry = service.get(bearing_id) if service is not None else None
-        except Exception:  # noqa: BLE001 - unknown twin: the app answers 404
+    def check_token(self, given: str | bytes | None, *, missing: str = "missing token",
+                    field: str | None = "token") -> Refusal | None:
+        """None if `given` is the token (or none is configured), else a 401 Refusal; `missing`
+        is the message when nothing was given (it says how to send it on that transport)."""
+        if self.token is None:
             return None
-        runner = getattr(entry, "runner", None)
-        if runner is None:
+        if given is not None and token_matches(given, self.token):
             return None
-        ok, retry_after = runner.admit_setpoint()
+        with self._lock:
+            self.unauthorized += 1
+        return Refusal(401, field, missing if given is None else "invalid token")
+
+    def check_size(self, size: int, what: str = "payload") -> Refusal | None:
+        """None if `size` [bytes] is within the cap, else a 413 Refusal."""
+        cap = self.max_payload_bytes
+        if cap is None or size <= cap:
+            return None
+        with self._lock:
+            self.too_large += 1
+        return Refusal(413, "body", f"{what} of {size} bytes is larger than the limit of {cap} bytes",
+                       [0, cap])
+
+    def take_setpoint(self, bearing_id: str) -> Refusal | None:
+        """Take one setpoint from the twin's budget: None, or a 429 Refusal with retry_after_s."""
+        if self.setpoint_rate_hz is None:
+            return None
+        with self._lock:
+            bucket = self._buckets.get(bearing_id)
+            if bucket is None:
+                bucket = self._buckets[bearing_id] = TokenBucket(
+                    self.setpoint_rate_hz, self.setpoint_burst, clock=self._clock)
+        ok, retry_after = bucket.take()
         if ok:
             return None
-        bucket = runner.setpoint_bucket
-        return retry_after, bucket.rate_hz, bucket.burst
+        return Refusal(429, None, f"too many setpoints for twin {bearing_id!r}: at most "
+                       f"{self.setpoint_rate_hz:g} per second (bursts of {self.setpoint_burst}); "
+                       f"retry after {retry_after:.3f} s", retry_after_s=retry_after)
 
+    def rate_limited(self, bearing_id: str) -> int:
+        """Setpoints of this twin refused by the rate limit so far."""
+        with self._lock:
+            bucket = self._buckets.get(bearing_id)
+        return bucket.refused if bucket is not None else 0
 
-def _headers(scope) -> dict[bytes, bytes]:
-    out: dict[bytes, bytes] = {}
-    for name, value in scope.get("headers") or ():
-        out.setdefault(name.lower(), value)   # the first of repeated headers
-    return out
-
-
-def _replay(body: bytes, receive: Callable[[], Awaitable[dict]]) -> Callable[[], Awaitable[dict]]:
-    sent = False
-
-    async def replay() -> dict:
-        nonlocal sent
-        if not sent:
-            sent = True
-            return {"type": "http.request", "body": body, "more_body": False}
-        return await receive()
-    return replay
-
-
-async def _answer(send, status: int, body: bytes, headers: list[tuple[bytes, bytes]] = ()) -> None:
-    await send({"type": "http.response.start", "status": status,
-                "headers": [(b"content-type", b"application/json"),
-                            (b"content-length", str(len(body)).encode()), *headers]})
-    await send({"type": "http.response.body", "body": body})
+    def forget(self, bearing_id: str) -> None:
+        """Drop a removed twin's budget."""
+        with self._lock:
+            self._buckets.pop(bearing_id, None)

@@ -1,22 +1,18 @@
-"""`TwinService`: the twins of one service and their wiring to the zenoh bus and rerun.
+"""`TwinRegistry`: the twins of one service, their runners, the admission gate and /health.
 
-This is the ONE place that touches `service.bus` and `service.recorder` (imported lazily, so the
-HTTP layer and the tests that disable them never import zenoh or rerun):
+No transport here: the zenoh bus and the recorders are plugged in from outside through
+`Bus` / `Recorder` (service.wiring opens them from the settings):
 
-    create twin -> TwinRunner (not started) -> bus.attach_twin(...) -> channel as a sink
+    create twin -> Twin (warm-started) -> TwinRunner (not started) -> SetpointIntake
+                -> bus.attach_twin(id, latest, intake) channel as a sink
                 -> recorder.add_twin_from(twin), recorder as a sink -> runner.start()
     delete twin -> runner.stop() -> channel.detach() -> per-twin recording closed
     close       -> every runner stopped (all asked first, then joined) -> channels detached
-                -> per-twin recordings closed -> service recording closed (drained, flushed)
-                -> zenoh session closed
+                -> per-twin recordings closed -> hook `_close_outputs` (service recording,
+                   zenoh session)
 
-Every recorder of the service makes its rerun streams through one `service.recorder.RerunStreams`
-owned by the `TwinService` (`rerun_streams()`): a per-twin recording gets a new recorder (its
-own recording id) per start, and its streams are freed when it stops (rerun-sdk 0.41 would keep
-them, and their threads, forever: see the recorder's module doc).
-
-A setpoint arriving over zenoh goes through `TwinRunner.submit_setpoint_json`, which uses the
-same validation as HTTP (`service.api.schemas.parse_setpoint` + the bearing's limits).
+A twin's own recording (`start_recording`) goes to a path under the recordings directory
+(relative, plain names, .rrd), made by `_new_recording(path)`.
 """
 
 from __future__ import annotations
@@ -27,76 +23,65 @@ import re
 import sys
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from pydantic import ValidationError
 
+from service.core.admission import AdmissionGate
+from service.core.errors import InputError, field_errors, setpoint_field_errors
+from service.core.intake import SetpointIntake
 from service.core.runner import TwinRunner
-from service.api.schemas import (
-    BearingCreate,
-    FieldError,
-    InputError,
-    field_errors,
-    setpoint_error,
-)
+from service.core.sinks import SnapshotSink
 from service.settings import ServiceSettings
 from twin import catalog
 from twin.engine import Twin
-from twin.setpoint import SetpointError
+from twin.setpoint import SetpointError, SetpointUpdate
+from twin.snapshot import Snapshot
+from twin.spec import Thermal
 
 log = logging.getLogger(__name__)
 
-_ID_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
+ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
+_ID_RE = re.compile(ID_PATTERN)
 # per-twin recording paths: relative, plain names (no control characters, spaces, '..', hidden
 # folders), so a request cannot reach outside the recordings directory or trip the file system
 _REC_PATH_RE = re.compile(r"^(?=.{1,256}$)(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/)*[A-Za-z0-9_][A-Za-z0-9_.-]*\.rrd$")
 
 
-class WiringError(RuntimeError):
-    """A component the settings ask for is missing or failed to start."""
+def admission_gate(settings: ServiceSettings) -> AdmissionGate:
+    """The service's one admission gate (HTTP and zenoh) from its settings."""
+    return AdmissionGate(token=settings.token_value, setpoint_rate_hz=settings.setpoint_rate_hz or None,
+                         setpoint_burst=settings.setpoint_burst, max_payload_bytes=settings.max_body_bytes)
 
 
-def open_bus(settings: ServiceSettings):
-    """The service's zenoh bus, or None when zenoh is disabled."""
-    if not settings.enable_zenoh:
-        return None
-    try:
-        from service.bus.zenoh_bus import ZenohBus
-    except ImportError as exc:
-        raise WiringError(f"zenoh is enabled but service.bus cannot be imported ({exc}); "
-                          "install eclipse-zenoh or run with --no-zenoh") from exc
-    return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode)
+class Channel(SnapshotSink, Protocol):
+    """A twin's link to the bus."""
+
+    def detach(self) -> None: ...
 
 
-def _recorder_class():
-    try:
-        from service.recorder import RerunRecorder
-    except ImportError as exc:
-        raise WiringError(f"recording is enabled but service.recorder cannot be imported ({exc}); "
-                          "install rerun-sdk or run with --no-record") from exc
-    return RerunRecorder
+class Bus(Protocol):
+    """The message bus the twins are attached to (service.bus.zenoh_bus.ZenohBus)."""
+
+    closed: bool
+
+    def attach_twin(self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
+                    on_setpoint: Callable[[bytes], dict]) -> Channel: ...
+
+    def close(self) -> None: ...
 
 
-def open_recorder(settings: ServiceSettings, streams: Any = None):
-    """The service-wide rerun recorder, or None when recording (and the viewer) are off.
-    `streams`: the service's `RerunStreams`, shared with the per-twin recordings (stream creation
-    and reclaim must not run concurrently, see `service.recorder.RerunStreams`)."""
-    path = settings.recording_path
-    if path is None and not settings.spawn_viewer:
-        return None
-    extra = {} if streams is None else {"streams": streams}
-    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer, **recorder_options(settings), **extra)
+class Recorder(SnapshotSink, Protocol):
+    """A recording of one or more twins (service.recorder.RerunRecorder)."""
 
+    path: Path | None
+    rows_logged: int
 
-def recorder_options(settings: ServiceSettings) -> dict:
-    """Send interval, segment rotation and footer of every recording the service writes."""
-    return dict(flush_interval_s=settings.record_flush_interval_s,
-                segment_s=settings.record_segment_s or None,
-                segment_bytes=round(settings.record_segment_mb * 1e6) or None,
-                write_footer=settings.record_footer)
+    def add_twin_from(self, twin: Twin) -> None: ...
 
 
 @dataclass
@@ -106,9 +91,10 @@ class TwinEntry:
     id: str
     twin: Twin
     runner: TwinRunner
+    intake: SetpointIntake
     lubricant: str
-    channel: Any = None                 # zenoh TwinChannel
-    recording: Any = None               # this twin's own RerunRecorder (POST .../recording)
+    channel: Any = None                 # the bus channel (a sink)
+    recording: Any = None               # this twin's own recording (POST .../recording)
     recording_path: Path | None = None
     created_wall_s: float = field(default_factory=time.time)
 
@@ -121,50 +107,50 @@ class TwinEntry:
         return float(self.twin.model.spec.mounting.diametral_clearance_m)
 
 
-class TwinService:
-    """Owns the twins, the bus and the recorder of one service (no module-level state)."""
+class TwinRegistry:
+    """Owns the twins, the admission gate and the plugged-in bus / recorder of one service."""
 
-    def __init__(self, settings: ServiceSettings):
+    def __init__(self, settings: ServiceSettings, gate: AdmissionGate | None = None):
         self.settings = settings
-        self.bus = None
-        self.recorder = None
+        self.gate = gate if gate is not None else admission_gate(settings)
+        self.bus: Bus | None = None
+        self.recorder: Recorder | None = None
         self.started_wall_s = time.monotonic()
         self._twins: dict[str, TwinEntry] = {}
         self._reserved: set[str] = set()    # ids of twins being built
         self._recording_lock = threading.RLock()
         self._lock = threading.RLock()
         self._closed = False
-        self._rerun_streams = None          # service.recorder.RerunStreams, made on first use
 
-    def rerun_streams(self):
-        """The `RerunStreams` that makes and frees every rerun stream of this service."""
-        with self._lock:
-            if self._rerun_streams is None:
-                _recorder_class()
-                from service.recorder import RerunStreams
+    # ---- outputs: hooks for the wiring ---------------------------------------------------
+    def _open_outputs(self) -> None:
+        """Open the bus and the service recording (none here)."""
 
-                self._rerun_streams = RerunStreams()
-            return self._rerun_streams
+    def _close_outputs(self) -> None:
+        """Close the service recording and the bus."""
+
+    def _new_recording(self, path: Path) -> Recorder:
+        """A recorder writing one twin to `path` (OSError / RuntimeError / ValueError when it
+        cannot)."""
+        raise RuntimeError("this service has no recorder")
 
     # ---- life cycle ------------------------------------------------------------------------
-    def open(self, *, default_twin: bool = True) -> TwinService:
-        """Start the bus (if enabled), the recorder (if enabled) and the `default` twin."""
+    def open(self, *, default_twin: bool = True) -> TwinRegistry:
+        """Open the outputs and start the `default` twin."""
         if sys.getswitchinterval() > self.settings.gil_switch_interval_s:
             sys.setswitchinterval(self.settings.gil_switch_interval_s)  # process-wide, see settings
         try:
-            self.bus = open_bus(self.settings)
-            if self.settings.recording_path is not None or self.settings.spawn_viewer:
-                self.recorder = open_recorder(self.settings, self.rerun_streams())
+            self._open_outputs()
             if default_twin and self.settings.start_twin:
-                self.create_twin(BearingCreate(id=self.settings.twin_id, designation=self.settings.bearing))
+                self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing)
         except BaseException:
             self.close()
             raise
         return self
 
     def close(self) -> None:
-        """Stop every runner, detach zenoh, close recordings (nothing queued is lost), close the
-        session. Idempotent; never raises."""
+        """Stop every runner, detach the bus, close recordings (nothing queued is lost), close
+        the outputs. Idempotent; never raises."""
         with self._lock:
             if self._closed:
                 return
@@ -180,16 +166,7 @@ class TwinService:
                 log.exception("stopping twin %s", e.id)
         for e in entries:
             self._unwire(e)
-        if self.recorder is not None:
-            try:
-                self.recorder.close()
-            except Exception:
-                log.exception("closing the recorder")
-        if self.bus is not None:
-            try:
-                self.bus.close()
-            except Exception:
-                log.exception("closing the zenoh bus")
+        self._close_outputs()
 
     def _unwire(self, e: TwinEntry) -> None:
         if e.channel is not None:
@@ -197,11 +174,12 @@ class TwinService:
                 e.runner.remove_sink(e.channel)
                 e.channel.detach()
             except Exception:
-                log.exception("detaching twin %s from zenoh", e.id)
+                log.exception("detaching twin %s from the bus", e.id)
             e.channel = None
         if self.recorder is not None:
             e.runner.remove_sink(self.recorder)
         self.stop_recording(e)
+        self.gate.forget(e.id)
 
     # ---- twins -----------------------------------------------------------------------------
     def entries(self) -> list[TwinEntry]:
@@ -209,6 +187,7 @@ class TwinService:
             return list(self._twins.values())
 
     def get(self, bearing_id: str) -> TwinEntry:
+        """The twin (InputError 404 naming the known ones)."""
         with self._lock:
             entry = self._twins.get(bearing_id)
             known = sorted(self._twins)
@@ -217,45 +196,50 @@ class TwinService:
                                  f"{', '.join(known) or 'none'}", known, status_code=404)
         return entry
 
+    def find(self, bearing_id: str) -> TwinEntry | None:
+        with self._lock:
+            return self._twins.get(bearing_id)
+
     def _new_id(self, designation: str) -> str:
         n = 1
         while f"{designation}-{n}" in self._twins or f"{designation}-{n}" in self._reserved:
             n += 1
         return f"{designation}-{n}"
 
-    def build_twin(self, req: BearingCreate, bearing_id: str) -> Twin:
-        """A warm-started Twin from a creation request (InputError naming the field if invalid)."""
-        designation = req.designation.strip().upper()
+    def build_twin(self, bearing_id: str, designation: str = "6208", diametral_clearance_m: float = 0.0,
+                   lubricant: str = "seed-000", setpoint: SetpointUpdate | None = None,
+                   thermal: Thermal | None = None) -> Twin:
+        """A warm-started Twin (InputError naming the field if a value is not valid)."""
+        wanted = designation
+        designation = designation.strip().upper()
         if designation not in catalog.designations():
-            raise InputError.one("designation", f"unknown bearing {req.designation!r}",
-                                 catalog.designations())
+            raise InputError.one("designation", f"unknown bearing {wanted!r}", catalog.designations())
         try:
-            lubricant = catalog.lubricant(req.lubricant)
+            lub = catalog.lubricant(lubricant)
         except ValueError as exc:
             raise InputError.one("lubricant", str(exc).removeprefix("lubricant: ")) from None
         try:
-            spec = catalog.bearing(designation, diametral_clearance_m=req.diametral_clearance_m,
-                                   lubricant=lubricant, **({"thermal": req.thermal} if req.thermal else {}))
+            spec = catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m,
+                                   lubricant=lub, **({"thermal": thermal} if thermal else {}))
         except ValidationError as exc:
             raise InputError(field_errors(exc.errors())) from None
-        try:
-            twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
-            if req.setpoint is not None:
-                twin.set_setpoint(req.setpoint)
-                twin.reset()  # warm start at the requested setpoint
-            return twin
-        except SetpointError as exc:
-            err = setpoint_error(exc)
-            raise InputError([FieldError(field=f"setpoint.{err.field}", message=err.message,
-                                         allowed=err.allowed)]) from None
+        twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
+        if setpoint is not None:
+            try:
+                twin.set_setpoint(setpoint)
+            except SetpointError as exc:
+                raise InputError(setpoint_field_errors(exc, prefix="setpoint.")) from None
+            twin.reset()  # warm start at the requested setpoint
+        return twin
 
-    def create_twin(self, req: BearingCreate) -> TwinEntry:
-        """Create, wire and start a twin. InputError 409 on a duplicate id or when full."""
+    def create_twin(self, id: str | None = None, designation: str = "6208", **options: Any) -> TwinEntry:
+        """Create, wire and start a twin (`options`: diametral_clearance_m, lubricant, setpoint,
+        thermal). InputError 409 on a duplicate id or when full, 422 for an invalid value."""
         s = self.settings
         with self._lock:
             if self._closed:
                 raise InputError.one(None, "the service is shutting down", status_code=503)
-            bearing_id = req.id or self._new_id(req.designation.strip().upper())
+            bearing_id = id or self._new_id(designation.strip().upper())
             if not _ID_RE.match(bearing_id):
                 raise InputError.one("id", f"{bearing_id!r}: letters, digits, '_', '.', '-' only "
                                      "(it is used in URLs and zenoh key expressions)")
@@ -269,15 +253,13 @@ class TwinService:
             self._reserved.add(bearing_id)
         entry = None
         try:
-            twin = self.build_twin(req, bearing_id)
-            runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s,
-                                token=s.token_value, setpoint_rate_hz=s.setpoint_rate_hz or None,
-                                setpoint_burst=s.setpoint_burst, max_payload_bytes=s.max_body_bytes)
+            twin = self.build_twin(bearing_id, designation, **options)
+            runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s)
             entry = TwinEntry(id=bearing_id, twin=twin, runner=runner,
+                              intake=SetpointIntake(bearing_id, self.gate, runner),
                               lubricant=twin.model.spec.lubricant.name)
             if self.bus is not None:
-                entry.channel = self.bus.attach_twin(bearing_id, runner.latest_snapshot,
-                                                     runner.submit_setpoint_json)
+                entry.channel = self.bus.attach_twin(bearing_id, runner.latest_snapshot, entry.intake)
                 runner.add_sink(entry.channel)
             if self.recorder is not None:
                 self.recorder.add_twin_from(twin)
@@ -341,16 +323,13 @@ class TwinService:
             t = target.resolve()
             if t == main or (t.parent == main.parent and re.fullmatch(re.escape(main.stem) + r"-\d{4,}\.rrd", t.name)):
                 raise InputError.one("path", f"{str(target)!r} is the service-wide recording or one of its segments")
-        recorder_cls = _recorder_class()
-        streams = self.rerun_streams()
         with self._recording_lock:
             self.stop_recording(entry)
             if target.exists() and not target.is_file():
                 raise InputError.one("path", f"{str(target)!r} exists and is not a file")
             try:
-                rec = recorder_cls(target, **recorder_options(self.settings), streams=streams)
+                rec = self._new_recording(target)
             except (OSError, RuntimeError, ValueError) as exc:   # e.g. a folder that is a file
-                streams.reclaim()            # the stream made for the file that failed
                 raise InputError.one("path", f"cannot record to {str(target)!r}: "
                                      f"{' '.join(str(exc).split())[:200]}") from None
             rec.add_twin_from(entry.twin)
@@ -359,8 +338,7 @@ class TwinService:
         return target
 
     def stop_recording(self, entry: TwinEntry) -> tuple[Path | None, int]:
-        """Finish the twin's own recording (flushed, complete; its rerun streams freed);
-        returns (path, rows written)."""
+        """Finish the twin's own recording (flushed, complete); returns (path, rows written)."""
         with self._recording_lock:
             rec, path = entry.recording, entry.recording_path
             if rec is None:
@@ -375,7 +353,9 @@ class TwinService:
 
     # ---- health ----------------------------------------------------------------------------
     def health(self) -> dict:
-        twins = [e.runner.stats() for e in self.entries()]
+        twins = [e.runner.stats(setpoints_refused=e.intake.refused,
+                                setpoints_rate_limited=self.gate.rate_limited(e.id))
+                 for e in self.entries()]
         degraded = any((not t["running"]) or t["errors"] for t in twins)
         rec = self.recorder
         return {

@@ -30,9 +30,11 @@ Rules:
 * every step has exactly one of `set` or `ramp`; a ramp needs `over_s` > 0 and must end by
   `duration_s`; `at_s` is non-decreasing and below `duration_s`;
 * setpoint fields are those of `twin.setpoint.SetpointUpdate` (units in the names); an unknown
-  field is an error;
-* values are checked against the bearing's limits before anything runs (`check_limits`), so an
-  out-of-range step is refused with its position, field and the allowed range;
+  field is an error, and so is a value that is not a number (a bool, a quoted "3000");
+* `bearing: 6208` (a YAML integer) is the designation "6208";
+* values are checked against the bearing's limits before anything runs (`check_limits`, by
+  `scenario check` as by `scenario run` and the service), so an out-of-range step is refused
+  with its position, field and the bearing's own range;
 * the engine's own shaft acceleration limit (ModelOptions.speed_ramp_rad_s2, 5000 rad/s^2 by
   default) still applies: a speed ramp faster than that lags behind its setpoint.
 
@@ -44,7 +46,7 @@ when a twin is created); `bearing-twin scenario run FILE` creates a fresh twin f
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -52,28 +54,13 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from twin import catalog
-from twin.setpoint import Setpoint, SetpointUpdate
-from twin.spec import Thermal
+from twin.setpoint import Setpoint, SetpointLimits, SetpointUpdate
+from twin.spec import BearingSpec, Thermal
 
 SCENARIO_SCHEMA = "bearing-twin/scenario/1"
 
-#: Setpoint fields of the public contract (DESIGN.md), whether or not this engine takes them yet.
-CONTRACT_SETPOINT_FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n",
-                            "oil_temperature_c", "shaft_current_a", "shaft_voltage_v")
-
 _NAME_RE = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
 _FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
-
-
-def supported_setpoint_fields() -> tuple[str, ...]:
-    """Setpoint fields this engine takes (SetpointUpdate's fields)."""
-    return tuple(SetpointUpdate.model_fields)
-
-
-def future_setpoint_fields() -> tuple[str, ...]:
-    """Contract setpoint fields this engine does not take yet (skipped with a warning)."""
-    supported = set(supported_setpoint_fields())
-    return tuple(f for f in CONTRACT_SETPOINT_FIELDS if f not in supported)
 
 
 class ScenarioError(ValueError):
@@ -81,7 +68,8 @@ class ScenarioError(ValueError):
 
     def __init__(self, field: str, message: str, allowed: list | None = None):
         self.field, self.message, self.allowed = field, message, allowed
-        super().__init__(f"{field}: {message}")
+        # the message may already start with the field (several errors, each with its path)
+        super().__init__(message if message.startswith(f"{field}: ") else f"{field}: {message}")
 
 
 class ScenarioStep(BaseModel):
@@ -124,56 +112,10 @@ class ScenarioRun(BaseModel):
     steps: list[ScenarioStep] | None = Field(default=None, description="Steps replacing the scenario's.")
     duration_s: float | None = Field(default=None, gt=0.0, le=3600.0, description="Run length [s of simulated time].")
 
-
-def _strip_future_fields(data: Any, warnings: list[str]) -> Any:
-    """Remove contract fields the engine does not take yet from every setpoint block; note where."""
-    future = set(future_setpoint_fields())
-    if not future or not isinstance(data, dict):
-        return data
-
-    def clean(block: Any, where: str) -> Any:
-        if not isinstance(block, dict):
-            return block
-        kept = {}
-        for key, value in block.items():
-            if key in future:
-                warnings.append(
-                    f"{where}.{key}: not a setpoint of this engine yet (it needs the electrical "
-                    f"issue); skipped, the rest of the scenario runs without it")
-            else:
-                kept[key] = value
-        return kept
-
-    def clean_steps(steps: Any, where: str) -> Any:
-        if not isinstance(steps, list):
-            return steps
-        out = []
-        for i, step in enumerate(steps):
-            if isinstance(step, dict):
-                step = dict(step)
-                for key in ("set", "ramp"):
-                    if key in step:
-                        step[key] = clean(step[key], f"{where}[{i}].{key}")
-            out.append(step)
-        return out
-
-    data = dict(data)
-    if "initial" in data:
-        data["initial"] = clean(data["initial"], "initial")
-    if "steps" in data:
-        data["steps"] = clean_steps(data["steps"], "steps")
-    if isinstance(data.get("runs"), list):
-        runs = []
-        for j, run in enumerate(data["runs"]):
-            if isinstance(run, dict):
-                run = dict(run)
-                if "initial" in run:
-                    run["initial"] = clean(run["initial"], f"runs[{j}].initial")
-                if "steps" in run:
-                    run["steps"] = clean_steps(run["steps"], f"runs[{j}].steps")
-            runs.append(run)
-        data["runs"] = runs
-    return data
+    @field_validator("bearing", mode="before")
+    @classmethod
+    def _designation_text(cls, value: Any) -> Any:
+        return _designation_text(value)
 
 
 def _drop_empty_steps(steps: list[ScenarioStep]) -> list[ScenarioStep]:
@@ -211,17 +153,12 @@ class Scenario(BaseModel):
     sample_every_s: float = Field(default=0.001, ge=1e-5, le=10.0, description="Sample period of the table and recording [s of simulated time].")
     steps: list[ScenarioStep] = Field(default_factory=list, description="Timed setpoints and ramps, in order of at_s.")
     runs: list[ScenarioRun] | None = Field(default=None, min_length=1, max_length=100, description="Optional runs with other mountings / bearings / timelines.")
-    warnings: list[str] = Field(default_factory=list, description="Set by the loader: fields that were skipped and why [text].")
+    warnings: list[str] = Field(default_factory=list, description="Notes of the loader on what it did not take [text].")
 
-    @model_validator(mode="before")
+    @field_validator("bearing", mode="before")
     @classmethod
-    def _future_fields(cls, data: Any) -> Any:
-        if not isinstance(data, dict):
-            return data
-        warnings: list[str] = list(data.get("warnings") or [])
-        data = _strip_future_fields(data, warnings)
-        data["warnings"] = warnings
-        return data
+    def _designation_text(cls, value: Any) -> Any:
+        return _designation_text(value)
 
     @field_validator("bearing")
     @classmethod
@@ -278,10 +215,25 @@ class Scenario(BaseModel):
                                          if getattr(run, k) is not None)))
         return out
 
+    def check_bearing_limits(self) -> None:
+        """Check every run's values against its bearing's own limits (ScenarioError naming the
+        run, step and field): the check `scenario run` and the service make before running."""
+        runs = self.resolved_runs()
+        for run in runs:
+            run.check_limits(run.bearing_limits(), where=f"runs[{run.index}]." if len(runs) > 1 else "")
+
     @property
     def total_duration_s(self) -> float:
         """Simulated seconds of all runs together [s]."""
         return sum(r.duration_s for r in self.resolved_runs())
+
+
+def _designation_text(value: Any) -> Any:
+    """YAML reads `bearing: 6208` as a number: a designation written as an integer is taken as
+    its text ("6208"); booleans and other types are left to the validation (refused)."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return str(value)
+    return value
 
 
 def _check_designation(value: str) -> str:
@@ -341,94 +293,42 @@ class ResolvedRun:
                 f"(POST /v1/bearings with 'thermal') or run the scenario offline (bearing-twin scenario run)",
                 [self.thermal.model_dump()])
 
+    def spec(self) -> BearingSpec:
+        """The bearing this run asks for: designation, mounting, lubricant, thermal options."""
+        return catalog.bearing(self.bearing, diametral_clearance_m=self.diametral_clearance_m,
+                               lubricant=catalog.lubricant(self.lubricant),
+                               **({"thermal": self.thermal} if self.thermal else {}))
+
+    def bearing_limits(self) -> SetpointLimits:
+        """The setpoint limits of this run's bearing (its compiled model)."""
+        from twin.model import make_model
+
+        return SetpointLimits.for_model(make_model(self.spec()))
+
     def initial_setpoint(self, base: Setpoint | None = None) -> Setpoint:
         """The complete setpoint at t = 0 (initial merged over `base` or the defaults)."""
         return self.initial.apply_to(base or Setpoint())
 
     def iter_values(self):
         """(where, field, value) of every setpoint value the run mentions."""
-        for name, value in self.initial.model_dump(exclude_none=True).items():
+        for name, value in self.initial.fields.items():
             yield "initial", name, value
         for i, step in enumerate(self.steps):
             kind = "set" if step.set is not None else "ramp"
-            for name, value in (step.set or step.ramp).model_dump(exclude_none=True).items():
+            for name, value in (step.set or step.ramp).fields.items():
                 yield f"steps[{i}].{kind}", name, value
 
-    def check_limits(self, limits: dict[str, tuple[float, float]], where: str = "") -> None:
-        """Raise ScenarioError for the first value outside the bearing's limits.
+    def check_limits(self, limits: SetpointLimits, where: str = "") -> None:
+        """Raise ScenarioError for the first value outside the bearing's limits (`Twin.limits`,
+        `SetpointLimits.for_model`): what `scenario check`, `scenario run` and the service check.
 
         The limits are boxes per field, so a linear ramp between values inside them stays inside."""
-        from twin.setpoint import _UNITS  # unit names of the setpoint fields
-
         for place, name, value in self.iter_values():
-            if name not in limits:
-                continue
-            low, high = limits[name]
-            if not (low <= value <= high):
-                unit = _UNITS.get(name, "")
-                raise ScenarioError(
-                    f"{where}{place}.{name}",
-                    f"{name} = {value:g} {unit} is outside the allowed range [{low:g}, {high:g}] "
-                    f"{unit} for bearing {self.bearing}", [low, high])
-
-
-# ---- execution (pure logic; the runner calls it between frames) -------------------------------
-@dataclass
-class _ActiveRamp:
-    field: str
-    start_s: float
-    over_s: float
-    start_value: float
-    target: float
-
-
-@dataclass
-class ScenarioExecutor:
-    """Turns a run's timeline into setpoint updates. `updates(t, current)` is called before each
-    frame with the scenario time t [s] and the setpoint in force; it returns the partial update
-    to apply now (or an empty dict). No threads, no clocks: the caller owns time."""
-
-    run: ResolvedRun
-    _next_step: int = 0
-    _ramps: dict[str, _ActiveRamp] = field(default_factory=dict)
-    _initial_done: bool = False
-    phase: str | None = None
-
-    def updates(self, t: float, current: Setpoint) -> dict[str, float]:
-        eps = 1e-9
-        out: dict[str, float] = {}
-        if not self._initial_done:
-            out.update(self.run.initial.model_dump(exclude_none=True))
-            self._initial_done = True
-        steps = self.run.steps
-        while self._next_step < len(steps) and steps[self._next_step].at_s <= t + eps:
-            step = steps[self._next_step]
-            self._next_step += 1
-            if step.phase is not None:
-                self.phase = step.phase
-            if step.set is not None:
-                fields = step.set.model_dump(exclude_none=True)
-                for name in fields:
-                    self._ramps.pop(name, None)  # a later set overrides a running ramp
-                out.update(fields)
-            else:
-                for name, target in step.ramp.model_dump(exclude_none=True).items():
-                    start_value = out.get(name, getattr(current, name))
-                    self._ramps[name] = _ActiveRamp(name, step.at_s, float(step.over_s),
-                                                    float(start_value), float(target))
-        for name, ramp in list(self._ramps.items()):
-            x = (t - ramp.start_s) / ramp.over_s
-            if x >= 1.0 - eps:
-                out[name] = ramp.target
-                del self._ramps[name]
-            else:
-                x = min(max(x, 0.0), 1.0)
-                out[name] = ramp.start_value + (ramp.target - ramp.start_value) * x
-        return out
-
-    def done(self, t: float) -> bool:
-        """Whether the scenario time t has reached the run's duration."""
-        return t >= self.run.duration_s - 1e-9
+            problems = limits.problems({name: value})
+            if problems:
+                p = problems[0]
+                raise ScenarioError(f"{where}{place}.{name}", p.message(limits.bearing or self.bearing),
+                                    [p.low, p.high])
 
 
 # ---- loading ----------------------------------------------------------------------------------

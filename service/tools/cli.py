@@ -7,7 +7,20 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import re
 import sys
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse with whole option names only (no abbreviations: `--clear` is not `--clearance`)
+    that takes '-1e-5' as a negative number, like '-1' and '-1.5' (Python 3.11's argparse takes
+    a value in scientific notation for an option: `--clearance -1e-5` would fail)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
 
 
 def _positive_float(text: str) -> float:
@@ -21,15 +34,16 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
     from twin.engine import Twin
-    from twin.setpoint import Setpoint, SetpointError
+    from twin.setpoint import SetpointError, SetpointUpdate
     from twin.spec import ModelOptions
 
     try:
         options = ModelOptions(time_step_s=args.dt, film_formula=args.film_formula)
-        setpoint = Setpoint(shaft_speed_rad_s=args.speed, radial_load_n=args.radial_load,
-                            axial_load_n=args.axial_load, oil_temperature_c=args.oil_temperature)
-        twin = Twin(args.bearing, options=options, setpoint=setpoint,
-                    diametral_clearance_m=args.clearance)
+        update = SetpointUpdate(shaft_speed_rad_s=args.speed, radial_load_n=args.radial_load,
+                                axial_load_n=args.axial_load, oil_temperature_c=args.oil_temperature)
+        twin = Twin(args.bearing, options=options, diametral_clearance_m=args.clearance, warm=False)
+        twin.set_setpoint(update)           # checked once, against this bearing's limits
+        twin.reset()                        # warm start at it
         twin.advance(args.duration)
     except (ValidationError, SetpointError, ValueError) as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
@@ -86,7 +100,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="bearing-twin", description=__doc__)
+    parser = ArgumentParser(prog="bearing-twin", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
 
     sim = sub.add_parser("simulate", help="run one twin for a duration, print the final snapshot")
@@ -293,7 +307,19 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         print("bearing-twin: zenoh off", flush=True)
     path = settings.recording_path
     print(f"bearing-twin: recording to {path}" if path else "bearing-twin: not recording", flush=True)
-    config = uvicorn.Config(create_app(settings), host=host, port=settings.port, workers=1,
+    from service.core.errors import InputError
+    from service.wiring import TwinService, WiringError
+
+    # open the twins, zenoh and the recording here, before uvicorn: what fails (a zenoh port in
+    # use, a recording path that cannot be written) is one line, like a busy HTTP port
+    try:
+        service = TwinService(settings).open()
+    except (WiringError, InputError, OSError) as exc:
+        print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    config = uvicorn.Config(create_app(settings, service=service), host=host, port=settings.port, workers=1,
                             log_level=args.log_level, lifespan="on", timeout_graceful_shutdown=3)
     server = uvicorn.Server(config)
     try:
@@ -312,6 +338,7 @@ def _cmd_scenario_check(args: argparse.Namespace) -> int:
     for file in args.files:
         try:
             scenario = load_scenario(file)
+            scenario.check_bearing_limits()     # what `scenario run` checks before it runs
         except ScenarioError as exc:
             print(f"{file}: error: {exc}", file=sys.stderr)
             status = 2
@@ -330,6 +357,7 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
 
     try:
         scenario = load_scenario(args.file)
+        scenario.check_bearing_limits()
     except ScenarioError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -393,7 +421,17 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    return args.func(args)
+    try:
+        status = args.func(args)
+        sys.stdout.flush()
+        return status
+    except BrokenPipeError:
+        # the reader went away (`bearing-twin simulate --json | head -c 100`): stop quietly, as
+        # a command killed by SIGPIPE would (status 128 + 13), without a traceback; stdout goes
+        # to /dev/null so that the interpreter's final flush does not fail again
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 141
 
 
 if __name__ == "__main__":

@@ -21,9 +21,9 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from service.core.runner import ScenarioHandle, TwinRunner
+from service.core.runner import TwinRunner
+from service.core.scenario_driver import ScenarioHandle
 from service.core.scenarios import ResolvedRun, Scenario
-from twin import catalog
 from twin.engine import Twin
 from twin.snapshot import Snapshot
 
@@ -134,17 +134,15 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
         from service.recorder import RerunRecorder
 
         recorder = RerunRecorder(record, queue_size=1_000_000)
+    scenario.check_bearing_limits()        # every run, before any runs (as `scenario check`)
     runs = scenario.resolved_runs()
     results: list[RunResult] = []
     done_s = 0.0
     try:
         for run in runs:
             bearing_id = scenario.name if len(runs) == 1 else run.id
-            lubricant = catalog.lubricant(run.lubricant)
-            spec = catalog.bearing(run.bearing, diametral_clearance_m=run.diametral_clearance_m,
-                                   lubricant=lubricant, **({"thermal": run.thermal} if run.thermal else {}))
+            spec = run.spec()
             twin = Twin(spec, setpoint=run.initial_setpoint(), bearing_id=bearing_id)
-            run.check_limits(twin.limits, where=f"runs[{run.index}]." if len(runs) > 1 else "")
             runner = TwinRunner(twin, fast=True, publish_rate_hz=1.0 / run.sample_every_s,
                                 frame_s=min(frame_s, run.sample_every_s), idle_without_scenario=True)
             runner.add_sink(table)
@@ -154,7 +152,7 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
             t_wall = time.perf_counter()
             runner.start(publish_initial=False)
             handle, _ = runner.start_scenario(run)
-            table.begin(run, handle, lubricant.name, twin.time_s)
+            table.begin(run, handle, spec.lubricant.name, twin.time_s)
             rows_before = len(table.rows)
             deadline = time.monotonic() + max(min_timeout_s, timeout_factor * run.duration_s)
             try:
@@ -164,7 +162,7 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
                     if runner.failed or not runner.running:
                         break
                     if time.monotonic() > deadline:
-                        handle._finish("failed", "timed out")
+                        handle.finish("failed", "timed out")
                         break
             finally:
                 runner.stop(timeout=10.0)

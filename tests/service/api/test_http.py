@@ -95,6 +95,8 @@ def test_put_setpoint_shows_up_in_state(client, wait_for):
     ({"shaft_speed_rad_s": 3000.0}, "shaft_speed_rad_s", 0.0, None),   # within the schema, above the 6208's limit
     ({"oil_temperature_c": 200.0}, "oil_temperature_c", -30.0, 150.0),
     ({"axial_load_n": "lots"}, "axial_load_n", None, None),
+    ({"radial_load_n": True}, "radial_load_n", 0.0, None),              # a bool is not a load
+    ({"radial_load_n": "3000"}, "radial_load_n", 0.0, None),            # nor is a string
 ])
 def test_invalid_setpoint_names_field_and_range(client, body, field, low, high):
     r = client.put("/v1/bearings/default/setpoint", json=body)
@@ -109,6 +111,36 @@ def test_invalid_setpoint_names_field_and_range(client, body, field, low, high):
     if high is not None:
         assert hi == high
     assert f"[{lo:g}, {hi:g}]" in err["message"]
+
+
+def test_strict_types_and_the_bearings_own_range(client):
+    """{"radial_load_n": true} is not 1 N and "3000" is not 3000 N: 422 naming the field; an
+    out-of-range value is answered with the 6208's own range, not the vocabulary's static bound."""
+    before = client.get("/v1/bearings/default").json()["setpoint"]
+    for body in ({"radial_load_n": True}, {"radial_load_n": "3000"}, {"shaft_speed_rad_s": False}):
+        r = client.put("/v1/bearings/default/setpoint", json=body)
+        assert r.status_code == 422, (body, r.text)
+        (err,) = detail(r)
+        assert err["field"] == next(iter(body)) and "number" in err["message"]
+    assert client.get("/v1/bearings/default").json()["setpoint"] == before   # nothing applied
+    r = client.put("/v1/bearings/default/setpoint", json={"shaft_speed_rad_s": 3000.0})
+    (err,) = detail(r)
+    assert err["allowed"][0] == 0.0 and err["allowed"][1] == pytest.approx(2073.66, abs=0.005)
+    assert "outside the allowed range [0, 2073.66] rad/s for bearing 6208" in err["message"]
+    # POST /v1/bearings: the initial setpoint of a new twin, with that bearing's range
+    r = client.post("/v1/bearings", json={"designation": "6200", "setpoint": {"radial_load_n": True}})
+    assert r.status_code == 422 and detail(r)[0]["field"] == "setpoint.radial_load_n"
+
+
+def test_docs_are_served_without_a_cdn(client):
+    page = client.get("/docs")
+    assert page.status_code == 200
+    assert "cdn." not in page.text and "http://" not in page.text and "https://" not in page.text
+    for asset in ("swagger-ui-bundle.js", "swagger-ui.css"):
+        assert f"/docs/assets/{asset}" in page.text
+        r = client.get(f"/docs/assets/{asset}")
+        assert r.status_code == 200 and len(r.content) > 10_000
+    assert client.get("/openapi.json").json()["openapi"].startswith("3.1")
 
 
 @pytest.mark.parametrize("raw", [b'{"shaft_speed_rad_s": NaN}', b'{"shaft_speed_rad_s": Infinity}',

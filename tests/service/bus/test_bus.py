@@ -18,7 +18,7 @@ zenoh = pytest.importorskip("zenoh")
 from service.bus.zenoh_bus import ZenohBus, make_config, wait_until
 from service.tools.monitor import add_monitor_command, run_monitor
 from twin.engine import Twin
-from twin.setpoint import SetpointUpdate
+from twin.setpoint import SetpointLimits, SetpointUpdate
 
 WAIT_S = 10.0
 
@@ -60,7 +60,8 @@ def client(endpoint, bus, support):
 
 def validating_on_setpoint(applied: list):
     def on_setpoint(payload: bytes) -> dict:
-        update = SetpointUpdate.model_validate_json(payload)  # raises on bad payloads
+        update = SetpointUpdate.model_validate_json(payload)  # raises on bad types
+        SetpointLimits.static().check(update)                  # and on values out of range
         applied.append(update)
         return {"accepted": True, "setpoint": update.model_dump(exclude_none=True)}
     return on_setpoint

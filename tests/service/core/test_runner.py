@@ -10,9 +10,11 @@ import time
 
 import pytest
 
+from service.core.admission import AdmissionGate
+from service.core.errors import InputError
+from service.core.intake import SetpointIntake
 from service.core.runner import TwinRunner
 from service.core.scenarios import ScenarioError, scenario_from_dict
-from service.api.schemas import InputError
 from twin.engine import Twin
 
 WAIT_S = 30.0
@@ -115,13 +117,14 @@ def test_setpoint_validation_names_field_and_range(twin, make_runner):
 
 def test_zenoh_setpoint_handler_never_raises(twin, make_runner):
     runner = make_runner(twin, fast=True)
-    ok = runner.submit_setpoint_json(b'{"radial_load_n": 2500}')
+    intake = SetpointIntake(twin.bearing_id, AdmissionGate(), runner)
+    ok = intake(b'{"radial_load_n": 2500}')
     assert ok["accepted"] is True and ok["setpoint"]["radial_load_n"] == 2500.0
     for payload, field in ((b'{"radial_load_n": NaN}', "radial_load_n"),
                            (b'{"shaft_speed_rad_s": 1e9}', "shaft_speed_rad_s"),
                            (b'{"axial_load_n": "x"}', "axial_load_n"),
                            (b"not json", None), (b"[1, 2]", None), (b"\xff\xfe", None)):
-        res = runner.submit_setpoint_json(payload)
+        res = intake(payload)
         assert res["accepted"] is False, payload
         json.dumps(res, allow_nan=False)  # the refusal itself is valid JSON
         if field is not None:
