@@ -12,6 +12,7 @@ their threads, forever: see the recorder's module doc).
 from __future__ import annotations
 
 import logging
+import re
 from pathlib import Path
 from typing import Any
 
@@ -41,8 +42,10 @@ def open_bus(settings: ServiceSettings):
     try:
         return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode)
     except (RuntimeError, ValueError) as exc:
-        raise WiringError(f"{exc} (is another service listening there? choose another with "
-                          "--zenoh-listen, or --no-zenoh)") from exc
+        text = re.sub(r"\s+at \S+\.rs:\d+\.?", "", " ".join(str(exc).split()))   # zenoh's Rust source lines
+        hint = (" (is another service listening there? choose another with --zenoh-listen, or --no-zenoh)"
+                if "already in use" in text else "")
+        raise WiringError(text + hint) from exc
 
 
 def _recorder_class():

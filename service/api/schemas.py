@@ -89,7 +89,7 @@ class ScenarioRequest(BaseModel):
 
     model_config = _STRICT
     name: str | None = Field(default=None, max_length=128, description="Name of a scenario file in scenarios/ (without .yaml) [text].")
-    scenario: dict[str, Any] | None = Field(default=None, description="Inline scenario, same format as the YAML files (see service/scenarios.py) [object, times in s, setpoint fields with units].")
+    scenario: dict[str, Any] | None = Field(default=None, description="Inline scenario, same format as the YAML files (see service/core/scenarios.py) [object, times in s, setpoint fields with units].")
     run: str | None = Field(default=None, max_length=64, description="Which run of a multi-run scenario (default: the first) [text].")
     restart: bool = Field(default=False, description="Warm-restart the twin at the scenario's initial setpoint before it starts (else the initial setpoint is applied as a step) [bool].")
 

@@ -1,6 +1,6 @@
 """The zenoh bus: ONE zenoh session for the whole service, one `TwinChannel` per twin.
 
-Key expressions (DESIGN.md, schema "bearing-twin/state/1"):
+Key expressions (README "Architecture", schema "bearing-twin/state/1"):
 
     bearing/{id}/state             snapshot JSON (publisher)
     bearing/{id}/ball/{i}          one ball: the ball's fields plus schema, bearing_id, time_s
@@ -391,7 +391,7 @@ class ZenohBus:
     """Owns the service's single zenoh session and the channels of the twins attached to it.
 
     >>> bus = ZenohBus(listen=["tcp/127.0.0.1:7447"], connect=[])
-    >>> channel = bus.attach_twin("t1", runner.latest_snapshot, runner.submit_setpoint_json)
+    >>> channel = bus.attach_twin("t1", runner.latest_snapshot, intake)   # intake(payload) -> dict
     >>> runner.add_sink(channel)      # runner calls channel.publish(snapshot) at its publish rate
     >>> bus.close()                   # in the lifespan `finally`: detaches all, closes the session
 

@@ -12,7 +12,7 @@ relative file name:
 - ``ehl_film_vs_speed.png``: isothermal h_c and h_min against speed, solver and Hamrock-Dowson
   (seed 003 Fig. 1).
 
-service/report.py calls it; it does not depend on anything else of the report.
+service/reports/report.py calls it; it does not depend on anything else of the report.
 """
 
 from __future__ import annotations

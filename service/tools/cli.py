@@ -162,7 +162,7 @@ def build_parser() -> argparse.ArgumentParser:
     scenario = sub.add_parser("scenario", help="scenarios: timelines of setpoints and ramps (YAML)")
     scenario_sub = scenario.add_subparsers(dest="scenario_command", required=True)
     run = scenario_sub.add_parser("run", help="run a scenario file in fast mode (fresh twin per run)")
-    run.add_argument("file", help="scenario YAML file (see scenarios/ and service/scenarios.py)")
+    run.add_argument("file", help="scenario YAML file (see scenarios/ and service/core/scenarios.py)")
     run.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording")
     run.add_argument("--table", metavar="OUT.parquet", help="write the per-sample table (Parquet; .csv for CSV)")
     run.add_argument("--no-progress", action="store_true", help="no progress bar")

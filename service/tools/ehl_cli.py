@@ -10,7 +10,7 @@ inputs (exit code 1 when the solver did not converge: the numbers are then not a
 `calibrate` regenerates the film-reduction table shipped with twin.ehl_solver; `bench` times
 the isothermal solve at the default speed (default 129 x 129, the solver's speed figure).
 
-service/cli.py registers this with `add_ehl_command(sub)`; `python -m service.tools.ehl_cli ehl ...`
+service/tools/cli.py registers this with `add_ehl_command(sub)`; `python -m service.tools.ehl_cli ehl ...`
 runs it on its own.
 """
 
@@ -150,7 +150,7 @@ def solve_to_dict(args: argparse.Namespace) -> dict:
 
 
 def _finite(obj):
-    """JSON never carries NaN or Infinity (DESIGN.md): non-finite floats become null."""
+    """JSON never carries NaN or Infinity (README "Architecture"): non-finite floats become null."""
     if isinstance(obj, float):
         return obj if math.isfinite(obj) else None
     if isinstance(obj, dict):

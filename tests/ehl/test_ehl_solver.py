@@ -356,7 +356,7 @@ def test_film_reduction_factor_interpolates_the_table():
 # --- command line --------------------------------------------------------------------------------
 
 def test_cli_solve_json_carries_the_required_fields():
-    """Issue 7 CLI contract: `bearing-twin ehl solve --json` (service/ehl_cli.py, Appendix 2
+    """Issue 7 CLI contract: `bearing-twin ehl solve --json` (service/tools/ehl_cli.py, Appendix 2
     defaults, 65 x 65 grid) carries the required fields and inputs (exact keys, eta0 = 0.04)."""
     from service.tools.ehl_cli import main
 

@@ -5,7 +5,7 @@ start) must find the equilibrium. The reference is the Hertz equilibrium of the 
 the balls' actual azimuths (`twin.validation.analytic.radial_equilibrium`) with the same contact law.
 
 Load parameter eps: the seed prints 0.685 / 0.5 / 0.4 for Pd = -12.6 / 0 / +12.6 um; those follow
-from its eq. 2 as printed, which lacks the 1/(1 - nu) factor (30 % too soft). With the DESIGN.md
+from its eq. 2 as printed, which lacks the 1/(1 - nu) factor (30 % too soft). With the README
 constant the Hertz equilibrium gives 0.745 / 0.5 / 0.388, which the test asserts.
 """
 

@@ -1,4 +1,4 @@
-"""Seed 000 eq. 2 (elliptic Hertz stiffness, DESIGN.md reading) and eq. 3 (ball-cage)."""
+"""Seed 000 eq. 2 (elliptic Hertz stiffness, README reading) and eq. 3 (ball-cage)."""
 
 import math
 
@@ -29,7 +29,7 @@ def test_inner_contact_stiffness_of_the_6208_by_hand():
 
 
 def test_design_constant_is_the_seed_constant_over_one_minus_nu():
-    # DESIGN.md: pi k E' == 2 pi k G / (1 - nu) (seed 004 eq. 2); the seed 000 print lacks 1/(1-nu)
+    # README: pi k E' == 2 pi k G / (1 - nu) (seed 004 eq. 2); the seed 000 print lacks 1/(1-nu)
     e, nu = 210e9, 0.3
     g = hertz.shear_modulus_pa(e, nu)
     assert math.pi * hertz.effective_modulus_pa(e, nu) == pytest.approx(2 * math.pi * g / (1 - nu), rel=1e-12)

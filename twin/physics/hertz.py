@@ -1,6 +1,6 @@
 """Hertz elliptic point contact: curvature, ellipticity, stiffness, contact ellipse.
 
-Seed 000 eq. 2 with the reading of DESIGN.md (the printed 2 pi k G lost the 1/(1 - nu) factor):
+Seed 000 eq. 2 with the README's reading (the printed 2 pi k G lost the 1/(1 - nu) factor):
 Q = K delta^1.5, K = pi k E' sqrt(2 Ebar R / (9 Fbar^3)); k = (Ry/Rx)^(2/pi),
 Fbar = 1 + (pi/2 - 1) ln(Ry/Rx), Ebar = 1 + (pi/2 - 1) Rx/Ry, R = Rx Ry / (Rx + Ry).
 Ball-ball (cage element) contacts, eq. 3: Q = 4 G sqrt(Req) / (3 (1 - nu)) delta^1.5.
@@ -53,7 +53,7 @@ def ellipticity(rx_m, ry_m):
 
 @njit(**JIT)
 def elliptic_integral_first_kind(rx_m, ry_m):
-    """Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) [-] (seed 000 eq. 2 as DESIGN.md reads it)."""
+    """Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) [-] (seed 000 eq. 2 as README reads it)."""
     return 1.0 + _Q * math.log(ry_m / rx_m)
 
 
@@ -65,7 +65,7 @@ def elliptic_integral_second_kind(rx_m, ry_m):
 
 @njit(**JIT)
 def raceway_stiffness_n_m15(rx_m, ry_m, effective_modulus):
-    """K [N/m^1.5] in Q = K delta^1.5 for a ball-raceway contact (seed 000 eq. 2, DESIGN.md)."""
+    """K [N/m^1.5] in Q = K delta^1.5 for a ball-raceway contact (seed 000 eq. 2, README)."""
     k = ellipticity(rx_m, ry_m)
     fbar = elliptic_integral_first_kind(rx_m, ry_m)
     ebar = elliptic_integral_second_kind(rx_m, ry_m)

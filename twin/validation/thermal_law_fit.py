@@ -12,7 +12,7 @@ over the converged cells of the solver's shipped film-reduction table
 (twin/ehl_solver/film_reduction_table.json: currents 0-30 A x entrainment speeds 0.832-4.16 m/s
 at seed 003's Appendix 2 inputs, the table's provenance names the solver run). The fitted
 constants are the defaults of twin.spec.Thermal (`film_temperature_exponent`,
-`inlet_shear_heating_factor`); tests/physics/test_thermal_calibration.py refits and pins them,
+`inlet_shear_heating_factor`); tests/validation/test_thermal_law_fit.py refits and pins them,
 so a regenerated table cannot silently disagree with the loop.
 
 Run `python -m twin.validation.thermal_law_fit` to print the fit and its residuals.

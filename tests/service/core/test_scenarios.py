@@ -244,3 +244,56 @@ def test_scenario_run_refuses_bad_input(tmp_path, capsys):
     assert "shaft_speed_rad_s" in err and "allowed range" in err
     assert main(["scenario", "run", str(path), "--table", "x.txt", "--no-progress"]) == 2
     assert main(["scenario", "check", str(SCENARIOS / "ev_motor_current_ramp.yaml")]) == 0
+
+
+def test_scenario_check_checks_the_bearing_limits_like_run(tmp_path, capsys):
+    """A scenario over the bearing's speed limit (the 6208's 2073.66 rad/s, inside the static
+    bound of 1e4) fails `scenario check` as it fails `scenario run`, with the bearing's range."""
+    path = _write(tmp_path, {"name": "too_fast", "bearing": "6208", "duration_s": 0.01,
+                             "steps": [{"at_s": 0.0, "ramp": {"shaft_speed_rad_s": 3000.0}, "over_s": 0.01}]})
+    assert main(["scenario", "check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "steps[0].ramp.shaft_speed_rad_s" in err
+    assert "outside the allowed range [0, 2073.66] rad/s for bearing 6208" in err
+    assert main(["scenario", "run", str(path), "--no-progress"]) == 2
+    assert "[0, 2073.66] rad/s" in capsys.readouterr().err
+    # the same timeline on a 6200 (a smaller bearing, a higher limit) is fine
+    ok = _write(tmp_path, {"name": "fast_6200", "bearing": "6200", "duration_s": 0.01,
+                           "steps": [{"at_s": 0.0, "ramp": {"shaft_speed_rad_s": 3000.0}, "over_s": 0.01}]})
+    assert main(["scenario", "check", str(ok)]) == 0
+
+
+def test_multi_run_limits_name_the_run():
+    s = scenario_from_dict(base(initial={"radial_load_n": 1000.0},
+                                runs=[{"id": "small", "bearing": "6200"}, {"id": "big", "bearing": "6208",
+                                      "steps": [{"at_s": 0.0, "set": {"shaft_speed_rad_s": 2500.0}}]}]))
+    with pytest.raises(ScenarioError) as exc:
+        s.check_bearing_limits()
+    assert exc.value.field == "runs[1].steps[0].set.shaft_speed_rad_s"
+
+
+def test_yaml_integer_designation_and_errors_name_the_field_once(tmp_path):
+    path = tmp_path / "int.yaml"
+    path.write_text("name: int_bearing\nbearing: 6208\nduration_s: 0.01\n"
+                    "runs:\n  - {id: a, bearing: 6200}\n")
+    s = load_scenario(path)
+    assert s.bearing == "6208" and s.resolved_runs()[0].bearing == "6200"
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("name: bad\nbearing: 9999\nduration_s: 0.01\n")
+    with pytest.raises(ScenarioError) as exc:
+        load_scenario(bad)
+    assert exc.value.field == "bearing"
+    assert str(exc.value).count("bearing:") == 1 and "unknown bearing '9999'" in str(exc.value)
+    for flag in ("true", "yes"):                      # a YAML bool is not a designation
+        bad.write_text(f"name: bad\nbearing: {flag}\nduration_s: 0.01\n")
+        with pytest.raises(ScenarioError):
+            load_scenario(bad)
+
+
+@pytest.mark.parametrize("value", ['"3000"', "true"])
+def test_yaml_setpoint_values_are_numbers(tmp_path, value):
+    path = tmp_path / "s.yaml"
+    path.write_text(f"name: s\nduration_s: 0.01\ninitial: {{radial_load_n: {value}}}\n")
+    with pytest.raises(ScenarioError) as exc:
+        load_scenario(path)
+    assert exc.value.field == "initial.radial_load_n" and "valid number" in exc.value.message

@@ -1,6 +1,8 @@
-"""The console script: simulate prints the contract as JSON, report writes Markdown and plots."""
+"""The console script: simulate prints the contract as JSON, report writes Markdown and plots;
+numbers in scientific notation, a closed pipe and a busy zenoh port are handled cleanly."""
 
 import json
+import socket
 import subprocess
 import sys
 
@@ -48,3 +50,38 @@ def test_report_quick(tmp_path):
     # the EV section (seed 003): Figs. 2/4 band, Fig. 7's thickest-film speed rising with current
     assert "## EV motor bearing under shaft current (seed 003)" in text
     assert "57.6-84.8 %" in text and "speed of the thickest film" in text
+
+
+def test_negative_numbers_in_scientific_notation_are_values():
+    """`--clearance -1e-5` (a preload) is the option's value, not an unknown option (Python
+    3.11's argparse only knows -1 and -1.5 as numbers); `--clearance=-1e-5` too."""
+    for args in (("--clearance", "-1e-5"), ("--clearance=-1e-5",)):
+        res = _run("simulate", *args, "--duration", "0.001", "--json")
+        assert res.returncode == 0, res.stderr
+        assert json.loads(res.stdout)["status"] == "ok"
+    res = _run("simulate", "--clear", "0", "--duration", "0.001")      # no abbreviations
+    assert res.returncode == 2 and "unrecognized arguments" in res.stderr
+
+
+def test_a_closed_pipe_ends_quietly():
+    """`simulate --json | head -c 100`: the reader goes away; no BrokenPipeError traceback."""
+    proc = subprocess.Popen([sys.executable, "-m", "service.cli", "simulate", "--duration", "0.001", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()                    # nothing reads: the first write fails with EPIPE
+    _out, err = proc.communicate(timeout=300)
+    assert proc.returncode == 141, err
+    assert b"Traceback" not in err and b"BrokenPipeError" not in err
+
+
+def test_a_busy_zenoh_port_is_a_one_line_error(tmp_path):
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        res = subprocess.run([sys.executable, "-m", "service.cli", "serve", "--port", "0", "--no-record",
+                              "--zenoh-listen", f"tcp/127.0.0.1:{port}"], capture_output=True, text=True,
+                             timeout=300, cwd=tmp_path)
+    assert res.returncode == 2
+    lines = [line for line in res.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: zenoh") and "already in use" in lines[0], res.stderr
+    assert ".rs:" not in lines[0]
