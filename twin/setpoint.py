@@ -153,8 +153,9 @@ class Admitted:
 
 
 @dataclass(frozen=True)
-class SetpointLimits:
-    """Allowed [low, high] of every setpoint field for one bearing (in the field's unit)."""
+class SetpointLimits(Mapping):
+    """Allowed [low, high] of every setpoint field for one bearing (in the field's unit); reads
+    like the dict `{field: (low, high)}` it was before."""
 
     ranges: Mapping[str, tuple[float, float]]
     bearing: str = ""   # designation, quoted in the errors
@@ -199,6 +200,14 @@ class SetpointLimits:
 
     def __contains__(self, name: object) -> bool:
         return name in self.ranges
+
+    def __iter__(self):
+        return iter(self.ranges)
+
+    def __len__(self) -> int:
+        return len(self.ranges)
+
+    __hash__ = None   # a mapping (compared by value), not hashable
 
     def as_dict(self) -> dict[str, tuple[float, float]]:
         return dict(self.ranges)
