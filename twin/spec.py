@@ -201,11 +201,11 @@ class Thermal(BaseModel):
     film_temperature_exponent: float = Field(
         default=1.46, gt=0.0, le=5.0,
         description="c_T of the loop's thermal film law h/h_iso = g(dT)^c_T [-], fitted to the thermal EHL solver "
-        "(twin.thermal_calibration, 33 solver cells of seed 003 Appendix 2, max error 3.8 points of reduction).")
+        "(twin.validation.thermal_law_fit, 33 solver cells of seed 003 Appendix 2, max error 3.8 points of reduction).")
     inlet_shear_heating_factor: float = Field(
         default=1.50, ge=0.0, le=20.0,
         description="c_s of the inlet shear heating dT = c_s 2 eta u^2 / k' (seed 003 eq. 6 at p -> 0) [-], fitted "
-        "with film_temperature_exponent (twin.thermal_calibration).")
+        "with film_temperature_exponent (twin.validation.thermal_law_fit).")
 
 
 class Mounting(BaseModel):

@@ -4,7 +4,8 @@ import math
 
 import pytest
 
-from twin import catalog, studies
+from twin import catalog
+from twin.validation import studies
 from twin.engine import Twin
 from twin.physics import thermal, viscosity
 from twin.spec import ModelOptions, Thermal

@@ -84,7 +84,7 @@ def inlet_shear_heating_temperature_rise_k(entrainment_speed_m_s: float, eta0_pa
     the inlet (p -> 0: the compression term vanishes and eq. 6 reduces to dT = 2 eta u^2 / k'),
     with eta the Roelands viscosity (eq. 3) at the heated inlet temperature theta0 + other_rise +
     dT (self-consistent: a hotter oil shears with less heat), times `shear_factor` (calibrated
-    against the full EHL solver, twin.thermal_calibration). Solved by bisection (the right-hand
+    against the full EHL solver, twin.validation.thermal_law_fit). Solved by bisection (the right-hand
     side falls as dT rises, so the root is unique) [K]."""
     u = entrainment_speed_m_s
     if u <= 0.0 or shear_factor <= 0.0:
@@ -113,6 +113,6 @@ def thermal_film_factor(temperature_rise_k: float, eta0_pa_s: float, theta0_k: f
                         temperature_exponent: float) -> float:
     """Film-reduction factor h(heated inlet) / h(isothermal) = g(dT)^c: the Hamrock-Dowson film
     ratio of a uniform inlet temperature rise (hamrock_dowson_temperature_film_ratio) raised to
-    the exponent c that the full thermal EHL solver of seed 003 gives (twin.thermal_calibration:
+    the exponent c that the full thermal EHL solver of seed 003 gives (twin.validation.thermal_law_fit:
     the solver's films fall faster with temperature than the isothermal formula's, c > 1)."""
     return hamrock_dowson_temperature_film_ratio(temperature_rise_k, eta0_pa_s, theta0_k, beta_k_inv) ** temperature_exponent
