@@ -1,6 +1,6 @@
 """The import rules of the README's "Architecture" section, as import-linter contracts in
 pyproject.toml ([tool.importlinter]): `twin` never imports `service` (nor fastapi, zenoh, rerun,
-matplotlib); `service.core` imports no fastapi, zenoh or rerun, nor the wings built on them;
+matplotlib); the runtime engine never imports `twin.validation` (the offline science); `service.core` imports no fastapi, zenoh or rerun, nor the wings built on them;
 the service's layers go tools > reports > api > wiring > bus | recorder > core > settings.
 import-linter reads every import statement, those inside functions included."""
 
@@ -20,8 +20,14 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_the_contracts_are_declared():
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
     contracts = {c["id"]: c for c in config["contracts"]}
-    assert set(contracts) == {"engine", "core", "layers"}
+    assert set(contracts) == {"engine", "runtime", "core", "layers"}
     assert {"service", "fastapi", "zenoh", "rerun"} <= set(contracts["engine"]["forbidden_modules"])
+    assert contracts["runtime"]["forbidden_modules"] == ["twin.validation"]
+    # every runtime module of twin/ (all but the offline packages) is a source of the "runtime" contract
+    runtime = {p.stem for p in (ROOT / "twin").glob("*.py") if p.stem != "__init__"}
+    runtime |= {p.name for p in (ROOT / "twin").iterdir() if (p / "__init__.py").exists()}
+    runtime -= {"validation", "ehl_solver"}
+    assert {m.removeprefix("twin.") for m in contracts["runtime"]["source_modules"]} == runtime
     assert {"fastapi", "zenoh", "rerun"} <= set(contracts["core"]["forbidden_modules"])
     assert contracts["layers"]["layers"][0] == "service.tools" and contracts["layers"]["layers"][-2] == "service.core"
 
