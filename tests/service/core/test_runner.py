@@ -1,6 +1,7 @@
 """TwinRunner: one thread per twin, mailbox latest-wins, setpoints between frames, pacing, fast
 mode, stop/join, scenarios in the runner thread, errors counted. Real Twin, bounded waits; no
-wall-clock threshold tighter than a real-time factor > 0.3 (the machines are shared and noisy)."""
+wall-clock speed threshold (the machines are shared and noisy): pacing is checked as "never ahead
+of the wall clock" on the real runner and exactly on a fake clock."""
 
 from __future__ import annotations
 
@@ -169,25 +170,115 @@ def test_setpoints_only_change_between_frames(twin, make_runner):
     assert writers == {runner._thread.name}
 
 
+class _TimedSink(ListSink):
+    """Keeps each snapshot with the wall time it arrived."""
+
+    def __init__(self):
+        super().__init__()
+        self.arrivals = []
+
+    def publish(self, snapshot):
+        with self._lock:
+            self.arrivals.append((time.perf_counter(), snapshot))
+        super().publish(snapshot)
+
+
 def test_real_time_pacing(twin, make_runner):
-    sink = ListSink()
+    """Real-time mode on a real twin, without a speed threshold (the machine is shared): the
+    simulated time never runs ahead of the wall clock (at every snapshot and at the end), every
+    frame is counted and advanced frame_s, and publishing follows the 50 Hz wall-clock schedule
+    (never more often). How fast the twin keeps up is the benchmark's business, not a test's."""
+    sink = _TimedSink()
     runner = make_runner(twin, publish_rate_hz=50.0, sinks=[sink])
+    time0 = twin.time_s
     t0 = time.perf_counter()
     runner.start()
-    time.sleep(1.5)
+    assert wait_until(lambda: runner.frames >= 50 and runner.published >= 3)   # progress (bounded wait)
+    assert runner.stop(timeout=10.0)
     wall = time.perf_counter() - t0
-    sim = runner.sim_elapsed_s
-    # never ahead of the wall clock, and not hopelessly behind it
+    frames, sim = runner.frames, runner.sim_elapsed_s
+    # frames counted: each advanced the twin by exactly frame_s
+    assert sim == pytest.approx(frames * runner.frame_s, rel=1e-12)
+    assert twin.time_s - time0 == pytest.approx(sim, abs=0.5 * twin.model.dt_s)
+    # never ahead of the wall clock (one frame of slack for the frame in progress, one for timing)
     assert sim <= wall + 2 * runner.frame_s
-    assert sim / wall > 0.3
-    assert runner.real_time_factor is not None and 0.3 < runner.real_time_factor < 1.2
-    assert runner.overruns <= runner.frames
-    # published on the wall clock at about 50 Hz (+ the initial one)
-    assert 0.3 * 50 * wall < runner.published <= 50 * wall + 5
+    for arrived, snap in sink.arrivals:
+        assert snap.time_s - time0 <= (arrived - t0) + 2 * runner.frame_s
+    assert 0 <= runner.overruns <= frames
+    # published on the wall clock at 50 Hz (+ the initial one), never more than once per frame
+    assert 3 <= runner.published <= min(frames + 1, 50 * wall + 2)
     rtfs = [s.real_time_factor for s in sink.snapshots[1:]]
-    assert rtfs and all(r is not None for r in rtfs)
+    assert rtfs and all(r is not None and r > 0.0 for r in rtfs)
     seqs = [s.seq for s in sink.snapshots]
     assert seqs == sorted(seqs) and len(set(seqs)) == len(seqs)
+
+
+class _FakeClock:
+    """A monotonic clock that only moves when told to (frame work) or when the pacing sleeps."""
+
+    def __init__(self):
+        self.t = 100.0
+        self.slept = 0.0
+
+    def __call__(self):
+        return self.t
+
+    def wait(self, seconds):       # threading.Event.wait as the pacing uses it
+        assert seconds >= 0.0
+        self.t += seconds
+        self.slept += seconds
+        return False
+
+
+def test_pacing_clock_holds_the_wall_clock_deterministically():
+    """PacingClock on a fake clock (no machine speed involved): frames that take 0.2 ms of 1 ms
+    sleep to their deadline exactly (simulated = wall, real-time factor 1); a 5 ms frame is an
+    overrun, the next frames catch up without sleeping (each still late is an overrun) and never
+    get ahead; a stall longer than
+    resync_after_s re-anchors the schedule; fast mode never sleeps."""
+    from service.core.pacing import PacingClock
+
+    clock = _FakeClock()
+    pacing = PacingClock(fast=False, publish_period_s=0.02, clock=clock, resync_after_s=0.25)
+    frame_s, sim = 1e-3, 0.0
+    wall0 = clock()
+    pacing.start(sim)
+
+    def frame(work_s):
+        nonlocal sim
+        clock.t += work_s
+        sim += frame_s
+        now = clock()
+        pacing.measure(now, sim)
+        pacing.wait_for_deadline(now, sim, clock)
+        assert sim <= clock() - wall0 + 1e-12          # never ahead of the wall clock
+
+    for _ in range(100):
+        frame(2e-4)
+    assert clock() - wall0 == pytest.approx(sim, abs=1e-12)    # on the deadline, to the rounding
+    assert pacing.overruns == 0 and pacing.real_time_factor == pytest.approx(1.0)
+    assert clock.slept == pytest.approx(100 * 8e-4)
+    frame(5e-3)                                                 # 4 ms late: an overrun, no sleep
+    assert pacing.overruns == 1
+    slept = clock.slept
+    for _ in range(5):                                          # 3.25, 2.5, 1.75, 1.0, 0.25 ms late
+        frame(2.5e-4)
+    assert clock.slept == slept and pacing.overruns == 6       # caught up without sleeping
+    frame(2.5e-4)                                               # 0.5 ms early: sleeps to the deadline
+    assert clock.slept - slept == pytest.approx(5e-4) and pacing.overruns == 6
+    assert clock() - wall0 == pytest.approx(sim, abs=1e-12)
+    frame(0.3)                                                  # a stall: re-anchored, not raced
+    assert pacing.resyncs == 1
+    before = clock.slept
+    frame(2e-4)
+    assert clock.slept - before == pytest.approx(8e-4)          # back on a schedule from the stall
+
+    fast = PacingClock(fast=True, publish_period_s=0.02, clock=clock)
+    fast.start(0.0)
+    slept = clock.slept
+    for k in range(1, 50):
+        fast.wait_for_deadline(clock(), k * frame_s, clock)
+    assert clock.slept == slept and fast.overruns == 0
 
 
 def test_fast_mode_publishes_on_simulated_time(twin, make_runner):
