@@ -29,6 +29,7 @@ from numba import njit
 from twin.jit import JIT
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
+    A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, C_XI_DECAY, G_NX, G_NY, G_NZ,
     C_CAPACITANCE, C_ENTRAINMENT, C_FLUID_DAMPING, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
     C_RESISTANCE, C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT,
     C_SRR, C_TANGENT_DAMPING, CW, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
@@ -40,7 +41,8 @@ from twin.kernels.layout import (
     P_OIL_RESISTIVITY, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_SHAFT_SPEED,
 )
-from twin.kernels.step import ELECTRICAL_EVERY, ROLLING_REGULARISATION_SPEED, step_n
+from twin.kernels.step import (ELECTRICAL_EVERY, ROLLING_REGULARISATION_SPEED, SPIN_CREEP_FACTOR, _at_angle,
+                               step_n)
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 
 PASSES = ("gather", "geometry", "forces", "tribology", "cage", "integration")
@@ -118,15 +120,26 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
             w[C_LOAD * CW + c] = q_el
             if tribology_now:
                 r = c & 1
+                # Hertz and film constants at the contact's current angle (angle table rows i, i + 1)
+                xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
+                ia = min(int(xa), ANGLE_POINTS - 2)
+                fa = xa - ia
+                w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
                 ex = w[O_EX * CW + c]
                 ey = w[O_EY * CW + c]
                 ez = w[O_EZ * CW + c]
                 u2 = ex * ex + ey * ey + ez * ez
                 u = math.sqrt(u2)
+                t = A_TRIBOLOGY
                 tri = contact_tribology(
-                    q_el, u, eta, roughness, tr[r, 0], tr[r, 1], tr[r, 2], tr[r, 3], tr[r, 4],
-                    tr[r, 5], tr[r, 6], tr[r, 7], tr[r, 8], tr[r, 9], tr[r, 10], tr[r, 11],
-                    tr[r, 12], tr[r, 13], tr[r, 14], friction_model, rolling_on)
+                    q_el, u, eta, roughness, _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
+                    _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
+                    _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
+                    _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
+                    _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
+                    _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
+                    _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
+                    _at_angle(tr, r, ia, fa, t + 14), friction_model, rolling_on)
                 w[C_H_MIN * CW + c] = tri[0]
                 w[C_H_C * CW + c] = tri[1]
                 w[C_LAMBDA * CW + c] = tri[2]
@@ -141,13 +154,19 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
                 kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
                 w[C_TANGENT_DAMPING * CW + c] = ct_ratio * 2.0 * math.sqrt(kt * tangent_mass)
                 w[C_ENTRAINMENT * CW + c] = u
+                ab = math.sqrt(tri[5] * tri[6])
+                spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
+                               + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
+                relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * tri[4] * q_el, 1e-12)
+                w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
                 w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
                                       + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
                 if not electrical_now:
                     continue
                 if tri[1] > 0.0:
                     res_ohm, cap_f = contact_electrical(
-                        q_el, tri[2], tri[1], tri[5], tri[6], tr[r, T_RX], tr[r, T_RY],
+                        q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
+                        _at_angle(tr, r, ia, fa, t + T_RY),
                         p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT], p[P_ASPERITY_RESISTANCE],
                         p[P_OIL_RESISTIVITY])
                 else:
@@ -267,7 +286,7 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     """ns per step of each pass (best and median of `repeats` loops of `reps` calls) on copies of
     the twin's state, and of `step_n` itself (`total`); see the module docstring."""
     m, s = twin.model, twin.state
-    p, tr, sp = m.params, m.race_tribology, twin._setpoint_vector
+    p, tr, sp = m.params, m.angle_table, twin._setpoint_vector
     nc = 2 * m.ball_count
     substeps = int(p[P_SUBSTEPS])
 
