@@ -66,7 +66,7 @@ class Peer:
     def __init__(self, endpoint: str, timeout_s: float = PEER_WAIT_S):
         import zenoh
 
-        from service.bus import make_config
+        from service.bus.zenoh_bus import make_config
 
         self.timeout_s = timeout_s
         self.session = zenoh.open(make_config([], [endpoint], "peer"))
@@ -139,7 +139,7 @@ class ThreadServer:
     def __init__(self, settings, start_timeout_s: float = 90.0, stop_timeout_s: float = 20.0):
         import uvicorn
 
-        from service.app import create_app
+        from service.api.app import create_app
 
         self.app = create_app(settings)
         config = uvicorn.Config(self.app, host="127.0.0.1", port=0, log_level="warning",

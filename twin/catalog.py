@@ -6,7 +6,7 @@
   raceway radii 24.0 / 36.6 mm, Z = 13, cage elements Rz = 1.01 mm, conformity
   B = (Rci + Rce)/(2 Rb) - 1 = 0.14, i.e. groove radii 0.57 D). Seed 004 gives no contact angle
   and prints eps = 2.46 under Fr = Fa = 3000 N at 500 rad/s; no contact angle reproduces it with
-  this geometry: a Jones quasi-static solution (twin.analytic.jones_equilibrium, exact Hertz,
+  this geometry: a Jones quasi-static solution (twin.validation.analytic.jones_equilibrium, exact Hertz,
   centrifugal force) gives eps = (1 + delta_a tan(alpha) / delta_r) / 2 = 0.42 (40 deg), 1.15
   (25 deg), 1.56 (15 deg), and at most 1.76 (near 8-9 deg): with the loose conformity
   B = 0.14 the loaded contact angle grows under the axial load (15 -> 17.3 deg), which bounds

@@ -23,11 +23,12 @@ from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_tempera
                                   roelands_temperature_viscosity_pa_s, thermal_film_factor,
                                   thermal_loading_parameter)
 from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
-from twin.setpoint import Setpoint, SetpointUpdate, check_limits
-from twin.electrical import bearing_network
+from twin.faults import Fault, FaultKind
+from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
+from twin.electrical_network import bearing_network
 from twin.life import LifeMonitor, LifeSettings
-from twin.snapshot import BallState, ContactState, LifeState, SetpointState, Snapshot
-from twin.snapshot import ElectricalState as ElectricalSnapshot
+from twin.snapshot import BallState, ContactState, LifeState, Snapshot
+from twin.snapshot import ElectricalState
 from twin.spec import BearingSpec, ModelOptions
 from twin.state import TwinState, make_state
 from twin.warmstart import warm_start
@@ -40,19 +41,6 @@ COUPLING_PERIOD_S = 0.01  # electro-thermal coupling refreshed every 10 ms of si
 
 def _finite_or_none(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
-
-
-def setpoint_limits(model: BearingModel) -> dict[str, tuple[float, float]]:
-    """Allowed (low, high) of each setpoint field for this bearing model."""
-    axial_low = 0.0 if model.spec.kind == "angular_contact" else -model.max_axial_load_n
-    return {
-        "shaft_speed_rad_s": (0.0, model.max_shaft_speed_rad_s),
-        "radial_load_n": (0.0, model.max_radial_load_n),
-        "axial_load_n": (axial_low, model.max_axial_load_n),
-        "oil_temperature_c": (-30.0, 150.0),
-        "shaft_current_a": (0.0, 100.0),
-        "shaft_voltage_v": (0.0, 1000.0),
-    }
 
 
 class Twin:
@@ -79,14 +67,16 @@ class Twin:
         self.life_monitor = LifeMonitor(self.model, life)  # rating life and damage (twin.life)
         self._setpoint_vector = np.zeros(L.N_SETPOINT)
         self._setpoint = Setpoint()
+        self.limits: SetpointLimits = SetpointLimits.for_model(self.model)
+        """Allowed [low, high] of each setpoint field for this bearing (twin.setpoint)."""
         self.seq = 0
         self.restarts = 0
-        self.status = "ok"
+        self.fault: Fault | None = None   # the last fault (None: none since start or the last new setpoint)
         self.halted = False
         self._last_restart_time_s = -math.inf
         self._last_good_time_s = 0.0
         self._last_torque_n_m = 0.0
-        self._apply(setpoint or self.default_setpoint())
+        self._apply(self.limits.admit(setpoint or self.default_setpoint()))
         self.reset(warm=warm)
 
     def default_setpoint(self) -> Setpoint:
@@ -102,17 +92,17 @@ class Twin:
 
     # ---- setpoint ---------------------------------------------------------------------------
     @property
-    def limits(self) -> dict[str, tuple[float, float]]:
-        """Allowed (low, high) of each setpoint field for this bearing."""
-        return setpoint_limits(self.model)
-
-    @property
     def setpoint(self) -> Setpoint:
         """The setpoint in force."""
         return self._setpoint
 
-    def _apply(self, new: Setpoint) -> Setpoint:
-        check_limits(new, self.limits)
+    @property
+    def status(self) -> str:
+        """'ok', or what the last fault was and what the engine did (`fault.describe()`)."""
+        return "ok" if self.fault is None else self.fault.describe()
+
+    def _apply(self, admitted: Admitted) -> Setpoint:
+        new = admitted.setpoint
         self._setpoint = new
         v = self._setpoint_vector
         v[L.S_SHAFT_SPEED] = new.shaft_speed_rad_s
@@ -129,7 +119,7 @@ class Twin:
         """Thermal film loss at the inlet, where the film is formed: the current discharge of the
         race track heats it (seed 003 eq. 10, with the bearing's equivalent resistance) and the
         film falls by g(dT)^c_T, calibrated against the thermal EHL solver's current heating
-        (twin.thermal_calibration); the back-flow shear of the inlet (Thermal.shear_heating)
+        (twin.validation.thermal_law_fit); the back-flow shear of the inlet (Thermal.shear_heating)
         reduces it further by the Murch-Wilson factor phi_T = 3.94 / (3.94 + L^0.62),
         L = beta eta u^2 / k_f at the current-heated inlet (twin.physics.thermal). The film the
         loop computes is the isothermal film at the oil temperature times both factors; they
@@ -223,14 +213,20 @@ class Twin:
             float(self.state.scalars[L.X_SHAFT_SPEED]) / (2.0 * math.pi), th.crater_depth_m,
             m.spec.material.density_kg_m3, th.ball_specific_heat_j_kg_k, m.contact_angle_rad))
 
-    def set_setpoint(self, update: SetpointUpdate | None = None, **fields) -> Setpoint:
-        """Apply a partial setpoint (validated; raises SetpointError / ValidationError naming the
-        field and its range). Takes effect at the next frame; returns the setpoint in force."""
-        update = update or SetpointUpdate(**fields)
-        applied = self._apply(update.apply_to(self._setpoint))
+    def set_setpoint(self, update: SetpointUpdate | Setpoint | Admitted | None = None, **fields) -> Setpoint:
+        """Apply a setpoint: a partial `SetpointUpdate` (or keyword fields), a complete
+        `Setpoint`, or one already `Admitted` by this twin's limits (not checked again). Raises
+        SetpointError naming every field outside the bearing's range (pydantic's ValidationError
+        for a wrong type). Takes effect at the next frame; returns the setpoint in force."""
+        if not (isinstance(update, Admitted) and update.limits == self.limits):
+            if isinstance(update, Admitted):
+                update = update.setpoint
+            update = self.limits.admit(update if update is not None else SetpointUpdate(**fields),
+                                       self._setpoint)
+        applied = self._apply(update)
         if self.halted:  # a new setpoint: try again from the warm start
             self.halted = False
-            self.status = "ok"
+            self.fault = None
             self.reset(keep_time=True)
         return applied
 
@@ -299,10 +295,9 @@ class Twin:
         self.restarts += 1
         if t - self._last_restart_time_s < RESTART_WINDOW_S:
             self.halted = True
-            self.status = (f"halted: {reason} again within {RESTART_WINDOW_S * 1e3:.0f} ms of a restart "
-                           f"at t = {t:.6f} s; the setpoint cannot be held, waiting for a new one")
+            self.fault = Fault(FaultKind.HALTED, reason, t, RESTART_WINDOW_S)
         else:
-            self.status = f"restarted: {reason} at t = {t:.6f} s"
+            self.fault = Fault(FaultKind.RESTARTED, reason, t)
         self._last_restart_time_s = t
         self.state.scalars[L.X_TIME] = t
         self.reset(keep_time=True)
@@ -368,7 +363,7 @@ class Twin:
         return float(kt * math.sqrt(c[L.T_XI0] ** 2 + c[L.T_XI1] ** 2 + c[L.T_XI2] ** 2) / c[L.C_LOAD])
 
     def electrical(self):
-        """The bearing's electrical network at the current state (twin.electrical)."""
+        """The bearing's electrical network at the current state (twin.electrical_network)."""
         sp = self._setpoint
         return bearing_network(self.model, self.state.contacts, sp.shaft_voltage_v, sp.shaft_current_a)
 
@@ -396,13 +391,13 @@ class Twin:
             time_s=self.time_s,
             real_time_factor=_finite_or_none(real_time_factor) if real_time_factor is not None else None,
             status=self.status, restarts=self.restarts,
-            setpoint=SetpointState(**sp.model_dump()),
+            setpoint=sp,
             shaft_speed_rad_s=float(s.scalars[L.X_SHAFT_SPEED]),
             cage_speed_rad_s=float(s.scalars[L.X_CAGE_SPEED]),
             inner_ring_displacement_m=tuple(float(a) for a in s.ring_position_m),
             friction_torque_n_m=float(self._last_torque_n_m),
             viscosity_pa_s=float(self._inlet_viscosity_pa_s),
-            electrical=ElectricalSnapshot(
+            electrical=ElectricalState(
                 resistance_ohm=_finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,
                 capacitance_reason=net.capacitance_reason,
                 impedance_ohm=net.impedance_ohm, phase_rad=net.phase_rad,

@@ -661,10 +661,9 @@ def rate_operating_point(designation: str, radial_load_n: float, axial_load_n: f
     centrifugal force included). Inputs are validated against the
     bearing's limits (SetpointError / ValidationError / ValueError naming the field)."""
     from twin import catalog
-    from twin.engine import setpoint_limits
     from twin.model import make_model
     from twin.physics.viscosity import kinematic_viscosity_m2_s
-    from twin.setpoint import Setpoint, check_limits
+    from twin.setpoint import Setpoint, SetpointLimits
 
     settings = settings or LifeSettings()
     spec = catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m,
@@ -672,7 +671,7 @@ def rate_operating_point(designation: str, radial_load_n: float, axial_load_n: f
     model = make_model(spec)
     setpoint = Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n, axial_load_n=axial_load_n,
                         oil_temperature_c=oil_temperature_c)
-    check_limits(setpoint, setpoint_limits(model))
+    SetpointLimits.for_model(model).check(setpoint)   # the one range check, quoting the bearing's range
     lub = spec.lubricant
     nu = kinematic_viscosity_m2_s(lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s,
                                   oil_temperature_c)

@@ -1,4 +1,4 @@
-"""The public state message, schema "bearing-twin/state/1" (DESIGN.md): immutable, units in
+"""The public state message, schema "bearing-twin/state/1" (README, Architecture): immutable, units in
 every field name, JSON without NaN or Infinity (undefined values are null)."""
 
 from __future__ import annotations
@@ -6,6 +6,8 @@ from __future__ import annotations
 from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field
+
+from twin.setpoint import Setpoint
 
 SCHEMA = "bearing-twin/state/1"
 
@@ -99,18 +101,6 @@ class LifeState(BaseModel):
     reason: str | None = Field(default=None, description="Why values are null, or a caveat; null when there is none.")
 
 
-class SetpointState(BaseModel):
-    """The setpoint in force."""
-
-    model_config = _FROZEN
-    shaft_speed_rad_s: float = Field(description="Shaft speed setpoint [rad/s].")
-    radial_load_n: float = Field(description="Radial load [N].")
-    axial_load_n: float = Field(description="Axial load [N].")
-    oil_temperature_c: float = Field(description="Oil temperature [degC].")
-    shaft_current_a: float = Field(description="Shaft current setpoint [A].")
-    shaft_voltage_v: float = Field(description="Shaft voltage setpoint [V].")
-
-
 class Snapshot(BaseModel):
     """Everything the world may see of one twin at one instant."""
 
@@ -124,7 +114,7 @@ class Snapshot(BaseModel):
     real_time_factor: float | None = Field(description="Simulated seconds per wall second over the last frames [-]; null when not measured.")
     status: str = Field(description="'ok' or what went wrong and what the twin did about it.")
     restarts: int = Field(description="Warm restarts after a diverged or overloaded state.")
-    setpoint: SetpointState
+    setpoint: Setpoint = Field(description="The setpoint in force during the frame that ended at time_s [fields with units].")
     shaft_speed_rad_s: float = Field(description="Current (ramped) shaft speed [rad/s].")
     cage_speed_rad_s: float = Field(description="Cage angular speed [rad/s].")
     inner_ring_displacement_m: tuple[float, float, float] = Field(description="Inner ring centre (x along the radial load, y, z axial) [m].")

@@ -215,7 +215,7 @@ class Thermal(BaseModel):
     film_temperature_exponent: float = Field(
         default=1.38, gt=0.0, le=5.0,
         description="c_T of the loop's current-heating film law h/h_iso = g(dT)^c_T [-], fitted to the current heating "
-        "of the thermal EHL solver (twin.thermal_calibration: the solver's film with current over its film without, "
+        "of the thermal EHL solver (twin.validation.thermal_law_fit: the solver's film with current over its film without, "
         "28 cells of seed 003 Appendix 2, rms 13 % in ln h, max error 6.4 points of reduction).")
 
 

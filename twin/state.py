@@ -39,6 +39,9 @@ class TwinState:
         rows = self.lanes.reshape(L.N_ROWS, L.CW)
         rows[: L.N_CACHED] = 0.0
         rows[L.T_XI0:L.T_XI2 + 1] = 0.0
+        # the spring's decay factor is read (xi * decay) before the first refresh sets it: a
+        # value left from a diverged state (NaN) would poison the spring after a warm restart
+        rows[L.C_XI_DECAY] = 1.0
         rows[L.C_LAMBDA] = -1.0
         rows[L.C_H_MIN] = -1.0
         rows[L.C_H_C] = -1.0

@@ -2,7 +2,7 @@
 
 The engine integrates with the leapfrog form of velocity-Verlet (seed 000 eq. 10), velocity-
 dependent forces taking the half-step velocity (turned on by the cage's half-step rotation, a
-turn of under 1e-3 rad that leaves the limit below unchanged, `twin.timestep_study` measures it):
+turn of under 1e-3 rad that leaves the limit below unchanged, `twin.validation.timestep_study` measures it):
 the central-difference scheme. For a linear oscillator of circular frequency omega and damping ratio zeta it is stable for
 
     dt <= dt_crit = 2 / omega (sqrt(1 + zeta^2) - zeta)
@@ -55,7 +55,7 @@ AUTO = "auto"
 # Q^(1/3) under the dynamic overshoot of a load step, a few % on omega), its elements are coupled
 # (the estimate treats each alone, and coupling raises the highest frequency slightly), and the
 # bound of the fluid damping holds at the reference oil temperature only. 0.8 leaves 25 % on the
-# step for these. Accuracy is not what sets it: `twin.timestep_study` shows that the outputs at
+# step for these. Accuracy is not what sets it: `twin.validation.timestep_study` shows that the outputs at
 # the auto step agree with 1 us within the tolerances of issue 13 over the operating envelope.
 SAFETY_FACTOR = 0.8
 FRAME_S = 1e-3                    # the auto step divides the 1 ms frame

@@ -41,7 +41,8 @@ from itertools import pairwise
 import numpy as np
 import pytest
 
-from twin.ehl_solver import calibration, solve_point_contact
+from twin.ehl_solver import film_reduction as calibration
+from twin.ehl_solver import solve_point_contact
 from twin.ehl_solver import params as prm
 from twin.ehl_solver.elastic import Deflection
 from twin.ehl_solver.solver import DEFAULT_DOMAIN, _Level
@@ -355,9 +356,9 @@ def test_film_reduction_factor_interpolates_the_table():
 # --- command line --------------------------------------------------------------------------------
 
 def test_cli_solve_json_carries_the_required_fields():
-    """Issue 7 CLI contract: `bearing-twin ehl solve --json` (service/ehl_cli.py, Appendix 2
+    """Issue 7 CLI contract: `bearing-twin ehl solve --json` (service/tools/ehl_cli.py, Appendix 2
     defaults, 65 x 65 grid) carries the required fields and inputs (exact keys, eta0 = 0.04)."""
-    from service.ehl_cli import main
+    from service.tools.ehl_cli import main
 
     buf = io.StringIO()
     with redirect_stdout(buf):
@@ -378,7 +379,7 @@ def test_report_section_writes_the_figures_and_the_table(tmp_path):
     """service/report_ehl.write_ehl_section on a small grid (33 x 33, for speed): the three PNGs
     (centre line isothermal and with 0/10/20/30 A: seed 003 Fig. 5; film vs speed: Fig. 1) exist,
     are real images (PNG signature, > 10 kB) and the Markdown embeds them and names the figures."""
-    from service import report_ehl
+    from service.reports import ehl as report_ehl
 
     md = report_ehl.write_ehl_section(tmp_path, grid=33, progress=False)
     for name in (report_ehl.CENTRE_LINE_PNG, report_ehl.CURRENT_PNG, report_ehl.SPEED_PNG):

@@ -13,7 +13,8 @@ import numpy as np
 import pytest
 from scipy import optimize
 
-from twin import analytic, catalog
+from twin import catalog
+from twin.validation import analytic
 from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.model import contact_constants, make_model

@@ -2,19 +2,19 @@
 
 The DEM is started at 1500 N and the load is stepped to 3000 N, so the dynamics (not the warm
 start) must find the equilibrium. The reference is the Hertz equilibrium of the rigid rings for
-the balls' actual azimuths (`twin.analytic.radial_equilibrium`) with the same contact law.
+the balls' actual azimuths (`twin.validation.analytic.radial_equilibrium`) with the same contact law.
 
 Load parameter eps: the seed prints 0.685 / 0.5 / 0.4 for Pd = -12.6 / 0 / +12.6 um, and exact
 Hertz constants (complete elliptic integrals, twin.physics.hertz) give 0.684 / 0.500 / 0.402 for
 the rigid-ring equilibrium: the DEM after settling must give the seed's values within 2 %.
 (This test used to assert 0.745 / 0.388, the values of the 32 % too stiff contact constant
-Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) that an earlier DESIGN.md reading carried: it asserted the defect.)
+Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) that an earlier reading of seed 000 eq. 2 carried: it asserted the defect.)
 """
 
 import numpy as np
 import pytest
 
-from twin import analytic
+from twin.validation import analytic
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 from twin.spec import ModelOptions

@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from twin import studies
+from twin.validation import studies
 from twin.spec import ModelOptions
 
 SPEEDS = [100, 300, 500, 700, 900, 1100, 1300, 1500, 1700]

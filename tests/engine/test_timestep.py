@@ -10,7 +10,8 @@ import numpy as np
 import pytest
 from pydantic import ValidationError
 
-from twin import catalog, timestep, timestep_study
+from twin import catalog, timestep
+from twin.validation import timestep_study
 from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.model import make_model

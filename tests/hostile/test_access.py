@@ -10,8 +10,9 @@ import json
 import httpx
 import pytest
 
-from service.runner import TwinRunner
-from service.security import bearer_token, token_matches
+from service.core.admission import AdmissionGate, bearer_token, token_matches
+from service.core.intake import SetpointIntake
+from service.core.runner import TwinRunner
 from service.settings import ServiceSettings
 
 TOKEN = "s3cret-Token_for.tests"
@@ -131,7 +132,7 @@ def test_settings_token_from_environment(monkeypatch):
     assert "has space" not in str(err.value)           # never echoed
 
 
-# ---- zenoh: the runner's handler --------------------------------------------------------------
+# ---- zenoh: the intake, through the same admission gate --------------------------------------------------------------
 @pytest.fixture(scope="module")
 def twin():
     from twin.engine import Twin
@@ -142,7 +143,8 @@ def twin():
 
 
 def test_zenoh_setpoints_need_the_token(twin):
-    runner = TwinRunner(twin, token=TOKEN)       # not started: submissions only hit the mailbox
+    runner = TwinRunner(twin)                    # not started: submissions only hit the mailbox
+    intake = SetpointIntake(twin.bearing_id, AdmissionGate(token=TOKEN), runner)
     cases = [
         (json.dumps({"radial_load_n": 3300.0}), 401),
         (json.dumps({"radial_load_n": 3300.0, "token": "wrong"}), 401),
@@ -153,13 +155,13 @@ def test_zenoh_setpoints_need_the_token(twin):
         (json.dumps({"radial_load_n": 3300.0, "token": TOKEN, "extra": 1}), 422),
     ]
     for payload, status in cases:
-        result = runner.submit_setpoint_json(payload)
+        result = intake(payload)
         assert result["accepted"] is False and result["status"] == status, (payload, result)
         assert TOKEN not in json.dumps(result)
-    ok = runner.submit_setpoint_json(json.dumps({"radial_load_n": 3300.0, "token": TOKEN}))
+    ok = intake(json.dumps({"radial_load_n": 3300.0, "token": TOKEN}))
     assert ok["accepted"] is True and ok["setpoint"]["radial_load_n"] == 3300.0
     assert "token" not in ok["setpoint"]
-    assert runner.setpoints_refused == len(cases)
+    assert intake.refused == len(cases)
 
 
 def test_zenoh_setpoints_through_a_real_session(hostile, tmp_path):

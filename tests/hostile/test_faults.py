@@ -7,13 +7,14 @@ from __future__ import annotations
 
 import json
 import math
+import threading
 import time
 
 import httpx
 import pytest
 
-from service.runner import TwinRunner
-from service.schemas import InputError
+from service.core.errors import InputError
+from service.core.runner import TwinRunner
 from service.settings import ServiceSettings
 from twin.engine import Twin
 from twin.kernels import layout as L
@@ -31,6 +32,41 @@ def wait_until(predicate, timeout=WAIT_S):
 
 def finite_json(text: str) -> dict:
     return json.loads(text, parse_constant=lambda c: pytest.fail(f"JSON carries {c}"))
+
+
+class FaultHook:
+    """Test-only fault injection (the production runner has none): wraps the twin's `advance`,
+    which the runner thread calls for every frame, so that a queued fault hits the engine
+    between frames, as a bug or a corrupted setpoint would. "nan" puts NaN into the first ball's
+    position; "overload" sets the radial load in force to `value` [N] behind the validation's
+    back (engine internals, as only a bug could)."""
+
+    def __init__(self, twin):
+        self.twin, self._queue, self._lock = twin, [], threading.Lock()
+        self._advance = twin.advance
+        twin.advance = self._advance_with_faults
+
+    @classmethod
+    def of(cls, twin) -> FaultHook:
+        hook = getattr(twin, "_test_fault_hook", None)
+        if hook is None:
+            hook = twin._test_fault_hook = cls(twin)
+        return hook
+
+    def inject(self, kind: str, value: float | None = None) -> None:
+        with self._lock:
+            self._queue.append((kind, value))
+
+    def _advance_with_faults(self, *args, **kwargs):
+        with self._lock:
+            faults, self._queue = self._queue, []
+        for kind, value in faults:
+            if kind == "nan":
+                self.twin.state.ball_position_m[0, 0] = math.nan
+            else:
+                self.twin._setpoint = self.twin.setpoint.model_copy(update={"radial_load_n": float(value)})
+                self.twin._setpoint_vector[L.S_RADIAL_LOAD] = float(value)
+        return self._advance(*args, **kwargs)
 
 
 class ListSink:
@@ -70,7 +106,7 @@ def test_nan_in_the_state_is_detected_and_restarted(twin):
     runner = TwinRunner(twin, sinks=[sink]).start()
     try:
         wait_until(lambda: runner.frames > 20)
-        runner.inject_fault("nan")
+        FaultHook.of(twin).inject("nan")
         wait_until(lambda: twin.restarts >= 1)
         wait_until(lambda: runner.latest.restarts >= 1)
         snap = runner.latest
@@ -92,7 +128,7 @@ def test_unholdable_setpoint_falls_back_to_the_last_safe_one(twin):
     try:
         runner.submit(radial_load_n=6000.0)
         wait_until(lambda: runner.last_safe_setpoint.radial_load_n == 6000.0)
-        runner.inject_fault("overload", 1e7)             # a corrupted setpoint in force
+        FaultHook.of(twin).inject("overload", 1e7)       # a corrupted setpoint in force
         wait_until(lambda: runner.fallbacks == 1)
         wait_until(lambda: "setpoint not held" in runner.latest.status)
         status = runner.latest.status
@@ -130,7 +166,7 @@ def test_http_state_after_an_overload_bypassing_validation(server, hostile):
     runner = srv.service.get("default").runner
     safe = client.get("/health").json()["twins"][0]["last_safe_setpoint"]["radial_load_n"]
     before = _state(client)["restarts"]
-    runner.inject_fault("overload", 1e7)
+    FaultHook.of(runner.twin).inject("overload", 1e7)
     s = hostile.wait_for(lambda: _state(client), lambda s: "setpoint not held" in s["status"], timeout=WAIT_S)
     assert "radial_load_n = 1e+07 N" in s["status"] and "overloaded" in s["status"]
     assert f"last safe setpoint (radial_load_n = {safe:g} N)" in s["status"]
@@ -169,7 +205,7 @@ def test_http_state_after_a_nan_is_injected(server, hostile):
     srv, client = server
     runner = srv.service.get("default").runner
     before = _state(client)["restarts"]
-    runner.inject_fault("nan")
+    FaultHook.of(runner.twin).inject("nan")
     s = hostile.wait_for(lambda: _state(client), lambda s: s["restarts"] > before, timeout=WAIT_S)
     assert "diverged: non-finite state" in s["status"]
     later = hostile.wait_for(lambda: _state(client), lambda x: x["seq"] > s["seq"] + 3)
@@ -179,11 +215,11 @@ def test_http_state_after_a_nan_is_injected(server, hostile):
 def test_scenario_into_a_value_not_held_fails_cleanly(twin):
     """A scenario stepping into a value the twin has already failed to hold stops with the reason
     (the value is refused like an HTTP setpoint would be); the twin keeps running."""
-    from service.scenarios import scenario_from_dict
+    from service.core.scenarios import scenario_from_dict
 
     runner = TwinRunner(twin)
     high = runner.limits["radial_load_n"][1]
-    runner._not_held["radial_load_n"] = (0.9 * high, "overloaded: excessive contact penetration")
+    runner.faults.not_held["radial_load_n"] = (0.9 * high, "overloaded: excessive contact penetration")
     scenario = scenario_from_dict({"name": "overload", "duration_s": 0.05, "initial": {"radial_load_n": 3000.0},
                                    "steps": [{"at_s": 0.01, "set": {"radial_load_n": 0.95 * high}}]})
     runner.start()
@@ -201,7 +237,7 @@ def test_scenario_into_a_value_not_held_fails_cleanly(twin):
 def test_learned_refusal_only_for_the_twin_that_failed(twin):
     runner = TwinRunner(twin)
     high = runner.limits["radial_load_n"][1]
-    runner._not_held["radial_load_n"] = (0.8 * high, "overloaded")
+    runner.faults.not_held["radial_load_n"] = (0.8 * high, "overloaded")
     with pytest.raises(InputError) as err:
         runner.submit(radial_load_n=0.9 * high)
     e = err.value.errors[0]

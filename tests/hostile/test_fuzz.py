@@ -17,7 +17,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from service.runner import TwinRunner
+from service.core.admission import AdmissionGate
+from service.core.intake import SetpointIntake
+from service.core.runner import TwinRunner
 from service.settings import ServiceSettings
 
 CAP = 4096
@@ -219,7 +221,8 @@ def running_runner():
     twin = Twin("6208")
     twin.advance(0.001)
     sink = ListSink()
-    runner = TwinRunner(twin, sinks=[sink], publish_rate_hz=50.0, max_payload_bytes=CAP).start()
+    runner = TwinRunner(twin, sinks=[sink], publish_rate_hz=50.0).start()
+    runner.intake = SetpointIntake("default", AdmissionGate(max_payload_bytes=CAP), runner)
     yield runner, sink
     assert runner.stop(10.0)
 
@@ -241,7 +244,7 @@ def _dumpable(value) -> bool:
 @given(payload=zenoh_payloads)
 def test_fuzz_zenoh_setpoint_handler(running_runner, payload):
     runner, _sink = running_runner
-    result = runner.submit_setpoint_json(payload)
+    result = runner.intake(payload)
     assert isinstance(result, dict) and isinstance(result["accepted"], bool)
     json.dumps(result, allow_nan=False)          # what the bus publishes: never NaN
     if not result["accepted"]:

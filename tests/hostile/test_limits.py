@@ -11,8 +11,9 @@ import time
 import httpx
 import pytest
 
-from service.runner import TwinRunner
-from service.security import TokenBucket
+from service.core.admission import AdmissionGate, TokenBucket
+from service.core.intake import SetpointIntake
+from service.core.runner import TwinRunner
 from service.settings import ServiceSettings
 
 RATE, BURST, CAP = 5.0, 10, 2048
@@ -146,15 +147,17 @@ def twin():
 
 
 def test_zenoh_handler_rate_and_size(twin):
-    runner = TwinRunner(twin, setpoint_rate_hz=RATE, setpoint_burst=BURST, max_payload_bytes=CAP)
-    results = [runner.submit_setpoint_json(b'{"oil_temperature_c": 44}') for _ in range(BURST + 5)]
+    gate = AdmissionGate(setpoint_rate_hz=RATE, setpoint_burst=BURST, max_payload_bytes=CAP)
+    intake = SetpointIntake(twin.bearing_id, gate, TwinRunner(twin))   # the same gate as HTTP's
+    results = [intake(b'{"oil_temperature_c": 44}') for _ in range(BURST + 5)]
     accepted = [r for r in results if r["accepted"]]
     limited = [r for r in results if not r["accepted"]]
     assert BURST <= len(accepted) < BURST + 5
     assert limited and all(r["status"] == 429 and r["retry_after_s"] > 0 for r in limited)
-    big = runner.submit_setpoint_json(b'{"oil_temperature_c": 44' + b" " * CAP + b"}")
+    big = intake(b'{"oil_temperature_c": 44' + b" " * CAP + b"}")
     assert big["accepted"] is False and big["status"] == 413
-    assert runner.stats()["setpoints_rate_limited"] == len(limited)
+    assert gate.rate_limited(twin.bearing_id) == len(limited)
+    assert intake.refused == len(limited) + 1
 
 
 def test_token_bucket_refills_on_its_clock():

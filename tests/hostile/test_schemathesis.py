@@ -11,7 +11,7 @@ schemathesis = pytest.importorskip("schemathesis")
 from hypothesis import HealthCheck, settings
 from schemathesis.checks import not_a_server_error
 
-from service.app import create_app
+from service.api.app import create_app
 from service.settings import ServiceSettings
 
 EXAMPLES = 60

@@ -13,7 +13,7 @@ import sys
 import pytest
 
 from service.settings import ServiceSettings
-from service.soak import SoakConfig, _memory, format_report, run_soak
+from service.tools.soak import SoakConfig, _memory, format_report, run_soak
 
 
 def test_soak_short_run_with_its_own_service(hostile, tmp_path):
@@ -102,7 +102,7 @@ def _segmented_recording(tmp_path, groups):
 
 def test_recording_check_reads_every_segment(tmp_path):
     pytest.importorskip("rerun")
-    from service.soak import _check_recording
+    from service.tools.soak import _check_recording
 
     rec = _segmented_recording(tmp_path, (4, 6, 5))
     r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None)
@@ -113,3 +113,27 @@ def test_recording_check_reads_every_segment(tmp_path):
     rec.segments[1].rename(tmp_path / "soak-0001.rrd.bak")
     r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None)
     assert r["segments"] == 1 and not r["complete"]
+
+
+def test_short_runs_report_memory_growth_without_judging_it():
+    """A 30 s soak: the warm-up is 10 s and the 20 s after it are too short to tell a leak from
+    a one-off settling step (a +28 MB step 28 s into a run, flat afterwards, was seen), so the
+    growth is reported, not judged; a run with 60 s or more after its warm-up is judged."""
+    from service.tools.soak import MIN_JUDGED_WINDOW_S, warmup_s
+
+    mib = 2**20
+    assert warmup_s(30.0) == 10.0 and warmup_s(120.0) == 30.0 and warmup_s(600.0) == 60.0
+    short = _memory([(0.0, 360 * mib), (10.0, 360 * mib), (20.0, 388 * mib), (30.0, 388 * mib)], warmup_s(30.0), "x")
+    assert short["growth_pct"] == pytest.approx(100 * 28 / 360, rel=1e-3) and short["judged"] is False
+    t_end = warmup_s(180.0) + MIN_JUDGED_WINDOW_S
+    long = _memory([(t, 360 * mib) for t in range(0, int(t_end) + 11, 10)], warmup_s(180.0), "x")
+    assert long["judged"] is True and long["growth_pct"] == 0.0
+
+
+def test_a_clean_sigterm_shutdown_reads_as_such():
+    from service.tools.soak import _shutdown_text
+
+    assert _shutdown_text({"killed": False, "exit_code": -15, "seconds": 0.2}) == "clean shutdown in 0.2 s"
+    assert _shutdown_text({"killed": False, "exit_code": 0, "seconds": 0.2}) == "clean shutdown in 0.2 s"
+    assert "not a clean shutdown" in _shutdown_text({"killed": False, "exit_code": 1, "seconds": 0.2})
+    assert "killed" in _shutdown_text({"killed": True, "exit_code": -9, "seconds": 30.0})

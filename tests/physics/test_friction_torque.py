@@ -4,7 +4,8 @@ for the frictional moment (an independent, public catalogue formula, twin.skf_fr
 import numpy as np
 import pytest
 
-from twin import catalog, skf_friction, studies
+from twin import catalog
+from twin.validation import skf_friction, studies
 from twin.physics import viscosity
 from twin.kernels import layout as L
 from twin.spec import ModelOptions

@@ -1,4 +1,4 @@
-"""Seed 000 eq. 2 (elliptic Hertz stiffness, DESIGN.md reading) with the EXACT Hertz constants,
+"""Seed 000 eq. 2 (elliptic Hertz stiffness, README reading) with the EXACT Hertz constants,
 eq. 3 (ball-cage), and the Brewe-Hamrock approximations bounded against the exact solution.
 
 Independent references: Hertz's closed form for two spheres; a numerical dry-contact solution
@@ -46,7 +46,7 @@ def test_circle_is_hertz_sphere_formula():
 
 
 def test_6208_constants_are_the_exact_values():
-    # issue 11 / DESIGN.md "Seed 000 eq. 2": exact Hertz gives 3.25e10 / 3.45e10 N/m^1.5
+    # issue 11 / README "Readings", seed 000 eq. 2: exact Hertz gives 3.25e10 / 3.45e10 N/m^1.5
     # (the earlier Fbar = 1 + ... reading gave 4.28e10 / 4.56e10, 32 % too stiff)
     model = make_model(bearing("6208"))
     ki, ko = model.race_params[0, L.R_STIFFNESS], model.race_params[1, L.R_STIFFNESS]
@@ -152,7 +152,7 @@ def test_exact_hertz_against_a_numerical_contact_solution(case):
 
 
 def test_design_constant_is_the_seed_constant_over_one_minus_nu():
-    # DESIGN.md: pi k E' == 2 pi k G / (1 - nu) (seed 004 eq. 2); the seed 000 print lacks 1/(1-nu)
+    # README: pi k E' == 2 pi k G / (1 - nu) (seed 004 eq. 2); the seed 000 print lacks 1/(1-nu)
     e, nu = 210e9, 0.3
     g = hertz.shear_modulus_pa(e, nu)
     assert math.pi * hertz.effective_modulus_pa(e, nu) == pytest.approx(2 * math.pi * g / (1 - nu), rel=1e-12)

@@ -22,7 +22,7 @@ from twin.physics.rolling import (
     sliding_friction_coefficient_asperity_share,
     speed_parameter_u,
 )
-from twin.physics.thrust_bearing_seed001 import (
+from twin.validation.thrust_bearing_seed001 import (
     TABLE_1_D3MM_Q0633N,
     TABLE_2_D635MM_Q0125N,
     ball_race_geometry,
@@ -75,7 +75,7 @@ def test_ehl_force_eq2_reduced_form():
 
 
 def test_ehl_parameter_eq4_negative_speed_exponent():
-    # Eq. 4 (DESIGN.md reading): M = 0.5549 k^-0.6029 W U^-0.75 = 0.5549 k^-0.6029 Q E*^(-1/4)
+    # Eq. 4 (README reading): M = 0.5549 k^-0.6029 W U^-0.75 = 0.5549 k^-0.6029 Q E*^(-1/4)
     # Rx^(-5/4) (eta u)^(-3/4); M falls with speed.
     rx, k, u = _case(6.35e-3, 120)
     hand = 0.5549 * k ** -0.6029 * 0.125 * E_STAR ** -0.25 * rx ** -1.25 * (ETA * u) ** -0.75

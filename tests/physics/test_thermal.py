@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from twin import catalog, studies
+from twin import catalog
+from twin.validation import studies
 from twin.engine import Twin
 from twin.physics import thermal, viscosity
 from twin.setpoint import Setpoint

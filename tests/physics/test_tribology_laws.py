@@ -1,5 +1,5 @@
 """Each in-loop tribology law against a hand-computed value (seed 000 eqs. 5-7, Table 2,
-section 2.3; seed 004 eq. 6; DESIGN.md readings)."""
+section 2.3; seed 004 eq. 6; README readings)."""
 
 import math
 
@@ -32,7 +32,7 @@ def test_hamrock_dowson_outer_contact_6208_by_hand():
 
 
 def test_masjedi_khonsari_by_hand_and_circular_limit():
-    # seed 004 eq. 6, exponents as products (DESIGN.md)
+    # seed 004 eq. 6, exponents as products (README)
     u_par, g_par, w_par, k = 2e-11, 5000.0, 1e-4, 7.0
     hand = (1.637 * RX_OUT * u_par ** (0.711 * k ** -0.023) * g_par ** (0.65 * k ** -0.045)
             * w_par ** (-0.09 * k ** -0.15) * (1 - 0.974 * math.exp(-0.676 * k)))

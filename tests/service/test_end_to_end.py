@@ -209,7 +209,7 @@ def test_serve_http_zenoh_rerun_sigterm(service, support):
 def test_two_services_on_one_zenoh_network_seen_by_one_monitor(tmp_path):
     """Service A listens; service B listens on its own port and connects to A; a monitor that
     connects to A only sees A's two twins and B's twin (gossip over the configured links)."""
-    from service.monitor import run_monitor
+    from service.tools.monitor import run_monitor
 
     a = Service(tmp_path / "a", "--twin-id", "pump-a", "--publish-rate", "20", record=False)
     b = None

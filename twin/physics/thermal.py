@@ -151,6 +151,6 @@ def thermal_film_factor(temperature_rise_k: float, eta0_pa_s: float, theta0_k: f
     """Film-reduction factor of the current heating, h(heated inlet) / h(isothermal) = g(dT)^c:
     the Hamrock-Dowson film ratio of a uniform inlet temperature rise
     (hamrock_dowson_temperature_film_ratio) raised to the exponent c that the full thermal EHL
-    solver of seed 003 gives for its current heating (twin.thermal_calibration: the solver's
+    solver of seed 003 gives for its current heating (twin.validation.thermal_law_fit: the solver's
     films fall faster with temperature than the isothermal formula's, c > 1)."""
     return hamrock_dowson_temperature_film_ratio(temperature_rise_k, eta0_pa_s, theta0_k, beta_k_inv) ** temperature_exponent

@@ -1,0 +1,107 @@
+"""The HTTP API: `create_app(settings) -> FastAPI`, an app factory (no module-level singletons).
+
+As in vLLM's OpenAI server (`build_app` + lifespan + `app.state`) and full-stack-fastapi-
+template (one `APIRouter` per resource, `Depends` in `deps.py`):
+
+* lifespan: opens the service (`service.wiring.TwinService`: the twins, the zenoh bus and the
+  rerun recorder as the settings say) unless one was handed in already open (the CLI opens it
+  before uvicorn so that a busy zenoh port is a one-line error), and closes it in `finally`
+  (runners stopped, zenoh detached and closed, recordings flushed);
+* routers (service.api.routers): health, bearings, setpoint, state, scenarios, recording, docs;
+  each resource has a `read` and a `write` router, and the factory decides which need the
+  bearer token (writes when BEARING_TWIN_TOKEN is set, reads too with read_requires_token;
+  /health never) - so the OpenAPI document declares the bearer scheme exactly where it applies,
+  without patching;
+* dependencies (service.api.deps): the registry, the twin, the token, the setpoint rate;
+  middleware (service.api.middleware): the body size cap only;
+* errors (service.api.errors): always {"detail": [{"field", "message", "allowed"}]}.
+
+Run ONE uvicorn worker per service: each worker would run its own lifespan and its own twins.
+"""
+
+from __future__ import annotations
+
+import logging
+from contextlib import asynccontextmanager
+
+from fastapi import Depends, FastAPI
+from starlette.concurrency import run_in_threadpool
+
+from service.api.deps import require_token
+from service.api.errors import install_error_handlers
+from service.api.middleware import BodySizeLimit
+from service.api.routers import bearings, docs, health, recording, scenarios, setpoint, state
+from service.api.schemas import ErrorResponse
+from service.core.registry import TwinRegistry, admission_gate
+from service.settings import ServiceSettings
+
+log = logging.getLogger(__name__)
+
+_UNAUTHORIZED = {401: {"model": ErrorResponse, "description": "Missing or wrong bearer token"}}
+
+
+def _loopback(host: str) -> bool:
+    return host in ("127.0.0.1", "localhost", "::1") or host.startswith("127.")
+
+
+def access_summary(settings: ServiceSettings) -> str:
+    """One line: whether a token is required, and for what."""
+    if settings.token is None:
+        return ("no token (BEARING_TWIN_TOKEN unset): anyone who can reach the port may change "
+                "setpoints")
+    reads = "reads too (except /health)" if settings.read_requires_token else "reads open"
+    return f"bearer token required for POST/PUT/DELETE and zenoh setpoints; {reads}"
+
+
+def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry | None = None) -> FastAPI:
+    """The FastAPI application for one service (see the module docstring). `service`: an
+    already open service to serve (and close at shutdown) instead of opening one."""
+    settings = settings or ServiceSettings()
+    gate = service.gate if service is not None else admission_gate(settings)
+
+    @asynccontextmanager
+    async def lifespan(app: FastAPI):
+        log.info("bearing-twin: HTTP bound to %s:%s (%s); %s", settings.host, settings.port,
+                 "loopback only" if _loopback(settings.host) else "reachable from other machines",
+                 access_summary(settings))
+        opened = service
+        if opened is None:
+            from service.wiring import TwinService
+
+            opened = TwinService(settings, gate=gate)
+            await run_in_threadpool(opened.open)
+        app.state.service = opened
+        try:
+            yield
+        finally:
+            app.state.service = None
+            await run_in_threadpool(opened.close)
+
+    app = FastAPI(
+        title="bearing-twin",
+        version="0.1.0",
+        summary="Real-time DEM digital twin of lubricated ball bearings",
+        description="Setpoints in, live contact state out. Units are in every field name and "
+        "description (SI, oil temperature in degC). State schema 'bearing-twin/state/1'; the same "
+        "snapshots stream on zenoh `bearing/{id}/state` and `bearing/{id}/ball/{i}`.",
+        lifespan=lifespan, openapi_url=None, docs_url=None, redoc_url=None,
+    )
+    app.state.settings = settings
+    app.state.gate = gate
+    app.state.service = None
+    app.add_middleware(BodySizeLimit, gate=gate)
+    install_error_handlers(app)
+
+    token = [Depends(require_token)] if gate.requires_token else []
+    writes = {"dependencies": token, "responses": {
+        **(_UNAUTHORIZED if token else {}),
+        413: {"model": ErrorResponse, "description": f"Body larger than {settings.max_body_bytes} bytes"}}}
+    reads = ({"dependencies": token, "responses": _UNAUTHORIZED}
+             if token and settings.read_requires_token else {})
+    app.include_router(health.router)
+    for router in (bearings.read, state.read, scenarios.read, docs.read):
+        app.include_router(router, **reads)
+    for router in (bearings.write, setpoint.write, scenarios.write, recording.write):
+        app.include_router(router, **writes)
+    docs.mount_assets(app)
+    return app

@@ -1,0 +1,1 @@
+"""One module per resource: health, bearings, setpoint, state, scenarios, recording, docs."""

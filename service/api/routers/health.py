@@ -1,0 +1,16 @@
+"""GET /health: service status, uptime, per-twin runner figures (always open: the liveness probe)."""
+
+from __future__ import annotations
+
+from fastapi import APIRouter
+
+from service.api.deps import RegistryDep
+from service.api.schemas import Health
+
+router = APIRouter(tags=["service"])
+
+
+@router.get("/health", response_model=Health)
+def health(registry: RegistryDep) -> Health:
+    """Service status, uptime and per-twin real-time factor, overruns and drops."""
+    return Health(**registry.health())

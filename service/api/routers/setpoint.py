@@ -1,0 +1,28 @@
+"""PUT /v1/bearings/{id}/setpoint: a partial setpoint, in the vocabulary of twin.setpoint."""
+
+from __future__ import annotations
+
+from typing import Annotated
+
+from fastapi import APIRouter, Body, Depends
+
+from service.api.deps import TwinDep, setpoint_rate
+from service.api.routers.bearings import INVALID, UNKNOWN_TWIN
+from service.api.schemas import ErrorResponse, SetpointResponse
+from twin.setpoint import SetpointUpdate
+
+write = APIRouter(prefix="/v1/bearings", tags=["bearings"])
+
+TOO_MANY = {429: {"model": ErrorResponse, "description": "Too many setpoints for this twin; see Retry-After",
+                  "headers": {"Retry-After": {"schema": {"type": "integer"}, "description": "seconds"}}}}
+
+
+@write.put("/{bearing_id}/setpoint", response_model=SetpointResponse,
+           dependencies=[Depends(setpoint_rate)], responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY})
+def put_setpoint(entry: TwinDep,
+                 update: Annotated[SetpointUpdate, Body(description="Partial setpoint: missing fields keep "
+                                                        "their value; units in the field names.")]) -> SetpointResponse:
+    """Partial setpoint update, checked once against the bearing's own limits; applied by the
+    twin's runner at its next frame. Returns the complete setpoint."""
+    setpoint = entry.runner.submit(update)
+    return SetpointResponse(bearing_id=entry.id, setpoint=setpoint, frame_s=entry.runner.frame_s)

@@ -1,0 +1,188 @@
+"""HTTP request and response models. Every field's description carries its unit in brackets
+("[rad/s]", "[-]" for counts and dimensionless numbers, "[text]" for names). The setpoint is
+`twin.setpoint` (Setpoint, SetpointUpdate), the state snapshot `twin.snapshot.Snapshot`: the
+HTTP layer has no vocabulary of its own.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from service.core.errors import FieldError, InputError
+from service.core.registry import ID_PATTERN
+from twin.setpoint import Setpoint, SetpointUpdate
+from twin.spec import Thermal
+
+__all__ = ["BearingCreate", "BearingInfo", "ErrorResponse", "FieldError", "Health", "InputError",
+           "RecordingRequest", "RecordingStatus", "ScenarioAccepted", "ScenarioList", "ScenarioRequest",
+           "ScenarioStatus", "SetpointResponse", "TwinHealth", "request_bounds"]
+
+_STRICT = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+
+class ErrorResponse(BaseModel):
+    """Body of every 4xx/5xx answer."""
+
+    detail: list[FieldError] = Field(description="The problems found [list].")
+
+
+# ---- bearings -----------------------------------------------------------------------------------
+class BearingCreate(BaseModel):
+    """A new twin: catalog bearing, mounting, lubricant, optional name and initial setpoint."""
+
+    model_config = _STRICT
+    id: str | None = Field(default=None, pattern=ID_PATTERN, description="Twin name used in URLs and zenoh keys [text: letters, digits, _ . -]; default '<designation>-<n>'.")
+    designation: str = Field(default="6208", max_length=32, description="Catalog designation, e.g. '6208', '7208', '6200'..'6210' [text].")
+    diametral_clearance_m: float = Field(default=0.0, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload (seed 000: +-12.6e-6 m).")
+    lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' (0.04 Pa s at 40 degC) or an ISO grade such as 'ISO VG 68' [text].")
+    setpoint: SetpointUpdate | None = Field(default=None, description="Initial setpoint (partial, defaults for the rest); the twin is warm-started at it [fields with units].")
+    thermal: Thermal | None = Field(default=None, description="Electro-thermal options (seed 003): shear_heating, current_heating, equivalent_resistance_ohm [ohm], crater_depth_m [m], ...; default: the spec's (shear heating off).")
+
+
+class ScenarioStatus(BaseModel):
+    """The scenario a twin runs or ran last."""
+
+    name: str = Field(description="Scenario name [text].")
+    run: str = Field(description="Run id within the scenario [text].")
+    state: Literal["pending", "running", "done", "cancelled", "failed"] = Field(description="Where it is [text].")
+    scenario_time_s: float = Field(description="Simulated time since the scenario started [s].")
+    duration_s: float = Field(description="Scenario length [s of simulated time].")
+    progress: float = Field(description="scenario_time_s / duration_s [-], 0..1.")
+    phase: str | None = Field(default=None, description="Label of the current phase, if the scenario names phases [text].")
+    error: str | None = Field(default=None, description="Why it failed, if it did [text].")
+
+
+class BearingInfo(BaseModel):
+    """One twin of this service."""
+
+    id: str = Field(description="Twin name [text].")
+    designation: str = Field(description="Catalog designation [text].")
+    kind: str = Field(description="'deep_groove' or 'angular_contact' [text].")
+    ball_count: int = Field(description="Number of balls [-].")
+    diametral_clearance_m: float = Field(description="Diametral clearance Pd [m]; negative = preload.")
+    lubricant: str = Field(description="Lubricant name [text].")
+    mode: Literal["real_time", "fast"] = Field(description="Pacing: real_time (paced to the wall clock) or fast [text].")
+    running: bool = Field(description="Whether the runner thread is alive [bool].")
+    time_s: float = Field(description="Simulated time of the latest snapshot [s].")
+    setpoint: Setpoint = Field(description="The setpoint in force or pending (latest accepted) [fields with units].")
+    limits: dict[str, tuple[float, float]] = Field(description="Allowed [low, high] of each setpoint field for this bearing, in the unit its name carries (shaft_speed_rad_s in rad/s, ...) [field unit].")
+    scenario: ScenarioStatus | None = Field(default=None, description="Current or last scenario [object].")
+    state_url: str = Field(description="Where to GET the latest snapshot [URL path].")
+    zenoh_state_key: str = Field(description="zenoh key expression of the snapshot stream [key expression].")
+
+
+# ---- setpoint -----------------------------------------------------------------------------------
+class SetpointResponse(BaseModel):
+    """The setpoint after a PUT: applied at the runner's next frame (<= one frame later)."""
+
+    bearing_id: str = Field(description="Twin name [text].")
+    setpoint: Setpoint = Field(description="The complete setpoint now in force for the next frame [fields with units].")
+    frame_s: float = Field(description="Frame length: the update applies at the next frame boundary [s of simulated time].")
+
+
+# ---- scenario -----------------------------------------------------------------------------------
+class ScenarioRequest(BaseModel):
+    """Run a named scenario (from the service's scenarios/ directory) or an inline one."""
+
+    model_config = _STRICT
+    name: str | None = Field(default=None, max_length=128, description="Name of a scenario file in scenarios/ (without .yaml) [text].")
+    scenario: dict[str, Any] | None = Field(default=None, description="Inline scenario, same format as the YAML files (see service/core/scenarios.py) [object, times in s, setpoint fields with units].")
+    run: str | None = Field(default=None, max_length=64, description="Which run of a multi-run scenario (default: the first) [text].")
+    restart: bool = Field(default=False, description="Warm-restart the twin at the scenario's initial setpoint before it starts (else the initial setpoint is applied as a step) [bool].")
+
+
+class ScenarioAccepted(BaseModel):
+    """A scenario handed to the twin's runner."""
+
+    accepted: bool = Field(description="Always true in a 202 answer [bool].")
+    bearing_id: str = Field(description="Twin name [text].")
+    name: str = Field(description="Scenario name [text].")
+    run: str = Field(description="Run id [text].")
+    expected_duration_s: float = Field(description="Scenario length [s of simulated time]; in real-time mode also about the wall time it takes.")
+    mode: Literal["real_time", "fast"] = Field(description="Pacing of the twin that runs it [text].")
+    replaced: str | None = Field(default=None, description="Name of a scenario that was still running and is cancelled [text].")
+    warnings: list[str] = Field(default_factory=list, description="Fields skipped by the loader and why [text].")
+
+
+class ScenarioList(BaseModel):
+    """Named scenarios this service can run."""
+
+    directory: str = Field(description="Where they are read from [path].")
+    scenarios: dict[str, str] = Field(description="name -> description [text].")
+
+
+# ---- recording ----------------------------------------------------------------------------------
+class RecordingRequest(BaseModel):
+    """Start or stop a rerun recording of one twin."""
+
+    model_config = _STRICT
+    action: Literal["start", "stop"] = Field(description="'start' or 'stop' [text].")
+    path: str | None = Field(default=None, max_length=512, description="For start: .rrd file, relative to the service's recordings directory [path]; default <id>-<UTC timestamp>.rrd.")
+
+
+class RecordingStatus(BaseModel):
+    """A twin's own recording (besides the service-wide one)."""
+
+    bearing_id: str = Field(description="Twin name [text].")
+    recording: bool = Field(description="Whether a recording of this twin is being written [bool].")
+    path: str | None = Field(default=None, description="The .rrd file [path].")
+    rows_logged: int = Field(default=0, description="Snapshots written to it so far [-].")
+
+
+# ---- health -------------------------------------------------------------------------------------
+class TwinHealth(BaseModel):
+    """Runner figures of one twin."""
+
+    id: str = Field(description="Twin name [text].")
+    running: bool = Field(description="Whether the runner thread is alive [bool].")
+    status: str = Field(description="'ok' or what went wrong [text].")
+    mode: Literal["real_time", "fast"] = Field(description="Pacing [text].")
+    time_s: float = Field(description="Simulated time [s].")
+    real_time_factor: float | None = Field(description="Simulated seconds per wall second over the last second [-]; null before it is measured.")
+    frames: int = Field(description="Frames advanced [-].")
+    overruns: int = Field(description="Frames that finished after their wall-clock deadline (real-time mode) [-].")
+    resyncs: int = Field(description="Times the schedule was re-anchored after falling far behind [-].")
+    published: int = Field(description="Snapshots published [-].")
+    dropped: int = Field(description="Snapshots dropped by the sinks' bounded queues [-].")
+    errors: int = Field(description="Exceptions caught in the runner loop (each followed by a warm restart) [-].")
+    restarts: int = Field(description="Engine warm restarts after a diverged or overloaded state [-].")
+    setpoints_accepted: int = Field(description="Setpoint updates accepted [-].")
+    setpoints_refused: int = Field(default=0, description="zenoh setpoints refused (token, size, rate, validation) [-].")
+    setpoints_rate_limited: int = Field(default=0, description="Setpoints refused by the rate limit, HTTP 429 and zenoh [-].")
+    fallbacks: int = Field(default=0, description="Times the twin could not hold its setpoint and was warm-restarted at the last safe one [-].")
+    last_safe_setpoint: Setpoint | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")
+
+
+class Health(BaseModel):
+    """Service health."""
+
+    status: Literal["ok", "degraded"] = Field(description="'ok', or 'degraded' when a twin's runner stopped or reports errors [text].")
+    uptime_s: float = Field(description="Wall time since the service started [s].")
+    twins: list[TwinHealth] = Field(description="One entry per twin [list].")
+    zenoh: bool = Field(description="Whether the zenoh bus is open [bool].")
+    zenoh_listen: list[str] = Field(description="zenoh endpoints listened on [zenoh locator].")
+    recording: str | None = Field(description="The service-wide .rrd being written [path]; null when off.")
+    recording_rows: int = Field(default=0, description="Snapshots written to the service-wide recording [-].")
+    pid: int | None = Field(default=None, description="Process id of the service [-] (for soak tests and monitoring).")
+    rss_bytes: int | None = Field(default=None, description="Resident memory of the service process [bytes]; null where /proc is unavailable.")
+
+
+@cache
+def request_bounds() -> dict[str, tuple[Any, Any]]:
+    """field name -> (low, high) declared on the request models (both sides of a range, since a
+    pydantic error names only the bound that was crossed)."""
+    from service.core.scenarios import Scenario, ScenarioRun, ScenarioStep
+
+    bounds: dict[str, tuple[Any, Any]] = {}
+    for model in (BearingCreate, RecordingRequest, ScenarioRequest, Scenario, ScenarioRun, ScenarioStep, Thermal):
+        for name, info in model.model_fields.items():
+            low = high = None
+            for m in info.metadata:
+                low = getattr(m, "ge", getattr(m, "gt", low)) if low is None else low
+                high = getattr(m, "le", getattr(m, "lt", high)) if high is None else high
+            if (low is not None or high is not None) and name not in bounds:
+                bounds[name] = (low, high)
+    return bounds

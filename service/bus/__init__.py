@@ -1,0 +1,1 @@
+"""The zenoh bus: session, per-twin channels and key expressions (`service.bus.zenoh_bus`)."""

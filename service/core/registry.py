@@ -1,0 +1,383 @@
+"""`TwinRegistry`: the twins of one service, their runners, the admission gate and /health.
+
+No transport here: the zenoh bus and the recorders are plugged in from outside through
+`Bus` / `Recorder` (service.wiring opens them from the settings):
+
+    create twin -> Twin (warm-started) -> TwinRunner (not started) -> SetpointIntake
+                -> bus.attach_twin(id, latest, intake) channel as a sink
+                -> recorder.add_twin_from(twin), recorder as a sink -> runner.start()
+    delete twin -> runner.stop() -> channel.detach() -> per-twin recording closed
+    close       -> every runner stopped (all asked first, then joined) -> channels detached
+                -> per-twin recordings closed -> hook `_close_outputs` (service recording,
+                   zenoh session)
+
+A twin's own recording (`start_recording`) goes to a path under the recordings directory
+(relative, plain names, .rrd), made by `_new_recording(path)`.
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import re
+import sys
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from datetime import UTC, datetime
+from pathlib import Path
+from typing import Any, Protocol
+
+from pydantic import ValidationError
+
+from service.core.admission import AdmissionGate
+from service.core.errors import InputError, field_errors, setpoint_field_errors
+from service.core.intake import SetpointIntake
+from service.core.runner import TwinRunner
+from service.core.sinks import SnapshotSink
+from service.settings import ServiceSettings
+from twin import catalog
+from twin.engine import Twin
+from twin.setpoint import SetpointError, SetpointUpdate
+from twin.snapshot import Snapshot
+from twin.spec import Thermal
+
+log = logging.getLogger(__name__)
+
+ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
+_ID_RE = re.compile(ID_PATTERN)
+# per-twin recording paths: relative, plain names (no control characters, spaces, '..', hidden
+# folders), so a request cannot reach outside the recordings directory or trip the file system
+_REC_PATH_RE = re.compile(r"^(?=.{1,256}$)(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/)*[A-Za-z0-9_][A-Za-z0-9_.-]*\.rrd$")
+
+
+def admission_gate(settings: ServiceSettings) -> AdmissionGate:
+    """The service's one admission gate (HTTP and zenoh) from its settings."""
+    return AdmissionGate(token=settings.token_value, setpoint_rate_hz=settings.setpoint_rate_hz or None,
+                         setpoint_burst=settings.setpoint_burst, max_payload_bytes=settings.max_body_bytes)
+
+
+class Channel(SnapshotSink, Protocol):
+    """A twin's link to the bus."""
+
+    def detach(self) -> None: ...
+
+
+class Bus(Protocol):
+    """The message bus the twins are attached to (service.bus.zenoh_bus.ZenohBus)."""
+
+    closed: bool
+
+    def attach_twin(self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
+                    on_setpoint: Callable[[bytes], dict]) -> Channel: ...
+
+    def close(self) -> None: ...
+
+
+class Recorder(SnapshotSink, Protocol):
+    """A recording of one or more twins (service.recorder.RerunRecorder)."""
+
+    path: Path | None
+    rows_logged: int
+
+    def add_twin_from(self, twin: Twin) -> None: ...
+
+
+@dataclass
+class TwinEntry:
+    """One twin of the service and what is wired to it."""
+
+    id: str
+    twin: Twin
+    runner: TwinRunner
+    intake: SetpointIntake
+    lubricant: str
+    channel: Any = None                 # the bus channel (a sink)
+    recording: Any = None               # this twin's own recording (POST .../recording)
+    recording_path: Path | None = None
+    created_wall_s: float = field(default_factory=time.time)
+
+    @property
+    def designation(self) -> str:
+        return self.twin.model.spec.designation
+
+    @property
+    def diametral_clearance_m(self) -> float:
+        return float(self.twin.model.spec.mounting.diametral_clearance_m)
+
+
+class TwinRegistry:
+    """Owns the twins, the admission gate and the plugged-in bus / recorder of one service."""
+
+    def __init__(self, settings: ServiceSettings, gate: AdmissionGate | None = None):
+        self.settings = settings
+        self.gate = gate if gate is not None else admission_gate(settings)
+        self.bus: Bus | None = None
+        self.recorder: Recorder | None = None
+        self.started_wall_s = time.monotonic()
+        self._twins: dict[str, TwinEntry] = {}
+        self._reserved: set[str] = set()    # ids of twins being built
+        self._recording_lock = threading.RLock()
+        self._lock = threading.RLock()
+        self._closed = False
+
+    # ---- outputs: hooks for the wiring ---------------------------------------------------
+    def _open_outputs(self) -> None:
+        """Open the bus and the service recording (none here)."""
+
+    def _close_outputs(self) -> None:
+        """Close the service recording and the bus."""
+
+    def _new_recording(self, path: Path) -> Recorder:
+        """A recorder writing one twin to `path` (OSError / RuntimeError / ValueError when it
+        cannot)."""
+        raise RuntimeError("this service has no recorder")
+
+    # ---- life cycle ------------------------------------------------------------------------
+    def open(self, *, default_twin: bool = True) -> TwinRegistry:
+        """Open the outputs and start the `default` twin."""
+        if sys.getswitchinterval() > self.settings.gil_switch_interval_s:
+            sys.setswitchinterval(self.settings.gil_switch_interval_s)  # process-wide, see settings
+        try:
+            self._open_outputs()
+            if default_twin and self.settings.start_twin:
+                self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing)
+        except BaseException:
+            self.close()
+            raise
+        return self
+
+    def close(self) -> None:
+        """Stop every runner, detach the bus, close recordings (nothing queued is lost), close
+        the outputs. Idempotent; never raises."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            entries = list(self._twins.values())
+            self._twins.clear()
+        for e in entries:                     # ask all to stop first, then join
+            e.runner.request_stop()
+        for e in entries:
+            try:
+                e.runner.stop(timeout=5.0)
+            except Exception:
+                log.exception("stopping twin %s", e.id)
+        for e in entries:
+            self._unwire(e)
+        self._close_outputs()
+
+    def _unwire(self, e: TwinEntry) -> None:
+        if e.channel is not None:
+            try:
+                e.runner.remove_sink(e.channel)
+                e.channel.detach()
+            except Exception:
+                log.exception("detaching twin %s from the bus", e.id)
+            e.channel = None
+        if self.recorder is not None:
+            e.runner.remove_sink(self.recorder)
+        self.stop_recording(e)
+        self.gate.forget(e.id)
+
+    # ---- twins -----------------------------------------------------------------------------
+    def entries(self) -> list[TwinEntry]:
+        with self._lock:
+            return list(self._twins.values())
+
+    def get(self, bearing_id: str) -> TwinEntry:
+        """The twin (InputError 404 naming the known ones)."""
+        with self._lock:
+            entry = self._twins.get(bearing_id)
+            known = sorted(self._twins)
+        if entry is None:
+            raise InputError.one("bearing_id", f"unknown twin {bearing_id!r}; known: "
+                                 f"{', '.join(known) or 'none'}", known, status_code=404)
+        return entry
+
+    def find(self, bearing_id: str) -> TwinEntry | None:
+        with self._lock:
+            return self._twins.get(bearing_id)
+
+    def _new_id(self, designation: str) -> str:
+        n = 1
+        while f"{designation}-{n}" in self._twins or f"{designation}-{n}" in self._reserved:
+            n += 1
+        return f"{designation}-{n}"
+
+    def build_twin(self, bearing_id: str, designation: str = "6208", diametral_clearance_m: float = 0.0,
+                   lubricant: str = "seed-000", setpoint: SetpointUpdate | None = None,
+                   thermal: Thermal | None = None) -> Twin:
+        """A warm-started Twin (InputError naming the field if a value is not valid)."""
+        wanted = designation
+        designation = designation.strip().upper()
+        if designation not in catalog.designations():
+            raise InputError.one("designation", f"unknown bearing {wanted!r}", catalog.designations())
+        try:
+            lub = catalog.lubricant(lubricant)
+        except ValueError as exc:
+            raise InputError.one("lubricant", str(exc).removeprefix("lubricant: ")) from None
+        try:
+            spec = catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m,
+                                   lubricant=lub, **({"thermal": thermal} if thermal else {}))
+        except ValidationError as exc:
+            raise InputError(field_errors(exc.errors())) from None
+        twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
+        if setpoint is not None:
+            try:
+                twin.set_setpoint(setpoint)
+            except SetpointError as exc:
+                raise InputError(setpoint_field_errors(exc, prefix="setpoint.")) from None
+            twin.reset()  # warm start at the requested setpoint
+        return twin
+
+    def create_twin(self, id: str | None = None, designation: str = "6208", **options: Any) -> TwinEntry:
+        """Create, wire and start a twin (`options`: diametral_clearance_m, lubricant, setpoint,
+        thermal). InputError 409 on a duplicate id or when full, 422 for an invalid value."""
+        s = self.settings
+        with self._lock:
+            if self._closed:
+                raise InputError.one(None, "the service is shutting down", status_code=503)
+            bearing_id = id or self._new_id(designation.strip().upper())
+            if not _ID_RE.match(bearing_id):
+                raise InputError.one("id", f"{bearing_id!r}: letters, digits, '_', '.', '-' only "
+                                     "(it is used in URLs and zenoh key expressions)")
+            if bearing_id in self._twins or bearing_id in self._reserved:
+                raise InputError.one("id", f"a twin named {bearing_id!r} already exists",
+                                     status_code=409)
+            if len(self._twins) + len(self._reserved) >= s.max_twins:
+                raise InputError.one(None, f"this service already runs {len(self._twins)} twins "
+                                     f"(max_twins = {s.max_twins})", [0, s.max_twins], status_code=409)
+            # reserve the id while the (slow) model is built outside the lock
+            self._reserved.add(bearing_id)
+        entry = None
+        try:
+            twin = self.build_twin(bearing_id, designation, **options)
+            runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s)
+            entry = TwinEntry(id=bearing_id, twin=twin, runner=runner,
+                              intake=SetpointIntake(bearing_id, self.gate, runner),
+                              lubricant=twin.model.spec.lubricant.name)
+            if self.bus is not None:
+                entry.channel = self.bus.attach_twin(bearing_id, runner.latest_snapshot, entry.intake)
+                runner.add_sink(entry.channel)
+            if self.recorder is not None:
+                self.recorder.add_twin_from(twin)
+                runner.add_sink(self.recorder)
+            runner.start()
+        except BaseException:
+            with self._lock:
+                self._reserved.discard(bearing_id)
+            if entry is not None:
+                entry.runner.stop(timeout=2.0)
+                self._unwire(entry)
+            raise
+        with self._lock:
+            self._reserved.discard(bearing_id)
+            if self._closed:   # closed while building: do not leak a running thread
+                entry.runner.stop(timeout=2.0)
+                self._unwire(entry)
+                raise InputError.one(None, "the service is shutting down", status_code=503)
+            self._twins[bearing_id] = entry
+        log.info("twin %s started (%s, Pd = %g m, %s, %s mode)", bearing_id, entry.designation,
+                 entry.diametral_clearance_m, entry.lubricant, runner.mode)
+        return entry
+
+    def delete_twin(self, bearing_id: str) -> TwinEntry:
+        with self._lock:
+            entry = self._twins.get(bearing_id)
+            if entry is None:
+                self.get(bearing_id)  # raises the 404
+            del self._twins[bearing_id]
+        entry.runner.stop(timeout=5.0)
+        self._unwire(entry)
+        return entry
+
+    # ---- per-twin recordings ---------------------------------------------------------------
+    def recordings_dir(self) -> Path:
+        rec = self.settings.record
+        return rec.parent if rec is not None else Path("recordings")
+
+    def resolve_recording_path(self, bearing_id: str, path: str | None) -> Path:
+        """A path under the recordings directory (relative only, no '..', .rrd)."""
+        base = self.recordings_dir()
+        if not path:
+            stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
+            return base / f"{bearing_id}-{stamp}.rrd"
+        if not _REC_PATH_RE.match(path):
+            raise InputError.one("path", "a recording path is a relative path of letters, digits "
+                                 "and '_', '.', '-' (folders separated by '/', none starting with "
+                                 "'.'), ending in .rrd, at most 256 characters")
+        p = Path(path)
+        if p.is_absolute() or ".." in p.parts:
+            raise InputError.one("path", f"{path!r}: give a path relative to the recordings "
+                                 f"directory {str(base)!r}, without '..'")
+        if p.suffix != ".rrd":
+            raise InputError.one("path", f"{path!r}: a rerun recording ends in .rrd")
+        return base / p
+
+    def start_recording(self, entry: TwinEntry, path: str | None) -> Path:
+        target = self.resolve_recording_path(entry.id, path)
+        if self.settings.recording_path is not None:
+            main = Path(self.settings.recording_path).resolve()
+            t = target.resolve()
+            if t == main or (t.parent == main.parent and re.fullmatch(re.escape(main.stem) + r"-\d{4,}\.rrd", t.name)):
+                raise InputError.one("path", f"{str(target)!r} is the service-wide recording or one of its segments")
+        with self._recording_lock:
+            self.stop_recording(entry)
+            if target.exists() and not target.is_file():
+                raise InputError.one("path", f"{str(target)!r} exists and is not a file")
+            try:
+                rec = self._new_recording(target)
+            except (OSError, RuntimeError, ValueError) as exc:   # e.g. a folder that is a file
+                raise InputError.one("path", f"cannot record to {str(target)!r}: "
+                                     f"{' '.join(str(exc).split())[:200]}") from None
+            rec.add_twin_from(entry.twin)
+            entry.recording, entry.recording_path = rec, target
+            entry.runner.add_sink(rec)
+        return target
+
+    def stop_recording(self, entry: TwinEntry) -> tuple[Path | None, int]:
+        """Finish the twin's own recording (flushed, complete); returns (path, rows written)."""
+        with self._recording_lock:
+            rec, path = entry.recording, entry.recording_path
+            if rec is None:
+                return None, 0
+            entry.runner.remove_sink(rec)
+            entry.recording = None
+        try:
+            rec.close()
+        except Exception:
+            log.exception("closing the recording of %s", entry.id)
+        return path, int(getattr(rec, "rows_logged", 0))
+
+    # ---- health ----------------------------------------------------------------------------
+    def health(self) -> dict:
+        twins = [e.runner.stats(setpoints_refused=e.intake.refused,
+                                setpoints_rate_limited=self.gate.rate_limited(e.id))
+                 for e in self.entries()]
+        degraded = any((not t["running"]) or t["errors"] for t in twins)
+        rec = self.recorder
+        return {
+            "status": "degraded" if degraded else "ok",
+            "uptime_s": time.monotonic() - self.started_wall_s,
+            "twins": twins,
+            "zenoh": self.bus is not None and not getattr(self.bus, "closed", False),
+            "zenoh_listen": list(self.settings.zenoh_listen) if self.bus is not None else [],
+            "recording": str(rec.path) if rec is not None and getattr(rec, "path", None) else None,
+            "recording_rows": int(getattr(rec, "rows_logged", 0)) if rec is not None else 0,
+            "pid": os.getpid(),
+            "rss_bytes": _own_rss_bytes(),
+        }
+
+
+def _own_rss_bytes() -> int | None:
+    """Resident set size of this process from /proc/self/status (None elsewhere)."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as f:
+            for line in f:
+                if line.startswith("VmRSS:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None

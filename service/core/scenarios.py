@@ -1,0 +1,406 @@
+"""Scenarios: YAML timelines of setpoints and ramps, validated with pydantic.
+
+Format (schema "bearing-twin/scenario/1"; all times are SIMULATED seconds from the scenario start)::
+
+    name: seed000_startup_steady_slowdown    # required, [A-Za-z0-9_.-]
+    description: free text                   # optional
+    bearing: "6208"                          # catalog designation (default 6208)
+    diametral_clearance_m: 0.0               # mounting [m], negative = preload (default 0)
+    lubricant: seed-000                      # 'seed-000' or 'ISO VG n' (default seed-000)
+    thermal: {shear_heating: true}           # electro-thermal options (twin.spec.Thermal; optional)
+    initial:                                 # setpoint at t = 0 (partial; unset fields keep
+      shaft_speed_rad_s: 0.0                 #   the twin's value, or the defaults for a fresh twin)
+      radial_load_n: 3000.0
+    duration_s: 0.4                          # length of the scenario [s]
+    sample_every_s: 0.001                    # table / recording sample period [s] (scenario run)
+    steps:                                   # in order of at_s
+      - at_s: 0.0                            # when the step starts [s]
+        phase: start-up                      # optional label, copied into the table
+        ramp: {shaft_speed_rad_s: 500.0}     # linear ramp from the value in force at at_s ...
+        over_s: 0.1                          # ... to the target over this many seconds
+      - at_s: 0.25
+        set: {radial_load_n: 5000.0}         # a step change (partial setpoint)
+    runs:                                    # optional: several runs of the same timeline,
+      - id: pd_minus_12_6um                  #   each with its own mounting / bearing / lubricant /
+        label: "Pd = -12.6 um"               #   thermal / initial / steps / duration_s
+        diametral_clearance_m: -12.6e-6
+
+Rules:
+
+* every step has exactly one of `set` or `ramp`; a ramp needs `over_s` > 0 and must end by
+  `duration_s`; `at_s` is non-decreasing and below `duration_s`;
+* setpoint fields are those of `twin.setpoint.SetpointUpdate` (units in the names); an unknown
+  field is an error, and so is a value that is not a number (a bool, a quoted "3000");
+* `bearing: 6208` (a YAML integer) is the designation "6208";
+* values are checked against the bearing's limits before anything runs (`check_limits`, by
+  `scenario check` as by `scenario run` and the service), so an out-of-range step is refused
+  with its position, field and the bearing's own range;
+* the engine's own shaft acceleration limit (ModelOptions.speed_ramp_rad_s2, 5000 rad/s^2 by
+  default) still applies: a speed ramp faster than that lags behind its setpoint.
+
+A twin in a service runs one run of a scenario at a time (`POST /v1/bearings/{id}/scenario`): the
+runs must not change the twin's bearing, mounting, lubricant or thermal options (those are fixed
+when a twin is created); `bearing-twin scenario run FILE` creates a fresh twin for every run.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import yaml
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from twin import catalog
+from twin.setpoint import Setpoint, SetpointLimits, SetpointUpdate
+from twin.spec import BearingSpec, Thermal
+
+SCENARIO_SCHEMA = "bearing-twin/scenario/1"
+
+_NAME_RE = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
+_FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+
+class ScenarioError(ValueError):
+    """A scenario that cannot run here; `field` names where (e.g. 'steps[2].ramp.radial_load_n')."""
+
+    def __init__(self, field: str, message: str, allowed: list | None = None):
+        self.field, self.message, self.allowed = field, message, allowed
+        # the message may already start with the field (several errors, each with its path)
+        super().__init__(message if message.startswith(f"{field}: ") else f"{field}: {message}")
+
+
+class ScenarioStep(BaseModel):
+    """One timed change of the setpoint."""
+
+    model_config = _FROZEN
+    at_s: float = Field(ge=0.0, description="Start of the step, from the scenario start [s of simulated time].")
+    set: SetpointUpdate | None = Field(default=None, description="Step change: partial setpoint applied at at_s (fields with units).")
+    ramp: SetpointUpdate | None = Field(default=None, description="Ramp targets: partial setpoint reached linearly at at_s + over_s (fields with units).")
+    over_s: float | None = Field(default=None, gt=0.0, description="Ramp duration [s of simulated time]; only with ramp.")
+    phase: str | None = Field(default=None, max_length=64, description="Optional label of the phase this step starts [text].")
+
+    @model_validator(mode="after")
+    def _one_action(self) -> ScenarioStep:
+        if (self.set is None) == (self.ramp is None):
+            raise ValueError("a step needs exactly one of 'set' or 'ramp'")
+        if self.ramp is not None and self.over_s is None:
+            raise ValueError("a ramp needs over_s > 0 [s]")
+        if self.set is not None and self.over_s is not None:
+            raise ValueError("over_s [s] belongs to a ramp, not to a set")
+        return self
+
+    @property
+    def end_s(self) -> float:
+        """When the step's change is complete [s]."""
+        return self.at_s + (self.over_s or 0.0)
+
+
+class ScenarioRun(BaseModel):
+    """One run of a multi-run scenario: overrides of the scenario's top-level fields."""
+
+    model_config = _FROZEN
+    id: str | None = Field(default=None, pattern=_NAME_RE, description="Run name [text]; default run<i>.")
+    label: str | None = Field(default=None, max_length=128, description="Human label of the run [text].")
+    bearing: str | None = Field(default=None, max_length=32, description="Catalog designation [text].")
+    diametral_clearance_m: float | None = Field(default=None, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload.")
+    lubricant: str | None = Field(default=None, max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
+    thermal: Thermal | None = Field(default=None, description="Electro-thermal options replacing the scenario's (twin.spec.Thermal, units in each field).")
+    initial: SetpointUpdate | None = Field(default=None, description="Initial setpoint, merged over the scenario's (fields with units).")
+    steps: list[ScenarioStep] | None = Field(default=None, description="Steps replacing the scenario's.")
+    duration_s: float | None = Field(default=None, gt=0.0, le=3600.0, description="Run length [s of simulated time].")
+
+    @field_validator("bearing", mode="before")
+    @classmethod
+    def _designation_text(cls, value: Any) -> Any:
+        return _designation_text(value)
+
+
+def _drop_empty_steps(steps: list[ScenarioStep]) -> list[ScenarioStep]:
+    return [s for s in steps if (s.set or s.ramp).model_dump(exclude_none=True)]
+
+
+def _check_steps(steps: list[ScenarioStep], duration_s: float, where: str) -> None:
+    """Model-level checks; messages start with the field path ('steps[2].at_s: ...')."""
+    previous = 0.0
+    for i, step in enumerate(steps):
+        if step.at_s < previous:
+            raise ValueError(f"{where}[{i}].at_s: {step.at_s:g} s is before the previous step "
+                             f"({previous:g} s); steps must be in order of at_s")
+        previous = step.at_s
+        if step.at_s >= duration_s and step.at_s > 0.0:
+            raise ValueError(f"{where}[{i}].at_s: {step.at_s:g} s must be below duration_s = {duration_s:g} s")
+        if step.end_s > duration_s + 1e-12:
+            raise ValueError(f"{where}[{i}].over_s: the ramp ends at {step.end_s:g} s, after "
+                             f"duration_s = {duration_s:g} s")
+
+
+class Scenario(BaseModel):
+    """A timeline of setpoints and ramps (see the module docstring for the YAML format)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+    name: str = Field(pattern=_NAME_RE, description="Scenario name [text: letters, digits, _ . -].")
+    description: str = Field(default="", max_length=4000, description="What the scenario shows [text].")
+    bearing: str = Field(default="6208", max_length=32, description="Catalog designation [text].")
+    diametral_clearance_m: float = Field(default=0.0, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload.")
+    lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
+    thermal: Thermal | None = Field(default=None, description="Electro-thermal options of the bearing (twin.spec.Thermal: shear / current heating, R_b, H_c; units in each field); default: the spec's.")
+    initial: SetpointUpdate = Field(default_factory=SetpointUpdate, description="Setpoint applied at t = 0 (fields with units).")
+    duration_s: float = Field(gt=0.0, le=3600.0, description="Scenario length [s of simulated time].")
+    sample_every_s: float = Field(default=0.001, ge=1e-5, le=10.0, description="Sample period of the table and recording [s of simulated time].")
+    steps: list[ScenarioStep] = Field(default_factory=list, description="Timed setpoints and ramps, in order of at_s.")
+    runs: list[ScenarioRun] | None = Field(default=None, min_length=1, max_length=100, description="Optional runs with other mountings / bearings / timelines.")
+    warnings: list[str] = Field(default_factory=list, description="Notes of the loader on what it did not take [text].")
+
+    @field_validator("bearing", mode="before")
+    @classmethod
+    def _designation_text(cls, value: Any) -> Any:
+        return _designation_text(value)
+
+    @field_validator("bearing")
+    @classmethod
+    def _known_bearing(cls, value: str) -> str:
+        return _check_designation(value)
+
+    @field_validator("lubricant")
+    @classmethod
+    def _known_lubricant(cls, value: str) -> str:
+        return _check_lubricant(value)
+
+    @model_validator(mode="after")
+    def _timeline(self) -> Scenario:
+        _check_steps(self.steps, self.duration_s, "steps")
+        for j, run in enumerate(self.runs or []):
+            if run.bearing is not None:
+                _check_designation(run.bearing)
+            if run.lubricant is not None:
+                _check_lubricant(run.lubricant)
+            steps = run.steps if run.steps is not None else self.steps
+            _check_steps(steps, run.duration_s or self.duration_s,
+                         f"runs[{j}].steps" if run.steps is not None else "steps")
+        ids = [r.id for r in self.resolved_runs()]
+        if len(set(ids)) != len(ids):
+            raise ValueError(f"runs: run ids must be unique, got {ids}")
+        return self
+
+    # ---- resolution -------------------------------------------------------------------------
+    def resolved_runs(self) -> list[ResolvedRun]:
+        """Every run with the top-level defaults filled in (one run when `runs` is absent)."""
+        top = frozenset(self.model_fields_set & {"bearing", "diametral_clearance_m", "lubricant"})
+        if not self.runs:
+            return [ResolvedRun(scenario=self.name, index=0, id="run0", label=self.name,
+                                bearing=self.bearing, diametral_clearance_m=self.diametral_clearance_m,
+                                lubricant=self.lubricant, initial=self.initial, thermal=self.thermal,
+                                steps=_drop_empty_steps(self.steps), duration_s=self.duration_s,
+                                sample_every_s=self.sample_every_s, explicit=top)]
+        out = []
+        for j, run in enumerate(self.runs):
+            initial = self.initial
+            if run.initial is not None:
+                initial = SetpointUpdate(**{**self.initial.model_dump(exclude_none=True),
+                                            **run.initial.model_dump(exclude_none=True)})
+            out.append(ResolvedRun(
+                scenario=self.name, index=j, id=run.id or f"run{j}", label=run.label or run.id or f"run{j}",
+                bearing=run.bearing or self.bearing,
+                diametral_clearance_m=(self.diametral_clearance_m if run.diametral_clearance_m is None
+                                       else run.diametral_clearance_m),
+                lubricant=run.lubricant or self.lubricant, initial=initial,
+                thermal=run.thermal if run.thermal is not None else self.thermal,
+                steps=_drop_empty_steps(run.steps if run.steps is not None else self.steps),
+                duration_s=run.duration_s or self.duration_s, sample_every_s=self.sample_every_s,
+                explicit=top | frozenset(k for k in ("bearing", "diametral_clearance_m", "lubricant")
+                                         if getattr(run, k) is not None)))
+        return out
+
+    def check_bearing_limits(self) -> None:
+        """Check every run's values against its bearing's own limits (ScenarioError naming the
+        run, step and field): the check `scenario run` and the service make before running."""
+        runs = self.resolved_runs()
+        for run in runs:
+            run.check_limits(run.bearing_limits(), where=f"runs[{run.index}]." if len(runs) > 1 else "")
+
+    @property
+    def total_duration_s(self) -> float:
+        """Simulated seconds of all runs together [s]."""
+        return sum(r.duration_s for r in self.resolved_runs())
+
+
+def _designation_text(value: Any) -> Any:
+    """YAML reads `bearing: 6208` as a number: a designation written as an integer is taken as
+    its text ("6208"); booleans and other types are left to the validation (refused)."""
+    if isinstance(value, int) and not isinstance(value, bool):
+        return str(value)
+    return value
+
+
+def _check_designation(value: str) -> str:
+    known = catalog.designations()
+    if value.strip().upper() not in known:
+        raise ValueError(f"unknown bearing {value!r}; known: {', '.join(known)}")
+    return value.strip().upper()
+
+
+def _check_lubricant(value: str) -> str:
+    try:
+        catalog.lubricant(value)
+    except ValueError as exc:
+        raise ValueError(str(exc).removeprefix("lubricant: ")) from None
+    return value
+
+
+@dataclass(frozen=True)
+class ResolvedRun:
+    """One run with every field decided: what a runner executes."""
+
+    scenario: str
+    index: int
+    id: str
+    label: str
+    bearing: str
+    diametral_clearance_m: float
+    lubricant: str
+    initial: SetpointUpdate
+    steps: list[ScenarioStep]
+    duration_s: float
+    sample_every_s: float
+    explicit: frozenset[str] = frozenset()   # which of bearing / clearance / lubricant were written
+    thermal: Thermal | None = None           # electro-thermal options (None: the spec's defaults)
+
+    def check_twin(self, designation: str, diametral_clearance_m: float, lubricant: str,
+                   thermal: Thermal | None = None) -> None:
+        """Raise ScenarioError if the run asks for another bearing, mounting, lubricant or
+        electro-thermal options than a running twin has (those are fixed when a twin is created)."""
+        wanted = {"bearing": (self.bearing, designation),
+                  "diametral_clearance_m": (self.diametral_clearance_m, diametral_clearance_m),
+                  "lubricant": (catalog.lubricant(self.lubricant).name, lubricant)}
+        for name in ("bearing", "diametral_clearance_m", "lubricant"):
+            if name not in self.explicit:
+                continue
+            want, have = wanted[name]
+            same = abs(want - have) <= 1e-12 if isinstance(want, float) else str(want) == str(have)
+            if not same:
+                raise ScenarioError(
+                    name, f"run {self.id!r} of scenario {self.scenario!r} needs {name} = {want!r}, "
+                    f"this twin has {have!r}: create a twin with it (POST /v1/bearings) or run the "
+                    f"scenario offline (bearing-twin scenario run)", [want])
+        if self.thermal is not None and thermal is not None and self.thermal != thermal:
+            raise ScenarioError(
+                "thermal", f"run {self.id!r} of scenario {self.scenario!r} needs thermal = "
+                f"{self.thermal.model_dump()}, this twin has {thermal.model_dump()}: create a twin with it "
+                f"(POST /v1/bearings with 'thermal') or run the scenario offline (bearing-twin scenario run)",
+                [self.thermal.model_dump()])
+
+    def spec(self) -> BearingSpec:
+        """The bearing this run asks for: designation, mounting, lubricant, thermal options."""
+        return catalog.bearing(self.bearing, diametral_clearance_m=self.diametral_clearance_m,
+                               lubricant=catalog.lubricant(self.lubricant),
+                               **({"thermal": self.thermal} if self.thermal else {}))
+
+    def bearing_limits(self) -> SetpointLimits:
+        """The setpoint limits of this run's bearing (its compiled model)."""
+        from twin.model import make_model
+
+        return SetpointLimits.for_model(make_model(self.spec()))
+
+    def initial_setpoint(self, base: Setpoint | None = None) -> Setpoint:
+        """The complete setpoint at t = 0 (initial merged over `base` or the defaults)."""
+        return self.initial.apply_to(base or Setpoint())
+
+    def iter_values(self):
+        """(where, field, value) of every setpoint value the run mentions."""
+        for name, value in self.initial.fields.items():
+            yield "initial", name, value
+        for i, step in enumerate(self.steps):
+            kind = "set" if step.set is not None else "ramp"
+            for name, value in (step.set or step.ramp).fields.items():
+                yield f"steps[{i}].{kind}", name, value
+
+    def check_limits(self, limits: SetpointLimits, where: str = "") -> None:
+        """Raise ScenarioError for the first value outside the bearing's limits (`Twin.limits`,
+        `SetpointLimits.for_model`): what `scenario check`, `scenario run` and the service check.
+
+        The limits are boxes per field, so a linear ramp between values inside them stays inside."""
+        for place, name, value in self.iter_values():
+            problems = limits.problems({name: value})
+            if problems:
+                p = problems[0]
+                raise ScenarioError(f"{where}{place}.{name}", p.message(limits.bearing or self.bearing),
+                                    [p.low, p.high])
+
+
+# ---- loading ----------------------------------------------------------------------------------
+def scenario_from_dict(data: Any, *, source: str = "scenario") -> Scenario:
+    """Validate a parsed scenario. Raises ScenarioError naming the field (first error) and
+    keeps pydantic's full error list in `__cause__`."""
+    if not isinstance(data, dict):
+        raise ScenarioError(source, f"a scenario is a mapping (name, duration_s, steps, ...), got {type(data).__name__}")
+    try:
+        return Scenario.model_validate(data)
+    except ValidationError as exc:
+        located = [_locate(e) for e in exc.errors()]
+        where = located[0][0]
+        message = "; ".join(f"{w or source}: {m}" for w, m in located)
+        raise ScenarioError(where or source, message) from exc
+
+
+_PATH_PREFIX = re.compile(r"^([A-Za-z_][\w.\[\]]*): (.*)$", re.DOTALL)
+
+
+def _locate(error: dict) -> tuple[str, str]:
+    """(field path, message) of a pydantic error; model-level errors carry the path in front of
+    their message ('steps[2].at_s: ...')."""
+    where = _loc_text(error.get("loc", ()))
+    msg = str(error.get("msg", "")).removeprefix("Value error, ")
+    match = _PATH_PREFIX.match(msg)
+    if match:
+        path, rest = match.groups()
+        return (f"{where}.{path}" if where else path), rest
+    return where, msg
+
+
+def _loc_text(loc) -> str:
+    out = ""
+    for part in loc:
+        if isinstance(part, int):
+            out += f"[{part}]"
+        else:
+            out += ("." if out else "") + str(part)
+    return out
+
+
+def load_scenario(path: str | Path) -> Scenario:
+    """Read and validate a scenario YAML file."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ScenarioError(str(path), f"cannot read: {exc.strerror or exc}") from exc
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        raise ScenarioError(str(path), f"not valid YAML: {' '.join(str(exc).split())}") from exc
+    return scenario_from_dict(data, source=str(path))
+
+
+def list_scenarios(directory: str | Path) -> dict[str, Path]:
+    """name -> file of every *.yaml / *.yml scenario in a directory (file stem = default name)."""
+    directory = Path(directory)
+    if not directory.is_dir():
+        return {}
+    out: dict[str, Path] = {}
+    for p in sorted([*directory.glob("*.yaml"), *directory.glob("*.yml")]):
+        out[p.stem] = p
+    return out
+
+
+def find_scenario(name: str, directory: str | Path) -> Scenario:
+    """Load the named scenario from a directory (by file stem). Raises ScenarioError('name', ...)."""
+    known = list_scenarios(directory)
+    if name not in known:
+        raise ScenarioError("name", f"unknown scenario {name!r}; known: {', '.join(known) or 'none'}",
+                            sorted(known))
+    return load_scenario(known[name])
+

@@ -1,0 +1,462 @@
+"""`bearing-twin` command line: simulate, bench, timestep-study, report, serve, scenario, bench-service, monitor,
+soak, ehl, life.
+
+Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import re
+import sys
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse with whole option names only (no abbreviations: `--clear` is not `--clearance`)
+    that takes '-1e-5' as a negative number, like '-1' and '-1.5' (Python 3.11's argparse takes
+    a value in scientific notation for an option: `--clearance -1e-5` would fail)."""
+
+    def __init__(self, *args, **kwargs):
+        kwargs.setdefault("allow_abbrev", False)
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
+
+
+def _positive_float(text: str) -> float:
+    value = float(text)
+    if not value > 0:
+        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
+    return value
+
+
+def _time_step(text: str) -> float | str:
+    from twin.timestep import parse_time_step
+
+    try:
+        return parse_time_step(text)
+    except ValueError as exc:
+        raise argparse.ArgumentTypeError(str(exc)) from None
+
+
+def _cmd_simulate(args: argparse.Namespace) -> int:
+    from pydantic import ValidationError
+
+    from twin.engine import Twin
+    from twin.setpoint import SetpointError, SetpointUpdate
+    from twin.spec import ModelOptions
+
+    try:
+        options = ModelOptions(time_step_s=args.dt, film_formula=args.film_formula)
+        update = SetpointUpdate(shaft_speed_rad_s=args.speed, radial_load_n=args.radial_load,
+                                axial_load_n=args.axial_load, oil_temperature_c=args.oil_temperature)
+        twin = Twin(args.bearing, options=options, diametral_clearance_m=args.clearance, warm=False)
+        twin.set_setpoint(update)           # checked once, against this bearing's limits
+        twin.reset()                        # warm start at it
+        twin.advance(args.duration)
+    except (ValidationError, SetpointError, ValueError) as exc:
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    snap = twin.snapshot()
+    if args.json:
+        print(snap.to_json())
+    else:
+        _print_table(snap)
+    return 0
+
+
+def _one_line(exc: Exception) -> str:
+    from pydantic import ValidationError
+
+    if isinstance(exc, ValidationError):
+        return "; ".join(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" for e in exc.errors())
+    return str(exc)
+
+
+def _print_table(snap) -> None:
+    from rich.console import Console
+    from rich.table import Table
+
+    table = Table(title=f"{snap.designation} at t = {snap.time_s:.4f} s, status {snap.status}")
+    for col in ("ball", "azimuth deg", "spin rad/s", "Q in N", "Q out N", "Lambda in", "Lambda out",
+                "regime in", "regime out"):
+        table.add_column(col, justify="right")
+    for b in snap.balls:
+        lam = lambda c: "-" if c.lambda_ is None else f"{c.lambda_:.2f}"  # noqa: E731
+        table.add_row(str(b.index), f"{b.azimuth_rad * 57.29578:.1f}", f"{b.spin_rad_s:.1f}",
+                      f"{b.inner.load_n:.0f}", f"{b.outer.load_n:.0f}", lam(b.inner), lam(b.outer),
+                      b.inner.regime, b.outer.regime)
+    console = Console()
+    console.print(table)
+    console.print(f"cage {snap.cage_speed_rad_s:.2f} rad/s, friction torque "
+                  f"{snap.friction_torque_n_m * 1e3:.2f} mN m")
+
+
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from twin.validation.bench import run_engine_benchmark, summary_text
+
+    try:
+        result = run_engine_benchmark(seconds=args.seconds, repeats=args.repeats)
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(json.dumps(result) if args.json else summary_text(result))
+    return 0
+
+
+def _cmd_timestep_study(args: argparse.Namespace) -> int:
+    from twin.validation import timestep_study
+
+    result = timestep_study.run_all(quick=args.quick, progress=lambda case, step: print(
+        f"{case.id}: {step}", file=sys.stderr, flush=True))
+    print(timestep_study.as_json(result) if args.json else timestep_study.markdown(result))
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = ArgumentParser(prog="bearing-twin", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+
+    sim = sub.add_parser("simulate", help="run one twin for a duration, print the final snapshot")
+    sim.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    sim.add_argument("--radial-load", type=float, default=3000.0, help="radial load [N]")
+    sim.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
+    sim.add_argument("--speed", type=float, default=500.0, help="shaft speed [rad/s]")
+    sim.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC]")
+    sim.add_argument("--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload")
+    sim.add_argument("--duration", type=float, default=0.05, help="simulated time [s]")
+    sim.add_argument("--dt", type=_time_step, default="auto",
+                     help="time step [s] or 'auto' (default: from the critical step, twin.timestep)")
+    sim.add_argument("--film-formula", choices=["hamrock_dowson", "masjedi_khonsari"], default="hamrock_dowson")
+    sim.add_argument("--json", action="store_true", help="print the snapshot as JSON")
+    sim.set_defaults(func=_cmd_simulate)
+
+    bench = sub.add_parser("bench", help="engine speed: real-time factor at the default step and at 1 us, "
+                           "further cases, per-pass timing")
+    bench.add_argument("--seconds", type=_positive_float, default=0.2, help="simulated seconds per repeat")
+    bench.add_argument("--repeats", type=int, default=5, help="repeats, at least 5 (best and median reported)")
+    bench.add_argument("--json", action="store_true")
+    bench.set_defaults(func=_cmd_bench)
+    study = sub.add_parser("timestep-study", help="the auto time step against 1 us over the operating envelope")
+    study.add_argument("--quick", action="store_true", help="a subset of the cases (the test suite's)")
+    study.add_argument("--json", action="store_true")
+    study.set_defaults(func=_cmd_timestep_study)
+    report = sub.add_parser("report", help="validation report against the seeds (Markdown + PNG plots)")
+    report.add_argument("--out", default="reports", help="output directory (default reports/)")
+    report.add_argument("--quick", action="store_true", help="fewer points and shorter runs")
+    report.set_defaults(func=_cmd_report)
+
+    serve = sub.add_parser(
+        "serve", help="run the service: HTTP API, zenoh bus, rerun recording, the `default` twin",
+        description="Run the service (one uvicorn worker). Each flag overrides its BEARING_TWIN_* "
+        "environment variable, which overrides the built-in default.")
+    serve.add_argument("--host", help="HTTP bind address (default 127.0.0.1: loopback only; "
+                       "0.0.0.0 exposes the API on every interface) [BEARING_TWIN_HOST]")
+    serve.add_argument("--port", type=int, help="HTTP port (default 8000) [BEARING_TWIN_PORT]")
+    serve.add_argument("--bearing", help="designation of the `default` twin (default 6208) [BEARING_TWIN_BEARING]")
+    serve.add_argument("--twin-id", metavar="ID",
+                       help="name of the twin started with the service (default `default`; give "
+                       "each service on one zenoh network its own) [BEARING_TWIN_TWIN_ID]")
+    serve.add_argument("--zenoh-listen", metavar="ENDPOINT", action="append",
+                       help="zenoh endpoint to listen on, repeatable (default tcp/127.0.0.1:7447) "
+                       "[BEARING_TWIN_ZENOH_LISTEN]")
+    serve.add_argument("--zenoh-connect", metavar="ENDPOINT", action="append",
+                       help="zenoh router or peer to connect to, repeatable (default none) "
+                       "[BEARING_TWIN_ZENOH_CONNECT]")
+    serve.add_argument("--zenoh-mode", choices=["peer", "client", "router"],
+                       help="zenoh session mode (default peer) [BEARING_TWIN_ZENOH_MODE]")
+    serve.add_argument("--record", metavar="PATH.rrd",
+                       help="rerun recording (default recordings/bearing-twin-<UTC timestamp>.rrd) "
+                       "[BEARING_TWIN_RECORD]")
+    serve.add_argument("--spawn-viewer", action="store_true", default=None,
+                       help="also stream to a rerun viewer spawned here [BEARING_TWIN_SPAWN_VIEWER]")
+    serve.add_argument("--fast", action="store_true", default=None,
+                       help="run the twins as fast as possible, not paced to the wall clock [BEARING_TWIN_FAST]")
+    serve.add_argument("--publish-rate", type=_positive_float, metavar="HZ",
+                       help="snapshot publishing rate [Hz] (default 50) [BEARING_TWIN_PUBLISH_RATE_HZ]")
+    serve.add_argument("--no-zenoh", action="store_true", help="debugging: do not start the zenoh bus")
+    serve.add_argument("--no-record", action="store_true", help="debugging: do not record")
+    serve.add_argument("--log-level", default="info", choices=["critical", "error", "warning", "info", "debug"])
+    serve.set_defaults(func=_cmd_serve)
+
+    scenario = sub.add_parser("scenario", help="scenarios: timelines of setpoints and ramps (YAML)")
+    scenario_sub = scenario.add_subparsers(dest="scenario_command", required=True)
+    run = scenario_sub.add_parser("run", help="run a scenario file in fast mode (fresh twin per run)")
+    run.add_argument("file", help="scenario YAML file (see scenarios/ and service/core/scenarios.py)")
+    run.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording")
+    run.add_argument("--table", metavar="OUT.parquet", help="write the per-sample table (Parquet; .csv for CSV)")
+    run.add_argument("--no-progress", action="store_true", help="no progress bar")
+    run.set_defaults(func=_cmd_scenario_run)
+    check = scenario_sub.add_parser("check", help="validate scenario files and print what they do")
+    check.add_argument("files", nargs="+")
+    check.set_defaults(func=_cmd_scenario_check)
+
+    bsv = sub.add_parser("bench-service", help="service benchmark: real-time factor with zenoh and "
+                         "recording on, HTTP setpoint -> published snapshot delay (p50/p99)")
+    bsv.add_argument("--seconds", type=_positive_float, default=10.0, help="measurement time [s of wall time]")
+    bsv.add_argument("--rate", type=_positive_float, default=20.0, help="setpoints per second [Hz]")
+    bsv.add_argument("--bearing", default="6208")
+    bsv.add_argument("--no-zenoh", action="store_true", help="without zenoh (then only the runner-side delay)")
+    bsv.add_argument("--no-record", action="store_true", help="without the rerun recording")
+    bsv.add_argument("--json", action="store_true")
+    bsv.set_defaults(func=_cmd_bench_service)
+
+    _add_monitor(sub)
+    from service.tools.soak import add_soak_command
+
+    add_soak_command(sub)
+    from service.tools.ehl_cli import add_ehl_command
+
+    add_ehl_command(sub)
+    from service.tools.life_cli import add_life_command
+
+    add_life_command(sub)
+    return parser
+
+
+def _cmd_bench_service(args: argparse.Namespace) -> int:
+    from service.tools.benchmark import run_service_benchmark
+
+    r = run_service_benchmark(seconds=args.seconds, rate_hz=args.rate, bearing=args.bearing,
+                              record=not args.no_record, zenoh_on=not args.no_zenoh)
+    if args.json:
+        print(json.dumps(r))
+        return 0
+    f = lambda v, spec="{:.2f}": "-" if v is None else spec.format(v)  # noqa: E731
+    print(f"{r['bearing']} real-time mode, zenoh {'on' if r['zenoh'] else 'off'}, recording "
+          f"{'on' if r['recording'] else 'off'}, {r['setpoints']} setpoints in {r['seconds']:g} s")
+    print(f"  real-time factor: median {f(r['real_time_factor_median'], '{:.3f}')}, "
+          f"min {f(r['real_time_factor_min'], '{:.3f}')}; overruns {r['overruns']} of {r['frames']} frames; "
+          f"dropped {r['dropped']}; recorded rows {r['recording_rows']}")
+    print(f"  HTTP PUT -> zenoh state [ms]: p50 {f(r['client_latency_ms_p50'])}, "
+          f"p99 {f(r['client_latency_ms_p99'])}, max {f(r['client_latency_ms_max'])}, lost {r['client_lost']}")
+    print(f"  accepted -> published (runner) [ms]: p50 {f(r['runner_latency_ms_p50'])}, "
+          f"p99 {f(r['runner_latency_ms_p99'])}")
+    return 0
+
+
+def _add_monitor(sub) -> None:
+    """`monitor` comes from service.tools.monitor (zenoh); if it cannot be imported the subcommand
+    still exists and says why."""
+    import importlib.util
+
+    try:
+        available = importlib.util.find_spec("service.tools.monitor") is not None
+    except (ImportError, ValueError):
+        available = False
+    if not available:
+        return
+    try:
+        from service.tools.monitor import add_monitor_command
+    except Exception as exc:  # noqa: BLE001 - keep the other subcommands working
+        reason = f"{type(exc).__name__}: {exc}"
+        stub = sub.add_parser("monitor", help="live table of the twins on the zenoh bus (unavailable)")
+        stub.set_defaults(func=lambda _args: _unavailable("monitor", reason))
+        return
+    add_monitor_command(sub)
+
+
+def _unavailable(name: str, reason: str) -> int:
+    print(f"error: `bearing-twin {name}` is unavailable: {reason}", file=sys.stderr)
+    return 2
+
+
+def _serve_settings(args: argparse.Namespace):
+    """BEARING_TWIN_* environment + the flags that were given."""
+    from service.settings import ServiceSettings
+
+    overrides = {}
+    for flag, name in (("host", "host"), ("port", "port"), ("bearing", "bearing"), ("twin_id", "twin_id"),
+                       ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
+                       ("zenoh_mode", "zenoh_mode"), ("record", "record"),
+                       ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),
+                       ("publish_rate", "publish_rate_hz")):
+        value = getattr(args, flag, None)
+        if value is not None:
+            overrides[name] = value
+    if args.no_zenoh:
+        overrides["enable_zenoh"] = False
+    if args.no_record:
+        overrides["enable_recording"] = False
+    if args.record is not None:
+        overrides["enable_recording"] = True
+    return ServiceSettings(**overrides)
+
+
+def _cmd_serve(args: argparse.Namespace) -> int:
+    import logging
+
+    from pydantic import ValidationError
+
+    from twin import catalog
+
+    try:
+        settings = _serve_settings(args)
+    except ValidationError as exc:
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    if args.no_record and args.record is not None:
+        print("error: --record and --no-record contradict each other", file=sys.stderr)
+        return 2
+    if settings.bearing.strip().upper() not in catalog.designations():
+        print(f"error: bearing: unknown {settings.bearing!r}; known: {', '.join(catalog.designations())}",
+              file=sys.stderr)
+        return 2
+
+    import uvicorn
+
+    from service.api.app import create_app
+
+    logging.basicConfig(level=getattr(logging, args.log_level.upper()),
+                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    host = settings.host
+    where = "loopback only; --host 0.0.0.0 to expose it" if host in ("127.0.0.1", "localhost", "::1") \
+        else "reachable from other machines"
+    port = settings.port if settings.port else "<a free port, see uvicorn's line below>"
+    print(f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
+          f"twin `{settings.twin_id}` = {settings.bearing.upper()}, {'fast' if settings.fast else 'real-time'} mode",
+          flush=True)
+    from service.api.app import access_summary
+
+    print(f"bearing-twin: access: {access_summary(settings)}; setpoints limited to "
+          + (f"{settings.setpoint_rate_hz:g}/s per twin (bursts of {settings.setpoint_burst})"
+             if settings.setpoint_rate_hz else "no rate")
+          + f"; request bodies up to {settings.max_body_bytes} bytes", flush=True)
+    if settings.enable_zenoh:
+        print(f"bearing-twin: zenoh {settings.zenoh_mode} listening on {', '.join(settings.zenoh_listen) or 'nothing'}"
+              + (f", connecting to {', '.join(settings.zenoh_connect)}" if settings.zenoh_connect else ""),
+              flush=True)
+    else:
+        print("bearing-twin: zenoh off", flush=True)
+    path = settings.recording_path
+    print(f"bearing-twin: recording to {path}" if path else "bearing-twin: not recording", flush=True)
+    from service.core.errors import InputError
+    from service.wiring import TwinService, WiringError
+
+    # open the twins, zenoh and the recording here, before uvicorn: what fails (a zenoh port in
+    # use, a recording path that cannot be written) is one line, like a busy HTTP port
+    try:
+        service = TwinService(settings).open()
+    except (WiringError, InputError, OSError) as exc:
+        print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        return 130
+    config = uvicorn.Config(create_app(settings, service=service), host=host, port=settings.port, workers=1,
+                            log_level=args.log_level, lifespan="on", timeout_graceful_shutdown=3)
+    server = uvicorn.Server(config)
+    try:
+        server.run()
+    except KeyboardInterrupt:
+        # uvicorn re-raises a captured SIGINT (Ctrl-C) once its graceful shutdown - our lifespan
+        # `finally`: runners stopped, zenoh closed, recordings flushed - is complete
+        return 130
+    return 0 if server.started else 1
+
+
+def _cmd_scenario_check(args: argparse.Namespace) -> int:
+    from service.core.scenarios import ScenarioError, load_scenario
+
+    status = 0
+    for file in args.files:
+        try:
+            scenario = load_scenario(file)
+            scenario.check_bearing_limits()     # what `scenario run` checks before it runs
+        except ScenarioError as exc:
+            print(f"{file}: error: {exc}", file=sys.stderr)
+            status = 2
+            continue
+        runs = scenario.resolved_runs()
+        print(f"{file}: ok: {scenario.name}, {len(runs)} run(s), {scenario.total_duration_s:g} s simulated, "
+              f"sample every {scenario.sample_every_s:g} s")
+        for w in scenario.warnings:
+            print(f"  warning: {w}")
+    return status
+
+
+def _cmd_scenario_run(args: argparse.Namespace) -> int:
+    from service.tools.offline import TableSink, run_scenario, write_table
+    from service.core.scenarios import ScenarioError, load_scenario
+
+    try:
+        scenario = load_scenario(args.file)
+        scenario.check_bearing_limits()
+    except ScenarioError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    for w in scenario.warnings:
+        print(f"warning: {w}", file=sys.stderr)
+    for path, suffixes in ((args.record, (".rrd",)), (args.table, (".parquet", ".pq", ".csv"))):
+        if path is not None and not path.lower().endswith(suffixes):
+            print(f"error: {path}: expected a file ending in {' or '.join(suffixes)}", file=sys.stderr)
+            return 2
+    total = scenario.total_duration_s
+    runs = scenario.resolved_runs()
+    print(f"{scenario.name}: {len(runs)} run(s), {total:g} s of simulated time, fast mode", file=sys.stderr)
+    table = TableSink()
+    bar = None
+    if not args.no_progress:
+        from tqdm import tqdm
+
+        bar = tqdm(total=round(total * 1000), unit="ms", desc=scenario.name, file=sys.stderr,
+                   bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} ms simulated "
+                   "[{elapsed}<{remaining}]")
+
+    def progress(done_s: float) -> None:
+        if bar is not None:
+            bar.n = min(bar.total, round(done_s * 1000))
+            bar.refresh()
+
+    try:
+        results = run_scenario(scenario, record=args.record, table=table, progress=progress)
+    except ScenarioError as exc:
+        if bar is not None:
+            bar.close()
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    if bar is not None:
+        bar.close()
+    status = 0
+    for r in results:
+        snap = r.final
+        lam = [c.lambda_ for b in (snap.balls if snap else ()) for c in (b.inner, b.outer) if c.lambda_ is not None]
+        summary = (f"min Lambda {min(lam):.2f}, friction torque {snap.friction_torque_n_m * 1e3:.2f} mN m, "
+                   f"status {snap.status}") if snap is not None and lam else (f"status {snap.status}" if snap else "")
+        print(f"  {r.run.id} ({r.run.label}): {r.state}, {r.rows} samples, {r.wall_s:.1f} s wall; {summary}"
+              + (f"; error: {r.error}" if r.error else ""))
+        if r.state != "done":
+            status = 1
+    if args.table:
+        path = write_table(table.rows, args.table)
+        print(f"table: {path} ({len(table.rows)} rows)")
+    if args.record:
+        print(f"recording: {args.record}")
+    return status
+
+
+def _cmd_report(args: argparse.Namespace) -> int:
+    from service.reports.report import write_report
+
+    path = write_report(args.out, quick=args.quick)
+    print(f"report written to {path}")
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        status = args.func(args)
+        sys.stdout.flush()
+        return status
+    except BrokenPipeError:
+        # the reader went away (`bearing-twin simulate --json | head -c 100`): stop quietly, as
+        # a command killed by SIGPIPE would (status 128 + 13), without a traceback; stdout goes
+        # to /dev/null so that the interpreter's final flush does not fail again
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+        return 141
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,286 @@
+"""`bearing-twin monitor`: a live table of every twin seen on the zenoh bus.
+
+    bearing-twin monitor                                   # connects to tcp/127.0.0.1:7447
+    bearing-twin monitor --connect tcp/10.0.0.5:7447 --connect tcp/10.0.0.6:7447
+    bearing-twin monitor --duration 10 'bearing/pump-*/state'
+
+The monitor opens its own peer session (multicast scouting off, gossip on so it also reaches the
+services connected to the one it connects to), subscribes to the state key expression and to the
+liveliness tokens `bearing/*/alive`, and renders one row per twin with rich. zenoh callbacks only
+push into a queue; the main thread parses, aggregates and renders.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import json
+import math
+import queue
+import sys
+import time
+from typing import Any
+
+DEFAULT_KEYEXPR = "bearing/*/state"
+DEFAULT_CONNECT = ["tcp/127.0.0.1:7447"]
+ALIVE_KEYEXPR = "bearing/*/alive"
+_REFRESH_S = 0.25
+_ONCE_SETTLE_S = 0.5
+
+
+def _reject_constant(name: str) -> float:
+    raise ValueError(f"non-finite JSON constant {name}")
+
+
+def _bearing_from_key(key: str) -> str | None:
+    parts = key.split("/")
+    return parts[1] if len(parts) >= 2 and parts[0] == "bearing" else None
+
+
+def _finite(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+class TwinTable:
+    """Aggregates state messages and liveliness events into one row per twin."""
+
+    def __init__(self) -> None:
+        self.rows: dict[str, dict[str, Any]] = {}
+        self.invalid = 0  # messages that were not contract JSON objects
+
+    def _row(self, bearing_id: str) -> dict[str, Any]:
+        row = self.rows.get(bearing_id)
+        if row is None:
+            row = self.rows[bearing_id] = {
+                "bearing_id": bearing_id, "designation": None, "time_s": None, "status": None,
+                "shaft_speed_rad_s": None, "min_lambda": None, "regimes": {},
+                "friction_torque_n_m": None, "discharge_risk": None, "seq": None, "gaps": 0,
+                "missing": 0, "messages": 0, "alive": None, "last_seen": None, "key": None,
+            }
+        return row
+
+    def on_state(self, key: str, payload: bytes) -> None:
+        try:
+            data = json.loads(payload, parse_constant=_reject_constant)
+        except (ValueError, UnicodeDecodeError):
+            data = None
+        if not isinstance(data, dict):
+            self.invalid += 1
+            return
+        if "balls" not in data:  # a ball or result message matched by a wide key expression
+            return
+        # the key names the twin (as its liveliness token does); the payload is the fallback
+        bearing_id = _bearing_from_key(key) or str(data.get("bearing_id") or key)
+        row = self._row(bearing_id)
+        row["messages"] += 1
+        row["key"] = key
+        row["last_seen"] = time.time()
+        if row["alive"] is None:
+            row["alive"] = True
+        for field in ("designation", "status"):
+            if data.get(field) is not None:
+                row[field] = data[field]
+        for field in ("time_s", "shaft_speed_rad_s", "friction_torque_n_m"):
+            row[field] = _finite(data.get(field))
+        seq = data.get("seq")
+        if isinstance(seq, int) and not isinstance(seq, bool):
+            last = row["seq"]
+            if last is not None and seq > last + 1:
+                row["gaps"] += 1
+                row["missing"] += seq - last - 1
+            row["seq"] = seq  # seq <= last: the twin (or service) restarted; follow it
+        lambdas: list[float] = []
+        regimes: dict[str, int] = {}
+        for ball in data.get("balls") or []:
+            if not isinstance(ball, dict):
+                continue
+            for side in ("inner", "outer"):
+                contact = ball.get(side)
+                if not isinstance(contact, dict):
+                    continue
+                lam = _finite(contact.get("lambda"))
+                if lam is not None:
+                    lambdas.append(lam)
+                regime = contact.get("regime")
+                if isinstance(regime, str):
+                    regimes[regime] = regimes.get(regime, 0) + 1
+        row["min_lambda"] = min(lambdas) if lambdas else None
+        row["regimes"] = regimes
+        electrical = data.get("electrical")
+        risk = electrical.get("discharge_risk") if isinstance(electrical, dict) else None
+        row["discharge_risk"] = risk if isinstance(risk, (str, int, float)) and not isinstance(risk, bool) else None
+
+    def on_alive(self, key: str, alive: bool) -> None:
+        bearing_id = _bearing_from_key(key)
+        if bearing_id:
+            self._row(bearing_id)["alive"] = alive
+
+    def snapshot(self) -> dict[str, dict[str, Any]]:
+        return {k: {**v, "regimes": dict(v["regimes"])} for k, v in sorted(self.rows.items())}
+
+    def render(self, title: str = "bearing-twin monitor"):
+        from rich.table import Table
+
+        table = Table(title=title, caption=f"{len(self.rows)} twin(s)"
+                      + (f", {self.invalid} invalid message(s)" if self.invalid else ""))
+        for col, justify in (("bearing", "left"), ("designation", "left"), ("alive", "left"),
+                             ("time s", "right"), ("status", "left"), ("shaft rad/s", "right"),
+                             ("min Lambda", "right"), ("regimes", "left"), ("torque mN m", "right"),
+                             ("discharge", "right"), ("seq", "right"), ("gaps", "right")):
+            table.add_column(col, justify=justify)
+        for bearing_id, r in sorted(self.rows.items()):
+            alive = {True: "[green]alive[/]", False: "[red]gone[/]", None: "?"}[r["alive"]]
+            risk = r["discharge_risk"]
+            risk_text = "-" if risk is None else (f"{risk:.3g}" if isinstance(risk, (int, float)) else str(risk))
+            status = r["status"] or "-"
+            table.add_row(
+                bearing_id, r["designation"] or "-", alive,
+                _fmt(r["time_s"], "{:.3f}"), status if status == "ok" else f"[yellow]{status}[/]",
+                _fmt(r["shaft_speed_rad_s"], "{:.1f}"), _fmt(r["min_lambda"], "{:.2f}"),
+                " ".join(f"{name}:{n}" for name, n in sorted(r["regimes"].items())) or "-",
+                _fmt(None if r["friction_torque_n_m"] is None else r["friction_torque_n_m"] * 1e3, "{:.2f}"),
+                risk_text, "-" if r["seq"] is None else str(r["seq"]),
+                str(r["gaps"]) if not r["gaps"] else f"[red]{r['gaps']}[/] ({r['missing']} lost)",
+            )
+        return table
+
+
+def _fmt(value: float | None, spec: str) -> str:
+    return "-" if value is None else spec.format(value)
+
+
+def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
+                keyexpr: str = DEFAULT_KEYEXPR, duration_s: float | None = None,
+                once: bool = False, out: Any = None) -> dict[str, dict[str, Any]]:
+    """Watch the bus and render a live table; return the final rows {bearing_id: {...}}.
+
+    connect: endpoints to connect to (None or [] -> tcp/127.0.0.1:7447 unless `listen` is given);
+    listen: endpoints to listen on (default none); duration_s: stop after this many seconds
+    (None: until Ctrl-C); once: print one table as soon as a twin has been seen (plus a short
+    settle time) and stop; out: a rich Console or a text file (default stdout).
+    """
+    import zenoh
+    from rich.console import Console
+    from rich.live import Live
+
+    from service.bus.zenoh_bus import make_config
+
+    connect = list(connect or [])
+    listen = list(listen or [])
+    if not connect and not listen:
+        connect = list(DEFAULT_CONNECT)
+    if isinstance(out, Console):
+        console = out
+    else:
+        stream = out if out is not None else sys.stdout
+        interactive = bool(getattr(stream, "isatty", lambda: False)())
+        console = Console(file=stream, width=None if interactive else 160)
+    table = TwinTable()
+    inbox: queue.SimpleQueue = queue.SimpleQueue()
+
+    def on_sample(sample: zenoh.Sample) -> None:  # zenoh thread: hand off only
+        with contextlib.suppress(Exception):
+            inbox.put(("state", str(sample.key_expr), sample.payload.to_bytes()))
+
+    def on_alive(sample: zenoh.Sample) -> None:
+        with contextlib.suppress(Exception):
+            inbox.put(("alive", str(sample.key_expr), sample.kind == zenoh.SampleKind.PUT))
+
+    def drain(timeout: float) -> int:
+        n = 0
+        try:
+            item = inbox.get(timeout=max(timeout, 0.0))
+            while True:
+                kind, key, value = item
+                if kind == "state":
+                    table.on_state(key, value)
+                else:
+                    table.on_alive(key, value)
+                n += 1
+                item = inbox.get_nowait()
+        except queue.Empty:
+            pass
+        return n
+
+    title = f"bearing-twin monitor: {keyexpr} via {', '.join(connect) or 'listen ' + ', '.join(listen)}"
+    session = zenoh.open(make_config(listen, connect, "peer"))
+    subscribers = []  # keep references: undeclared when dropped or at the end
+    try:
+        subscribers.append(session.declare_subscriber(keyexpr, on_sample))
+        subscribers.append(session.liveliness().declare_subscriber(ALIVE_KEYEXPR, on_alive, history=True))
+        start = time.monotonic()
+        deadline = None if duration_s is None else start + duration_s
+        if once:
+            first_seen = None
+            while deadline is None or time.monotonic() < deadline:
+                drain(0.05)
+                if first_seen is None and any(r["messages"] for r in table.rows.values()):
+                    first_seen = time.monotonic()
+                if first_seen is not None and time.monotonic() - first_seen >= _ONCE_SETTLE_S:
+                    break
+            console.print(table.render(title))
+        else:
+            try:
+                with Live(table.render(title), console=console, auto_refresh=False,
+                          transient=False) as live:
+                    next_refresh = 0.0
+                    while deadline is None or time.monotonic() < deadline:
+                        now = time.monotonic()
+                        wait = _REFRESH_S if deadline is None else min(_REFRESH_S, deadline - now)
+                        drain(wait)
+                        if time.monotonic() >= next_refresh:
+                            live.update(table.render(title), refresh=True)
+                            next_refresh = time.monotonic() + _REFRESH_S
+                    drain(0.0)
+                    live.update(table.render(title), refresh=True)
+            except KeyboardInterrupt:
+                pass
+            if not console.is_terminal:
+                console.line()  # Live leaves the cursor after the last line of a file
+    finally:
+        for sub in subscribers:
+            with contextlib.suppress(Exception):
+                sub.undeclare()
+        session.close()
+    return table.snapshot()
+
+
+def _cmd_monitor(args: argparse.Namespace) -> int:
+    try:
+        run_monitor(args.connect, args.listen, args.keyexpr, duration_s=args.duration, once=args.once)
+    except KeyboardInterrupt:
+        return 0
+    except Exception as exc:  # noqa: BLE001 - bad endpoint, port in use, ...
+        print(f"error: monitor: {' '.join(str(exc).split())}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def _positive(text: str) -> float:
+    value = float(text)
+    if not (value > 0 and math.isfinite(value)):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
+    return value
+
+
+def add_monitor_command(subparsers: Any) -> argparse.ArgumentParser:
+    """Register `monitor` on an argparse subparsers object; its `func(args)` returns an exit code."""
+    p = subparsers.add_parser("monitor", help="live table of the twins on the zenoh bus",
+                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("keyexpr", nargs="?", default=DEFAULT_KEYEXPR,
+                   help=f"state key expression to subscribe to (default {DEFAULT_KEYEXPR})")
+    p.add_argument("--connect", metavar="ENDPOINT", action="append", default=None,
+                   help="zenoh endpoint to connect to (repeatable; default tcp/127.0.0.1:7447)")
+    p.add_argument("--listen", metavar="ENDPOINT", action="append", default=None,
+                   help="zenoh endpoint to listen on (repeatable; default: none)")
+    p.add_argument("--duration", type=_positive, default=None, metavar="SECONDS",
+                   help="stop after this many seconds (default: until Ctrl-C)")
+    p.add_argument("--once", action="store_true", help="print one table once a twin is seen, then exit")
+    p.set_defaults(func=_cmd_monitor)
+    return p
+
+
+build_parser = add_monitor_command  # alias

@@ -1,0 +1,448 @@
+"""ZenohBus, TwinChannel and the monitor against real zenoh sessions.
+
+Peer mode, loopback endpoints on free ports, multicast scouting off; every wait is bounded.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import queue
+import threading
+import time
+
+import pytest
+
+zenoh = pytest.importorskip("zenoh")
+
+from service.bus.zenoh_bus import ZenohBus, make_config, wait_until
+from service.tools.monitor import add_monitor_command, run_monitor
+from twin.engine import Twin
+from twin.setpoint import SetpointLimits, SetpointUpdate
+
+WAIT_S = 10.0
+
+
+def reject(name: str):
+    raise AssertionError(f"JSON carries {name}")
+
+
+def loads(payload: bytes) -> dict:
+    return json.loads(payload, parse_constant=reject)
+
+
+@pytest.fixture(scope="module")
+def twin():
+    tw = Twin("6208", bearing_id="t1")
+    tw.advance(0.002)
+    return tw
+
+
+@pytest.fixture
+def endpoint(support):
+    return support.free_endpoint()
+
+
+@pytest.fixture
+def bus(endpoint):
+    b = ZenohBus(listen=[endpoint], connect=[])
+    yield b
+    b.close()
+
+
+@pytest.fixture
+def client(endpoint, bus, support):
+    """A separate peer session (another process in real life) connected to the bus."""
+    c = support.Peer(endpoint, timeout_s=WAIT_S)
+    yield c
+    c.close()
+
+
+def validating_on_setpoint(applied: list):
+    def on_setpoint(payload: bytes) -> dict:
+        update = SetpointUpdate.model_validate_json(payload)  # raises on bad types
+        SetpointLimits.static().check(update)                  # and on values out of range
+        applied.append(update)
+        return {"accepted": True, "setpoint": update.model_dump(exclude_none=True)}
+    return on_setpoint
+
+
+# ---- (a) state and ball messages ------------------------------------------------------------
+def test_state_and_ball_messages_reach_a_remote_session(bus, client, twin):
+    snap = twin.snapshot()
+    channel = bus.attach_twin("t1", lambda: snap, lambda p: {"accepted": False, "error": "n/a"})
+    client.subscribe("bearing/t1/state")
+    client.subscribe("bearing/t1/ball/0")
+    got = {}
+
+    def is_new(item):
+        key, _, payload = item
+        got.setdefault(key, loads(payload))
+        return "bearing/t1/state" in got and "bearing/t1/ball/0" in got
+
+    client.wait_for(is_new, poke=lambda: channel.publish(snap))
+    state, ball = got["bearing/t1/state"], got["bearing/t1/ball/0"]
+    assert state["schema"] == "bearing-twin/state/1"
+    assert state["bearing_id"] == "t1" and state["designation"] == "6208"
+    assert state["seq"] == snap.seq and len(state["balls"]) == len(snap.balls)
+    assert state == json.loads(snap.to_json())
+    assert ball["schema"] == "bearing-twin/state/1"
+    assert ball["bearing_id"] == "t1" and ball["time_s"] == snap.time_s and ball["index"] == 0
+    assert ball["inner"] == state["balls"][0]["inner"]
+    assert wait_until(lambda: channel.published >= 1, 5.0) and channel.errors == 0
+
+
+def test_every_ball_is_published(bus, client, twin):
+    snap = twin.snapshot()
+    channel = bus.attach_twin("t1", lambda: snap, lambda p: {})
+    client.subscribe("bearing/t1/ball/*")
+    seen: set[str] = set()
+
+    def all_balls(item):
+        seen.add(item[0])
+        return len(seen) == len(snap.balls)
+
+    client.wait_for(all_balls, poke=lambda: channel.publish(snap))
+    assert seen == {f"bearing/t1/ball/{b.index}" for b in snap.balls}
+
+
+# ---- (b) queryable ---------------------------------------------------------------------------
+def test_queryable_answers_with_the_latest_snapshot(bus, client, twin):
+    latest = {"snap": None}
+    bus.attach_twin("t1", lambda: latest["snap"], lambda p: {})
+
+    def query(selector):
+        replies = []
+        deadline = time.monotonic() + WAIT_S
+        while not replies and time.monotonic() < deadline:  # the queryable may not be known yet
+            replies = list(client.session.get(selector, timeout=2.0))
+            if not replies:
+                time.sleep(0.1)
+        assert replies, "no reply"
+        return replies
+
+    # no snapshot yet: an error reply, not a hang
+    (reply,) = query("bearing/t1/snapshot")
+    assert reply.err is not None and "no snapshot" in reply.err.payload.to_string()
+
+    latest["snap"] = twin.snapshot()
+    (reply,) = query("bearing/t1/snapshot")
+    assert reply.ok is not None
+    assert str(reply.ok.key_expr) == "bearing/t1/snapshot"
+    data = loads(reply.ok.payload.to_bytes())
+    assert data["seq"] == latest["snap"].seq and data["schema"] == "bearing-twin/state/1"
+
+    latest["snap"] = twin.snapshot()  # newer
+    (reply,) = query("bearing/*/snapshot")  # wildcard query, concrete reply key
+    assert str(reply.ok.key_expr) == "bearing/t1/snapshot"
+    assert loads(reply.ok.payload.to_bytes())["seq"] == latest["snap"].seq
+
+
+# ---- (c) setpoints ---------------------------------------------------------------------------
+def test_setpoints_are_applied_and_refusals_reported(bus, client, twin):
+    applied: list = []
+    snap = twin.snapshot()
+    channel = bus.attach_twin("t1", lambda: snap, validating_on_setpoint(applied))
+    client.subscribe("bearing/t1/setpoint/result")
+    pub = client.session.declare_publisher("bearing/t1/setpoint")
+
+    def put_and_wait(payload: bytes) -> dict:
+        client.drain()
+        # put again every 0.5 s until a result arrives: the first put may precede route discovery
+        _, _, data = client.wait_for(lambda item: True, poke=lambda: pub.put(payload), poke_every_s=0.5)
+        return loads(data)
+
+    result = put_and_wait(b'{"shaft_speed_rad_s": 300.0}')
+    assert result["accepted"] is True and result["bearing_id"] == "t1"
+    assert result["setpoint"] == {"shaft_speed_rad_s": 300.0}
+    assert applied and applied[-1].shaft_speed_rad_s == 300.0
+
+    for bad in (b"not json", b'{"shaft_speed_rad_s": "fast"}', b'{"shaft_speed_rad_s": NaN}',
+                b'{"shaft_speed_rad_s": -5}', b'{"warp_factor": 9}', b"\xff\xfe", b""):
+        result = put_and_wait(bad)
+        assert result["accepted"] is False, bad
+        assert isinstance(result["error"], str) and result["error"], bad
+    assert "shaft_speed_rad_s" in put_and_wait(b'{"shaft_speed_rad_s": "fast"}')["error"]
+
+    # the bus keeps working: a good setpoint after the bad ones, and state still flows
+    result = put_and_wait(b'{"radial_load_n": 4000.0}')
+    assert result["accepted"] is True and applied[-1].radial_load_n == 4000.0
+    client.subscribe("bearing/t1/state")
+    client.wait_for(lambda item: item[0] == "bearing/t1/state", poke=lambda: channel.publish(snap))
+    pub.undeclare()
+
+
+def test_handler_that_misbehaves_is_a_refusal(bus, client, twin):
+    calls = {"n": 0}
+
+    def on_setpoint(payload: bytes):
+        calls["n"] += 1
+        if payload == b"boom":
+            raise RuntimeError("handler exploded")
+        if payload == b"none":
+            return None
+        if payload == b"nan":
+            return {"accepted": True, "setpoint": {"shaft_speed_rad_s": float("nan")}}
+        return {"accepted": True}
+
+    bus.attach_twin("t1", lambda: None, on_setpoint)
+    client.subscribe("bearing/t1/setpoint/result")
+    results = {}
+    deadline = time.monotonic() + WAIT_S
+    while len(results) < 4 and time.monotonic() < deadline:
+        for payload in (b"boom", b"none", b"nan", b"ok"):
+            if payload not in results:
+                client.session.put("bearing/t1/setpoint", payload)
+                try:
+                    _, _, data = client.inbox.get(timeout=0.5)
+                    results[payload] = loads(data)
+                except queue.Empty:
+                    pass
+    assert results[b"boom"]["accepted"] is False and "exploded" in results[b"boom"]["error"]
+    assert results[b"none"]["accepted"] is False
+    assert results[b"nan"]["accepted"] is False  # result itself not valid contract JSON
+    assert results[b"ok"]["accepted"] is True
+
+
+# ---- (d) liveliness --------------------------------------------------------------------------
+def test_liveliness_token_follows_attach_and_detach(bus, client):
+    client.subscribe("bearing/*/alive", liveliness=True)
+    channel = bus.attach_twin("t1", lambda: None, lambda p: {})
+    key, kind, _ = client.wait_for(lambda item: True)
+    assert key == "bearing/t1/alive" and kind == zenoh.SampleKind.PUT
+    replies = list(client.session.liveliness().get("bearing/*/alive", timeout=2.0))
+    assert [str(r.ok.key_expr) for r in replies if r.ok] == ["bearing/t1/alive"]
+
+    channel.detach()
+    key, kind, _ = client.wait_for(lambda item: True)
+    assert key == "bearing/t1/alive" and kind == zenoh.SampleKind.DELETE
+    channel.detach()  # idempotent
+    assert "t1" not in bus.channels
+    # the id can be attached again after a detach
+    bus.attach_twin("t1", lambda: None, lambda p: {})
+    key, kind, _ = client.wait_for(lambda item: True)
+    assert kind == zenoh.SampleKind.PUT
+
+
+def test_closing_the_bus_withdraws_every_token(endpoint, twin, support):
+    bus = ZenohBus(listen=[endpoint], connect=[])
+    client = support.Peer(endpoint, timeout_s=WAIT_S)
+    try:
+        client.subscribe("bearing/*/alive", liveliness=True)
+        for name in ("a", "b"):
+            bus.attach_twin(name, lambda: None, lambda p: {})
+        alive: dict[str, bool] = {}
+
+        def track(item):
+            alive[item[0]] = item[1] == zenoh.SampleKind.PUT
+            return len(alive) == 2 and all(alive.values())
+
+        client.wait_for(track)
+        bus.close()
+        bus.close()  # idempotent
+        client.wait_for(lambda item: track(item) or (len(alive) == 2 and not any(alive.values())))
+        assert alive == {"bearing/a/alive": False, "bearing/b/alive": False}
+        with pytest.raises(RuntimeError):
+            bus.attach_twin("c", lambda: None, lambda p: {})
+    finally:
+        bus.close()
+        client.close()
+
+
+def test_bad_ids_and_duplicates_are_refused(bus):
+    for bad in ("", "a/b", "a*", "**", "a$b", "what?", "x#1"):
+        with pytest.raises(ValueError):
+            bus.attach_twin(bad, lambda: None, lambda p: {})
+    bus.attach_twin("ok-1", lambda: None, lambda p: {})
+    with pytest.raises(ValueError):
+        bus.attach_twin("ok-1", lambda: None, lambda p: {})
+
+
+def test_listen_conflict_is_a_clear_error(endpoint, bus):
+    with pytest.raises(RuntimeError, match="cannot open"):
+        ZenohBus(listen=[endpoint], connect=[])
+
+
+@pytest.mark.parametrize("bad", ["tcp/127.0.0.1:notaport", "127.0.0.1:7447", "tcp/127.0.0.1",
+                                 "tcp/:7447", "tcp/127.0.0.1:70000", ""])
+def test_malformed_endpoints_are_refused_up_front(bad):
+    with pytest.raises(ValueError, match="not a zenoh endpoint"):
+        make_config([], [bad])
+    with pytest.raises(ValueError, match="not a zenoh endpoint"):
+        ZenohBus(listen=[bad])
+
+
+def test_endpoint_forms_that_are_accepted():
+    make_config(["tcp/127.0.0.1:0", "tcp/[::1]:7447"], ["tcp/localhost:7447", "udp/127.0.0.1:7447",
+                                                         "unixsock-stream/tmp/x.sock"])
+
+
+# ---- (e) monitor -----------------------------------------------------------------------------
+def test_monitor_sees_twins_of_two_services(endpoint, twin, support):
+    endpoint2 = support.free_endpoint()
+    bus1 = ZenohBus(listen=[endpoint], connect=[])
+    bus2 = ZenohBus(listen=[endpoint2], connect=[endpoint])  # a second service, joined to the first
+    stop = threading.Event()
+    try:
+        base = twin.snapshot()
+        names = ("m1", "m2", "m3")
+        snaps = {name: base.model_copy(update={"bearing_id": name}) for name in names}
+        channels = {name: (bus1 if name != "m3" else bus2).attach_twin(name, lambda n=name: snaps[n],
+                                                                        lambda p: {})
+                    for name in names}
+
+        def runner():  # the runners' job: publish at a fixed rate (20 Hz here)
+            seq = 0
+            while not stop.is_set():
+                seq += 1
+                for name in names:
+                    snaps[name] = base.model_copy(update={"bearing_id": name, "seq": seq})
+                    channels[name].publish(snaps[name])
+                stop.wait(0.05)
+
+        thread = threading.Thread(target=runner, daemon=True)
+        thread.start()
+        out = io.StringIO()
+        t0 = time.monotonic()
+        rows = run_monitor([endpoint], [], "bearing/*/state", duration_s=3.5, out=out)
+        assert time.monotonic() - t0 < 8.0
+    finally:
+        stop.set()
+        bus2.close()
+        bus1.close()
+    assert set(rows) == {"m1", "m2", "m3"}, rows.keys()
+    for row in rows.values():
+        assert row["designation"] == "6208"
+        assert row["alive"] is True
+        assert row["messages"] >= 1 and row["seq"] is not None
+        assert row["min_lambda"] is None or row["min_lambda"] > 0
+        assert sum(row["regimes"].values()) == 2 * len(base.balls)
+        electrical = base.to_dict().get("electrical")
+        assert row["discharge_risk"] == (electrical["discharge_risk"] if electrical else None)
+        assert row["shaft_speed_rad_s"] == pytest.approx(500.0, rel=0.05)
+        assert row["gaps"] == 0
+    text = out.getvalue()
+    assert "m1" in text and "m3" in text
+
+
+def test_monitor_counts_gaps_marks_gone_and_reads_electrical(endpoint, twin):
+    bus = ZenohBus(listen=[endpoint], connect=[])
+    result: dict = {}
+    try:
+        channel = bus.attach_twin("g1", lambda: None, lambda p: {})
+        pub = bus.session.declare_publisher("bearing/g1/state")
+        base = twin.snapshot().to_dict()
+        base["bearing_id"] = "g1"
+        base["electrical"] = {"discharge_risk": 0.75}
+
+        th = threading.Thread(target=lambda: result.update(
+            run_monitor([endpoint], None, duration_s=3.0, out=io.StringIO())), daemon=True)
+        th.start()
+        # wait until the monitor's subscriber is routed to this publisher (NB: matching_status
+        # is a MatchingStatus object, always truthy: read .matching), then send seq 1..10
+        # without 4, 7, 8
+        assert wait_until(lambda: pub.matching_status.matching, 8.0)
+        for seq in (1, 2, 3, 5, 6, 9, 10):
+            pub.put(json.dumps({**base, "seq": seq}))
+        pub.put(b"garbage")
+        time.sleep(0.5)
+        channel.detach()
+        pub.undeclare()
+        th.join(10.0)
+        assert not th.is_alive()
+    finally:
+        bus.close()
+    row = result["g1"]
+    assert row["seq"] == 10 and row["gaps"] == 2 and row["missing"] == 3
+    assert row["discharge_risk"] == 0.75
+    assert row["alive"] is False
+
+
+def test_monitor_once_prints_one_table_and_returns(endpoint, twin):
+    bus = ZenohBus(listen=[endpoint], connect=[])
+    stop = threading.Event()
+    try:
+        snap = twin.snapshot().model_copy(update={"bearing_id": "o1"})
+        channel = bus.attach_twin("o1", lambda: snap, lambda p: {})
+        thread = threading.Thread(target=lambda: [channel.publish(snap) for _ in iter(lambda: stop.wait(0.05), True)],
+                                  daemon=True)
+        thread.start()
+        out = io.StringIO()
+        t0 = time.monotonic()
+        rows = run_monitor([endpoint], [], once=True, duration_s=8.0, out=out)
+        assert time.monotonic() - t0 < 6.0  # returned on the first twin, not at the deadline
+    finally:
+        stop.set()
+        bus.close()
+    assert list(rows) == ["o1"] and rows["o1"]["designation"] == "6208"
+    assert "6208" in out.getvalue()
+
+
+def test_monitor_command_registers_with_argparse():
+    import argparse
+
+    parser = argparse.ArgumentParser(prog="bearing-twin")
+    sub = parser.add_subparsers(dest="command", required=True)
+    add_monitor_command(sub)
+    args = parser.parse_args(["monitor", "--connect", "tcp/127.0.0.1:1", "--connect",
+                              "tcp/127.0.0.1:2", "--duration", "1", "bearing/x/state"])
+    assert args.connect == ["tcp/127.0.0.1:1", "tcp/127.0.0.1:2"]
+    assert args.keyexpr == "bearing/x/state" and args.duration == 1.0 and callable(args.func)
+    args = parser.parse_args(["monitor"])
+    assert args.keyexpr == "bearing/*/state" and not args.once
+    bad = parser.parse_args(["monitor", "--connect", "tcp/127.0.0.1:notaport", "--duration", "0.2"])
+    assert bad.func(bad) == 2
+
+
+# ---- (f) publish never blocks ----------------------------------------------------------------
+class _Blocker:
+    """A 'snapshot' whose serialisation blocks the publisher thread until released."""
+
+    def __init__(self):
+        self.entered = threading.Event()
+        self.release = threading.Event()
+
+    def to_dict(self):
+        self.entered.set()
+        self.release.wait(10.0)
+        raise RuntimeError("not a real snapshot")  # must not kill the publisher thread
+
+
+def test_publish_never_blocks_and_counts_drops(bus, client, twin):
+    snap = twin.snapshot()
+    channel = bus.attach_twin("t1", lambda: snap, lambda p: {}, queue_size=8)
+    blocker = _Blocker()
+    channel.publish(blocker)
+    assert blocker.entered.wait(5.0)
+    worst = 0.0
+    for _ in range(200):
+        t = time.perf_counter()
+        channel.publish(snap)
+        worst = max(worst, time.perf_counter() - t)
+    assert channel.dropped == 200 - 8
+    assert worst < 0.05
+    channel.publish(object())  # garbage is accepted without raising
+    assert channel.dropped == 200 - 8 + 1
+    blocker.release.set()
+    # the thread survives the failures and drains the queue
+    assert wait_until(lambda: channel.published == 7 and channel.errors == 2, 5.0), \
+        (channel.published, channel.errors)
+    client.subscribe("bearing/t1/state")
+    client.wait_for(lambda item: True, poke=lambda: channel.publish(snap))
+    channel.detach()
+    channel.publish(snap)  # after detach: a no-op, no exception
+
+
+def test_publish_burst_is_cheap_and_close_is_prompt(bus, twin):
+    snaps = [twin.snapshot() for _ in range(5)]
+    channel = bus.attach_twin("t1", lambda: snaps[-1], lambda p: {}, queue_size=64)
+    t = time.perf_counter()
+    for i in range(5000):
+        channel.publish(snaps[i % 5])
+    assert time.perf_counter() - t < 1.0
+    assert channel.dropped > 0
+    t = time.perf_counter()
+    bus.close()
+    assert time.perf_counter() - t < 5.0
+    assert channel.closed
+    assert channel.published + channel.dropped + channel.errors <= 5000

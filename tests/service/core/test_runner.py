@@ -1,0 +1,432 @@
+"""TwinRunner: one thread per twin, mailbox latest-wins, setpoints between frames, pacing, fast
+mode, stop/join, scenarios in the runner thread, errors counted. Real Twin, bounded waits; no
+wall-clock speed threshold (the machines are shared and noisy): pacing is checked as "never ahead
+of the wall clock" on the real runner and exactly on a fake clock."""
+
+from __future__ import annotations
+
+import json
+import threading
+import time
+
+import pytest
+
+from service.core.admission import AdmissionGate
+from service.core.errors import InputError
+from service.core.intake import SetpointIntake
+from service.core.runner import TwinRunner
+from service.core.scenarios import ScenarioError, scenario_from_dict
+from twin.engine import Twin
+
+WAIT_S = 30.0
+
+
+class ListSink:
+    """A SnapshotSink that keeps everything (tests only)."""
+
+    def __init__(self):
+        self.snapshots = []
+        self.threads = set()
+        self.dropped = 0
+        self._lock = threading.Lock()
+
+    def publish(self, snapshot):
+        with self._lock:
+            self.snapshots.append(snapshot)
+            self.threads.add(threading.current_thread().name)
+
+    def close(self):
+        pass
+
+    def wait_for(self, predicate, timeout=WAIT_S):
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            with self._lock:
+                for s in self.snapshots:
+                    if predicate(s):
+                        return s
+            time.sleep(0.01)
+        return None
+
+
+def wait_until(predicate, timeout=WAIT_S, interval=0.01):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if predicate():
+            return True
+        time.sleep(interval)
+    return predicate()
+
+
+@pytest.fixture
+def twin():
+    tw = Twin("6208", bearing_id="t")
+    tw.advance(0.001)  # compiled and warm
+    return tw
+
+
+@pytest.fixture
+def make_runner():
+    runners = []
+
+    def make(twin, **kw):
+        r = TwinRunner(twin, **kw)
+        runners.append(r)
+        return r
+
+    yield make
+    for r in runners:
+        assert r.stop(timeout=10.0)
+
+
+def test_mailbox_latest_wins_and_merges_in_order(twin, make_runner):
+    sink = ListSink()
+    runner = make_runner(twin, fast=True, sinks=[sink])
+    runner.submit(radial_load_n=4000.0)
+    runner.submit(shaft_speed_rad_s=300.0)
+    target = runner.submit({"radial_load_n": 5000.0, "oil_temperature_c": 60.0})
+    # merged in order, latest wins per field; nothing applied yet (no frame has run)
+    assert (target.radial_load_n, target.shaft_speed_rad_s, target.oil_temperature_c) == (5000.0, 300.0, 60.0)
+    assert twin.setpoint.radial_load_n == 3000.0
+    runner.start()
+    first = sink.snapshots[0]
+    assert first.setpoint.radial_load_n == 3000.0  # published before the first frame
+    assert wait_until(lambda: runner.frames >= 3)
+    assert runner.setpoints_applied == 1           # three updates, one application
+    assert runner.setpoints_accepted == 3
+    sp = twin.setpoint
+    assert (sp.radial_load_n, sp.shaft_speed_rad_s, sp.oil_temperature_c) == (5000.0, 300.0, 60.0)
+
+
+def test_setpoint_validation_names_field_and_range(twin, make_runner):
+    runner = make_runner(twin, fast=True)
+    with pytest.raises(InputError) as exc:
+        runner.submit(shaft_speed_rad_s=5000.0)  # above the 6208's limit, below the schema's 1e4
+    err = exc.value.errors[0]
+    assert err.field == "shaft_speed_rad_s"
+    low, high = err.allowed
+    assert low == 0.0 and 2000.0 < high < 2100.0
+    with pytest.raises(InputError) as exc:
+        runner.submit({"radial_load_n": -1.0})
+    assert exc.value.errors[0].field == "radial_load_n"
+    with pytest.raises(InputError) as exc:
+        runner.submit({"radial_load": 1.0})
+    assert exc.value.errors[0].field == "radial_load"
+    # a refused update changes nothing
+    assert runner.target_setpoint == twin.setpoint
+
+
+def test_zenoh_setpoint_handler_never_raises(twin, make_runner):
+    runner = make_runner(twin, fast=True)
+    intake = SetpointIntake(twin.bearing_id, AdmissionGate(), runner)
+    ok = intake(b'{"radial_load_n": 2500}')
+    assert ok["accepted"] is True and ok["setpoint"]["radial_load_n"] == 2500.0
+    for payload, field in ((b'{"radial_load_n": NaN}', "radial_load_n"),
+                           (b'{"shaft_speed_rad_s": 1e9}', "shaft_speed_rad_s"),
+                           (b'{"axial_load_n": "x"}', "axial_load_n"),
+                           (b"not json", None), (b"[1, 2]", None), (b"\xff\xfe", None)):
+        res = intake(payload)
+        assert res["accepted"] is False, payload
+        json.dumps(res, allow_nan=False)  # the refusal itself is valid JSON
+        if field is not None:
+            assert field in res["error"]
+    assert runner.target_setpoint.radial_load_n == 2500.0
+
+
+def test_setpoints_only_change_between_frames(twin, make_runner):
+    """The runner thread is the only writer and never changes the setpoint during a frame."""
+    violations, writers = [], set()
+    advance, set_setpoint = twin.advance, twin.set_setpoint
+
+    def checked_advance(*a, **kw):
+        before = twin.setpoint
+        advance(*a, **kw)
+        if twin.setpoint is not before:
+            violations.append(twin.time_s)
+
+    def recorded_set_setpoint(*a, **kw):
+        writers.add(threading.current_thread().name)
+        return set_setpoint(*a, **kw)
+
+    twin.advance, twin.set_setpoint = checked_advance, recorded_set_setpoint
+    runner = make_runner(twin, fast=True).start()
+    stop = threading.Event()
+
+    def hammer():
+        i = 0
+        while not stop.is_set():
+            runner.submit(radial_load_n=2000.0 + (i % 50) * 10.0)
+            i += 1
+            time.sleep(0.0005)
+
+    threads = [threading.Thread(target=hammer) for _ in range(2)]
+    for t in threads:
+        t.start()
+    assert wait_until(lambda: runner.setpoints_applied >= 20)
+    stop.set()
+    for t in threads:
+        t.join(5.0)
+    assert not violations
+    assert writers == {runner._thread.name}
+
+
+class _TimedSink(ListSink):
+    """Keeps each snapshot with the wall time it arrived."""
+
+    def __init__(self):
+        super().__init__()
+        self.arrivals = []
+
+    def publish(self, snapshot):
+        with self._lock:
+            self.arrivals.append((time.perf_counter(), snapshot))
+        super().publish(snapshot)
+
+
+def test_real_time_pacing(twin, make_runner):
+    """Real-time mode on a real twin, without a speed threshold (the machine is shared): the
+    simulated time never runs ahead of the wall clock (at every snapshot and at the end), every
+    frame is counted and advanced frame_s, and publishing follows the 50 Hz wall-clock schedule
+    (never more often). How fast the twin keeps up is the benchmark's business, not a test's."""
+    sink = _TimedSink()
+    runner = make_runner(twin, publish_rate_hz=50.0, sinks=[sink])
+    time0 = twin.time_s
+    t0 = time.perf_counter()
+    runner.start()
+    assert wait_until(lambda: runner.frames >= 50 and runner.published >= 3)   # progress (bounded wait)
+    assert runner.stop(timeout=10.0)
+    wall = time.perf_counter() - t0
+    frames, sim = runner.frames, runner.sim_elapsed_s
+    # frames counted: each advanced the twin by exactly frame_s
+    assert sim == pytest.approx(frames * runner.frame_s, rel=1e-12)
+    assert twin.time_s - time0 == pytest.approx(sim, abs=0.5 * twin.model.dt_s)
+    # never ahead of the wall clock (one frame of slack for the frame in progress, one for timing)
+    assert sim <= wall + 2 * runner.frame_s
+    for arrived, snap in sink.arrivals:
+        assert snap.time_s - time0 <= (arrived - t0) + 2 * runner.frame_s
+    assert 0 <= runner.overruns <= frames
+    # published on the wall clock at 50 Hz (+ the initial one), never more than once per frame
+    assert 3 <= runner.published <= min(frames + 1, 50 * wall + 2)
+    rtfs = [s.real_time_factor for s in sink.snapshots[1:]]
+    assert rtfs and all(r is not None and r > 0.0 for r in rtfs)
+    seqs = [s.seq for s in sink.snapshots]
+    assert seqs == sorted(seqs) and len(set(seqs)) == len(seqs)
+
+
+class _FakeClock:
+    """A monotonic clock that only moves when told to (frame work) or when the pacing sleeps."""
+
+    def __init__(self):
+        self.t = 100.0
+        self.slept = 0.0
+
+    def __call__(self):
+        return self.t
+
+    def wait(self, seconds):       # threading.Event.wait as the pacing uses it
+        assert seconds >= 0.0
+        self.t += seconds
+        self.slept += seconds
+        return False
+
+
+def test_pacing_clock_holds_the_wall_clock_deterministically():
+    """PacingClock on a fake clock (no machine speed involved): frames that take 0.2 ms of 1 ms
+    sleep to their deadline exactly (simulated = wall, real-time factor 1); a 5 ms frame is an
+    overrun, the next frames catch up without sleeping (each still late is an overrun) and never
+    get ahead; a stall longer than
+    resync_after_s re-anchors the schedule; fast mode never sleeps."""
+    from service.core.pacing import PacingClock
+
+    clock = _FakeClock()
+    pacing = PacingClock(fast=False, publish_period_s=0.02, clock=clock, resync_after_s=0.25)
+    frame_s, sim = 1e-3, 0.0
+    wall0 = clock()
+    pacing.start(sim)
+
+    def frame(work_s):
+        nonlocal sim
+        clock.t += work_s
+        sim += frame_s
+        now = clock()
+        pacing.measure(now, sim)
+        pacing.wait_for_deadline(now, sim, clock)
+        assert sim <= clock() - wall0 + 1e-12          # never ahead of the wall clock
+
+    for _ in range(100):
+        frame(2e-4)
+    assert clock() - wall0 == pytest.approx(sim, abs=1e-12)    # on the deadline, to the rounding
+    assert pacing.overruns == 0 and pacing.real_time_factor == pytest.approx(1.0)
+    assert clock.slept == pytest.approx(100 * 8e-4)
+    frame(5e-3)                                                 # 4 ms late: an overrun, no sleep
+    assert pacing.overruns == 1
+    slept = clock.slept
+    for _ in range(5):                                          # 3.25, 2.5, 1.75, 1.0, 0.25 ms late
+        frame(2.5e-4)
+    assert clock.slept == slept and pacing.overruns == 6       # caught up without sleeping
+    frame(2.5e-4)                                               # 0.5 ms early: sleeps to the deadline
+    assert clock.slept - slept == pytest.approx(5e-4) and pacing.overruns == 6
+    assert clock() - wall0 == pytest.approx(sim, abs=1e-12)
+    frame(0.3)                                                  # a stall: re-anchored, not raced
+    assert pacing.resyncs == 1
+    before = clock.slept
+    frame(2e-4)
+    assert clock.slept - before == pytest.approx(8e-4)          # back on a schedule from the stall
+
+    fast = PacingClock(fast=True, publish_period_s=0.02, clock=clock)
+    fast.start(0.0)
+    slept = clock.slept
+    for k in range(1, 50):
+        fast.wait_for_deadline(clock(), k * frame_s, clock)
+    assert clock.slept == slept and fast.overruns == 0
+
+
+def test_fast_mode_publishes_on_simulated_time(twin, make_runner):
+    sink = ListSink()
+    runner = make_runner(twin, fast=True, publish_rate_hz=200.0, sinks=[sink]).start()
+    assert wait_until(lambda: runner.sim_elapsed_s >= 0.05)
+    assert runner.stop(timeout=10.0)
+    assert runner.overruns == 0 and runner.resyncs == 0
+    # one snapshot at start + one per 5 ms of simulated time
+    expected = 1 + round(runner.sim_elapsed_s / 0.005)
+    assert abs(len(sink.snapshots) - expected) <= 1
+    times = [s.time_s for s in sink.snapshots[1:]]
+    gaps = [b - a for a, b in zip(times, times[1:])]
+    assert all(abs(g - 0.005) < 1e-6 for g in gaps)
+
+
+def test_stop_joins_and_is_idempotent(twin, make_runner):
+    runner = make_runner(twin).start()
+    assert wait_until(lambda: runner.frames >= 2)
+    t0 = time.monotonic()
+    assert runner.stop(timeout=5.0)
+    assert time.monotonic() - t0 < 5.0
+    assert not runner.running
+    frames = runner.frames
+    time.sleep(0.05)
+    assert runner.frames == frames
+    assert runner.stop(timeout=1.0)
+
+
+def test_setpoint_timing_records_first_reflecting_snapshot(twin, make_runner):
+    sink = ListSink()
+    runner = make_runner(twin, publish_rate_hz=20.0, sinks=[sink]).start()
+    assert wait_until(lambda: runner.frames >= 5)
+    runner.submit(radial_load_n=4321.0)
+    assert wait_until(lambda: runner.setpoint_latencies())
+    (timing,) = runner.setpoint_latencies()
+    assert timing.latency_s is not None and timing.latency_s >= 0.0
+    by_seq = {s.seq: s for s in sink.snapshots}
+    assert by_seq[timing.seq].setpoint.radial_load_n == 4321.0
+    assert by_seq[timing.seq - 1].setpoint.radial_load_n == 3000.0
+    # published at once, not at the next 50 ms publishing tick
+    assert timing.published_wall_s - timing.applied_wall_s < 0.05 + 10 * runner.frame_s
+
+
+def _scenario(**kw):
+    data = {"name": "t", "duration_s": 0.03, "sample_every_s": 0.001,
+            "initial": {"radial_load_n": 2000.0},
+            "steps": [{"at_s": 0.005, "set": {"oil_temperature_c": 60.0}},
+                      {"at_s": 0.01, "ramp": {"radial_load_n": 4000.0}, "over_s": 0.01}]}
+    data.update(kw)
+    return scenario_from_dict(data)
+
+
+def test_scenario_runs_in_the_runner_thread(twin, make_runner):
+    sink = ListSink()
+    runner = make_runner(twin, fast=True, publish_rate_hz=1000.0, sinks=[sink],
+                         idle_without_scenario=True).start(publish_initial=False)
+    writers = set()
+    set_setpoint = twin.set_setpoint
+
+    def recorded(*a, **kw):
+        writers.add(threading.current_thread().name)
+        return set_setpoint(*a, **kw)
+
+    twin.set_setpoint = recorded
+    handle, replaced = runner.start_scenario(_scenario().resolved_runs()[0])
+    assert replaced is None
+    assert handle.wait(WAIT_S)
+    assert handle.state == "done" and handle.progress == 1.0
+    assert writers == {runner._thread.name}
+    t0 = sink.snapshots[0].time_s
+    by_t = {round(s.time_s - t0, 6): s.setpoint for s in sink.snapshots}
+    assert by_t[0.0].radial_load_n == 2000.0
+    assert by_t[0.004].oil_temperature_c == 40.0 and by_t[0.006].oil_temperature_c == 60.0
+    assert by_t[0.010].radial_load_n == pytest.approx(2000.0)
+    # a snapshot at t shows the setpoint in force during the frame that ended at t, i.e. the
+    # ramp's value at t - frame_s: 2000 + 2000 * (0.014 - 0.010) / 0.010
+    assert by_t[0.015].radial_load_n == pytest.approx(2800.0)
+    assert by_t[0.025].radial_load_n == 4000.0
+    assert max(by_t) == pytest.approx(0.03)                              # last sample at the end
+    # idle afterwards: no frames without a scenario
+    frames = runner.frames
+    time.sleep(0.1)
+    assert runner.frames == frames
+
+
+def test_scenario_replaced_and_cancelled(twin, make_runner):
+    runner = make_runner(twin, fast=True).start()
+    long = _scenario(duration_s=60.0, steps=[]).resolved_runs()[0]
+    first, _ = runner.start_scenario(long)
+    assert wait_until(lambda: first.state == "running")
+    second, replaced = runner.start_scenario(long)
+    assert replaced is first
+    assert first.wait(WAIT_S) and first.state == "cancelled"
+    assert wait_until(lambda: second.state == "running")
+    assert runner.cancel_scenario() is second
+    assert second.wait(WAIT_S) and second.state == "cancelled"
+    assert runner.running
+
+
+def test_scenario_restart_warm_starts_at_the_initial_setpoint(twin, make_runner):
+    runner = make_runner(twin, fast=True).start()
+    assert wait_until(lambda: runner.sim_elapsed_s >= 0.005)
+    before = twin.time_s
+    run = _scenario(initial={"radial_load_n": 1000.0, "shaft_speed_rad_s": 200.0}, steps=[]).resolved_runs()[0]
+    handle, _ = runner.start_scenario(run, restart=True)
+    assert handle.wait(WAIT_S) and handle.state == "done"
+    assert twin.setpoint.radial_load_n == 1000.0
+    assert twin.time_s > before                 # time went on through the restart
+    assert runner.latest.shaft_speed_rad_s == pytest.approx(200.0)   # started there, not ramped
+
+
+def test_scenario_outside_the_bearing_limits_is_refused(twin, make_runner):
+    runner = make_runner(twin, fast=True)
+    bad = _scenario(steps=[{"at_s": 0.0, "set": {"shaft_speed_rad_s": 5000.0}}]).resolved_runs()[0]
+    with pytest.raises(ScenarioError) as exc:
+        runner.start_scenario(bad)
+    assert exc.value.field.endswith("steps[0].set.shaft_speed_rad_s")
+    assert exc.value.allowed[1] < 5000.0
+
+
+def test_loop_exception_is_counted_shown_and_survived(twin, make_runner):
+    advance = twin.advance
+    calls = {"n": 0}
+
+    def flaky(*a, **kw):
+        calls["n"] += 1
+        if calls["n"] == 3:
+            raise RuntimeError("injected failure")
+        return advance(*a, **kw)
+
+    twin.advance = flaky
+    sink = ListSink()
+    runner = make_runner(twin, fast=True, publish_rate_hz=1000.0, sinks=[sink]).start()
+    assert wait_until(lambda: runner.frames >= 10)
+    assert runner.errors == 1 and runner.running and not runner.failed
+    assert "injected failure" in runner.latest.status
+    assert "injected failure" in runner.stats()["status"]
+    times = [s.time_s for s in sink.snapshots]
+    assert times == sorted(times)          # the warm restart keeps the simulated clock
+
+
+def test_repeated_exceptions_stop_the_runner_with_a_status(twin, make_runner):
+    def broken(*a, **kw):
+        raise RuntimeError("always")
+
+    twin.advance = broken
+    runner = make_runner(twin, fast=True, max_consecutive_errors=3).start()
+    assert wait_until(lambda: not runner.running)
+    assert runner.failed and runner.errors == 3
+    assert runner.latest.status.startswith("failed")

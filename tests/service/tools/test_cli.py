@@ -1,0 +1,92 @@
+"""The console script: simulate prints the contract as JSON, report writes Markdown and plots;
+numbers in scientific notation, a closed pipe and a busy zenoh port are handled cleanly."""
+
+import json
+import socket
+import subprocess
+import sys
+
+import pytest
+
+
+def _run(*args, timeout=300):
+    return subprocess.run([sys.executable, "-m", "service.cli", *args], capture_output=True, text=True,
+                          timeout=timeout)
+
+
+def test_simulate_json_is_the_contract():
+    res = _run("simulate", "--bearing", "6208", "--radial-load", "3000", "--speed", "500",
+               "--duration", "0.005", "--json")
+    assert res.returncode == 0, res.stderr
+    snap = json.loads(res.stdout, parse_constant=lambda c: pytest.fail(f"non-finite {c}"))
+    assert snap["schema"] == "bearing-twin/state/1"
+    assert snap["time_s"] == pytest.approx(0.005)
+    assert len(snap["balls"]) == 9
+    ball = snap["balls"][0]
+    assert set(ball["inner"]) >= {"load_n", "entrainment_speed_m_s", "slide_roll_ratio", "h_min_m", "lambda",
+                                  "regime", "mu"}
+    assert snap["setpoint"]["radial_load_n"] == 3000.0
+
+
+def test_simulate_refuses_bad_input_by_name():
+    res = _run("simulate", "--radial-load", "-10", "--duration", "0.001")
+    assert res.returncode == 2
+    assert "radial_load_n" in res.stderr and "Traceback" not in res.stderr
+    res = _run("simulate", "--clearance", "0.01", "--duration", "0.001")
+    assert res.returncode == 2 and "diametral_clearance_m" in res.stderr
+
+
+def test_report_quick(tmp_path):
+    res = _run("report", "--out", str(tmp_path), "--quick", timeout=600)
+    assert res.returncode == 0, res.stderr
+    text = (tmp_path / "report.md").read_text()
+    for png in ("lambda_azimuth_500.png", "lambda_speed.png", "lambda_load.png", "lambda_clearance.png",
+                "startup.png", "seed001_torque.png", "seed003_reduction.png", "seed003_fig7_speed.png",
+                "seed003_temperature_resistance.png", "ehl_centre_line_isothermal.png",
+                "ehl_centre_line_current.png", "ehl_film_vs_speed.png", "angular_contact_jones.png"):
+        assert (tmp_path / png).stat().st_size > 10_000
+        assert png in text
+    assert "0.6797" in text and "-0.0727" in text
+    # the EV section (seed 003): Figs. 2/4 band, Fig. 7's thickest-film speed rising with current
+    assert "## EV motor bearing under shaft current (seed 003)" in text
+    assert "57.6-84.8 %" in text and "speed of the thickest film" in text
+    # the 7208 family against Jones' quasi-static solution (service/reports/angular_contact.py)
+    assert "## Angular-contact 7208 family against Jones' quasi-static solution" in text
+    assert "| 7208AC | 3000 / 3000 |" in text
+    # issue 13: the time-step study's table
+    assert "## Time step: the auto step against 1 us" in text and "| 6208-serve | auto |" in text
+
+
+def test_negative_numbers_in_scientific_notation_are_values():
+    """`--clearance -1e-5` (a preload) is the option's value, not an unknown option (Python
+    3.11's argparse only knows -1 and -1.5 as numbers); `--clearance=-1e-5` too."""
+    for args in (("--clearance", "-1e-5"), ("--clearance=-1e-5",)):
+        res = _run("simulate", *args, "--duration", "0.001", "--json")
+        assert res.returncode == 0, res.stderr
+        assert json.loads(res.stdout)["status"] == "ok"
+    res = _run("simulate", "--clear", "0", "--duration", "0.001")      # no abbreviations
+    assert res.returncode == 2 and "unrecognized arguments" in res.stderr
+
+
+def test_a_closed_pipe_ends_quietly():
+    """`simulate --json | head -c 100`: the reader goes away; no BrokenPipeError traceback."""
+    proc = subprocess.Popen([sys.executable, "-m", "service.cli", "simulate", "--duration", "0.001", "--json"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()                    # nothing reads: the first write fails with EPIPE
+    _out, err = proc.communicate(timeout=300)
+    assert proc.returncode == 141, err
+    assert b"Traceback" not in err and b"BrokenPipeError" not in err
+
+
+def test_a_busy_zenoh_port_is_a_one_line_error(tmp_path):
+    with socket.socket() as busy:
+        busy.bind(("127.0.0.1", 0))
+        busy.listen()
+        port = busy.getsockname()[1]
+        res = subprocess.run([sys.executable, "-m", "service.cli", "serve", "--port", "0", "--no-record",
+                              "--zenoh-listen", f"tcp/127.0.0.1:{port}"], capture_output=True, text=True,
+                             timeout=300, cwd=tmp_path)
+    assert res.returncode == 2
+    lines = [line for line in res.stderr.splitlines() if line.strip()]
+    assert len(lines) == 1 and lines[0].startswith("error: zenoh") and "already in use" in lines[0], res.stderr
+    assert ".rs:" not in lines[0]

@@ -1,0 +1,135 @@
+"""Engine benchmark (issue 13): the twin `serve` runs by default, at its default step and at 1 us,
+further cases, and the per-pass timing of the step.
+
+- `real_time_factor`, `time_step_s`: the twin `bearing-twin serve` starts (6208, 3000 N,
+  500 rad/s, 40 degC, no current) at its default step (`time_step_s = "auto"`, `twin.timestep`);
+  `real_time_factor_1us`: the same twin at the seed's 1 us;
+- `cases`: the electro-thermal coupling on (5 A shaft current, current and inlet shear heating fed
+  back into the film every 10 ms), the 7208 under Fr = Fa = 3000 N, the 6208 at 1700 rad/s and
+  7500 N; each at its default step and at 1 us;
+- every figure: best and median real-time factor (simulated s per wall s) of `repeats` (>= 5)
+  runs of `seconds` simulated seconds each, and ns per step;
+- `passes`: ns per step of gather, geometry, forces, tribology, cage and integration
+  (`twin.validation.step_timing`, a harness that times each pass alone), at the default step.
+
+Wall-clock figures belong here and in README, never in tests (machines are shared and noisy).
+"""
+
+from __future__ import annotations
+
+import os
+import statistics
+import time
+from dataclasses import asdict, dataclass
+
+from twin import catalog
+from twin.engine import Twin
+from twin.setpoint import Setpoint
+from twin.spec import BearingSpec, ModelOptions
+
+MIN_REPEATS = 5
+
+
+@dataclass(frozen=True)
+class BenchCase:
+    """One benchmarked operating point (SI)."""
+
+    id: str
+    designation: str = "6208"
+    shaft_speed_rad_s: float = 500.0
+    radial_load_n: float = 3000.0
+    axial_load_n: float = 0.0
+    shaft_current_a: float = 0.0
+    shear_heating: bool = False
+
+
+SERVE_DEFAULT = BenchCase("serve-default")  # Twin("6208")'s default setpoint, what `serve` runs
+CASES = (
+    BenchCase("ev-5A-heating", shaft_current_a=5.0, shear_heating=True),
+    BenchCase("7208-combined", designation="7208", axial_load_n=3000.0),
+    BenchCase("6208-1700rad-7.5kN", shaft_speed_rad_s=1700.0, radial_load_n=7500.0),
+)
+
+
+def _twin(case: BenchCase, time_step_s: float | str) -> Twin:
+    spec = catalog.bearing(case.designation)
+    if case.shear_heating != spec.thermal.shear_heating:
+        spec = BearingSpec.model_validate({**spec.model_dump(), "thermal": {
+            **spec.thermal.model_dump(), "shear_heating": case.shear_heating}})
+    return Twin(spec, options=ModelOptions(time_step_s=time_step_s),
+                setpoint=Setpoint(shaft_speed_rad_s=case.shaft_speed_rad_s, radial_load_n=case.radial_load_n,
+                                  axial_load_n=case.axial_load_n, shaft_current_a=case.shaft_current_a))
+
+
+def measure(case: BenchCase, time_step_s: float | str = "auto", seconds: float = 0.2,
+            repeats: int = MIN_REPEATS) -> dict:
+    """Best and median real-time factor and ns per step of `repeats` runs of `seconds`."""
+    twin = _twin(case, time_step_s)
+    twin.advance(0.002)  # compile / warm caches
+    factors = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        twin.advance(seconds)
+        factors.append(seconds / (time.perf_counter() - t0))
+    dt = twin.model.dt_s
+    best, median = max(factors), statistics.median(factors)
+    return {"time_step_s": dt, "real_time_factor": best, "real_time_factor_median": median,
+            "ns_per_step": dt / best * 1e9, "ns_per_step_median": dt / median * 1e9,
+            "repeats": repeats, "status": twin.status}
+
+
+def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, cases: bool = True,
+                         passes: bool = True) -> dict:
+    """The benchmark (module docstring). `cases` / `passes`: include those parts."""
+    if repeats < MIN_REPEATS:
+        raise ValueError(f"repeats = {repeats}: at least {MIN_REPEATS}")
+    load_before = os.getloadavg()
+    auto = measure(SERVE_DEFAULT, "auto", seconds, repeats)
+    one = measure(SERVE_DEFAULT, 1e-6, seconds, repeats)
+    result = {
+        **asdict(SERVE_DEFAULT), "bearing": SERVE_DEFAULT.designation,
+        "simulated_seconds_per_repeat": seconds, "repeats": repeats,
+        "time_step_s": auto["time_step_s"], "real_time_factor": auto["real_time_factor"],
+        "real_time_factor_median": auto["real_time_factor_median"], "ns_per_step": auto["ns_per_step"],
+        "ns_per_step_median": auto["ns_per_step_median"], "status": auto["status"],
+        "real_time_factor_1us": one["real_time_factor"], "real_time_factor_1us_median": one["real_time_factor_median"],
+        "ns_per_step_1us": one["ns_per_step"], "ns_per_step_1us_median": one["ns_per_step_median"],
+    }
+    if cases:
+        result["cases"] = [
+            {**asdict(c), "default_step": measure(c, "auto", seconds, repeats),
+             "step_1us": measure(c, 1e-6, seconds, repeats)}
+            for c in CASES]
+    if passes:
+        from twin.validation.step_timing import time_passes
+
+        twin = _twin(SERVE_DEFAULT, "auto")
+        twin.advance(0.005)
+        result["passes"] = time_passes(twin, repeats=repeats)
+    result["load_average_1min"] = [load_before[0], os.getloadavg()[0]]  # before, after
+    result["cpu_count"] = os.cpu_count()
+    return result
+
+
+def summary_text(result: dict) -> str:
+    """The benchmark as a few lines of text (what `bearing-twin bench` prints without --json)."""
+    def fig(r: dict, key: str = "") -> str:
+        return (f"real-time factor {r[f'real_time_factor{key}']:.2f} best / {r[f'real_time_factor{key}_median']:.2f} "
+                f"median, {r[f'ns_per_step{key}']:.0f} ns per step")
+
+    lines = [f"{result['bearing']} at {result['radial_load_n']:.0f} N, {result['shaft_speed_rad_s']:.0f} rad/s, "
+             f"best and median of {result['repeats']} x {result['simulated_seconds_per_repeat']:g} s:",
+             f"  default step dt = {result['time_step_s'] * 1e6:.3f} us: {fig(result)}",
+             f"  dt = 1 us: {fig(result, '_1us')}"]
+    for c in result.get("cases", []):
+        d, o = c["default_step"], c["step_1us"]
+        lines.append(f"  {c['id']}: dt = {d['time_step_s'] * 1e6:.3f} us: {fig(d)}; 1 us: {fig(o)}")
+    p = result.get("passes")
+    if p:
+        parts = ", ".join(f"{k} {p[k]['best_ns']:.0f}" for k in ("gather", "geometry", "forces", "tribology",
+                                                                  "cage", "integration"))
+        lines.append(f"  per pass, ns per step (best): {parts}; sum {p['sum_of_passes']['best_ns']:.0f}, "
+                     f"step_n {p['total']['best_ns']:.0f}")
+    lines.append(f"  load average (1 min) before / after: {result['load_average_1min'][0]:.2f} / "
+                 f"{result['load_average_1min'][1]:.2f}")
+    return "\n".join(lines)

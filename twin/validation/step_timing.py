@@ -1,0 +1,338 @@
+"""Per-pass timing of one step (issue 13): gather, geometry, forces, tribology, cage, integration.
+
+`twin.kernels.step.compute_accelerations` runs its passes inline in one compiled function, so a
+profiler cannot split them. This harness times each pass on its own, on a copy of a settled
+twin's state, each in its own compiled loop of `reps` calls (no Python between calls):
+
+- geometry, forces: the kernel's own `raceway_geometry` and `raceway_forces` on the lanes;
+- tribology: the kernel's per-contact pass (copy of its loop) with the kernel's own
+  `contact_tribology` and `contact_electrical`, timed without refresh, with the tribology
+  refresh and with the electrical refresh too; per step it costs the first plus the refreshes
+  divided by their periods in steps (the model's tribology sub-rate, x ELECTRICAL_EVERY);
+- gather (the lanes filled from the ball and ring state), cage (the per-ball force sums and the
+  ball-cage contacts with the kernel's own `cage_contact`) and integration (the leapfrog kicks and
+  drifts of `step_n` with its co-rotating velocity turn): copies of the kernel's inline loops.
+
+The copies mirror `twin/kernels/step.py` as of this writing; `total` is `step_n` itself, so the
+sum of the passes against `total` shows how far the harness is from the real step (call
+overheads and what LLVM fuses or hoists across passes).
+"""
+
+from __future__ import annotations
+
+import math
+import statistics
+import time
+
+import numpy as np
+
+from numba import njit
+
+from twin.jit import JIT
+from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
+from twin.kernels.layout import (
+    A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, C_XI_DECAY, G_NX, G_NY, G_NZ,
+    C_CAPACITANCE, C_ENTRAINMENT, C_FLUID_DAMPING, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
+    C_RESISTANCE, C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT,
+    C_SRR, C_TANGENT_DAMPING, CW, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
+    K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, O_EX, O_EY,
+    O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, P_ALPHA_E,
+    P_ASPERITY_RESISTANCE, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
+    P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS, P_CAGE_STIFFNESS,
+    P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_GAP_LIMIT, P_KT_RATIO, P_OIL_PERMITTIVITY,
+    P_OIL_RESISTIVITY, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED,
+    X_CAGE_TORQUE, X_SHAFT_SPEED,
+)
+from twin.kernels.step import (ELECTRICAL_EVERY, ROLLING_REGULARISATION_SPEED, SPIN_CREEP_FACTOR, _at_angle,
+                               step_n)
+from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
+
+PASSES = ("gather", "geometry", "forces", "tribology", "cage", "integration")
+
+
+@njit(**JIT)
+def _gather(bx, bv, bw, rx, rv, scal, w, reps):
+    z = bx.shape[0]
+    acc = 0.0
+    for _ in range(reps):
+        ring_speed = scal[X_SHAFT_SPEED]
+        for j in range(z):
+            x0 = bx[j, 0]
+            x1 = bx[j, 1]
+            x2 = bx[j, 2]
+            v0 = bv[j, 0]
+            v1 = bv[j, 1]
+            rho2 = x0 * x0 + x1 * x1
+            orbital = (x0 * v1 - x1 * v0) / rho2 if rho2 > 0.0 else 0.0
+            for r in range(2):
+                c = 2 * j + r
+                inner = r == 0
+                w[K_PX * CW + c] = x0 - rx[0] if inner else x0
+                w[K_PY * CW + c] = x1 - rx[1] if inner else x1
+                w[K_PZ * CW + c] = x2 - rx[2] if inner else x2
+                w[K_BX * CW + c] = x0
+                w[K_BY * CW + c] = x1
+                w[K_VX * CW + c] = v0
+                w[K_VY * CW + c] = v1
+                w[K_VZ * CW + c] = bv[j, 2]
+                w[K_WX * CW + c] = bw[j, 0]
+                w[K_WY * CW + c] = bw[j, 1]
+                w[K_WZ * CW + c] = bw[j, 2]
+                w[K_OVX * CW + c] = rv[0] if inner else 0.0
+                w[K_OVY * CW + c] = rv[1] if inner else 0.0
+                w[K_OVZ * CW + c] = rv[2] if inner else 0.0
+                w[K_SPIN * CW + c] = ring_speed if inner else 0.0
+                w[K_ORBIT * CW + c] = orbital
+        acc += w[K_ORBIT * CW]
+    return acc
+
+
+@njit(**JIT)
+def _geometry(w, nc, reps):
+    for _ in range(reps):
+        raceway_geometry(w, nc)
+    return w[G_DELTA * CW]
+
+
+@njit(**JIT)
+def _forces(w, nc, rb, dt, kt_ratio, alpha_e, reps):
+    for _ in range(reps):
+        raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e)
+    return w[O_FX * CW]
+
+
+@njit(**JIT)
+def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
+    kt_ratio = p[P_KT_RATIO]
+    ct_ratio = p[P_CT_RATIO]
+    tangent_mass = p[P_BALL_REDUCED_TANGENT_MASS]
+    friction_model = int(p[P_FRICTION_MODEL])
+    rolling_on = p[P_ROLLING] != 0.0
+    roughness = p[P_ROUGHNESS]
+    eta = sp[S_VISCOSITY]
+    max_pen = 0.0
+    for _ in range(reps):
+        for c in range(nc):
+            delta = w[G_DELTA * CW + c]
+            if delta <= 0.0:
+                continue
+            if delta > max_pen:
+                max_pen = delta
+            q_el = w[G_LOAD * CW + c]
+            w[C_LOAD * CW + c] = q_el
+            if tribology_now:
+                r = c & 1
+                # Hertz and film constants at the contact's current angle (angle table rows i, i + 1)
+                xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
+                ia = min(int(xa), ANGLE_POINTS - 2)
+                fa = xa - ia
+                w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
+                ex = w[O_EX * CW + c]
+                ey = w[O_EY * CW + c]
+                ez = w[O_EZ * CW + c]
+                u2 = ex * ex + ey * ey + ez * ez
+                u = math.sqrt(u2)
+                t = A_TRIBOLOGY
+                tri = contact_tribology(
+                    q_el, u, eta, roughness, _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
+                    _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
+                    _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
+                    _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
+                    _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
+                    _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
+                    _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
+                    _at_angle(tr, r, ia, fa, t + 14), friction_model, rolling_on)
+                w[C_H_MIN * CW + c] = tri[0]
+                w[C_H_C * CW + c] = tri[1]
+                w[C_LAMBDA * CW + c] = tri[2]
+                w[C_REGIME * CW + c] = tri[3]
+                w[C_MU * CW + c] = tri[4]
+                w[C_SEMI_MAJOR * CW + c] = tri[5]
+                w[C_SEMI_MINOR * CW + c] = tri[6]
+                w[C_FLUID_DAMPING * CW + c] = tri[7]
+                w[C_ROLLING_FORCE * CW + c] = tri[8]
+                w[C_ROLLING_PER_SPEED * CW + c] = tri[8] / max(u, ROLLING_REGULARISATION_SPEED)
+                w[C_SPIN_MOMENT * CW + c] = tri[9]
+                kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
+                w[C_TANGENT_DAMPING * CW + c] = ct_ratio * 2.0 * math.sqrt(kt * tangent_mass)
+                w[C_ENTRAINMENT * CW + c] = u
+                ab = math.sqrt(tri[5] * tri[6])
+                spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
+                               + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
+                relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * tri[4] * q_el, 1e-12)
+                w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
+                w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
+                                      + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
+                if not electrical_now:
+                    continue
+                if tri[1] > 0.0:
+                    res_ohm, cap_f = contact_electrical(
+                        q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
+                        _at_angle(tr, r, ia, fa, t + T_RY),
+                        p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT], p[P_ASPERITY_RESISTANCE],
+                        p[P_OIL_RESISTIVITY])
+                else:
+                    res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
+                w[C_RESISTANCE * CW + c] = res_ohm
+                w[C_CAPACITANCE * CW + c] = cap_f
+    return max_pen
+
+
+@njit(**JIT)
+def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, reps):
+    z = bx.shape[0]
+    m = p[P_BALL_MASS]
+    inertia = p[P_BALL_INERTIA]
+    rc = p[P_CAGE_RADIUS]
+    s_cage = p[P_CAGE_CONTACT_DISTANCE]
+    k_cage = p[P_CAGE_STIFFNESS]
+    m_cage = p[P_CAGE_REDUCED_MASS]
+    cage_speed = scal[X_CAGE_SPEED]
+    step_angle = 2.0 * math.pi / z
+    c_step = math.cos(step_angle)
+    s_step = math.sin(step_angle)
+    acc = 0.0
+    for _ in range(reps):
+        ring_tz = 0.0
+        for j in range(z):
+            ci = 2 * j
+            co = ci + 1
+            ba[j, 0] = w[O_FX * CW + ci] + w[O_FX * CW + co]
+            ba[j, 1] = w[O_FY * CW + ci] + w[O_FY * CW + co]
+            ba[j, 2] = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
+            balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) / inertia
+            balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) / inertia
+            balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) / inertia
+            ring_tz += w[O_RING_TZ * CW + ci]
+        theta = scal[X_CAGE_ANGLE] - 0.5 * step_angle
+        prev_c = math.cos(theta)
+        prev_s = math.sin(theta)
+        first_c = prev_c
+        first_s = prev_s
+        cage_tz = 0.0
+        for j in range(z):
+            fx = ba[j, 0]
+            fy = ba[j, 1]
+            fz = ba[j, 2]
+            next_c = prev_c * c_step - prev_s * s_step
+            next_s = prev_s * c_step + prev_c * s_step
+            if j == z - 1:
+                next_c = first_c
+                next_s = first_s
+            for slot in range(2):
+                ex = rc * (next_c if slot == 0 else prev_c)
+                ey = rc * (next_s if slot == 0 else prev_s)
+                f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], bv[j, 0], bv[j, 1],
+                                             bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage)
+                cage_load[j, slot] = f
+                fx += f * nx
+                fy += f * ny
+                fz += f * nz
+                cage_tz -= ex * f * ny - ey * f * nx
+            prev_c = next_c
+            prev_s = next_s
+            ba[j, 0] = fx / m
+            ba[j, 1] = fy / m
+            ba[j, 2] = fz / m
+        acc += cage_tz + ring_tz
+    return acc
+
+
+@njit(**JIT)
+def _integration(p, scal, bx, bv, bw, ba, balpha, rx, rv, ra, reps):
+    z = bx.shape[0]
+    dt = p[P_DT]
+    half = 0.5 * dt
+    cage_inertia = p[P_CAGE_INERTIA]
+    for _ in range(reps):
+        for j in range(z):
+            for k in range(3):
+                bv[j, k] += dt * ba[j, k]
+                bw[j, k] += dt * balpha[j, k]
+                bx[j, k] += dt * bv[j, k]
+        for k in range(3):
+            rv[k] += dt * ra[k]
+            rx[k] += dt * rv[k]
+        scal[X_CAGE_SPEED] += dt * scal[X_CAGE_TORQUE] / cage_inertia
+        scal[X_CAGE_ANGLE] += dt * scal[X_CAGE_SPEED]
+        turn = half * scal[X_CAGE_SPEED]
+        ct = math.cos(turn)
+        st = math.sin(turn)
+        for j in range(z):
+            vx = bv[j, 0]
+            bv[j, 0] = ct * vx - st * bv[j, 1]
+            bv[j, 1] = st * vx + ct * bv[j, 1]
+            wx = bw[j, 0]
+            bw[j, 0] = ct * wx - st * bw[j, 1]
+            bw[j, 1] = st * wx + ct * bw[j, 1]
+        for j in range(z):
+            vx = bv[j, 0]
+            bv[j, 0] = ct * vx + st * bv[j, 1]
+            bv[j, 1] = -st * vx + ct * bv[j, 1]
+            wx = bw[j, 0]
+            bw[j, 0] = ct * wx + st * bw[j, 1]
+            bw[j, 1] = -st * wx + ct * bw[j, 1]
+    return bx[0, 0]
+
+
+def _best_median_ns(fn, reps: int, repeats: int) -> tuple[float, float]:
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        fn(reps)
+        times.append((time.perf_counter() - t0) / reps * 1e9)
+    return min(times), statistics.median(times)
+
+
+def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
+    """ns per step of each pass (best and median of `repeats` loops of `reps` calls) on copies of
+    the twin's state, and of `step_n` itself (`total`); see the module docstring."""
+    m, s = twin.model, twin.state
+    p, tr, sp = m.params, m.angle_table, twin._setpoint_vector
+    nc = 2 * m.ball_count
+    substeps = int(p[P_SUBSTEPS])
+    # the tribology pass is timed with the race constants at the nominal angle (the kernel
+    # interpolates them in the angle table per contact: a few ns more per refresh)
+    tr_nominal = np.ascontiguousarray(m.race_tribology)
+
+    def copies():
+        args = [a.copy() for a in s.kernel_args()]
+        return args  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load
+
+    scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load = copies()
+    runs = {
+        "gather": lambda n: _gather(bx, bv, bw, rx, rv, scal, w, n),
+        "geometry": lambda n: _geometry(w, nc, n),
+        "forces": lambda n: _forces(w, nc, p[P_BALL_RADIUS], p[P_DT], p[P_KT_RATIO], p[P_ALPHA_E], n),
+        "tribology_no_refresh": lambda n: _tribology(p, tr_nominal, sp, w, nc, False, False, n),
+        "tribology_refresh": lambda n: _tribology(p, tr_nominal, sp, w, nc, True, False, n),
+        "tribology_refresh_electrical": lambda n: _tribology(p, tr_nominal, sp, w, nc, True, True, n),
+        "cage": lambda n: _cage(p, scal, bx, bv, ba, balpha, w, cage_load, n),
+    }
+    for fn in runs.values():  # compile
+        fn(1)
+    out = {}
+    for name, fn in runs.items():
+        best, median = _best_median_ns(fn, reps, repeats)
+        out[name] = {"best_ns": best, "median_ns": median}
+    ig = copies()
+    _integration(p, ig[0], ig[1], ig[2], ig[3], ig[4], ig[5], ig[6], ig[7], ig[8], 1)
+    best, median = _best_median_ns(
+        lambda n: _integration(p, ig[0], ig[1], ig[2], ig[3], ig[4], ig[5], ig[6], ig[7], ig[8], n),
+        reps, repeats)
+    out["integration"] = {"best_ns": best, "median_ns": median}
+    # per step: the refreshes weighted by their periods in steps
+    t0, t1, t2 = (out[k] for k in ("tribology_no_refresh", "tribology_refresh", "tribology_refresh_electrical"))
+    out["tribology"] = {key: t0[key] + (t1[key] - t0[key]) / substeps
+                        + (t2[key] - t1[key]) / (substeps * ELECTRICAL_EVERY) for key in ("best_ns", "median_ns")}
+    # the real step on a copy of the state
+    st = copies()
+    n_total = max(1000, reps // 10)
+    step_n(p, tr, sp, *st, 10)
+    best, median = _best_median_ns(lambda n: step_n(p, tr, sp, *st, n), n_total, repeats)
+    out["total"] = {"best_ns": best, "median_ns": median}
+    out["sum_of_passes"] = {key: sum(out[k][key] for k in PASSES) for key in ("best_ns", "median_ns")}
+    out["tribology_steps_per_refresh"] = substeps
+    out["electrical_steps_per_refresh"] = substeps * ELECTRICAL_EVERY
+    return out
+
