@@ -1,16 +1,16 @@
 """`TwinService`: the twins of one service and their wiring to the zenoh bus and rerun.
 
-This is the ONE place that touches `service.bus` and `service.recorder` (imported lazily, so the
+This is the ONE place that touches `service.bus` and `service.recording` (imported lazily, so the
 HTTP layer and the tests that disable them never import zenoh or rerun):
 
     create twin -> TwinRunner (not started) -> bus.attach_twin(...) -> channel as a sink
                 -> recorder.add_twin_from(twin), recorder as a sink -> runner.start()
-    delete twin -> runner.stop() -> channel.detach() -> per-twin recording closed
+    delete twin -> runner.stop() -> channel.detach() -> recorder.remove_twin -> per-twin recording closed
     close       -> every runner stopped (all asked first, then joined) -> channels detached
                 -> per-twin recordings closed -> service recording closed (drained, flushed)
                 -> zenoh session closed
 
-Every recorder of the service makes its rerun streams through one `service.recorder.RerunStreams`
+Every recorder of the service makes its rerun streams through one `service.recording.RerunStreams`
 owned by the `TwinService` (`rerun_streams()`): a per-twin recording gets a new recorder (its
 own recording id) per start, and its streams are freed when it stops (rerun-sdk 0.41 would keep
 them, and their threads, forever: see the recorder's module doc).
@@ -50,9 +50,6 @@ from twin.setpoint import SetpointError
 log = logging.getLogger(__name__)
 
 _ID_RE = re.compile(r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$")
-# per-twin recording paths: relative, plain names (no control characters, spaces, '..', hidden
-# folders), so a request cannot reach outside the recordings directory or trip the file system
-_REC_PATH_RE = re.compile(r"^(?=.{1,256}$)(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/)*[A-Za-z0-9_][A-Za-z0-9_.-]*\.rrd$")
 
 
 class WiringError(RuntimeError):
@@ -73,9 +70,9 @@ def open_bus(settings: ServiceSettings):
 
 def _recorder_class():
     try:
-        from service.recorder import RerunRecorder
+        from service.recording import RerunRecorder
     except ImportError as exc:
-        raise WiringError(f"recording is enabled but service.recorder cannot be imported ({exc}); "
+        raise WiringError(f"recording is enabled but service.recording cannot be imported ({exc}); "
                           "install rerun-sdk or run with --no-record") from exc
     return RerunRecorder
 
@@ -83,12 +80,26 @@ def _recorder_class():
 def open_recorder(settings: ServiceSettings, streams: Any = None):
     """The service-wide rerun recorder, or None when recording (and the viewer) are off.
     `streams`: the service's `RerunStreams`, shared with the per-twin recordings (stream creation
-    and reclaim must not run concurrently, see `service.recorder.RerunStreams`)."""
+    and reclaim must not run concurrently, see `service.recording.streams`). A recording path
+    that exists already (an earlier run) is kept: this run records under the next free name
+    (`service.recording.paths`). Retention (`record_keep_mb`, `record_keep_hours`) applies to the
+    family of the service-wide recording only."""
     path = settings.recording_path
     if path is None and not settings.spawn_viewer:
         return None
+    cls = _recorder_class()
+    from service.recording import RecordingPathError, RecordingWriteError, Retention
+
     extra = {} if streams is None else {"streams": streams}
-    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer, **recorder_options(settings), **extra)
+    retention = None
+    if path is not None and (settings.record_keep_mb > 0 or settings.record_keep_hours > 0):
+        retention = Retention.for_recording(path, keep_bytes=round(settings.record_keep_mb * 1e6),
+                                            keep_age_s=settings.record_keep_hours * 3600.0)
+    try:
+        return cls(path, spawn_viewer=settings.spawn_viewer, retention=retention, **recorder_options(settings), **extra)
+    except (RecordingPathError, RecordingWriteError, OSError) as exc:
+        raise WiringError(f"cannot record to {str(path)!r}: {' '.join(str(exc).split())[:300]} "
+                          "(--record PATH.rrd elsewhere, or --no-record)") from None
 
 
 def recorder_options(settings: ServiceSettings) -> dict:
@@ -141,7 +152,7 @@ class TwinService:
         with self._lock:
             if self._rerun_streams is None:
                 _recorder_class()
-                from service.recorder import RerunStreams
+                from service.recording import RerunStreams
 
                 self._rerun_streams = RerunStreams()
             return self._rerun_streams
@@ -201,6 +212,10 @@ class TwinService:
             e.channel = None
         if self.recorder is not None:
             e.runner.remove_sink(self.recorder)
+            try:
+                self.recorder.remove_twin(e.id)   # its rows are written, its entry freed
+            except Exception:
+                log.exception("removing twin %s from the recording", e.id)
         self.stop_recording(e)
 
     # ---- twins -----------------------------------------------------------------------------
@@ -280,7 +295,7 @@ class TwinService:
                                                      runner.submit_setpoint_json)
                 runner.add_sink(entry.channel)
             if self.recorder is not None:
-                self.recorder.add_twin_from(twin)
+                self.recorder.add_twin_from(twin, context=lambda: runner.scenario)
                 runner.add_sink(self.recorder)
             runner.start()
         except BaseException:
@@ -317,46 +332,53 @@ class TwinService:
         return rec.parent if rec is not None else Path("recordings")
 
     def resolve_recording_path(self, bearing_id: str, path: str | None) -> Path:
-        """A path under the recordings directory (relative only, no '..', .rrd)."""
-        base = self.recordings_dir()
+        """The checked relative path (or the default name) under the recordings directory; the
+        file system is not touched (InputError 422 naming `path`)."""
+        from service.recording.paths import RecordingPathError, check_relative_path
+
         if not path:
             stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
-            return base / f"{bearing_id}-{stamp}.rrd"
-        if not _REC_PATH_RE.match(path):
-            raise InputError.one("path", "a recording path is a relative path of letters, digits "
-                                 "and '_', '.', '-' (folders separated by '/', none starting with "
-                                 "'.'), ending in .rrd, at most 256 characters")
-        p = Path(path)
-        if p.is_absolute() or ".." in p.parts:
-            raise InputError.one("path", f"{path!r}: give a path relative to the recordings "
-                                 f"directory {str(base)!r}, without '..'")
-        if p.suffix != ".rrd":
-            raise InputError.one("path", f"{path!r}: a rerun recording ends in .rrd")
-        return base / p
+            return self.recordings_dir() / f"{bearing_id}-{stamp}.rrd"
+        try:
+            rel = check_relative_path(path)
+        except RecordingPathError as exc:
+            raise InputError.one("path", str(exc)) from None
+        return self.recordings_dir() / rel
 
     def start_recording(self, entry: TwinEntry, path: str | None) -> Path:
+        """Start the twin's own recording in a new file under the recordings directory: created
+        exclusively, never through a link, never over an existing file (422 naming `path`, the
+        file system unchanged). Without a path: `<id>-<UTC>.rrd` (a taken name gets `.runN`)."""
         target = self.resolve_recording_path(entry.id, path)
-        if self.settings.recording_path is not None:
-            main = Path(self.settings.recording_path).resolve()
-            t = target.resolve()
-            if t == main or (t.parent == main.parent and re.fullmatch(re.escape(main.stem) + r"-\d{4,}\.rrd", t.name)):
+        main = getattr(self.recorder, "path", None) or self.settings.recording_path
+        if main is not None:
+            from service.recording import is_segment_of
+
+            if is_segment_of(main, target):
                 raise InputError.one("path", f"{str(target)!r} is the service-wide recording or one of its segments")
         recorder_cls = _recorder_class()
+        from service.recording import RecordingPathError, RecordingWriteError, create_exclusive, create_recording
+
         streams = self.rerun_streams()
         with self._recording_lock:
             self.stop_recording(entry)
-            if target.exists() and not target.is_file():
-                raise InputError.one("path", f"{str(target)!r} exists and is not a file")
             try:
-                rec = recorder_cls(target, **recorder_options(self.settings), streams=streams)
-            except (OSError, RuntimeError, ValueError) as exc:   # e.g. a folder that is a file
-                streams.reclaim()            # the stream made for the file that failed
+                if path:
+                    created = create_exclusive(self.recordings_dir(), target.relative_to(self.recordings_dir()).as_posix())
+                else:
+                    created = create_recording(target, rename=True)
+            except RecordingPathError as exc:
+                raise InputError.one("path", f"{' '.join(str(exc).split())[:300]}") from None
+            try:
+                rec = recorder_cls(created, **recorder_options(self.settings), streams=streams)
+            except (OSError, RuntimeError, ValueError, RecordingWriteError) as exc:
+                created.discard()            # removed (it was made for this start), descriptors closed
                 raise InputError.one("path", f"cannot record to {str(target)!r}: "
                                      f"{' '.join(str(exc).split())[:200]}") from None
-            rec.add_twin_from(entry.twin)
-            entry.recording, entry.recording_path = rec, target
+            rec.add_twin_from(entry.twin, context=lambda: entry.runner.scenario)
+            entry.recording, entry.recording_path = rec, created.path
             entry.runner.add_sink(rec)
-        return target
+        return created.path
 
     def stop_recording(self, entry: TwinEntry) -> tuple[Path | None, int]:
         """Finish the twin's own recording (flushed, complete; its rerun streams freed);
@@ -374,9 +396,20 @@ class TwinService:
         return path, int(getattr(rec, "rows_logged", 0))
 
     # ---- health ----------------------------------------------------------------------------
+    def recording_health(self) -> dict:
+        """The state of the service's recordings: the service-wide one, and any per-twin one
+        that cannot write (`service.recording.recorder` "Faults")."""
+        recs = [r for r in [self.recorder, *(e.recording for e in self.entries())] if r is not None]
+        faults = [f"{getattr(r, 'path', None)}: {r.fault}" for r in recs if getattr(r, "fault", None)]
+        return {"recording_status": "off" if not recs else "degraded" if faults else "ok",
+                "recording_error": "; ".join(faults) or None,
+                "recording_write_errors": sum(int(getattr(r, "write_errors", 0)) for r in recs),
+                "recording_rows_lost": sum(int(getattr(r, "rows_lost", 0)) for r in recs)}
+
     def health(self) -> dict:
         twins = [e.runner.stats() for e in self.entries()]
-        degraded = any((not t["running"]) or t["errors"] for t in twins)
+        recording = self.recording_health()
+        degraded = any((not t["running"]) or t["errors"] for t in twins) or recording["recording_status"] == "degraded"
         rec = self.recorder
         return {
             "status": "degraded" if degraded else "ok",
@@ -386,6 +419,7 @@ class TwinService:
             "zenoh_listen": list(self.settings.zenoh_listen) if self.bus is not None else [],
             "recording": str(rec.path) if rec is not None and getattr(rec, "path", None) else None,
             "recording_rows": int(getattr(rec, "rows_logged", 0)) if rec is not None else 0,
+            **recording,
             "pid": os.getpid(),
             "rss_bytes": _own_rss_bytes(),
         }
