@@ -619,9 +619,11 @@ class RerunRecorder:
                       context=context)
 
     def remove_twin(self, bearing_id: str) -> bool:
-        """Forget a twin (its runner has stopped): what it published is sent first, then its
-        entry, context and buffers are dropped. A twin created later under the same id continues
-        on `sim_time` after this one (1 s later), with a line break. Returns whether it was known."""
+        """Forget a twin (its runner has stopped): what it published is sent and written first,
+        then its entry, context and buffers are dropped, and the outputs move to fresh rerun
+        streams (rerun-sdk keeps state for every entity path a stream has seen: the old streams,
+        and that state, are freed). A twin created later under the same id continues on
+        `sim_time` after this one (1 s later), with a line break. Returns whether it was known."""
         with self._io_lock:
             self._context.pop(bearing_id, None)
             if bearing_id not in self._twins:
@@ -635,7 +637,43 @@ class RerunRecorder:
                 while len(self._ended) > _MAX_ENDED:
                     self._ended.pop(next(iter(self._ended)))
             self._blueprint_dirty = bool(self._twins)
+            renewed = not self._closed and self._renew_streams_locked()
+        if renewed:
+            self._streams.reclaim()
         return True
+
+    def _renew_streams_locked(self) -> bool:
+        """Move every output that can to a fresh stream of the same recording (files written
+        directly continue where they are; a viewer is connected again); the old streams are
+        dropped for `RerunStreams.reclaim`. Outputs written by rerun's own file sink (footer on)
+        keep their stream."""
+        renewed = False
+        for out in self._outputs():
+            if out.stream is None or (out.file is not None and out.file.rebind is None):
+                continue
+            old = out.stream
+            if out.file is not None:
+                try:
+                    out.file.write(self.write_timeout_s)
+                except RecordingWriteError as exc:
+                    if out is self._primary:
+                        self._on_write_error(out, exc, 0)
+                    continue
+            stream = self._new_stream()
+            if out.file is not None:
+                out.file.rebind(stream)
+            elif out.viewer:
+                stream.connect_grpc(f"rerun+http://127.0.0.1:{self.viewer_port}/proxy")
+            else:                     # degraded main file: a sink emptied after each send
+                out.stream = stream
+                self._sink_to_nowhere(out)
+            out.stream = stream                  # (the file and the viewer have the static data)
+            try:
+                old.disconnect()
+            except Exception as exc:  # noqa: BLE001 - only keeps the old stream alive
+                log.warning("rerun: disconnect of a replaced stream failed: %s", exc)
+            renewed = True
+        return renewed
 
     @property
     def bearing_ids(self) -> list[str]:

@@ -176,6 +176,12 @@ class DirectFile:
     def size(self) -> int:
         return self.bytes
 
+    def rebind(self, stream) -> None:
+        """Continue this file from another stream of the same recording (write everything sent
+        to the old one first): its sink is a new binary stream whose first read starts with a
+        stream header (left out: the file has one) and the store info (kept)."""
+        self._storage = stream.binary_stream()
+
     def detach(self, stream) -> None:
         """Nothing to hand back: the next writer (or `disconnect`) replaces the sink; bytes
         left in this one belong to nothing any more (everything sent was written)."""
@@ -196,6 +202,7 @@ class RerunFile:
     """One segment written by rerun's own file sink, with the RRD footer (module doc)."""
 
     footer = True
+    rebind = None           # rerun's file sink cannot continue a file from another stream
 
     def __init__(self, created: CreatedFile, stream) -> None:
         self.created = created

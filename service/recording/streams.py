@@ -91,51 +91,47 @@ class RerunStreams:
 
 
 class BlueprintSender:
-    """Sends blueprints through ONE blueprint stream for the recorder's lifetime.
+    """Sends blueprints, each through a blueprint stream of its own that is freed right after.
 
-    `RecordingStream.send_blueprint` creates a new blueprint `RecordingStream` per call, and
-    rerun-sdk 0.41 never frees one (its threads keep running, rerun issue #2116): once per segment
-    that would grow without bound. Here the blueprint is logged again into the same blueprint
-    stream, behind a fresh in-memory sink, and that storage is sent (what `send_blueprint` does
-    with its throw-away stream). Uses rerun internals (`rerun_bindings.new_blueprint`,
-    `Blueprint._log_to_stream`): if they are missing, falls back to `send_blueprint`."""
+    A blueprint stream keeps state for every entity path it ever logged, and every blueprint
+    logs new ones (each view and container has a fresh id): a stream reused for the
+    recorder's lifetime grows with every blueprint sent (a twin created or deleted, a segment
+    opened). Here each send makes a blueprint stream through `RerunStreams` (on the caller's
+    thread), logs the blueprint into an in-memory sink, hands that storage to the recording
+    (what `RecordingStream.send_blueprint` does), drops the stream and reclaims it. Uses rerun
+    internals (`rerun_bindings.new_blueprint`, `Blueprint._log_to_stream`); if they are
+    missing, falls back to `send_blueprint` (whose stream is reclaimed as well)."""
 
     def __init__(self, application_id: str, streams: RerunStreams):
         self.application_id = application_id
         self._streams = streams
-        self._stream: rr.RecordingStream | None = None
         self._fallback = False
-        try:     # made now, on the caller's thread (see `RerunStreams`), not on the worker
-            self._stream = streams.new_blueprint(application_id)
-        except (ImportError, AttributeError, TypeError) as exc:
-            self._fallback = True
-            log.warning("rerun: blueprint stream reuse unavailable (%s): using send_blueprint", exc)
+        self.sent = 0
 
     def close(self) -> None:
-        """Drop the blueprint stream (freed by the next `RerunStreams.reclaim`). Its in-memory
-        sink holds the stream itself (a reference cycle in rerun-sdk 0.41): `disconnect()`
-        replaces that sink first, or the stream could never be freed."""
-        stream, self._stream = self._stream, None
-        if stream is not None:
-            try:
-                stream.disconnect()
-            except Exception as exc:  # noqa: BLE001 - only keeps the stream alive
-                log.warning("rerun: disconnect of the blueprint stream failed: %s", exc)
+        """Nothing is kept between sends."""
 
     def send(self, blueprint: rrb.Blueprint, recording: rr.RecordingStream) -> None:
+        self.sent += 1
         if not self._fallback:
             try:
                 import rerun_bindings
 
-                if self._stream is None:
-                    raise AttributeError("the blueprint stream is closed")
-                storage = self._stream.memory_recording().storage
-                self._stream.set_time("blueprint", sequence=0)
-                blueprint.to_blueprint()._log_to_stream(self._stream)
-                rerun_bindings.send_blueprint(storage, True, True, recording=recording.to_native())
+                stream = self._streams.new_blueprint(self.application_id)
+                try:
+                    storage = stream.memory_recording().storage
+                    stream.set_time("blueprint", sequence=0)
+                    blueprint.to_blueprint()._log_to_stream(stream)
+                    rerun_bindings.send_blueprint(storage, True, True, recording=recording.to_native())
+                finally:
+                    # the in-memory sink holds the stream (a reference cycle in rerun-sdk 0.41):
+                    # disconnect() replaces it, then the stream can be freed
+                    stream.disconnect()
+                    del stream
+                self._streams.reclaim()
                 return
             except (ImportError, AttributeError, TypeError) as exc:
                 self._fallback = True
-                log.warning("rerun: blueprint stream reuse unavailable (%s): using send_blueprint", exc)
+                log.warning("rerun: blueprint stream API unavailable (%s): using send_blueprint", exc)
         self._streams.send_blueprint(blueprint, recording)
-
+        self._streams.reclaim()
