@@ -1,7 +1,8 @@
 """Reading a recording back with `rerun.chunk.RrdReader` (a file, or the segments of one
 recording given as a list of paths). Flush and close the recorder first.
 
-Rows are the snapshots recorded: the chunks of an entity that carry the `seq` timeline. The
+An empty file (a segment created but never written, e.g. by a kill -9 in between) reads as an
+empty segment. Rows are the snapshots recorded: the chunks of an entity that carry the `seq` timeline. The
 line breaks of `service.recording.columns.Batch.breaks` (empty rows on `sim_time` only) are no
 snapshots and are counted apart (`"breaks"`).
 """
@@ -23,6 +24,15 @@ def _paths(path: PathOrPaths) -> list[Path]:
     if isinstance(path, (str, Path)):
         return [Path(path)]
     return [Path(p) for p in path]
+
+
+def _empty(path: Path) -> bool:
+    """A file created but never written (a kill between creating a segment and writing its
+    first bytes): an empty segment, nothing to read."""
+    try:
+        return path.stat().st_size == 0
+    except OSError:
+        return False
 
 
 def open_reader(path: str | Path):
@@ -50,9 +60,11 @@ def describe_recording(path: PathOrPaths) -> dict:
     info: dict = {"application_id": None, "recording_id": None, "blueprints": 0, "segments": 0, "entities": {}}
     entities: dict = info["entities"]
     for p in _paths(path):
+        info["segments"] += 1
+        if _empty(p):
+            continue
         reader = open_reader(p)
         recordings = reader.recordings()
-        info["segments"] += 1
         info["blueprints"] += len(reader.blueprints())
         if not recordings:
             continue
@@ -106,6 +118,8 @@ def read_column(path: PathOrPaths, entity: str, column: str) -> list:
     want = "/" + entity.lstrip("/")
     values: list = []
     for p in _paths(path):
+        if _empty(p):
+            continue
         for chunk in open_reader(p).stream():
             if chunk.entity_path == want and not chunk.is_static and SEQ in chunk.timeline_names:
                 batch = chunk.to_record_batch()
