@@ -152,7 +152,7 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
         s.log(f"{root}/geometry/load_line",
               rr.Arrows3D(origins=[[tw.outer_raceway_radius_m * 1.05, 0.0, 0.0]],
                           vectors=[[tw.outer_raceway_radius_m * 0.35, 0.0, 0.0]],
-                          colors=[(230, 230, 230)], labels=["Fr (azimuth 0)"],
+                          colors=[(230, 60, 60)], labels=["Fr"],
                           radii=rr.components.Radius.ui_points(2.0)), static=True)
         s.log(f"{root}/balls", rr.Points3D.from_fields(radii=[rb], show_labels=False), static=True)
         s.log(f"{root}/loads", rr.Arrows3D.from_fields(colors=[INNER_RGB], radii=[0.08 * rb]), static=True)

@@ -93,11 +93,11 @@ class Retention:
         now = time.time() if now is None else now
         with self._lock:
             protected = set(self._protected)
-        kept = 0
+        candidates = self.candidates()
+        kept = sum(size for _, size, path in candidates if os.path.abspath(path) in protected)   # open: always kept
         deleted: list[Path] = []
-        for mtime, size, path in self.candidates():
+        for mtime, size, path in candidates:
             if os.path.abspath(path) in protected:
-                kept += size
                 continue
             too_old = self.keep_age_s > 0 and now - mtime > self.keep_age_s
             too_much = self.keep_bytes > 0 and kept + size > self.keep_bytes
