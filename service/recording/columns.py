@@ -365,7 +365,11 @@ def events(tw: TwinLayout, batch: Batch) -> None:
         if r.context != last.get("context", "-") and (r.context is not None or "context" in last):
             texts.append((j, r.context or "no scenario", "INFO"))
         last["context"] = r.context
-        if r.setpoint is not None and r.setpoint != last.get("setpoint"):
+        # a running scenario changes the setpoint at every frame of a ramp: its phase rows stand
+        # for those, and the setpoint is logged (as the change since the last row) when the
+        # phase changes or the scenario ends
+        in_phase = (r.context is not None and ": running" in r.context and r.context == last.get("logged_context"))
+        if r.setpoint is not None and r.setpoint != last.get("setpoint") and not in_phase:
             old = last.get("setpoint")
             if old is None:
                 what = ", ".join(f"{n} = {_fmt(v)}" for n, v in zip(SETPOINT_FIELDS, r.setpoint, strict=True))
@@ -375,6 +379,7 @@ def events(tw: TwinLayout, batch: Batch) -> None:
                                  for n, a, b in zip(SETPOINT_FIELDS, old, r.setpoint, strict=True) if a != b)
                 texts.append((j, f"setpoint: {what}", "INFO"))
             last["setpoint"] = r.setpoint
+        last["logged_context"] = r.context
         restarted = "restarts" in last and r.restarts > last["restarts"]
         last["restarts"] = r.restarts
         status_changed = r.status != last.get("status")

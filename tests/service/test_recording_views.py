@@ -64,6 +64,17 @@ def test_one_chunk_per_entity_and_send_and_one_blueprint(tmp_path, run):
 
 def test_a_log_row_for_every_setpoint_scenario_restart_and_fallback(tmp_path, run):
     twin, snaps = run
+    # without a scenario every setpoint change is a row at the snapshot that shows it
+    plain = tmp_path / "plain.rrd"
+    rec = RerunRecorder(plain)
+    rec.add_twin_from(twin)
+    for s in snaps:
+        rec.publish(s)
+    rec.close()
+    at = {t: s for s, t, _ in _events(plain)}
+    assert at["setpoint: radial_load_n 3000 -> 4000"] == snaps[20].seq
+    assert at["setpoint: shaft_speed_rad_s 500 -> 300"] == snaps[40].seq
+
     path = tmp_path / "ev.rrd"
     scenario = SimpleNamespace(name="ramp", state="running", phase="up", error=None)
     rec = RerunRecorder(path)
@@ -89,8 +100,11 @@ def test_a_log_row_for_every_setpoint_scenario_restart_and_fallback(tmp_path, ru
     assert texts[1].startswith("setpoint in force: shaft_speed_rad_s = ")
     assert texts[2] == "status: ok"
     at = {t: s for s, t, _ in ev}
-    assert at["setpoint: radial_load_n 3000 -> 4000"] == snaps[20].seq
-    assert at["setpoint: shaft_speed_rad_s 500 -> 300"] == snaps[40].seq
+    # while a scenario phase runs its setpoint changes (a ramp: every frame) are not logged one
+    # by one; the change shows with the next phase, or when the scenario ends
+    assert at["setpoint: radial_load_n 3000 -> 4000"] == snaps[30].seq
+    assert at["setpoint: shaft_speed_rad_s 500 -> 300"] == snaps[45].seq
+    assert sum(t.startswith("setpoint") for t in texts) == 3
     assert at["scenario ramp: running, phase hold"] == snaps[30].seq
     assert at["scenario ramp: done"] == snaps[45].seq
     restart = [(s, t, lv) for s, t, lv in ev if t.startswith("restart")]
