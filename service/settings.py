@@ -71,7 +71,8 @@ class ServiceSettings(BaseSettings):
     record: Path | None = Field(
         default_factory=default_recording_path,
         description="rerun recording written while the service runs [path to a .rrd file]; "
-        "default recordings/bearing-twin-<UTC timestamp>.rrd.")
+        "default recordings/bearing-twin-<UTC timestamp>.rrd. A file of that name is never "
+        "overwritten: this run then records beside it as <stem>.run2.rrd, <stem>.run3.rrd, ...")
     record_segment_s: float = Field(
         default=600.0, ge=0.0, le=7 * 24 * 3600.0,
         description="Rotate the service-wide recording: once its open segment is this old, close it "
@@ -84,18 +85,27 @@ class ServiceSettings(BaseSettings):
     record_footer: bool = Field(
         default=False,
         description="End each recording segment with rerun's RRD footer (chunk manifest) [bool]. "
-        "rerun-sdk 0.41 holds the manifest of an open file in memory (about 1 kB per chunk, nearly "
-        "as much as the segment's size on disk: ~1 MB/s for one twin at 50 snapshots/s) until it "
-        "closes: on = memory grows with each segment (bound it with small segments); off (default) "
-        "= flat memory, the files still load in the viewer and with RrdReader.stream(); "
-        "`rerun rrd optimize` adds the footer afterwards.")
+        "On: rerun's own file sink writes the segment and holds the manifest in memory (about 2 kB "
+        "per chunk, about 25 chunks/s per twin) until the segment closes, and a write error shows only "
+        "as a failed flush. Off (default): the service writes the file itself (flat memory, exact "
+        "write-error handling); the viewer and RrdReader.stream() read it, `rerun rrd optimize` adds "
+        "the footer afterwards.")
     record_flush_interval_s: float = Field(
-        default=0.1, gt=0.0, le=60.0,
-        description="The recorder sends what it buffered every this often, one rerun chunk per "
-        "entity [s]; each chunk costs about 1.3 kB on disk besides its rows (and, with the footer, "
-        "about 1 kB of memory until its segment closes), so 1 s makes the file about 5x smaller than "
-        "0.1 s at 50 snapshots/s (about 0.3 instead of 1.7 MB/s for a 6208 twin), at the cost of a "
-        "1 s lag in a live viewer.")
+        default=1.0, gt=0.0, le=60.0,
+        description="The recorder sends and writes what it buffered every this often: one rerun chunk "
+        "per entity with all rows of the interval [s]. Each chunk costs about 1.5 kB besides its rows, "
+        "so shorter intervals make larger files with more chunks (0.1 s: about 10x the chunks) and a "
+        "live viewer lags by up to this much.")
+    record_keep_mb: float = Field(
+        default=2000.0, ge=0.0, le=1e9,
+        description="Retention: keep the newest segments of the service-wide recordings (this run's and "
+        "earlier runs' in the same folder, same name family) up to this total size and delete older "
+        "ones [MB = 10^6 bytes]; 0 = no size limit. The open segment and per-twin recordings are "
+        "never deleted; nothing else deletes recordings.")
+    record_keep_hours: float = Field(
+        default=0.0, ge=0.0, le=1e6,
+        description="Retention: also delete segments of the service-wide recordings older than this "
+        "[h of wall time, by modification time]; 0 = no age limit.")
     spawn_viewer: bool = Field(default=False,
                                description="Also stream to a rerun viewer spawned on this machine [bool].")
     fast: bool = Field(default=False,

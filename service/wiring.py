@@ -1,6 +1,6 @@
 """The composition root: `TwinService` = the core's `TwinRegistry` with the zenoh bus and the
 rerun recorders opened from the settings. This is the ONE module that touches `service.bus`
-and `service.recorder` for the service (imported lazily, so a service with zenoh or recording
+and `service.recording` for the service (imported lazily, so a service with zenoh or recording
 off never imports them).
 
 Every recorder of the service makes its rerun streams through one `RerunStreams` owned by the
@@ -13,10 +13,12 @@ from __future__ import annotations
 
 import logging
 import re
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
 from service.core.admission import AdmissionGate
+from service.core.errors import InputError
 from service.core.registry import Recorder, TwinEntry, TwinRegistry
 from service.settings import ServiceSettings
 
@@ -50,9 +52,9 @@ def open_bus(settings: ServiceSettings):
 
 def _recorder_class():
     try:
-        from service.recorder import RerunRecorder
+        from service.recording import RerunRecorder
     except ImportError as exc:
-        raise WiringError(f"recording is enabled but service.recorder cannot be imported ({exc}); "
+        raise WiringError(f"recording is enabled but service.recording cannot be imported ({exc}); "
                           "install rerun-sdk or run with --no-record") from exc
     return RerunRecorder
 
@@ -68,12 +70,23 @@ def recorder_options(settings: ServiceSettings) -> dict:
 def open_recorder(settings: ServiceSettings, streams: Any = None):
     """The service-wide rerun recorder, or None when recording (and the viewer) are off.
     `streams`: the service's `RerunStreams`, shared with the per-twin recordings (stream creation
-    and reclaim must not run concurrently, see `service.recorder.RerunStreams`)."""
+    and reclaim must not run concurrently, see `service.recording.RerunStreams`)."""
     path = settings.recording_path
     if path is None and not settings.spawn_viewer:
         return None
+    cls = _recorder_class()
+    from service.recording import RecordingPathError, RecordingWriteError, Retention
+
     extra = {} if streams is None else {"streams": streams}
-    return _recorder_class()(path, spawn_viewer=settings.spawn_viewer, **recorder_options(settings), **extra)
+    retention = None
+    if path is not None and (settings.record_keep_mb > 0 or settings.record_keep_hours > 0):
+        retention = Retention.for_recording(path, keep_bytes=round(settings.record_keep_mb * 1e6),
+                                            keep_age_s=settings.record_keep_hours * 3600.0)
+    try:
+        return cls(path, spawn_viewer=settings.spawn_viewer, retention=retention, **recorder_options(settings), **extra)
+    except (RecordingPathError, RecordingWriteError, OSError) as exc:
+        raise WiringError(f"cannot record to {str(path)!r}: {' '.join(str(exc).split())[:300]} "
+                          "(--record PATH.rrd elsewhere, or --no-record)") from None
 
 
 class TwinService(TwinRegistry):
@@ -81,14 +94,14 @@ class TwinService(TwinRegistry):
 
     def __init__(self, settings: ServiceSettings, gate: AdmissionGate | None = None):
         super().__init__(settings, gate)
-        self._rerun_streams = None          # service.recorder.RerunStreams, made on first use
+        self._rerun_streams = None          # service.recording.RerunStreams, made on first use
 
     def rerun_streams(self):
         """The `RerunStreams` that makes and frees every rerun stream of this service."""
         with self._lock:
             if self._rerun_streams is None:
                 _recorder_class()
-                from service.recorder import RerunStreams
+                from service.recording import RerunStreams
 
                 self._rerun_streams = RerunStreams()
             return self._rerun_streams
@@ -109,6 +122,84 @@ class TwinService(TwinRegistry):
                 self.bus.close()
             except Exception:
                 log.exception("closing the zenoh bus")
+
+    def _unwire(self, e) -> None:
+        recorder = self.recorder
+        super()._unwire(e)
+        if recorder is not None:
+            try:
+                recorder.remove_twin(e.id)   # its rows are written, its entry freed
+            except Exception:
+                log.exception("removing twin %s from the recording", e.id)
+
+    # ---- per-twin recordings: append-only, inside the recordings directory ------------------
+    def resolve_recording_path(self, bearing_id: str, path: str | None) -> Path:
+        """The checked relative path (or the default name) under the recordings directory; the
+        file system is not touched (InputError 422 naming `path`)."""
+        from service.recording.paths import RecordingPathError, check_relative_path
+
+        if not path:
+            stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
+            return self.recordings_dir() / f"{bearing_id}-{stamp}.rrd"
+        try:
+            rel = check_relative_path(path)
+        except RecordingPathError as exc:
+            raise InputError.one("path", str(exc)) from None
+        return self.recordings_dir() / rel
+
+    def start_recording(self, entry, path: str | None) -> Path:
+        """Start the twin's own recording in a new file under the recordings directory: created
+        exclusively, never through a link, never over an existing file (422 naming `path`, the
+        file system unchanged). Without a path: `<id>-<UTC>.rrd` (a taken name gets `.runN`)."""
+        target = self.resolve_recording_path(entry.id, path)
+        main = getattr(self.recorder, "path", None) or self.settings.recording_path
+        if main is not None:
+            from service.recording import is_segment_of
+
+            if is_segment_of(main, target):
+                raise InputError.one("path", f"{str(target)!r} is the service-wide recording or one of its segments")
+        recorder_cls = _recorder_class()
+        from service.recording import RecordingPathError, RecordingWriteError, create_exclusive, create_recording
+
+        streams = self.rerun_streams()
+        with self._recording_lock:
+            self.stop_recording(entry)
+            try:
+                if path:
+                    created = create_exclusive(self.recordings_dir(), target.relative_to(self.recordings_dir()).as_posix())
+                else:
+                    created = create_recording(target, rename=True)
+            except RecordingPathError as exc:
+                raise InputError.one("path", f"{' '.join(str(exc).split())[:300]}") from None
+            try:
+                rec = recorder_cls(created, **recorder_options(self.settings), streams=streams)
+            except (OSError, RuntimeError, ValueError, RecordingWriteError) as exc:
+                created.discard()            # removed (it was made for this start), descriptors closed
+                raise InputError.one("path", f"cannot record to {str(target)!r}: "
+                                     f"{' '.join(str(exc).split())[:200]}") from None
+            rec.add_twin_from(entry.twin, context=lambda: entry.runner.scenario)
+            entry.recording, entry.recording_path = rec, created.path
+            entry.runner.add_sink(rec)
+        return created.path
+
+    # ---- health ----------------------------------------------------------------------------
+    def recording_health(self) -> dict:
+        """The state of the service's recordings: the service-wide one, and any per-twin one
+        that cannot write (`service.recording.recorder` "Faults")."""
+        recs = [r for r in [self.recorder, *(e.recording for e in self.entries())] if r is not None]
+        faults = [f"{getattr(r, 'path', None)}: {r.fault}" for r in recs if getattr(r, "fault", None)]
+        return {"recording_status": "off" if not recs else "degraded" if faults else "ok",
+                "recording_error": "; ".join(faults) or None,
+                "recording_write_errors": sum(int(getattr(r, "write_errors", 0)) for r in recs),
+                "recording_rows_lost": sum(int(getattr(r, "rows_lost", 0)) for r in recs)}
+
+    def health(self) -> dict:
+        out = super().health()
+        recording = self.recording_health()
+        out.update(recording)
+        if recording["recording_status"] == "degraded":
+            out["status"] = "degraded"
+        return out
 
     def _new_recording(self, path: Path) -> Recorder:
         recorder_cls = _recorder_class()

@@ -1,7 +1,7 @@
 """The import rules of the README's "Architecture" section, as import-linter contracts in
 pyproject.toml ([tool.importlinter]): `twin` never imports `service` (nor fastapi, zenoh, rerun,
 matplotlib); the runtime engine never imports `twin.validation` (the offline science); `service.core` imports no fastapi, zenoh or rerun, nor the wings built on them;
-the service's layers go tools > reports > api > wiring > bus | recorder > core > settings.
+the service's layers go tools > reports > api > wiring > bus | recording > core > settings.
 import-linter reads every import statement, those inside functions included."""
 
 from __future__ import annotations

@@ -159,13 +159,17 @@ class TwinHealth(BaseModel):
 class Health(BaseModel):
     """Service health."""
 
-    status: Literal["ok", "degraded"] = Field(description="'ok', or 'degraded' when a twin's runner stopped or reports errors [text].")
+    status: Literal["ok", "degraded"] = Field(description="'ok', or 'degraded' when a twin's runner stopped or reports errors, or a recording cannot be written [text].")
     uptime_s: float = Field(description="Wall time since the service started [s].")
     twins: list[TwinHealth] = Field(description="One entry per twin [list].")
     zenoh: bool = Field(description="Whether the zenoh bus is open [bool].")
     zenoh_listen: list[str] = Field(description="zenoh endpoints listened on [zenoh locator].")
     recording: str | None = Field(description="The service-wide .rrd being written [path]; null when off.")
-    recording_rows: int = Field(default=0, description="Snapshots written to the service-wide recording [-].")
+    recording_rows: int = Field(default=0, description="Snapshots written to the service-wide recording (never those a write error lost) [-].")
+    recording_status: Literal["ok", "degraded", "off"] = Field(default="off", description="'degraded' while a recording cannot be written (disk full, permission): the twins keep running, the recorder retries with a new segment [text].")
+    recording_error: str | None = Field(default=None, description="Why a recording is degraded [text]; null when none is.")
+    recording_write_errors: int = Field(default=0, description="Recording writes that failed [-].")
+    recording_rows_lost: int = Field(default=0, description="Snapshots that could not be written to a recording [-].")
     pid: int | None = Field(default=None, description="Process id of the service [-] (for soak tests and monitoring).")
     rss_bytes: int | None = Field(default=None, description="Resident memory of the service process [bytes]; null where /proc is unavailable.")
 

@@ -76,7 +76,7 @@ class Bus(Protocol):
 
 
 class Recorder(SnapshotSink, Protocol):
-    """A recording of one or more twins (service.recorder.RerunRecorder)."""
+    """A recording of one or more twins (service.recording.RerunRecorder)."""
 
     path: Path | None
     rows_logged: int

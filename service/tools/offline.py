@@ -131,7 +131,7 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
     table = table if table is not None else TableSink()
     recorder = None
     if record is not None:
-        from service.recorder import RerunRecorder
+        from service.recording import RerunRecorder
 
         recorder = RerunRecorder(record, queue_size=1_000_000)
     scenario.check_bearing_limits()        # every run, before any runs (as `scenario check`)
@@ -147,7 +147,7 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
                                 frame_s=min(frame_s, run.sample_every_s), idle_without_scenario=True)
             runner.add_sink(table)
             if recorder is not None:
-                recorder.add_twin_from(twin)
+                recorder.add_twin_from(twin, context=lambda runner=runner: runner.scenario)
                 runner.add_sink(recorder)
             t_wall = time.perf_counter()
             runner.start(publish_initial=False)

@@ -27,7 +27,7 @@ What it does, for `minutes` of wall time:
   other than 429, an acceptance of an invalid one;
 * with `--start` it launches `bearing-twin serve` on free loopback ports with a token and a
   recording in a temp dir, and at the end stops it with SIGTERM (bounded wait) and reads the
-  recording back, every segment of it (`service.recorder.recording_segments`; `--record-segment-s`
+  recording back, every segment of it (`service.recording.recording_segments`; `--record-segment-s`
   sets the service's rotation period): complete = every segment readable on its own (one
   recording id, the static geometry, a blueprint), together at least the rows the service
   reported, no gap in the recorded `seq`, nothing recorded twice.
@@ -614,7 +614,8 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
     try:
         import numpy as np
 
-        from service.recorder import _reader, recording_segments
+        from service.recording import recording_segments
+        from service.recording.reader import open_reader as _reader
 
         entity = f"/bearing/{bearing_id}/friction_torque_n_m"
         static = f"/bearing/{bearing_id}/geometry/inner_raceway"

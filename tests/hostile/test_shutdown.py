@@ -1,11 +1,12 @@
 """Shutdown and restart (issue 6), with a real `bearing-twin serve` subprocess on free loopback
 ports: SIGTERM and SIGINT flush and close the recordings (service-wide and per-twin) and zenoh
 (the liveliness token goes away), the process exits (bounded wait) and the .rrd files read back
-completely; after a kill -9 the recordings already closed are intact and the service starts again
-cleanly on the same ports."""
+completely; after a kill -9 every file of the killed run is left intact and readable, and the
+service started again with the same --record on the same ports writes beside them (issue 16)."""
 
 from __future__ import annotations
 
+import hashlib
 import json
 import signal
 import time
@@ -16,13 +17,13 @@ import pytest
 zenoh = pytest.importorskip("zenoh")
 pytest.importorskip("rerun")
 
-from service.recorder import (
-    _reader,
+from service.recording import (
     describe_recording,
     read_index,
     read_recording,
     recording_segments,
 )
+from service.recording.reader import open_reader as _reader
 
 TOKEN = "shutdown-test-token"
 AUTH = {"Authorization": f"Bearer {TOKEN}"}
@@ -78,8 +79,16 @@ def test_signal_flushes_recordings_and_closes_zenoh(hostile, tmp_path, sig):
     assert clip_rows[TORQUE] > 0 and _seq_gaps(clip)[1] == 0
 
 
-def test_kill_9_keeps_closed_recordings_and_restarts_on_the_same_ports(hostile, tmp_path):
-    first = hostile.ServeProcess(tmp_path, record=tmp_path / "first.rrd")
+def _digests(folder) -> dict[str, str]:
+    return {p.name: hashlib.sha256(p.read_bytes()).hexdigest() for p in sorted(folder.glob("*.rrd"))}
+
+
+def test_kill_9_keeps_every_file_and_restarts_beside_them_on_the_same_ports(hostile, tmp_path):
+    """kill -9 while recording (service-wide, rotating every second, and a per-twin clip open),
+    then a restart with the same --record: the killed run's files are byte for byte as the kill
+    left them and readable; the new run records under a new name beside them."""
+    rec = tmp_path / "rec"
+    first = hostile.ServeProcess(tmp_path, record=rec / "first.rrd", env={"BEARING_TWIN_RECORD_SEGMENT_S": "1"})
     port, endpoint = first.port, first.zenoh_endpoint
     assert "access: no token (BEARING_TWIN_TOKEN unset)" in first.text, first.text
     try:
@@ -91,25 +100,33 @@ def test_kill_9_keeps_closed_recordings_and_restarts_on_the_same_ports(hostile, 
             assert stop.status_code == 200, stop.text
             rows_logged = stop.json()["rows_logged"]
             assert rows_logged > 0
-            # an open one at the moment of the kill (not checked: it may be cut anywhere)
+            # an open one at the moment of the kill
             assert c.post("/v1/bearings/default/recording",
                           json={"action": "start", "path": "open.rrd"}).status_code == 200
-            time.sleep(0.3)
+            hostile.wait_for(lambda: len(recording_segments(rec / "first.rrd")), lambda n: n >= 3, timeout=60)
     finally:
         first.proc.send_signal(signal.SIGKILL)
         first.proc.wait(15)
     assert first.proc.returncode == -signal.SIGKILL
+    killed = _digests(rec)
+    assert {"first.rrd", "first-0001.rrd", "closed.rrd", "open.rrd"} <= set(killed)
 
-    closed = tmp_path / "closed.rrd"
+    closed = recording_segments(rec / "closed.rrd")          # it rotated too (1 s segments)
     rows = read_recording(closed)
     assert rows[TORQUE] == rows_logged
     assert _seq_gaps(closed) == (rows_logged, 0)
+    # the killed run's service-wide segments (the last one cut by the kill) read back, no seq twice
+    segs = recording_segments(rec / "first.rrd")
+    seqs = read_index(segs, TORQUE)
+    assert len(seqs) > 0 and len(set(seqs.tolist())) == len(seqs)
+    assert read_recording(rec / "open.rrd").get(TORQUE, 0) >= 0
 
-    # the same ports, at once: HTTP answers, zenoh streams, no stale state
+    # the same ports and the same --record, at once: HTTP answers, zenoh streams, no stale state
     second = hostile.ServeProcess(tmp_path, port=port, zenoh_port=int(endpoint.rsplit(":", 1)[1]),
-                                  record=tmp_path / "second.rrd")
+                                  record=rec / "first.rrd")
     try:
         assert second.url.endswith(f":{port}") and second.zenoh_endpoint == endpoint
+        assert "first.run2.rrd" in second.text, second.text
         peer = hostile.Peer(endpoint)
         try:
             peer.subscribe("bearing/default/state")
@@ -121,12 +138,19 @@ def test_kill_9_keeps_closed_recordings_and_restarts_on_the_same_ports(hostile, 
         with httpx.Client(base_url=second.url, timeout=30.0) as c:
             h = c.get("/health").json()
             assert h["status"] == "ok" and h["zenoh"] is True
+            assert h["recording"] == str(rec / "first.run2.rrd")
             assert c.put("/v1/bearings/default/setpoint", json={"radial_load_n": 3500.0}).status_code == 200
+            # the killed run's names are taken: a clip may not reuse one
+            r = c.post("/v1/bearings/default/recording", json={"action": "start", "path": "open.rrd"})
+            assert r.status_code == 422 and r.json()["detail"][0]["field"] == "path"
+            hostile.wait_for(lambda: c.get("/health").json(), lambda h: h["recording_rows"] >= 10, timeout=60)
         second.signal(signal.SIGTERM, timeout=EXIT_BOUND_S)
         assert "Traceback" not in second.text, second.text
     finally:
         second.kill()
-    assert read_recording(tmp_path / "second.rrd")[TORQUE] > 0
+    after = _digests(rec)
+    assert {k: after[k] for k in killed} == killed            # every file of the killed run untouched
+    assert read_recording(rec / "first.run2.rrd")[TORQUE] > 0
     json.dumps(rows)
 
 
@@ -156,7 +180,7 @@ def test_sigterm_closes_the_open_segment_of_a_rotating_recording(hostile, tmp_pa
         info = describe_recording(seg)
         ids.add(info["recording_id"])
         assert info["blueprints"] >= 1 and "bearing/default/geometry/inner_raceway" in info["entities"], seg
-        assert "bearing/default/status" in info["entities"], seg   # each segment logs the status again
+        assert "bearing/default/events" in info["entities"], seg   # each segment logs the state again
         _reader(seg).store()        # footer on: every segment, the last one too, was closed properly
     assert len(ids) == 1
     rows = read_recording(segs)

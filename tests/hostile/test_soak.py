@@ -84,7 +84,7 @@ def test_soak_refuses_unbounded_runs():
 
 def _segmented_recording(tmp_path, groups):
     """A recording of `groups` snapshots per segment, rotated with `rotate()`."""
-    from service.recorder import RerunRecorder
+    from service.recording import RerunRecorder
     from twin.engine import Twin
 
     twin = Twin("6208", bearing_id="default")

@@ -1,18 +1,21 @@
 """RerunRecorder: record snapshots of real twins into .rrd files and read them back with
-`rerun.chunk.RrdReader` (through service.recorder.read_recording / read_column)."""
+`rerun.chunk.RrdReader` (through service.recording.read_recording / read_column). The entity
+layout is that of `service.recording.layout`: one entity per quantity, all balls / contacts of a
+snapshot in one row."""
 
 from __future__ import annotations
 
 import logging
+import math
 import time
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from service.recorder import (
+from service.recording import (
+    RecordingPathError,
     RerunRecorder,
-    _reader,
     describe_recording,
     read_column,
     read_index,
@@ -20,6 +23,8 @@ from service.recorder import (
     recording_segments,
     segment_path,
 )
+from service.recording.layout import REGIME_CODE
+from service.recording.reader import open_reader as _reader
 from twin.engine import Twin
 
 N = 40            # snapshots per twin
@@ -66,22 +71,33 @@ def _defined(snaps, i: int, side: str, attr: str = "lambda_") -> int:
     return sum(getattr(getattr(s.balls[i], side), attr) is not None for s in snaps)
 
 
-def _assert_tree(rows: dict, bearing_id: str, snaps: list) -> None:
+FAST = ("balls", "loads", "friction_torque_n_m", "loads_n", "speeds_rad_s", "min_lambda", "regime_counts",
+        "temperatures_c") + tuple(f"load_zone/{f}/{side}" for f in ("load_n", "lambda", "mu") for side in ("inner", "outer"))
+SLOW = ("contacts/load_n", "contacts/lambda", "contacts/mu")
+
+
+def _assert_tree(rows: dict, bearing_id: str, snaps: list, geometry: bool = True) -> None:
+    """One row per snapshot in every per-snapshot entity (all balls / contacts in it)."""
     root = f"bearing/{bearing_id}"
     n = len(snaps)
-    for name in ("inner_raceway", "outer_raceway", "pitch_circle", "load_line"):
-        assert f"{root}/geometry/{name}" in rows            # static geometry
-    assert rows[f"{root}/balls"] == n
-    assert rows[f"{root}/loads/inner"] == n
-    assert rows[f"{root}/loads/outer"] == n
-    assert rows[f"{root}/friction_torque_n_m"] == n
-    assert rows[f"{root}/cage_speed_rad_s"] == n
-    for i in range(len(snaps[0].balls)):
-        for side in ("inner", "outer"):
-            assert rows[f"{root}/ball/{i}/{side}/load_n"] == n
-            assert rows[f"{root}/ball/{i}/{side}/mu"] == n
-            # null Lambda (no contact) is not logged for that row
-            assert rows.get(f"{root}/ball/{i}/{side}/lambda", 0) == _defined(snaps, i, side)
+    if geometry:
+        for name in ("inner_raceway", "outer_raceway", "pitch_circle", "load_line"):
+            assert f"{root}/geometry/{name}" in rows            # static geometry
+    for leaf in FAST + SLOW:
+        if not geometry and leaf in ("balls", "loads"):
+            assert f"{root}/{leaf}" not in rows or rows[f"{root}/{leaf}"] == 0
+            continue
+        assert rows[f"{root}/{leaf}"] == n, leaf
+
+
+def _ball_regime(ball) -> int:
+    """The worst loaded contact's regime (boundary < mixed < full film), no contact if none."""
+    loaded = [REGIME_CODE[c.regime] for c in (ball.inner, ball.outer) if c.regime != "no_contact"]
+    return min(loaded) if loaded else 0
+
+
+def _scalars(path, entity: str) -> np.ndarray:
+    return np.array(read_column(path, entity, "Scalars:scalars"), dtype=float)
 
 
 def test_one_twin_round_trip(tmp_path, twin_a):
@@ -112,25 +128,53 @@ def test_one_twin_round_trip(tmp_path, twin_a):
     torque = [v[0] for v in read_column(path, "bearing/a/friction_torque_n_m", "Scalars:scalars")]
     assert torque == pytest.approx([s.friction_torque_n_m for s in snaps])
 
-    # balls on the pitch circle at their azimuth, coloured by the inner-contact regime
+    # balls on the pitch circle at their azimuth, class id = ball regime (annotation context)
     pos = np.array(read_column(path, "bearing/a/balls", "Points3D:positions")[-1])
     last = snaps[-1]
     az = np.array([b.azimuth_rad for b in last.balls])
     rp = twin.model.pitch_radius_m
     np.testing.assert_allclose(pos[:, 0], rp * np.cos(az), atol=1e-6)
     np.testing.assert_allclose(pos[:, 1], rp * np.sin(az), atol=1e-6)
-    colors = read_column(path, "bearing/a/balls", "Points3D:colors")[-1]
-    palette = {"no_contact": 0x969696FF, "boundary": 0xDC2828FF, "mixed": 0xFF9600FF, "full_film": 0x28B446FF}
-    assert colors == [palette[b.inner.regime] for b in last.balls]
+    assert read_column(path, "bearing/a/balls", "Points3D:class_ids")[-1] == [_ball_regime(b) for b in last.balls]
+    assert "AnnotationContext:context" in info["entities"]["bearing/a"]["components"]
 
     # inner-load arrows point from the ball centre towards the inner raceway, length ~ load
-    vec = np.array(read_column(path, "bearing/a/loads/inner", "Arrows3D:vectors")[-1])
+    vec = np.array(read_column(path, "bearing/a/loads", "Arrows3D:vectors")[-1])
     loads = np.array([b.inner.load_n for b in last.balls])
     radial = (vec[:, :2] * pos[:, :2]).sum(axis=1)
     assert np.all(radial[loads > 0] < 0.0)
     lengths = np.linalg.norm(vec, axis=1)
     k = loads > 0
     np.testing.assert_allclose(lengths[k] / loads[k], (lengths[k] / loads[k])[0], rtol=1e-5)
+
+    # the load zone now: one bar per ball at its azimuth [deg], inner left of outer
+    for leaf, attr in (("load_n", "load_n"), ("lambda", "lambda_"), ("mu", "mu")):
+        for side in ("inner", "outer"):
+            entity = f"bearing/a/load_zone/{leaf}/{side}"
+            values = np.array(read_column(path, entity, "BarChart:values")[-1][0]["buffer"], dtype=float)
+            x = np.array(read_column(path, entity, "BarChart:abscissa")[-1][0]["buffer"], dtype=float)
+            want = np.array([getattr(getattr(b, side), attr) or 0.0 for b in last.balls])
+            np.testing.assert_allclose(values, want, rtol=1e-6, atol=1e-9)
+            shift = np.degrees(np.angle(np.exp(1j * az))) - x
+            assert np.all(shift > 0) if side == "inner" else np.all(shift < 0)
+            np.testing.assert_allclose(np.abs(shift), 360.0 / len(az) * 0.15, rtol=1e-4)
+
+    # bearing-level trends with the setpoint beside them
+    lo = _scalars(path, "bearing/a/loads_n")[-1]
+    qmax = max(max(b.inner.load_n, b.outer.load_n) for b in last.balls)
+    np.testing.assert_allclose(lo, [qmax, last.setpoint.radial_load_n, last.setpoint.axial_load_n], rtol=1e-9)
+    sp = _scalars(path, "bearing/a/speeds_rad_s")[-1]
+    np.testing.assert_allclose(sp, [last.setpoint.shaft_speed_rad_s, last.shaft_speed_rad_s, last.cage_speed_rad_s])
+    counts = _scalars(path, "bearing/a/regime_counts")
+    assert np.all(counts.sum(axis=1) == len(az))
+    ml = _scalars(path, "bearing/a/min_lambda")[-1]
+    inner = [b.inner.lambda_ for b in last.balls if b.inner.lambda_ is not None and b.inner.load_n > 0]
+    assert ml[0] == pytest.approx(min(inner))
+    # the per-contact series: ball 0 inner, ball 0 outer, ball 1 inner, ...
+    cl = np.array(read_column(path, "bearing/a/contacts/load_n", "Scalars:scalars")[-1])
+    np.testing.assert_allclose(cl, [x for b in last.balls for x in (b.inner.load_n, b.outer.load_n)])
+    # one blueprint, one chunk per entity for a run shorter than a send interval
+    assert info["entities"]["bearing/a/friction_torque_n_m"]["chunks"] == 1
 
 
 def test_two_twins_in_one_recording(tmp_path, twin_a, twin_b):
@@ -253,7 +297,8 @@ def test_positions_override_and_unregistered_twin(tmp_path, twin_a):
     np.testing.assert_allclose(read_column(path, "bearing/a/balls", "Points3D:positions")[0], given, rtol=1e-6)
     rows = read_recording(path)
     assert rows["bearing/c/friction_torque_n_m"] == 1
-    assert rows["bearing/c/ball/0/inner/load_n"] == 1
+    assert rows["bearing/c/contacts/load_n"] == 1
+    assert rows["bearing/c/load_zone/load_n/inner"] == 1
     assert "bearing/c/balls" not in rows
 
 
@@ -267,15 +312,10 @@ def _without_electrical(s):
     return strip(s, balls=balls)
 
 
-def _count(snaps, i: int, side: str | None, leaf: str) -> int:
-    """Snapshots in which ball i's `leaf` (of its `side` contact, or of the ball) is not null."""
-    return sum(getattr(getattr(s.balls[i], side) if side else s.balls[i], leaf) is not None for s in snaps)
-
-
 def test_electrical_series_follow_the_snapshot(tmp_path, twin_a):
+    """The electrical panel in engineering units: C in pF, R and |Z| as log10 of kohm (NaN
+    where there is no conduction), the discharge risk as a state, one row per change."""
     twin, snaps = twin_a
-    if getattr(snaps[0].balls[0].inner, "resistance_ohm", "absent") == "absent":
-        pytest.skip("the snapshot schema has no electrical fields yet")
     path = tmp_path / "elec.rrd"
     rec = _recorder(path, twin)
     for s in snaps:
@@ -283,21 +323,26 @@ def test_electrical_series_follow_the_snapshot(tmp_path, twin_a):
     rec.close()
     assert rec.errors == 0
     rows = read_recording(path)
-    for i in range(len(snaps[0].balls)):
-        for side in ("inner", "outer"):
-            for leaf in ("resistance_ohm", "capacitance_f"):   # null R (open circuit) is not logged
-                expected = _count(snaps, i, side, leaf)
-                assert rows.get(f"bearing/a/ball/{i}/{side}/{leaf}", 0) == expected
-        assert rows.get(f"bearing/a/ball/{i}/resistance_ohm", 0) == _count(snaps, i, None, "resistance_ohm")
-        assert rows[f"bearing/a/ball/{i}/capacitance_f"] == N
-    assert rows.get("bearing/a/electrical/capacitance_f", 0) == \
-        sum(s.electrical.capacitance_f is not None for s in snaps)   # null where not capacitive
-    assert rows["bearing/a/electrical/shaft_voltage_v"] == N
-    assert rows.get("bearing/a/electrical/resistance_ohm", 0) == \
-        sum(s.electrical.resistance_ohm is not None for s in snaps)
-    assert rows["bearing/a/electrical/discharge_risk"] >= 1          # TextLog on change
-    text = read_column(path, "bearing/a/electrical/discharge_risk", "TextLog:text")[0][0]
-    assert text.startswith(snaps[0].electrical.discharge_risk)
+    for leaf in ("capacitance_pf", "resistance_log10_kohm", "shaft_voltage_v", "shaft_current_ma",
+                 "film_field_v_per_um", "current_density_a_per_mm2"):
+        assert rows[f"bearing/a/electrical/{leaf}"] == N, leaf
+    c = _scalars(path, "bearing/a/electrical/capacitance_pf")[:, 0]
+    np.testing.assert_allclose(c, [s.electrical.capacitance_f * 1e12 if s.electrical.capacitance_f is not None else math.nan
+                                   for s in snaps], rtol=1e-12)   # NaN (a line break) where C is null
+    r = _scalars(path, "bearing/a/electrical/resistance_log10_kohm")
+    want_r = [math.log10(s.electrical.resistance_ohm / 1e3) if s.electrical.resistance_ohm else math.nan for s in snaps]
+    np.testing.assert_allclose(r[:, 0], want_r, rtol=1e-12)          # NaN where R is null
+    np.testing.assert_allclose(r[:, 1], [math.log10(s.electrical.impedance_ohm / 1e3) for s in snaps], rtol=1e-12)
+    np.testing.assert_allclose(_scalars(path, "bearing/a/electrical/shaft_current_ma")[:, 0],
+                               [s.electrical.shaft_current_a * 1e3 for s in snaps], rtol=1e-12, atol=1e-15)
+    # per contact: C [pF] for all 2 Z contacts
+    cc = np.array(read_column(path, "bearing/a/contacts/capacitance_pf", "Scalars:scalars")[-1])
+    np.testing.assert_allclose(cc, [x * 1e12 for b in snaps[-1].balls
+                                    for x in (b.inner.capacitance_f, b.outer.capacitance_f)], rtol=1e-12)
+    risks = [s.electrical.discharge_risk for s in snaps]
+    changes = 1 + sum(a != b for a, b in zip(risks, risks[1:]))
+    assert rows["bearing/a/electrical/discharge_risk"] == changes      # StateChange on change
+    assert read_column(path, "bearing/a/electrical/discharge_risk", "StateChange:state")[0] == [risks[0]]
 
 
 def test_snapshots_without_electrical_fields(tmp_path, twin_a):
@@ -310,7 +355,7 @@ def test_snapshots_without_electrical_fields(tmp_path, twin_a):
     assert rec.errors == 0 and rec.rows_logged == 10
     rows = read_recording(path)
     _assert_tree(rows, "a", snaps[:10])
-    assert not [k for k in rows if "resistance" in k or "capacitance" in k or "electrical" in k]
+    assert not [k for k, v in rows.items() if v and ("resistance" in k or "capacitance" in k or "electrical" in k)]
 
 
 def test_spawn_viewer_headless_falls_back_to_file(tmp_path, twin_a, monkeypatch, caplog):
@@ -454,26 +499,34 @@ def test_rotation_happens_in_the_worker(tmp_path, twin_a):
     assert list(read_index(segs, "bearing/a/balls")) == [s.seq for s in snaps]
 
 
-def test_segment_names_and_stale_segments(tmp_path, twin_a):
+def test_segment_names_and_earlier_runs_are_kept(tmp_path, twin_a):
+    """Recordings are append-only history: a recorder on a name that exists (with segments of an
+    earlier, longer recording) records under the next free `<stem>.runN.rrd` and leaves every
+    earlier file as it was."""
     twin, snaps = twin_a
     path = tmp_path / "run.rrd"
     assert segment_path(path, 0) == path and segment_path(path, 12) == tmp_path / "run-0012.rrd"
     assert recording_segments(path) == []
-    # with rotation on, segments of an earlier, longer recording to the same name are removed
-    # (run.rrd itself is overwritten), other files are left alone; without rotation nothing is
-    for name in ("run-0001.rrd", "run-0002.rrd", "run-0003.rrd", "run-x.rrd", "run-0001.txt", "other-0001.rrd"):
-        (tmp_path / name).write_bytes(b"old")
-    _segmented(path, twin).close()
-    assert (tmp_path / "run-0002.rrd").exists()
+    old = {name: f"old {name}".encode() for name in ("run.rrd", "run-0001.rrd", "run-0002.rrd", "run-0003.rrd",
+                                                     "run-x.rrd", "run-0001.txt", "other-0001.rrd", "run.run2-0001.rrd")}
+    for name, data in old.items():
+        (tmp_path / name).write_bytes(data)
     rec = _segmented(path, twin, segment_bytes=1)
-    assert not (tmp_path / "run-0002.rrd").exists() and not (tmp_path / "run-0003.rrd").exists()
-    assert all((tmp_path / n).exists() for n in ("run-x.rrd", "run-0001.txt", "other-0001.rrd"))
+    assert rec.path == tmp_path / "run.run3.rrd"          # run.run2 is taken by a stray segment
     _publish_in_groups(rec, snaps[:10], (10,))
     rec.close()
-    assert recording_segments(path) == [path, tmp_path / "run-0001.rrd"]
+    assert all((tmp_path / name).read_bytes() == data for name, data in old.items())
+    assert recording_segments(rec.path) == [rec.path, tmp_path / "run.run3-0001.rrd"]
+    assert read_recording(recording_segments(rec.path))["bearing/a/balls"] == 10
+    assert recording_segments(path) == [path, tmp_path / "run-0001.rrd", tmp_path / "run-0002.rrd",
+                                        tmp_path / "run-0003.rrd"]
     # a missing number ends the list
-    (tmp_path / "run-0003.rrd").write_bytes(b"x")
-    assert recording_segments(path) == [path, tmp_path / "run-0001.rrd"]
+    (tmp_path / "run-0005.rrd").write_bytes(b"x")
+    assert len(recording_segments(path)) == 4
+    # without renaming an existing name is refused, the file untouched
+    with pytest.raises(RecordingPathError, match="exists"):
+        RerunRecorder(path, rename_existing=False)
+    assert (tmp_path / "run.rrd").read_bytes() == old["run.rrd"]
     with pytest.raises(ValueError):
         RerunRecorder(path, segment_s=-1.0)
     with pytest.raises(ValueError):
@@ -489,7 +542,7 @@ def test_service_settings_reach_the_recorder(tmp_path, monkeypatch):
     rec = open_recorder(s)
     try:
         assert rec.segment_s == 600.0 and rec.segment_bytes == 1_000_000_000 and rec.write_footer is False
-        assert rec.flush_interval_s == 0.1
+        assert rec.flush_interval_s == 1.0
     finally:
         rec.close()
     monkeypatch.setenv("BEARING_TWIN_RECORD_SEGMENT_S", "0")
@@ -537,8 +590,8 @@ def test_rotation_keeps_one_stream_and_closes_the_old_segment_at_once(tmp_path, 
 def test_a_failed_rotation_keeps_writing_the_open_segment(tmp_path, twin_a):
     twin, snaps = twin_a
     path = tmp_path / "run.rrd"
-    (tmp_path / "run-0001.rrd").mkdir()           # the next segment cannot be created
     rec = _segmented(path, twin)
+    (tmp_path / "run-0001.rrd").mkdir()           # the next segment cannot be created
     for s in snaps[:5]:
         rec.publish(s)
     assert rec.rotate() is None and rec.errors == 1

@@ -14,14 +14,14 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.recorder import (  # noqa: E402
+from service.recording import (  # noqa: E402
     RerunRecorder,
     RerunStreams,
-    _reader,
     describe_recording,
     read_index,
     read_recording,
 )
+from service.recording.reader import open_reader as _reader  # noqa: E402
 from twin.engine import Twin  # noqa: E402
 
 FRAME_S = 0.002

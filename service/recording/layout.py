@@ -1,0 +1,261 @@
+"""Entity layout, static data (geometry, styles, legends) and the default blueprint of a twin.
+
+Entities of one twin, under `bearing/{id}/` (timelines `sim_time`: duration, the twin's simulated
+time; `seq`: sequence, the snapshot's `seq`). One entity per quantity, all balls or contacts of a
+snapshot in one row (rerun draws one line per instance), sent in chunks of `flush_interval_s`
+(per-ball series: `slow_interval_s`) of rows each:
+
+```
+geometry/inner_raceway, outer_raceway, pitch_circle   LineStrips3D, static
+geometry/load_line            Arrows3D, static: azimuth 0, the radial load line
+balls                         Points3D at the ball centres, class id = ball regime (legend below)
+loads                         Arrows3D: the inner contact loads, from the ball centres inwards
+load_zone/{load_n,lambda,mu}/{inner,outer}
+                              BarChart against ball azimuth [deg] (seed 000 Fig. 8): the load zone
+                              now, one bar per ball
+friction_torque_n_m           Scalars: friction torque [N m]
+loads_n                       Scalars: Qmax (largest contact load), radial and axial load [N]
+speeds_rad_s                  Scalars: shaft speed setpoint, shaft speed, cage speed [rad/s]
+min_lambda                    Scalars: smallest Lambda of the loaded inner / outer contacts [-]
+regime_counts                 Scalars: balls in full film, mixed, boundary, without contact
+temperatures_c                Scalars: oil temperature setpoint, contact inlet [degC]
+electrical/capacitance_pf     Scalars: bearing capacitance [pF]
+electrical/resistance_log10_kohm   Scalars: log10 of R and |Z| [kohm] (decades; no log axes in
+                              the viewer); a row without R (no conduction) breaks the line
+electrical/shaft_voltage_v, electrical/shaft_current_ma, electrical/film_field_v_per_um,
+electrical/current_density_a_per_mm2                              Scalars
+electrical/discharge_risk     StateChange (none / possible / likely), one row per change
+events                        TextLog: setpoints, scenario state and phase, restarts, fallbacks,
+                              status, recording gaps - one row each
+contacts/{load_n,lambda,mu,resistance_log10_kohm,capacitance_pf}
+                              Scalars, 2 Z instances (ball 0 inner, ball 0 outer, ball 1 inner,
+                              ...): the per-contact series, not in the default layout
+```
+
+The annotation context at `bearing/{id}` names the regimes (class ids 0-3); the regime colours
+are the same everywhere (balls, `regime_counts`). A value that is undefined (Lambda without
+contact, R without conduction) is NaN in a multi-instance row and an empty row (a line break)
+in a single-instance one.
+"""
+
+from __future__ import annotations
+
+import colorsys
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+SIM_TIME = "sim_time"
+SEQ = "seq"
+
+# regimes: class ids, labels, colours (seed 000 Table 2: Lambda < 1 boundary, 1..3 mixed, > 3 full film)
+REGIME_CODE = {"no_contact": 0, "boundary": 1, "mixed": 2, "full_film": 3}
+REGIME_LABEL = ("no contact", "boundary", "mixed", "full film")
+REGIME_RGB = np.array([[150, 150, 150], [220, 40, 40], [255, 150, 0], [40, 180, 70]], dtype=np.uint8)
+REGIME_ORDER = (3, 2, 1, 0)       # order of the regime_counts series: full film first
+
+INNER_RGB = (60, 120, 255)
+OUTER_RGB = (200, 80, 255)
+_RACEWAY_RGB = (170, 170, 180)
+_PITCH_RGB = (90, 90, 100)
+RISK_VALUES = ("none", "possible", "likely")
+RISK_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
+
+SIDES = ("inner", "outer")
+LOAD_ZONE = (("load_n", "contact load Q [N]"), ("lambda", "film parameter Lambda [-]"),
+             ("mu", "friction coefficient mu [-]"))
+# per-contact fields: entity leaf, title
+CONTACT_SERIES = (("load_n", "contact load [N]"), ("lambda", "Lambda [-]"), ("mu", "mu [-]"),
+                  ("resistance_log10_kohm", "log10 R [kohm]"), ("capacitance_pf", "C [pF]"))
+
+# single quantities: entity leaf -> (series names, colours)
+SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
+    "friction_torque_n_m": (("friction torque",), ((255, 200, 0),)),
+    "loads_n": (("Qmax", "Fr", "Fa"),
+                ((230, 60, 60), (80, 160, 255), (160, 120, 255))),
+    "speeds_rad_s": (("shaft setpoint", "shaft", "cage"),
+                     ((150, 150, 150), (80, 160, 255), (0, 210, 200))),
+    "min_lambda": (("inner", "outer"), (INNER_RGB, OUTER_RGB)),
+    "regime_counts": (tuple(REGIME_LABEL[c] for c in REGIME_ORDER),
+                      tuple(tuple(int(v) for v in REGIME_RGB[c]) for c in REGIME_ORDER)),
+    "temperatures_c": (("oil", "inlet"), ((150, 150, 150), (255, 120, 40))),
+    "electrical/capacitance_pf": (("bearing C",), ((0, 200, 255),)),
+    "electrical/resistance_log10_kohm": (("R", "|Z|"), ((255, 200, 0), (200, 200, 200))),
+    "electrical/shaft_voltage_v": (("shaft voltage",), ((255, 120, 40),)),
+    "electrical/shaft_current_ma": (("shaft current",), ((80, 160, 255),)),
+    "electrical/film_field_v_per_um": (("largest film field",), ((220, 40, 40),)),
+    "electrical/current_density_a_per_mm2": (("largest current density",), ((255, 150, 0),)),
+}
+FAST_SERIES = tuple(SERIES)
+
+
+def ball_rgb(i: int, count: int, side: int) -> tuple[int, int, int]:
+    r, g, b = colorsys.hsv_to_rgb(i / max(count, 1), 0.75 if side == 0 else 0.55, 0.95 if side == 0 else 0.7)
+    return int(r * 255), int(g * 255), int(b * 255)
+
+
+def _circle(radius_m: float, n: int = 181) -> np.ndarray:
+    a = np.linspace(0.0, 2.0 * math.pi, n)
+    return np.column_stack([radius_m * np.cos(a), radius_m * np.sin(a), np.zeros(n)])
+
+
+@dataclass
+class TwinLayout:
+    """What the recorder knows of one twin (geometry optional) and its entity paths."""
+
+    bearing_id: str
+    designation: str
+    ball_count: int
+    pitch_radius_m: float | None = None
+    ball_radius_m: float | None = None
+    inner_raceway_radius_m: float | None = None
+    outer_raceway_radius_m: float | None = None
+    load_scale_m_per_n: float | None = None
+    # state of the event rows, per output segment (reset when a segment starts)
+    last: dict = field(default_factory=dict)
+
+    @property
+    def has_geometry(self) -> bool:
+        return self.pitch_radius_m is not None
+
+    @property
+    def root(self) -> str:
+        return f"bearing/{self.bearing_id}"
+
+    def path(self, leaf: str) -> str:
+        return f"{self.root}/{leaf}"
+
+    @property
+    def bar_width_deg(self) -> float:
+        return 360.0 / max(self.ball_count, 1) * 0.3
+
+
+def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
+    """The static data of one twin: geometry, legends, series names and colours."""
+    root = tw.root
+    s = stream
+    s.log(root, rr.AnnotationContext([(c, REGIME_LABEL[c], tuple(int(v) for v in REGIME_RGB[c]))
+                                      for c in range(4)]), static=True)
+    if tw.has_geometry:
+        rb = tw.ball_radius_m
+        line = rr.components.Radius.ui_points(1.5)
+        s.log(f"{root}/geometry/inner_raceway",
+              rr.LineStrips3D([_circle(tw.inner_raceway_radius_m)], radii=line, colors=_RACEWAY_RGB), static=True)
+        s.log(f"{root}/geometry/outer_raceway",
+              rr.LineStrips3D([_circle(tw.outer_raceway_radius_m)], radii=line, colors=_RACEWAY_RGB), static=True)
+        s.log(f"{root}/geometry/pitch_circle",
+              rr.LineStrips3D([_circle(tw.pitch_radius_m)], radii=rr.components.Radius.ui_points(0.5),
+                              colors=_PITCH_RGB), static=True)
+        s.log(f"{root}/geometry/load_line",
+              rr.Arrows3D(origins=[[tw.outer_raceway_radius_m * 1.05, 0.0, 0.0]],
+                          vectors=[[tw.outer_raceway_radius_m * 0.35, 0.0, 0.0]],
+                          colors=[(230, 60, 60)], labels=["Fr"],
+                          radii=rr.components.Radius.ui_points(2.0)), static=True)
+        s.log(f"{root}/balls", rr.Points3D.from_fields(radii=[rb], show_labels=False), static=True)
+        s.log(f"{root}/loads", rr.Arrows3D.from_fields(colors=[INNER_RGB], radii=[0.08 * rb]), static=True)
+    for field_, _title in LOAD_ZONE:
+        for side, name in enumerate(SIDES):
+            s.log(f"{root}/load_zone/{field_}/{name}", [
+                rr.components.ColorBatch([INNER_RGB if side == 0 else OUTER_RGB]).described(
+                    rr.BarChart.descriptor_color()),
+                rr.components.LengthBatch(np.full(tw.ball_count, tw.bar_width_deg, dtype=np.float32)).described(
+                    rr.BarChart.descriptor_widths())], static=True)
+    for leaf, (names, colors) in SERIES.items():
+        s.log(f"{root}/{leaf}", rr.SeriesLines(names=list(names), colors=list(colors)), static=True)
+    z = tw.ball_count
+    names = [f"ball {i} {side}" for i in range(z) for side in SIDES]
+    colors = [ball_rgb(i, z, k) for i in range(z) for k in range(2)]
+    for leaf, _title in CONTACT_SERIES:
+        s.log(f"{root}/contacts/{leaf}", rr.SeriesLines(names=names, colors=colors), static=True)
+    s.log(f"{root}/electrical/discharge_risk",
+          rr.StateConfiguration(values=list(RISK_VALUES), labels=["no discharge risk", "discharge possible",
+                                                                  "discharge likely"],
+                                colors=np.array(RISK_RGBA, dtype=np.uint32)), static=True)
+
+
+# ---- blueprint --------------------------------------------------------------------------------
+def _window(seconds: float | None):
+    if not seconds:
+        return None
+    return rrb.VisibleTimeRange(SIM_TIME, start=rrb.TimeRangeBoundary.cursor_relative(seconds=-float(seconds)),
+                                end=rrb.TimeRangeBoundary.cursor_relative())
+
+
+def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Container:
+    """The default layout of one twin: top, the bearing in 3D, the load zone now and the
+    bearing-level trends with the setpoint beside them; bottom, the events and the electrical
+    panel. The per-contact series (`contacts/...`) are not in it (add them from the streams)."""
+    root = f"/{tw.root}"
+    tag = tw.bearing_id
+    window = _window(series_window_s)
+
+    def ts(title: str, leaf: str, legend: bool = True) -> rrb.TimeSeriesView:
+        return rrb.TimeSeriesView(name=title, origin=root, contents=[f"+ {root}/{leaf}"], time_ranges=window,
+                                  plot_legend=rrb.PlotLegend(visible=legend, corner="LeftTop"))
+
+    def bars(field_: str, title: str) -> rrb.BarChartView:
+        return rrb.BarChartView(name=f"{title} vs azimuth [deg]", origin=root,
+                                contents=[f"+ {root}/load_zone/{field_}/**"],
+                                plot_legend=rrb.PlotLegend(visible=False))
+
+    top: list = []
+    shares: list = []
+    if tw.has_geometry:
+        distance = 3.4 * tw.outer_raceway_radius_m
+        top.append(rrb.Spatial3DView(
+            name=f"{tag} ({tw.designation}): balls by regime (colours as in 'balls per regime')", origin=root,
+            contents=[f"+ {root}/geometry/**", f"+ {root}/balls", f"+ {root}/loads"],
+            # look along the axis (-z) with the radial load line (+x, azimuth 0) pointing down
+            eye_controls=rrb.EyeControls3D(position=[0.0, 0.0, distance], look_target=[0.0, 0.0, 0.0],
+                                           eye_up=[-1.0, 0.0, 0.0]),
+            line_grid=False))
+        shares.append(1.0)
+    top.append(rrb.Vertical(*(bars(f, t) for f, t in LOAD_ZONE), name="load zone now (inner blue, outer violet)"))
+    shares.append(1.0)
+    top.append(rrb.Grid(
+        ts("loads [N]: Qmax, radial Fr, axial Fa", "loads_n"),
+        ts("speeds [rad/s]", "speeds_rad_s"),
+        ts("friction torque [N m]", "friction_torque_n_m", legend=False),
+        ts("smallest Lambda, loaded contacts [-]", "min_lambda"),
+        ts("balls per regime (Lambda < 1 boundary, 1-3 mixed, > 3 full film)", "regime_counts"),
+        ts("temperatures [degC]", "temperatures_c"),
+        grid_columns=3, name="trends"))
+    shares.append(2.4)
+    electrical = rrb.Vertical(
+        rrb.Grid(
+            ts("bearing capacitance [pF]", "electrical/capacitance_pf", legend=False),
+            ts("log10 R, log10 |Z| [kohm]", "electrical/resistance_log10_kohm"),
+            ts("largest film field [V/um]", "electrical/film_field_v_per_um", legend=False),
+            ts("shaft voltage [V]", "electrical/shaft_voltage_v", legend=False),
+            ts("shaft current [mA]", "electrical/shaft_current_ma", legend=False),
+            ts("largest current density [A/mm2]", "electrical/current_density_a_per_mm2", legend=False),
+            grid_columns=3),
+        rrb.StateTimelineView(name="discharge risk", origin=root, contents=[f"+ {root}/electrical/discharge_risk"],
+                              time_ranges=window),
+        row_shares=[4.0, 1.0], name="electrical")
+    events = rrb.TextLogView(
+        name=f"{tag}: events (setpoints, scenarios, restarts, fallbacks)", origin=root, contents=[f"+ {root}/events"],
+        columns=rrb.archetypes.TextLogColumns(
+            timeline_columns=[rrb.encodings.TimelineColumn(SIM_TIME), rrb.encodings.TimelineColumn(SEQ, visible=False)],
+            text_log_columns=[rrb.encodings.TextLogColumn("LogLevel"), rrb.encodings.TextLogColumn("Body"),
+                              rrb.encodings.TextLogColumn("EntityPath", visible=False)]))
+    return rrb.Vertical(rrb.Horizontal(*top, column_shares=shares),
+                        rrb.Horizontal(events, electrical, column_shares=[1.0, 1.6]),
+                        row_shares=[1.5, 1.0], name=tag)
+
+
+def blueprint(twins: list[TwinLayout], series_window_s: float | None) -> rrb.Blueprint:
+    """The default layout: one twin, or one tab per twin."""
+    layouts = [twin_blueprint(tw, series_window_s) for tw in twins]
+    if not layouts:
+        body = rrb.Vertical()
+    elif len(layouts) == 1:
+        body = layouts[0]
+    else:
+        body = rrb.Tabs(*layouts)
+    return rrb.Blueprint(body, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
+                         rrb.TimePanel(timeline=SIM_TIME, play_state="following", state="collapsed"),
+                         collapse_panels=True)
