@@ -389,7 +389,8 @@ def test_monitor_command_registers_with_argparse():
     assert args.connect == ["tcp/127.0.0.1:1", "tcp/127.0.0.1:2"]
     assert args.keyexpr == "bearing/x/state" and args.duration == 1.0 and callable(args.func)
     args = parser.parse_args(["monitor"])
-    assert args.keyexpr == "bearing/*/state" and not args.once
+    assert args.keyexpr is None and args.prefix is None and not args.once   # {prefix}/*/state
+    assert args.forget_after == 10.0
     bad = parser.parse_args(["monitor", "--connect", "tcp/127.0.0.1:notaport", "--duration", "0.2"])
     assert bad.func(bad) == 2
 
