@@ -71,7 +71,7 @@ class TwinTable:
         self.forget_gone_s = forget_gone_s   # drop a gone twin's row after this long [s]
         self.rows: dict[str, dict[str, Any]] = {}
         self.invalid = 0  # messages that were not contract JSON objects
-        self.forgotten = 0
+        self.departed: dict[str, float] = {}   # forgotten twins: late messages do not revive them
 
     def _row(self, bearing_id: str) -> dict[str, Any]:
         row = self.rows.get(bearing_id)
@@ -98,8 +98,8 @@ class TwinTable:
         # the key names the twin (as its liveliness token does); the payload is the fallback
         bearing_id = twin_name(key, self.prefix) or str(data.get("bearing_id") or key)
         row = self.rows.get(bearing_id)
-        if row is not None and row["alive"] is False:
-            return      # a late message of a twin that is gone
+        if bearing_id in self.departed or (row is not None and row["alive"] is False):
+            return      # a late message of a twin that is gone (its last snapshots follow its token)
         row = self._row(bearing_id)
         row["messages"] += 1
         row["key"] = key
@@ -142,6 +142,10 @@ class TwinTable:
     def on_alive(self, key: str, alive: bool) -> None:
         bearing_id = twin_name(key, self.prefix)
         if bearing_id:
+            if alive:
+                self.departed.pop(bearing_id, None)
+            elif bearing_id in self.departed:
+                return
             row = self._row(bearing_id)
             row["alive"] = alive
             row["gone_at"] = None if alive else time.monotonic()
@@ -154,8 +158,7 @@ class TwinTable:
         gone = [k for k, r in self.rows.items()
                 if r["alive"] is False and r["gone_at"] is not None and now - r["gone_at"] >= self.forget_gone_s]
         for k in gone:
-            del self.rows[k]
-        self.forgotten += len(gone)
+            self.departed[k] = self.rows.pop(k)["gone_at"]
         return gone
 
     def snapshot(self) -> dict[str, dict[str, Any]]:
@@ -196,7 +199,7 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
                 keyexpr: str | None = None, duration_s: float | None = None,
                 once: bool = False, out: Any = None, *, prefix: str = DEFAULT_PREFIX,
                 forget_gone_s: float | None = None, access: Any = None,
-                on_update: Any = None) -> dict[str, dict[str, Any]]:
+                on_update: Any = None, stop: Any = None) -> dict[str, dict[str, Any]]:
     """Watch the bus and render a live table; return the final rows {twin: {...}}.
 
     connect: endpoints to connect to (None or [] -> tcp/127.0.0.1:7447 unless `listen` is given);
@@ -206,8 +209,8 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
     table as soon as a twin has been seen (plus a short settle time) and stop; forget_gone_s:
     drop gone twins after this long (None: keep them, marked gone); access: zenoh credentials
     (service.bus.access.ZenohAccess; default from the environment); on_update(rows): called
-    from the monitor's thread after each batch of messages (tests); out: a rich Console or a
-    text file (default stdout).
+    from the monitor's thread after each batch of messages (tests); stop: a threading.Event that
+    ends the watch when set; out: a rich Console or a text file (default stdout).
     """
     import zenoh
     from rich.console import Console
@@ -279,7 +282,7 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
                 with Live(table.render(title), console=console, auto_refresh=False,
                           transient=False) as live:
                     next_refresh = 0.0
-                    while deadline is None or time.monotonic() < deadline:
+                    while (deadline is None or time.monotonic() < deadline) and not (stop and stop.is_set()):
                         now = time.monotonic()
                         wait = _REFRESH_S if deadline is None else min(_REFRESH_S, deadline - now)
                         drain(wait)
