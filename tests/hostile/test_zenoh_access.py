@@ -391,3 +391,98 @@ def test_router_command_runs_until_stopped(hostile, users, capsys):
     stop.set()
     th.join(10.0)
     assert not th.is_alive() and done["rc"] == 0
+
+
+# ---- mutual TLS: roles by certificate common name ----------------------------------------------------
+def _certificates(out, names):
+    """A throw-away CA and, per name, a certificate (CN = name, SAN 127.0.0.1) and its key."""
+    import datetime
+    import ipaddress
+
+    from cryptography import x509
+    from cryptography.hazmat.primitives import hashes, serialization
+    from cryptography.hazmat.primitives.asymmetric import ec
+    from cryptography.x509.oid import ExtendedKeyUsageOID, NameOID
+
+    now = datetime.datetime.now(datetime.UTC)
+    ca_key = ec.generate_private_key(ec.SECP256R1())
+    ca_name = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, "bearing-twin test CA")])
+
+    def builder(subject, key):
+        return (x509.CertificateBuilder().subject_name(subject).issuer_name(ca_name).public_key(key.public_key())
+                .serial_number(x509.random_serial_number()).not_valid_before(now - datetime.timedelta(minutes=5))
+                .not_valid_after(now + datetime.timedelta(hours=2)))
+    ca = (builder(ca_name, ca_key).add_extension(x509.BasicConstraints(ca=True, path_length=None), critical=True)
+          .add_extension(x509.KeyUsage(digital_signature=True, key_cert_sign=True, crl_sign=True,
+                                       content_commitment=False, key_encipherment=False, data_encipherment=False,
+                                       key_agreement=False, encipher_only=False, decipher_only=False), critical=True)
+          .sign(ca_key, hashes.SHA256()))
+    (out / "ca.pem").write_bytes(ca.public_bytes(serialization.Encoding.PEM))
+    for name in names:
+        key = ec.generate_private_key(ec.SECP256R1())
+        cert = (builder(x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, name)]), key)
+                .add_extension(x509.SubjectAlternativeName([x509.DNSName("localhost"),
+                                                            x509.IPAddress(ipaddress.ip_address("127.0.0.1"))]),
+                               critical=False)
+                .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
+                .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH, ExtendedKeyUsageOID.CLIENT_AUTH]),
+                               critical=False)
+                .sign(ca_key, hashes.SHA256()))
+        (out / f"{name}.pem").write_bytes(cert.public_bytes(serialization.Encoding.PEM))
+        (out / f"{name}.key").write_bytes(key.private_bytes(serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8,
+                                                            serialization.NoEncryption()))
+
+
+def test_mutual_tls_roles_by_certificate_common_name(hostile, tmp_path):
+    """Router and service with TLS client certificates (no users file): roles match the
+    certificates' common names; a certificate of the same CA without a role gets nothing, a
+    client without a certificate cannot connect."""
+    pytest.importorskip("cryptography")
+    from service.tools.router import open_router
+
+    _certificates(tmp_path, ["router", "twin", "op", "viewer", "stranger"])
+
+    def tls(name):
+        return dict(zenoh_tls_root_ca=tmp_path / "ca.pem", zenoh_tls_certificate=tmp_path / f"{name}.pem",
+                    zenoh_tls_private_key=tmp_path / f"{name}.key")
+
+    def client(name):
+        return zenoh.open(make_config([], [endpoint], "client", access=ZenohAccess(
+            tls_root_ca=tmp_path / "ca.pem", tls_certificate=tmp_path / f"{name}.pem",
+            tls_private_key=tmp_path / f"{name}.key")))
+
+    endpoint = f"tls/127.0.0.1:{hostile.free_port()}"
+    with pytest.raises(ValueError, match="tls/HOST:PORT only"):        # a tcp/ endpoint would be open
+        RouterSettings(zenoh_listen=[f"tcp/127.0.0.1:{hostile.free_port()}"], **tls("router"))
+    router, described = open_router(RouterSettings(zenoh_listen=[endpoint], zenoh_services=["twin"],
+                                                   zenoh_writers=["op"], zenoh_readers=["viewer"], **tls("router")))
+    assert "mutual TLS" in described
+    sessions: dict = {}
+    try:
+        with hostile.ThreadServer(_service_settings(hostile, zenoh_connect=[endpoint], **tls("twin"))) as srv, \
+                httpx.Client(base_url=srv.url, timeout=30.0) as http:
+            channel = srv.service.find("default").channel
+            seen: dict = {name: [] for name in ("op", "viewer", "stranger")}
+            subs = []
+            for name in seen:
+                sessions[name] = client(name)
+                subs.append(sessions[name].declare_subscriber("bearing/*/state", lambda smp, n=name: seen[n].append(1)))
+            with pytest.raises(Exception):
+                zenoh.open(make_config([], [endpoint], "client"))            # no certificate
+            _wait(lambda: len(seen["viewer"]) >= CONTROL_N and len(seen["op"]) >= CONTROL_N, what="states")
+            before = channel.setpoints_received
+            for name, load in (("stranger", 3300.0), ("viewer", 3400.0)):
+                sessions[name].put("bearing/default/setpoint", json.dumps({"radial_load_n": load}))
+            time.sleep(1.0)
+            sessions["op"].put("bearing/default/setpoint", json.dumps({"radial_load_n": 3500.0}))
+            hostile.wait_for(lambda: http.get("/v1/bearings/default/state").json(),
+                             lambda st: st["setpoint"]["radial_load_n"] == 3500.0)
+            time.sleep(0.5)
+            assert channel.setpoints_received - before == 1
+            assert seen["stranger"] == []
+            for sub in subs:
+                sub.undeclare()
+    finally:
+        for session in sessions.values():
+            session.close()
+        router.close()
