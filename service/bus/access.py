@@ -211,5 +211,5 @@ class ZenohAccess:
             parts.append("rules: " + "; ".join(f"{role} {', '.join(names) or '(none)'}"
                                                 for role, names in self.roles.items()))
         elif not listening:
-            parts.append("the router's rules apply")
+            parts.append("the rules of the router (or service) it connects to apply")
         return "zenoh access control on: " + ", ".join(parts)
