@@ -8,11 +8,12 @@ accept a JSON list (`'["tcp/127.0.0.1:7447"]'`) or a comma-separated string
 from __future__ import annotations
 
 import json
+import re
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import Field, SecretStr, field_validator
+from pydantic import Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 
@@ -43,7 +44,217 @@ def _split_endpoints(value):
     return value
 
 
-class ServiceSettings(BaseSettings):
+DEFAULT_ZENOH_LISTEN = ["tcp/127.0.0.1:7447"]
+_CHUNK = r"[A-Za-z0-9_.-]+"
+_PREFIX_RE = re.compile(rf"^{_CHUNK}(?:/{_CHUNK}){{0,7}}$")
+_PATTERN_RE = re.compile(rf"^(?:{_CHUNK}|\*|\*\*)(?:/(?:{_CHUNK}|\*|\*\*)){{0,7}}$")
+_NAME_RE = re.compile(r"^[A-Za-z0-9_.@+-]{1,128}$")
+
+
+def _split_names(value):
+    if value is None:
+        return []
+    if isinstance(value, str):
+        text = value.strip()
+        if text.startswith("["):
+            return json.loads(text)
+        return [part.strip() for part in text.split(",") if part.strip()]
+    return value
+
+
+def read_usersfile(path: Path) -> list[str]:
+    """The user names of a zenoh users file (`user:password`, one a line, blank lines skipped;
+    zenoh's `transport.auth.usrpwd.dictionary_file` format). ValueError naming the line, never
+    the password, when it is not one."""
+    try:
+        text = Path(path).read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise ValueError(f"cannot read {str(path)!r}: {type(exc).__name__}") from None
+    users = []
+    for number, line in enumerate(text.splitlines(), 1):
+        line = line.strip()
+        if not line:
+            continue
+        user, sep, password = line.partition(":")
+        if not sep or not user.strip() or not password.strip():
+            raise ValueError(f"{str(path)!r} line {number}: expected `user:password` "
+                             "(both non-empty)")
+        users.append(user.strip())
+    if not users:
+        raise ValueError(f"{str(path)!r} holds no `user:password` line")
+    return users
+
+
+class ZenohAccessSettings(BaseSettings):
+    """Who may do what on zenoh (README "zenoh access control"), read by the service, the router
+    and the bundled clients (`monitor`, `soak`, benchmarks) from `BEARING_TWIN_ZENOH_*`.
+
+    Access control is on when a users file, credentials or TLS client certificates are
+    configured. Then every zenoh link is authenticated (zenoh's user-password handshake
+    `transport.auth.usrpwd`, or mutual TLS) and the node that accepts links (a listening service,
+    `bearing-twin router`) applies zenoh's `access_control` rules built from the three roles
+    (service.bus.access): readers subscribe to state, ball and result keys, query snapshots and
+    see liveliness tokens; writers also put setpoints; services publish, answer queries and
+    declare liveliness tokens. A peer without credentials cannot open a link at all."""
+
+    model_config = SettingsConfigDict(env_prefix="BEARING_TWIN_", extra="ignore",
+                                      validate_default=True, hide_input_in_errors=True)
+
+    zenoh_prefix: str = Field(
+        default="bearing",
+        description="Key prefix of the twins on zenoh [key expression chunks, e.g. plant1/line2/motor7]: "
+        "a twin publishes under {prefix}/{id}/...; site / line / asset, up to 8 chunks of letters, "
+        "digits, '_', '.', '-'. The router and the monitor also take patterns with '*' and '**' "
+        "(e.g. plant1/**).")
+    zenoh_user: str | None = Field(
+        default=None,
+        description="User name this process presents when it connects to a zenoh router or peer "
+        "[text]; with zenoh_password (zenoh user-password authentication).")
+    zenoh_password: SecretStr | None = Field(
+        default=None,
+        description="Password of zenoh_user [text]; give it in the environment "
+        "(BEARING_TWIN_ZENOH_PASSWORD), never on a command line.")
+    zenoh_usersfile: Path | None = Field(
+        default=None,
+        description="Users allowed to connect to this process's zenoh endpoints [path to a file of "
+        "`user:password` lines, zenoh's usrpwd dictionary]; keep it readable by the service only.")
+    zenoh_writers: Annotated[list[str], NoDecode] = Field(
+        default_factory=list,
+        description="Users (or TLS certificate common names) that may put setpoints, and read "
+        "[comma-separated names].")
+    zenoh_readers: Annotated[list[str], NoDecode] = Field(
+        default_factory=list,
+        description="Users (or certificate common names) that may only read: state, balls, "
+        "setpoint results, snapshots, liveliness [comma-separated names].")
+    zenoh_services: Annotated[list[str], NoDecode] = Field(
+        default_factory=list,
+        description="Users (or certificate common names) of twin services joining a router: they "
+        "publish state, answer queries and declare liveliness tokens [comma-separated names]; "
+        "the service's own zenoh_user is always one.")
+    zenoh_tls_root_ca: Path | None = Field(
+        default=None, description="CA certificate that signed every node's certificate [path, PEM]; "
+        "with zenoh_tls_certificate and zenoh_tls_private_key: mutual TLS on tls/ endpoints.")
+    zenoh_tls_certificate: Path | None = Field(
+        default=None, description="This process's TLS certificate [path, PEM]; its common name is "
+        "the name the roles match.")
+    zenoh_tls_private_key: Path | None = Field(
+        default=None, description="Private key of zenoh_tls_certificate [path, PEM].")
+
+    @field_validator("zenoh_writers", "zenoh_readers", "zenoh_services", mode="before")
+    @classmethod
+    def _names(cls, value):
+        names = _split_names(value)
+        for name in names:
+            if not isinstance(name, str) or not _NAME_RE.match(name):
+                raise ValueError("role members are user names or certificate common names: 1-128 "
+                                 "letters, digits, '_', '.', '@', '+', '-'")
+        return list(dict.fromkeys(names))
+
+    @field_validator("zenoh_user", mode="before")
+    @classmethod
+    def _user(cls, value):
+        if isinstance(value, str) and not value.strip():
+            return None
+        if value is not None and (not isinstance(value, str) or not _NAME_RE.match(value)):
+            raise ValueError("a zenoh user name is 1-128 letters, digits, '_', '.', '@', '+', '-'")
+        return value
+
+    @field_validator("zenoh_password", mode="before")
+    @classmethod
+    def _password(cls, value):
+        if isinstance(value, SecretStr):
+            value = value.get_secret_value()
+        if value is None or (isinstance(value, str) and not value):
+            return None
+        if isinstance(value, str) and (":" in value or any(c.isspace() or not c.isprintable() for c in value)):
+            raise ValueError("the zenoh password must be printable characters without spaces or ':'")
+        return value
+
+    @field_validator("zenoh_usersfile", "zenoh_tls_root_ca", "zenoh_tls_certificate",
+                     "zenoh_tls_private_key", mode="before")
+    @classmethod
+    def _optional_path(cls, value):
+        if isinstance(value, str) and value.strip().lower() in ("", "none", "off"):
+            return None
+        return value
+
+    @field_validator("zenoh_prefix")
+    @classmethod
+    def _prefix(cls, value: str) -> str:
+        value = value.strip().strip("/")
+        if len(value) > 200 or not _PATTERN_RE.match(value):
+            raise ValueError("a key prefix is 1-8 chunks of letters, digits, '_', '.', '-' separated "
+                             "by '/' (patterns may use '*' and '**'), e.g. plant1/line2/motor7")
+        return value
+
+    @model_validator(mode="after")
+    def _access(self):
+        if (self.zenoh_user is None) != (self.zenoh_password is None):
+            missing = "zenoh_password" if self.zenoh_password is None else "zenoh_user"
+            raise ValueError(f"{missing}: zenoh credentials are a user and a password together "
+                             "(BEARING_TWIN_ZENOH_USER, BEARING_TWIN_ZENOH_PASSWORD)")
+        if self.zenoh_usersfile is not None:
+            read_usersfile(self.zenoh_usersfile)            # ValueError naming the line
+        tls = (self.zenoh_tls_root_ca, self.zenoh_tls_certificate, self.zenoh_tls_private_key)
+        if any(t is not None for t in tls) and not all(t is not None for t in tls):
+            raise ValueError("zenoh_tls_certificate: mutual TLS needs the CA certificate, this "
+                             "process's certificate and its private key together")
+        for name, path in zip(("zenoh_tls_root_ca", "zenoh_tls_certificate", "zenoh_tls_private_key"),
+                              tls, strict=True):
+            if path is not None and not Path(path).is_file():
+                raise ValueError(f"{name}: {str(path)!r} is not a file")
+        return self
+
+    @property
+    def zenoh_password_value(self) -> str | None:
+        return self.zenoh_password.get_secret_value() if self.zenoh_password is not None else None
+
+    @property
+    def zenoh_tls(self) -> bool:
+        """Mutual TLS configured (CA, certificate and key)."""
+        return self.zenoh_tls_certificate is not None
+
+    @property
+    def zenoh_access_control(self) -> bool:
+        """zenoh authentication (and, where links are accepted, access control) is on."""
+        return self.zenoh_usersfile is not None or self.zenoh_user is not None or self.zenoh_tls
+
+    @property
+    def zenoh_prefix_is_pattern(self) -> bool:
+        return "*" in self.zenoh_prefix
+
+
+class RouterSettings(ZenohAccessSettings):
+    """Configuration of `bearing-twin router` (env prefix `BEARING_TWIN_`)."""
+
+    zenoh_listen: Annotated[list[str], NoDecode] = Field(
+        default_factory=lambda: list(DEFAULT_ZENOH_LISTEN),
+        description="zenoh endpoints the router listens on [zenoh locator, e.g. tcp/0.0.0.0:7447].")
+
+    @field_validator("zenoh_listen", mode="before")
+    @classmethod
+    def _endpoints(cls, value):
+        return _split_endpoints(value)
+
+    @model_validator(mode="after")
+    def _router(self):
+        if not self.zenoh_listen:
+            raise ValueError("zenoh_listen: a router listens on at least one endpoint")
+        _check_tls_endpoints(self)
+        return self
+
+
+def _check_tls_endpoints(s) -> None:
+    """With TLS client certificates as the only authentication, a tcp/ listen endpoint would
+    accept anyone: every listen endpoint must then be tls/ (or quic/)."""
+    if s.zenoh_tls and s.zenoh_usersfile is None:
+        plain = [e for e in s.zenoh_listen if not e.startswith(("tls/", "quic/"))]
+        if plain:
+            raise ValueError(f"zenoh_listen: {plain[0]!r} would accept peers without a client "
+                             "certificate; with TLS (and no users file) listen on tls/HOST:PORT only")
+
+
+class ServiceSettings(ZenohAccessSettings):
     """Configuration of `bearing-twin serve` (env prefix `BEARING_TWIN_`)."""
 
     model_config = SettingsConfigDict(env_prefix="BEARING_TWIN_", extra="ignore",
@@ -60,14 +271,16 @@ class ServiceSettings(BaseSettings):
                          description="Name of the twin started with the service [text]; give each "
                          "service on one zenoh network its own (keys are bearing/{id}/...).")
     start_twin: bool = Field(default=True, description="Start that twin with the service [bool].")
-    zenoh_listen: Annotated[list[str], NoDecode] = Field(
-        default_factory=lambda: ["tcp/127.0.0.1:7447"],
-        description="zenoh endpoints to listen on [zenoh locator, e.g. tcp/127.0.0.1:7447].")
+    zenoh_listen: Annotated[list[str] | None, NoDecode] = Field(
+        default=None,
+        description="zenoh endpoints to listen on [zenoh locator, e.g. tcp/127.0.0.1:7447]; default "
+        "tcp/127.0.0.1:7447, or none when zenoh_connect is given (the service joins a router).")
     zenoh_connect: Annotated[list[str], NoDecode] = Field(
         default_factory=list,
         description="zenoh endpoints (routers or peers) to connect to [zenoh locator].")
-    zenoh_mode: Literal["peer", "client", "router"] = Field(
-        default="peer", description="zenoh session mode [peer | client | router].")
+    zenoh_mode: Literal["peer", "client", "router"] | None = Field(
+        default=None, description="zenoh session mode [peer | client | router]; default client when "
+        "the service only connects (joins a router: every message goes through it), else peer.")
     record: Path | None = Field(
         default_factory=default_recording_path,
         description="rerun recording written while the service runs [path to a .rrd file]; "
@@ -129,8 +342,10 @@ class ServiceSettings(BaseSettings):
     token: SecretStr | None = Field(
         default=None,
         description="Bearer token [text]: when set, every mutating HTTP request (POST, PUT, DELETE) "
-        "needs `Authorization: Bearer <token>` and every zenoh setpoint a \"token\" field; unset "
-        "(default) = no authentication. Give it in the environment (BEARING_TWIN_TOKEN), not on a "
+        "needs `Authorization: Bearer <token>`; unset "
+        "(default) = no authentication. It never travels on zenoh: zenoh has its own access "
+        "control (zenoh_usersfile ...), and without it a service with a token refuses zenoh "
+        "setpoints. Give it in the environment (BEARING_TWIN_TOKEN), not on a "
         "command line other users can read.")
     read_requires_token: bool = Field(
         default=False,
@@ -154,7 +369,40 @@ class ServiceSettings(BaseSettings):
     @field_validator("zenoh_listen", "zenoh_connect", mode="before")
     @classmethod
     def _endpoints(cls, value):
+        if value is None:
+            return None
         return _split_endpoints(value)
+
+    @model_validator(mode="after")
+    def _zenoh(self):
+        """Resolve the listen default and the mode; refuse what zenoh's access control cannot
+        guard (README "zenoh access control")."""
+        if self.zenoh_listen is None:
+            self.zenoh_listen = [] if self.zenoh_connect else list(DEFAULT_ZENOH_LISTEN)
+        if self.zenoh_mode is None:
+            self.zenoh_mode = "client" if self.zenoh_connect and not self.zenoh_listen else "peer"
+        if self.zenoh_prefix_is_pattern:
+            raise ValueError("zenoh_prefix: a service publishes under a concrete prefix: no '*' "
+                             "or '**' (those are for the router and the monitor)")
+        if not self.enable_zenoh or not self.zenoh_access_control:
+            return self
+        if self.zenoh_listen and self.zenoh_connect:
+            raise ValueError(
+                "zenoh_connect: with zenoh access control a service either listens (its own access "
+                "rules guard who connects) or joins a router (the router's rules guard everyone), "
+                "not both: zenoh authenticates only the side that connects, so the links this "
+                "service opens would match none of its own rules")
+        if self.zenoh_listen and self.zenoh_usersfile is None and not self.zenoh_tls:
+            raise ValueError(
+                "zenoh_usersfile: a service that listens with zenoh access control needs the users "
+                "allowed to connect (BEARING_TWIN_ZENOH_USERSFILE) or TLS client certificates; "
+                "to join a router instead give --zenoh-connect")
+        if self.zenoh_connect and self.zenoh_user is None and not self.zenoh_tls:
+            raise ValueError(
+                "zenoh_user: joining a router with access control needs this service's credentials "
+                "(BEARING_TWIN_ZENOH_USER and BEARING_TWIN_ZENOH_PASSWORD) or a TLS certificate")
+        _check_tls_endpoints(self)
+        return self
 
     @field_validator("token", mode="before")
     @classmethod

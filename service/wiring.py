@@ -37,12 +37,16 @@ def open_bus(settings: ServiceSettings):
     if not settings.enable_zenoh:
         return None
     try:
+        from service.bus.access import ZenohAccess
         from service.bus.zenoh_bus import ZenohBus
     except ImportError as exc:
         raise WiringError(f"zenoh is enabled but service.bus cannot be imported ({exc}); "
                           "install eclipse-zenoh or run with --no-zenoh") from exc
+    owner = {"http": f"http://{settings.host}:{settings.port}"} if settings.port else {}
     try:
-        return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode)
+        return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode,
+                        prefix=settings.zenoh_prefix, owner=owner,
+                        access=ZenohAccess.from_settings(settings, enforce=True))
     except (RuntimeError, ValueError) as exc:
         text = re.sub(r"\s+at \S+\.rs:\d+\.?", "", " ".join(str(exc).split()))   # zenoh's Rust source lines
         hint = (" (is another service listening there? choose another with --zenoh-listen, or --no-zenoh)"

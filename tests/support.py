@@ -59,17 +59,21 @@ class Sample(NamedTuple):
 
 
 class Peer:
-    """A separate zenoh peer session (another process in real life): peer mode, connected to
-    `endpoint` on loopback, multicast scouting off (service.bus.make_config). Subscriptions
-    put a `Sample` per message in `inbox`; `wait_for` waits at most `timeout_s`."""
+    """A separate zenoh session (another process in real life): peer mode (or `mode`), connected
+    to `endpoint` on loopback, multicast scouting off (service.bus.make_config), with the zenoh
+    credentials of `access` (service.bus.access.ZenohAccess; default none). Subscriptions put a
+    `Sample` per message in `inbox`; `wait_for` waits at most `timeout_s`. `prefix`: the twins'
+    key prefix (result keys)."""
 
-    def __init__(self, endpoint: str, timeout_s: float = PEER_WAIT_S):
+    def __init__(self, endpoint: str, timeout_s: float = PEER_WAIT_S, *, mode: str = "peer",
+                 access: Any = None, prefix: str = "bearing"):
         import zenoh
 
         from service.bus.zenoh_bus import make_config
 
         self.timeout_s = timeout_s
-        self.session = zenoh.open(make_config([], [endpoint], "peer"))
+        self.prefix = prefix
+        self.session = zenoh.open(make_config([], [endpoint], mode, access=access))
         self.inbox: queue.Queue[Sample] = queue.Queue()
         self._subs: list = []
 
@@ -108,7 +112,7 @@ class Peer:
         """Put a setpoint and return the next message on its result key (strict JSON)."""
         self.drain()
         self.session.put(key, payload)
-        sample = self.wait_for(lambda item: item.key == f"bearing/{bearing_id}/setpoint/result", timeout_s)
+        sample = self.wait_for(lambda item: item.key == f"{self.prefix}/{bearing_id}/setpoint/result", timeout_s)
         return strict_loads(sample.payload)
 
     def drain(self) -> None:

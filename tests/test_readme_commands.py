@@ -50,7 +50,9 @@ SKIPPED = {
     r"\. \.venv/bin/activate": "installation",
     r"pip install": "installation",
     r"docker ": "no docker in the test environment",
-    r"host[AB]\$|anywhere\$": "several hosts: tests/service/test_end_to_end.py runs it on loopback",
+    r"host[AB]\$|anywhere\$|router\$": "several hosts: tests/service/test_end_to_end.py, test_fleet.py and "
+                                         "tests/hostile/test_zenoh_access.py run them on loopback",
+    r"bearing-twin router": "runs until stopped: tests/service/test_fleet.py runs it",
     r"bearing-twin soak --minutes 60 --url": "needs a service of its own: the --start variant is run",
     r"export BEARING_TWIN_TOKEN": "run by test_token_commands",
 }

@@ -50,7 +50,7 @@ def access_summary(settings: ServiceSettings) -> str:
         return ("no token (BEARING_TWIN_TOKEN unset): anyone who can reach the port may change "
                 "setpoints")
     reads = "reads too (except /health)" if settings.read_requires_token else "reads open"
-    return f"bearer token required for POST/PUT/DELETE and zenoh setpoints; {reads}"
+    return f"bearer token required for POST/PUT/DELETE (HTTP only, never sent on zenoh); {reads}"
 
 
 def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry | None = None) -> FastAPI:

@@ -150,7 +150,7 @@ class TwinHealth(BaseModel):
     errors: int = Field(description="Exceptions caught in the runner loop (each followed by a warm restart) [-].")
     restarts: int = Field(description="Engine warm restarts after a diverged or overloaded state [-].")
     setpoints_accepted: int = Field(description="Setpoint updates accepted [-].")
-    setpoints_refused: int = Field(default=0, description="zenoh setpoints refused (token, size, rate, validation) [-].")
+    setpoints_refused: int = Field(default=0, description="zenoh setpoints refused (bus closed to writes, size, rate, validation) [-].")
     setpoints_rate_limited: int = Field(default=0, description="Setpoints refused by the rate limit, HTTP 429 and zenoh [-].")
     fallbacks: int = Field(default=0, description="Times the twin could not hold its setpoint and was warm-restarted at the last safe one [-].")
     last_safe_setpoint: Setpoint | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")

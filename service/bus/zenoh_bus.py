@@ -1,15 +1,23 @@
 """The zenoh bus: ONE zenoh session for the whole service, one `TwinChannel` per twin.
 
-Key expressions (README "Architecture", schema "bearing-twin/state/1"):
+Key expressions (README "Architecture", schema "bearing-twin/state/1"), under the service's key
+prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/line2/motor7`):
 
-    bearing/{id}/state             snapshot JSON (publisher)
-    bearing/{id}/ball/{i}          one ball: the ball's fields plus schema, bearing_id, time_s
-    bearing/{id}/setpoint          setpoint JSON in (subscriber)
-    bearing/{id}/setpoint/result   what became of each setpoint message (publisher):
-                                   {"accepted": true, "setpoint": {...}} or
-                                   {"accepted": false, "error": "..."}; always carries bearing_id
-    bearing/{id}/snapshot          queryable: replies with the latest snapshot JSON
-    bearing/{id}/alive             liveliness token while the twin is attached
+    P/{id}/state             snapshot JSON (publisher)
+    P/{id}/ball/{i}          one ball: the ball's fields plus schema, bearing_id, time_s
+    P/{id}/setpoint          setpoint JSON in (subscriber); no token: who may put is zenoh's
+                             access control (service.bus.access)
+    P/{id}/setpoint/result   what became of each setpoint message (publisher):
+                             {"accepted": true, "setpoint": {...}} or
+                             {"accepted": false, "error": "..."}; always carries bearing_id
+    P/{id}/snapshot          queryable: replies with the latest snapshot JSON
+    P/{id}/owner             queryable: which process runs the twin (pid, host, zenoh id, HTTP)
+    P/{id}/alive             liveliness token while the twin is attached
+
+One id per prefix in the whole zenoh network: `attach_twin` first asks for the liveliness token
+P/{id}/alive and refuses (InputError 409 naming the owner, from P/{id}/owner) when another process
+has it; after declaring its own, it asks P/{id}/owner again and withdraws if another process
+answers (two processes claiming the same id at once: neither, or only one, keeps it).
 
 Threads. zenoh runs its callbacks on its own threads; ours only hand work off (append to a
 Python queue) and return. Each channel owns two daemon threads:
@@ -36,6 +44,12 @@ Zenoh 1.x notes (checked against eclipse-zenoh 1.10.2):
 * a malformed *connect* endpoint does not fail `zenoh.open` (only a listen one does), so
   `make_config` checks endpoints itself.
 * open sessions only after any fork (one service process owns the bus).
+* zenoh >= 1.9 has no "failover brokering": a router does not relay between two PEERS that are
+  not linked to each other. Whatever joins a router without listening itself (a service with
+  --zenoh-connect, the monitor, soak) is therefore a zenoh CLIENT: every message goes through
+  the router (and its access-control rules).
+* with access control on (service.bus.access) gossip scouting is off: a secured node opens
+  links only to the endpoints it was given.
 """
 
 from __future__ import annotations
@@ -45,7 +59,9 @@ import collections
 import contextlib
 import json
 import logging
+import os
 import re
+import socket
 import threading
 import time
 import weakref
@@ -54,11 +70,14 @@ from typing import Any, Self
 
 import zenoh
 
+from service.bus.access import ZenohAccess
+from service.core.errors import InputError
 from twin.snapshot import Snapshot
 
 log = logging.getLogger(__name__)
 
 DEFAULT_LISTEN = ["tcp/127.0.0.1:7447"]
+DEFAULT_PREFIX = "bearing"
 DEFAULT_QUEUE_SIZE = 64
 _CONTROL_QUEUE_SIZE = 256
 _JSON = "application/json"
@@ -66,24 +85,53 @@ _ID_RE = re.compile(r"^[A-Za-z0-9_.:+=,;~@%-]+$")  # one key-expression chunk, n
 
 
 def make_config(listen: Iterable[str] | None = None, connect: Iterable[str] | None = None,
-                mode: str = "peer", *, gossip: bool = True) -> zenoh.Config:
+                mode: str = "peer", *, gossip: bool = True, access: ZenohAccess | None = None,
+                prefix: str | Iterable[str] = DEFAULT_PREFIX) -> zenoh.Config:
     """A zenoh config that touches only what it is told.
 
     `listen` None means DEFAULT_LISTEN (loopback 7447); an empty list means do not listen.
     Multicast scouting is off (no UDP to 224.0.0.224); gossip scouting (over the configured
-    links only) is on by default so that peers connected through a common peer find each other.
+    links only) is on by default so that peers connected through a common peer find each other,
+    and off with access control. `access`: authentication and, on a node that listens, the
+    access-control rules for the key prefix(es) `prefix` (service.bus.access).
     """
     if mode not in ("peer", "client", "router"):
         raise ValueError(f"zenoh mode must be peer, client or router, got {mode!r}")
     listen = [check_endpoint(e) for e in (DEFAULT_LISTEN if listen is None else listen)]
     connect = [check_endpoint(e) for e in (connect or [])]
+    if mode == "client" and listen:
+        raise ValueError("a zenoh client does not listen: give no listen endpoint or use peer mode")
+    secured = access is not None and access.enabled
     config = zenoh.Config()
     config.insert_json5("mode", json.dumps(mode))
     config.insert_json5("listen/endpoints", json.dumps(listen))
     config.insert_json5("connect/endpoints", json.dumps(connect))
     config.insert_json5("scouting/multicast/enabled", "false")
-    config.insert_json5("scouting/gossip/enabled", json.dumps(bool(gossip)))
+    config.insert_json5("scouting/gossip/enabled", json.dumps(bool(gossip) and not secured))
+    if secured:
+        access.apply(config, [prefix] if isinstance(prefix, str) else list(prefix), listening=bool(listen))
     return config
+
+
+def client_config(connect: Iterable[str], *, access: ZenohAccess | None = None,
+                  listen: Iterable[str] | None = None, prefix: str = DEFAULT_PREFIX) -> zenoh.Config:
+    """The config of a bundled client (monitor, soak, benchmarks): a zenoh client of the
+    endpoints (a router or a service), or a peer when it listens itself; credentials from the
+    environment (BEARING_TWIN_ZENOH_USER / _PASSWORD, _TLS_*) unless `access` is given."""
+    listen = list(listen or [])
+    access = ZenohAccess.from_env() if access is None else access
+    return make_config(listen, list(connect), "peer" if listen else "client", access=access, prefix=prefix)
+
+
+_PREFIX_RE = re.compile(r"^[A-Za-z0-9_.:+=,;~@%-]+(?:/[A-Za-z0-9_.:+=,;~@%-]+){0,7}$")
+
+
+def check_prefix(prefix: str) -> str:
+    """A concrete key prefix (1-8 chunks, no wildcards), else ValueError."""
+    if not isinstance(prefix, str) or not _PREFIX_RE.match(prefix):
+        raise ValueError(f"key prefix {prefix!r}: 1-8 key-expression chunks separated by '/', "
+                         "no wildcards (e.g. plant1/line2/motor7)")
+    return prefix
 
 
 _ENDPOINT_RE = re.compile(r"^([a-z0-9-]+)/([^?#]+)([?#].*)?$")
@@ -138,7 +186,7 @@ class TwinChannel:
             raise ValueError("queue_size must be >= 1")
         self.bus = bus
         self.bearing_id = bearing_id
-        self.prefix = f"bearing/{bearing_id}"
+        self.prefix = f"{bus.prefix}/{bearing_id}"   # the twin's key: P/{id}
         self._get_snapshot = get_snapshot
         self._on_setpoint = on_setpoint
         self._flush_timeout_s = flush_timeout_s
@@ -173,6 +221,7 @@ class TwinChannel:
             congestion_control=zenoh.CongestionControl.DROP)
         self._setpoint_sub = session.declare_subscriber(f"{self.prefix}/setpoint", self._on_setpoint_sample)
         self._queryable = session.declare_queryable(f"{self.prefix}/snapshot", self._on_query)
+        self._owner_queryable = session.declare_queryable(f"{self.prefix}/owner", self._on_owner_query)
         self._token = session.liveliness().declare_token(f"{self.prefix}/alive")
 
         self._publisher_thread = threading.Thread(
@@ -219,7 +268,7 @@ class TwinChannel:
             if self._closed:
                 return
             self._closed = True
-        for entity in (self._token, self._setpoint_sub, self._queryable):
+        for entity in (self._token, self._setpoint_sub, self._queryable, self._owner_queryable):
             self._undeclare(entity)
         with self._control_cond:
             self._control.append(None)
@@ -260,8 +309,8 @@ class TwinChannel:
             except Exception as exc:  # noqa: BLE001 - nothing kills the publisher
                 self.errors += 1
                 if self.errors <= 3 or self.errors % 1000 == 0:
-                    log.warning("bearing/%s: snapshot not published (%d so far): %s",
-                                self.bearing_id, self.errors, _one_line(exc))
+                    log.warning("%s: snapshot not published (%d so far): %s",
+                                self.prefix, self.errors, _one_line(exc))
 
     def _send(self, snapshot: Snapshot) -> None:
         data = snapshot.to_dict()
@@ -300,6 +349,9 @@ class TwinChannel:
     def _on_query(self, query: zenoh.Query) -> None:
         self._enqueue_control(("query", query))
 
+    def _on_owner_query(self, query: zenoh.Query) -> None:
+        self._enqueue_control(("owner", query))
+
     def _enqueue_control(self, item: tuple[str, Any]) -> None:
         with self._control_cond:
             if self._closed:
@@ -315,7 +367,7 @@ class TwinChannel:
 
     @staticmethod
     def _finish_query(item: Any, error: str) -> None:
-        if item is None or item[0] != "query":
+        if item is None or item[0] not in ("query", "owner"):
             return
         query = item[1]
         with contextlib.suppress(Exception):
@@ -340,10 +392,12 @@ class TwinChannel:
             try:
                 if kind == "setpoint":
                     self._handle_setpoint(value)
+                elif kind == "owner":
+                    self._handle_owner_query(value)
                 else:
                     self._handle_query(value)
             except Exception as exc:  # noqa: BLE001 - nothing kills the control thread
-                log.warning("bearing/%s: %s handling failed: %s", self.bearing_id, kind, _one_line(exc))
+                log.warning("%s: %s handling failed: %s", self.prefix, kind, _one_line(exc))
 
     def _handle_setpoint(self, payload: bytes) -> None:
         self.setpoints_received += 1
@@ -378,6 +432,14 @@ class TwinChannel:
                 query.drop()
 
 
+    def _handle_owner_query(self, query: zenoh.Query) -> None:
+        try:
+            query.reply(f"{self.prefix}/owner", _dumps(self.bus.owner(self.bearing_id)), encoding=_JSON)
+        finally:
+            with contextlib.suppress(Exception):
+                query.drop()
+
+
 def _closer(ref: weakref.ref) -> Callable[[], None]:
     """atexit safety net: close the bus if the owner forgot (an open session can hang exit)."""
     def close() -> None:
@@ -399,19 +461,32 @@ class ZenohBus:
     """
 
     def __init__(self, listen: Iterable[str] | None = None, connect: Iterable[str] | None = None,
-                 mode: str = "peer", *, gossip: bool = True):
+                 mode: str = "peer", *, gossip: bool = True, prefix: str = DEFAULT_PREFIX,
+                 access: ZenohAccess | None = None, owner: dict | None = None,
+                 claim_timeout_s: float = 2.0):
+        """`prefix`: the key prefix P of every twin (README "Fleet"); `access`: zenoh's
+        authentication and access-control rules (service.bus.access); `owner`: what P/{id}/owner
+        tells about this process besides pid, host and zenoh id (e.g. {"http": url});
+        `claim_timeout_s`: how long the id clash check waits for answers [s]."""
         self.listen = list(DEFAULT_LISTEN if listen is None else listen)
         self.connect = list(connect or [])
         self.mode = mode
+        self.prefix = check_prefix(prefix)
+        self.access = access if access is not None else ZenohAccess()
+        self.claim_timeout_s = float(claim_timeout_s)
+        self._owner = {"pid": os.getpid(), "host": socket.gethostname(), **(owner or {})}
         self._channels: dict[str, TwinChannel] = {}
+        self._claiming: set[str] = set()
         self._lock = threading.Lock()
         self._closed = True  # until the session is open
-        config = make_config(self.listen, self.connect, mode, gossip=gossip)  # ValueError on typos
+        config = make_config(self.listen, self.connect, mode, gossip=gossip, access=self.access,
+                             prefix=self.prefix)  # ValueError on typos
         try:
             self.session = zenoh.open(config)
         except Exception as exc:
             raise RuntimeError(f"zenoh: cannot open a {mode} session (listen={self.listen}, "
                                f"connect={self.connect}): {_one_line(exc)}") from exc
+        self.zid = str(self.session.info.zid())
         self._closed = False
         self._atexit = _closer(weakref.ref(self))
         atexit.register(self._atexit)
@@ -440,19 +515,85 @@ class ZenohBus:
     def attach_twin(self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
                     on_setpoint: Callable[[bytes], dict], *,
                     queue_size: int = DEFAULT_QUEUE_SIZE) -> TwinChannel:
-        """Declare the twin's publishers, setpoint subscriber, snapshot queryable and liveliness
-        token; return its channel (a SnapshotSink: hand it to the runner)."""
+        """Declare the twin's publishers, setpoint subscriber, snapshot and owner queryables and
+        liveliness token; return its channel (a SnapshotSink: hand it to the runner).
+
+        InputError 409 (field `id`) naming the other process when the id is taken under this
+        prefix anywhere on the zenoh network (see the module docstring)."""
         if not isinstance(bearing_id, str) or not _ID_RE.match(bearing_id):
             raise ValueError(f"bearing id {bearing_id!r} is not a single key-expression chunk "
                              "(letters, digits, _ . - ... ; no '/', '*', '$', '?', '#')")
         with self._lock:
             if self._closed:
                 raise RuntimeError("zenoh bus is closed")
-            if bearing_id in self._channels:
+            if bearing_id in self._channels or bearing_id in self._claiming:
                 raise ValueError(f"twin {bearing_id!r} is already attached to this bus")
+            self._claiming.add(bearing_id)
+        try:
+            key = f"{self.prefix}/{bearing_id}"
+            if self._alive_elsewhere(key):
+                raise self._taken(bearing_id, self._owners(key))
             channel = TwinChannel(self, bearing_id, get_snapshot, on_setpoint, queue_size=queue_size)
-            self._channels[bearing_id] = channel
+            others = [o for o in self._owners(key) if o.get("zid") != self.zid]
+            if others:                      # claimed at the same moment elsewhere: withdraw
+                channel.detach()
+                raise self._taken(bearing_id, others)
+            with self._lock:
+                if self._closed:
+                    channel.detach()
+                    raise RuntimeError("zenoh bus is closed")
+                self._channels[bearing_id] = channel
+        finally:
+            with self._lock:
+                self._claiming.discard(bearing_id)
         return channel
+
+    # ---- one id per prefix across processes ---------------------------------------------
+    def owner(self, bearing_id: str) -> dict:
+        """What P/{id}/owner answers: the twin's key, this process and its zenoh id."""
+        return {"key": f"{self.prefix}/{bearing_id}", "bearing_id": bearing_id, **self._owner,
+                "zid": self.zid}
+
+    def _alive_elsewhere(self, key: str) -> bool:
+        """Whether a liveliness token `key`/alive exists on the network (ours are not: the
+        caller checked its own channels)."""
+        try:
+            replies = self.session.liveliness().get(f"{key}/alive", timeout=self.claim_timeout_s)
+            return any(reply.ok is not None for reply in replies)
+        except Exception as exc:  # noqa: BLE001 - a failed check must not block creation
+            log.warning("%s: liveliness check failed: %s", key, _one_line(exc))
+            return False
+
+    def _owners(self, key: str) -> list[dict]:
+        """Every answer of `key`/owner (all queryables, no consolidation)."""
+        out = []
+        try:
+            replies = self.session.get(f"{key}/owner", target=zenoh.QueryTarget.ALL,
+                                       consolidation=zenoh.ConsolidationMode.NONE,
+                                       timeout=self.claim_timeout_s)
+            for reply in replies:
+                if reply.ok is None:
+                    continue
+                with contextlib.suppress(Exception):
+                    data = json.loads(reply.ok.payload.to_bytes())
+                    if isinstance(data, dict):
+                        out.append(data)
+        except Exception as exc:  # noqa: BLE001
+            log.warning("%s: owner query failed: %s", key, _one_line(exc))
+        return out
+
+    def _taken(self, bearing_id: str, owners: list[dict]) -> InputError:
+        others = [o for o in owners if o.get("zid") != self.zid]
+        if others:
+            o = others[0]
+            who = (f"process {o.get('pid', '?')} on {o.get('host', '?')}"
+                   + (f" (HTTP {o['http']})" if o.get("http") else "")
+                   + f", zenoh id {o.get('zid', '?')}")
+        else:
+            who = "another process (it did not say which)"
+        return InputError.one("id", f"twin {bearing_id!r} already runs under {self.prefix!r} in {who}; "
+                              "twin ids are unique per key prefix across the zenoh network: choose "
+                              "another id or prefix", status_code=409)
 
     def detach_twin(self, bearing_id: str) -> None:
         channel = self.channels.get(bearing_id)

@@ -3,11 +3,20 @@
 * `token_matches(given, expected)`: constant-time comparison (hmac.compare_digest on UTF-8
   bytes), so the time an answer takes does not tell how much of a guessed token was right.
 * `TokenBucket`: a rate limit (sustained `rate_hz`, bursts of `burst`).
-* `AdmissionGate`: the service's token, body/payload size cap and per-twin setpoint rate (one
-  token bucket per twin, shared by HTTP and zenoh). Each check returns None (admitted) or a
-  `Refusal` with the status the transport answers with (401, 413, 429), the field and a
-  message; the HTTP layer turns it into its error answer (service.api.deps), the zenoh intake
-  into a refusal on the result key (service.core.intake).
+* `AdmissionGate`: the service's HTTP token, body/payload size cap, per-twin setpoint rate (one
+  token bucket per twin, shared by HTTP and zenoh) and whether setpoints from the bus are taken
+  at all. Each check returns None (admitted) or a `Refusal` with the status the transport
+  answers with (401, 403, 413, 429), the field and a message; the HTTP layer turns it into its
+  error answer (service.api.deps), the zenoh intake into a refusal on the result key
+  (service.core.intake).
+
+The HTTP token is for HTTP only: it never travels on zenoh (any subscriber could read it there).
+Who may put a setpoint on zenoh is decided by zenoh's own authentication and access-control
+rules (service.bus.access); the gate only knows the outcome of the settings (`bus_writes`):
+"authorized" (zenoh access control on: what arrives was allowed by the rules), "open" (no
+access control and no HTTP token: an open service, as on loopback by default) or "closed" (an
+HTTP token but no zenoh access control: zenoh setpoints are refused with 403, since anyone could
+send them).
 
 No transport here: no fastapi, no zenoh.
 """
@@ -78,7 +87,7 @@ class TokenBucket:
 class Refusal:
     """Why the gate refused: the status to answer with, the field at fault and a message."""
 
-    status: int                       # 401, 413 or 429
+    status: int                       # 401, 403, 413 or 429
     field: str | None
     message: str
     allowed: list | None = None
@@ -89,12 +98,20 @@ class AdmissionGate:
     """Token, size and per-twin setpoint rate for every transport (see the module docstring).
 
     `token` None: no authentication. `setpoint_rate_hz` None or 0: no rate limit.
-    `max_payload_bytes` None: no size cap."""
+    `max_payload_bytes` None: no size cap. `bus_writes`: "open", "authorized" or "closed"
+    (module docstring); default "closed" when a token is given, else "open"."""
+
+    BUS_WRITES = ("open", "authorized", "closed")
 
     def __init__(self, *, token: str | None = None, setpoint_rate_hz: float | None = None,
                  setpoint_burst: int = 100, max_payload_bytes: int | None = None,
-                 clock: Callable[[], float] = time.monotonic):
+                 bus_writes: str | None = None, clock: Callable[[], float] = time.monotonic):
         self.token = token
+        if bus_writes is None:
+            bus_writes = "closed" if token is not None else "open"
+        if bus_writes not in self.BUS_WRITES:
+            raise ValueError(f"bus_writes = {bus_writes!r}: one of {', '.join(self.BUS_WRITES)}")
+        self.bus_writes = bus_writes
         self.setpoint_rate_hz = float(setpoint_rate_hz) if setpoint_rate_hz else None
         self.setpoint_burst = int(setpoint_burst)
         if self.setpoint_rate_hz is not None:
@@ -121,6 +138,17 @@ class AdmissionGate:
         with self._lock:
             self.unauthorized += 1
         return Refusal(401, field, missing if given is None else "invalid token")
+
+    def check_bus_writer(self) -> Refusal | None:
+        """None if setpoints from the bus are taken, else a 403 Refusal saying how to allow them."""
+        if self.bus_writes != "closed":
+            return None
+        with self._lock:
+            self.unauthorized += 1
+        return Refusal(403, None, "zenoh setpoints are refused: the HTTP API of this service needs a "
+                       "token, and zenoh access control is off, so anyone could send them; configure "
+                       "zenoh access control (BEARING_TWIN_ZENOH_USERSFILE and BEARING_TWIN_ZENOH_WRITERS, "
+                       "or join a secured router) or send the setpoint over HTTP")
 
     def check_size(self, size: int, what: str = "payload") -> Refusal | None:
         """None if `size` [bytes] is within the cap, else a 413 Refusal."""

@@ -1,12 +1,14 @@
-"""Setpoints that arrive as raw payloads (zenoh `bearing/{id}/setpoint`): the admission gate,
+"""Setpoints that arrive as raw payloads (zenoh `{prefix}/{id}/setpoint`): the admission gate,
 then the same validation and mailbox as HTTP.
 
-`SetpointIntake(bearing_id, gate, runner)(payload) -> dict` never raises. In order: the size cap
-(413), the token (401: with a token configured the payload must be a JSON object carrying it as
-"token", removed before validation, never echoed), the twin's rate budget (429, shared with
-HTTP), the strict setpoint vocabulary and the bearing's limits (422). The answer is
-{"accepted": True, "setpoint": {...}} or {"accepted": False, "status": 401 | 413 | 422 | 429,
-"error": "...", ...}, what the transport publishes on the result key.
+`SetpointIntake(bearing_id, gate, runner)(payload) -> dict` never raises. In order: whether the
+bus may write at all (403 when the HTTP API needs a token but zenoh access control is off: see
+service.core.admission), the size cap (413), the twin's rate budget (429, shared with HTTP), the
+strict setpoint vocabulary and the bearing's limits (422). A payload never carries a token (the
+HTTP token would be readable by every subscriber of the key): a "token" field is refused (422,
+field `token`, never echoed). The answer is {"accepted": True, "setpoint": {...}} or
+{"accepted": False, "status": 403 | 413 | 422 | 429, "error": "...", ...}, what the transport
+publishes on the result key.
 """
 
 from __future__ import annotations
@@ -19,7 +21,8 @@ from service.core.admission import AdmissionGate, Refusal
 from service.core.errors import InputError
 from service.core.runner import TwinRunner, parse_update
 
-_MISSING_TOKEN = 'missing token: send the setpoint as a JSON object with a "token" field'
+_TOKEN_FIELD = ("zenoh setpoints carry no token (every subscriber of the key could read it): who "
+                "may write is zenoh's access control (BEARING_TWIN_ZENOH_WRITERS); remove the field")
 
 
 class SetpointIntake:
@@ -32,25 +35,17 @@ class SetpointIntake:
 
     def __call__(self, payload: bytes | str) -> dict:
         try:
-            refusal = self.gate.check_size(len(payload))
+            refusal = self.gate.check_bus_writer() or self.gate.check_size(len(payload))
             if refusal is not None:
                 return self._refused(refusal)
-            data: Any = _NOT_PARSED
-            if self.gate.requires_token:
-                data = _loads(payload)
-                given = data.pop("token", None) if isinstance(data, dict) else None
-                if given is not None and not isinstance(given, str):
-                    given = ""            # a wrong type is a wrong token, never a crash
-                refusal = self.gate.check_token(given, missing=_MISSING_TOKEN)
-                if refusal is not None:
-                    return self._refused(refusal)
             refusal = self.gate.take_setpoint(self.bearing_id)
             if refusal is not None:
                 return self._refused(refusal)
-            if data is _NOT_PARSED:
-                data = _loads(payload)
+            data = _loads(payload)
             if data is _INVALID:
                 raise InputError.one(None, "payload is not valid JSON")
+            if isinstance(data, dict) and "token" in data:
+                raise InputError.one("token", _TOKEN_FIELD)
             setpoint = self.runner.submit(parse_update(data, self.runner.limits))
             return {"accepted": True, "setpoint": setpoint.model_dump()}
         except InputError as exc:
@@ -73,7 +68,6 @@ class SetpointIntake:
         return out
 
 
-_NOT_PARSED = object()
 _INVALID = object()
 
 

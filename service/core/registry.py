@@ -54,8 +54,11 @@ _REC_PATH_RE = re.compile(r"^(?=.{1,256}$)(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/)*[A-Za
 
 def admission_gate(settings: ServiceSettings) -> AdmissionGate:
     """The service's one admission gate (HTTP and zenoh) from its settings."""
+    bus_writes = ("authorized" if settings.zenoh_access_control
+                  else "closed" if settings.token is not None else "open")
     return AdmissionGate(token=settings.token_value, setpoint_rate_hz=settings.setpoint_rate_hz or None,
-                         setpoint_burst=settings.setpoint_burst, max_payload_bytes=settings.max_body_bytes)
+                         setpoint_burst=settings.setpoint_burst, max_payload_bytes=settings.max_body_bytes,
+                         bus_writes=bus_writes)
 
 
 class Channel(SnapshotSink, Protocol):

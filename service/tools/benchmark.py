@@ -69,14 +69,15 @@ def run_service_benchmark(seconds: float = 10.0, rate_hz: float = 20.0, bearing:
         if zenoh_on:
             import zenoh
 
-            from service.bus.zenoh_bus import make_config
+            from service.bus.zenoh_bus import client_config
 
-            session = zenoh.open(make_config([], [endpoint], "peer"))
+            # a zenoh client with the credentials of the environment (BEARING_TWIN_ZENOH_USER ...)
+            session = zenoh.open(client_config([endpoint], prefix=settings.zenoh_prefix))
 
             def on_state(sample):  # zenoh thread: hand off only
                 inbox.put((time.perf_counter(), sample.payload.to_bytes()))
 
-            sub = session.declare_subscriber(f"bearing/{settings.twin_id}/state", on_state)
+            sub = session.declare_subscriber(f"{settings.zenoh_prefix}/{settings.twin_id}/state", on_state)
         client_latencies: list[float] = []
         lost = 0
         rtf_samples: list[float] = []

@@ -1,5 +1,5 @@
-"""`bearing-twin` command line: simulate, bench, timestep-study, report, serve, scenario, bench-service, monitor,
-soak, ehl, life.
+"""`bearing-twin` command line: simulate, bench, timestep-study, report, serve, router, scenario, bench-service,
+monitor, soak, ehl, life.
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -70,7 +70,9 @@ def _one_line(exc: Exception) -> str:
     from pydantic import ValidationError
 
     if isinstance(exc, ValidationError):
-        return "; ".join(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" for e in exc.errors())
+        # a model-level check names its field at the start of its message ("zenoh_user: ...")
+        return "; ".join(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" if e["loc"]
+                         else str(e["msg"]).removeprefix("Value error, ") for e in exc.errors())
     return str(exc)
 
 
@@ -165,7 +167,13 @@ def build_parser() -> argparse.ArgumentParser:
                        help="zenoh router or peer to connect to, repeatable (default none) "
                        "[BEARING_TWIN_ZENOH_CONNECT]")
     serve.add_argument("--zenoh-mode", choices=["peer", "client", "router"],
-                       help="zenoh session mode (default peer) [BEARING_TWIN_ZENOH_MODE]")
+                       help="zenoh session mode (default client with --zenoh-connect and no "
+                       "--zenoh-listen, else peer) [BEARING_TWIN_ZENOH_MODE]")
+    serve.add_argument("--zenoh-prefix", metavar="PREFIX",
+                       help="key prefix of the twins on zenoh: site / line / asset, e.g. "
+                       "plant1/line2/motor7 (default bearing) [BEARING_TWIN_ZENOH_PREFIX]; zenoh "
+                       "credentials and access rules come from the environment (README \"zenoh "
+                       "access control\")")
     serve.add_argument("--record", metavar="PATH.rrd",
                        help="rerun recording (default recordings/bearing-twin-<UTC timestamp>.rrd) "
                        "[BEARING_TWIN_RECORD]")
@@ -203,6 +211,9 @@ def build_parser() -> argparse.ArgumentParser:
     bsv.set_defaults(func=_cmd_bench_service)
 
     _add_monitor(sub)
+    from service.tools.router import add_router_command
+
+    add_router_command(sub)
     from service.tools.soak import add_soak_command
 
     add_soak_command(sub)
@@ -269,7 +280,7 @@ def _serve_settings(args: argparse.Namespace):
     overrides = {}
     for flag, name in (("host", "host"), ("port", "port"), ("bearing", "bearing"), ("twin_id", "twin_id"),
                        ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
-                       ("zenoh_mode", "zenoh_mode"), ("record", "record"),
+                       ("zenoh_mode", "zenoh_mode"), ("zenoh_prefix", "zenoh_prefix"), ("record", "record"),
                        ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),
                        ("publish_rate", "publish_rate_hz")):
         value = getattr(args, flag, None)
@@ -324,9 +335,15 @@ def _cmd_serve(args: argparse.Namespace) -> int:
              if settings.setpoint_rate_hz else "no rate")
           + f"; request bodies up to {settings.max_body_bytes} bytes", flush=True)
     if settings.enable_zenoh:
+        from service.bus.access import ZenohAccess
+
         print(f"bearing-twin: zenoh {settings.zenoh_mode} listening on {', '.join(settings.zenoh_listen) or 'nothing'}"
-              + (f", connecting to {', '.join(settings.zenoh_connect)}" if settings.zenoh_connect else ""),
-              flush=True)
+              + (f", connecting to {', '.join(settings.zenoh_connect)}" if settings.zenoh_connect else "")
+              + f", keys {settings.zenoh_prefix}/<id>/...", flush=True)
+        zenoh_access = ZenohAccess.from_settings(settings, enforce=True).describe(listening=bool(settings.zenoh_listen))
+        if not settings.zenoh_access_control and settings.token is not None:
+            zenoh_access += "; zenoh setpoints refused (the HTTP API needs a token)"
+        print(f"bearing-twin: {zenoh_access}", flush=True)
     else:
         print("bearing-twin: zenoh off", flush=True)
     path = settings.recording_path

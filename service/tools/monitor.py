@@ -1,12 +1,16 @@
 """`bearing-twin monitor`: a live table of every twin seen on the zenoh bus.
 
     bearing-twin monitor                                   # connects to tcp/127.0.0.1:7447
-    bearing-twin monitor --connect tcp/10.0.0.5:7447 --connect tcp/10.0.0.6:7447
+    bearing-twin monitor --connect tcp/router.plant1:7447 --prefix 'plant1/**'   # a whole fleet
     bearing-twin monitor --duration 10 'bearing/pump-*/state'
 
-The monitor opens its own peer session (multicast scouting off, gossip on so it also reaches the
-services connected to the one it connects to), subscribes to the state key expression and to the
-liveliness tokens `bearing/*/alive`, and renders one row per twin with rich. zenoh callbacks only
+The monitor is a zenoh client of the endpoint it connects to (a service or a router; with
+--listen it is a peer instead; multicast scouting off), subscribes to the state key expression
+`{prefix}/*/state` and to the liveliness tokens `{prefix}/*/alive`, and renders one row per twin
+with rich: the twin's key without the prefix when the prefix is concrete (`default`), its whole
+key under a pattern (`plant1/line2/motor7/de`). A twin whose liveliness token goes (its service
+stopped or lost) is shown gone, and dropped after --forget-after seconds. zenoh credentials
+come from the environment (BEARING_TWIN_ZENOH_USER / _PASSWORD, or _TLS_*). zenoh callbacks only
 push into a queue; the main thread parses, aggregates and renders.
 """
 
@@ -21,9 +25,18 @@ import sys
 import time
 from typing import Any
 
+DEFAULT_PREFIX = "bearing"
 DEFAULT_KEYEXPR = "bearing/*/state"
 DEFAULT_CONNECT = ["tcp/127.0.0.1:7447"]
 ALIVE_KEYEXPR = "bearing/*/alive"
+
+
+def twin_keys(prefix: str) -> tuple[str, str]:
+    """(state, liveliness) key expressions of the twins under `prefix` (canonical form)."""
+    import zenoh
+
+    return (str(zenoh.KeyExpr.autocanonize(f"{prefix}/*/state")),
+            str(zenoh.KeyExpr.autocanonize(f"{prefix}/*/alive")))
 _REFRESH_S = 0.25
 _ONCE_SETTLE_S = 0.5
 
@@ -32,9 +45,15 @@ def _reject_constant(name: str) -> float:
     raise ValueError(f"non-finite JSON constant {name}")
 
 
-def _bearing_from_key(key: str) -> str | None:
-    parts = key.split("/")
-    return parts[1] if len(parts) >= 2 and parts[0] == "bearing" else None
+def twin_name(key: str, prefix: str = DEFAULT_PREFIX) -> str | None:
+    """The twin of a `.../{id}/state` or `.../{id}/alive` key: its id when the key is under the
+    concrete `prefix`, else its whole key (`plant1/line2/motor7/de`)."""
+    head, sep, _last = key.rpartition("/")
+    if not sep or not head:
+        return None
+    if "*" not in prefix and head.startswith(prefix + "/") and "/" not in head[len(prefix) + 1:]:
+        return head[len(prefix) + 1:]
+    return head
 
 
 def _finite(value: Any) -> float | None:
@@ -47,9 +66,12 @@ def _finite(value: Any) -> float | None:
 class TwinTable:
     """Aggregates state messages and liveliness events into one row per twin."""
 
-    def __init__(self) -> None:
+    def __init__(self, prefix: str = DEFAULT_PREFIX, forget_gone_s: float | None = None) -> None:
+        self.prefix = prefix
+        self.forget_gone_s = forget_gone_s   # drop a gone twin's row after this long [s]
         self.rows: dict[str, dict[str, Any]] = {}
         self.invalid = 0  # messages that were not contract JSON objects
+        self.departed: dict[str, float] = {}   # forgotten twins: late messages do not revive them
 
     def _row(self, bearing_id: str) -> dict[str, Any]:
         row = self.rows.get(bearing_id)
@@ -59,6 +81,7 @@ class TwinTable:
                 "shaft_speed_rad_s": None, "min_lambda": None, "regimes": {},
                 "friction_torque_n_m": None, "discharge_risk": None, "seq": None, "gaps": 0,
                 "missing": 0, "messages": 0, "alive": None, "last_seen": None, "key": None,
+                "gone_at": None,
             }
         return row
 
@@ -73,7 +96,10 @@ class TwinTable:
         if "balls" not in data:  # a ball or result message matched by a wide key expression
             return
         # the key names the twin (as its liveliness token does); the payload is the fallback
-        bearing_id = _bearing_from_key(key) or str(data.get("bearing_id") or key)
+        bearing_id = twin_name(key, self.prefix) or str(data.get("bearing_id") or key)
+        row = self.rows.get(bearing_id)
+        if bearing_id in self.departed or (row is not None and row["alive"] is False):
+            return      # a late message of a twin that is gone (its last snapshots follow its token)
         row = self._row(bearing_id)
         row["messages"] += 1
         row["key"] = key
@@ -114,9 +140,26 @@ class TwinTable:
         row["discharge_risk"] = risk if isinstance(risk, (str, int, float)) and not isinstance(risk, bool) else None
 
     def on_alive(self, key: str, alive: bool) -> None:
-        bearing_id = _bearing_from_key(key)
+        bearing_id = twin_name(key, self.prefix)
         if bearing_id:
-            self._row(bearing_id)["alive"] = alive
+            if alive:
+                self.departed.pop(bearing_id, None)
+            elif bearing_id in self.departed:
+                return
+            row = self._row(bearing_id)
+            row["alive"] = alive
+            row["gone_at"] = None if alive else time.monotonic()
+
+    def forget_gone(self, now: float | None = None) -> list[str]:
+        """Drop the rows of twins gone for longer than `forget_gone_s`; returns their names."""
+        if self.forget_gone_s is None:
+            return []
+        now = time.monotonic() if now is None else now
+        gone = [k for k, r in self.rows.items()
+                if r["alive"] is False and r["gone_at"] is not None and now - r["gone_at"] >= self.forget_gone_s]
+        for k in gone:
+            self.departed[k] = self.rows.pop(k)["gone_at"]
+        return gone
 
     def snapshot(self) -> dict[str, dict[str, Any]]:
         return {k: {**v, "regimes": dict(v["regimes"])} for k, v in sorted(self.rows.items())}
@@ -153,21 +196,30 @@ def _fmt(value: float | None, spec: str) -> str:
 
 
 def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
-                keyexpr: str = DEFAULT_KEYEXPR, duration_s: float | None = None,
-                once: bool = False, out: Any = None) -> dict[str, dict[str, Any]]:
-    """Watch the bus and render a live table; return the final rows {bearing_id: {...}}.
+                keyexpr: str | None = None, duration_s: float | None = None,
+                once: bool = False, out: Any = None, *, prefix: str = DEFAULT_PREFIX,
+                forget_gone_s: float | None = None, access: Any = None,
+                on_update: Any = None, stop: Any = None) -> dict[str, dict[str, Any]]:
+    """Watch the bus and render a live table; return the final rows {twin: {...}}.
 
     connect: endpoints to connect to (None or [] -> tcp/127.0.0.1:7447 unless `listen` is given);
-    listen: endpoints to listen on (default none); duration_s: stop after this many seconds
-    (None: until Ctrl-C); once: print one table as soon as a twin has been seen (plus a short
-    settle time) and stop; out: a rich Console or a text file (default stdout).
+    listen: endpoints to listen on (default none: the monitor is a zenoh client); keyexpr: the
+    state key expression (default {prefix}/*/state); prefix: the twins' key prefix or a pattern
+    (`plant1/**`); duration_s: stop after this many seconds (None: until Ctrl-C); once: print one
+    table as soon as a twin has been seen (plus a short settle time) and stop; forget_gone_s:
+    drop gone twins after this long (None: keep them, marked gone); access: zenoh credentials
+    (service.bus.access.ZenohAccess; default from the environment); on_update(rows): called
+    from the monitor's thread after each batch of messages (tests); stop: a threading.Event that
+    ends the watch when set; out: a rich Console or a text file (default stdout).
     """
     import zenoh
     from rich.console import Console
     from rich.live import Live
 
-    from service.bus.zenoh_bus import make_config
+    from service.bus.zenoh_bus import client_config
 
+    state_key, alive_key = twin_keys(prefix)
+    keyexpr = keyexpr or state_key
     connect = list(connect or [])
     listen = list(listen or [])
     if not connect and not listen:
@@ -178,7 +230,7 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
         stream = out if out is not None else sys.stdout
         interactive = bool(getattr(stream, "isatty", lambda: False)())
         console = Console(file=stream, width=None if interactive else 160)
-    table = TwinTable()
+    table = TwinTable(prefix, forget_gone_s)
     inbox: queue.SimpleQueue = queue.SimpleQueue()
 
     def on_sample(sample: zenoh.Sample) -> None:  # zenoh thread: hand off only
@@ -203,14 +255,17 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
                 item = inbox.get_nowait()
         except queue.Empty:
             pass
+        table.forget_gone()
+        if on_update is not None:
+            on_update(table.snapshot())
         return n
 
     title = f"bearing-twin monitor: {keyexpr} via {', '.join(connect) or 'listen ' + ', '.join(listen)}"
-    session = zenoh.open(make_config(listen, connect, "peer"))
+    session = zenoh.open(client_config(connect, listen=listen, access=access, prefix=prefix))
     subscribers = []  # keep references: undeclared when dropped or at the end
     try:
         subscribers.append(session.declare_subscriber(keyexpr, on_sample))
-        subscribers.append(session.liveliness().declare_subscriber(ALIVE_KEYEXPR, on_alive, history=True))
+        subscribers.append(session.liveliness().declare_subscriber(alive_key, on_alive, history=True))
         start = time.monotonic()
         deadline = None if duration_s is None else start + duration_s
         if once:
@@ -227,7 +282,7 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
                 with Live(table.render(title), console=console, auto_refresh=False,
                           transient=False) as live:
                     next_refresh = 0.0
-                    while deadline is None or time.monotonic() < deadline:
+                    while (deadline is None or time.monotonic() < deadline) and not (stop and stop.is_set()):
                         now = time.monotonic()
                         wait = _REFRESH_S if deadline is None else min(_REFRESH_S, deadline - now)
                         drain(wait)
@@ -249,8 +304,22 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
 
 
 def _cmd_monitor(args: argparse.Namespace) -> int:
+    from pydantic import ValidationError
+
+    from service.settings import ZenohAccessSettings
+
     try:
-        run_monitor(args.connect, args.listen, args.keyexpr, duration_s=args.duration, once=args.once)
+        env = ZenohAccessSettings(**({"zenoh_prefix": args.prefix} if args.prefix else {}))
+    except ValidationError as exc:
+        print("error: monitor: " + "; ".join(str(e["msg"]).removeprefix("Value error, ") for e in exc.errors()),
+              file=sys.stderr)
+        return 2
+    try:
+        from service.bus.access import ZenohAccess
+
+        run_monitor(args.connect, args.listen, args.keyexpr, duration_s=args.duration, once=args.once,
+                    prefix=env.zenoh_prefix, forget_gone_s=args.forget_after,
+                    access=ZenohAccess.from_settings(env))
     except KeyboardInterrupt:
         return 0
     except Exception as exc:  # noqa: BLE001 - bad endpoint, port in use, ...
@@ -270,8 +339,13 @@ def add_monitor_command(subparsers: Any) -> argparse.ArgumentParser:
     """Register `monitor` on an argparse subparsers object; its `func(args)` returns an exit code."""
     p = subparsers.add_parser("monitor", help="live table of the twins on the zenoh bus",
                               description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("keyexpr", nargs="?", default=DEFAULT_KEYEXPR,
-                   help=f"state key expression to subscribe to (default {DEFAULT_KEYEXPR})")
+    p.add_argument("keyexpr", nargs="?", default=None,
+                   help="state key expression to subscribe to (default {prefix}/*/state)")
+    p.add_argument("--prefix", default=None,
+                   help="key prefix of the twins, or a pattern for a fleet: plant1/** (default "
+                   "$BEARING_TWIN_ZENOH_PREFIX, else bearing)")
+    p.add_argument("--forget-after", type=_positive, default=10.0, metavar="SECONDS",
+                   help="drop a gone twin's row after this long (default 10)")
     p.add_argument("--connect", metavar="ENDPOINT", action="append", default=None,
                    help="zenoh endpoint to connect to (repeatable; default tcp/127.0.0.1:7447)")
     p.add_argument("--listen", metavar="ENDPOINT", action="append", default=None,

@@ -9,9 +9,13 @@ What it does, for `minutes` of wall time:
 * sends `rate` setpoints per second (half over HTTP PUT, half over zenoh when connected), a
   `invalid` share of them invalid on purpose (negative or out-of-range values, NaN/Infinity
   literals, wrong types, unknown fields, non-JSON bytes, bodies above 64 KiB, a missing or wrong
-  token when the service has one) and the rest valid (random values well inside the bearing's
-  limits, with the token); every 4th tick also reads GET state (strict JSON: no NaN/Infinity);
-* subscribes to `bearing/*/state` and counts gaps in each twin's `seq` (dropped messages),
+  HTTP token when the service has one, a zenoh payload carrying a "token" field) and the rest
+  valid (random values well inside the bearing's limits; HTTP with the token, zenoh without:
+  zenoh has its own access control); every 4th tick also reads GET state (strict JSON);
+* zenoh: a client of the endpoint with the credentials of BEARING_TWIN_ZENOH_USER / _PASSWORD
+  (with --start: a generated users file for the service and a generated writer `soak`), key
+  prefix BEARING_TWIN_ZENOH_PREFIX (default bearing);
+* subscribes to `{prefix}/*/state` and counts gaps in each twin's `seq` (dropped messages),
   out-of-order messages and non-finite numbers, and to the setpoint result key, pairing each
   zenoh setpoint with its result in order (zenoh keeps the order of one link);
 * every `sample_s` reads /health (real-time factor, frames, overruns, runner errors, restarts,
@@ -25,8 +29,8 @@ What it does, for `minutes` of wall time:
   cannot be told from a leak there (`MIN_JUDGED_WINDOW_S`);
 * an unexpected answer is an error: a 5xx, a transport failure, a refusal of a valid setpoint
   other than 429, an acceptance of an invalid one;
-* with `--start` it launches `bearing-twin serve` on free loopback ports with a token and a
-  recording in a temp dir, and at the end stops it with SIGTERM (bounded wait) and reads the
+* with `--start` it launches `bearing-twin serve` on free loopback ports with a token, zenoh
+  access control (a generated users file: the writer `soak`) and a recording in a temp dir, and at the end stops it with SIGTERM (bounded wait) and reads the
   recording back, every segment of it (`service.recording.recording_segments`; `--record-segment-s`
   sets the service's rotation period): complete = every segment readable on its own (one
   recording id, the static geometry, a blueprint), together at least the rows the service
@@ -122,11 +126,17 @@ def _strict(text: bytes | str):
 
 
 class _Started:
-    """`bearing-twin serve` as a subprocess on free loopback ports, token in its environment."""
+    """`bearing-twin serve` as a subprocess on free loopback ports, token and zenoh access control
+    (a users file with the writer `soak`, its password in `zenoh_password`) in its environment."""
 
     def __init__(self, token: str, publish_rate_hz: float | None, log, record: bool = True,
                  record_segment_s: float | None = None):
         self.dir = Path(tempfile.mkdtemp(prefix="bearing-twin-soak-"))
+        self.zenoh_user, self.zenoh_password = "soak", secrets.token_urlsafe(18)
+        users = self.dir / "zenoh-users.txt"
+        fd = os.open(users, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+        with os.fdopen(fd, "w") as f:
+            f.write(f"{self.zenoh_user}:{self.zenoh_password}\n")
         self.port = _free_port()
         self.zenoh_endpoint = f"tcp/127.0.0.1:{_free_port()}"
         self.rrd = self.dir / "soak.rrd" if record else None
@@ -137,7 +147,8 @@ class _Started:
         if publish_rate_hz:
             cmd += ["--publish-rate", str(publish_rate_hz)]
         env = {k: v for k, v in os.environ.items() if not k.startswith("BEARING_TWIN_")}
-        env.update({"BEARING_TWIN_TOKEN": token, "PYTHONUNBUFFERED": "1"})
+        env.update({"BEARING_TWIN_TOKEN": token, "PYTHONUNBUFFERED": "1",
+                    "BEARING_TWIN_ZENOH_USERSFILE": str(users), "BEARING_TWIN_ZENOH_WRITERS": self.zenoh_user})
         if record_segment_s is not None:
             env["BEARING_TWIN_RECORD_SEGMENT_S"] = repr(float(record_segment_s))
         self._log_file = open(self.log_path, "wb")
@@ -188,14 +199,14 @@ class _Started:
 
 
 class _Stream:
-    """zenoh subscriber: seq gaps of bearing/*/state and the setpoint results of one twin."""
+    """zenoh client: seq gaps of {prefix}/*/state and the setpoint results of one twin."""
 
-    def __init__(self, endpoint: str, bearing_id: str):
+    def __init__(self, endpoint: str, bearing_id: str, prefix: str = "bearing", access: Any = None):
         import zenoh
 
-        from service.bus.zenoh_bus import make_config
+        from service.bus.zenoh_bus import client_config
 
-        self.session = zenoh.open(make_config([], [endpoint], "peer"))
+        self.session = zenoh.open(client_config([endpoint], access=access, prefix=prefix))
         self.bearing_id = bearing_id
         self.lock = threading.Lock()
         self.last_seq: dict[str, int] = {}
@@ -206,9 +217,9 @@ class _Stream:
         self.non_finite = 0
         self.first_at: float | None = None
         self.results: collections.deque = collections.deque()
-        self._subs = [self.session.declare_subscriber("bearing/*/state", self._on_state),
-                      self.session.declare_subscriber(f"bearing/{bearing_id}/setpoint/result", self._on_result)]
-        self.publisher_key = f"bearing/{bearing_id}/setpoint"
+        self._subs = [self.session.declare_subscriber(f"{prefix}/*/state", self._on_state),
+                      self.session.declare_subscriber(f"{prefix}/{bearing_id}/setpoint/result", self._on_result)]
+        self.publisher_key = f"{prefix}/{bearing_id}/setpoint"
 
     def _on_state(self, sample) -> None:
         try:
@@ -312,29 +323,22 @@ class _Driver:
         return body, hdr
 
     def zenoh_payload(self, valid: bool) -> bytes:
+        """A zenoh setpoint: never the HTTP token (zenoh has its own access control); a payload
+        with a "token" field is one of the invalid kinds (refused with 422)."""
         if valid:
-            data = self.valid()
-            if self.token is not None:
-                data["token"] = self.token
-            return json.dumps(data).encode()
-        kinds = ["negative", "nan", "unknown", "garbage", "big"]
-        if self.token is not None:
-            kinds += ["no-token", "wrong-token"]
-        kind = self.rng.choice(kinds)
-        tok = f', "token": {json.dumps(self.token)}' if self.token is not None else ""
+            return json.dumps(self.valid()).encode()
+        kind = self.rng.choice(["negative", "nan", "unknown", "garbage", "big", "token-field"])
         if kind == "negative":
-            return ('{"radial_load_n": -5' + tok + "}").encode()
+            return b'{"radial_load_n": -5}'
         if kind == "nan":
-            return ('{"shaft_speed_rad_s": NaN' + tok + "}").encode()
+            return b'{"shaft_speed_rad_s": NaN}'
         if kind == "unknown":
-            return ('{"radial_load": 3000' + tok + "}").encode()
+            return b'{"radial_load": 3000}'
         if kind == "garbage":
             return b"\xff\xfenot json"
         if kind == "big":
-            return ('{"unknown": "' + "x" * _BIG + '"' + tok + "}").encode()
-        if kind == "no-token":
-            return json.dumps(self.valid()).encode()
-        return json.dumps({**self.valid(), "token": "wrong"}).encode()
+            return ('{"unknown": "' + "x" * _BIG + '"}').encode()
+        return json.dumps({**self.valid(), "token": "not-a-zenoh-field"}).encode()
 
 
 def run_soak(cfg: SoakConfig) -> dict:
@@ -371,7 +375,15 @@ def run_soak(cfg: SoakConfig) -> dict:
         limits = {k: tuple(v) for k, v in info.json()["limits"].items()}
         driver = _Driver(rng, limits, token)
         if zenoh_endpoint:
-            stream = _Stream(zenoh_endpoint, cfg.bearing_id)
+            from service.bus.access import ZenohAccess
+            from service.settings import ZenohAccessSettings
+
+            env = ZenohAccessSettings()
+            access = (ZenohAccess(user=started.zenoh_user, password=started.zenoh_password)
+                      if started is not None else ZenohAccess.from_settings(env))
+            prefix = "bearing" if started is not None else env.zenoh_prefix   # the started one: default
+            stream = _Stream(zenoh_endpoint, cfg.bearing_id, prefix, access)
+            report["zenoh_access"] = access.describe(listening=False) if access.enabled else "none"
         health0 = client.get(f"{url}/health", headers=headers).json()
         pid = started.proc.pid if started is not None else health0.get("pid")
         local = started is not None or (urlparse(url).hostname in ("127.0.0.1", "localhost", "::1"))
@@ -570,7 +582,9 @@ def _pair_results(report: dict, stream: _Stream) -> None:
         else:
             key = str(msg.get("status", "?"))
             z["refused"][key] = z["refused"].get(key, 0) + 1
-        bad = (valid is None or accepted is None or (valid and accepted is not True and msg.get("status") != 429)
+        # 429: rate limit; 403: the service has an HTTP token and no zenoh access control
+        bad = (valid is None or accepted is None
+               or (valid and accepted is not True and msg.get("status") not in (429, 403))
                or (not valid and accepted is True))
         if bad:
             z["unexpected"] += 1
@@ -721,7 +735,10 @@ def format_report(r: dict) -> str:
     z = r.get("zenoh_results")
     if z:
         lines.append(f"  zenoh results: {z['received']} ({z['accepted']} accepted, refused {z['refused']}), "
-                     f"unexpected {z['unexpected']}, missing {z['missing']}")
+                     f"unexpected {z['unexpected']}, missing {z['missing']}; access {r.get('zenoh_access')}")
+        if z["refused"].get("403"):
+            lines.append("  note: zenoh setpoints refused with 403: the service needs an HTTP token and has "
+                         "no zenoh access control (README \"zenoh access control\")")
     s = r.get("stream")
     if s:
         lines.append(f"  state stream: {s['messages']} messages ({s['rate_hz']:.1f}/s), seq gaps {s['seq_gaps']} "

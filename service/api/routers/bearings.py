@@ -26,7 +26,8 @@ def bearing_info(entry: TwinEntry) -> BearingInfo:
         time_s=latest.time_s if latest is not None else 0.0,
         setpoint=r.target_setpoint, limits=r.limits.as_dict(),
         scenario=ScenarioStatus(**handle.status()) if handle is not None else None,
-        state_url=f"/v1/bearings/{entry.id}/state", zenoh_state_key=f"bearing/{entry.id}/state")
+        state_url=f"/v1/bearings/{entry.id}/state",
+        zenoh_state_key=f"{getattr(entry.channel, 'prefix', None) or 'bearing/' + entry.id}/state")
 
 
 @read.get("", response_model=list[BearingInfo])

@@ -258,6 +258,72 @@ def test_bad_ids_and_duplicates_are_refused(bus):
         bus.attach_twin("ok-1", lambda: None, lambda p: {})
 
 
+def test_twin_ids_are_unique_per_prefix_across_buses(endpoint, support):
+    """One id per key prefix on the whole zenoh network: a second bus (another process in real
+    life) refuses an id the first runs, with a 409 naming the owner (P/{id}/owner); another
+    prefix may use it; after a detach the id is free again."""
+    import os
+
+    from service.core.errors import InputError
+
+    bus1 = ZenohBus(listen=[endpoint], connect=[], prefix="plant1/line2", owner={"http": "http://127.0.0.1:8001"})
+    bus2 = ZenohBus(listen=[], connect=[endpoint], mode="client", prefix="plant1/line2")
+    bus3 = ZenohBus(listen=[], connect=[endpoint], mode="client", prefix="plant1/line3")
+    try:
+        first = bus1.attach_twin("x", lambda: None, lambda p: {})
+        assert first.prefix == "plant1/line2/x"
+        owners = bus2._owners("plant1/line2/x")
+        assert owners == [{"key": "plant1/line2/x", "bearing_id": "x", "pid": os.getpid(),
+                           "host": bus1.owner("x")["host"], "http": "http://127.0.0.1:8001", "zid": bus1.zid}]
+        with pytest.raises(InputError) as err:
+            bus2.attach_twin("x", lambda: None, lambda p: {})
+        assert err.value.status_code == 409 and err.value.errors[0].field == "id"
+        message = err.value.errors[0].message
+        assert f"process {os.getpid()}" in message and bus1.zid in message and "8001" in message
+        assert "x" not in bus2.channels
+        assert bus3.attach_twin("x", lambda: None, lambda p: {}).prefix == "plant1/line3/x"
+        first.detach()
+        assert wait_until(lambda: not bus2._alive_elsewhere("plant1/line2/x"), WAIT_S)
+        assert bus2.attach_twin("x", lambda: None, lambda p: {}).prefix == "plant1/line2/x"
+        with pytest.raises(InputError):          # and now the first one is refused
+            bus1.attach_twin("x", lambda: None, lambda p: {})
+    finally:
+        bus3.close()
+        bus2.close()
+        bus1.close()
+
+
+def test_prefixes_are_checked():
+    from service.bus.zenoh_bus import check_prefix
+
+    assert check_prefix("plant1/line2/motor7") == "plant1/line2/motor7"
+    for bad in ("", "/a", "a/", "a//b", "a/*", "a/**", "a/$x", "a b", "/".join("x" * 9)):
+        with pytest.raises(ValueError):
+            check_prefix(bad)
+
+
+def test_monitor_names_rows_and_forgets_gone_twins():
+    from service.tools.monitor import TwinTable, twin_keys, twin_name
+
+    assert twin_name("bearing/default/state") == "default"
+    assert twin_name("plant1/line2/motor7/de/alive", "plant1/**") == "plant1/line2/motor7/de"
+    assert twin_name("plant1/line2/motor7/de/state", "plant1/line2/motor7") == "de"
+    assert twin_keys("plant1/**") == ("plant1/*/**/state", "plant1/*/**/alive")
+    table = TwinTable("plant1/**", forget_gone_s=1.0)
+    state = json.dumps({"balls": [], "seq": 1, "designation": "6208"}).encode()
+    table.on_alive("plant1/l/a/alive", True)
+    table.on_state("plant1/l/a/state", state)
+    table.on_alive("plant1/l/a/alive", False)
+    table.on_state("plant1/l/a/state", state)          # a late snapshot after the token went
+    assert table.rows["plant1/l/a"]["alive"] is False and table.rows["plant1/l/a"]["messages"] == 1
+    assert table.forget_gone(time.monotonic() + 0.5) == []
+    assert table.forget_gone(time.monotonic() + 1.5) == ["plant1/l/a"]
+    table.on_state("plant1/l/a/state", state)          # does not bring it back
+    assert "plant1/l/a" not in table.rows
+    table.on_alive("plant1/l/a/alive", True)           # a twin of that name started again
+    assert table.rows["plant1/l/a"]["alive"] is True
+
+
 def test_listen_conflict_is_a_clear_error(endpoint, bus):
     with pytest.raises(RuntimeError, match="cannot open"):
         ZenohBus(listen=[endpoint], connect=[])
@@ -389,7 +455,8 @@ def test_monitor_command_registers_with_argparse():
     assert args.connect == ["tcp/127.0.0.1:1", "tcp/127.0.0.1:2"]
     assert args.keyexpr == "bearing/x/state" and args.duration == 1.0 and callable(args.func)
     args = parser.parse_args(["monitor"])
-    assert args.keyexpr == "bearing/*/state" and not args.once
+    assert args.keyexpr is None and args.prefix is None and not args.once   # {prefix}/*/state
+    assert args.forget_after == 10.0
     bad = parser.parse_args(["monitor", "--connect", "tcp/127.0.0.1:notaport", "--duration", "0.2"])
     assert bad.func(bad) == 2
 
