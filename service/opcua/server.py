@@ -143,7 +143,9 @@ class OpcUaFacade:
         settings = registry.settings
         self.registry = registry
         self.endpoint = endpoint
-        self.period_s = float(period_s) if period_s else 1.0 / settings.publish_rate_hz
+        # one publish period (of wall time; in fast mode of simulated time, at least 10 ms)
+        self.period_s = float(period_s) if period_s else max(1.0 / settings.publish_rate_hz,
+                                                              0.01 if settings.fast else 0.0)
         self.read_requires_token = (settings.read_requires_token if read_requires_token is None
                                     else read_requires_token)
         self.server_name = server_name
