@@ -95,6 +95,9 @@ class TokenUserManager:
         return TwinUser(role=UserRole.User, name=username or "user", authenticated=True)
 
 
+_ADMIN = User(role=UserRole.Admin)       # asyncua's default user of a server-side write
+
+
 class _GatedAttributeService(AttributeService):
     """asyncua's attribute service with the Setpoint variables answered by the facade."""
 
@@ -102,7 +105,7 @@ class _GatedAttributeService(AttributeService):
         super().__init__(aspace)
         self._facade = facade
 
-    async def write(self, params: ua.WriteParameters, user: User = User(role=UserRole.Admin)) -> list[ua.StatusCode]:
+    async def write(self, params: ua.WriteParameters, user: User = _ADMIN) -> list[ua.StatusCode]:
         setpoints = self._facade._setpoint_nodes
         if user.role == UserRole.Admin or not any(w.NodeId in setpoints for w in params.NodesToWrite):
             return await super().write(params, user)     # the server's own writes, other nodes
