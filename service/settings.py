@@ -13,7 +13,7 @@ from datetime import UTC, datetime
 from pathlib import Path
 from typing import Annotated, Literal
 
-from pydantic import Field, SecretStr, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
 
@@ -255,6 +255,81 @@ def _check_tls_endpoints(s) -> None:
 
 
 class ServiceSettings(ZenohAccessSettings):
+
+
+class AlarmSettings(BaseModel):
+    """Alarm thresholds and timing (service.core.alarms; README "Alarms"). Times are simulated
+    seconds (the twin's clock). Give them in the environment as JSON:
+    `BEARING_TWIN_ALARMS='{"machine_group": 1, "support": "flexible"}'`."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+
+    machine_group: Literal[1, 2] = Field(
+        default=2, description="ISO 20816-3 machine group [1 | 2]: 1 = large machines (300 kW to "
+        "50 MW, Table A.1), 2 = medium machines (15 kW to 300 kW, Table A.2).")
+    support: Literal["rigid", "flexible"] = Field(
+        default="rigid", description="ISO 20816-3 support class [rigid | flexible] (clause 4.4).")
+    clear_ratio: float = Field(
+        default=0.9, gt=0.0, lt=1.0,
+        description="Hysteresis of the 'above' alarms: an alarm raised at threshold T clears below "
+        "clear_ratio x T (the 'below' alarms clear above T / clear_ratio) [-].")
+    clear_hold_s: float = Field(
+        default=1.0, ge=0.0, le=3600.0,
+        description="The value must stay on the clear side of the clear threshold this long before "
+        "an alarm clears or steps down [s of simulated time].")
+    vibration_delay_s: float = Field(
+        default=0.0, ge=0.0, le=3600.0,
+        description="A vibration zone alarm rises after the velocity RMS stays in zone C or D this long [s].")
+    lubrication_delay_s: float = Field(
+        default=1.0, ge=0.0, le=3600.0,
+        description="A lubrication alarm rises after kappa < kappa_threshold, or a loaded contact in "
+        "the boundary regime, lasts this long [s of simulated time].")
+    kappa_threshold: float = Field(
+        default=1.0, gt=0.0, le=10.0,
+        description="Viscosity ratio kappa = nu / nu1 (ISO 281:2007 clause 9.3) below which the "
+        "lubrication alarm rises [-].")
+    boundary_lambda: float = Field(
+        default=1.0, gt=0.0, le=10.0,
+        description="Film parameter at or below which a contact is in the boundary regime (seed "
+        "000 Table 2: Lambda <= 1) [-].")
+    loaded_contact_fraction: float = Field(
+        default=0.1, ge=0.0, le=1.0,
+        description="A contact counts as loaded when it carries at least this fraction of the "
+        "largest contact load of the snapshot [-].")
+    discharge_delay_s: float = Field(
+        default=0.0, ge=0.0, le=3600.0,
+        description="The electrical alarm rises after the discharge risk stays 'possible' or "
+        "'likely' this long [s of simulated time].")
+    defect_amplitude_m_s2: float = Field(
+        default=0.5, gt=0.0, le=1e4,
+        description="Envelope amplitude of a defect line (FTF, BPFO, BPFI, BSF) above which its "
+        "alarm rises [m/s^2]; a line must also stand defect_significance x the envelope noise "
+        "floor above it when the floor is known.")
+    defect_significance: float = Field(
+        default=4.0, ge=1.0, le=100.0,
+        description="Times the envelope noise floor (median) a defect line must exceed [-] "
+        "(twin.vibration.indicators.SIGNIFICANCE).")
+    defect_delay_s: float = Field(
+        default=0.0, ge=0.0, le=3600.0, description="A defect alarm rises after its line stays above "
+        "the threshold this long [s of simulated time].")
+    life_used_warning: float = Field(
+        default=0.5, gt=0.0, le=10.0,
+        description="Palmgren-Miner damage fraction above which the life alarm is a warning [-].")
+    life_used_critical: float = Field(
+        default=0.9, gt=0.0, le=10.0,
+        description="Damage fraction above which the life alarm is critical [-].")
+    history: int = Field(default=200, ge=1, le=100000,
+                         description="Alarm events kept per twin for GET .../alarms [count].")
+
+    @model_validator(mode="after")
+    def _ordered(self) -> "AlarmSettings":
+        if self.life_used_critical < self.life_used_warning:
+            raise ValueError(f"life_used_critical = {self.life_used_critical:g} must be >= "
+                             f"life_used_warning = {self.life_used_warning:g}")
+        return self
+
+
+class ServiceSettings(BaseSettings):
     """Configuration of `bearing-twin serve` (env prefix `BEARING_TWIN_`)."""
 
     model_config = SettingsConfigDict(env_prefix="BEARING_TWIN_", extra="ignore",
@@ -365,6 +440,14 @@ class ServiceSettings(ZenohAccessSettings):
         default=None,
         description="Directory of named scenarios [path]; default ./scenarios if it exists, else "
         "the scenarios/ folder of the source tree.")
+
+    # ---- alarms and the OPC UA facade (README "Alarms", "OPC UA") -------------------------------
+    alarms: AlarmSettings = Field(default_factory=AlarmSettings,
+                                  description="Alarm thresholds and timing [see AlarmSettings].")
+    opcua: str | None = Field(
+        default=None, pattern=r"^opc\.tcp://[^/\s]+:\d{1,5}(/\S*)?$",
+        description="OPC UA endpoint to serve the twins on [opc.tcp://HOST:PORT[/path]], e.g. "
+        "opc.tcp://127.0.0.1:4840; unset (default) = no OPC UA server.")
 
     @field_validator("zenoh_listen", "zenoh_connect", mode="before")
     @classmethod

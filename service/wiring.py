@@ -1,7 +1,8 @@
-"""The composition root: `TwinService` = the core's `TwinRegistry` with the zenoh bus and the
-rerun recorders opened from the settings. This is the ONE module that touches `service.bus`
-and `service.recording` for the service (imported lazily, so a service with zenoh or recording
-off never imports them).
+"""The composition root: `TwinService` = the core's `TwinRegistry` with the zenoh bus, the
+rerun recorders and the OPC UA facade opened from the settings. This is the ONE module that
+touches `service.bus`, `service.recording` and `service.opcua` for the service (imported lazily,
+so a service with zenoh, recording or OPC UA off never imports them). The alarm hub of the
+registry hands its events to the bus (registry), the recorder and the OPC UA facade (here).
 
 Every recorder of the service makes its rerun streams through one `RerunStreams` owned by the
 `TwinService` (`rerun_streams()`): a per-twin recording gets a new recorder (its own recording
@@ -24,7 +25,8 @@ from service.settings import ServiceSettings
 
 log = logging.getLogger(__name__)
 
-__all__ = ["TwinEntry", "TwinService", "WiringError", "open_bus", "open_recorder", "recorder_options"]
+__all__ = ["TwinEntry", "TwinService", "WiringError", "open_bus", "open_opcua", "open_recorder",
+           "recorder_options"]
 
 
 class WiringError(RuntimeError):
@@ -93,12 +95,31 @@ def open_recorder(settings: ServiceSettings, streams: Any = None):
                           "(--record PATH.rrd elsewhere, or --no-record)") from None
 
 
+def open_opcua(settings: ServiceSettings, registry: TwinRegistry):
+    """The OPC UA facade serving `registry` (started), or None when `settings.opcua` is unset.
+    WiringError (one line) when it cannot start (e.g. the port is taken)."""
+    if not settings.opcua:
+        return None
+    try:
+        from service.opcua import OpcUaError, OpcUaFacade
+    except ImportError as exc:
+        raise WiringError(f"OPC UA is enabled but service.opcua cannot be imported ({exc}); "
+                          "install asyncua or run without --opcua") from exc
+    try:
+        return OpcUaFacade(registry, settings.opcua).start()
+    except (OpcUaError, ValueError) as exc:
+        hint = (" (is another server listening there? choose another port with --opcua)"
+                if "address already in use" in str(exc).lower() or "errno 98" in str(exc).lower() else "")
+        raise WiringError(f"{exc}{hint}") from exc
+
+
 class TwinService(TwinRegistry):
     """The twins of one service, wired to zenoh and rerun as the settings say."""
 
     def __init__(self, settings: ServiceSettings, gate: AdmissionGate | None = None):
         super().__init__(settings, gate)
         self._rerun_streams = None          # service.recording.RerunStreams, made on first use
+        self.opcua = None                   # service.opcua.OpcUaFacade when settings.opcua is set
 
     def rerun_streams(self):
         """The `RerunStreams` that makes and frees every rerun stream of this service."""
@@ -114,8 +135,18 @@ class TwinService(TwinRegistry):
         self.bus = open_bus(self.settings)
         if self.settings.recording_path is not None or self.settings.spawn_viewer:
             self.recorder = open_recorder(self.settings, self.rerun_streams())
+        if self.recorder is not None and hasattr(self.recorder, "log_alarm"):
+            self.alarms.subscribe(self.recorder.log_alarm)     # alarm events into the recording
+        self.opcua = open_opcua(self.settings, self)
+        if self.opcua is not None:
+            self.alarms.subscribe(self.opcua.on_alarm)
 
     def _close_outputs(self) -> None:
+        if self.opcua is not None:
+            try:
+                self.opcua.close()
+            except Exception:
+                log.exception("closing the OPC UA server")
         if self.recorder is not None:
             try:
                 self.recorder.close()

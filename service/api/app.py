@@ -7,7 +7,8 @@ template (one `APIRouter` per resource, `Depends` in `deps.py`):
   rerun recorder as the settings say) unless one was handed in already open (the CLI opens it
   before uvicorn so that a busy zenoh port is a one-line error), and closes it in `finally`
   (runners stopped, zenoh detached and closed, recordings flushed);
-* routers (service.api.routers): health, bearings, setpoint, state, scenarios, recording, docs;
+* routers (service.api.routers): health, bearings, setpoint, state, alarms, scenarios, recording,
+  docs;
   each resource has a `read` and a `write` router, and the factory decides which need the
   bearer token (writes when BEARING_TWIN_TOKEN is set, reads too with read_requires_token;
   /health never) - so the OpenAPI document declares the bearer scheme exactly where it applies,
@@ -30,7 +31,7 @@ from starlette.concurrency import run_in_threadpool
 from service.api.deps import require_token
 from service.api.errors import install_error_handlers
 from service.api.middleware import BodySizeLimit
-from service.api.routers import bearings, docs, health, recording, scenarios, setpoint, state
+from service.api.routers import alarms, bearings, docs, health, recording, scenarios, setpoint, state
 from service.api.schemas import ErrorResponse
 from service.core.registry import TwinRegistry, admission_gate
 from service.settings import ServiceSettings
@@ -99,7 +100,7 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
     reads = ({"dependencies": token, "responses": _UNAUTHORIZED}
              if token and settings.read_requires_token else {})
     app.include_router(health.router)
-    for router in (bearings.read, state.read, scenarios.read, docs.read):
+    for router in (bearings.read, state.read, alarms.read, scenarios.read, docs.read):
         app.include_router(router, **reads)
     for router in (bearings.write, setpoint.write, scenarios.write, recording.write):
         app.include_router(router, **writes)

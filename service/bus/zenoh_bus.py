@@ -12,6 +12,8 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
                              {"accepted": false, "error": "..."}; always carries bearing_id
     P/{id}/snapshot          queryable: replies with the latest snapshot JSON
     P/{id}/owner             queryable: which process runs the twin (pid, host, zenoh id, HTTP)
+    P/{id}/alarm             alarm events JSON, schema "bearing-twin/alarm/1" (publisher;
+                             service.core.alarms, handed over by the alarm hub)
     P/{id}/alive             liveliness token while the twin is attached
 
 One id per prefix in the whole zenoh network: `attach_twin` first asks for the liveliness token
@@ -213,6 +215,7 @@ class TwinChannel:
         self._control_cond = threading.Condition()
 
         self._ball_publishers: dict[int, zenoh.Publisher] = {}
+        self._alarm_pub: zenoh.Publisher | None = None   # declared with the first alarm
         self._pub_lock = threading.Lock()
         self._state_pub = session.declare_publisher(
             f"{self.prefix}/state", encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP)
@@ -282,6 +285,8 @@ class TwinChannel:
         with self._pub_lock:
             self._publishers_gone = True
             publishers = [self._state_pub, self._result_pub, *self._ball_publishers.values()]
+            if self._alarm_pub is not None:
+                publishers.append(self._alarm_pub)
             self._ball_publishers.clear()
         for pub in publishers:
             self._undeclare(pub)
@@ -337,6 +342,17 @@ class TwinChannel:
                     congestion_control=zenoh.CongestionControl.DROP)
                 self._ball_publishers[index] = pub
             return pub
+
+    def publish_alarm(self, event: dict) -> None:
+        """Put one alarm event on `bearing/{id}/alarm` (called from the alarm hub's thread; events
+        are rare, so they are put at once, not queued)."""
+        with self._pub_lock:
+            if self._publishers_gone:
+                return
+            if self._alarm_pub is None:
+                self._alarm_pub = self.bus.session.declare_publisher(f"{self.prefix}/alarm", encoding=_JSON)
+            pub = self._alarm_pub
+        pub.put(_dumps({**event, "bearing_id": self.bearing_id}))
 
     # ---- zenoh callbacks: hand off only -----------------------------------------------------
     def _on_setpoint_sample(self, sample: zenoh.Sample) -> None:

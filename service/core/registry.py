@@ -5,8 +5,9 @@ No transport here: the zenoh bus and the recorders are plugged in from outside t
 
     create twin -> Twin (warm-started) -> TwinRunner (not started) -> SetpointIntake
                 -> bus.attach_twin(id, latest, intake) channel as a sink
-                -> recorder.add_twin_from(twin), recorder as a sink -> runner.start()
-    delete twin -> runner.stop() -> channel.detach() -> per-twin recording closed
+                -> recorder.add_twin_from(twin), recorder as a sink
+                -> alarms.add_twin(id), the alarm hub as a sink -> runner.start()
+    delete twin -> runner.stop() -> channel.detach() -> alarms forgotten -> per-twin recording closed
     close       -> every runner stopped (all asked first, then joined) -> channels detached
                 -> per-twin recordings closed -> hook `_close_outputs` (service recording,
                    zenoh session)
@@ -32,6 +33,8 @@ from typing import Any, Protocol
 from pydantic import ValidationError
 
 from service.core.admission import AdmissionGate
+from service.core.alarm_hub import AlarmHub
+from service.core.alarms import AlarmEvent
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import SetpointIntake
 from service.core.runner import TwinRunner
@@ -65,6 +68,8 @@ class Channel(SnapshotSink, Protocol):
     """A twin's link to the bus."""
 
     def detach(self) -> None: ...
+
+    # optional: `publish_alarm(event: dict)` puts an alarm event on `bearing/{id}/alarm`
 
 
 class Bus(Protocol):
@@ -124,6 +129,15 @@ class TwinRegistry:
         self._recording_lock = threading.RLock()
         self._lock = threading.RLock()
         self._closed = False
+        self.alarms = AlarmHub(settings.alarms)    # every twin's alarms (a sink on each runner)
+        self.alarms.subscribe(self._alarm_to_bus)
+
+    def _alarm_to_bus(self, event: AlarmEvent) -> None:
+        """Hand an alarm event to the twin's bus channel (`bearing/{id}/alarm`)."""
+        entry = self.find(event.bearing_id)
+        publish = getattr(entry.channel, "publish_alarm", None) if entry is not None else None
+        if publish is not None:
+            publish(event.to_dict())
 
     # ---- outputs: hooks for the wiring ---------------------------------------------------
     def _open_outputs(self) -> None:
@@ -169,6 +183,7 @@ class TwinRegistry:
                 log.exception("stopping twin %s", e.id)
         for e in entries:
             self._unwire(e)
+        self.alarms.close()
         self._close_outputs()
 
     def _unwire(self, e: TwinEntry) -> None:
@@ -181,6 +196,8 @@ class TwinRegistry:
             e.channel = None
         if self.recorder is not None:
             e.runner.remove_sink(self.recorder)
+        e.runner.remove_sink(self.alarms)
+        self.alarms.forget(e.id)
         self.stop_recording(e)
         self.gate.forget(e.id)
 
@@ -267,6 +284,8 @@ class TwinRegistry:
             if self.recorder is not None:
                 self.recorder.add_twin_from(twin)
                 runner.add_sink(self.recorder)
+            self.alarms.add_twin(bearing_id)
+            runner.add_sink(self.alarms)
             runner.start()
         except BaseException:
             with self._lock:

@@ -183,6 +183,9 @@ def build_parser() -> argparse.ArgumentParser:
                        help="run the twins as fast as possible, not paced to the wall clock [BEARING_TWIN_FAST]")
     serve.add_argument("--publish-rate", type=_positive_float, metavar="HZ",
                        help="snapshot publishing rate [Hz] (default 50) [BEARING_TWIN_PUBLISH_RATE_HZ]")
+    serve.add_argument("--opcua", metavar="opc.tcp://HOST:PORT",
+                       help="also serve the twins over OPC UA on this endpoint, e.g. "
+                       "opc.tcp://127.0.0.1:4840 (default off) [BEARING_TWIN_OPCUA]")
     serve.add_argument("--no-zenoh", action="store_true", help="debugging: do not start the zenoh bus")
     serve.add_argument("--no-record", action="store_true", help="debugging: do not record")
     serve.add_argument("--log-level", default="info", choices=["critical", "error", "warning", "info", "debug"])
@@ -282,7 +285,7 @@ def _serve_settings(args: argparse.Namespace):
                        ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
                        ("zenoh_mode", "zenoh_mode"), ("zenoh_prefix", "zenoh_prefix"), ("record", "record"),
                        ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),
-                       ("publish_rate", "publish_rate_hz")):
+                       ("publish_rate", "publish_rate_hz"), ("opcua", "opcua")):
         value = getattr(args, flag, None)
         if value is not None:
             overrides[name] = value
@@ -348,6 +351,10 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         print("bearing-twin: zenoh off", flush=True)
     path = settings.recording_path
     print(f"bearing-twin: recording to {path}" if path else "bearing-twin: not recording", flush=True)
+    if settings.opcua:
+        print(f"bearing-twin: OPC UA on {settings.opcua} (namespace urn:bearing-twin:opcua; "
+              + ("user name + the token as password to write" if settings.token else "anonymous writes allowed")
+              + ")", flush=True)
     from service.core.errors import InputError
     from service.wiring import TwinService, WiringError
 

@@ -11,7 +11,8 @@ with rich: the twin's key without the prefix when the prefix is concrete (`defau
 key under a pattern (`plant1/line2/motor7/de`). A twin whose liveliness token goes (its service
 stopped or lost) is shown gone, and dropped after --forget-after seconds. zenoh credentials
 come from the environment (BEARING_TWIN_ZENOH_USER / _PASSWORD, or _TLS_*). zenoh callbacks only
-push into a queue; the main thread parses, aggregates and renders.
+push into a queue; the main thread parses, aggregates and renders. Alarm events `{prefix}/*/alarm` fill the `alarms` column (the active alarms seen since the
+monitor started, `id:severity`; GET /v1/bearings/{id}/alarms lists them all).
 """
 
 from __future__ import annotations
@@ -82,6 +83,7 @@ class TwinTable:
                 "friction_torque_n_m": None, "discharge_risk": None, "seq": None, "gaps": 0,
                 "missing": 0, "messages": 0, "alive": None, "last_seen": None, "key": None,
                 "gone_at": None,
+                "alarms": {},
             }
         return row
 
@@ -139,6 +141,22 @@ class TwinTable:
         risk = electrical.get("discharge_risk") if isinstance(electrical, dict) else None
         row["discharge_risk"] = risk if isinstance(risk, (str, int, float)) and not isinstance(risk, bool) else None
 
+    def on_alarm(self, key: str, payload: bytes) -> None:
+        """An alarm event (schema bearing-twin/alarm/1): keep the twin's active alarms."""
+        try:
+            data = json.loads(payload, parse_constant=_reject_constant)
+        except (ValueError, UnicodeDecodeError):
+            data = None
+        alarm_id = data.get("alarm_id") if isinstance(data, dict) else None
+        if not isinstance(alarm_id, str):
+            self.invalid += 1
+            return
+        alarms = self._row(_bearing_from_key(key) or str(data.get("bearing_id") or key))["alarms"]
+        if data.get("active") is True:
+            alarms[alarm_id] = str(data.get("severity") or "?")
+        else:
+            alarms.pop(alarm_id, None)
+
     def on_alive(self, key: str, alive: bool) -> None:
         bearing_id = twin_name(key, self.prefix)
         if bearing_id:
@@ -162,7 +180,8 @@ class TwinTable:
         return gone
 
     def snapshot(self) -> dict[str, dict[str, Any]]:
-        return {k: {**v, "regimes": dict(v["regimes"])} for k, v in sorted(self.rows.items())}
+        return {k: {**v, "regimes": dict(v["regimes"]), "alarms": dict(v["alarms"])}
+                for k, v in sorted(self.rows.items())}
 
     def render(self, title: str = "bearing-twin monitor"):
         from rich.table import Table
@@ -172,7 +191,7 @@ class TwinTable:
         for col, justify in (("bearing", "left"), ("designation", "left"), ("alive", "left"),
                              ("time s", "right"), ("status", "left"), ("shaft rad/s", "right"),
                              ("min Lambda", "right"), ("regimes", "left"), ("torque mN m", "right"),
-                             ("discharge", "right"), ("seq", "right"), ("gaps", "right")):
+                             ("discharge", "right"), ("alarms", "left"), ("seq", "right"), ("gaps", "right")):
             table.add_column(col, justify=justify)
         for bearing_id, r in sorted(self.rows.items()):
             alive = {True: "[green]alive[/]", False: "[red]gone[/]", None: "?"}[r["alive"]]
@@ -185,10 +204,16 @@ class TwinTable:
                 _fmt(r["shaft_speed_rad_s"], "{:.1f}"), _fmt(r["min_lambda"], "{:.2f}"),
                 " ".join(f"{name}:{n}" for name, n in sorted(r["regimes"].items())) or "-",
                 _fmt(None if r["friction_torque_n_m"] is None else r["friction_torque_n_m"] * 1e3, "{:.2f}"),
-                risk_text, "-" if r["seq"] is None else str(r["seq"]),
+                risk_text, _alarms_text(r["alarms"]), "-" if r["seq"] is None else str(r["seq"]),
                 str(r["gaps"]) if not r["gaps"] else f"[red]{r['gaps']}[/] ({r['missing']} lost)",
             )
         return table
+
+
+def _alarms_text(alarms: dict[str, str]) -> str:
+    colour = {"critical": "red", "warning": "yellow"}
+    return " ".join(f"[{colour.get(sev, 'white')}]{alarm_id}:{sev}[/]"
+                    for alarm_id, sev in sorted(alarms.items())) or "-"
 
 
 def _fmt(value: float | None, spec: str) -> str:
@@ -237,6 +262,10 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
         with contextlib.suppress(Exception):
             inbox.put(("state", str(sample.key_expr), sample.payload.to_bytes()))
 
+    def on_alarm(sample: zenoh.Sample) -> None:
+        with contextlib.suppress(Exception):
+            inbox.put(("alarm", str(sample.key_expr), sample.payload.to_bytes()))
+
     def on_alive(sample: zenoh.Sample) -> None:
         with contextlib.suppress(Exception):
             inbox.put(("alive", str(sample.key_expr), sample.kind == zenoh.SampleKind.PUT))
@@ -249,6 +278,8 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
                 kind, key, value = item
                 if kind == "state":
                     table.on_state(key, value)
+                elif kind == "alarm":
+                    table.on_alarm(key, value)
                 else:
                     table.on_alive(key, value)
                 n += 1
@@ -265,6 +296,7 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
     subscribers = []  # keep references: undeclared when dropped or at the end
     try:
         subscribers.append(session.declare_subscriber(keyexpr, on_sample))
+        subscribers.append(session.declare_subscriber(alive_key.replace("/alive", "/alarm"), on_alarm))
         subscribers.append(session.liveliness().declare_subscriber(alive_key, on_alive, history=True))
         start = time.monotonic()
         deadline = None if duration_s is None else start + duration_s

@@ -1,1 +1,1 @@
-"""One module per resource: health, bearings, setpoint, state, scenarios, recording, docs."""
+"""One module per resource: health, bearings, setpoint, state, alarms, scenarios, recording, docs."""

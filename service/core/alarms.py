@@ -1,0 +1,495 @@
+"""Alarms with state: pure functions and state machines, no I/O, no threads, no transport.
+
+`AlarmEvaluator(bearing_id, settings).update(inputs) -> [AlarmEvent]` follows one twin. Its
+inputs are typed (`AlarmInputs`), made from a snapshot by `inputs_from_snapshot`; the blocks a
+snapshot may not carry yet (`life`, `vibration`) are optional, and their alarms stay quiet while
+they are absent.
+
+The alarms (ids are stable; README "Alarms"):
+
+* `vibration_zone` - ISO 20816-3:2022 evaluation zones from the broadband velocity RMS
+  [mm/s] (10-1000 Hz, twin.vibration.indicators.velocity_rms_mm_s). Zone boundaries of Annex A,
+  Table A.1 (group 1: large machines, 300 kW to 50 MW) and Table A.2 (group 2: medium machines,
+  15 kW to 300 kW), rigid / flexible support (clause 4.4). Zone C ("unsatisfactory for long-term
+  continuous operation") raises a warning, zone D ("severe enough to cause damage") a critical
+  alarm (ISO 20816-1:2016 clause 6.2.2 zone descriptions); zones A and B raise nothing.
+* `lubrication_kappa` - kappa = nu / nu1 (ISO 281:2007 clause 9.3, snapshot `life.kappa`) below
+  `kappa_threshold` (1: the oil is thinner than the rated viscosity).
+* `lubrication_boundary` - a loaded contact in the boundary regime: the smallest film parameter
+  Lambda over the loaded contacts at or below `boundary_lambda` (seed 000 Table 2: boundary for
+  Lambda <= 1). A contact is loaded when it carries at least `loaded_contact_fraction` of the
+  largest contact load (the light contacts at the edge of the load zone do not count).
+  Both lubrication alarms rise only after the condition lasts `lubrication_delay_s`.
+* `electrical_discharge` - snapshot `electrical.discharge_risk`: 'possible' warning, 'likely'
+  critical (the value is 0 / 1 / 2 for none / possible / likely; the message quotes the
+  engine's reason).
+* `defect_ftf`, `defect_bpfo`, `defect_bpfi`, `defect_bsf` - envelope-spectrum amplitude at the
+  fundamental of a defect frequency [m/s^2] above `defect_amplitude_m_s2` and above
+  `defect_significance` x the envelope noise floor when the floor is known (Randall & Antoni 2011
+  sec. 3.3; twin.vibration.indicators.SIGNIFICANCE).
+* `life_used` - Palmgren-Miner damage fraction (snapshot `life.damage_fraction`) above
+  `life_used_warning` (warning) and `life_used_critical` (critical).
+
+State (`AlarmTracker`): every alarm has ordered levels (warning, critical), each with a raise
+threshold and a clear threshold on the safe side of it (a deadband; `clear_ratio`). A level is
+entered once the value has stayed beyond its raise threshold for the alarm's raise delay (an
+on-delay), and left once the value has stayed on the safe side of its clear threshold for
+`clear_hold_s` (an off-delay): the deadband and on/off-delays of alarm rationalisation in
+ANSI/ISA-18.2-2016 (IEC 62682:2014) clause 11.5. Each transition is an `AlarmEvent`: raised,
+escalated, deescalated, cleared. Times are the twin's simulated time [s] (a fast-mode twin
+judges durations on its own clock); events also carry the wall-clock time they were made.
+A value that is undefined (null: kappa at rest, no vibration block) changes nothing and resets
+the pending on/off-delays.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+from pydantic import BaseModel, ConfigDict, Field
+
+from service.settings import AlarmSettings
+
+__all__ = ["ALARM_IDS", "ISO_20816_3_ZONES", "Alarm", "AlarmEvaluator", "AlarmEvent", "AlarmInputs",
+           "AlarmSettings", "AlarmTracker", "Level", "Rule", "VibrationInputs", "inputs_from_snapshot",
+           "vibration_inputs", "vibration_zone", "zone_boundaries"]
+
+EVENT_SCHEMA = "bearing-twin/alarm/1"
+
+Severity = Literal["warning", "critical"]
+Transition = Literal["raised", "escalated", "deescalated", "cleared"]
+Direction = Literal["above", "below"]
+
+# OPC UA event Severity (1..1000, OPC 10000-5 BaseEventType) of each level
+OPCUA_SEVERITY = {"warning": 500, "critical": 800, None: 100}
+
+# ISO 20816-3:2022 Annex A: zone boundaries A/B, B/C, C/D of the broadband velocity RMS [mm/s]
+# (10-1000 Hz), Table A.1 (group 1) and Table A.2 (group 2), by support class.
+ISO_20816_3_ZONES: Mapping[tuple[int, str], tuple[float, float, float]] = {
+    (1, "rigid"): (2.3, 4.5, 7.1),
+    (1, "flexible"): (3.5, 7.1, 11.0),
+    (2, "rigid"): (1.4, 2.8, 4.5),
+    (2, "flexible"): (2.3, 4.5, 7.1),
+}
+
+DEFECT_LINES = ("ftf", "bpfo", "bpfi", "bsf")
+_TIME_EPS_S = 1e-9   # a delay of 0.2 s is over at t = 0.3 after 0.1 (0.3 - 0.1 = 0.19999999999999998)
+DISCHARGE_LEVELS = {"none": 0.0, "possible": 1.0, "likely": 2.0}
+
+ALARM_IDS: tuple[str, ...] = ("vibration_zone", "lubrication_kappa", "lubrication_boundary",
+                              "electrical_discharge", *(f"defect_{n}" for n in DEFECT_LINES), "life_used")
+
+
+def zone_boundaries(machine_group: int, support: str) -> tuple[float, float, float]:
+    """(A/B, B/C, C/D) boundaries [mm/s] of ISO 20816-3:2022 Table A.1 (group 1) / A.2 (group 2)."""
+    try:
+        return ISO_20816_3_ZONES[(int(machine_group), support)]
+    except KeyError:
+        raise ValueError(f"no ISO 20816-3 zones for machine group {machine_group!r} and support "
+                         f"{support!r}; known: {sorted(ISO_20816_3_ZONES)}") from None
+
+
+def vibration_zone(velocity_rms_mm_s: float, machine_group: int = 2, support: str = "rigid") -> str:
+    """ISO 20816-3 evaluation zone 'A', 'B', 'C' or 'D' of a velocity RMS [mm/s] (a value on a
+    boundary belongs to the worse zone)."""
+    ab, bc, cd = zone_boundaries(machine_group, support)
+    v = float(velocity_rms_mm_s)
+    return "A" if v < ab else "B" if v < bc else "C" if v < cd else "D"
+
+
+# ---- inputs ------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class VibrationInputs:
+    """What the vibration indicators give the alarms (twin.vibration.indicators)."""
+
+    velocity_rms_mm_s: float | None = None                     # ISO 20816 band 10-1000 Hz [mm/s]
+    line_amplitudes_m_s2: Mapping[str, float] = field(default_factory=dict)  # envelope, fundamental [m/s^2]
+    noise_floor_m_s2: float | None = None                      # median envelope amplitude [m/s^2]
+
+
+@dataclass(frozen=True)
+class AlarmInputs:
+    """One twin at one instant, as the alarms see it (SI unless the name says otherwise)."""
+
+    time_s: float                                     # simulated time [s]
+    min_loaded_lambda: float | None = None            # smallest Lambda over the loaded contacts [-]
+    boundary_contacts: int = 0                        # loaded contacts with Lambda <= boundary_lambda
+    kappa: float | None = None                        # ISO 281 viscosity ratio [-]
+    discharge_risk: str | None = None                 # 'none' | 'possible' | 'likely'
+    discharge_reason: str = ""
+    damage_fraction: float | None = None              # Palmgren-Miner damage [-]
+    vibration: VibrationInputs | None = None
+
+
+def _get(obj: Any, *names: str) -> Any:
+    """The first of `names` that `obj` (a model, an object or a mapping) has and is not None."""
+    if obj is None:
+        return None
+    for name in names:
+        value = obj.get(name) if isinstance(obj, Mapping) else getattr(obj, name, None)
+        if value is not None:
+            return value
+    return None
+
+
+def _finite(value: Any) -> float | None:
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        return None
+    value = float(value)
+    return value if math.isfinite(value) else None
+
+
+def _line_amplitude(entry: Any) -> float | None:
+    """A defect line's fundamental amplitude from a number, {'amplitude_m_s2': a}, or the
+    {'harmonics': [a1, a2, ...]} entries of twin.vibration.indicators.defect_line_amplitudes."""
+    direct = _finite(entry)
+    if direct is not None:
+        return direct
+    harmonics = _get(entry, "harmonics")
+    if isinstance(harmonics, (list, tuple)) and harmonics:
+        return _finite(harmonics[0])
+    return _finite(_get(entry, "amplitude_m_s2", "amplitude"))
+
+
+def vibration_inputs(block: Any) -> VibrationInputs | None:
+    """`VibrationInputs` from a snapshot's vibration block (a model or a dict): velocity RMS
+    from `velocity_rms_mm_s`; defect lines from `defect_lines` / `envelope_lines` / `lines`
+    ({name: amplitude or indicator entry}) or fields `<name>_m_s2`; the floor from
+    `noise_floor_m_s2` / `envelope_noise_floor_m_s2`. None without a block."""
+    if block is None:
+        return None
+    lines: dict[str, float] = {}
+    table = _get(block, "defect_lines", "envelope_lines", "lines")
+    if table is not None:
+        items = table.items() if isinstance(table, Mapping) else (
+            (k, getattr(table, k, None)) for k in DEFECT_LINES)
+        for name, entry in items:
+            a = _line_amplitude(entry)
+            if a is not None:
+                lines[str(name)] = a
+    for name in DEFECT_LINES:
+        if name not in lines:
+            a = _finite(_get(block, f"{name}_m_s2", f"envelope_{name}_m_s2"))
+            if a is not None:
+                lines[name] = a
+    return VibrationInputs(velocity_rms_mm_s=_finite(_get(block, "velocity_rms_mm_s")),
+                           line_amplitudes_m_s2=lines,
+                           noise_floor_m_s2=_finite(_get(block, "noise_floor_m_s2", "envelope_noise_floor_m_s2")))
+
+
+def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -> AlarmInputs:
+    """The alarms' inputs from a `twin.snapshot.Snapshot` (or its dict): contacts, electrical,
+    and the optional `life` and `vibration` blocks."""
+    s = settings or AlarmSettings()
+    contacts = []
+    for ball in _get(snapshot, "balls") or ():
+        for side in ("inner", "outer"):
+            c = _get(ball, side)
+            if c is not None:
+                contacts.append(c)
+    loads = [(_finite(_get(c, "load_n")) or 0.0) for c in contacts]
+    peak = max(loads, default=0.0)
+    min_lambda, boundary = None, 0
+    if peak > 0.0:
+        cut = s.loaded_contact_fraction * peak
+        for c, load in zip(contacts, loads, strict=True):
+            if load <= 0.0 or load < cut:
+                continue
+            lam = _finite(_get(c, "lambda_", "lambda"))
+            if lam is None:
+                continue
+            min_lambda = lam if min_lambda is None else min(min_lambda, lam)
+            if lam <= s.boundary_lambda:
+                boundary += 1
+    electrical = _get(snapshot, "electrical")
+    life = _get(snapshot, "life")
+    return AlarmInputs(
+        time_s=float(_get(snapshot, "time_s") or 0.0),
+        min_loaded_lambda=min_lambda, boundary_contacts=boundary,
+        kappa=_finite(_get(life, "kappa")),
+        discharge_risk=_get(electrical, "discharge_risk"),
+        discharge_reason=str(_get(electrical, "reason") or ""),
+        damage_fraction=_finite(_get(life, "damage_fraction")),
+        vibration=vibration_inputs(_get(snapshot, "vibration")),
+    )
+
+
+# ---- state machine -----------------------------------------------------------------------------
+@dataclass(frozen=True)
+class Level:
+    """One level of an alarm: raised beyond `threshold`, left on the safe side of `clear`."""
+
+    severity: Severity
+    threshold: float
+    clear: float
+
+
+@dataclass(frozen=True)
+class Rule:
+    """What an alarm watches: its id, category, unit, direction and timing."""
+
+    id: str
+    category: str
+    unit: str
+    direction: Direction
+    raise_delay_s: float
+    clear_hold_s: float
+    description: str
+
+    def beyond(self, value: float, limit: float) -> bool:
+        """Whether `value` is on the alarm side of `limit` (inclusive)."""
+        return value >= limit if self.direction == "above" else value <= limit
+
+
+class AlarmEvent(BaseModel):
+    """A transition of one alarm: JSON on zenoh `bearing/{id}/alarm`, rows in the recording,
+    OPC UA events (README "Alarms")."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+    schema_: str = Field(default=EVENT_SCHEMA, alias="schema", serialization_alias="schema",
+                         description="Message schema identifier [text].")
+    seq: int = Field(description="Per-twin counter of alarm events [-].")
+    bearing_id: str = Field(description="Twin name [text].")
+    alarm_id: str = Field(description="Alarm id, e.g. 'lubrication_boundary' [text].")
+    category: str = Field(description="vibration | lubrication | electrical | defect | life [text].")
+    transition: Transition = Field(description="raised | escalated | deescalated | cleared [text].")
+    active: bool = Field(description="Whether the alarm is active after this event [bool].")
+    severity: Severity | None = Field(description="Level after the event; null when cleared [text].")
+    opcua_severity: int = Field(description="OPC UA event severity 1..1000 (warning 500, critical 800, cleared 100) [-].")
+    since_s: float | None = Field(description="Simulated time the alarm was raised; null when cleared [s].")
+    time_s: float = Field(description="Simulated time of this event [s].")
+    wall_time_s: float = Field(description="Wall-clock time of this event, seconds since the Unix epoch [s].")
+    value: float = Field(description="The watched value at the event [unit].")
+    threshold: float = Field(description="Raise threshold of the level concerned [unit].")
+    clear_threshold: float = Field(description="Clear threshold of that level (hysteresis) [unit].")
+    unit: str = Field(description="Unit of value and thresholds [text].")
+    message: str = Field(description="What happened, in words [text].")
+
+    def to_dict(self) -> dict:
+        return self.model_dump(by_alias=True, mode="json")
+
+    def to_json(self) -> str:
+        return self.model_dump_json(by_alias=True)
+
+
+class Alarm(BaseModel):
+    """The state of one alarm of one twin (GET /v1/bearings/{id}/alarms)."""
+
+    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+    alarm_id: str = Field(description="Alarm id [text].")
+    category: str = Field(description="vibration | lubrication | electrical | defect | life [text].")
+    description: str = Field(description="What it watches [text].")
+    active: bool = Field(description="Whether it is active [bool].")
+    severity: Severity | None = Field(description="warning | critical; null when inactive [text].")
+    since_s: float | None = Field(description="Simulated time it was raised; null when inactive [s].")
+    since_wall_time_s: float | None = Field(description="Wall-clock time it was raised (Unix epoch); null when inactive [s].")
+    value: float | None = Field(description="Latest value; null when undefined (e.g. no vibration block) [unit].")
+    threshold: float | None = Field(description="Raise threshold of the active level, else of the first level [unit].")
+    clear_threshold: float | None = Field(description="Clear threshold of that level [unit].")
+    unit: str = Field(description="Unit of value and thresholds [text].")
+    message: str = Field(description="Latest word on it [text].")
+
+
+class AlarmTracker:
+    """One alarm's state machine (module docstring: deadband and on/off-delays)."""
+
+    def __init__(self, rule: Rule):
+        self.rule = rule
+        self.level = -1                       # index into the levels, -1 inactive
+        self.since_s: float | None = None     # simulated time raised
+        self.since_wall_s: float | None = None
+        self.value: float | None = None
+        self.levels: tuple[Level, ...] = ()
+        self.message = ""
+        self._pending_level = -1              # level waiting for its on-delay
+        self._pending_since: float | None = None
+        self._clear_since: float | None = None
+        self._last_t: float | None = None
+
+    @property
+    def active(self) -> bool:
+        return self.level >= 0
+
+    def _reset_timers(self) -> None:
+        self._pending_level, self._pending_since, self._clear_since = -1, None, None
+
+    def update(self, t: float, value: float | None, levels: Iterable[Level], message: str = "",
+               wall_s: float = 0.0) -> Transition | None:
+        """Feed the value at simulated time `t`; the transition it causes, if any."""
+        levels = tuple(levels)
+        self.levels = levels
+        if self._last_t is not None and t < self._last_t:
+            self._reset_timers()              # the clock went back (a restarted twin)
+        self._last_t = t
+        if value is None or not math.isfinite(value) or not levels:
+            self.value = None if value is None or not math.isfinite(value) else value
+            self._reset_timers()
+            return None
+        self.value, self.message = value, message
+        rule = self.rule
+        raised = max((i for i, lv in enumerate(levels) if rule.beyond(value, lv.threshold)), default=-1)
+        held = max((i for i, lv in enumerate(levels) if rule.beyond(value, lv.clear)), default=-1)
+        held = max(held, raised)
+        if raised > self.level:                           # towards a worse level: on-delay
+            self._clear_since = None
+            if self._pending_since is None:
+                self._pending_since = t
+            self._pending_level = raised
+            if t - self._pending_since >= rule.raise_delay_s - _TIME_EPS_S:
+                was = self.level
+                self.level = raised
+                self._reset_timers()
+                if was < 0:
+                    self.since_s, self.since_wall_s = t, wall_s
+                    return "raised"
+                return "escalated"
+            return None
+        self._pending_level, self._pending_since = -1, None
+        if held < self.level:                             # back past the clear threshold: off-delay
+            if self._clear_since is None:
+                self._clear_since = t
+            if t - self._clear_since >= rule.clear_hold_s - _TIME_EPS_S:
+                self.level = held
+                self._clear_since = None
+                if held < 0:
+                    self.since_s = self.since_wall_s = None
+                    return "cleared"
+                return "deescalated"
+            return None
+        self._clear_since = None
+        return None
+
+    def state(self) -> Alarm:
+        lv = self.levels[self.level] if self.active else (self.levels[0] if self.levels else None)
+        return Alarm(alarm_id=self.rule.id, category=self.rule.category, description=self.rule.description,
+                     active=self.active, severity=lv.severity if self.active else None,
+                     since_s=self.since_s, since_wall_time_s=self.since_wall_s, value=self.value,
+                     threshold=lv.threshold if lv else None, clear_threshold=lv.clear if lv else None,
+                     unit=self.rule.unit, message=self.message)
+
+
+# ---- the alarms of one twin --------------------------------------------------------------------
+def _above(severity: Severity, threshold: float, ratio: float) -> Level:
+    return Level(severity, threshold, threshold * ratio)
+
+
+def _below(severity: Severity, threshold: float, ratio: float) -> Level:
+    return Level(severity, threshold, threshold / ratio)
+
+
+class AlarmEvaluator:
+    """Every alarm of one twin (module docstring); `update(inputs)` returns the events."""
+
+    def __init__(self, bearing_id: str, settings: AlarmSettings | None = None,
+                 wall_clock: Callable[[], float] = time.time):
+        s = self.settings = settings or AlarmSettings()
+        self.bearing_id = bearing_id
+        self._wall_clock = wall_clock
+        self.seq = 0
+        zones = zone_boundaries(s.machine_group, s.support)
+        self.zones = zones
+        hold = s.clear_hold_s
+        table = (f"ISO 20816-3:2022 Table A.{s.machine_group}, group {s.machine_group}, {s.support} "
+                 f"support: A/B {zones[0]:g}, B/C {zones[1]:g}, C/D {zones[2]:g} mm/s")
+        rules = [
+            Rule("vibration_zone", "vibration", "mm/s", "above", s.vibration_delay_s, hold,
+                 f"Velocity RMS 10-1000 Hz in zone C (warning) or D (critical) of {table}"),
+            Rule("lubrication_kappa", "lubrication", "-", "below", s.lubrication_delay_s, hold,
+                 f"kappa = nu / nu1 (ISO 281:2007 clause 9.3) below {s.kappa_threshold:g} for "
+                 f"{s.lubrication_delay_s:g} s"),
+            Rule("lubrication_boundary", "lubrication", "-", "below", s.lubrication_delay_s, hold,
+                 f"a loaded contact in the boundary regime (Lambda <= {s.boundary_lambda:g}, seed 000 "
+                 f"Table 2) for {s.lubrication_delay_s:g} s; value: the smallest Lambda of the "
+                 f"contacts carrying >= {s.loaded_contact_fraction:g} x the largest load"),
+            Rule("electrical_discharge", "electrical", "-", "above", s.discharge_delay_s, hold,
+                 "electrical discharge risk: possible (warning), likely (critical); value 0/1/2 = "
+                 "none/possible/likely"),
+            *(Rule(f"defect_{n}", "defect", "m/s^2", "above", s.defect_delay_s, hold,
+                   f"envelope amplitude at {n.upper()} above {s.defect_amplitude_m_s2:g} m/s^2 and "
+                   f"{s.defect_significance:g} x the envelope noise floor") for n in DEFECT_LINES),
+            Rule("life_used", "life", "-", "above", 0.0, hold,
+                 f"Palmgren-Miner damage fraction above {s.life_used_warning:g} (warning), "
+                 f"{s.life_used_critical:g} (critical)"),
+        ]
+        self.trackers: dict[str, AlarmTracker] = {r.id: AlarmTracker(r) for r in rules}
+        r = s.clear_ratio
+        self._static_levels = {
+            "vibration_zone": (_above("warning", zones[1], r), _above("critical", zones[2], r)),
+            "lubrication_kappa": (_below("warning", s.kappa_threshold, r),),
+            "lubrication_boundary": (_below("warning", s.boundary_lambda, r),),
+            # ordinal value: warning at 1 (possible), critical at 2 (likely); clear = one step down
+            "electrical_discharge": (Level("warning", 1.0, 0.5), Level("critical", 2.0, 1.5)),
+            "life_used": (_above("warning", s.life_used_warning, r), _above("critical", s.life_used_critical, r)),
+        }
+        for tracker in self.trackers.values():
+            tracker.levels = self._levels(tracker.rule.id, None)
+
+    def _levels(self, alarm_id: str, vib: VibrationInputs | None) -> tuple[Level, ...]:
+        if alarm_id.startswith("defect_"):
+            s = self.settings
+            floor = vib.noise_floor_m_s2 if vib is not None else None
+            threshold = max(s.defect_amplitude_m_s2, s.defect_significance * floor if floor else 0.0)
+            return (_above("warning", threshold, s.clear_ratio),)
+        return self._static_levels[alarm_id]
+
+    def _values(self, x: AlarmInputs) -> dict[str, tuple[float | None, str]]:
+        s = self.settings
+        vib = x.vibration
+        out: dict[str, tuple[float | None, str]] = {}
+        v = vib.velocity_rms_mm_s if vib is not None else None
+        out["vibration_zone"] = (v, "" if v is None else
+                                 f"velocity RMS {v:.3g} mm/s: ISO 20816-3 zone "
+                                 f"{vibration_zone(v, s.machine_group, s.support)}")
+        out["lubrication_kappa"] = (x.kappa, "" if x.kappa is None else f"kappa = {x.kappa:.3g}")
+        lam = x.min_loaded_lambda
+        out["lubrication_boundary"] = (lam, "" if lam is None else
+                                       f"smallest Lambda of the loaded contacts {lam:.3g}; "
+                                       f"{x.boundary_contacts} loaded contact(s) in the boundary regime")
+        risk = x.discharge_risk
+        out["electrical_discharge"] = (DISCHARGE_LEVELS.get(risk) if risk is not None else None,
+                                       f"discharge risk {risk}: {x.discharge_reason}" if risk else "")
+        lines = vib.line_amplitudes_m_s2 if vib is not None else {}
+        for n in DEFECT_LINES:
+            a = lines.get(n)
+            out[f"defect_{n}"] = (a, "" if a is None else f"envelope amplitude at {n.upper()} {a:.3g} m/s^2")
+        d = x.damage_fraction
+        out["life_used"] = (d, "" if d is None else f"damage fraction {d:.3g}")
+        return out
+
+    def update(self, inputs: AlarmInputs) -> list[AlarmEvent]:
+        """Feed one instant; the events it causes (in alarm order)."""
+        events = []
+        wall = self._wall_clock()
+        for alarm_id, (value, message) in self._values(inputs).items():
+            tracker = self.trackers[alarm_id]
+            levels = self._levels(alarm_id, inputs.vibration)
+            transition = tracker.update(inputs.time_s, value, levels, message, wall)
+            if transition is not None:
+                events.append(self._event(tracker, transition, inputs.time_s, wall))
+        return events
+
+    def _event(self, tracker: AlarmTracker, transition: Transition, t: float, wall: float) -> AlarmEvent:
+        self.seq += 1
+        rule, level = tracker.rule, tracker.level
+        lv = tracker.levels[level] if level >= 0 else tracker.levels[0]   # cleared: the first level
+        severity = lv.severity if level >= 0 else None
+        word = {"raised": "raised", "escalated": "escalated to", "deescalated": "stepped down to",
+                "cleared": "cleared"}[transition]
+        text = f"{rule.id} {word}{'' if severity is None else ' ' + severity}: {tracker.message}"
+        return AlarmEvent(seq=self.seq, bearing_id=self.bearing_id, alarm_id=rule.id,
+                          category=rule.category, transition=transition, active=level >= 0,
+                          severity=severity, opcua_severity=OPCUA_SEVERITY[severity],
+                          since_s=tracker.since_s, time_s=t, wall_time_s=wall,
+                          value=float(tracker.value), threshold=lv.threshold, clear_threshold=lv.clear,
+                          unit=rule.unit, message=text)
+
+    def states(self) -> list[Alarm]:
+        """Every alarm's state (active or not), in the order of ALARM_IDS."""
+        return [t.state() for t in self.trackers.values()]
+
+    def active(self) -> list[Alarm]:
+        return [t.state() for t in self.trackers.values() if t.active]

@@ -1,0 +1,236 @@
+"""The address space of the OPC UA facade: namespace URI, folders and browse names, and how each
+variable is read from a twin's latest snapshot (README "OPC UA").
+
+Browse names are the service's own field names (units in the name, as in the JSON contract and
+the setpoint vocabulary twin.setpoint), so one vocabulary serves HTTP, zenoh and OPC UA. Node ids
+are strings in the facade's namespace: `<twin id>`, `<twin id>/<Folder>`,
+`<twin id>/<Folder>/<browse name>` (a twin id never holds a '/').
+
+No asyncua here: types are named by their OPC UA built-in type name ("Double", "String", ...).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any, Literal
+
+from service.core.alarms import ALARM_IDS, Alarm, AlarmInputs, vibration_zone
+from service.settings import AlarmSettings
+from twin.setpoint import FIELDS as SETPOINT_FIELDS
+from twin.setpoint import Setpoint
+from twin.snapshot import Snapshot
+
+NAMESPACE_URI = "urn:bearing-twin:opcua"        # the twins' nodes
+APPLICATION_URI = "urn:bearing-twin:server"      # the server application (namespace 1)
+ROOT_FOLDER = "BearingTwins"          # under Objects: one object per twin
+EVENT_TYPE = "BearingAlarmEventType"  # under BaseEventType
+LAST_RESULT = "last_result"           # Setpoint/last_result: what became of the latest write
+
+UaType = Literal["Double", "String", "UInt32", "Int64", "Boolean"]
+
+
+@dataclass(frozen=True)
+class View:
+    """What a twin's variables are read from at one update."""
+
+    snapshot: Snapshot | None
+    inputs: AlarmInputs | None
+    alarms: Mapping[str, Alarm]
+    target: Setpoint | None
+    settings: AlarmSettings
+
+
+@dataclass(frozen=True)
+class Var:
+    """One variable: browse name (units in it), built-in type, description and reader."""
+
+    name: str
+    type: UaType
+    description: str
+    read: Callable[[View], Any]
+
+
+def _contacts(v: View) -> list:
+    snap = v.snapshot
+    if snap is None:
+        return []
+    return [c for b in snap.balls for c in (b.inner, b.outer)]
+
+
+def _min(values) -> float | None:
+    values = [x for x in values if x is not None and math.isfinite(x)]
+    return min(values) if values else None
+
+
+def _max(values) -> float | None:
+    values = [x for x in values if x is not None and math.isfinite(x)]
+    return max(values) if values else None
+
+
+def _snap(attr: str) -> Callable[[View], Any]:
+    return lambda v: getattr(v.snapshot, attr) if v.snapshot is not None else None
+
+
+def _in_force(name: str) -> Callable[[View], Any]:
+    return lambda v: getattr(v.snapshot.setpoint, name) if v.snapshot is not None else None
+
+
+def _electrical(name: str) -> Callable[[View], Any]:
+    return lambda v: getattr(v.snapshot.electrical, name) if v.snapshot is not None else None
+
+
+def _life(name: str) -> Callable[[View], Any]:
+    def read(v: View) -> Any:
+        life = getattr(v.snapshot, "life", None) if v.snapshot is not None else None
+        return getattr(life, name, None) if life is not None else None
+    return read
+
+
+def _vib(v: View):
+    return v.inputs.vibration if v.inputs is not None else None
+
+
+def _zone(v: View) -> str | None:
+    vib = _vib(v)
+    if vib is None or vib.velocity_rms_mm_s is None:
+        return None
+    return vibration_zone(vib.velocity_rms_mm_s, v.settings.machine_group, v.settings.support)
+
+
+def _line(name: str) -> Callable[[View], Any]:
+    return lambda v: (_vib(v).line_amplitudes_m_s2.get(name) if _vib(v) is not None else None)
+
+
+def _regime_count(regime: str) -> Callable[[View], Any]:
+    return lambda v: sum(1 for c in _contacts(v) if c.regime == regime) if v.snapshot is not None else None
+
+
+def _alarm_level(alarm_id: str) -> Callable[[View], Any]:
+    def read(v: View) -> str | None:
+        a = v.alarms.get(alarm_id)
+        return None if a is None else (a.severity if a.active else "inactive")
+    return read
+
+
+# ---- the folders of a twin (Identification is static: see `identification`) ------------------
+FOLDERS: dict[str, tuple[Var, ...]] = {
+    "OperatingConditions": (
+        Var("time_s", "Double", "Simulated time of the snapshot [s].", _snap("time_s")),
+        Var("seq", "Int64", "Snapshot counter of the twin (gaps: snapshots not shown) [-].", _snap("seq")),
+        Var("status", "String", "'ok' or what went wrong and what the twin did about it [text].", _snap("status")),
+        Var("real_time_factor", "Double", "Simulated seconds per wall second [-].", _snap("real_time_factor")),
+        Var("shaft_speed_rad_s", "Double", "Current (ramped) shaft speed [rad/s].", _snap("shaft_speed_rad_s")),
+        Var("cage_speed_rad_s", "Double", "Cage angular speed [rad/s].", _snap("cage_speed_rad_s")),
+        *(Var(f.name, "Double", f"{f.description} in force during the last frame [{f.unit}] "
+              "(the writable target is Setpoint/" + f.name + ").", _in_force(f.name))
+          for f in SETPOINT_FIELDS if f.name != "shaft_speed_rad_s"),
+    ),
+    "Lubrication": (
+        Var("viscosity_pa_s", "Double", "Inlet viscosity (Roelands, with inlet heating) [Pa s].", _snap("viscosity_pa_s")),
+        Var("min_lambda", "Double", "Smallest film parameter Lambda over the contacts [-].",
+            lambda v: _min(c.lambda_ for c in _contacts(v))),
+        Var("min_loaded_lambda", "Double", "Smallest Lambda over the loaded contacts (the lubrication "
+            "alarm's value) [-].", lambda v: v.inputs.min_loaded_lambda if v.inputs is not None else None),
+        Var("min_film_thickness_m", "Double", "Smallest minimum film thickness h_min over the contacts [m].",
+            lambda v: _min(c.h_min_m for c in _contacts(v))),
+        Var("boundary_contacts", "UInt32", "Contacts in the boundary regime (seed 000 Table 2) [-].", _regime_count("boundary")),
+        Var("mixed_contacts", "UInt32", "Contacts in the mixed regime [-].", _regime_count("mixed")),
+        Var("full_film_contacts", "UInt32", "Contacts in the full-film regime [-].", _regime_count("full_film")),
+        Var("max_contact_load_n", "Double", "Largest ball-raceway contact load [N].",
+            lambda v: _max(c.load_n for c in _contacts(v))),
+        Var("max_pressure_pa", "Double", "Largest Hertz maximum pressure [Pa].",
+            lambda v: _max(c.max_pressure_pa for c in _contacts(v))),
+        Var("kappa", "Double", "Viscosity ratio nu / nu1 (ISO 281:2007 clause 9.3) [-]; no value "
+            "without the snapshot's life block.", _life("kappa")),
+    ),
+    "Friction": (
+        Var("friction_torque_n_m", "Double", "Torque the shaft supplies to the bearing [N m].", _snap("friction_torque_n_m")),
+        Var("max_friction_coefficient", "Double", "Largest sliding friction coefficient over the contacts [-].",
+            lambda v: _max(c.mu for c in _contacts(v))),
+        Var("max_slide_roll_ratio", "Double", "Largest |sliding / entrainment speed| over the contacts [-].",
+            lambda v: _max(abs(c.slide_roll_ratio) for c in _contacts(v))),
+    ),
+    "Electrical": (
+        Var("discharge_risk", "String", "none | possible | likely [text].", _electrical("discharge_risk")),
+        Var("reason", "String", "Why the risk is what it is [text].", _electrical("reason")),
+        Var("shaft_voltage_v", "Double", "Voltage across the bearing [V].", _electrical("shaft_voltage_v")),
+        Var("shaft_current_a", "Double", "Current through the bearing [A].", _electrical("shaft_current_a")),
+        Var("resistance_ohm", "Double", "Equivalent parallel resistance [ohm]; no value: no conduction.", _electrical("resistance_ohm")),
+        Var("capacitance_f", "Double", "Equivalent parallel capacitance [F].", _electrical("capacitance_f")),
+        Var("impedance_ohm", "Double", "Impedance magnitude [ohm].", _electrical("impedance_ohm")),
+        Var("phase_rad", "Double", "Impedance phase [rad].", _electrical("phase_rad")),
+        Var("frequency_hz", "Double", "Frequency of the impedance [Hz].", _electrical("frequency_hz")),
+        Var("max_film_field_v_m", "Double", "Largest electric field across a film or gap [V/m].", _electrical("max_film_field_v_m")),
+        Var("current_density_a_m2", "Double", "Largest apparent current density [A/m^2].", _electrical("current_density_a_m2")),
+        Var("contact_temperature_rise_k", "Double", "Inlet temperature rise above the oil [K].", _electrical("contact_temperature_rise_k")),
+    ),
+    "Vibration": (
+        Var("velocity_rms_mm_s", "Double", "Housing velocity RMS 10-1000 Hz (ISO 20816-1) [mm/s]; no "
+            "value without the snapshot's vibration block.",
+            lambda v: _vib(v).velocity_rms_mm_s if _vib(v) is not None else None),
+        Var("zone", "String", "ISO 20816-3 evaluation zone A | B | C | D for the configured machine "
+            "group and support [text].", _zone),
+        *(Var(f"{n}_m_s2", "Double", f"Envelope-spectrum amplitude at {n.upper()} [m/s^2].", _line(n))
+          for n in ("ftf", "bpfo", "bpfi", "bsf")),
+        Var("noise_floor_m_s2", "Double", "Envelope-spectrum noise floor (median) [m/s^2].",
+            lambda v: _vib(v).noise_floor_m_s2 if _vib(v) is not None else None),
+    ),
+    "Life": tuple(Var(name, "Double", desc + "; no value without the snapshot's life block.", _life(name)) for name, desc in (
+        ("kappa", "Viscosity ratio nu / nu1 (ISO 281:2007 clause 9.3) [-]"),
+        ("a_iso", "Life modification factor a_ISO (ISO 281:2007 clause 9.3, <= 50) [-]"),
+        ("l10_h", "Basic rating life L10 at the current speed [h]"),
+        ("l10m_h", "Modified rating life a_ISO L10 [h]"),
+        ("l10_contact_loads_h", "Life from the twin's contact loads (ISO/TS 16281 spirit) [h]"),
+        ("damage_fraction", "Palmgren-Miner damage accumulated [-]"),
+        ("remaining_life_h", "Remaining life at the current conditions [h]"),
+    )),
+    "Alarms": (
+        Var("active_count", "UInt32", "Number of active alarms [-].",
+            lambda v: sum(1 for a in v.alarms.values() if a.active)),
+        *(Var(alarm_id, "String", f"State of alarm {alarm_id}: inactive | warning | critical [text] "
+              "(transitions are BearingAlarmEventType events on the twin object and the Server).",
+              _alarm_level(alarm_id)) for alarm_id in ALARM_IDS),
+    ),
+}
+
+# Setpoint/<field>: writable, the latest accepted target (twin.setpoint vocabulary)
+SETPOINT_VARS: tuple[Var, ...] = tuple(
+    Var(f.name, "Double", f"{f.description} [{f.unit}], target (write it to change the setpoint; the "
+        "bearing's own limits apply, as over HTTP).", (lambda name: lambda v: getattr(v.target, name)
+                                                       if v.target is not None else None)(f.name))
+    for f in SETPOINT_FIELDS)
+
+
+def identification(entry: Any) -> list[tuple[str, UaType, str, Any]]:
+    """Static (name, type, description, value) of a twin: designation, kind, geometry, C, C0.
+
+    C and C0 come from `twin.life.ratings_for` (catalogue, else ISO 281 / ISO 76 from the
+    geometry) when the engine has it; without it C has no value and C0 is the radial load at
+    which the model's Hertz pressure reaches ISO 76's 4.2 GPa (the model's load limit)."""
+    model = entry.twin.model
+    spec = model.spec
+    g = spec.geometry
+    c = c0 = None
+    try:
+        from twin.life import ratings_for  # on the engine once rating life is merged
+    except ImportError:
+        c0 = float(model.max_radial_load_n)
+    else:
+        r = ratings_for(spec)
+        c, c0 = float(r.dynamic_load_rating_n), float(r.static_load_rating_n)
+    return [
+        ("bearing_id", "String", "Twin name [text].", entry.id),
+        ("designation", "String", "Catalog designation [text].", spec.designation),
+        ("kind", "String", "deep_groove | angular_contact [text].", spec.kind),
+        ("dynamic_load_rating_n", "Double", "Basic dynamic load rating C (ISO 281) [N].", c),
+        ("static_load_rating_n", "Double", "Basic static load rating C0 (ISO 76) [N].", c0),
+        ("ball_count", "UInt32", "Number of balls Z [-].", int(model.ball_count)),
+        ("ball_diameter_m", "Double", "Ball diameter Dw [m].", 2.0 * float(g.ball_radius_m)),
+        ("pitch_diameter_m", "Double", "Pitch diameter Dpw [m].", 2.0 * float(model.pitch_radius_m)),
+        ("contact_angle_rad", "Double", "Nominal contact angle [rad].", float(model.contact_angle_rad)),
+        ("diametral_clearance_m", "Double", "Diametral clearance Pd [m]; negative = preload.",
+         float(entry.diametral_clearance_m)),
+        ("lubricant", "String", "Lubricant name [text].", entry.lubricant),
+    ]

@@ -1,0 +1,426 @@
+"""`OpcUaFacade`: the twins of a service as an OPC UA server (asyncua), in its own thread.
+
+    facade = OpcUaFacade(registry, "opc.tcp://127.0.0.1:4840").start()   # listening on return
+    registry.alarms.subscribe(facade.on_alarm)                           # alarms as OPC UA events
+    facade.close()
+
+The server runs its own asyncio loop in a daemon thread. Every half publish period it reads each
+twin's latest published snapshot (`runner.latest`, no work on the stepping threads) and, when
+the snapshot is new, writes the variables that changed; twins created or deleted in the
+registry appear or disappear at the same pace. Address space: service.opcua.layout (README
+"OPC UA").
+
+Writes. The Setpoint variables are answered by `_GatedAttributeService` (it replaces asyncua's
+attribute service and passes every other write on): the same admission gate and setpoint path as
+HTTP and zenoh (service.core.admission, `runner.submit` -> `SetpointLimits.admit`). Status codes:
+BadUserAccessDenied (a token is set and the session is anonymous), BadTooManyOperations (the
+twin's setpoint rate), BadTypeMismatch (not a number), BadOutOfRange (outside the bearing's
+range, or not finite). The OPC UA write response carries only the status code, so the words
+(naming the field and the bearing's range, as the HTTP 422) go to the twin's
+`Setpoint/last_result` variable, JSON like the zenoh result key:
+{"accepted": false, "status": "BadOutOfRange", "field": "radial_load_n", "error": "..."}.
+
+Users. The bearer token is the password of a user-name identity (any user name); a wrong
+password refuses the session (BadUserAccessDenied at ActivateSession). With a token set,
+anonymous sessions read (unless `read_requires_token`, then they are refused) but cannot write.
+Without a token anyone may write, as over HTTP. Only the None security policy is offered, so the
+password crosses the network in clear, like the bearer token over plain HTTP: keep the endpoint
+on loopback or a trusted network.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import json
+import logging
+import math
+import threading
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from typing import Any
+from urllib.parse import urlparse
+
+from asyncua import Server, ua
+from asyncua.crypto.permission_rules import User, UserRole
+from asyncua.server.address_space import AttributeService
+from asyncua.server.event_generator import EventGenerator
+
+from service.core.alarms import AlarmEvent, inputs_from_snapshot
+from service.core.errors import InputError
+from service.opcua.layout import (APPLICATION_URI, EVENT_TYPE, FOLDERS, LAST_RESULT, NAMESPACE_URI, ROOT_FOLDER, SETPOINT_VARS,
+                                  View, identification)
+
+log = logging.getLogger(__name__)
+
+_VT = {"Double": ua.VariantType.Double, "String": ua.VariantType.String, "UInt32": ua.VariantType.UInt32,
+       "Int64": ua.VariantType.Int64, "Boolean": ua.VariantType.Boolean}
+_NUMERIC = {ua.VariantType.Double, ua.VariantType.Float, ua.VariantType.SByte, ua.VariantType.Byte,
+            ua.VariantType.Int16, ua.VariantType.UInt16, ua.VariantType.Int32, ua.VariantType.UInt32,
+            ua.VariantType.Int64, ua.VariantType.UInt64}
+_EVENT_FIELDS = (("alarm_id", ua.VariantType.String), ("category", ua.VariantType.String),
+                 ("transition", ua.VariantType.String), ("active", ua.VariantType.Boolean),
+                 ("level", ua.VariantType.String), ("value", ua.VariantType.Double),
+                 ("threshold", ua.VariantType.Double), ("clear_threshold", ua.VariantType.Double),
+                 ("unit", ua.VariantType.String), ("since_s", ua.VariantType.Double),
+                 ("time_s", ua.VariantType.Double))
+
+
+class OpcUaError(RuntimeError):
+    """The OPC UA server could not start (e.g. the port is taken)."""
+
+
+@dataclass
+class TwinUser(User):
+    """A session's user: `authenticated` when it gave the token as its password."""
+
+    authenticated: bool = False
+
+
+class TokenUserManager:
+    """asyncua user manager: the service token is the password (see the module docstring)."""
+
+    def __init__(self, gate: Any, read_requires_token: bool = False):
+        self.gate, self.read_requires_token = gate, read_requires_token
+
+    def get_user(self, iserver: Any, username: str | None = None, password: str | None = None,
+                 certificate: Any = None) -> User | None:
+        if username is None and password is None:
+            if self.gate.requires_token and self.read_requires_token:
+                self.gate.check_token(None)            # counted as unauthorized
+                return None
+            # role User: asyncua's ruleset gives the Anonymous role nothing, not even reads
+            return TwinUser(role=UserRole.User, name=None, authenticated=not self.gate.requires_token)
+        if self.gate.check_token(password or "") is not None:
+            return None                                # BadUserAccessDenied at ActivateSession
+        return TwinUser(role=UserRole.User, name=username or "user", authenticated=True)
+
+
+_ADMIN = User(role=UserRole.Admin)       # asyncua's default user of a server-side write
+
+
+class _GatedAttributeService(AttributeService):
+    """asyncua's attribute service with the Setpoint variables answered by the facade."""
+
+    def __init__(self, aspace: Any, facade: OpcUaFacade):
+        super().__init__(aspace)
+        self._facade = facade
+
+    async def write(self, params: ua.WriteParameters, user: User = _ADMIN) -> list[ua.StatusCode]:
+        setpoints = self._facade._setpoint_nodes
+        if user.role == UserRole.Admin or not any(w.NodeId in setpoints for w in params.NodesToWrite):
+            return await super().write(params, user)     # the server's own writes, other nodes
+        results: list[ua.StatusCode] = []
+        for w in params.NodesToWrite:
+            if w.NodeId in setpoints:
+                results.append(await self._facade._write_setpoint(w, setpoints[w.NodeId], user))
+            else:
+                results.extend(await super().write(ua.WriteParameters(NodesToWrite=[w]), user))
+        return results
+
+
+def _status(name: str) -> ua.StatusCode:
+    return ua.StatusCode(getattr(ua.StatusCodes, name))
+
+
+class _TwinNodes:
+    """The nodes of one twin in the server."""
+
+    def __init__(self, bearing_id: str, obj: Any):
+        self.bearing_id = bearing_id
+        self.obj = obj
+        self.vars: dict[str, tuple[ua.NodeId, ua.VariantType, Any]] = {}   # key -> (node id, type, reader)
+        self.last: dict[str, Any] = {}
+        self.seq: int | None = None
+        self.generators: list[EventGenerator] = []
+        self.last_result: ua.NodeId | None = None
+
+
+class OpcUaFacade:
+    """The OPC UA server of a service (see the module docstring)."""
+
+    def __init__(self, registry: Any, endpoint: str, *, period_s: float | None = None,
+                 read_requires_token: bool | None = None, server_name: str = "bearing-twin"):
+        parsed = urlparse(endpoint)
+        if parsed.scheme != "opc.tcp" or not parsed.hostname or parsed.port is None:
+            raise ValueError(f"opcua = {endpoint!r}: expected opc.tcp://HOST:PORT[/path]")
+        settings = registry.settings
+        self.registry = registry
+        self.endpoint = endpoint
+        # one publish period (of wall time; in fast mode of simulated time, at least 10 ms)
+        self.period_s = float(period_s) if period_s else max(1.0 / settings.publish_rate_hz,
+                                                              0.01 if settings.fast else 0.0)
+        self.read_requires_token = (settings.read_requires_token if read_requires_token is None
+                                    else read_requires_token)
+        self.server_name = server_name
+        self.url: str | None = None             # the endpoint actually listened on
+        self.namespace_index: int | None = None
+        self.updates = 0
+        self.events_sent = 0
+        self._setpoint_nodes: dict[ua.NodeId, tuple[str, str]] = {}
+        self._twins: dict[str, _TwinNodes] = {}
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self._alarms: asyncio.Queue | None = None
+        self._stop: asyncio.Event | None = None
+        self._ready = threading.Event()
+        self._error: BaseException | None = None
+        self._thread: threading.Thread | None = None
+
+    # ---- life cycle (any thread) ---------------------------------------------------------------
+    def start(self, timeout_s: float = 60.0) -> OpcUaFacade:
+        """Start the server thread; return once it listens (OpcUaError if it cannot)."""
+        logging.getLogger("asyncua").setLevel(max(logging.WARNING, logging.getLogger("asyncua").level))
+        self._thread = threading.Thread(target=self._thread_main, name="opcua", daemon=True)
+        self._thread.start()
+        if not self._ready.wait(timeout_s):
+            self.close()
+            raise OpcUaError(f"OPC UA server on {self.endpoint} did not start within {timeout_s:g} s")
+        if self._error is not None:
+            self._thread.join(5.0)
+            raise OpcUaError(f"OPC UA server on {self.endpoint}: {' '.join(str(self._error).split())}") from self._error
+        return self
+
+    def close(self, timeout_s: float = 10.0) -> None:
+        """Stop the server and its thread (idempotent)."""
+        loop, stop = self._loop, self._stop
+        if loop is not None and stop is not None and not loop.is_closed():
+            try:
+                loop.call_soon_threadsafe(stop.set)
+            except RuntimeError:
+                pass                                    # the loop already ended
+        if self._thread is not None and self._thread is not threading.current_thread():
+            self._thread.join(timeout_s)
+
+    @property
+    def running(self) -> bool:
+        return self._thread is not None and self._thread.is_alive() and self._ready.is_set() and self._error is None
+
+    def on_alarm(self, event: AlarmEvent) -> None:
+        """Alarm hub subscriber: queue the event for the server's loop (never blocks)."""
+        loop, q = self._loop, self._alarms
+        if loop is None or q is None or loop.is_closed():
+            return
+        try:
+            loop.call_soon_threadsafe(q.put_nowait, event)
+        except RuntimeError:
+            pass
+
+    # ---- the server's thread -------------------------------------------------------------------
+    def _thread_main(self) -> None:
+        try:
+            asyncio.run(self._main())
+        except BaseException as exc:  # noqa: BLE001 - reported by start()
+            if not self._ready.is_set():
+                self._error = exc
+                self._ready.set()
+            else:
+                log.exception("OPC UA server stopped")
+
+    async def _main(self) -> None:
+        self._loop = asyncio.get_running_loop()
+        self._alarms = asyncio.Queue()
+        self._stop = asyncio.Event()
+        server = self.server = Server(user_manager=TokenUserManager(self.registry.gate, self.read_requires_token))
+        await server.init()
+        server.set_endpoint(self.endpoint)
+        server.set_server_name(self.server_name)
+        await server.set_application_uri(APPLICATION_URI)
+        server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        server.set_identity_tokens([ua.AnonymousIdentityToken, ua.UserNameIdentityToken])
+        server.iserver.attribute_service = _GatedAttributeService(server.iserver.aspace, self)
+        idx = self.namespace_index = await server.register_namespace(NAMESPACE_URI)
+        self._root = await server.nodes.objects.add_folder(ua.NodeId(ROOT_FOLDER, idx), ua.QualifiedName(ROOT_FOLDER, idx))
+        self._event_type = await server.create_custom_event_type(idx, EVENT_TYPE, ua.ObjectIds.BaseEventType,
+                                                                 list(_EVENT_FIELDS))
+        await server.start()
+        try:
+            sock = server.bserver._server.sockets[0].getsockname()   # the port really bound (0: any)
+            self.url = f"opc.tcp://{urlparse(self.endpoint).hostname}:{sock[1]}{urlparse(self.endpoint).path}"
+        except Exception:  # noqa: BLE001
+            self.url = self.endpoint
+        log.info("OPC UA server on %s (namespace %s)", self.url, NAMESPACE_URI)
+        self._ready.set()
+        try:
+            while not self._stop.is_set():
+                try:
+                    await self._sync()
+                    await self._send_alarms()
+                except Exception:  # noqa: BLE001 - the server keeps serving
+                    log.exception("OPC UA update failed")
+                try:
+                    await asyncio.wait_for(self._stop.wait(), timeout=0.5 * self.period_s)
+                except TimeoutError:
+                    pass
+        finally:
+            await server.stop()
+
+    # ---- twins ---------------------------------------------------------------------------------
+    async def _sync(self) -> None:
+        entries = {e.id: e for e in self.registry.entries()}
+        for gone in [i for i in self._twins if i not in entries]:
+            await self._remove_twin(gone)
+        for bearing_id, entry in entries.items():
+            nodes = self._twins.get(bearing_id)
+            if nodes is None:
+                nodes = await self._add_twin(entry)
+            await self._update(nodes, entry)
+
+    def _nid(self, *parts: str) -> ua.NodeId:
+        return ua.NodeId("/".join(parts), self.namespace_index)
+
+    async def _add_twin(self, entry: Any) -> _TwinNodes:
+        obj = await self._root.add_object(self._nid(entry.id), ua.QualifiedName(entry.id, self.namespace_index))
+        try:
+            return await self._populate(entry, obj)
+        except BaseException:
+            for nid in [n for n, (b, _) in self._setpoint_nodes.items() if b == entry.id]:
+                del self._setpoint_nodes[nid]
+            await self.server.delete_nodes([obj], recursive=True)    # tried again next time
+            raise
+
+    async def _populate(self, entry: Any, obj: Any) -> _TwinNodes:
+        idx, bid = self.namespace_index, entry.id
+        qn = lambda name: ua.QualifiedName(name, idx)  # noqa: E731
+        nodes = _TwinNodes(bid, obj)
+        ident = await obj.add_folder(self._nid(bid, "Identification"), qn("Identification"))
+        for name, vtype, desc, value in identification(entry):
+            vt = _VT[vtype]
+            node = await ident.add_variable(self._nid(bid, "Identification", name), qn(name),
+                                            ua.Variant(value if value is not None else ua.get_default_value(vt), vt),
+                                            varianttype=vt)
+            await node.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(desc))))
+            if value is None:
+                await self.server.write_attribute_value(node.nodeid, ua.DataValue(StatusCode=_status("BadNoValue")))
+        for folder, variables in (*FOLDERS.items(), ("Setpoint", SETPOINT_VARS)):
+            fnode = await obj.add_folder(self._nid(bid, folder), qn(folder))
+            for var in variables:
+                vt = _VT[var.type]
+                node = await fnode.add_variable(self._nid(bid, folder, var.name), qn(var.name),
+                                                ua.Variant(ua.get_default_value(vt), vt), varianttype=vt)
+                await self.server.write_attribute_value(
+                    node.nodeid, ua.DataValue(StatusCode=_status("BadWaitingForInitialData")))
+                await node.write_attribute(ua.AttributeIds.Description,
+                                           ua.DataValue(ua.Variant(ua.LocalizedText(var.description))))
+                nodes.vars[f"{folder}/{var.name}"] = (node.nodeid, vt, var.read)
+                if folder == "Setpoint":
+                    await node.set_writable(True)
+                    low, high = entry.runner.limits[var.name]
+                    await node.add_property(self._nid(bid, folder, var.name, "EURange"), qn("EURange"),
+                                            ua.Range(low, high))
+                    self._setpoint_nodes[node.nodeid] = (bid, var.name)
+            if folder == "Setpoint":
+                last = await fnode.add_variable(self._nid(bid, folder, LAST_RESULT), qn(LAST_RESULT), "",
+                                                varianttype=ua.VariantType.String)
+                await last.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(
+                    "What became of the latest write to a Setpoint variable, JSON: accepted, status, "
+                    "field, error naming the field and the bearing's range [text]."))))
+                nodes.last_result = last.nodeid
+        # alarm events: from the twin object, and from the Server object (SourceNode = the twin)
+        isession = self.server.iserver.isession
+        for emitter, add_ref in ((obj.nodeid, True), (ua.NodeId(ua.ObjectIds.Server), False)):
+            gen = EventGenerator(isession)
+            await gen.init(self._event_type, emitting_node=emitter, add_generates_event=add_ref)
+            gen.event.SourceNode, gen.event.SourceName = obj.nodeid, bid
+            nodes.generators.append(gen)
+        self._twins[bid] = nodes
+        log.info("OPC UA: twin %s added", bid)
+        return nodes
+
+    async def _remove_twin(self, bearing_id: str) -> None:
+        nodes = self._twins.pop(bearing_id)
+        for nid in [n for n, (b, _) in self._setpoint_nodes.items() if b == bearing_id]:
+            del self._setpoint_nodes[nid]
+        await self.server.delete_nodes([nodes.obj], recursive=True)
+        log.info("OPC UA: twin %s removed", bearing_id)
+
+    async def _update(self, nodes: _TwinNodes, entry: Any) -> None:
+        snap = entry.runner.latest
+        seq = None if snap is None else snap.seq
+        target = entry.runner.target_setpoint
+        if seq is not None and seq == nodes.seq and nodes.last.get("Setpoint/_target") is target:
+            return
+        nodes.seq = seq
+        nodes.last["Setpoint/_target"] = target
+        hub = self.registry.alarms
+        settings = hub.settings
+        view = View(snapshot=snap, inputs=inputs_from_snapshot(snap, settings) if snap is not None else None,
+                    alarms={a.alarm_id: a for a in hub.states(entry.id)}, target=target, settings=settings)
+        now = datetime.now(UTC)
+        for key, (nid, vt, read) in nodes.vars.items():
+            try:
+                value = read(view)
+            except Exception:  # noqa: BLE001 - one bad reader never stops the others
+                value = None
+            if isinstance(value, float) and not math.isfinite(value):
+                value = None
+            if key in nodes.last and nodes.last[key] == value:
+                continue
+            nodes.last[key] = value
+            if value is None:
+                dv = ua.DataValue(StatusCode=_status("BadNoValue" if snap is not None else "BadWaitingForInitialData"),
+                                  SourceTimestamp=now, ServerTimestamp=now)
+            else:
+                dv = ua.DataValue(ua.Variant(float(value) if vt == ua.VariantType.Double else value, vt),
+                                  SourceTimestamp=now, ServerTimestamp=now)
+            await self.server.write_attribute_value(nid, dv)
+        self.updates += 1
+
+    # ---- alarms --------------------------------------------------------------------------------
+    async def _send_alarms(self) -> None:
+        while self._alarms is not None and not self._alarms.empty():
+            event: AlarmEvent = self._alarms.get_nowait()
+            nodes = self._twins.get(event.bearing_id)
+            if nodes is None:
+                continue
+            for gen in nodes.generators:
+                ev = gen.event
+                ev.Severity = event.opcua_severity
+                for name, _vt in _EVENT_FIELDS:
+                    value = event.severity if name == "level" else getattr(event, name)
+                    setattr(ev, name, "" if value is None and name == "level" else value)
+                await gen.trigger(message=event.message)
+            self.events_sent += 1
+
+    # ---- setpoint writes (server loop) ---------------------------------------------------------
+    async def _write_setpoint(self, w: ua.WriteValue, target: tuple[str, str], user: User) -> ua.StatusCode:
+        bearing_id, name = target
+        nodes = self._twins.get(bearing_id)
+
+        async def answer(status: str, message: str | None = None, **extra: Any) -> ua.StatusCode:
+            if nodes is not None and nodes.last_result is not None:
+                body = {"accepted": status == "Good", "status": status, "field": name, **extra}
+                if message is not None:
+                    body["error"] = message
+                await self.server.write_attribute_value(
+                    nodes.last_result, ua.DataValue(ua.Variant(json.dumps(body, allow_nan=False), ua.VariantType.String)))
+            return _status(status) if status != "Good" else ua.StatusCode()
+
+        if w.AttributeId != ua.AttributeIds.Value:
+            return _status("BadNotWritable")
+        gate = self.registry.gate
+        if gate.requires_token and not getattr(user, "authenticated", False):
+            refusal = gate.check_token(None, missing="anonymous writes are refused: this service has a token; "
+                                       "connect with a user name and the token as password")
+            return await answer("BadUserAccessDenied", refusal.message if refusal else None)
+        variant = w.Value.Value if w.Value is not None else None
+        if variant is None or variant.VariantType not in _NUMERIC or variant.is_array:
+            kind = "nothing" if variant is None else variant.VariantType.name
+            return await answer("BadTypeMismatch", f"{name}: a setpoint is a number (Double), got {kind}")
+        value = variant.Value
+        entry = self.registry.find(bearing_id)
+        if entry is None:
+            return await answer("BadNodeIdUnknown", f"twin {bearing_id!r} is gone")
+        refusal = gate.take_setpoint(bearing_id)
+        if refusal is not None:
+            return await answer("BadTooManyOperations", refusal.message, retry_after_s=refusal.retry_after_s)
+        number = float(value) if variant.VariantType in (ua.VariantType.Double, ua.VariantType.Float) else int(value)
+        try:
+            setpoint = entry.runner.submit({name: number})
+        except InputError as exc:
+            out_of_range = (not math.isfinite(number)) or bool(entry.runner.limits.problems({name: number}))
+            return await answer("BadOutOfRange" if out_of_range else "BadTypeMismatch", str(exc))
+        if nodes is not None:
+            nid = self._nid(bearing_id, "Setpoint", name)
+            await self.server.write_attribute_value(nid, ua.DataValue(ua.Variant(float(getattr(setpoint, name)),
+                                                                                 ua.VariantType.Double)))
+            nodes.last[f"Setpoint/{name}"] = getattr(setpoint, name)
+        return await answer("Good", setpoint=setpoint.model_dump())
