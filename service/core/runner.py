@@ -356,6 +356,7 @@ class TwinRunner:
             if self.idle_without_scenario and not self.scenarios.active:
                 if (event and pacing.last_publish_sim != self.sim_elapsed_s) or changed:
                     self._publish(self._clock())
+                self._notify_ended()
                 pacing.restart_sample_grid(self.sim_elapsed_s)
                 self._reanchor = True
                 return Schedule(self._clock() + IDLE_POLL_S)
@@ -368,6 +369,7 @@ class TwinRunner:
         except Exception as exc:  # noqa: BLE001 - counted, shown, recovered
             self._consecutive += 1
             self._on_error(exc, self._consecutive)
+            self._notify_ended()
             if self._consecutive >= self.max_consecutive_errors:
                 self.counters.failed = True
                 self.publisher.note = (f"failed: runner stopped after {self._consecutive} errors in a "
@@ -380,10 +382,17 @@ class TwinRunner:
         now = self._clock()
         sim = self.sim_elapsed_s
         pacing.measure(now, sim)
+        release = pacing.frame_done(now, sim)
         if pacing.publish_due(now, sim, changed or event):
             self._safe_publish(now)
-        release = pacing.frame_done(now, sim)
+        self._notify_ended()
         return Schedule(release, math.inf if self.fast else release + self.frame_s)
+
+    def _notify_ended(self) -> None:
+        """A scenario ended in this step: its waiters wake once what it published is delivered."""
+        ended = self.scenarios.take_ended()
+        if ended is not None:
+            self.publisher.after_pending(ended.notify)
 
     def left_pool(self) -> None:
         """The pool let the twin go: done once its last capture is delivered."""
