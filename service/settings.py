@@ -140,8 +140,9 @@ class ServiceSettings(BaseSettings):
     gil_switch_interval_s: float = Field(
         default=0.0005, ge=1e-5, le=0.1,
         description="Python thread switch interval set when the service starts [s] (sys.setswitchinterval; "
-        "Python's 5 ms default makes a runner thread wait up to 5 ms for the GIL after each 1 ms "
-        "frame while the zenoh/rerun/HTTP threads run; 0.5 ms keeps the real-time factor at 1).")
+        "Python's 5 ms default makes a stepping thread wait up to 5 ms for the GIL after each frame "
+        "while the publish worker and the zenoh/rerun/HTTP threads run; 0.5 ms keeps that wait a small "
+        "share of a frame).")
     max_twins: int | None = Field(
         default=None, ge=1, le=256,
         description="Most twins one service runs at a time [count]; unset = as many as the measured "
