@@ -254,7 +254,6 @@ def _check_tls_endpoints(s) -> None:
                              "certificate; with TLS (and no users file) listen on tls/HOST:PORT only")
 
 
-class ServiceSettings(ZenohAccessSettings):
 
 
 class AlarmSettings(BaseModel):
@@ -329,7 +328,7 @@ class AlarmSettings(BaseModel):
         return self
 
 
-class ServiceSettings(BaseSettings):
+class ServiceSettings(ZenohAccessSettings):
     """Configuration of `bearing-twin serve` (env prefix `BEARING_TWIN_`)."""
 
     model_config = SettingsConfigDict(env_prefix="BEARING_TWIN_", extra="ignore",
@@ -402,17 +401,49 @@ class ServiceSettings(BaseSettings):
         default=50.0, gt=0.0, le=1000.0,
         description="Snapshot publishing rate [Hz] (of wall time in real-time mode, of simulated "
         "time in fast mode).")
-    frame_s: float = Field(default=0.001, ge=1e-5, le=0.1,
-                           description="Simulated time per frame: setpoints apply between frames [s].")
+    frame_s: float = Field(
+        default=0.005, ge=1e-5, le=0.1,
+        description="Simulated time per frame: setpoints and scenario steps apply between frames [s]. "
+        "A stepping thread runs one frame of one twin at a time; 5 ms keeps the Python between frames "
+        "a small share of the work (README \"Runner pool\").")
+    setpoint_frame_s: float = Field(
+        default=0.001, ge=1e-5, le=0.1,
+        description="Real-time mode: the frame that applies an outside setpoint (HTTP, zenoh) lasts this "
+        "long when shorter than frame_s, and a twin waiting for its next frame starts it at once, so "
+        "the state carrying the setpoint is published sooner [s].")
+    lateness_s: float = Field(
+        default=0.005, ge=0.0, le=1.0,
+        description="A frame is late (counted in /health `overruns` and `late_fraction`) when it ends "
+        "more than this after its wall-clock deadline [s].")
+    stepping_threads: int | None = Field(
+        default=None, ge=1, le=64,
+        description="Threads that advance the twins, earliest deadline first [count]; unset = one per "
+        "core this process may use.")
+    admission: Literal["measured", "off"] = Field(
+        default="measured",
+        description="'measured': a twin created over the API that this host cannot run in real time "
+        "(its calibrated CPU need beside the running twins' measured need exceeds the capacity) is "
+        "refused with 503, the reason and the figures; 'off': no capacity check (fast mode never "
+        "checks) [text].")
+    capacity_core_fraction: float = Field(
+        default=0.85, gt=0.0, le=1.0,
+        description="Share of each core the twins may use in real time; the rest is left to the "
+        "zenoh, rerun and HTTP threads [-]. One twin may use at most this much of one core.")
+    calibration_s: float = Field(
+        default=0.02, ge=0.001, le=1.0,
+        description="Simulated time a new twin runs at creation to measure its CPU need [s].")
     enable_zenoh: bool = Field(default=True, description="Start the zenoh bus [bool].")
     enable_recording: bool = Field(default=True, description="Write the rerun recording [bool].")
     gil_switch_interval_s: float = Field(
         default=0.0005, ge=1e-5, le=0.1,
         description="Python thread switch interval set when the service starts [s] (sys.setswitchinterval; "
-        "Python's 5 ms default makes a runner thread wait up to 5 ms for the GIL after each 1 ms "
-        "frame while the zenoh/rerun/HTTP threads run; 0.5 ms keeps the real-time factor at 1).")
-    max_twins: int = Field(default=8, ge=1, le=256,
-                           description="Most twins one service runs at a time [count].")
+        "Python's 5 ms default makes a stepping thread wait up to 5 ms for the GIL after each frame "
+        "while the publish worker and the zenoh/rerun/HTTP threads run; 0.5 ms keeps that wait a small "
+        "share of a frame).")
+    max_twins: int | None = Field(
+        default=None, ge=1, le=256,
+        description="Most twins one service runs at a time [count]; unset = as many as the measured "
+        "capacity admits (admission 'measured'), at most 256.")
     # ---- hardening (README "Hardening") -------------------------------------------------------
     token: SecretStr | None = Field(
         default=None,
@@ -512,6 +543,11 @@ class ServiceSettings(BaseSettings):
         if isinstance(value, str) and value.strip().lower() in ("", "none", "off"):
             return None
         return value
+
+    @property
+    def twin_limit(self) -> int:
+        """The fixed cap on the number of twins (max_twins, or 256 when unset)."""
+        return self.max_twins if self.max_twins is not None else 256
 
     @property
     def scenarios_path(self) -> Path:

@@ -112,6 +112,7 @@ class Snapshot(BaseModel):
     seq: int = Field(description="Per-twin counter of snapshots (gaps reveal drops).")
     time_s: float = Field(description="Simulated time [s].")
     real_time_factor: float | None = Field(description="Simulated seconds per wall second over the last frames [-]; null when not measured.")
+    late_fraction: float | None = Field(default=None, description="Fraction of the frames of the last 10 s of wall time that ended later than the service's lateness (5 ms by default) after their wall-clock deadline [-]; null when not measured (fast mode, before the first frame, outside the service).")
     status: str = Field(description="'ok' or what went wrong and what the twin did about it.")
     restarts: int = Field(description="Warm restarts after a diverged or overloaded state.")
     setpoint: Setpoint = Field(description="The setpoint in force during the frame that ended at time_s [fields with units].")

@@ -65,7 +65,7 @@ class BearingInfo(BaseModel):
     diametral_clearance_m: float = Field(description="Diametral clearance Pd [m]; negative = preload.")
     lubricant: str = Field(description="Lubricant name [text].")
     mode: Literal["real_time", "fast"] = Field(description="Pacing: real_time (paced to the wall clock) or fast [text].")
-    running: bool = Field(description="Whether the runner thread is alive [bool].")
+    running: bool = Field(description="Whether the twin is being stepped (started, neither stopped nor failed) [bool].")
     time_s: float = Field(description="Simulated time of the latest snapshot [s].")
     setpoint: Setpoint = Field(description="The setpoint in force or pending (latest accepted) [fields with units].")
     limits: dict[str, tuple[float, float]] = Field(description="Allowed [low, high] of each setpoint field for this bearing, in the unit its name carries (shaft_speed_rad_s in rad/s, ...) [field unit].")
@@ -132,18 +132,46 @@ class RecordingStatus(BaseModel):
     rows_logged: int = Field(default=0, description="Snapshots written to it so far [-].")
 
 
+class TwinCost(BaseModel):
+    """CPU a twin needs in real time (service.core.capacity)."""
+
+    engine_cpu_s_per_sim_s: float = Field(description="Engine CPU time per simulated second [CPU s / s]: 1 / the real-time factor the twin would have alone on a core.")
+    publish_cpu_s_per_s: float = Field(description="CPU time spent building its snapshots per wall second, at the publish rate [CPU s / s].")
+    cpu_s_per_s: float = Field(description="The sum: CPU time the twin needs per wall second in real time [CPU s / s].")
+
+
+class Capacity(BaseModel):
+    """The host's capacity for twins in real time, as measured (admission rule: README "Runner pool")."""
+
+    admission: Literal["measured", "off"] = Field(description="Whether new twins are checked against the capacity [text].")
+    cores: int = Field(description="Cores this process may use [-].")
+    stepping_threads: int = Field(description="Threads that advance the twins [-].")
+    core_fraction: float = Field(description="Share of each core the twins may use; also the most one twin may use [-].")
+    budget_cpu_s_per_s: float = Field(description="min(stepping threads, cores) x core_fraction [CPU s / s].")
+    used_cpu_s_per_s: float = Field(description="What the running twins need, as measured [CPU s / s].")
+    over_budget: bool = Field(default=False, description="Whether the running twins need more than the budget [bool].")
+    max_twins: int | None = Field(default=None, description="Twins this host holds in real time: the running ones plus as many more like the last calibrated one as the budget has room for (capped by max_twins when set) [-]; null before a calibration.")
+    max_twins_set: int | None = Field(default=None, description="The max_twins setting; null = unset [-].")
+    last_calibration: TwinCost | None = Field(default=None, description="The cost measured at the last twin creation [CPU s / s]; null before one.")
+    over_capacity: str | None = Field(default=None, description="Why the configured twin runs although it does not fit; null when it fits [text].")
+
+
+
 # ---- health -------------------------------------------------------------------------------------
 class TwinHealth(BaseModel):
     """Runner figures of one twin."""
 
     id: str = Field(description="Twin name [text].")
-    running: bool = Field(description="Whether the runner thread is alive [bool].")
+    running: bool = Field(description="Whether the twin is being stepped (started, neither stopped nor failed) [bool].")
     status: str = Field(description="'ok' or what went wrong [text].")
     mode: Literal["real_time", "fast"] = Field(description="Pacing [text].")
     time_s: float = Field(description="Simulated time [s].")
     real_time_factor: float | None = Field(description="Simulated seconds per wall second over the last second [-]; null before it is measured.")
+    late_fraction: float | None = Field(default=None, description="Late frames (ended more than lateness_s after their wall-clock deadline) / frames over the last 10 s of wall time [-]; null in fast mode and before the first frame.")
+    lateness_s: float | None = Field(default=None, description="How late a frame may end before it counts as late [s].")
+    frame_s: float | None = Field(default=None, description="Simulated time per frame [s].")
     frames: int = Field(description="Frames advanced [-].")
-    overruns: int = Field(description="Frames that finished after their wall-clock deadline (real-time mode) [-].")
+    overruns: int = Field(description="Frames that ended more than lateness_s after their wall-clock deadline, since the start (real-time mode) [-].")
     resyncs: int = Field(description="Times the schedule was re-anchored after falling far behind [-].")
     published: int = Field(description="Snapshots published [-].")
     dropped: int = Field(description="Snapshots dropped by the sinks' bounded queues [-].")
@@ -154,6 +182,8 @@ class TwinHealth(BaseModel):
     setpoints_rate_limited: int = Field(default=0, description="Setpoints refused by the rate limit, HTTP 429 and zenoh [-].")
     fallbacks: int = Field(default=0, description="Times the twin could not hold its setpoint and was warm-restarted at the last safe one [-].")
     last_safe_setpoint: Setpoint | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")
+    publish_skipped: int = Field(default=0, description="Captured states dropped before their snapshot was built because the publish worker was behind (real-time mode) [-].")
+    cost: TwinCost | None = Field(default=None, description="CPU this twin needs in real time, as measured (its calibration until measured while running) [CPU s / s]; null when not measured.")
 
 
 class Health(BaseModel):
@@ -162,6 +192,7 @@ class Health(BaseModel):
     status: Literal["ok", "degraded"] = Field(description="'ok', or 'degraded' when a twin's runner stopped or reports errors, or a recording cannot be written [text].")
     uptime_s: float = Field(description="Wall time since the service started [s].")
     twins: list[TwinHealth] = Field(description="One entry per twin [list].")
+    capacity: Capacity | None = Field(default=None, description="The host's measured capacity for twins in real time [CPU s / s, counts].")
     zenoh: bool = Field(description="Whether the zenoh bus is open [bool].")
     zenoh_listen: list[str] = Field(description="zenoh endpoints listened on [zenoh locator].")
     recording: str | None = Field(description="The service-wide .rrd being written [path]; null when off.")

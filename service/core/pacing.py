@@ -1,12 +1,17 @@
-"""The pacing clock of a runner: frame deadlines, real-time factor, publishing schedule.
+"""The pacing clock of a runner: frame deadlines, lateness, real-time factor, publishing schedule.
 
-Real-time mode: frame k ends at the deadline `anchor + k * frame_s` on the monotonic clock; a
-frame that finishes after its deadline is an overrun (counted), the loop then does not sleep and
-catches up on the following frames. If it falls more than `resync_after_s` behind (a stall, a
-cold JIT compile) the schedule is re-anchored (`resyncs`) instead of racing to catch up. Fast
-mode never sleeps.
+Real-time mode: the frame that ends at simulated time s (counted from the anchor) should end by
+the wall-clock DEADLINE `anchor_wall + (s - anchor_sim)`; its successor may start then (its
+RELEASE, `frame_done` returns it to the stepping pool, which waits). A frame is LATE (counted
+in `overruns`, and in `late_fraction`) when it ends more than `lateness_s` (5 ms by default)
+after its deadline, not when it ends a few microseconds after it: a twin running a frame or so
+ahead of or behind the wall clock is real time to anyone watching it. A twin behind its
+schedule is released at once and catches up; if it falls more than `resync_after_s` behind (a
+stall, a cold JIT compile) the schedule is re-anchored (`resyncs`) instead of racing to catch
+up. Fast mode never waits and is never late.
 
 Real-time factor: simulated / wall time over a sliding window (`rtf_window_s`, 1 s).
+Late fraction: late frames / frames over a sliding window of wall time (`late_window_s`, 10 s).
 
 Publishing (choice): in real-time mode every 1/publish_rate_hz of WALL time (what a viewer or a
 zenoh subscriber sees stays steady even if the twin falls behind), plus right after a frame that
@@ -19,26 +24,33 @@ from __future__ import annotations
 
 import collections
 import math
-import threading
 from collections.abc import Callable
 
 
 class PacingClock:
-    """Deadlines, real-time factor and publishing schedule of one runner (runner thread only)."""
+    """Deadlines, lateness, real-time factor and publishing schedule of one runner (written by
+    whichever stepping thread runs the twin's frame; read by any)."""
 
     def __init__(self, *, fast: bool, publish_period_s: float, clock: Callable[[], float],
                  rtf_window_s: float = 1.0, resync_after_s: float = 0.25,
-                 setpoint_publish_min_interval_s: float = 0.002):
+                 setpoint_publish_min_interval_s: float = 0.002, lateness_s: float = 0.005,
+                 late_window_s: float = 10.0):
+        if not (lateness_s >= 0.0 and math.isfinite(lateness_s)):
+            raise ValueError(f"lateness_s = {lateness_s!r}: must be >= 0 [s]")
         self.fast = fast
         self.publish_period_s = publish_period_s
         self.rtf_window_s = rtf_window_s
-        self.resync_after_s = resync_after_s
+        self.resync_after_s = max(resync_after_s, lateness_s)
         self.setpoint_publish_min_interval_s = setpoint_publish_min_interval_s
+        self.lateness_s = lateness_s
+        self.late_window_s = late_window_s
         self.clock = clock
-        self.overruns = 0
+        self.overruns = 0           # frames that ended more than lateness_s after their deadline
         self.resyncs = 0
         self._rtf: float | None = None
         self._samples: collections.deque[tuple[float, float]] = collections.deque()
+        self._late: collections.deque[tuple[float, bool]] = collections.deque()
+        self._late_in_window = 0
         self._anchor_wall = self._anchor_sim = 0.0
         self._next_publish_wall = self._next_publish_sim = 0.0
         self._publish_soon = False
@@ -49,6 +61,13 @@ class PacingClock:
     def real_time_factor(self) -> float | None:
         return self._rtf
 
+    @property
+    def late_fraction(self) -> float | None:
+        """Late frames / frames over the last `late_window_s` of wall time (None before any
+        real-time frame)."""
+        n = len(self._late)
+        return self._late_in_window / n if n else None
+
     def start(self, sim_s: float) -> None:
         """Anchor the schedule at the loop's start."""
         now = self.clock()
@@ -56,13 +75,17 @@ class PacingClock:
         self._next_publish_wall = now + self.publish_period_s
         self._next_publish_sim = sim_s + self.publish_period_s
 
-    def reanchor(self, sim_s: float) -> None:
-        """After idling or an error: deadlines count from now."""
-        self._anchor_wall, self._anchor_sim = self.clock(), sim_s
+    def reanchor(self, sim_s: float, at: float | None = None) -> None:
+        """After idling or an error: deadlines count from now (or `at`)."""
+        self._anchor_wall, self._anchor_sim = (self.clock() if at is None else at), sim_s
 
     def restart_sample_grid(self, sim_s: float) -> None:
         """Fast mode: the next sample one period after `sim_s` (a scenario started or ended)."""
         self._next_publish_sim = sim_s + self.publish_period_s
+
+    def deadline(self, sim_s: float) -> float:
+        """The wall-clock time at which the simulated clock should read `sim_s` [s]."""
+        return self._anchor_wall + (sim_s - self._anchor_sim)
 
     def measure(self, now: float, sim_s: float) -> None:
         """A frame ended at wall time `now` with `sim_s` simulated: update the real-time factor."""
@@ -102,16 +125,27 @@ class PacingClock:
         """Publish at the next frame (subject to the minimum interval)."""
         self._publish_soon = True
 
-    def wait_for_deadline(self, now: float, sim_s: float, stop: threading.Event) -> None:
-        """Real-time mode: sleep until the frame's deadline (or count an overrun, re-anchoring
-        when far behind). Fast mode: return at once."""
+    def frame_done(self, now: float, sim_s: float) -> float:
+        """A frame ended at `now` with the simulated clock at `sim_s`: count it late or not
+        (real-time mode) and return when the next frame may start [wall-clock s]: its release,
+        `now` itself when the twin is behind (and always in fast mode)."""
         if self.fast:
-            return
-        late = now - (self._anchor_wall + (sim_s - self._anchor_sim))
-        if late > 0.0:
+            return now
+        behind = now - self.deadline(sim_s)
+        late = behind > self.lateness_s
+        if late:
             self.overruns += 1
-            if late > self.resync_after_s:
-                self.resyncs += 1
-                self._anchor_wall, self._anchor_sim = now, sim_s
-        else:
-            stop.wait(-late)
+        self._count_late(now, late)
+        if behind > self.resync_after_s:
+            self.resyncs += 1
+            self._anchor_wall, self._anchor_sim = now, sim_s
+            return now
+        return max(now, self.deadline(sim_s))
+
+    def _count_late(self, now: float, late: bool) -> None:
+        w = self._late
+        w.append((now, late))
+        self._late_in_window += late
+        while w and now - w[0][0] > self.late_window_s:
+            _, was_late = w.popleft()
+            self._late_in_window -= was_late

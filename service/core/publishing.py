@@ -1,20 +1,39 @@
-"""Publishing of a runner: the snapshot taken after a frame goes to every sink.
+"""Publishing of a runner: what a frame captured becomes a snapshot for every sink, off the
+stepping threads.
+
+After a frame that is due to publish, the stepping thread only CAPTURES the twin: a frozen copy
+(`freeze`: the twin object shallow-copied with its state arrays copied, some microseconds) with
+the real-time factor, the late fraction and the runner's status note of that moment. The
+pool's `PublishWorker` thread builds the `Snapshot` from it (pydantic, about a millisecond) and
+hands it to the sinks, in capture order. Without a worker (before the runner starts) a capture
+is built and delivered at once.
+
+Back-pressure. At most `max_pending` captures of a twin wait for the worker. Real-time mode:
+one more drops the oldest waiting capture (counted in `skipped`; the setpoint timings it
+carried move to the newer one, which reflects the same setpoints). Lossless mode (fast mode: a
+scenario's samples must all arrive) makes the stepping thread wait instead.
 
 Sinks (zenoh channel, recorder, table) only enqueue (bounded, drop-oldest, counted: see
-service.core.sinks), so publishing never blocks the physics; a sink that raises is counted and
+service.core.sinks), so the worker never blocks on I/O; a sink that raises is counted and
 skipped. The runner's own status note (a fallback, a caught error) is written into the
 snapshot's `status` beside the engine's. The first snapshot that reflects an accepted setpoint
-completes its `SetpointTiming`.
+completes its `SetpointTiming` (published = when the worker handed it to the sinks).
 """
 
 from __future__ import annotations
 
 import collections
+import copy
+import dataclasses
 import logging
 import threading
-from collections.abc import Iterable
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field
 
+from service.core.capacity import CpuMeter
 from service.core.mailbox import SetpointTiming
+from service.core.pool import PublishWorker
 from service.core.sinks import SnapshotSink
 from twin.engine import Twin
 from twin.snapshot import Snapshot
@@ -22,19 +41,53 @@ from twin.snapshot import Snapshot
 log = logging.getLogger(__name__)
 
 
-class Publisher:
-    """Sinks, the latest snapshot and the status note of one twin."""
+def freeze(twin: Twin) -> Twin:
+    """A copy of `twin` that `snapshot()` can read while the original runs on: the object
+    shallow-copied (the model, setpoint and fault are immutable; numbers are values) with its
+    mutable state arrays copied."""
+    frozen = copy.copy(twin)
+    state = twin.state
+    frozen.state = dataclasses.replace(state, **{f.name: getattr(state, f.name).copy()
+                                                 for f in dataclasses.fields(state)})
+    return frozen
 
-    def __init__(self, bearing_id: str, sinks: Iterable[SnapshotSink] = (), timing_history: int = 10000):
+
+@dataclass
+class Capture:
+    """A twin as a frame left it, waiting to become a snapshot."""
+
+    twin: Twin
+    real_time_factor: float | None
+    late_fraction: float | None
+    note: str | None
+    timings: list[SetpointTiming] = field(default_factory=list)
+
+
+class Publisher:
+    """Sinks, the latest snapshot, the status note and the captures waiting for the worker of
+    one twin (see the module docstring)."""
+
+    def __init__(self, bearing_id: str, sinks: Iterable[SnapshotSink] = (), timing_history: int = 10000,
+                 *, max_pending: int = 8, lossless: bool = False, clock: Callable[[], float] = time.perf_counter):
         self.bearing_id = bearing_id
+        self.max_pending = max(1, int(max_pending))
+        self.lossless = lossless
+        self.clock = clock
         self._lock = threading.Lock()
+        self._cv = threading.Condition(threading.Lock())
         self._sinks: list[SnapshotSink] = list(sinks)
         self._latest: Snapshot | None = None
         self._unpublished: list[SetpointTiming] = []
+        self._pending: collections.deque[Capture] = collections.deque()
         self._timings: collections.deque[SetpointTiming] = collections.deque(maxlen=timing_history)
+        self._worker: PublishWorker | None = None
+        self._seq: int | None = None
+        self._carry: list[SetpointTiming] = []   # timings of a capture whose snapshot failed (worker)
         self.note: str | None = None     # the runner's word on the twin's state, or None
         self.published = 0
         self.sink_errors = 0
+        self.skipped = 0                 # captures dropped before they were built (real time, worker behind)
+        self.cpu = CpuMeter(window=50)   # CPU s per snapshot built and handed to the sinks
 
     # ---- any thread ------------------------------------------------------------------------
     @property
@@ -67,20 +120,38 @@ class Publisher:
                 pass
         return total
 
+    @property
+    def pending(self) -> int:
+        """Captures waiting for the worker."""
+        with self._cv:
+            return len(self._pending)
+
     def timings(self) -> list[SetpointTiming]:
         """Completed setpoint timings (oldest first)."""
         with self._lock:
             return list(self._timings)
 
-    def status_text(self, engine_status: str) -> str:
+    def status_text(self, engine_status: str, note: str | None = None) -> str:
         """The snapshot status: the engine's, with the runner's note in front."""
-        if self.note is None:
+        note = self.note if note is None else note
+        if note is None:
             return engine_status
         if engine_status and engine_status != "ok":
-            return f"{self.note}; engine: {engine_status}"
-        return self.note
+            return f"{note}; engine: {engine_status}"
+        return note
 
-    # ---- runner thread ---------------------------------------------------------------------
+    def attach(self, worker: PublishWorker | None) -> None:
+        """Build and deliver on `worker` from now on (None: in the calling thread)."""
+        self._worker = worker
+
+    def after_pending(self, fn: Callable[[], None]) -> None:
+        """Run `fn` once every capture queued so far is delivered (on the worker, or now)."""
+        worker = self._worker
+        if worker is None or not worker.submit(fn):
+            self._drain()
+            fn()
+
+    # ---- stepping thread -------------------------------------------------------------------
     def await_snapshot(self, timings: list[SetpointTiming]) -> None:
         """These setpoints were applied: complete their timings at the next publication."""
         self._unpublished.extend(timings)
@@ -89,11 +160,62 @@ class Publisher:
         """The latest snapshot without publishing it (before the runner starts)."""
         self._latest = snapshot
 
-    def publish(self, twin: Twin, real_time_factor: float | None, now: float) -> Snapshot:
-        """Take a snapshot of `twin` and hand it to every sink."""
-        snap = twin.snapshot(real_time_factor=real_time_factor)
-        if self.note is not None:
-            snap = snap.model_copy(update={"status": self.status_text(snap.status)})
+    def capture(self, twin: Twin, real_time_factor: float | None, late_fraction: float | None = None,
+                *, stop: threading.Event | None = None) -> None:
+        """Capture `twin` for publication (frozen copy when a worker builds it later)."""
+        worker = self._worker
+        timings, self._unpublished = self._unpublished, []
+        if worker is None or not worker.alive:
+            self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings))
+            return
+        cap = Capture(freeze(twin), real_time_factor, late_fraction, self.note, timings)
+        with self._cv:
+            if self.lossless:
+                while (len(self._pending) >= self.max_pending and worker.alive
+                       and not (stop is not None and stop.is_set())):
+                    self._cv.wait(0.1)
+            elif len(self._pending) >= self.max_pending:
+                old = self._pending.popleft()
+                cap.timings[:0] = old.timings
+                self.skipped += 1
+            self._pending.append(cap)
+        if not worker.submit(self._deliver_next):
+            self._drain()
+
+    # ---- worker thread (or the caller without one) -----------------------------------------
+    def _drain(self) -> None:
+        while self._deliver_next():
+            pass
+
+    def _deliver_next(self) -> bool:
+        with self._cv:
+            if not self._pending:
+                return False
+            cap = self._pending.popleft()
+            self._cv.notify_all()
+        self._deliver(cap)
+        return True
+
+    def _deliver(self, cap: Capture) -> None:
+        c0 = time.thread_time()
+        if self._carry:
+            cap.timings[:0], self._carry = self._carry, []
+        try:
+            tw = cap.twin
+            if self._seq is not None:
+                tw.seq = self._seq            # the publisher numbers the snapshots of its twin
+            snap = tw.snapshot(real_time_factor=cap.real_time_factor)
+            self._seq = snap.seq
+            update = {"late_fraction": cap.late_fraction} if cap.late_fraction is not None else {}
+            if cap.note is not None:
+                update["status"] = self.status_text(snap.status, cap.note)
+            if update:
+                snap = snap.model_copy(update=update)
+        except Exception as exc:  # noqa: BLE001 - counted; the twin goes on
+            self.sink_errors += 1
+            self._carry = cap.timings       # completed by the next snapshot that is built
+            log.warning("twin %s: snapshot failed: %s", self.bearing_id, exc)
+            return
         self._latest = snap
         self.published += 1
         for sink in self.sinks:
@@ -103,10 +225,10 @@ class Publisher:
                 self.sink_errors += 1
                 if self.sink_errors <= 5:
                     log.warning("twin %s: sink %r failed: %s", self.bearing_id, sink, exc)
-        if self._unpublished:
-            done, self._unpublished = self._unpublished, []
-            for t in done:
+        if cap.timings:
+            now = self.clock()
+            for t in cap.timings:
                 t.published_wall_s, t.seq = now, snap.seq
             with self._lock:
-                self._timings.extend(done)
-        return snap
+                self._timings.extend(cap.timings)
+        self.cpu.add(time.thread_time() - c0, 1.0)

@@ -3,14 +3,20 @@
 No transport here: the zenoh bus and the recorders are plugged in from outside through
 `Bus` / `Recorder` (service.wiring opens them from the settings):
 
-    create twin -> Twin (warm-started) -> TwinRunner (not started) -> SetpointIntake
+    create twin -> Twin (warm-started) -> admission by measured capacity (service.core.capacity:
+                   calibration, 503 when this host cannot run it in real time beside the others)
+                -> TwinRunner (not started, stepped by the registry's SteppingPool) -> SetpointIntake
                 -> bus.attach_twin(id, latest, intake) channel as a sink
                 -> recorder.add_twin_from(twin), recorder as a sink
                 -> alarms.add_twin(id), the alarm hub as a sink -> runner.start()
     delete twin -> runner.stop() -> channel.detach() -> alarms forgotten -> per-twin recording closed
     close       -> every runner stopped (all asked first, then joined) -> channels detached
-                -> per-twin recordings closed -> hook `_close_outputs` (service recording,
-                   zenoh session)
+                -> per-twin recordings closed -> stepping pool closed -> hook `_close_outputs`
+                   (service recording, zenoh session)
+
+One `SteppingPool` (service.core.pool) runs every twin's frames on `stepping_threads` threads
+(one per core by default), earliest deadline first, and builds their snapshots on its publish
+worker.
 
 A twin's own recording (`start_recording`) goes to a path under the recordings directory
 (relative, plain names, .rrd), made by `_new_recording(path)`.
@@ -35,8 +41,10 @@ from pydantic import ValidationError
 from service.core.admission import AdmissionGate
 from service.core.alarm_hub import AlarmHub
 from service.core.alarms import AlarmEvent
+from service.core.capacity import Capacity, TwinCost, calibrate, usable_cores
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import SetpointIntake
+from service.core.pool import SteppingPool
 from service.core.runner import TwinRunner
 from service.core.sinks import SnapshotSink
 from service.settings import ServiceSettings
@@ -126,6 +134,13 @@ class TwinRegistry:
         self.started_wall_s = time.monotonic()
         self._twins: dict[str, TwinEntry] = {}
         self._reserved: set[str] = set()    # ids of twins being built
+        self._admitting: dict[str, TwinCost] = {}   # costs of twins admitted, not yet running
+        threads = settings.stepping_threads or usable_cores()
+        self.pool = SteppingPool(threads, name="step")
+        self.capacity = Capacity(threads, settings.capacity_core_fraction)
+        self.last_calibration: TwinCost | None = None
+        self.over_capacity: str | None = None     # why the configured twin runs over capacity
+        self._over_capacity_id: str | None = None
         self._recording_lock = threading.RLock()
         self._lock = threading.RLock()
         self._closed = False
@@ -157,9 +172,11 @@ class TwinRegistry:
         if sys.getswitchinterval() > self.settings.gil_switch_interval_s:
             sys.setswitchinterval(self.settings.gil_switch_interval_s)  # process-wide, see settings
         try:
+            self.pool.start()
             self._open_outputs()
             if default_twin and self.settings.start_twin:
-                self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing)
+                self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing,
+                                 over_capacity_ok=True)
         except BaseException:
             self.close()
             raise
@@ -184,6 +201,8 @@ class TwinRegistry:
         for e in entries:
             self._unwire(e)
         self.alarms.close()
+        if not self.pool.close(timeout=5.0):
+            log.error("the stepping pool did not stop within 5 s")
         self._close_outputs()
 
     def _unwire(self, e: TwinEntry) -> None:
@@ -252,9 +271,12 @@ class TwinRegistry:
             twin.reset()  # warm start at the requested setpoint
         return twin
 
-    def create_twin(self, id: str | None = None, designation: str = "6208", **options: Any) -> TwinEntry:
+    def create_twin(self, id: str | None = None, designation: str = "6208", *,
+                    over_capacity_ok: bool = False, **options: Any) -> TwinEntry:
         """Create, wire and start a twin (`options`: diametral_clearance_m, lubricant, setpoint,
-        thermal). InputError 409 on a duplicate id or when full, 422 for an invalid value."""
+        thermal). InputError 409 on a duplicate id or at max_twins, 503 when this host cannot
+        run it in real time (admission 'measured'; `over_capacity_ok`: start it anyway, with a
+        warning: the twin of the configuration), 422 for an invalid value."""
         s = self.settings
         with self._lock:
             if self._closed:
@@ -266,15 +288,19 @@ class TwinRegistry:
             if bearing_id in self._twins or bearing_id in self._reserved:
                 raise InputError.one("id", f"a twin named {bearing_id!r} already exists",
                                      status_code=409)
-            if len(self._twins) + len(self._reserved) >= s.max_twins:
+            limit = s.twin_limit
+            if len(self._twins) + len(self._reserved) >= limit:
                 raise InputError.one(None, f"this service already runs {len(self._twins)} twins "
-                                     f"(max_twins = {s.max_twins})", [0, s.max_twins], status_code=409)
+                                     f"(max_twins = {limit})", [0, limit], status_code=409)
             # reserve the id while the (slow) model is built outside the lock
             self._reserved.add(bearing_id)
         entry = None
         try:
             twin = self.build_twin(bearing_id, designation, **options)
-            runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s)
+            cost = self._admit(bearing_id, twin, over_capacity_ok)
+            runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s,
+                                setpoint_frame_s=s.setpoint_frame_s, lateness_s=s.lateness_s,
+                                pool=self.pool, cost=cost)
             entry = TwinEntry(id=bearing_id, twin=twin, runner=runner,
                               intake=SetpointIntake(bearing_id, self.gate, runner),
                               lubricant=twin.model.spec.lubricant.name)
@@ -290,13 +316,15 @@ class TwinRegistry:
         except BaseException:
             with self._lock:
                 self._reserved.discard(bearing_id)
+                self._admitting.pop(bearing_id, None)
             if entry is not None:
                 entry.runner.stop(timeout=2.0)
                 self._unwire(entry)
             raise
         with self._lock:
             self._reserved.discard(bearing_id)
-            if self._closed:   # closed while building: do not leak a running thread
+            self._admitting.pop(bearing_id, None)
+            if self._closed:   # closed while building: do not leak a running twin
                 entry.runner.stop(timeout=2.0)
                 self._unwire(entry)
                 raise InputError.one(None, "the service is shutting down", status_code=503)
@@ -305,12 +333,67 @@ class TwinRegistry:
                  entry.diametral_clearance_m, entry.lubricant, runner.mode)
         return entry
 
+    # ---- admission by measured capacity ----------------------------------------------------
+    def _admit(self, bearing_id: str, twin: Twin, over_capacity_ok: bool) -> TwinCost | None:
+        """Calibrate the new twin and check it against the capacity (service.core.capacity);
+        InputError 503 with the reason and the figures when it does not fit. Returns its cost
+        (None when admission is off or in fast mode)."""
+        s = self.settings
+        if s.admission == "off" or s.fast:
+            return None
+        cost = calibrate(twin, sim_s=s.calibration_s, frame_steps=max(1, round(s.frame_s / twin.model.dt_s)),
+                         publish_rate_hz=s.publish_rate_hz)
+        with self._lock:
+            self.last_calibration = cost
+            verdict = self.capacity.check(cost, self._running_costs())
+            if not verdict.admitted:
+                if not over_capacity_ok:
+                    log.warning("twin %s (%s) refused: %s", bearing_id, twin.model.spec.designation, verdict.reason)
+                    raise InputError.one(
+                        None, f"twin {bearing_id!r} ({twin.model.spec.designation}) refused: {verdict.reason}",
+                        [0.0, round(max(0.0, min(verdict.per_twin_cpu_s_per_s,
+                                                 verdict.budget_cpu_s_per_s - verdict.used_cpu_s_per_s)), 4)],
+                        status_code=503)
+                self.over_capacity = f"twin {bearing_id!r}: {verdict.reason}"
+                self._over_capacity_id = bearing_id
+                log.warning("twin %s (%s) started over capacity (it is the configured twin): %s",
+                            bearing_id, twin.model.spec.designation, verdict.reason)
+            self._admitting[bearing_id] = cost
+        return cost
+
+    def _running_costs(self) -> list[TwinCost]:
+        """What the twins running (and those admitted, still starting) need (lock held)."""
+        costs = [c for c in (e.runner.cost for e in self._twins.values()) if c is not None]
+        return costs + list(self._admitting.values())
+
+    def capacity_record(self) -> dict:
+        """The /health `capacity` entry: the rule's figures as measured now."""
+        with self._lock:
+            costs = self._running_costs()
+            running = len(self._twins)
+        used = sum(c.cpu_s_per_s for c in costs)
+        typical = self.last_calibration
+        cap = self.capacity
+        estimate = cap.estimate_max_twins(typical, running, used)
+        if self.settings.max_twins is not None:
+            estimate = self.settings.max_twins if estimate is None else min(estimate, self.settings.max_twins)
+        return {
+            "admission": "off" if self.settings.fast else self.settings.admission,
+            "cores": cap.cores, "stepping_threads": cap.stepping_threads,
+            "core_fraction": cap.core_fraction, "budget_cpu_s_per_s": cap.budget_cpu_s_per_s,
+            "used_cpu_s_per_s": used, "over_budget": used > cap.budget_cpu_s_per_s, "max_twins": estimate, "max_twins_set": self.settings.max_twins,
+            "last_calibration": typical.as_dict() if typical is not None else None,
+            "over_capacity": self.over_capacity,
+        }
+
     def delete_twin(self, bearing_id: str) -> TwinEntry:
         with self._lock:
             entry = self._twins.get(bearing_id)
             if entry is None:
                 self.get(bearing_id)  # raises the 404
             del self._twins[bearing_id]
+            if bearing_id == self._over_capacity_id:
+                self.over_capacity = self._over_capacity_id = None
         entry.runner.stop(timeout=5.0)
         self._unwire(entry)
         return entry
@@ -382,6 +465,7 @@ class TwinRegistry:
         rec = self.recorder
         return {
             "status": "degraded" if degraded else "ok",
+            "capacity": self.capacity_record(),
             "uptime_s": time.monotonic() - self.started_wall_s,
             "twins": twins,
             "zenoh": self.bus is not None and not getattr(self.bus, "closed", False),

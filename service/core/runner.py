@@ -1,20 +1,28 @@
-"""`TwinRunner`: one thread per twin, the ONLY writer of that twin's state.
+"""`TwinRunner`: one twin's frame loop, run by a stepping pool; the ONLY writer of the twin's state.
 
-Loop (one iteration per frame, `frame_s` of simulated time, 1 ms by default)::
+One `step` = one frame (`frame_s` of simulated time; the service runs 5 ms frames)::
 
     scenarios.tick()          take over a new scenario, offer its updates (ScenarioDriver)
     mailbox.take()            the pending setpoint, admitted once at submission (Mailbox)
-    faults.advance_frame()    twin.advance(frame_s), fall back when not held (FaultPolicy)
-    pacing.publish_due()      publisher.publish(): snapshot to every sink (PacingClock, Publisher)
-    pacing.wait_for_deadline()  real-time mode: sleep until the frame's wall-clock deadline
+    faults.advance_frame()    twin.advance(frame), fall back when not held (FaultPolicy)
+    pacing.publish_due()      publisher.capture(): a frozen copy for the publish worker (Publisher)
+    pacing.frame_done()       lateness counted; the release of the next frame is returned
 
 The jobs live in their own classes (service.core.pacing, .mailbox, .faults, .scenario_driver,
-.publishing, .stats); this class owns the thread and the frame loop and offers their public
-face (submit, start_scenario, latest, stats, ...).
+.publishing, .stats); this class owns the frame loop and offers their public face (submit,
+start_scenario, latest, stats, ...). The loop does not own a thread: a `SteppingPool`
+(service.core.pool) runs `step` on one of its stepping threads, earliest deadline first, and
+waits for the release time `step` returns (real time: the wall-clock time the twin's simulated
+clock has reached). A runner given no pool makes its own, of one stepping thread. Only one
+thread at a time runs a twin's frame, so its state has one writer at any moment.
 
 Frame semantics. A setpoint (from the mailbox or a scenario at scenario time t) is in force for
 the whole frame [t, t + frame_s); a snapshot taken at the end of a frame shows the setpoint that
-was in force during it (so a ramp sampled at t shows the ramp's value at t - frame_s).
+was in force during it (so a ramp sampled at t shows the ramp's value at t - frame_s). A
+setpoint that arrives mid-frame applies at the next frame. In real-time mode an outside
+setpoint also releases a twin that waits for its next frame at once, and the frame that applies
+it lasts `setpoint_frame_s` (1 ms, when shorter than `frame_s`), so the state that reflects it
+is published within about a millisecond of simulated time instead of a whole frame.
 
 Errors. An exception in the loop is caught, counted (`errors`), logged, shown in the snapshots'
 `status`, and the twin is warm-restarted at the setpoint in force; after
@@ -38,9 +46,11 @@ from typing import Any
 from pydantic import ValidationError
 
 from service.core.errors import InputError, field_errors, setpoint_field_errors
+from service.core.capacity import CpuMeter, TwinCost
 from service.core.faults import Fallback, FaultPolicy
 from service.core.mailbox import Mailbox, SetpointTiming
 from service.core.pacing import PacingClock
+from service.core.pool import Job, Schedule, SteppingPool
 from service.core.publishing import Publisher
 from service.core.scenario_driver import ScenarioDriver, ScenarioHandle
 from service.core.scenarios import ResolvedRun
@@ -53,6 +63,9 @@ from twin.snapshot import Snapshot
 log = logging.getLogger(__name__)
 
 __all__ = ["ScenarioHandle", "SetpointTiming", "TwinRunner", "parse_update"]
+
+IDLE_POLL_S = 0.05      # an idle twin (no scenario) looks at its mailbox this often [s]
+ERROR_PAUSE_S = 0.01    # pause after a caught error [s]
 
 
 def parse_update(data: Any, limits: SetpointLimits) -> SetpointUpdate:
@@ -70,7 +83,7 @@ def parse_update(data: Any, limits: SetpointLimits) -> SetpointUpdate:
 
 
 class TwinRunner:
-    """Runs one `Twin` in its own thread (see the module docstring)."""
+    """Runs one `Twin` frame by frame in a stepping pool (see the module docstring)."""
 
     def __init__(self, twin: Twin, *, fast: bool = False, publish_rate_hz: float = 50.0,
                  frame_s: float = 0.001, sinks: Iterable[SnapshotSink] = (),
@@ -78,6 +91,8 @@ class TwinRunner:
                  idle_without_scenario: bool = False, max_consecutive_errors: int = 20,
                  setpoint_publish_min_interval_s: float = 0.002, timing_history: int = 10000,
                  safe_after_frames: int = 20, max_restarts_per_frame: int = 2,
+                 lateness_s: float = 0.005, setpoint_frame_s: float | None = 0.001,
+                 pool: SteppingPool | None = None, cost: TwinCost | None = None,
                  clock: Callable[[], float] = time.perf_counter):
         if not (publish_rate_hz > 0 and math.isfinite(publish_rate_hz)):
             raise ValueError(f"publish_rate_hz = {publish_rate_hz!r}: must be > 0 [Hz]")
@@ -87,13 +102,17 @@ class TwinRunner:
             raise ValueError(f"frame_s = {frame_s!r} s is shorter than the time step {dt:g} s")
         self.twin = twin
         self.bearing_id = twin.bearing_id
+        self.name = f"twin-{self.bearing_id}"
         self.fast = bool(fast)
         self.publish_rate_hz = float(publish_rate_hz)
         self.frame_steps = steps
         self.frame_s = steps * dt
+        sp_steps = steps if setpoint_frame_s is None else max(1, min(steps, round(setpoint_frame_s / dt)))
+        self.setpoint_frame_steps = steps if self.fast else sp_steps
         self.idle_without_scenario = idle_without_scenario
         self.max_consecutive_errors = max_consecutive_errors
         self.limits: SetpointLimits = twin.limits
+        self.calibration: TwinCost | None = cost    # measured at admission (service.core.capacity)
         self._clock = clock
 
         self.mailbox = Mailbox(twin.setpoint, self.limits, clock=clock)
@@ -101,14 +120,21 @@ class TwinRunner:
                                   max_restarts_per_frame=max_restarts_per_frame)
         self.pacing = PacingClock(fast=self.fast, publish_period_s=1.0 / self.publish_rate_hz, clock=clock,
                                   rtf_window_s=rtf_window_s, resync_after_s=resync_after_s,
-                                  setpoint_publish_min_interval_s=setpoint_publish_min_interval_s)
-        self.publisher = Publisher(self.bearing_id, sinks, timing_history=timing_history)
+                                  setpoint_publish_min_interval_s=setpoint_publish_min_interval_s,
+                                  lateness_s=lateness_s)
+        self.publisher = Publisher(self.bearing_id, sinks, timing_history=timing_history,
+                                   lossless=self.fast, clock=clock)
         self.scenarios = ScenarioDriver()
         self.counters = LoopCounters()
-        self._sim_frames = 0                 # frames advanced by this runner (integer: no drift)
+        self.engine_cpu = CpuMeter(window=2.0)   # CPU s per simulated s of this twin's frames
+        self._sim_steps = 0                  # steps advanced by this runner (integer: no drift)
+        self._consecutive = 0
+        self._reanchor = False
         self._stop = threading.Event()
-        self._wake = threading.Event()
-        self._thread: threading.Thread | None = None
+        self._done = threading.Event()
+        self._pool = pool
+        self._own_pool = pool is None
+        self._job: Job | None = None
 
     # ---- public, any thread ------------------------------------------------------------------
     @property
@@ -117,7 +143,13 @@ class TwinRunner:
 
     @property
     def running(self) -> bool:
-        return self._thread is not None and self._thread.is_alive()
+        """Started, and neither stopped nor failed (its last snapshot delivered)."""
+        return self._job is not None and not self._done.is_set()
+
+    @property
+    def stepping_threads(self) -> list[str]:
+        """Names of the threads that may run this twin's frames."""
+        return self._pool.thread_names if self._pool is not None else []
 
     @property
     def latest(self) -> Snapshot | None:
@@ -131,11 +163,30 @@ class TwinRunner:
     @property
     def sim_elapsed_s(self) -> float:
         """Simulated seconds advanced by this runner [s] (survives warm restarts of the twin)."""
-        return self._sim_frames * self.frame_s
+        return self._sim_steps * self.twin.model.dt_s
 
     @property
     def real_time_factor(self) -> float | None:
         return self.pacing.real_time_factor
+
+    @property
+    def late_fraction(self) -> float | None:
+        """Frames later than `lateness_s` / frames, last 10 s (None in fast mode)."""
+        return None if self.fast else self.pacing.late_fraction
+
+    @property
+    def cost(self) -> TwinCost | None:
+        """CPU this twin needs in real time: measured while running (engine over the last 2 s of
+        simulated time, snapshots over the last 50), its calibration until then."""
+        cal = self.calibration
+        engine = self.engine_cpu.rate
+        snap = self.publisher.cpu.rate
+        if engine is None and cal is None:
+            return None
+        return TwinCost(
+            engine_cpu_s_per_sim_s=engine if engine is not None else cal.engine_cpu_s_per_sim_s,
+            publish_cpu_s_per_s=(snap * self.publish_rate_hz if snap is not None
+                                 else (cal.publish_cpu_s_per_s if cal is not None else 0.0)))
 
     @property
     def target_setpoint(self) -> Setpoint:
@@ -173,24 +224,26 @@ class TwinRunner:
 
     def submit(self, update: SetpointUpdate | dict | None = None, **fields) -> Setpoint:
         """Put a partial setpoint in the mailbox: merged over what is pending (latest wins per
-        field), checked against the bearing's limits once, applied by the runner thread at the
-        next frame boundary. Returns the setpoint that will be in force. Raises InputError
+        field), checked against the bearing's limits once, applied by the stepping thread at
+        the next frame boundary. Returns the setpoint that will be in force. Raises InputError
         naming each field and the bearing's range."""
         update = parse_update(fields if update is None else update, self.limits)
-        return self._offer(update, timed=True)
+        setpoint = self._offer(update, timed=True)
+        self._wake()
+        return setpoint
 
     def start_scenario(self, run: ResolvedRun, *, restart: bool = False) -> tuple[ScenarioHandle, ScenarioHandle | None]:
-        """Hand a scenario run to the runner thread (a running one is cancelled). Values are
-        checked against the bearing's limits first (ScenarioError). Returns (handle, replaced)."""
+        """Hand a scenario run to the runner (a running one is cancelled). Values are checked
+        against the bearing's limits first (ScenarioError). Returns (handle, replaced)."""
         run.check_limits(self.limits, where="scenario.")
         handle, replaced = self.scenarios.start(run, restart=restart)
-        self._wake.set()
+        self._wake()
         return handle, replaced
 
     def cancel_scenario(self) -> ScenarioHandle | None:
         """Stop the running scenario where it is (the setpoint stays at its last value)."""
         handle = self.scenarios.cancel()
-        self._wake.set()
+        self._wake()
         return handle
 
     @property
@@ -208,35 +261,44 @@ class TwinRunner:
         return health_record(self, **refusals)
 
     def start(self, *, publish_initial: bool = True) -> TwinRunner:
-        """Take the first snapshot (so GET state never finds none) and start the thread."""
-        if self._thread is not None:
+        """Take the first snapshot (so GET state never finds none) and hand the twin to the pool."""
+        if self._job is not None:
             raise RuntimeError("runner already started")
         if publish_initial:
-            self._publish(self._clock())
+            self.publisher.capture(self.twin, None)      # no worker yet: built here, now
         else:
             self.publisher.set_latest(self.twin.snapshot(real_time_factor=None))
-        self._thread = threading.Thread(target=self._run, name=f"twin-{self.bearing_id}", daemon=True)
-        self._thread.start()
+        if self._pool is None:
+            self._pool = SteppingPool(1, name=self.name, clock=self._clock)
+        self._pool.start()
+        self.publisher.attach(self._pool.publisher)
+        self.pacing.start(self.sim_elapsed_s)
+        self._job = self._pool.add(self)
         return self
 
     def request_stop(self) -> None:
-        """Ask the thread to stop at the end of its frame (does not wait)."""
+        """Ask the runner to stop at the end of its frame (does not wait)."""
         self._stop.set()
-        self._wake.set()
+        self._wake()
 
     def stop(self, timeout: float = 5.0) -> bool:
-        """Ask the thread to stop and join it; returns whether it stopped within the timeout."""
+        """Stop at the end of the frame and wait until the last snapshot is delivered; returns
+        whether that happened within the timeout."""
         self.request_stop()
-        thread = self._thread
-        if thread is None:
+        if self._job is None:
             return True
-        thread.join(timeout)
-        alive = thread.is_alive()
-        if alive:
+        stopped = self._done.wait(timeout)
+        if not stopped:
             log.error("twin %s: runner did not stop within %.1f s", self.bearing_id, timeout)
         else:
             self.scenarios.stopped()
-        return not alive
+            if self._own_pool and self._pool is not None:
+                self._pool.close(timeout)
+        return stopped
+
+    def _wake(self) -> None:
+        if self._pool is not None and self._job is not None:
+            self._pool.wake(self._job)
 
     # ---- mailbox -------------------------------------------------------------------------------
     def _offer(self, update: SetpointUpdate, *, timed: bool) -> Setpoint:
@@ -246,16 +308,17 @@ class TwinRunner:
         except SetpointError as exc:
             raise InputError(setpoint_field_errors(exc)) from None
 
-    def _apply_mailbox(self) -> bool:
-        """Apply the pending setpoint (runner thread). Returns whether a setpoint came in."""
+    def _apply_mailbox(self) -> tuple[bool, bool]:
+        """Apply the pending setpoint (stepping thread). Returns (a setpoint came in, it was an
+        outside one)."""
         pending, timings = self.mailbox.take()
         if pending is not None:
             self.twin.set_setpoint(pending)
         if timings:
             self.publisher.await_snapshot(timings)
-        return pending is not None or bool(timings)
+        return pending is not None or bool(timings), bool(timings)
 
-    # ---- the loop (runner thread) --------------------------------------------------------------
+    # ---- the frame (stepping thread) -----------------------------------------------------------
     def _restart_at(self, initial: SetpointUpdate) -> None:
         """A scenario asked to start from the warm start at its initial setpoint."""
         self._offer(initial, timed=False)
@@ -267,54 +330,73 @@ class TwinRunner:
         log.warning("twin %s: %s", self.bearing_id, self.publisher.note)
         self.pacing.publish_soon()
 
-    def _frame(self) -> None:
-        fallback = self.faults.advance_frame(self.twin, self.frame_s, self.frame_steps,
-                                             on_fallback=self.mailbox.reset)
+    def _frame(self, steps: int) -> None:
+        dt = self.twin.model.dt_s
+        c0 = time.thread_time()
+        fallback = self.faults.advance_frame(self.twin, steps * dt, steps, on_fallback=self.mailbox.reset)
+        self.engine_cpu.add(time.thread_time() - c0, steps * dt)
         if fallback is not None:
             self._on_fallback(fallback)
         self.counters.frames += 1
-        self._sim_frames += 1
+        self._sim_steps += steps
 
-    def _run(self) -> None:
-        pacing, consecutive = self.pacing, 0
-        pacing.start(self.sim_elapsed_s)
-        while not self._stop.is_set():
-            try:
-                event = self.scenarios.tick(self.sim_elapsed_s, self.mailbox.target,
-                                            lambda u: self._offer(u, timed=False), self._restart_at)
-                changed = self._apply_mailbox()
-                if self.idle_without_scenario and not self.scenarios.active:
-                    if (event and pacing.last_publish_sim != self.sim_elapsed_s) or changed:
-                        self._publish(self._clock())
-                    self._wake.wait(0.05)
-                    self._wake.clear()
-                    pacing.reanchor(self.sim_elapsed_s)
-                    pacing.restart_sample_grid(self.sim_elapsed_s)
-                    continue
-                if event and self.fast and (changed or pacing.last_publish_sim != self.sim_elapsed_s):
-                    # a scenario started or ended: sample now and restart the sample grid there
-                    self._publish(self._clock())
-                    pacing.restart_sample_grid(self.sim_elapsed_s)
-                self._frame()
-                consecutive = 0
-            except Exception as exc:  # noqa: BLE001 - counted, shown, recovered
-                consecutive += 1
-                self._on_error(exc, consecutive)
-                if consecutive >= self.max_consecutive_errors:
-                    self.counters.failed = True
-                    self.publisher.note = (f"failed: runner stopped after {consecutive} errors in a "
-                                           f"row; last: {self.last_error}")
-                    log.error("twin %s: %s", self.bearing_id, self.publisher.note)
-                    self._safe_publish()
-                    return
-                self._stop.wait(0.01)
+    def step(self, now: float) -> Schedule | None:
+        """One frame (or one idle look at the mailbox); returns when the pool should run the
+        next, None when the runner stops (asked to, or failed)."""
+        if self._stop.is_set():
+            return None
+        pacing = self.pacing
+        try:
+            if self._reanchor:
                 pacing.reanchor(self.sim_elapsed_s)
-                continue
-            now = self._clock()
-            pacing.measure(now, self.sim_elapsed_s)
-            if pacing.publish_due(now, self.sim_elapsed_s, changed or event):
-                self._safe_publish(now)
-            pacing.wait_for_deadline(now, self.sim_elapsed_s, self._stop)
+                self._reanchor = False
+            event = self.scenarios.tick(self.sim_elapsed_s, self.mailbox.target,
+                                        lambda u: self._offer(u, timed=False), self._restart_at)
+            changed, outside = self._apply_mailbox()
+            if self.idle_without_scenario and not self.scenarios.active:
+                if (event and pacing.last_publish_sim != self.sim_elapsed_s) or changed:
+                    self._publish(self._clock())
+                self._notify_ended()
+                pacing.restart_sample_grid(self.sim_elapsed_s)
+                self._reanchor = True
+                return Schedule(self._clock() + IDLE_POLL_S)
+            if event and self.fast and (changed or pacing.last_publish_sim != self.sim_elapsed_s):
+                # a scenario started or ended: sample now and restart the sample grid there
+                self._publish(self._clock())
+                pacing.restart_sample_grid(self.sim_elapsed_s)
+            self._frame(self.setpoint_frame_steps if outside else self.frame_steps)
+            self._consecutive = 0
+        except Exception as exc:  # noqa: BLE001 - counted, shown, recovered
+            self._consecutive += 1
+            self._on_error(exc, self._consecutive)
+            self._notify_ended()
+            if self._consecutive >= self.max_consecutive_errors:
+                self.counters.failed = True
+                self.publisher.note = (f"failed: runner stopped after {self._consecutive} errors in a "
+                                       f"row; last: {self.last_error}")
+                log.error("twin %s: %s", self.bearing_id, self.publisher.note)
+                self._safe_publish()
+                return None
+            self._reanchor = True
+            return Schedule(self._clock() + ERROR_PAUSE_S)
+        now = self._clock()
+        sim = self.sim_elapsed_s
+        pacing.measure(now, sim)
+        release = pacing.frame_done(now, sim)
+        if pacing.publish_due(now, sim, changed or event):
+            self._safe_publish(now)
+        self._notify_ended()
+        return Schedule(release, math.inf if self.fast else release + self.frame_s)
+
+    def _notify_ended(self) -> None:
+        """A scenario ended in this step: its waiters wake once what it published is delivered."""
+        ended = self.scenarios.take_ended()
+        if ended is not None:
+            self.publisher.after_pending(ended.notify)
+
+    def left_pool(self) -> None:
+        """The pool let the twin go: done once its last capture is delivered."""
+        self.publisher.after_pending(self._done.set)
 
     def _on_error(self, exc: BaseException, consecutive: int) -> None:
         self.counters.error(exc)
@@ -336,5 +418,5 @@ class TwinRunner:
             log.warning("twin %s: snapshot failed: %s", self.bearing_id, exc)
 
     def _publish(self, now: float) -> None:
-        self.publisher.publish(self.twin, self.pacing.real_time_factor, now)
+        self.publisher.capture(self.twin, self.pacing.real_time_factor, self.late_fraction, stop=self._stop)
         self.pacing.published(now, self.sim_elapsed_s)

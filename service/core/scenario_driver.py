@@ -88,6 +88,8 @@ class ScenarioHandle:
         self.phase: str | None = None
         self.error: str | None = None
         self.done = threading.Event()
+        self._lock = threading.Lock()
+        self._finished = False
 
     @property
     def name(self) -> str:
@@ -101,11 +103,23 @@ class ScenarioHandle:
     def progress(self) -> float:
         return min(1.0, self.scenario_time_s / self.run.duration_s) if self.run.duration_s > 0 else 1.0
 
-    def finish(self, state: str, error: str | None = None) -> None:
-        """End it (first call wins)."""
-        if self.done.is_set():
-            return
-        self.state, self.error = state, error
+    @property
+    def finished(self) -> bool:
+        """Whether it has ended (`done` may be set a little later: after its last sample is out)."""
+        return self._finished
+
+    def finish(self, state: str, error: str | None = None, *, notify: bool = True) -> None:
+        """End it (first call wins); `notify=False`: set `done` later (`notify()`)."""
+        with self._lock:
+            if self._finished:
+                return
+            self._finished = True
+            self.state, self.error = state, error
+        if notify:
+            self.done.set()
+
+    def notify(self) -> None:
+        """Wake whoever waits for the end."""
         self.done.set()
 
     def wait(self, timeout: float | None = None) -> bool:
@@ -127,6 +141,7 @@ class ScenarioDriver:
         self._last: ScenarioHandle | None = None
         self._executor: ScenarioExecutor | None = None
         self._t0_s = 0.0
+        self._ended: ScenarioHandle | None = None       # ended in the runner, not yet notified
 
     # ---- any thread ----------------------------------------------------------------------------
     def start(self, run: ResolvedRun, *, restart: bool = False) -> tuple[ScenarioHandle, ScenarioHandle | None]:
@@ -138,7 +153,7 @@ class ScenarioDriver:
             old_request, self._request = self._request, handle
         if old_request is not None:
             old_request.finish("cancelled", "replaced before it started")
-        return handle, (replaced if replaced is not None and not replaced.done.is_set() else None)
+        return handle, (replaced if replaced is not None and not replaced.finished else None)
 
     def cancel(self) -> ScenarioHandle | None:
         """Stop the running (or pending) scenario where it is."""
@@ -164,9 +179,16 @@ class ScenarioDriver:
 
     def stopped(self) -> None:
         """The runner stopped: whatever is pending or running is cancelled."""
-        for handle in (self._running, self._request):
+        for handle in (self._running, self._request, self._ended):
             if handle is not None:
                 handle.finish("cancelled", "runner stopped")
+                handle.notify()
+
+    def take_ended(self) -> ScenarioHandle | None:
+        """The scenario the last `tick` ended, to `notify()` once its last sample is published
+        (runner thread)."""
+        ended, self._ended = self._ended, None
+        return ended
 
     # ---- runner thread -------------------------------------------------------------------------
     def tick(self, elapsed_s: float, target: Setpoint, offer: Callable[[SetpointUpdate], object],
@@ -177,7 +199,7 @@ class ScenarioDriver:
         event = False
         with self._lock:
             request, self._request = self._request, None
-        if request is not None and not request.done.is_set():
+        if request is not None and not request.finished:
             if self._running is not None:
                 self._running.finish("cancelled", f"replaced by {request.name}")
                 self._last = self._running
@@ -191,7 +213,7 @@ class ScenarioDriver:
         handle = self._running
         if handle is None:
             return event
-        if handle.done.is_set():       # cancelled from outside
+        if handle.finished:            # cancelled from outside
             self._end(handle)
             return True
         t = elapsed_s - self._t0_s
@@ -202,12 +224,12 @@ class ScenarioDriver:
                 offer(update)
             handle.phase = self._executor.phase
         except Exception as exc:  # noqa: BLE001 - a bad scenario must not stop the twin
-            handle.finish("failed", f"{type(exc).__name__}: {exc}")
+            handle.finish("failed", f"{type(exc).__name__}: {exc}", notify=False)
             self._end(handle)
             return True
         if self._executor.done(t):
             handle.scenario_time_s = handle.duration_s
-            handle.finish("done")
+            handle.finish("done", notify=False)
             self._end(handle)
             return True
         return event
@@ -215,3 +237,5 @@ class ScenarioDriver:
     def _end(self, handle: ScenarioHandle) -> None:
         with self._lock:
             self._last, self._running, self._executor = handle, None, None
+        if not handle.done.is_set():
+            self._ended = handle

@@ -26,14 +26,18 @@ def health_record(runner: Any, *, setpoints_refused: int = 0, setpoints_rate_lim
     """One twin's /health entry from its runner (`service.core.runner.TwinRunner`) and the
     refusals counted outside it (zenoh intake, admission gate)."""
     latest = runner.latest
+    cost = runner.cost
     return {
         "id": runner.bearing_id, "running": runner.running, "mode": runner.mode,
         "status": latest.status if latest is not None else runner.publisher.status_text(runner.twin.status),
         "time_s": latest.time_s if latest is not None else runner.twin.time_s,
-        "real_time_factor": runner.real_time_factor, "frames": runner.frames,
+        "real_time_factor": runner.real_time_factor, "late_fraction": runner.late_fraction,
+        "lateness_s": runner.pacing.lateness_s, "frame_s": runner.frame_s, "frames": runner.frames,
         "overruns": runner.overruns, "resyncs": runner.resyncs, "published": runner.published,
         "dropped": runner.dropped, "errors": runner.errors, "restarts": runner.twin.restarts,
         "setpoints_accepted": runner.setpoints_accepted, "setpoints_refused": setpoints_refused,
         "setpoints_rate_limited": setpoints_rate_limited, "fallbacks": runner.fallbacks,
         "last_safe_setpoint": runner.last_safe_setpoint.model_dump(),
+        "publish_skipped": runner.publisher.skipped,
+        "cost": cost.as_dict() if cost is not None else None,
     }

@@ -1,29 +1,51 @@
-"""Service benchmark (`bearing-twin bench-service`): the real-time factor of a twin in real-time
-mode with publishing (zenoh) and recording (rerun) on, and the delay from an HTTP setpoint to the
-first published snapshot that reflects it.
+"""Service benchmark (`bearing-twin bench-service --twins N [--seconds S] [--json]`): N twins of
+different designations in one real-time service with zenoh and the recording on; per twin the
+median real-time factor and the late fraction, and the delay from an HTTP setpoint to the zenoh
+state that carries it.
 
-It starts the real service in this process (uvicorn on a free loopback port, zenoh listening on a
-free loopback port, a recording into a temporary directory), connects a zenoh peer, and PUTs a new
-radial load every 1/rate seconds. Two delays are measured for each setpoint:
+It starts `bearing-twin serve` as a SUBPROCESS (as deployed: the benchmark's own HTTP and zenoh
+clients do not share the service's GIL; they do share the machine's cores) on free loopback
+ports, recording into a temporary directory; the first twin is the service's configured twin,
+the others are created with POST /v1/bearings, through the admission by measured capacity (a
+refused twin is listed under `refused` with the service's answer; `force=True` turns the
+admission off to measure what happens beyond the capacity). The twins, in turn (cycled for
+N > 4): 6208, 6205, 7208 (3000 N radial), 6208 with 5 A of shaft current.
 
-* client: from just before the HTTP PUT is sent to the arrival, at the zenoh subscriber, of the
-  first `bearing/default/state` message carrying it (HTTP + mailbox + frame + zenoh);
-* runner: from the moment the runner accepted it to the moment it published the first snapshot
-  reflecting it (TwinRunner.setpoint_latencies(), seq recorded).
+Measured over `seconds` after the twins have settled:
 
-Wall-clock figures belong here and in README, never in tests.
+* per twin: `real_time_factor_median` / `_min` (the `real_time_factor` of /health, sampled every
+  0.5 s), `late_fraction` = frames that ended more than the service's lateness (5 ms) after
+  their wall-clock deadline / frames in the window (from the /health counters), frames,
+  snapshots dropped by the sinks, its measured CPU cost;
+* `client_latency_ms_p50` / `_p99` / `_max`: a PUT of a new radial load every 1/rate s (the
+  twins in turn), from just before the request is sent to the arrival at a zenoh subscriber of
+  the first `bearing/{id}/state` message carrying it (HTTP + mailbox + frame + snapshot +
+  zenoh); `client_lost`: none arrived within 1 s.
+
+Wall-clock figures belong here and in the README, never in tests.
 """
 
 from __future__ import annotations
 
-import json
+import os
 import queue
+import re
 import socket
 import statistics
+import subprocess
+import sys
 import tempfile
 import threading
 import time
 from pathlib import Path
+
+#: (designation, initial setpoint) of the twins, in order
+TWIN_MIX: tuple[tuple[str, dict], ...] = (
+    ("6208", {}),
+    ("6205", {}),
+    ("7208", {"radial_load_n": 3000.0}),
+    ("6208", {"shaft_current_a": 5.0}),
+)
 
 
 def _free_port() -> int:
@@ -40,99 +62,185 @@ def _percentile(values: list[float], q: float) -> float | None:
     return values[k]
 
 
-def run_service_benchmark(seconds: float = 10.0, rate_hz: float = 20.0, bearing: str = "6208",
-                          record: bool = True, zenoh_on: bool = True) -> dict:
+def twin_plan(n: int) -> list[tuple[str, str, dict]]:
+    """(id, designation, initial setpoint) of the n twins of the benchmark."""
+    plan = []
+    for i in range(n):
+        designation, setpoint = TWIN_MIX[i % len(TWIN_MIX)]
+        tag = "-5A" if setpoint.get("shaft_current_a") else ""
+        plan.append((f"b{i + 1}-{designation}{tag}", designation, dict(setpoint)))
+    return plan
+
+
+class _Serve:
+    """`bearing-twin serve` in a subprocess, its output kept."""
+
+    def __init__(self, args: list[str], env: dict, cwd: Path):
+        self.proc = subprocess.Popen([sys.executable, "-m", "service.cli", "serve", *args], cwd=cwd, env=env,
+                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.log: list[str] = []
+        threading.Thread(target=self._read, daemon=True).start()
+
+    def _read(self) -> None:
+        for line in self.proc.stdout:
+            self.log.append(line)
+
+    def stop(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.terminate()
+            try:
+                self.proc.wait(30.0)
+            except subprocess.TimeoutExpired:
+                self.proc.kill()
+                self.proc.wait(10.0)
+
+
+def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float = 20.0, *,
+                          record: bool = True, zenoh_on: bool = True, force: bool = False,
+                          settle_s: float = 3.0, start_timeout_s: float = 300.0) -> dict:
     import httpx
-    import uvicorn
 
-    from service.api.app import create_app
-    from service.settings import ServiceSettings
-
-    endpoint = f"tcp/127.0.0.1:{_free_port()}"
+    if twins < 1:
+        raise ValueError(f"twins = {twins!r}: at least 1")
+    plan = twin_plan(twins)
+    port, zport = _free_port(), _free_port()
+    endpoint = f"tcp/127.0.0.1:{zport}"
+    repo = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONUNBUFFERED": "1",
+           "PYTHONPATH": os.pathsep.join(filter(None, [str(repo), os.environ.get("PYTHONPATH")]))}
+    if force:
+        env["BEARING_TWIN_ADMISSION"] = "off"
+    first_id, first_designation, first_setpoint = plan[0]
     with tempfile.TemporaryDirectory(prefix="bearing-twin-bench-") as tmp:
-        settings = ServiceSettings(port=0, bearing=bearing, zenoh_listen=[endpoint], enable_zenoh=zenoh_on,
-                                   enable_recording=record, record=Path(tmp) / "bench.rrd")
-        app = create_app(settings)
-        server = uvicorn.Server(uvicorn.Config(app, host="127.0.0.1", port=0, log_level="warning",
-                                               lifespan="on", timeout_graceful_shutdown=2))
-        thread = threading.Thread(target=server.run, daemon=True)
-        thread.start()
-        deadline = time.monotonic() + 120.0
-        while not server.started:
-            if not thread.is_alive() or time.monotonic() > deadline:
-                raise RuntimeError("the service did not start")
-            time.sleep(0.02)
-        url = f"http://127.0.0.1:{server.servers[0].sockets[0].getsockname()[1]}"
-        runner = app.state.service.get(settings.twin_id).runner
-        inbox: queue.SimpleQueue = queue.SimpleQueue()
+        args = ["--port", str(port), "--twin-id", first_id, "--bearing", first_designation,
+                "--log-level", "warning"]
+        args += ["--zenoh-listen", endpoint] if zenoh_on else ["--no-zenoh"]
+        args += ["--record", str(Path(tmp) / "bench.rrd")] if record else ["--no-record"]
+        serve = _Serve(args, env, Path(tmp))
         session = sub = None
-        if zenoh_on:
-            import zenoh
+        from service.settings import ZenohAccessSettings
 
-            from service.bus.zenoh_bus import client_config
-
-            # a zenoh client with the credentials of the environment (BEARING_TWIN_ZENOH_USER ...)
-            session = zenoh.open(client_config([endpoint], prefix=settings.zenoh_prefix))
-
-            def on_state(sample):  # zenoh thread: hand off only
-                inbox.put((time.perf_counter(), sample.payload.to_bytes()))
-
-            sub = session.declare_subscriber(f"{settings.zenoh_prefix}/{settings.twin_id}/state", on_state)
-        client_latencies: list[float] = []
-        lost = 0
-        rtf_samples: list[float] = []
+        prefix = ZenohAccessSettings().zenoh_prefix   # the service it starts inherits the environment
+        inbox: queue.SimpleQueue = queue.SimpleQueue()
+        url = f"http://127.0.0.1:{port}"
+        refused: list[dict] = []
+        samples: dict[str, list[float]] = {}
         try:
-            with httpx.Client(base_url=url, timeout=10.0) as http:
-                time.sleep(1.0)  # let the twin settle into its pace
-                frames0, overruns0 = runner.frames, runner.overruns
+            with httpx.Client(base_url=url, timeout=60.0) as http:
+                deadline = time.monotonic() + start_timeout_s
+                while True:
+                    if serve.proc.poll() is not None:
+                        raise RuntimeError("the service did not start: " + "".join(serve.log[-20:]))
+                    try:
+                        if http.get("/health", timeout=2.0).status_code == 200:
+                            break
+                    except httpx.HTTPError:
+                        pass
+                    if time.monotonic() > deadline:
+                        raise RuntimeError("the service did not answer /health")
+                    time.sleep(0.2)
+                if first_setpoint:
+                    http.put(f"/v1/bearings/{first_id}/setpoint", json=first_setpoint).raise_for_status()
+                running = [(first_id, first_designation)]
+                for twin_id, designation, setpoint in plan[1:]:
+                    body = {"id": twin_id, "designation": designation, **({"setpoint": setpoint} if setpoint else {})}
+                    r = http.post("/v1/bearings", json=body)
+                    if r.status_code == 201:
+                        running.append((twin_id, designation))
+                    else:
+                        detail = r.json().get("detail") or [{}]
+                        refused.append({"id": twin_id, "designation": designation, "status": r.status_code,
+                                        "message": detail[0].get("message")})
+                base_load = {tid: http.get(f"/v1/bearings/{tid}").json()["setpoint"]["radial_load_n"]
+                             for tid, _ in running}
+                if zenoh_on:
+                    import zenoh
+
+                    from service.bus.zenoh_bus import client_config
+
+                    # a zenoh client with the credentials of the environment (BEARING_TWIN_ZENOH_USER ...)
+                    session = zenoh.open(client_config([endpoint], prefix=prefix))
+
+                    def on_state(sample):  # zenoh thread: hand off only
+                        inbox.put((time.perf_counter(), str(sample.key_expr), sample.payload.to_bytes()))
+
+                    sub = session.declare_subscriber(f"{prefix}/*/state", on_state)
+                # settle: every twin stepping, then settle_s more
+                settle_end = time.monotonic() + 120.0
+                while time.monotonic() < settle_end:
+                    h = http.get("/health").json()
+                    if all(t["frames"] > 0 for t in h["twins"]):
+                        break
+                    time.sleep(0.2)
+                time.sleep(settle_s)
+                first = {t["id"]: t for t in http.get("/health").json()["twins"]}
+                latencies: dict[str, list[float]] = {tid: [] for tid, _ in running}
+                lost = k = 0
+                next_health = time.perf_counter()
                 t_end = time.perf_counter() + seconds
-                k = 0
                 while time.perf_counter() < t_end:
+                    tid = running[k % len(running)][0]
                     k += 1
-                    load = 3000.0 + (k % 200)            # a new value every time
+                    load = base_load[tid] - 0.5 * (k % 400)        # a new value every time, in range
+                    pattern = re.compile(rb'"radial_load_n":' + re.escape(repr(float(load)).encode()) + rb"[,}]")
+                    key = f"{prefix}/{tid}/state"
                     t0 = time.perf_counter()
-                    r = http.put(f"/v1/bearings/{settings.twin_id}/setpoint", json={"radial_load_n": load})
-                    r.raise_for_status()
+                    http.put(f"/v1/bearings/{tid}/setpoint", json={"radial_load_n": load}).raise_for_status()
                     if zenoh_on:
-                        seen = None
-                        wait_until = t0 + 1.0
+                        seen, wait_until = None, t0 + 1.0
                         while seen is None and time.perf_counter() < wait_until:
                             try:
-                                t_msg, payload = inbox.get(timeout=max(0.0, wait_until - time.perf_counter()))
+                                t_msg, k_msg, payload = inbox.get(timeout=max(0.0, wait_until - time.perf_counter()))
                             except queue.Empty:
                                 break
-                            if json.loads(payload)["setpoint"]["radial_load_n"] == load:
+                            if k_msg == key and t_msg >= t0 and pattern.search(payload):
                                 seen = t_msg
                         if seen is None:
                             lost += 1
                         else:
-                            client_latencies.append(seen - t0)
-                    if runner.real_time_factor is not None:
-                        rtf_samples.append(runner.real_time_factor)
+                            latencies[tid].append(seen - t0)
+                    now = time.perf_counter()
+                    if now >= next_health:
+                        next_health = now + 0.5
+                        for t in http.get("/health").json()["twins"]:
+                            if t.get("real_time_factor") is not None:
+                                samples.setdefault(t["id"], []).append(t["real_time_factor"])
                     time.sleep(max(0.0, t0 + 1.0 / rate_hz - time.perf_counter()))
                 health = http.get("/health").json()
-                frames, overruns = runner.frames - frames0, runner.overruns - overruns0
-            runner_latencies = [t.latency_s for t in runner.setpoint_latencies() if t.latency_s is not None]
         finally:
             if sub is not None:
                 sub.undeclare()
             if session is not None:
                 session.close()
-            server.should_exit = True
-            thread.join(30.0)
-    twin = next(t for t in health["twins"] if t["id"] == settings.twin_id)
-    ms = lambda v: None if v is None else 1e3 * v
+            serve.stop()
+    last = {t["id"]: t for t in health["twins"]}
+    ms = lambda v: None if v is None else round(1e3 * v, 3)  # noqa: E731
+    rows = []
+    for tid, designation in running:
+        a, b = first.get(tid, {}), last.get(tid, {})
+        frames = b.get("frames", 0) - a.get("frames", 0)
+        late = b.get("overruns", 0) - a.get("overruns", 0)
+        rtf = samples.get(tid, [])
+        rows.append({
+            "id": tid, "designation": designation,
+            "real_time_factor_median": statistics.median(rtf) if rtf else None,
+            "real_time_factor_min": min(rtf) if rtf else None,
+            "late_fraction": late / frames if frames else None,
+            "frames": frames, "late_frames": late, "resyncs": b.get("resyncs", 0) - a.get("resyncs", 0),
+            "dropped": b.get("dropped"), "publish_skipped": b.get("publish_skipped"),
+            "cost": b.get("cost"), "setpoints": len(latencies.get(tid, [])),
+            "client_latency_ms_p99": ms(_percentile(latencies.get(tid, []), 99)),
+        })
+    every = [v for values in latencies.values() for v in values]
     return {
-        "bearing": bearing, "seconds": seconds, "setpoints": k, "rate_hz": rate_hz,
-        "zenoh": zenoh_on, "recording": record,
-        "real_time_factor_median": statistics.median(rtf_samples) if rtf_samples else None,
-        "real_time_factor_min": min(rtf_samples) if rtf_samples else None,
-        "frames": frames, "overruns": overruns, "overrun_fraction": overruns / frames if frames else None,
-        "dropped": twin["dropped"], "recording_rows": health["recording_rows"],
-        "client_latency_ms_p50": ms(_percentile(client_latencies, 50)),
-        "client_latency_ms_p99": ms(_percentile(client_latencies, 99)),
-        "client_latency_ms_max": ms(max(client_latencies)) if client_latencies else None,
+        "twins_requested": twins, "seconds": seconds, "rate_hz": rate_hz, "zenoh": zenoh_on,
+        "recording": record, "admission": "off" if force else health.get("capacity", {}).get("admission"),
+        "frame_s": (last.get(running[0][0]) or {}).get("frame_s"),
+        "lateness_s": (last.get(running[0][0]) or {}).get("lateness_s"),
+        "twins": rows, "refused": refused, "setpoints": k,
+        "client_latency_ms_p50": ms(_percentile(every, 50)),
+        "client_latency_ms_p99": ms(_percentile(every, 99)),
+        "client_latency_ms_max": ms(max(every)) if every else None,
         "client_lost": lost,
-        "runner_latency_ms_p50": ms(_percentile(runner_latencies, 50)),
-        "runner_latency_ms_p99": ms(_percentile(runner_latencies, 99)),
+        "capacity": health.get("capacity"), "recording_rows": health.get("recording_rows"),
     }

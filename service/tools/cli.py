@@ -40,6 +40,16 @@ def _time_step(text: str) -> float | str:
         raise argparse.ArgumentTypeError(str(exc)) from None
 
 
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a whole number, got {text}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
+    return value
+
+
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
@@ -203,12 +213,16 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("files", nargs="+")
     check.set_defaults(func=_cmd_scenario_check)
 
-    bsv = sub.add_parser("bench-service", help="service benchmark: real-time factor with zenoh and "
-                         "recording on, HTTP setpoint -> published snapshot delay (p50/p99)")
+    bsv = sub.add_parser("bench-service", help="service benchmark: N twins in real time with zenoh and "
+                         "recording on: real-time factor and late fraction per twin, HTTP setpoint -> "
+                         "zenoh state delay (p50/p99)")
+    bsv.add_argument("--twins", type=_positive_int, default=1,
+                     help="twins to run: 6208, 6205, 7208, 6208 with 5 A, in turn (default 1)")
     bsv.add_argument("--seconds", type=_positive_float, default=10.0, help="measurement time [s of wall time]")
-    bsv.add_argument("--rate", type=_positive_float, default=20.0, help="setpoints per second [Hz]")
-    bsv.add_argument("--bearing", default="6208")
-    bsv.add_argument("--no-zenoh", action="store_true", help="without zenoh (then only the runner-side delay)")
+    bsv.add_argument("--rate", type=_positive_float, default=20.0, help="setpoints per second, all twins [Hz]")
+    bsv.add_argument("--force", action="store_true",
+                     help="admission off: run every twin even beyond the measured capacity")
+    bsv.add_argument("--no-zenoh", action="store_true", help="without zenoh (then no setpoint delay)")
     bsv.add_argument("--no-record", action="store_true", help="without the rerun recording")
     bsv.add_argument("--json", action="store_true")
     bsv.set_defaults(func=_cmd_bench_service)
@@ -232,21 +246,31 @@ def build_parser() -> argparse.ArgumentParser:
 def _cmd_bench_service(args: argparse.Namespace) -> int:
     from service.tools.benchmark import run_service_benchmark
 
-    r = run_service_benchmark(seconds=args.seconds, rate_hz=args.rate, bearing=args.bearing,
-                              record=not args.no_record, zenoh_on=not args.no_zenoh)
+    try:
+        r = run_service_benchmark(twins=args.twins, seconds=args.seconds, rate_hz=args.rate,
+                                  record=not args.no_record, zenoh_on=not args.no_zenoh, force=args.force)
+    except RuntimeError as exc:
+        print(f"error: {' '.join(str(exc).split())[:2000]}", file=sys.stderr)
+        return 1
     if args.json:
         print(json.dumps(r))
         return 0
     f = lambda v, spec="{:.2f}": "-" if v is None else spec.format(v)  # noqa: E731
-    print(f"{r['bearing']} real-time mode, zenoh {'on' if r['zenoh'] else 'off'}, recording "
-          f"{'on' if r['recording'] else 'off'}, {r['setpoints']} setpoints in {r['seconds']:g} s")
-    print(f"  real-time factor: median {f(r['real_time_factor_median'], '{:.3f}')}, "
-          f"min {f(r['real_time_factor_min'], '{:.3f}')}; overruns {r['overruns']} of {r['frames']} frames; "
-          f"dropped {r['dropped']}; recorded rows {r['recording_rows']}")
+    print(f"{len(r['twins'])} twin(s) in real time, frames of {f(r['frame_s'], '{:g}')} s, zenoh "
+          f"{'on' if r['zenoh'] else 'off'}, recording {'on' if r['recording'] else 'off'}, admission "
+          f"{r['admission']}; {r['setpoints']} setpoints in {r['seconds']:g} s")
+    for t in r["twins"]:
+        print(f"  {t['id']:<14} {t['designation']:<5} real-time factor median {f(t['real_time_factor_median'], '{:.3f}')} "
+              f"(min {f(t['real_time_factor_min'], '{:.3f}')}), late {f(t['late_fraction'], '{:.2%}')} of "
+              f"{t['frames']} frames, dropped {t['dropped']}, PUT -> zenoh p99 {f(t['client_latency_ms_p99'])} ms")
+    for t in r["refused"]:
+        print(f"  {t['id']:<14} {t['designation']:<5} refused ({t['status']}): {t['message']}")
     print(f"  HTTP PUT -> zenoh state [ms]: p50 {f(r['client_latency_ms_p50'])}, "
           f"p99 {f(r['client_latency_ms_p99'])}, max {f(r['client_latency_ms_max'])}, lost {r['client_lost']}")
-    print(f"  accepted -> published (runner) [ms]: p50 {f(r['runner_latency_ms_p50'])}, "
-          f"p99 {f(r['runner_latency_ms_p99'])}")
+    cap = r.get("capacity") or {}
+    if cap:
+        print(f"  capacity: {f(cap.get('used_cpu_s_per_s'), '{:.3f}')} of {f(cap.get('budget_cpu_s_per_s'), '{:.3f}')} "
+              f"CPU s per s in use; max twins like the last calibrated one: {cap.get('max_twins')}")
     return 0
 
 

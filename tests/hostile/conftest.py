@@ -42,7 +42,7 @@ class ServeProcess:
                "--zenoh-listen", self.zenoh_endpoint, "--log-level", "info", *extra]
         cmd += ["--record", str(record)] if record is not None else ["--no-record"]
         full_env = {k: v for k, v in os.environ.items() if not k.startswith("BEARING_TWIN_")}
-        full_env.update({"PYTHONUNBUFFERED": "1", **(env or {})})
+        full_env.update({"PYTHONUNBUFFERED": "1", "BEARING_TWIN_ADMISSION": "off", **(env or {})})
         self.proc = subprocess.Popen(cmd, cwd=tmp_path, env={**full_env, "PYTHONPATH": str(REPO)},
                                      stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         self.lines: queue.Queue = queue.Queue()

@@ -51,6 +51,7 @@ class Service:
         cmd += ["--record", str(self.rrd)] if record else ["--no-record"]
         env = {**os.environ, "PYTHONUNBUFFERED": "1"}
         env = {k: v for k, v in env.items() if not k.startswith("BEARING_TWIN_")}
+        env["BEARING_TWIN_ADMISSION"] = "off"     # twins whatever this machine's speed (tests/conftest.py)
         self.proc = subprocess.Popen(cmd, cwd=REPO, env=env, stdout=subprocess.PIPE,
                                      stderr=subprocess.STDOUT, text=True)
         self.lines: queue.Queue = queue.Queue()

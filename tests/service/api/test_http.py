@@ -55,8 +55,12 @@ def test_health(client):
     assert h["uptime_s"] >= 0.0
     assert h["zenoh"] is False and h["recording"] is None
     (tw,) = [t for t in h["twins"] if t["id"] == "default"]
-    for key in ("real_time_factor", "overruns", "dropped", "frames", "published", "errors", "mode"):
+    for key in ("real_time_factor", "late_fraction", "lateness_s", "frame_s", "overruns", "dropped", "frames",
+                "published", "errors", "mode", "cost"):
         assert key in tw
+    cap = h["capacity"]
+    assert cap["admission"] in ("measured", "off") and cap["stepping_threads"] >= 1
+    assert cap["budget_cpu_s_per_s"] > 0.0
     assert tw["running"] and tw["mode"] == "real_time"
 
 

@@ -1,7 +1,8 @@
-"""TwinRunner: one thread per twin, mailbox latest-wins, setpoints between frames, pacing, fast
-mode, stop/join, scenarios in the runner thread, errors counted. Real Twin, bounded waits; no
-wall-clock speed threshold (the machines are shared and noisy): pacing is checked as "never ahead
-of the wall clock" on the real runner and exactly on a fake clock."""
+"""TwinRunner: frames run by a stepping pool (its own, of one thread, here), mailbox latest-wins,
+setpoints between frames, pacing, fast mode, stop/join, scenarios in the stepping thread, errors
+counted, snapshots built off the stepping thread. Real Twin, bounded waits; no wall-clock speed
+threshold (the machines are shared and noisy): pacing is checked as "never ahead of the wall clock"
+on the real runner and exactly on a fake clock (tests/service/core/test_pool.py)."""
 
 from __future__ import annotations
 
@@ -167,7 +168,7 @@ def test_setpoints_only_change_between_frames(twin, make_runner):
     for t in threads:
         t.join(5.0)
     assert not violations
-    assert writers == {runner._thread.name}
+    assert writers == set(runner.stepping_threads)   # the stepping thread, never the submitters
 
 
 class _TimedSink(ListSink):
@@ -184,11 +185,10 @@ class _TimedSink(ListSink):
 
 
 def test_real_time_pacing(twin, make_runner):
-    """Real-time mode on a real twin, without a speed threshold (the machine is shared): the
-    simulated time never runs ahead of the wall clock (at every snapshot and at the end), every
-    frame is counted and advanced frame_s, and publishing follows the 50 Hz wall-clock schedule
-    (never more often). How fast the twin keeps up is the benchmark's business, not a test's."""
-    sink = _TimedSink()
+    """Paced to the wall clock: never ahead of it by more than the frame that may run early.
+    How far behind depends on this shared machine's load (the pool's behaviour under load is
+    tests/service/core/test_pool.py's, with a fake clock), so only progress is asserted here."""
+    sink = ListSink()
     runner = make_runner(twin, publish_rate_hz=50.0, sinks=[sink])
     time0 = twin.time_s
     t0 = time.perf_counter()
@@ -196,19 +196,17 @@ def test_real_time_pacing(twin, make_runner):
     assert wait_until(lambda: runner.frames >= 50 and runner.published >= 3)   # progress (bounded wait)
     assert runner.stop(timeout=10.0)
     wall = time.perf_counter() - t0
-    frames, sim = runner.frames, runner.sim_elapsed_s
-    # frames counted: each advanced the twin by exactly frame_s
-    assert sim == pytest.approx(frames * runner.frame_s, rel=1e-12)
-    assert twin.time_s - time0 == pytest.approx(sim, abs=0.5 * twin.model.dt_s)
-    # never ahead of the wall clock (one frame of slack for the frame in progress, one for timing)
-    assert sim <= wall + 2 * runner.frame_s
-    for arrived, snap in sink.arrivals:
-        assert snap.time_s - time0 <= (arrived - t0) + 2 * runner.frame_s
-    assert 0 <= runner.overruns <= frames
-    # published on the wall clock at 50 Hz (+ the initial one), never more than once per frame
-    assert 3 <= runner.published <= min(frames + 1, 50 * wall + 2)
+    sim = runner.sim_elapsed_s
+    assert 0.0 < sim <= wall + 2 * runner.frame_s
+    assert runner.real_time_factor is not None and runner.real_time_factor > 0.0
+    assert runner.overruns <= runner.frames
+    lf = runner.late_fraction
+    assert lf is not None and 0.0 <= lf <= 1.0
+    # published on the wall clock at about 50 Hz (+ the initial one), never faster
+    assert 1 <= runner.published <= 50 * wall + 5
     rtfs = [s.real_time_factor for s in sink.snapshots[1:]]
-    assert rtfs and all(r is not None and r > 0.0 for r in rtfs)
+    assert rtfs and all(r is not None for r in rtfs)
+    assert all(s.late_fraction is not None for s in sink.snapshots[1:])
     seqs = [s.seq for s in sink.snapshots]
     assert seqs == sorted(seqs) and len(set(seqs)) == len(seqs)
 
@@ -348,7 +346,9 @@ def test_scenario_runs_in_the_runner_thread(twin, make_runner):
     assert replaced is None
     assert handle.wait(WAIT_S)
     assert handle.state == "done" and handle.progress == 1.0
-    assert writers == {runner._thread.name}
+    assert writers == set(runner.stepping_threads)
+    # the snapshots are built and handed to the sinks by the publish worker, not the stepping thread
+    assert sink.threads == {runner._pool.publisher.thread_name}
     t0 = sink.snapshots[0].time_s
     by_t = {round(s.time_s - t0, 6): s.setpoint for s in sink.snapshots}
     assert by_t[0.0].radial_load_n == 2000.0

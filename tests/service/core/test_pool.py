@@ -1,0 +1,370 @@
+"""The stepping pool (service.core.pool), the lateness accounting (service.core.pacing) and the
+admission by measured capacity (service.core.capacity, the registry's 503).
+
+The scheduler's ordering and accounting are checked with a fake clock and fake twins (a discrete
+event simulation of the pool's rule: a free stepping thread takes the released job with the
+earliest deadline); the threaded pool with fake jobs and bounded waits; the admission with given
+costs. No wall-clock threshold anywhere."""
+
+from __future__ import annotations
+
+import heapq
+import math
+import threading
+import time
+
+import pytest
+
+from service.core.capacity import Capacity, CpuMeter, TwinCost, calibrate
+from service.core.errors import InputError
+from service.core.pacing import PacingClock
+from service.core.pool import EdfQueue, Job, Schedule, SteppingPool
+
+WAIT_S = 30.0
+
+
+class _Named:
+    def __init__(self, name):
+        self.name = name
+
+
+def _job(name):
+    return Job(_Named(name))
+
+
+# ---- EdfQueue: the ordering ----------------------------------------------------------------------
+def test_released_job_with_the_earliest_deadline_goes_first():
+    q = EdfQueue()
+    a, b, c, d = (_job(n) for n in "abcd")
+    q.put(a, Schedule(release=0.000, deadline=0.010))
+    q.put(b, Schedule(release=0.000, deadline=0.006))
+    q.put(c, Schedule(release=0.004, deadline=0.005))   # earliest deadline, not yet released
+    q.put(d, Schedule(release=0.000))                   # no deadline (fast mode): after the others
+    assert q.take(0.001) is b
+    assert q.take(0.001) is a
+    assert q.take(0.001) is d
+    assert q.take(0.001) is None
+    assert q.next_release() == pytest.approx(0.004)
+    assert q.take(0.004) is c
+    assert q.next_release() is None
+
+
+def test_jobs_without_deadline_go_round_robin():
+    q = EdfQueue()
+    jobs = [_job(n) for n in "abc"]
+    for j in jobs:
+        q.put(j, Schedule(0.0))
+    order = []
+    for _ in range(9):
+        j = q.take(1.0)
+        order.append(j.task.name)
+        q.put(j, Schedule(1.0))          # back at the end of the line
+    assert "".join(order) == "abcabcabc"
+
+
+def test_wake_releases_a_waiting_job_now_and_stale_entries_are_ignored():
+    q = EdfQueue()
+    a, b = _job("a"), _job("b")
+    q.put(a, Schedule(release=0.050, deadline=0.055))
+    q.put(b, Schedule(release=0.010, deadline=0.015))
+    assert q.take(0.001) is None
+    assert q.wake(a, 0.001)                  # a setpoint arrived: released now, deadline kept
+    assert not q.wake(a, 0.001)              # already released
+    assert q.take(0.001) is a
+    assert not q.wake(a, 0.002)              # running: nothing to release
+    q.put(a, Schedule(release=0.020, deadline=0.025))
+    assert q.take(0.012) is b
+    assert q.take(0.012) is None             # a's old entry (release 0.050) is stale, its new one waits
+    assert q.next_release() == pytest.approx(0.020)
+    q.remove(a)
+    assert q.take(1.0) is None and q.next_release() is None
+
+
+# ---- the pool's rule with a fake clock and fake twins ---------------------------------------------
+class FakeTwin:
+    """A twin whose frame of `frame_s` simulated seconds costs `cost_s` wall seconds, paced by the
+    real PacingClock on the simulation's clock."""
+
+    def __init__(self, name, frame_s, cost_s, clock, lateness_s=0.005):
+        self.name, self.frame_s, self.cost_s = name, frame_s, cost_s
+        self.sim_s = 0.0
+        self.pacing = PacingClock(fast=False, publish_period_s=0.02, clock=clock, lateness_s=lateness_s)
+        self.pacing.start(0.0)
+        self.frames = 0
+
+    def run(self, now):
+        """One frame started at `now`: (its end, the schedule of the next)."""
+        end = now + self.cost_s
+        self.sim_s += self.frame_s
+        self.frames += 1
+        self.pacing.measure(end, self.sim_s)
+        release = self.pacing.frame_done(end, self.sim_s)
+        return end, Schedule(release, release + self.frame_s)
+
+
+def simulate(twins, workers, until):
+    """Discrete event simulation of `workers` stepping threads under the pool's rule."""
+    clock = {"now": 0.0}
+    q = EdfQueue()
+    for t in twins:
+        q.put(Job(t), Schedule(0.0, t.frame_s))
+    running = []            # heap of (end, n, job, schedule)
+    n = 0
+    now = 0.0
+    while now < until:
+        clock["now"] = now
+        while running and running[0][0] <= now:
+            _, _, job, sched = heapq.heappop(running)
+            q.put(job, sched)
+        while len(running) < workers:
+            job = q.take(now)
+            if job is None:
+                break
+            end, sched = job.task.run(now)
+            n += 1
+            heapq.heappush(running, (end, n, job, sched))
+        nexts = [running[0][0]] if running else []
+        nr = q.next_release()
+        if nr is not None and len(running) < workers:
+            nexts.append(max(nr, now))
+        now = min(nexts)
+    return twins
+
+
+def _fake_twins(costs, frame_s=0.005):
+    clock = {"now": 0.0}
+    return [FakeTwin(f"t{i}", frame_s, c, lambda: clock["now"]) for i, c in enumerate(costs)]
+
+
+def test_twins_within_capacity_are_never_late():
+    # 4 twins of 0.8 of a core each (4 ms of work per 5 ms frame) on 4 threads; 3 twins of 0.6 on 2
+    for costs, workers in (([0.004] * 4, 4), ([0.003] * 3, 2)):
+        twins = simulate(_fake_twins(costs), workers, until=2.0)
+        for t in twins:
+            assert t.pacing.overruns == 0 and t.pacing.late_fraction == 0.0
+            assert t.sim_s == pytest.approx(2.0, abs=2 * t.frame_s)   # real time: no more, no less
+            assert t.pacing.real_time_factor == pytest.approx(1.0, abs=0.01)
+
+
+def test_overloaded_twins_fall_behind_together():
+    # 3 twins of 0.8 of a core on 2 threads: 2.4 cores of work on 2. Earliest deadline first keeps
+    # them level (the one furthest behind goes next): each runs at 2 / 2.4 of real time, none starves.
+    twins = simulate(_fake_twins([0.004] * 3), 2, until=3.0)
+    sims = [t.sim_s for t in twins]
+    assert max(sims) - min(sims) <= 0.005 + 1e-12            # within one frame of each other
+    for t in twins:
+        assert t.sim_s / 3.0 == pytest.approx(2.0 / 2.4, abs=0.02)
+        assert t.pacing.late_fraction > 0.5                  # and they say so
+    # a twin alone on a thread beside them would have been on time: the pool, not the twin, is full
+
+
+def test_lateness_counts_frames_ending_beyond_it_not_every_microsecond():
+    clock = {"now": 0.0}
+    p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: clock["now"], lateness_s=0.005,
+                    late_window_s=10.0)
+    p.start(0.0)
+    assert p.late_fraction is None
+    # frames of 5 ms ending 1 us, 4.9 ms and 6 ms after their deadline
+    assert p.frame_done(0.005 + 1e-6, 0.005) == pytest.approx(0.005 + 1e-6)  # behind: next at once
+    p.frame_done(0.010 + 0.0049, 0.010)
+    assert p.overruns == 0 and p.late_fraction == 0.0
+    p.frame_done(0.015 + 0.006, 0.015)
+    assert p.overruns == 1 and p.late_fraction == pytest.approx(1 / 3)
+    # ahead of the wall clock: the next frame is released at the deadline
+    assert p.frame_done(0.017, 0.020) == pytest.approx(0.020)
+    assert p.late_fraction == pytest.approx(1 / 4)
+    # the window forgets frames older than 10 s of wall time
+    p.reanchor(0.020, at=20.0)
+    p.frame_done(20.005, 0.025)
+    assert p.late_fraction == 0.0 and p.overruns == 1
+    # more than resync_after_s behind: re-anchored, counted
+    p.frame_done(20.5, 0.030)
+    assert p.resyncs == 1 and p.frame_done(20.5, 0.030) == pytest.approx(20.5)
+
+
+def test_fast_mode_is_never_late():
+    p = PacingClock(fast=True, publish_period_s=0.02, clock=lambda: 0.0)
+    p.start(0.0)
+    assert p.frame_done(100.0, 0.005) == 100.0
+    assert p.overruns == 0 and p.late_fraction is None
+
+
+# ---- the threaded pool with fake jobs --------------------------------------------------------------
+class CountingJob:
+    """A fast-mode job that records which threads run it and whether two ever overlap."""
+
+    def __init__(self, name, limit):
+        self.name, self.limit = name, limit
+        self.steps = 0
+        self.threads = set()
+        self.inside = 0
+        self.overlaps = 0
+        self.left = threading.Event()
+        self._lock = threading.Lock()
+
+    def step(self, now):
+        with self._lock:
+            self.inside += 1
+            self.overlaps += self.inside > 1
+        self.threads.add(threading.current_thread().name)
+        time.sleep(0.0002)
+        with self._lock:
+            self.inside -= 1
+        self.steps += 1
+        return None if self.steps >= self.limit else Schedule(now)
+
+    def left_pool(self):
+        self.left.set()
+
+
+def test_pool_runs_each_job_on_one_thread_at_a_time():
+    pool = SteppingPool(2, name="t-pool").start()
+    try:
+        jobs = [CountingJob(f"j{i}", 200) for i in range(3)]
+        handles = [pool.add(j) for j in jobs]
+        for j, h in zip(jobs, handles):
+            assert j.left.wait(WAIT_S) and h.done.wait(WAIT_S)
+            assert j.steps == 200 and j.overlaps == 0
+            assert j.threads <= set(pool.thread_names)
+    finally:
+        assert pool.close(timeout=10.0)
+
+
+class SleepyJob:
+    """Real time: released again only in an hour, unless woken."""
+
+    name = "sleepy"
+
+    def __init__(self):
+        self.steps = 0
+        self.stepped = threading.Event()
+
+    def step(self, now):
+        self.steps += 1
+        self.stepped.set()
+        return Schedule(now + 3600.0, now + 3600.005)
+
+    def left_pool(self):
+        pass
+
+
+def test_wake_releases_a_job_waiting_for_its_release():
+    pool = SteppingPool(1, name="t-wake").start()
+    try:
+        job = SleepyJob()
+        handle = pool.add(job)
+        assert job.stepped.wait(WAIT_S)
+        deadline = time.monotonic() + WAIT_S
+        while handle.state != "waiting" and time.monotonic() < deadline:
+            time.sleep(0.001)
+        job.stepped.clear()
+        pool.wake(handle)
+        assert job.stepped.wait(WAIT_S) and job.steps == 2
+    finally:
+        assert pool.close(timeout=10.0)
+
+
+# ---- capacity: the rule ----------------------------------------------------------------------------
+def test_cpu_meter_reports_the_last_closed_window():
+    m = CpuMeter(window=1.0)
+    m.add(0.3, 0.5)
+    assert m.rate is None
+    m.add(0.5, 0.5)
+    assert m.rate == pytest.approx(0.8)
+    m.add(0.2, 1.0)
+    assert m.rate == pytest.approx(0.2) and m.cpu_s == pytest.approx(1.0)
+
+
+def test_capacity_rule():
+    cap = Capacity(stepping_threads=2, core_fraction=0.85, cores=2)
+    assert cap.budget_cpu_s_per_s == pytest.approx(1.7)
+    small = TwinCost(0.3, 0.05)
+    assert cap.check(small, []).admitted
+    assert cap.check(small, [small] * 3).admitted                 # 1.4 of 1.7
+    full = cap.check(small, [small] * 4)                           # 1.75 > 1.7
+    assert not full.admitted and "no capacity left" in full.reason and "1.400 of 1.700" in full.reason
+    big = cap.check(TwinCost(0.9, 0.05), [])                       # one core's share is 0.85
+    assert not big.admitted and "cannot run the twin in real time" in big.reason
+    assert cap.estimate_max_twins(small, running=1, used_cpu_s_per_s=0.35) == 1 + 3
+    # more threads than cores buy nothing; fewer threads than cores limit the budget
+    assert Capacity(8, 0.85, cores=2).budget_cpu_s_per_s == pytest.approx(1.7)
+    assert Capacity(1, 0.85, cores=2).budget_cpu_s_per_s == pytest.approx(0.85)
+
+
+def test_calibration_measures_thread_cpu_per_simulated_second():
+    from twin.engine import Twin
+
+    twin = Twin("6205", bearing_id="cal")
+    seq = twin.seq
+    ticks = iter([0.0, 0.012, 1.0, 1.011, 2.0, 2.0005])         # two halves of 10 ms, one snapshot
+    cost = calibrate(twin, sim_s=0.02, frame_steps=1000, publish_rate_hz=50.0, cpu_clock=lambda: next(ticks))
+    assert cost.engine_cpu_s_per_sim_s == pytest.approx(0.011 / 0.01)    # the cheaper half
+    assert cost.publish_cpu_s_per_s == pytest.approx(0.0005 * 50.0)
+    assert twin.time_s == pytest.approx(0.021)                           # warm-up frame + 20 ms
+    assert twin.seq == seq                                               # nothing published
+
+
+# ---- the registry: 503 with the reason, the configured twin over capacity --------------------------
+def test_registry_refuses_a_twin_beyond_the_measured_capacity(monkeypatch):
+    import service.core.registry as registry_module
+    from service.core.registry import TwinRegistry
+    from service.settings import ServiceSettings
+
+    from service.core.runner import TwinRunner
+
+    costs = iter([TwinCost(0.6, 0.05), TwinCost(0.6, 0.05), TwinCost(0.9, 0.05), TwinCost(0.6, 0.05)])
+    monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: next(costs))
+    # the running twins' costs as calibrated (not as this machine's speed would measure them)
+    monkeypatch.setattr(TwinRunner, "cost", property(lambda self: self.calibration))
+    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, admission="measured",
+                               stepping_threads=2, capacity_core_fraction=0.85, start_twin=False)
+    reg = TwinRegistry(settings)
+    reg.capacity.cores = 2                       # this test's host has 2 cores, whatever runs it
+    reg.open()
+    try:
+        reg.create_twin(id="a", designation="6205")                           # 0.65 of 1.7
+        reg.create_twin(id="b", designation="6205")                           # 1.3 of 1.7
+        with pytest.raises(InputError) as exc:                                # 0.95 > one core's 0.85
+            reg.create_twin(id="c", designation="6205")
+        assert exc.value.status_code == 503
+        err = exc.value.errors[0]
+        assert "refused" in err.message and "cannot run the twin in real time" in err.message
+        assert "0.950" in err.message and "0.850" in err.message
+        assert [e.id for e in reg.entries()] == ["a", "b"]
+        with pytest.raises(InputError) as exc:                                # 1.3 + 0.65 > 1.7
+            reg.create_twin(id="d", designation="6205")
+        assert exc.value.status_code == 503 and "no capacity left" in exc.value.errors[0].message
+        cap = reg.health()["capacity"]
+        assert cap["admission"] == "measured" and cap["budget_cpu_s_per_s"] == pytest.approx(1.7)
+        assert cap["used_cpu_s_per_s"] == pytest.approx(1.3)
+        assert {t["id"] for t in reg.health()["twins"]} == {"a", "b"}
+    finally:
+        reg.close()
+
+
+def test_configured_twin_starts_over_capacity_and_says_so(monkeypatch):
+    import service.core.registry as registry_module
+    from service.core.registry import TwinRegistry
+    from service.settings import ServiceSettings
+
+    monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: TwinCost(1.5, 0.05))
+    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, admission="measured",
+                               bearing="6205", stepping_threads=1)
+    reg = TwinRegistry(settings).open()
+    try:
+        assert [e.id for e in reg.entries()] == ["default"]
+        cap = reg.health()["capacity"]
+        assert "cannot run the twin in real time" in cap["over_capacity"]
+        assert cap["max_twins"] == 1
+        reg.delete_twin("default")
+        assert reg.health()["capacity"]["over_capacity"] is None
+    finally:
+        reg.close()
+
+
+def test_max_twins_unset_means_the_capacity_decides():
+    from service.settings import ServiceSettings
+
+    assert ServiceSettings().max_twins is None and ServiceSettings().twin_limit == 256
+    assert ServiceSettings(max_twins=3).twin_limit == 3
+    assert math.isclose(ServiceSettings().frame_s, 0.005) and ServiceSettings().lateness_s == 0.005

@@ -1,0 +1,30 @@
+"""`bearing-twin bench-service --twins N`: one real small run (2 twins, 2 s, zenoh and recording
+on, a served subprocess on loopback ports) whose JSON carries the keys the README documents. The
+figures themselves depend on the machine and are never asserted."""
+
+from __future__ import annotations
+
+import json
+
+from service.tools.benchmark import run_service_benchmark, twin_plan
+
+
+def test_twin_plan_cycles_the_designations():
+    plan = twin_plan(5)
+    assert [(d, sp.get("shaft_current_a")) for _, d, sp in plan] == [
+        ("6208", None), ("6205", None), ("7208", None), ("6208", 5.0), ("6208", None)]
+    assert len({i for i, _, _ in plan}) == 5
+
+
+def test_bench_service_two_twins_reports_per_twin_figures():
+    r = run_service_benchmark(twins=2, seconds=2.0, rate_hz=10.0, force=True, settle_s=0.5)
+    json.dumps(r, allow_nan=False)
+    assert r["zenoh"] is True and r["recording"] is True and r["admission"] == "off"
+    assert r["refused"] == []
+    assert [(t["id"], t["designation"]) for t in r["twins"]] == [("b1-6208", "6208"), ("b2-6205", "6205")]
+    for t in r["twins"]:
+        assert {"id", "designation", "real_time_factor_median", "late_fraction", "frames", "cost"} <= set(t)
+        assert t["frames"] > 0 and 0.0 <= t["late_fraction"] <= 1.0
+        assert t["real_time_factor_median"] > 0.0
+    assert "client_latency_ms_p99" in r and r["setpoints"] > 0
+    assert r["capacity"]["stepping_threads"] >= 1 and r["recording_rows"] > 0
