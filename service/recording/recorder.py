@@ -929,10 +929,11 @@ class RerunRecorder:
             except RecordingWriteError as exc:
                 if out is self._primary:
                     self._on_write_error(out, exc, rows)
-                else:
+                else:                       # a start_file clip: closed where it stands
                     self._write_errors += 1
-                    log.error("rerun: %s; the file %s is closed", exc, out.file.path)
-                    out.file.close()
+                    f, out.file = out.file, None
+                    log.error("rerun: %s; the file %s is closed", exc, f.path)
+                    f.close()
                     self._extra = None
                     self._close_output(out)
                 continue
