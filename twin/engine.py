@@ -184,9 +184,9 @@ class Twin:
         loaded = delta > 0.0
         if loaded.all() or not loaded.any():
             return float(z) if loaded.all() else 0.0
-        order = np.argsort(self.ball_azimuths_rad())
-        az = self.ball_azimuths_rad()[order]
-        d = delta[order]
+        az = self.ball_azimuths_rad()
+        order = np.argsort(az)
+        az, d = az[order], delta[order]
         arc = 0.0
         for j in range(z):
             k = (j + 1) % z

@@ -161,7 +161,8 @@ def test_bench_json_keys_positive_and_finite():
     assert res.returncode == 0, res.stderr
     r = json.loads(res.stdout, parse_constant=lambda c: pytest.fail(f"non-finite {c}"))
     for key in ("real_time_factor", "real_time_factor_median", "time_step_s", "ns_per_step",
-                "real_time_factor_1us", "real_time_factor_1us_median", "ns_per_step_1us"):
+                "real_time_factor_1us", "real_time_factor_1us_median", "ns_per_step_1us",
+                "cpu_real_time_factor", "cpu_real_time_factor_1us"):
         assert math.isfinite(r[key]) and r[key] > 0, key
     assert r["repeats"] >= 5 and r["time_step_s"] > 1e-6
     assert {c["id"] for c in r["cases"]} == {"ev-5A-heating", "7208-combined", "6208-1700rad-7.5kN"}
