@@ -148,8 +148,8 @@ O_EZ = 55
 O_SX = 56     # slip velocity ball minus ring, tangential [m/s]
 O_SY = 57
 O_SZ = 58
-# tangential spring relaxation (refreshed with the tribology): xi <- decay xi + v_slip dt
-C_XI_DECAY = 59  # 1 / (1 + u dt / L), L = sqrt(a b) the contact's relaxation length [-]
+# tangential spring relaxation (refreshed with the tribology): xi <- decay (xi + v_slip dt)
+C_XI_DECAY = 59  # 1 / (1 + r dt), r = u / L + spin sliding, L = sqrt(a b) the relaxation length [-]
 # friction over the contact ellipse (twin.kernels.traction), refreshed with the strip integration
 E_SLIP = 60          # centre slip s0 of the last strip solution (warm start) [m/s]
 E_MOMENT_T2 = 61     # moment of the traction about the contact centre along t2 = n x t1 [N m]

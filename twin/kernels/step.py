@@ -21,13 +21,13 @@ from twin.kernels.layout import (
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
-    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
+    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
     P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
 )
-from twin.kernels.traction import apply_traction_moments, ellipse_traction
+from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 
 
@@ -158,8 +158,11 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             w[C_H_C * CW + c] = tri[1]
             w[C_LAMBDA * CW + c] = tri[2]
             w[C_REGIME * CW + c] = tri[3]
-            if friction_model != FRICTION_ELLIPSE or w[C_MU * CW + c] == 0.0:
-                w[C_MU * CW + c] = tri[4]  # ellipse friction: its capacity (ellipse_traction) once solved
+            # the contact's limiting friction coefficient: the Coulomb law's mu, or with the ellipse
+            # friction its traction capacity over Q (not the effective |F_t| / Q it publishes)
+            mu_lim = (limiting_traction_coefficient(tri[2], p[P_LIMITING_SHEAR])
+                      if friction_model == FRICTION_ELLIPSE else tri[4])
+            w[C_MU * CW + c] = mu_lim
             w[C_SEMI_MAJOR * CW + c] = tri[5]
             w[C_SEMI_MINOR * CW + c] = tri[6]
             w[C_FLUID_DAMPING * CW + c] = tri[7]
@@ -170,11 +173,12 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             w[C_TANGENT_DAMPING * CW + c] = ct_ratio * 2.0 * math.sqrt(kt * tangent_mass)
             w[C_ENTRAINMENT * CW + c] = u
             # tangential spring relaxation (contacts.raceway_forces): by rolling over L = sqrt(a b)
-            # and by the spin sliding of the contact, kt |w_spin| sqrt(a b) / (1.3 mu Q)
+            # and by the spin sliding of the contact, kt |w_spin| sqrt(a b) / (1.3 mu Q) with mu the
+            # limiting coefficient of the fully sliding traction (mu_lim)
             ab = math.sqrt(tri[5] * tri[6])
             spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
                            + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
-            relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * tri[4] * q_el, 1e-12)
+            relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
             w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
             w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
                                   + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)

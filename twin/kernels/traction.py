@@ -50,9 +50,7 @@ from twin.kernels.layout import (
 )
 from twin.physics.friction import stribeck_line_mu
 from twin.physics.rolling import asperity_load_share
-from twin.physics.traction import (
-    barus_viscosity_pa_s, eyring_saturation_slip_m_s, traction_capacity,
-)
+from twin.physics.traction import barus_viscosity_pa_s, eyring_saturation_slip_m_s, traction_capacity
 
 NEWTON_MAX_ITERATIONS = 40
 NEWTON_FORCE_TOLERANCE = 1e-3   # of the capacity Q: |sum f_k - target| below this stops the solve
@@ -60,9 +58,23 @@ TARGET_FRACTION = 0.999         # the net force is kept inside the capacity by t
 
 
 @njit(**JIT)
+def limiting_traction_coefficient(film_parameter, limiting_shear_coefficient):
+    """Traction capacity of a contact over its normal load, every element sliding one way [-]:
+    Qa/Q mu(Lambda) + (1 - Qa/Q) gamma (twin.physics.traction.traction_capacity; seed 001 eq. A2
+    share, seed 000 mu(Lambda), Bair-Winer gamma). It is the contact's limiting friction
+    coefficient: the tangential spring's Coulomb limit (C_MU) and the mu of the fully sliding
+    traction that the spin-creep relaxation linearises (twin.kernels.step). In full film
+    (Lambda >= 2.26, no asperity share) it is gamma without evaluating a power."""
+    share = asperity_load_share(film_parameter)
+    if share == 0.0:
+        return limiting_shear_coefficient
+    return traction_capacity(share, stribeck_line_mu(film_parameter), limiting_shear_coefficient)
+
+
+@njit(**JIT)
 def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
     """For every loaded contact: the traction capacity (the tangential spring's Coulomb limit,
-    C_MU) and the strip integration of the module docstring, written to the E_* rows. Open
+    C_MU, `limiting_traction_coefficient`) and the strip integration of the module docstring, written to the E_* rows. Open
     contacts get zero moments. Reads the contact lanes after the tribology refresh."""
     n_strips = int(p[P_TRACTION_STRIPS])
     gamma = p[P_LIMITING_SHEAR]
@@ -83,7 +95,7 @@ def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
         lam = w[C_LAMBDA * CW + c]
         share = asperity_load_share(lam)
         mu_a = stribeck_line_mu(lam)
-        capacity = traction_capacity(share, mu_a, gamma)
+        capacity = limiting_traction_coefficient(lam, gamma)  # as the tribology refresh set it
         w[C_MU * CW + c] = capacity
         q = w[C_LOAD * CW + c]
         # net tangential force on the ball: the elastic part of the tangential spring

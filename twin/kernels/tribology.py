@@ -116,8 +116,9 @@ def contact_tribology(load_n, entrainment_m_s, viscosity_pa_s, roughness_m, t0, 
 
 @njit(**JIT)
 def _mu(film_parameter, friction_model):
-    # 0: seed 000's line; 2 (friction over the ellipse): only the spring's limit of a contact that
-    # has just closed, until twin.kernels.traction sets its capacity: the line, without powers
+    # 0: seed 000's line; 2 (friction over the ellipse): not used (the refresh takes the contact's
+    # traction capacity, twin.kernels.traction.limiting_traction_coefficient, and seed 001's
+    # pivoting moment is off): the line, without powers
     if friction_model != 1:
         return stribeck_line_mu(film_parameter)
     return sliding_friction_coefficient_asperity_share(asperity_load_share(film_parameter), 0.03, 0.11)
