@@ -5,7 +5,10 @@ Every case runs three times from the same warm start, at the seed's 1 us, at `ti
 whole cage revolutions (at least MIN_WINDOW_S): per race, the ball load, Lambda, h_min and mu
 against azimuth (AZIMUTH_BINS bins over the balls' actual azimuths), the cage speed, the balls'
 spin and orbital speeds, the friction torque (the torque the shaft supplies, averaged over every
-step), the bearing capacitance and, with a shaft current, the current-heating temperature rise.
+step), the bearing's impedance magnitude |Z| (always defined), its capacitance where the snapshot
+publishes one (the network is capacitive: the mean over the samples that publish it, compared when
+both runs publish it in every sample, else null) and, with a shaft current, the current-heating
+temperature rise.
 The deviations from 1 us are checked against TOLERANCES (issue 13: 0.5 % for loads, films,
 Lambda and speeds, 2 % for torque and electrical values; mu, a film value, is held to 0.5 %).
 
@@ -55,7 +58,7 @@ LOADED_FRACTION = 0.05         # bins with a mean load above this fraction of th
 TOLERANCES = {  # relative, issue 13
     "ball_load": 0.005, "lambda": 0.005, "h_min": 0.005, "mu": 0.005,
     "cage_speed": 0.005, "ball_spin": 0.005, "ball_orbital_speed": 0.005,
-    "friction_torque": 0.02, "capacitance": 0.02, "current_heating": 0.02,
+    "friction_torque": 0.02, "impedance": 0.02, "capacitance": 0.02, "current_heating": 0.02,
 }
 QUANTITIES = tuple(TOLERANCES)
 
@@ -154,8 +157,8 @@ def run_case(case: Case, time_step_s: float | str, **options) -> _Run:
     mu_sum = np.zeros((2, b))
     cage = spin = orbit = 0.0
     torque_sum = torque_steps = 0.0
-    cap_sum = heat_sum = 0.0
-    cap_n = 0
+    cap_sum = heat_sum = imp_sum = 0.0
+    cap_n = elec_n = 0
     s = twin.state
     done = 0
     samples = 0
@@ -191,9 +194,12 @@ def run_case(case: Case, time_step_s: float | str, **options) -> _Run:
         samples += 1
         if samples % ELECTRICAL_EVERY_SAMPLES == 0:
             e = twin.snapshot().electrical
-            cap_sum += e.capacitance_f
+            imp_sum += e.impedance_ohm
             heat_sum += e.current_temperature_rise_k
-            cap_n += 1
+            elec_n += 1
+            if e.capacitance_f is not None:  # published only where the network is capacitive
+                cap_sum += e.capacitance_f
+                cap_n += 1
     samples = max(samples, 1)
     with np.errstate(invalid="ignore", divide="ignore"):
         closed_n = np.maximum(closed_count, 1.0)
@@ -205,8 +211,10 @@ def run_case(case: Case, time_step_s: float | str, **options) -> _Run:
             scalars={"cage_speed": cage / samples, "ball_spin": spin / samples,
                      "ball_orbital_speed": orbit / samples,
                      "friction_torque": torque_sum / max(torque_steps, 1.0),
-                     "capacitance": cap_sum / max(cap_n, 1),
-                     "current_heating": heat_sum / max(cap_n, 1)})
+                     "impedance": imp_sum / max(elec_n, 1),
+                     "capacitance": cap_sum / cap_n if cap_n else math.nan,
+                     "capacitive_everywhere": cap_n == elec_n > 0,
+                     "current_heating": heat_sum / max(elec_n, 1)})
     return run
 
 
@@ -234,8 +242,11 @@ def compare(run: _Run, ref: _Run, with_current: bool) -> dict[str, float]:
             if free.any():
                 worst.append(_relative(float(np.mean(a[race, free])), float(np.mean(r[race, free]))))
         out[key] = max(worst) if worst else math.nan
-    for key in ("cage_speed", "ball_spin", "ball_orbital_speed", "friction_torque", "capacitance"):
+    for key in ("cage_speed", "ball_spin", "ball_orbital_speed", "friction_torque", "impedance"):
         out[key] = _relative(run.scalars[key], ref.scalars[key])
+    out["capacitance"] = (_relative(run.scalars["capacitance"], ref.scalars["capacitance"])
+                          if run.scalars["capacitive_everywhere"] and ref.scalars["capacitive_everywhere"]
+                          else math.nan)
     out["current_heating"] = (_relative(run.scalars["current_heating"], ref.scalars["current_heating"])
                               if with_current else math.nan)
     return out
@@ -269,6 +280,7 @@ def run_study(cases: list[Case] | None = None, *, quick: bool = False, progress=
                 "restarts": run.restarts, "deviation": dev, "within_tolerance": ok,
                 "friction_torque_n_m": run.scalars["friction_torque"],
                 "reference_friction_torque_n_m": ref.scalars["friction_torque"],
+                "impedance_ohm": run.scalars["impedance"],
                 "capacitance_f": run.scalars["capacitance"],
             })
     return rows
@@ -285,8 +297,8 @@ def summary(rows: list[dict], step: str = "auto") -> dict[str, float]:
 
 
 _HEAD = ("ball_load", "lambda", "h_min", "mu", "cage_speed", "ball_spin", "ball_orbital_speed",
-         "friction_torque", "capacitance", "current_heating")
-_TITLE = ("load", "Lambda", "h_min", "mu", "cage", "spin", "orbit", "torque", "C", "heating")
+         "friction_torque", "impedance", "capacitance", "current_heating")
+_TITLE = ("load", "Lambda", "h_min", "mu", "cage", "spin", "orbit", "torque", "abs Z", "C", "heating")
 
 
 def _pct(x: float | None) -> str:
