@@ -24,7 +24,6 @@ import math
 import statistics
 import time
 
-import numpy as np
 
 from numba import njit
 
@@ -291,9 +290,6 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     p, tr, sp = m.params, m.angle_table, twin._setpoint_vector
     nc = 2 * m.ball_count
     substeps = int(p[P_SUBSTEPS])
-    # the tribology pass is timed with the race constants at the nominal angle (the kernel
-    # interpolates them in the angle table per contact: a few ns more per refresh)
-    tr_nominal = np.ascontiguousarray(m.race_tribology)
 
     def copies():
         args = [a.copy() for a in s.kernel_args()]
@@ -304,9 +300,9 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
         "gather": lambda n: _gather(bx, bv, bw, rx, rv, scal, w, n),
         "geometry": lambda n: _geometry(w, nc, n),
         "forces": lambda n: _forces(w, nc, p[P_BALL_RADIUS], p[P_DT], p[P_KT_RATIO], p[P_ALPHA_E], n),
-        "tribology_no_refresh": lambda n: _tribology(p, tr_nominal, sp, w, nc, False, False, n),
-        "tribology_refresh": lambda n: _tribology(p, tr_nominal, sp, w, nc, True, False, n),
-        "tribology_refresh_electrical": lambda n: _tribology(p, tr_nominal, sp, w, nc, True, True, n),
+        "tribology_no_refresh": lambda n: _tribology(p, tr, sp, w, nc, False, False, n),
+        "tribology_refresh": lambda n: _tribology(p, tr, sp, w, nc, True, False, n),
+        "tribology_refresh_electrical": lambda n: _tribology(p, tr, sp, w, nc, True, True, n),
         "cage": lambda n: _cage(p, scal, bx, bv, ba, balpha, w, cage_load, n),
     }
     for fn in runs.values():  # compile

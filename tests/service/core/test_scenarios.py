@@ -233,7 +233,7 @@ def test_scenario_run_command_writes_a_recording(tmp_path):
             rows[chunk.entity_path] = rows.get(chunk.entity_path, 0) + chunk.num_rows
     assert rows["/bearing/rec/friction_torque_n_m"] == 11          # one row per sample, 0..10 ms
     assert rows["/bearing/rec/balls"] == 11
-    assert rows["/bearing/rec/ball/0/inner/load_n"] == 11
+    assert rows["/bearing/rec/contacts/load_n"] == 11          # all contacts of a sample in one row
 
 
 def test_scenario_run_refuses_bad_input(tmp_path, capsys):
