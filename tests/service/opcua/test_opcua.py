@@ -92,7 +92,13 @@ def test_browse_the_namespace_folders_and_setpoint(url):
             eu = await (await node.get_child(f"{idx}:EURange")).read_value()
             return eu
     eu = run(main())
-    assert (eu.Low, eu.High) == (0.0, pytest.approx(21510.05, rel=1e-4))
+    # the bearing's own range: the 6208's radial-load limit of the compiled model (static capacity,
+    # 4.2 GPa with the exact Hertz constants)
+    from twin import catalog
+    from twin.model import make_model
+
+    limit = make_model(catalog.bearing("6208")).max_radial_load_n
+    assert (eu.Low, eu.High) == (0.0, pytest.approx(limit, rel=1e-9))
 
 
 def test_state_is_within_one_publish_period_of_http(url, http):
