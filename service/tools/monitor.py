@@ -151,7 +151,7 @@ class TwinTable:
         if not isinstance(alarm_id, str):
             self.invalid += 1
             return
-        alarms = self._row(_bearing_from_key(key) or str(data.get("bearing_id") or key))["alarms"]
+        alarms = self._row(twin_name(key, self.prefix) or str(data.get("bearing_id") or key))["alarms"]
         if data.get("active") is True:
             alarms[alarm_id] = str(data.get("severity") or "?")
         else:
