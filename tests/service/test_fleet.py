@@ -35,7 +35,10 @@ class Proc:
 
     def __init__(self, tmp_path: Path, *args: str, ready: str, env: dict | None = None):
         full_env = {k: v for k, v in os.environ.items() if not k.startswith("BEARING_TWIN_")}
-        full_env.update({"PYTHONUNBUFFERED": "1", "PYTHONPATH": str(REPO), **(env or {})})
+        # the capacity admission is not what this test is about (a loaded CI host may refuse a
+        # third twin): tests/service/core/test_pool.py and test_capacity cover it
+        full_env.update({"PYTHONUNBUFFERED": "1", "PYTHONPATH": str(REPO), "BEARING_TWIN_ADMISSION": "off",
+                         **(env or {})})
         self.proc = subprocess.Popen([sys.executable, "-m", "service.cli", *args], cwd=tmp_path,
                                      env=full_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
         self.lines: list[str] = []
