@@ -36,7 +36,7 @@ def _run(designation, radial, time_step):
     disp = []
     for _ in range(int(round(WINDOW_S / SAMPLE_S))):
         twin.advance(SAMPLE_S, frame_steps=100)
-        disp.append(np.linalg.norm(twin.state.ring_position_m))
+        disp.append(np.linalg.norm(twin.state.inner_ring_offset_m))
     snap = twin.snapshot()
     jones = analytic.jones_equilibrium(twin.model, radial, 3000.0, snap.shaft_speed_rad_s,
                                        azimuths_rad=twin.ball_azimuths_rad())
