@@ -1,5 +1,5 @@
 """`bearing-twin` command line: simulate, bench, timestep-study, report, serve, router, scenario, bench-service,
-monitor, soak, ehl, life.
+monitor, soak, attack, ehl, life.
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -234,6 +234,9 @@ def build_parser() -> argparse.ArgumentParser:
     from service.tools.soak import add_soak_command
 
     add_soak_command(sub)
+    from service.tools.attack import add_attack_command
+
+    add_attack_command(sub)
     from service.tools.ehl_cli import add_ehl_command
 
     add_ehl_command(sub)
