@@ -85,6 +85,7 @@ def test_reads_are_rate_limited_per_client(guarded):
     assert err["allowed"] == [0, 5.0]
     # /health is not counted: the liveness probe answers while the reads are refused
     assert all(client.get("/health").status_code == 200 for _ in range(20))
+    assert client.get("/health").json()["reads_rate_limited"] >= codes.count(429)
 
 
 def _slow_sockets(port: int) -> list[tuple[socket.socket, str, bytes]]:
@@ -152,7 +153,8 @@ def test_slowloris_connections_are_closed_and_health_answers(guarded):
     while len(state.connections) > baseline + 1 and time.monotonic() < deadline:
         time.sleep(0.05)
     assert len(state.connections) <= baseline + 1      # + the test's own kept-alive client
-    assert client.get("/health").json()["status"] == "ok"
+    h = client.get("/health").json()
+    assert h["status"] == "ok" and h["http_slow_closed"] >= SLOW
 
 
 def test_query_string_tokens_never_reach_the_access_log(hostile, tmp_path):
