@@ -114,7 +114,7 @@ class GuardedH11Protocol(H11Protocol):
             return
         n = closures.count(what)
         if n <= 5 or n % 100 == 0:
-            client = "%s:%d" % self.client if self.client else "a client"
+            client = f"{self.client[0]}:{self.client[1]}" if self.client else "a client"
             log.warning("closed the connection of %s: request %s not complete within %g s "
                         "(%d such so far)", client, what, timeout_s, n)
         cycle = self.cycle if what == "body" else None

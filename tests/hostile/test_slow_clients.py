@@ -14,7 +14,6 @@ Every wait is a bounded liveness wait; no wall-clock figure is asserted."""
 from __future__ import annotations
 
 import json
-import os
 import select
 import signal
 import socket
@@ -62,7 +61,7 @@ def guarded(hostile, tmp_path_factory):
 
 
 def test_reads_are_rate_limited_per_client(guarded):
-    srv, client = guarded
+    _, client = guarded
     time.sleep(2.5)                           # a full bucket (10 reads at 5/s refill)
     t0 = time.monotonic()
     codes, refused = [], None
