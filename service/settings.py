@@ -467,6 +467,30 @@ class ServiceSettings(ZenohAccessSettings):
         default=64 * 1024, ge=256, le=64 * 1024 * 1024,
         description="Largest HTTP request body (and zenoh setpoint payload) accepted [bytes]; "
         "larger: 413.")
+    read_rate_hz: float = Field(
+        default=100.0, ge=0.0, le=1e6,
+        description="Sustained rate of API reads (GET/HEAD under /v1/) per client address [1/s]; 0 = no "
+        "limit. Beyond it: 429 with Retry-After naming the limit. /health and the docs are not counted.")
+    read_burst: int = Field(
+        default=200, ge=1, le=1_000_000,
+        description="Reads a client may make in a burst before read_rate_hz applies [count].")
+    http_header_timeout_s: float = Field(
+        default=10.0, gt=0.0, le=600.0,
+        description="A request's line and headers must be complete this long after the connection "
+        "opened (or the next request's first byte arrived); else 408 and the connection is closed "
+        "(slow clients) [s].")
+    http_body_timeout_s: float = Field(
+        default=30.0, gt=0.0, le=3600.0,
+        description="A request body must be complete this long after its headers; else 408 and the "
+        "connection is closed [s].")
+    http_keep_alive_s: int = Field(
+        default=5, ge=1, le=3600,
+        description="An idle kept-alive HTTP connection is closed after this long (uvicorn "
+        "timeout_keep_alive) [s].")
+    http_max_connections: int = Field(
+        default=256, ge=8, le=100_000,
+        description="Open HTTP connections (or running requests) beyond which a new request gets 503 "
+        "(uvicorn limit_concurrency) [count].")
     scenario_dir: Path | None = Field(
         default=None,
         description="Directory of named scenarios [path]; default ./scenarios if it exists, else "

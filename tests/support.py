@@ -146,8 +146,10 @@ class ThreadServer:
         from service.api.app import create_app
 
         self.app = create_app(settings)
-        config = uvicorn.Config(self.app, host="127.0.0.1", port=0, log_level="warning",
-                                lifespan="on", timeout_graceful_shutdown=2)
+        from service.api.server import uvicorn_config
+
+        config = uvicorn_config(self.app, self.app.state.settings, host="127.0.0.1", port=0,
+                                log_level="warning", timeout_graceful_shutdown=2)
         self.server = uvicorn.Server(config)
         self.thread = threading.Thread(target=self.server.run, daemon=True)
         self.start_timeout_s, self.stop_timeout_s = start_timeout_s, stop_timeout_s

@@ -54,6 +54,7 @@ SKIPPED = {
                                          "tests/hostile/test_zenoh_access.py run them on loopback",
     r"bearing-twin router": "runs until stopped: tests/service/test_fleet.py runs it",
     r"bearing-twin soak --minutes 60 --url": "needs a service of its own: the --start variant is run",
+    r"bearing-twin attack --seconds 60 --url": "needs a service of its own: the --start variant is run",
     r"export BEARING_TWIN_TOKEN": "run by test_token_commands",
 }
 SERVED = (r"bearing-twin serve", r"curl ", r"bearing-twin monitor")   # run by test_serve_and_its_clients
@@ -95,6 +96,8 @@ ONE_SHOT = {
     "bearing-twin life": lambda out: ["life", "--bearing", "6208", "--radial-load", "3000", "--speed", "500",
                                       "--json"],
     "bearing-twin soak --minutes 10 --start": lambda out: ["soak", "--minutes", "0.5", "--start", "--json"],
+    "bearing-twin attack --seconds 60 --start": lambda out: ["attack", "--seconds", "3", "--start", "--baseline",
+                                                             "1", "--json"],
     "bearing-twin ehl solve": lambda out: ["ehl", "solve", "--current", "20", "--json"],
 }
 PYTHON_MODULES = {"python -m twin.validation.thermal_law_fit": ["-m", "twin.validation.thermal_law_fit"]}

@@ -14,7 +14,9 @@ template (one `APIRouter` per resource, `Depends` in `deps.py`):
   /health never) - so the OpenAPI document declares the bearer scheme exactly where it applies,
   without patching;
 * dependencies (service.api.deps): the registry, the twin, the token, the setpoint rate;
-  middleware (service.api.middleware): the body size cap only;
+  middleware (service.api.middleware): the body size cap and the per-client read rate;
+* the server (service.api.server): uvicorn with header/body deadlines for slow clients, a
+  connection cap and an access log that never shows a token;
 * errors (service.api.errors): always {"detail": [{"field", "message", "allowed"}]}.
 
 Run ONE uvicorn worker per service: each worker would run its own lifespan and its own twins.
@@ -30,7 +32,7 @@ from starlette.concurrency import run_in_threadpool
 
 from service.api.deps import require_token
 from service.api.errors import install_error_handlers
-from service.api.middleware import BodySizeLimit
+from service.api.middleware import BodySizeLimit, ReadRateLimit
 from service.api.routers import alarms, bearings, docs, health, recording, scenarios, setpoint, state
 from service.api.schemas import ErrorResponse
 from service.core.registry import TwinRegistry, admission_gate
@@ -91,6 +93,7 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
     app.state.gate = gate
     app.state.service = None
     app.add_middleware(BodySizeLimit, gate=gate)
+    app.add_middleware(ReadRateLimit, gate=gate)      # outermost: a refused read costs the least
     install_error_handlers(app)
 
     token = [Depends(require_token)] if gate.requires_token else []

@@ -178,7 +178,7 @@ class TwinHealth(BaseModel):
     errors: int = Field(description="Exceptions caught in the runner loop (each followed by a warm restart) [-].")
     restarts: int = Field(description="Engine warm restarts after a diverged or overloaded state [-].")
     setpoints_accepted: int = Field(description="Setpoint updates accepted [-].")
-    setpoints_refused: int = Field(default=0, description="zenoh setpoints refused (bus closed to writes, size, rate, validation) [-].")
+    setpoints_refused: int = Field(default=0, description="zenoh setpoints refused (bus closed to writes, size, rate, validation, control queue full) [-].")
     setpoints_rate_limited: int = Field(default=0, description="Setpoints refused by the rate limit, HTTP 429 and zenoh [-].")
     fallbacks: int = Field(default=0, description="Times the twin could not hold its setpoint and was warm-restarted at the last safe one [-].")
     last_safe_setpoint: Setpoint | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")
@@ -201,6 +201,8 @@ class Health(BaseModel):
     recording_error: str | None = Field(default=None, description="Why a recording is degraded [text]; null when none is.")
     recording_write_errors: int = Field(default=0, description="Recording writes that failed [-].")
     recording_rows_lost: int = Field(default=0, description="Snapshots that could not be written to a recording [-].")
+    reads_rate_limited: int = Field(default=0, description="API reads refused with 429 by the per-client read rate [-].")
+    http_slow_closed: int = Field(default=0, description="HTTP connections closed (408) because their headers or body were not complete in time, in this process [-].")
     pid: int | None = Field(default=None, description="Process id of the service [-] (for soak tests and monitoring).")
     rss_bytes: int | None = Field(default=None, description="Resident memory of the service process [bytes]; null where /proc is unavailable.")
 

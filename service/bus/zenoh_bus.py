@@ -7,9 +7,11 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
     P/{id}/ball/{i}          one ball: the ball's fields plus schema, bearing_id, time_s
     P/{id}/setpoint          setpoint JSON in (subscriber); no token: who may put is zenoh's
                              access control (service.bus.access)
-    P/{id}/setpoint/result   what became of each setpoint message (publisher):
-                             {"accepted": true, "setpoint": {...}} or
-                             {"accepted": false, "error": "..."}; always carries bearing_id
+    P/{id}/setpoint/result   what became of each setpoint message (publisher), one result for
+                             each: {"accepted": true, "setpoint": {...}} or
+                             {"accepted": false, "status": 403|413|422|429, "error": "..."};
+                             always carries bearing_id (429 also when too many wait: never
+                             dropped unanswered)
     P/{id}/snapshot          queryable: replies with the latest snapshot JSON
     P/{id}/owner             queryable: which process runs the twin (pid, host, zenoh id, HTTP)
     P/{id}/alarm             alarm events JSON, schema "bearing-twin/alarm/1" (publisher;
@@ -205,7 +207,9 @@ class TwinChannel:
         self.published = 0          # snapshots fully put on the bus
         self.errors = 0             # snapshots that failed to serialise or put
         self.setpoints_received = 0
-        self.setpoints_dropped = 0  # control queue overflow (never expected)
+        self.setpoints_refused_busy = 0   # setpoints refused (429 on the result key): control queue full
+        self._busy_pending = 0      # of those, refusals not yet published
+        self._busy_marked = 0       # 1 while a ("busy", None) marker waits in the control queue
         self.queries_answered = 0
         self._last: tuple[Any, str] | None = None  # (snapshot object, its state JSON)
         self._last_lock = threading.Lock()
@@ -369,15 +373,25 @@ class TwinChannel:
         self._enqueue_control(("owner", query))
 
     def _enqueue_control(self, item: tuple[str, Any]) -> None:
+        """Queue a setpoint or query for the control thread. Nothing is dropped unanswered: when
+        `_CONTROL_QUEUE_SIZE` items wait, a new query is answered "busy" at once and a new
+        setpoint is counted; the control thread then publishes one refusal (status 429, with
+        retry_after_s) on the result key for each such setpoint."""
         with self._control_cond:
             if self._closed:
                 self._finish_query(item, error="twin detached")
                 return
-            if len(self._control) >= _CONTROL_QUEUE_SIZE:
-                old = self._control.popleft()
-                if old is not None and old[0] == "setpoint":
-                    self.setpoints_dropped += 1
-                self._finish_query(old, error="busy")
+            if len(self._control) - self._busy_marked >= _CONTROL_QUEUE_SIZE:
+                if item[0] == "setpoint":
+                    self.setpoints_refused_busy += 1
+                    self._busy_pending += 1
+                    if not self._busy_marked:        # one marker, beyond the bound
+                        self._busy_marked = 1
+                        self._control.append(("busy", None))
+                        self._control_cond.notify()
+                else:
+                    self._finish_query(item, error="busy: too many requests waiting, retry")
+                return
             self._control.append(item)
             self._control_cond.notify()
 
@@ -406,7 +420,9 @@ class TwinChannel:
                 return
             kind, value = item
             try:
-                if kind == "setpoint":
+                if kind == "busy":
+                    self._refuse_busy()
+                elif kind == "setpoint":
                     self._handle_setpoint(value)
                 elif kind == "owner":
                     self._handle_owner_query(value)
@@ -427,6 +443,20 @@ class TwinChannel:
         except Exception as exc:  # noqa: BLE001 - every failure is a refusal
             text = _dumps({"accepted": False, "error": _one_line(exc), "bearing_id": self.bearing_id})
         if not self._publishers_gone:
+            self._result_pub.put(text)
+
+    def _refuse_busy(self) -> None:
+        """Publish one 429 refusal for each setpoint that found the control queue full."""
+        with self._control_cond:
+            count, self._busy_pending, self._busy_marked = self._busy_pending, 0, 0
+        text = _dumps({"accepted": False, "status": 429, "retry_after_s": 0.1,
+                       "error": f"too many setpoints waiting for twin {self.bearing_id!r} "
+                       f"({_CONTROL_QUEUE_SIZE} queued, the most this twin queues): refused, retry",
+                       "bearing_id": self.bearing_id})
+        self.setpoints_received += count
+        for _ in range(count):
+            if self._publishers_gone:
+                return
             self._result_pub.put(text)
 
     def _handle_query(self, query: zenoh.Query) -> None:

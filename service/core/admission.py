@@ -4,8 +4,9 @@
   bytes), so the time an answer takes does not tell how much of a guessed token was right.
 * `TokenBucket`: a rate limit (sustained `rate_hz`, bursts of `burst`).
 * `AdmissionGate`: the service's HTTP token, body/payload size cap, per-twin setpoint rate (one
-  token bucket per twin, shared by HTTP and zenoh) and whether setpoints from the bus are taken
-  at all. Each check returns None (admitted) or a `Refusal` with the status the transport
+  token bucket per twin, shared by HTTP and zenoh), per-client read rate (one token bucket per
+  client address, the most recently seen `MAX_READ_CLIENTS` kept) and whether setpoints from the
+  bus are taken at all. Each check returns None (admitted) or a `Refusal` with the status the transport
   answers with (401, 403, 413, 429), the field and a message; the HTTP layer turns it into its
   error answer (service.api.deps), the zenoh intake into a refusal on the result key
   (service.core.intake).
@@ -23,6 +24,7 @@ No transport here: no fastapi, no zenoh.
 
 from __future__ import annotations
 
+import collections
 import hmac
 import math
 import threading
@@ -102,10 +104,12 @@ class AdmissionGate:
     (module docstring); default "closed" when a token is given, else "open"."""
 
     BUS_WRITES = ("open", "authorized", "closed")
+    MAX_READ_CLIENTS = 10_000     # read budgets kept (least recently seen client dropped first)
 
     def __init__(self, *, token: str | None = None, setpoint_rate_hz: float | None = None,
                  setpoint_burst: int = 100, max_payload_bytes: int | None = None,
-                 bus_writes: str | None = None, clock: Callable[[], float] = time.monotonic):
+                 bus_writes: str | None = None, read_rate_hz: float | None = None,
+                 read_burst: int = 200, clock: Callable[[], float] = time.monotonic):
         self.token = token
         if bus_writes is None:
             bus_writes = "closed" if token is not None else "open"
@@ -116,6 +120,12 @@ class AdmissionGate:
         self.setpoint_burst = int(setpoint_burst)
         if self.setpoint_rate_hz is not None:
             TokenBucket(self.setpoint_rate_hz, self.setpoint_burst)   # ValueError on bad settings
+        self.read_rate_hz = float(read_rate_hz) if read_rate_hz else None
+        self.read_burst = int(read_burst)
+        if self.read_rate_hz is not None:
+            TokenBucket(self.read_rate_hz, self.read_burst)           # ValueError on bad settings
+        self._readers: collections.OrderedDict[str, TokenBucket] = collections.OrderedDict()
+        self.reads_limited = 0
         self.max_payload_bytes = max_payload_bytes
         self._clock = clock
         self._buckets: dict[str, TokenBucket] = {}
@@ -175,6 +185,30 @@ class AdmissionGate:
         return Refusal(429, None, f"too many setpoints for twin {bearing_id!r}: at most "
                        f"{self.setpoint_rate_hz:g} per second (bursts of {self.setpoint_burst}); "
                        f"retry after {retry_after:.3f} s", retry_after_s=retry_after)
+
+    def take_read(self, client: str) -> Refusal | None:
+        """Take one read from the budget of `client` (its address): None, or a 429 Refusal naming
+        the limit, with retry_after_s."""
+        if self.read_rate_hz is None:
+            return None
+        with self._lock:
+            bucket = self._readers.get(client)
+            if bucket is None:
+                bucket = self._readers[client] = TokenBucket(self.read_rate_hz, self.read_burst,
+                                                             clock=self._clock)
+                if len(self._readers) > self.MAX_READ_CLIENTS:
+                    self._readers.popitem(last=False)
+            else:
+                self._readers.move_to_end(client)
+        ok, retry_after = bucket.take()
+        if ok:
+            return None
+        with self._lock:
+            self.reads_limited += 1
+        return Refusal(429, None, f"too many reads from {client}: at most {self.read_rate_hz:g} per "
+                       f"second per client (read_rate_hz, bursts of {self.read_burst}: read_burst); "
+                       f"retry after {retry_after:.3f} s", [0, self.read_rate_hz],
+                       retry_after_s=retry_after)
 
     def rate_limited(self, bearing_id: str) -> int:
         """Setpoints of this twin refused by the rate limit so far."""

@@ -69,7 +69,8 @@ def admission_gate(settings: ServiceSettings) -> AdmissionGate:
                   else "closed" if settings.token is not None else "open")
     return AdmissionGate(token=settings.token_value, setpoint_rate_hz=settings.setpoint_rate_hz or None,
                          setpoint_burst=settings.setpoint_burst, max_payload_bytes=settings.max_body_bytes,
-                         bus_writes=bus_writes)
+                         bus_writes=bus_writes, read_rate_hz=settings.read_rate_hz or None,
+                         read_burst=settings.read_burst)
 
 
 class Channel(SnapshotSink, Protocol):
@@ -458,7 +459,7 @@ class TwinRegistry:
 
     # ---- health ----------------------------------------------------------------------------
     def health(self) -> dict:
-        twins = [e.runner.stats(setpoints_refused=e.intake.refused,
+        twins = [e.runner.stats(setpoints_refused=e.intake.refused + int(getattr(e.channel, "setpoints_refused_busy", 0)),
                                 setpoints_rate_limited=self.gate.rate_limited(e.id))
                  for e in self.entries()]
         degraded = any((not t["running"]) or t["errors"] for t in twins)
@@ -466,6 +467,7 @@ class TwinRegistry:
         return {
             "status": "degraded" if degraded else "ok",
             "capacity": self.capacity_record(),
+            "reads_rate_limited": self.gate.reads_limited,
             "uptime_s": time.monotonic() - self.started_wall_s,
             "twins": twins,
             "zenoh": self.bus is not None and not getattr(self.bus, "closed", False),

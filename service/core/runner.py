@@ -156,6 +156,10 @@ class TwinRunner:
         """The latest published snapshot (None before start)."""
         return self.publisher.latest
 
+    def latest_json(self) -> bytes | None:
+        """The latest snapshot's contract JSON, serialised once per publication (Publisher.latest_json)."""
+        return self.publisher.latest_json()
+
     def latest_snapshot(self) -> Snapshot | None:
         """Same as `latest` (a callable for the zenoh queryable)."""
         return self.publisher.latest

@@ -1,5 +1,5 @@
 """`bearing-twin` command line: simulate, bench, timestep-study, report, serve, router, scenario, bench-service,
-monitor, soak, ehl, life, vibration.
+monitor, soak, attack, ehl, life, vibration.
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -296,6 +296,9 @@ def build_parser() -> argparse.ArgumentParser:
     from service.tools.soak import add_soak_command
 
     add_soak_command(sub)
+    from service.tools.attack import add_attack_command
+
+    add_attack_command(sub)
     from service.tools.ehl_cli import add_ehl_command
 
     add_ehl_command(sub)
@@ -435,8 +438,6 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         print(f"bearing-twin: {zenoh_access}", flush=True)
     else:
         print("bearing-twin: zenoh off", flush=True)
-    path = settings.recording_path
-    print(f"bearing-twin: recording to {path}" if path else "bearing-twin: not recording", flush=True)
     if settings.opcua:
         print(f"bearing-twin: OPC UA on {settings.opcua} (namespace urn:bearing-twin:opcua; "
               + ("user name + the token as password to write" if settings.token else "anonymous writes allowed")
@@ -453,8 +454,17 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         return 2
     except KeyboardInterrupt:
         return 130
-    config = uvicorn.Config(create_app(settings, service=service), host=host, port=settings.port, workers=1,
-                            log_level=args.log_level, lifespan="on", timeout_graceful_shutdown=3)
+    recorder = getattr(service, "recorder", None)
+    written = getattr(recorder, "path", None) if recorder is not None else None
+    if written is not None:     # the file actually written: <stem>.run2.rrd when the name was taken
+        print(f"bearing-twin: recording to {written}", flush=True)
+    else:
+        print("bearing-twin: not recording" if settings.recording_path is None
+              else f"bearing-twin: recording to {settings.recording_path}", flush=True)
+    from service.api.server import uvicorn_config
+
+    config = uvicorn_config(create_app(settings, service=service), settings, host=host,
+                            log_level=args.log_level, timeout_graceful_shutdown=3)
     server = uvicorn.Server(config)
     try:
         server.run()
@@ -519,7 +529,9 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
             bar.refresh()
 
     try:
-        results = run_scenario(scenario, record=args.record, table=table, progress=progress)
+        written: list = []
+        results = run_scenario(scenario, record=args.record, table=table, progress=progress,
+                               on_recording=written.append)
     except ScenarioError as exc:
         if bar is not None:
             bar.close()
@@ -540,8 +552,8 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
     if args.table:
         path = write_table(table.rows, args.table)
         print(f"table: {path} ({len(table.rows)} rows)")
-    if args.record:
-        print(f"recording: {args.record}")
+    if args.record:      # the file written: <stem>.run2.rrd when the name was taken
+        print(f"recording: {written[0] if written else args.record}")
     return status
 
 

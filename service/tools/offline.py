@@ -123,17 +123,22 @@ def write_table(rows: list[dict[str, Any]], path: str | Path) -> Path:
 def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
                  table: TableSink | None = None, frame_s: float = 0.001,
                  progress: Callable[[float], None] | None = None,
-                 timeout_factor: float = 200.0, min_timeout_s: float = 120.0) -> list[RunResult]:
+                 timeout_factor: float = 200.0, min_timeout_s: float = 120.0,
+                 on_recording: Callable[[Path], None] | None = None) -> list[RunResult]:
     """Run every run of a scenario in fast mode, each on a fresh warm-started twin.
 
     `progress(simulated seconds done over all runs)` is called about 10 times a second.
-    `record`: an .rrd with every run as `bearing/<run id>/...` (lossless queue)."""
+    `record`: an .rrd with every run as `bearing/<run id>/...` (lossless queue); an existing file of
+    that name is never overwritten (the recorder writes `<stem>.run2.rrd` beside it), and
+    `on_recording(path)` is told the file actually written."""
     table = table if table is not None else TableSink()
     recorder = None
     if record is not None:
         from service.recording import RerunRecorder
 
         recorder = RerunRecorder(record, queue_size=1_000_000)
+        if on_recording is not None and recorder.path is not None:
+            on_recording(recorder.path)
     scenario.check_bearing_limits()        # every run, before any runs (as `scenario check`)
     runs = scenario.resolved_runs()
     results: list[RunResult] = []

@@ -6,6 +6,7 @@ from fastapi import APIRouter
 
 from service.api.deps import RegistryDep
 from service.api.schemas import Health
+from service.api.server import closures
 
 router = APIRouter(tags=["service"])
 
@@ -13,4 +14,4 @@ router = APIRouter(tags=["service"])
 @router.get("/health", response_model=Health)
 def health(registry: RegistryDep) -> Health:
     """Service status, uptime and per-twin real-time factor, overruns and drops."""
-    return Health(**registry.health())
+    return Health(**registry.health(), http_slow_closed=closures.headers + closures.body)

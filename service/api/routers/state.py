@@ -17,9 +17,12 @@ read = APIRouter(prefix="/v1/bearings", tags=["bearings"])
 @read.get("/{bearing_id}/state",
           responses={200: {"model": Snapshot, "description": "Latest snapshot, schema bearing-twin/state/1"},
                      **UNKNOWN_TWIN, **INVALID, 503: {"model": ErrorResponse, "description": "No snapshot yet"}})
-def get_state(entry: TwinDep) -> Response:
-    """The latest published snapshot (the public contract, schema bearing-twin/state/1)."""
-    snap = entry.runner.latest
-    if snap is None:
+async def get_state(entry: TwinDep) -> Response:
+    """The latest published snapshot (the public contract, schema bearing-twin/state/1).
+
+    Served from the JSON the runner's publisher serialised once for that snapshot
+    (TwinRunner.latest_json): a read costs no serialisation and no worker thread."""
+    body = entry.runner.latest_json()
+    if body is None:
         raise InputError.one(None, "no snapshot yet", status_code=503)
-    return Response(content=snap.to_json(), media_type="application/json")
+    return Response(content=body, media_type="application/json")

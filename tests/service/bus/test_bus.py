@@ -513,3 +513,53 @@ def test_publish_burst_is_cheap_and_close_is_prompt(bus, twin):
     assert time.perf_counter() - t < 5.0
     assert channel.closed
     assert channel.published + channel.dropped + channel.errors <= 5000
+
+
+def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
+    """Issue 16: zenoh setpoint results are never silently dropped. The twin's control thread is
+    held inside the handler; 256 setpoints fill its queue (_CONTROL_QUEUE_SIZE) and each of the
+    next 40 gets a refusal with status 429 and retry_after_s on the result key: one result for
+    every setpoint sent, none lost."""
+    from service.bus.zenoh_bus import _CONTROL_QUEUE_SIZE
+
+    entered, release = threading.Event(), threading.Event()
+
+    def on_setpoint(payload: bytes) -> dict:
+        if payload == b"hold":
+            entered.set()
+            release.wait(WAIT_S)
+        return {"accepted": True}
+
+    channel = bus.attach_twin("t1", lambda: None, on_setpoint)
+    client.subscribe("bearing/t1/setpoint/result")
+    pub = client.session.declare_publisher("bearing/t1/setpoint",
+                                           congestion_control=zenoh.CongestionControl.BLOCK)
+    client.wait_for(lambda item: True, poke=lambda: pub.put(b"warm"), poke_every_s=0.5)   # routes up
+    deadline = time.monotonic() + WAIT_S
+    while not entered.is_set() and time.monotonic() < deadline:
+        client.drain()
+        pub.put(b"hold")
+        entered.wait(0.5)
+    assert entered.is_set()
+    time.sleep(0.5)
+    client.drain()                          # warm-up results (the held setpoint's comes later)
+    over = 40
+    for i in range(_CONTROL_QUEUE_SIZE + over):
+        pub.put(f"n{i}".encode())
+    deadline = time.monotonic() + WAIT_S
+    while channel.setpoints_refused_busy < over and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert channel.setpoints_refused_busy == over
+    release.set()
+    results = []
+    deadline = time.monotonic() + WAIT_S
+    while len(results) < _CONTROL_QUEUE_SIZE + over + 1 and time.monotonic() < deadline:
+        try:
+            results.append(loads(client.inbox.get(timeout=0.2).payload))
+        except queue.Empty:
+            pass
+    refused = [r for r in results if not r["accepted"]]
+    assert len(results) == _CONTROL_QUEUE_SIZE + over + 1        # the held one, the queued, the refused
+    assert len(refused) == over
+    assert all(r["status"] == 429 and r["retry_after_s"] > 0 and "retry" in r["error"] for r in refused)
+    pub.undeclare()

@@ -90,3 +90,21 @@ def test_a_busy_zenoh_port_is_a_one_line_error(tmp_path):
     lines = [line for line in res.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and lines[0].startswith("error: zenoh") and "already in use" in lines[0], res.stderr
     assert ".rs:" not in lines[0]
+
+
+def test_scenario_run_names_the_recording_it_wrote(tmp_path):
+    """A --record name that is taken is never overwritten: the run records beside it as
+    <stem>.run2.rrd and says so (issue 16: it used to print the name it did not write)."""
+    pytest.importorskip("rerun")
+    scenario = tmp_path / "tiny.yaml"
+    scenario.write_text("name: tiny\nbearing: \"6208\"\ninitial: {shaft_speed_rad_s: 300.0, radial_load_n: 3000.0}\n"
+                        "duration_s: 0.01\nsample_every_s: 0.005\nsteps:\n  - at_s: 0.0\n"
+                        "    set: {shaft_speed_rad_s: 300.0}\n")
+    taken = tmp_path / "x.rrd"
+    taken.write_bytes(b"an earlier run")
+    res = subprocess.run([sys.executable, "-m", "service.cli", "scenario", "run", str(scenario), "--record",
+                          str(taken), "--no-progress"], capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    assert res.returncode == 0, res.stdout + res.stderr
+    written = tmp_path / "x.run2.rrd"
+    assert f"recording: {written}" in res.stdout, res.stdout
+    assert written.stat().st_size > 0 and taken.read_bytes() == b"an earlier run"

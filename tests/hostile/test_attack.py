@@ -1,0 +1,53 @@
+"""`bearing-twin attack` (issue 16): a short run against its own real service on loopback (token,
+zenoh access control): the report's structure, and no 5xx and no non-finite number in the
+hostile HTTP flood, the unauthenticated read flood and the zenoh flood, every zenoh setpoint
+answered. The real-time factor and /health latency are reported, never asserted (shared host)."""
+
+from __future__ import annotations
+
+import pytest
+
+from service.tools.attack import AttackConfig, check_loopback, format_report, run_attack
+
+
+def test_attack_short_run_with_its_own_service():
+    r = run_attack(AttackConfig(seconds=4.0, start=True, baseline_s=1.0, seed=7, zenoh_rate_hz=200.0))
+    print("\n" + format_report(r))
+    assert r["ok"], r["failures"]
+    t = r["totals"]
+    assert t["5xx"] == 0 and t["non_finite"] == 0 and t["transport_errors"] == 0
+    assert t["2xx"] > 0 and t["4xx"] > 0 and t["nan_checked"] > 0
+    hostile, reads, z = r["http_flood"], r["read_flood"], r["zenoh_flood"]
+    assert hostile["workers"] == 32 and reads["workers"] == 4
+    # the hostile mix was sent and refused as it should be
+    assert {"valid", "nan", "big", "no-token", "unknown-twin"} <= set(hostile["kinds"])
+    assert {401, 413, 422} <= {int(code) for code in hostile["status"]}
+    assert hostile["counts"].get("valid_refused", 0) == 0 and hostile["counts"].get("hostile_accepted", 0) == 0
+    assert sum(reads["status"].values()) > 0
+    assert z["sent"] > 0 and z["unanswered"] == 0 and z["non_finite"] == 0
+    assert sum(z["results"].values()) == z["sent"]
+    for phase in ("baseline", "flood"):
+        f = r[phase]
+        assert f["probes"] > 0 and f["failed"] == 0
+        assert f["health_p99_ms"] is not None and f["real_time_factor_median"] is not None
+    assert set(r["targets"]) == {"real_time_factor_median_min", "health_p99_ms_max", "real_time_factor_median",
+                                 "health_p99_ms", "met"}
+    assert r["shutdown"]["clean"]
+
+
+@pytest.mark.parametrize("url, zenoh", [("http://10.0.0.8:8000", None), ("http://example.org", None),
+                                        ("http://127.0.0.1:8000", "tcp/192.168.1.4:7447")])
+def test_attack_is_loopback_only(url, zenoh):
+    with pytest.raises(ValueError, match="loopback"):
+        check_loopback(url, zenoh)
+    with pytest.raises(ValueError, match="loopback"):
+        run_attack(AttackConfig(seconds=1.0, url=url, zenoh_connect=zenoh))
+
+
+@pytest.mark.parametrize("field, value", [("seconds", 601.0), ("seconds", float("inf")), ("seconds", 0.0),
+                                          ("concurrency", 65), ("concurrency", 0)])
+def test_attack_is_bounded(field, value):
+    cfg = AttackConfig(seconds=1.0)
+    setattr(cfg, field, value)
+    with pytest.raises(ValueError, match=field):
+        run_attack(cfg)
