@@ -264,7 +264,7 @@ class Twin:
         """Model arrays, setpoint and state in `step_n` / `evaluate` order (without n)."""
         m, s = self.model, self.state
         return (m.params, m.angle_table, self._setpoint_vector, *s.kernel_args(), m.housing_params,
-                m.vibration_params, m.decimator_taps, s.active_defect_rows)
+                m.decimator_taps)
 
     def _place_on_housing(self, radial_load_n: float, axial_load_n: float) -> None:
         """Warm start on the housing (issue 14): the outer ring at the static equilibrium of its
