@@ -123,7 +123,7 @@ defect_table = njit(**JIT_INLINE)(defect_table)
 orientations = njit(**JIT_INLINE)(orientations)
 
 
-@njit(**JIT)
+@njit(**JIT_INLINE)
 def apply_defects(w, nc, count, shaft_angle, p, rb):
     """`defect_drops` of the `count` active defect rows of the workspace then, where a defect
     opens a clearance, `subtract_drops` (module docstring). Called only while a defect is active
