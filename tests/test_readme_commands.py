@@ -99,6 +99,9 @@ ONE_SHOT = {
     "bearing-twin attack --seconds 60 --start": lambda out: ["attack", "--seconds", "3", "--start", "--baseline",
                                                              "1", "--json"],
     "bearing-twin ehl solve": lambda out: ["ehl", "solve", "--current", "20", "--json"],
+    "bearing-twin vibration": lambda out: ["vibration", "--bearing", "6208", "--speed", "523", "--radial-load", "3000",
+                                           "--defect", "outer", "--duration", "0.1", "--json",
+                                           "--plot", str(out / "vib.png")],
 }
 PYTHON_MODULES = {"python -m twin.validation.thermal_law_fit": ["-m", "twin.validation.thermal_law_fit"]}
 

@@ -264,7 +264,7 @@ class Twin:
         """Model arrays, setpoint and state in `step_n` / `evaluate` order (without n)."""
         m, s = self.model, self.state
         return (m.params, m.angle_table, self._setpoint_vector, *s.kernel_args(), m.housing_params,
-                m.vibration_params, m.decimator_taps, s.active_defect_rows)
+                m.decimator_taps)
 
     def _place_on_housing(self, radial_load_n: float, axial_load_n: float) -> None:
         """Warm start on the housing (issue 14): the outer ring at the static equilibrium of its
@@ -302,7 +302,9 @@ class Twin:
         s.scalars[L.X_TORQUE_COUNT] = 0.0
         status, done = step_n(*self._kernel_args(), n)
         if self._sensor is not None:
-            self._sensor.drain(s, float(s.scalars[L.X_SHAFT_SPEED]))
+            self._sensor.after_frame(s, done, float(s.scalars[L.X_SHAFT_SPEED]))
+            if status != L.STATUS_OK:
+                self._sensor.flush(s)
         if s.scalars[L.X_TORQUE_COUNT] > 0:
             self._last_torque_n_m = s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT]
         if status != L.STATUS_OK:
@@ -397,14 +399,20 @@ class Twin:
     def vibration(self):
         """Indicators of the last complete accelerometer window (twin.snapshot.VibrationState), or
         None before the first window or with the rigid outer ring."""
-        return None if self._sensor is None else self._sensor.latest
+        if self._sensor is None:
+            return None
+        self._sensor.flush(self.state)
+        return self._sensor.latest
 
     def drain_waveform(self) -> list[WaveformBlock]:
         """The accelerometer samples [m/s^2] produced since the last call, as contiguous float32
         blocks with their start time t0_s [s] and rate (twin.vibration.sensor.WaveformBlock;
         twin.vibration.waveform encodes them for a bus). At most WAVEFORM_QUEUE_S of signal is
         kept between calls. [] with the rigid outer ring."""
-        return [] if self._sensor is None else self._sensor.drain_waveform()
+        if self._sensor is None:
+            return []
+        self._sensor.flush(self.state)
+        return self._sensor.drain_waveform()
 
     # ---- outputs ----------------------------------------------------------------------------
     def ball_azimuths_rad(self) -> np.ndarray:

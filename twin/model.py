@@ -62,9 +62,13 @@ class BearingModel:
     rest_capacitance_f: float = 0.0                     # the rings' lands across the oil-filled annulus [F]
     # issue 14 (twin.vibration): housing H_* vector, V_* vector, accelerometer decimator
     housing_params: np.ndarray | None = None
-    vibration_params: np.ndarray | None = None
     decimator: DecimatorDesign | None = None  # None with the rigid outer ring
     decimator_taps: np.ndarray | None = None  # reversed FIR taps (K R,); a dummy (1,) without housing
+
+    @property
+    def vibration_params(self) -> np.ndarray:
+        """The V_* vector of issue 14 (twin.kernels.layout), a view of params[P_VIB:]."""
+        return self.params[L.P_VIB:L.P_VIB + L.N_VIB_PARAMS]
 
     @property
     def housing_on(self) -> bool:
@@ -336,7 +340,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     taps = decimator.reversed_taps if decimator is not None else np.zeros(1)
     # the defect drops (twin.kernels.vibration) take the raceway and curvature radii at the
     # nominal contact angle (the drop is second order in the pit's size over these radii)
-    v = np.zeros(L.N_VIB_PARAMS)
+    v = p[L.P_VIB:L.P_VIB + L.N_VIB_PARAMS]  # a view: written into p
     v[L.V_HOUSING_ON] = 1.0 if housing.enabled else 0.0
     v[L.V_DECIMATION_RATIO] = decimator.ratio if decimator is not None else 1.0
     v[L.V_INNER_RACEWAY_RADIUS] = g.inner_raceway_radius_m
@@ -351,7 +355,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
         tribology[:, T_PIVOT] = 0.0
         angle_table[:, :, L.A_TRIBOLOGY + T_PIVOT] = 0.0
     hp = housing_params(housing)
-    for a in (p, race, tribology, angle_table, v, taps, hp):
+    for a in (p, race, tribology, angle_table, taps, hp):
         a.setflags(write=False)
     return BearingModel(
         spec=spec, options=options, params=p, race_params=race,
@@ -360,5 +364,5 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
         contact_angle_rad=alpha, inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),
         max_radial_load_n=float(max_radial), max_axial_load_n=float(max_axial),
         max_shaft_speed_rad_s=float(max_speed), time_step=critical, gap_limit_m=(gap_in, gap_out),
-        rest_capacitance_f=rest, housing_params=hp, vibration_params=v, decimator=decimator,
+        rest_capacitance_f=rest, housing_params=hp, decimator=decimator,
         decimator_taps=taps)

@@ -8,11 +8,11 @@ import numpy as np
 
 from twin.kernels import layout as L
 from twin.model import BearingModel
+from twin.kernels.layout import MAX_DEFECTS
 from twin.vibration.defects import N_DEFECT_PARAMS
 from twin.vibration.housing import N_HOUSING_DOF
 from twin.vibration.signal import N_DD_HEADER, N_RS_HEADER
 
-MAX_DEFECTS = 8          # defect rows a twin holds at once
 SAMPLE_RING_S = 2.0      # the accelerometer's sample ring holds this much signal [s]
 
 
@@ -30,18 +30,27 @@ class TwinState:
     ring_position_m: np.ndarray  # inner ring centre (3,)
     ring_velocity_m_s: np.ndarray
     ring_acceleration: np.ndarray
-    lanes: np.ndarray            # flat per-contact lanes, row k of contact c at [k * CW + c]
+    workspace: np.ndarray        # the kernel's `w` (layout.N_WORKSPACE): the lanes, then the defects
+    lanes: np.ndarray            # flat per-contact lanes, row k of contact c at [k * CW + c] (a view)
     cage_load_n: np.ndarray      # (Z, 2) ball j against cage element ahead (0) and behind (1)
     # issue 14 (twin.vibration); all zero and unused with the rigid outer ring
     housing_displacement_m: np.ndarray  # (N_HOUSING_DOF,) outer ring x, y, z, sprung mass [m]
     housing_velocity_m_s: np.ndarray     # [m/s]
     housing_acceleration_m_s2: np.ndarray  # [m/s^2]
-    ball_orientation: np.ndarray  # (Z, 4) unit quaternions (w, x, y, z), body -> world
+    ball_orientation: np.ndarray  # (Z, 4) unit quaternions (w, x, y, z), body -> world (workspace view)
     decimator_state: np.ndarray   # twin.vibration.signal direct-form decimator state
     sample_ring_m_s2: np.ndarray  # float32 ring of accelerometer samples [m/s^2]
     sample_ring_state: np.ndarray  # twin.vibration.signal RS_* counters
-    defect_rows: np.ndarray       # (MAX_DEFECTS, N_DEFECT_PARAMS), the first `defect_count` active
-    defect_count: int = 0
+    defect_rows: np.ndarray       # (MAX_DEFECTS, N_DEFECT_PARAMS) workspace view, the first `defect_count` active
+
+    @property
+    def defect_count(self) -> int:
+        """Active defect rows (scalars[X_DEFECT_COUNT])."""
+        return int(self.scalars[L.X_DEFECT_COUNT])
+
+    @defect_count.setter
+    def defect_count(self, n: int) -> None:
+        self.scalars[L.X_DEFECT_COUNT] = float(n)
 
     @property
     def inner_ring_offset_m(self) -> np.ndarray:
@@ -90,9 +99,9 @@ class TwinState:
         return (self.scalars, self.ball_position_m, self.ball_velocity_m_s,
                 self.ball_angular_velocity_rad_s, self.ball_acceleration,
                 self.ball_angular_acceleration, self.ring_position_m, self.ring_velocity_m_s,
-                self.ring_acceleration, self.lanes, self.cage_load_n,
+                self.ring_acceleration, self.workspace, self.cage_load_n,
                 self.housing_displacement_m, self.housing_velocity_m_s,
-                self.housing_acceleration_m_s2, self.ball_orientation, self.decimator_state,
+                self.housing_acceleration_m_s2, self.decimator_state,
                 self.sample_ring_m_s2, self.sample_ring_state)
 
 
@@ -101,7 +110,8 @@ def make_state(model: BearingModel) -> TwinState:
     if 2 * model.ball_count > L.CW:
         raise ValueError(f"ball_count = {model.ball_count}: at most {L.CW // 2} balls")
     z = model.ball_count
-    lanes = np.zeros(L.N_ROWS * L.CW)
+    workspace = np.zeros(L.N_WORKSPACE)
+    lanes = workspace[:L.N_ROWS * L.CW]
     rows = lanes.reshape(L.N_ROWS, L.CW)
     for r in range(2):
         rows[L.M_GROOVE_CENTRE_RADIUS, r:2 * z:2] = model.race_params[r, L.R_GROOVE_CENTRE_RADIUS]
@@ -111,14 +121,16 @@ def make_state(model: BearingModel) -> TwinState:
         rows[L.M_STIFFNESS, r:2 * z:2] = model.race_params[r, L.R_STIFFNESS]
     dec = model.decimator
     ring = int(round(SAMPLE_RING_S * dec.output_rate_hz)) if dec is not None else 1
-    orientation = np.zeros((z, 4))
+    orientation = workspace[L.W_ORIENTATION:L.W_ORIENTATION + 4 * z].reshape(z, 4)
     orientation[:, 0] = 1.0
     return TwinState(
         housing_displacement_m=np.zeros(N_HOUSING_DOF), housing_velocity_m_s=np.zeros(N_HOUSING_DOF),
         housing_acceleration_m_s2=np.zeros(N_HOUSING_DOF), ball_orientation=orientation,
         decimator_state=dec.new_direct_state() if dec is not None else np.zeros(N_DD_HEADER + 2),
         sample_ring_m_s2=np.zeros(ring, dtype=np.float32), sample_ring_state=np.zeros(N_RS_HEADER),
-        defect_rows=np.zeros((MAX_DEFECTS, N_DEFECT_PARAMS)),
+        defect_rows=workspace[L.W_DEFECTS:L.W_DEFECTS + MAX_DEFECTS * N_DEFECT_PARAMS].reshape(
+            MAX_DEFECTS, N_DEFECT_PARAMS),
+        workspace=workspace,
         scalars=np.zeros(L.N_SCALARS),
         ball_position_m=np.zeros((z, 3)), ball_velocity_m_s=np.zeros((z, 3)),
         ball_angular_velocity_rad_s=np.zeros((z, 3)), ball_acceleration=np.zeros((z, 3)),

@@ -1,6 +1,8 @@
 """Index layout of the flat float64 vectors the kernels share (model, setpoint, state scalars,
 per-contact outputs). Module-level ints are compile-time constants for numba."""
 
+from twin.vibration.defects import N_DEFECT_PARAMS
+
 # ---- model parameter vector (immutable, built by twin.model) --------------------------------
 P_DT = 0
 P_BALL_RADIUS = 1
@@ -40,7 +42,10 @@ P_DEFORMED_RADIUS = 33     # contact-surface radius across the groove, inner (33
 P_GAP_LIMIT_OUTER = 35     # gap limit of the outer-zone capacitance, outer race [m]
 P_STRIP_TABLE = 36         # MAX_STRIPS rows of 4: mean t, mean t^2, load share, mean pressure / p_h
 MAX_STRIPS = 32
-N_PARAMS = P_STRIP_TABLE + 4 * MAX_STRIPS
+# issue 14 (twin.vibration): the model's V_* vector (end of this file) at p[P_VIB + V_*]
+P_VIB = P_STRIP_TABLE + 4 * MAX_STRIPS
+N_VIB_PARAMS = 10
+N_PARAMS = P_VIB + N_VIB_PARAMS
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]
@@ -73,7 +78,8 @@ X_DRIVE_TORQUE = 7    # instantaneous torque the contacts apply to the inner rin
 X_TORQUE_SUM = 8      # sum of X_DRIVE_TORQUE over steps since the last reset
 X_TORQUE_COUNT = 9
 X_MAX_PENETRATION = 10  # largest ball-raceway penetration since the last reset [m]
-N_SCALARS = 11
+X_DEFECT_COUNT = 11   # issue 14: active local defects (rows at W_DEFECTS of the workspace)
+N_SCALARS = 12
 
 # ---- per-contact lanes ---------------------------------------------------------------------------
 # Everything per ball-raceway contact (c = 2 ball + race, race 0 inner, 1 outer) lives in ONE flat
@@ -171,6 +177,16 @@ E_SCRATCH_SIGNED_HALF = 71  # half-width of strip k in t, signed like ds/dt acro
 G_DEFECT_DROP = 75  # extra radial clearance a defect opens at the contact, taken off G_DELTA [m]
 N_ROWS = 76
 
+# ---- the kernel workspace `w`: the N_ROWS x CW contact lanes, then (issue 14) the local defects ---
+# The defect table and the balls' orientations ride in the workspace after the lanes, so that the
+# force pass takes no further array argument (an array argument of a compiled call costs its
+# reference counting, measured ~50 ns per array per step): `TwinState.lanes` is the first
+# N_ROWS * CW of the workspace, `defect_rows` and `ball_orientation` views of the rest.
+MAX_DEFECTS = 8                                   # defect rows a twin holds at once
+W_DEFECTS = N_ROWS * CW                           # MAX_DEFECTS rows of N_DEFECT_PARAMS (D_*), active first
+W_ORIENTATION = W_DEFECTS + MAX_DEFECTS * N_DEFECT_PARAMS  # (CW // 2, 4) unit quaternions (w, x, y, z)
+N_WORKSPACE = W_ORIENTATION + 4 * (CW // 2)
+
 # ---- kernel status codes ----------------------------------------------------------------------
 STATUS_OK = 0
 STATUS_NOT_FINITE = 1
@@ -190,8 +206,8 @@ A_STIFFNESS = 0    # Hertz K [N/m^1.5]
 A_TRIBOLOGY = 1    # first of the N_TRIBOLOGY coefficients of twin.kernels.tribology (T_* + 1)
 
 # ---- vibration (issue 14): housing, local defects, accelerometer (twin.vibration) --------------
-# Model vector `vibration_params[V_*]` (twin.model); the housing's own vector is
-# twin.vibration.housing.H_*, a defect row twin.vibration.defects.D_*.
+# Model vector p[P_VIB + V_*] (twin.model; `BearingModel.vibration_params` is a view of it); the
+# housing's own vector is twin.vibration.housing.H_*, a defect row twin.vibration.defects.D_*.
 V_HOUSING_ON = 0            # 1: the outer ring rides on the housing model and the sensor is sampled
 V_DECIMATION_RATIO = 1      # R: DEM steps per accelerometer sample (dt = 1 / (R f_s))
 V_INNER_RACEWAY_RADIUS = 2  # raceway radius at the contact, for the arc length over a spall [m]
@@ -202,4 +218,3 @@ V_INNER_RX = 6              # relative radius of curvature along the rolling dir
 V_OUTER_RX = 7
 V_INNER_RY = 8              # across it [m]
 V_OUTER_RY = 9
-N_VIB_PARAMS = 10

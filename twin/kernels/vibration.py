@@ -30,11 +30,11 @@ from twin.jit import JIT, JIT_VECTOR
 JIT_INLINE = dict(JIT, inline="always")
 from twin.kernels.layout import (
     CW, G_DEFECT_DROP, G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_PX, K_PY, K_WX, K_WY,
-    K_WZ, M_STIFFNESS, O_FX, O_FY, O_FZ, V_INNER_GROOVE_RADIUS, V_INNER_RACEWAY_RADIUS, V_INNER_RX,
+    K_WZ, M_STIFFNESS, N_VIB_PARAMS, O_FX, O_FY, O_FZ, P_VIB, W_DEFECTS, W_ORIENTATION, V_INNER_GROOVE_RADIUS, V_INNER_RACEWAY_RADIUS, V_INNER_RX,
     V_INNER_RY, V_OUTER_GROOVE_RADIUS, V_OUTER_RACEWAY_RADIUS, V_OUTER_RX, V_OUTER_RY,
 )
 from twin.vibration.defects import (
-    D_BALL, D_CENTRE_COS, D_CENTRE_SIN, D_KIND, D_REACH_COS, KIND_BALL, KIND_INNER, KIND_OUTER,
+    N_DEFECT_PARAMS, D_BALL, D_CENTRE_COS, D_CENTRE_SIN, D_KIND, D_REACH_COS, KIND_BALL, KIND_INNER, KIND_OUTER,
     contact_defect_drop_m, quat_integrate,
 )
 
@@ -108,12 +108,29 @@ def subtract_drops(w, nc):
         w[G_LOAD * CW + c] = w[M_STIFFNESS * CW + c] * pos * sq
 
 
+def defect_table(w, count):
+    """The first `count` defect rows of the workspace (twin.kernels.layout.W_DEFECTS), a
+    (count, N_DEFECT_PARAMS) view."""
+    return w[W_DEFECTS:W_DEFECTS + count * N_DEFECT_PARAMS].reshape((count, N_DEFECT_PARAMS))
+
+
+def orientations(w, z):
+    """The balls' unit quaternions in the workspace (W_ORIENTATION), a (z, 4) view."""
+    return w[W_ORIENTATION:W_ORIENTATION + 4 * z].reshape((z, 4))
+
+
+defect_table = njit(**JIT_INLINE)(defect_table)
+orientations = njit(**JIT_INLINE)(orientations)
+
+
 @njit(**JIT_INLINE)
-def apply_defects(w, nc, defects, bq, shaft_angle, vp, rb):
-    """`defect_drops` then, where a defect opens a clearance, `subtract_drops` (module docstring);
-    nothing without defect rows."""
-    if defects.shape[0] == 0:
-        return
+def apply_defects(w, nc, count, shaft_angle, p, rb):
+    """`defect_drops` of the `count` active defect rows of the workspace then, where a defect
+    opens a clearance, `subtract_drops` (module docstring). Called only while a defect is active
+    (X_DEFECT_COUNT > 0)."""
+    defects = defect_table(w, count)
+    bq = orientations(w, nc // 2)
+    vp = p[P_VIB:P_VIB + N_VIB_PARAMS]
     if defect_drops(w, nc, defects, bq, shaft_angle, vp, rb):
         subtract_drops(w, nc)
 

@@ -323,7 +323,7 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
                         + (t2[key] - t1[key]) / (substeps * ELECTRICAL_EVERY) for key in ("best_ns", "median_ns")}
     # the real step on a copy of the state
     st = copies()
-    vib = (m.housing_params, m.vibration_params, m.decimator_taps, s.active_defect_rows.copy())
+    vib = (m.housing_params, m.decimator_taps)
     n_total = max(1000, reps // 10)
     step_n(p, tr, sp, *st, *vib, 10)
     best, median = _best_median_ns(lambda n: step_n(p, tr, sp, *st, *vib, n), n_total, repeats)
