@@ -30,7 +30,7 @@ def client(recordings, support):
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, scenario_dir=SCENARIOS,
                                record=recordings / "service.rrd", max_twins=4)
     with support.ThreadServer(settings, start_timeout_s=60.0, stop_timeout_s=15.0) as srv, \
-            httpx.Client(base_url=srv.url, timeout=30.0) as c:
+            httpx.Client(base_url=srv.url, timeout=120.0) as c:
         yield c
 
 
