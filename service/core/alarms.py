@@ -116,6 +116,7 @@ class AlarmInputs:
     """One twin at one instant, as the alarms see it (SI unless the name says otherwise)."""
 
     time_s: float                                     # simulated time [s]
+    seq: int | None = None                            # the snapshot's seq (None: not from a snapshot)
     min_loaded_lambda: float | None = None            # smallest Lambda over the loaded contacts [-]
     boundary_contacts: int = 0                        # loaded contacts with Lambda <= boundary_lambda
     kappa: float | None = None                        # ISO 281 viscosity ratio [-]
@@ -181,6 +182,10 @@ def vibration_inputs(block: Any) -> VibrationInputs | None:
                            noise_floor_m_s2=_finite(_get(block, "noise_floor_m_s2", "envelope_noise_floor_m_s2")))
 
 
+def _seq(value: Any) -> int | None:
+    return int(value) if isinstance(value, int) and not isinstance(value, bool) else None
+
+
 def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -> AlarmInputs:
     """The alarms' inputs from a `twin.snapshot.Snapshot` (or its dict): contacts, electrical,
     and the optional `life` and `vibration` blocks."""
@@ -209,6 +214,7 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
     life = _get(snapshot, "life")
     return AlarmInputs(
         time_s=float(_get(snapshot, "time_s") or 0.0),
+        seq=_seq(_get(snapshot, "seq")),
         min_loaded_lambda=min_lambda, boundary_contacts=boundary,
         kappa=_finite(_get(life, "kappa")),
         discharge_risk=_get(electrical, "discharge_risk"),
@@ -262,6 +268,8 @@ class AlarmEvent(BaseModel):
     opcua_severity: int = Field(description="OPC UA event severity 1..1000 (warning 500, critical 800, cleared 100) [-].")
     since_s: float | None = Field(description="Simulated time the alarm was raised; null when cleared [s].")
     time_s: float = Field(description="Simulated time of this event [s].")
+    snapshot_seq: int | None = Field(default=None, description="seq of the snapshot that caused the event; null when "
+                                     "the inputs came from elsewhere [-].")
     wall_time_s: float = Field(description="Wall-clock time of this event, seconds since the Unix epoch [s].")
     value: float = Field(description="The watched value at the event [unit].")
     threshold: float = Field(description="Raise threshold of the level concerned [unit].")
@@ -469,10 +477,11 @@ class AlarmEvaluator:
             levels = self._levels(alarm_id, inputs.vibration)
             transition = tracker.update(inputs.time_s, value, levels, message, wall)
             if transition is not None:
-                events.append(self._event(tracker, transition, inputs.time_s, wall))
+                events.append(self._event(tracker, transition, inputs.time_s, wall, inputs.seq))
         return events
 
-    def _event(self, tracker: AlarmTracker, transition: Transition, t: float, wall: float) -> AlarmEvent:
+    def _event(self, tracker: AlarmTracker, transition: Transition, t: float, wall: float,
+               snapshot_seq: int | None = None) -> AlarmEvent:
         self.seq += 1
         rule, level = tracker.rule, tracker.level
         lv = tracker.levels[level] if level >= 0 else tracker.levels[0]   # cleared: the first level
@@ -483,7 +492,7 @@ class AlarmEvaluator:
         return AlarmEvent(seq=self.seq, bearing_id=self.bearing_id, alarm_id=rule.id,
                           category=rule.category, transition=transition, active=level >= 0,
                           severity=severity, opcua_severity=OPCUA_SEVERITY[severity],
-                          since_s=tracker.since_s, time_s=t, wall_time_s=wall,
+                          since_s=tracker.since_s, time_s=t, snapshot_seq=snapshot_seq, wall_time_s=wall,
                           value=float(tracker.value), threshold=lv.threshold, clear_threshold=lv.clear,
                           unit=rule.unit, message=text)
 

@@ -19,6 +19,8 @@ import pyarrow as pa
 import rerun as rr
 
 from service.recording.layout import (
+    ALARM_LOG_LEVEL,
+    ALARM_STATES,
     CONTACT_SERIES,
     LOAD_ZONE,
     REGIME_CODE,
@@ -404,3 +406,84 @@ def events(tw: TwinLayout, batch: Batch) -> None:
         sel = np.array([j for j, _ in risks])
         batch.out.append((f"{tw.root}/electrical/discharge_risk", batch.index(sel),
                           rr.StateChange.columns(state=[s for _, s in risks])))
+
+
+# ---- alarms ---------------------------------------------------------------------------------------
+@dataclass(slots=True)
+class AlarmRow:
+    """One alarm event (service.core.alarms.AlarmEvent) as the recorder keeps it."""
+
+    bearing_id: str
+    alarm_id: str
+    transition: str                   # raised | escalated | deescalated | cleared
+    severity: str | None              # warning | critical | None (cleared)
+    time_s: float                     # simulated time of the event [s]
+    seq: int | None                   # seq of the snapshot that caused it
+    value: float
+    threshold: float
+    clear_threshold: float
+    unit: str
+    message: str
+
+    @classmethod
+    def of(cls, event) -> AlarmRow:
+        """From an `AlarmEvent` (or its dict)."""
+        get = event.get if isinstance(event, Mapping) else (lambda k, d=None: getattr(event, k, d))
+        seq = get("snapshot_seq")
+        return cls(bearing_id=str(get("bearing_id")), alarm_id=str(get("alarm_id")),
+                   transition=str(get("transition")), severity=get("severity"),
+                   time_s=float(get("time_s")), seq=int(seq) if isinstance(seq, int) else None,
+                   value=float(get("value")), threshold=float(get("threshold")),
+                   clear_threshold=float(get("clear_threshold")), unit=str(get("unit") or "-"),
+                   message=str(get("message") or ""))
+
+    @property
+    def state(self) -> str:
+        return self.severity if self.severity in ALARM_STATES else "inactive"
+
+    @property
+    def text(self) -> str:
+        unit = "" if self.unit == "-" else f" {self.unit}"
+        return (f"{self.message} [value {_fmt(self.value)}{unit}, raise at {_fmt(self.threshold)}{unit}, "
+                f"clear at {_fmt(self.clear_threshold)}{unit}]")
+
+
+def _alarm_index(times_ns: np.ndarray, seqs: list[int | None]) -> list:
+    """sim_time, and seq when every row has one."""
+    index = [rr.TimeColumn(SIM_TIME, duration=times_ns.astype("timedelta64[ns]"))]
+    if all(s is not None for s in seqs):
+        index.append(rr.TimeColumn(SEQ, sequence=np.array(seqs, dtype=np.int64)))
+    return index
+
+
+def alarm_columns(tw: TwinLayout, rows: list[AlarmRow], offset_s: float) -> list:
+    """(entity path, index columns, component columns) triples of a twin's alarm events: a
+    TextLog row at `alarms/{alarm_id}` and a StateChange row at `alarm_states/{alarm_id}` per
+    event, at the event's simulated time (shifted by the twin's offset) and snapshot seq."""
+    out: list = []
+    by_alarm: dict[str, list[AlarmRow]] = {}
+    for r in rows:
+        by_alarm.setdefault(r.alarm_id, []).append(r)
+    for alarm_id, group in by_alarm.items():
+        # rows with and without a snapshot seq go in separate calls (index columns of one length)
+        for part in ([r for r in group if r.seq is not None], [r for r in group if r.seq is None]):
+            if not part:
+                continue
+            t = np.round((np.array([r.time_s for r in part]) + offset_s) * 1e9).astype(np.int64)
+            seqs = [r.seq for r in part]
+            out.append((f"{tw.root}/alarms/{alarm_id}", _alarm_index(t, seqs),
+                        rr.TextLog.columns(text=[r.text for r in part],
+                                           level=[ALARM_LOG_LEVEL.get(r.severity, "INFO") for r in part])))
+            out.append((f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, seqs),
+                        rr.StateChange.columns(state=[r.state for r in part])))
+    return out
+
+
+def alarm_states_in_force(tw: TwinLayout, states: Mapping[str, str], time_s: float, seq: int | None,
+                          offset_s: float) -> list:
+    """StateChange rows of the alarms active when a new output (a segment) started, at `time_s`
+    (its first row), so that its state timeline does not begin empty."""
+    active = [(k, v) for k, v in states.items() if v != "inactive"]
+    t = np.array([round((time_s + offset_s) * 1e9)], dtype=np.int64)
+    return [(f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, [seq]), rr.StateChange.columns(state=[state]))
+            for alarm_id, state in active]

@@ -27,10 +27,19 @@ electrical/current_density_a_per_mm2                              Scalars
 electrical/discharge_risk     StateChange (none / possible / likely), one row per change
 events                        TextLog: setpoints, scenario state and phase, restarts, fallbacks,
                               status, recording gaps - one row each
+alarms/{alarm_id}             TextLog, one row per alarm event (raised, escalated, deescalated,
+                              cleared; service.core.alarms): level WARN (warning), CRITICAL
+                              (critical), INFO (cleared); the text names the transition, the
+                              value, the raise and clear thresholds with their unit
+alarm_states/{alarm_id}       StateChange inactive / warning / critical, one row per event (and
+                              the active ones again at the start of a new segment)
 contacts/{load_n,lambda,mu,resistance_log10_kohm,capacitance_pf}
                               Scalars, 2 Z instances (ball 0 inner, ball 0 outer, ball 1 inner,
                               ...): the per-contact series, not in the default layout
 ```
+
+Alarm rows are placed at the simulated time of the snapshot that caused them (`sim_time`) and
+at its `seq` (`AlarmEvent.snapshot_seq`), so they line up with the series of that snapshot.
 
 The annotation context at `bearing/{id}` names the regimes (class ids 0-3); the regime colours
 are the same everywhere (balls, `regime_counts`). A value that is undefined (Lambda without
@@ -48,6 +57,8 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from service.core.alarms import ALARM_IDS
+
 SIM_TIME = "sim_time"
 SEQ = "seq"
 
@@ -63,6 +74,9 @@ _RACEWAY_RGB = (170, 170, 180)
 _PITCH_RGB = (90, 90, 100)
 RISK_VALUES = ("none", "possible", "likely")
 RISK_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
+ALARM_STATES = ("inactive", "warning", "critical")
+ALARM_STATE_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
+ALARM_LOG_LEVEL = {"warning": "WARN", "critical": "CRITICAL", None: "INFO"}
 
 SIDES = ("inner", "outer")
 LOAD_ZONE = (("load_n", "contact load Q [N]"), ("lambda", "film parameter Lambda [-]"),
@@ -174,6 +188,10 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
           rr.StateConfiguration(values=list(RISK_VALUES), labels=["no discharge risk", "discharge possible",
                                                                   "discharge likely"],
                                 colors=np.array(RISK_RGBA, dtype=np.uint32)), static=True)
+    for alarm_id in ALARM_IDS:
+        s.log(f"{root}/alarm_states/{alarm_id}",
+              rr.StateConfiguration(values=list(ALARM_STATES), labels=[f"{alarm_id} {v}" for v in ALARM_STATES],
+                                    colors=np.array(ALARM_STATE_RGBA, dtype=np.uint32)), static=True)
 
 
 # ---- blueprint --------------------------------------------------------------------------------
@@ -186,8 +204,8 @@ def _window(seconds: float | None):
 
 def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Container:
     """The default layout of one twin: top, the bearing in 3D, the load zone now and the
-    bearing-level trends with the setpoint beside them; bottom, the events and the electrical
-    panel. The per-contact series (`contacts/...`) are not in it (add them from the streams)."""
+    bearing-level trends with the setpoint beside them; bottom, the events, the alarms (states
+    and events) and the electrical panel. The per-contact series (`contacts/...`) are not in it (add them from the streams)."""
     root = f"/{tw.root}"
     tag = tw.bearing_id
     window = _window(series_window_s)
@@ -242,8 +260,19 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Contain
             timeline_columns=[rrb.encodings.TimelineColumn(SIM_TIME), rrb.encodings.TimelineColumn(SEQ, visible=False)],
             text_log_columns=[rrb.encodings.TextLogColumn("LogLevel"), rrb.encodings.TextLogColumn("Body"),
                               rrb.encodings.TextLogColumn("EntityPath", visible=False)]))
+    alarms = rrb.Vertical(
+        rrb.StateTimelineView(name=f"{tag}: alarm states", origin=root, contents=[f"+ {root}/alarm_states/**"],
+                              time_ranges=window),
+        rrb.TextLogView(
+            name=f"{tag}: alarm events", origin=root, contents=[f"+ {root}/alarms/**"],
+            columns=rrb.archetypes.TextLogColumns(
+                timeline_columns=[rrb.encodings.TimelineColumn(SIM_TIME),
+                                  rrb.encodings.TimelineColumn(SEQ, visible=False)],
+                text_log_columns=[rrb.encodings.TextLogColumn("LogLevel"), rrb.encodings.TextLogColumn("Body"),
+                                  rrb.encodings.TextLogColumn("EntityPath", visible=False)])),
+        row_shares=[1.0, 1.0], name="alarms")
     return rrb.Vertical(rrb.Horizontal(*top, column_shares=shares),
-                        rrb.Horizontal(events, electrical, column_shares=[1.0, 1.6]),
+                        rrb.Horizontal(events, alarms, electrical, column_shares=[1.0, 1.0, 1.6]),
                         row_shares=[1.5, 1.0], name=tag)
 
 

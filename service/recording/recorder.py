@@ -119,6 +119,9 @@ class _Twin(TwinLayout):
     time_offset_s: float = 0.0                        # added to sim_time (a re-created twin)
     continue_after_s: float | None = None             # where the previous run of this id ended
     note: str | None = None                           # logged (with a line break) before the next row
+    alarm_rows: list = field(default_factory=list)    # alarm events not sent yet (columns.AlarmRow)
+    alarm_states: dict = field(default_factory=dict)  # alarm id -> latest state seen (ALARM_STATES)
+    alarm_carry: dict = field(default_factory=dict)   # a new output: the active states to log again
 
 
 @dataclass
@@ -191,6 +194,9 @@ class RerunRecorder:
         self._streams = streams if streams is not None else RerunStreams()
 
         self._queue: deque = deque()
+        self._alarm_queue: deque = deque()
+        self._alarms_dropped = 0
+        self._alarms_logged = 0
         self._qlock = threading.Lock()
         self._io_lock = threading.RLock()
         self._wake = threading.Event()
@@ -303,6 +309,7 @@ class RerunRecorder:
         for tw in self._twins.values():
             send_static(out.stream, tw)
             tw.last.clear()
+            tw.alarm_carry = {k: v for k, v in tw.alarm_states.items() if v != "inactive"}
         self._send_blueprint([out])
 
     def _outputs(self) -> list[_Output]:
@@ -599,6 +606,7 @@ class RerunRecorder:
                 tw.rows, tw.slow_rows, tw.last = old.rows, old.slow_rows, old.last
                 tw.last_time_s, tw.last_seq, tw.time_offset_s = old.last_time_s, old.last_seq, old.time_offset_s
                 tw.prev_time_s, tw.slow_prev_time_s = old.prev_time_s, old.slow_prev_time_s
+                tw.alarm_rows, tw.alarm_states = old.alarm_rows, old.alarm_states
             else:
                 tw.continue_after_s = self._ended.pop(tw.bearing_id, None)
             self._twins[tw.bearing_id] = tw
@@ -721,6 +729,35 @@ class RerunRecorder:
         if n >= self._wake_at:
             self._wake.set()
 
+    def log_alarm(self, event) -> None:
+        """Queue an alarm event (`service.core.alarms.AlarmEvent`, or its dict) for the twin's
+        `alarms/{alarm_id}` and `alarm_states/{alarm_id}` entities (`service.recording.layout`);
+        never blocks or raises (an alarm-hub subscriber). Events of a twin this recorder does not
+        record are left out; when `queue_size` events wait, the oldest is dropped and counted."""
+        if self._closed:
+            return
+        try:
+            row = C.AlarmRow.of(event)
+        except Exception as exc:  # noqa: BLE001 - never raise into the alarm hub
+            self._errors += 1
+            log.warning("rerun recorder: alarm event skipped: %s", exc)
+            return
+        with self._qlock:
+            if len(self._alarm_queue) >= self.queue_size:
+                self._alarm_queue.popleft()
+                self._alarms_dropped += 1
+            self._alarm_queue.append(row)
+
+    @property
+    def alarms_logged(self) -> int:
+        """Alarm events sent to the outputs."""
+        return self._alarms_logged
+
+    @property
+    def alarms_dropped(self) -> int:
+        """Alarm events dropped because their queue was full."""
+        return self._alarms_dropped
+
     @property
     def dropped(self) -> int:
         """Snapshots dropped because the queue was full (or published after close)."""
@@ -814,6 +851,13 @@ class RerunRecorder:
         with self._qlock:
             items = list(self._queue)
             self._queue.clear()
+            alarms = list(self._alarm_queue)
+            self._alarm_queue.clear()
+        for row in alarms:
+            tw = self._twins.get(row.bearing_id)
+            if tw is not None:
+                tw.alarm_rows.append(row)
+                tw.alarm_states[row.alarm_id] = row.state
         if not items:
             return
         if not self._outputs():        # nowhere to write (no file, no viewer): nothing to convert
@@ -875,10 +919,19 @@ class RerunRecorder:
         sent = 0
         for tw in self._twins.values():
             rows, tw.rows = tw.rows, []
+            alarm_rows, tw.alarm_rows = tw.alarm_rows, []
             if not outs:
                 continue
             triples: list = []
             try:
+                if tw.alarm_carry and (rows or alarm_rows):
+                    first = rows[0] if rows else None
+                    carry, tw.alarm_carry = tw.alarm_carry, {}
+                    triples += C.alarm_states_in_force(
+                        tw, carry, first.time_s if first else alarm_rows[0].time_s,
+                        first.seq if first else alarm_rows[0].seq, tw.time_offset_s)
+                if alarm_rows:
+                    triples += C.alarm_columns(tw, alarm_rows, tw.time_offset_s)
                 if rows:
                     batch = C.Batch.of(rows, tw.time_offset_s)
                     C.fast_columns(tw, batch)
@@ -900,6 +953,7 @@ class RerunRecorder:
                     for out in outs:
                         out.stream.send_columns(path, indexes=indexes, columns=columns)
                 sent += len(rows)
+                self._alarms_logged += len(alarm_rows)
             except Exception:
                 self._errors += len(rows)
                 log.exception("rerun recorder: %d rows of %s lost", len(rows), tw.bearing_id)

@@ -423,6 +423,16 @@ def _cmd_scenario_check(args: argparse.Namespace) -> int:
     return status
 
 
+def _alarm_settings_from_env():
+    """`BEARING_TWIN_ALARMS` (JSON, as for `serve`), or None for the defaults."""
+    import os
+
+    from service.settings import AlarmSettings
+
+    text = os.environ.get("BEARING_TWIN_ALARMS")
+    return AlarmSettings.model_validate_json(text) if text else None
+
+
 def _cmd_scenario_run(args: argparse.Namespace) -> int:
     from service.tools.offline import TableSink, run_scenario, write_table
     from service.core.scenarios import ScenarioError, load_scenario
@@ -435,6 +445,11 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
         return 2
     for w in scenario.warnings:
         print(f"warning: {w}", file=sys.stderr)
+    try:
+        alarm_settings = _alarm_settings_from_env()
+    except ValueError as exc:                   # pydantic's ValidationError is a ValueError
+        print(f"error: BEARING_TWIN_ALARMS: {' '.join(str(exc).split())[:300]}", file=sys.stderr)
+        return 2
     for path, suffixes in ((args.record, (".rrd",)), (args.table, (".parquet", ".pq", ".csv"))):
         if path is not None and not path.lower().endswith(suffixes):
             print(f"error: {path}: expected a file ending in {' or '.join(suffixes)}", file=sys.stderr)
@@ -457,7 +472,8 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
             bar.refresh()
 
     try:
-        results = run_scenario(scenario, record=args.record, table=table, progress=progress)
+        results = run_scenario(scenario, record=args.record, table=table, progress=progress,
+                               alarms=alarm_settings)
     except ScenarioError as exc:
         if bar is not None:
             bar.close()
@@ -473,6 +489,8 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
                    f"status {snap.status}") if snap is not None and lam else (f"status {snap.status}" if snap else "")
         print(f"  {r.run.id} ({r.run.label}): {r.state}, {r.rows} samples, {r.wall_s:.1f} s wall; {summary}"
               + (f"; error: {r.error}" if r.error else ""))
+        for e in r.alarms:
+            print(f"    alarm at {e.time_s:.3f} s: {e.message}")
         if r.state != "done":
             status = 1
     if args.table:
