@@ -99,6 +99,8 @@ class Recorder(SnapshotSink, Protocol):
 
     def add_twin_from(self, twin: Twin) -> None: ...
 
+    def log_alarm(self, event: AlarmEvent) -> None: ...
+
 
 @dataclass
 class TwinEntry:
