@@ -289,7 +289,7 @@ class TwinChannel:
         except Exception:  # noqa: BLE001, S110 - a sink never raises into the physics
             pass
 
-    def publish_waveform(self, bearing_id: str, blocks: list) -> None:
+    def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
         """Queue accelerometer blocks (twin.vibration.sensor.WaveformBlock) for
         `P/{id}/vibration/waveform`; returns at once, never raises (same queue as the snapshots)."""
         try:

@@ -18,7 +18,7 @@ service.core.sinks), so the worker never blocks on I/O; a sink that raises is co
 skipped. The runner's own status note (a fallback, a caught error) is written into the
 snapshot's `status` beside the engine's. The accelerometer samples the twin produced since the
 last capture (`Twin.drain_waveform`, issue 14) are drained with each capture and handed, after
-the snapshot, to the sinks that have `publish_waveform(bearing_id, blocks)` (zenoh
+the snapshot, to the sinks that have `publish_waveform(bearing_id, blocks, seq=...)` (zenoh
 `.../vibration/waveform`, the recorder); a capture dropped under back-pressure passes its
 samples on to the next one. The first snapshot that reflects an accepted setpoint
 completes its `SetpointTiming` (published = when the worker handed it to the sinks).
@@ -243,7 +243,7 @@ class Publisher:
                 if cap.waveform:
                     publish_waveform = getattr(sink, "publish_waveform", None)
                     if publish_waveform is not None:
-                        publish_waveform(self.bearing_id, cap.waveform)
+                        publish_waveform(self.bearing_id, cap.waveform, seq=snap.seq)
             except Exception as exc:  # noqa: BLE001 - a sink never stops the physics
                 self.sink_errors += 1
                 if self.sink_errors <= 5:

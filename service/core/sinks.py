@@ -28,5 +28,5 @@ class WaveformSink(Protocol):
     (float32 [m/s^2], t0_s [s], sample_rate_hz [Hz]), handed over after the snapshot they came
     with; the same rules (never block, drop-oldest, count)."""
 
-    def publish_waveform(self, bearing_id: str, blocks: list) -> None:
-        """Hand the blocks over without blocking."""
+    def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
+        """Hand the blocks over without blocking (`seq`: the snapshot they came with)."""

@@ -19,6 +19,7 @@ import pyarrow as pa
 import rerun as rr
 
 from service.recording.layout import (
+    VIB_LINES,
     ALARM_LOG_LEVEL,
     ALARM_STATES,
     CONTACT_SERIES,
@@ -62,6 +63,8 @@ class Row:
     context: str | None               # scenario state given with the snapshot (recorder.publish)
     positions_m: np.ndarray | None
     gap_before: str | None = None     # why the line breaks before this row (lost rows, new run)
+    defects: tuple | None = None      # the active local defects as text (None: not in the snapshot)
+    vibration: object | None = None   # the snapshot's vibration block (twin.snapshot.VibrationState)
 
 
 _FIELD_CACHE: dict = {}
@@ -121,6 +124,9 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
         if isinstance(r, str):
             risk = r
             reason = items.get("reason") if isinstance(items.get("reason"), str) else None
+    has_defects, has_vibration = _present(snapshot, ("defects", "vibration"))
+    defects = tuple(_defect_text(d) for d in snapshot.defects or ()) if has_defects else None
+    vibration = snapshot.vibration if has_vibration else None
     sp = getattr(snapshot, "setpoint", None) if _present(snapshot, ("setpoint",))[0] else None
     setpoint = tuple(_num(getattr(sp, f, None)) for f in SETPOINT_FIELDS) if sp is not None else None
     return Row(time_s=float(snapshot.time_s), seq=int(snapshot.seq), status=str(snapshot.status),
@@ -130,7 +136,18 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
                friction_torque_n_m=_num(snapshot.friction_torque_n_m),
                contacts=contacts, regimes=regimes, azimuth_rad=azimuth,
                electrical=electrical, risk=risk, risk_reason=reason, context=context,
-               positions_m=positions_m)
+               positions_m=positions_m, defects=defects, vibration=vibration)
+
+
+def _defect_text(d) -> str:
+    """'outer spall 0.5 x 0.6 mm, 50 um deep at 0 deg' of a twin.vibration.defects model."""
+    get = d.get if isinstance(d, Mapping) else (lambda k, default=None: getattr(d, k, default))
+    kind = get("kind")
+    size = f"{_fmt(get('width_m', 0.0) * 1e3)} x {_fmt(get('length_m', 0.0) * 1e3)} mm, {_fmt(get('depth_m', 0.0) * 1e6)} um deep"
+    where = {"outer": f"outer spall {size} at azimuth {_fmt(get('azimuth_deg', 0.0))} deg",
+             "inner": f"inner spall {size} at ring angle {_fmt(get('ring_angle_deg', 0.0))} deg",
+             "ball": f"ball {get('ball_index', 0)} defect {size}"}
+    return where.get(kind, f"{kind} defect {size}")
 
 
 # ---- arrow helpers ------------------------------------------------------------------------------
@@ -392,6 +409,11 @@ def events(tw: TwinLayout, batch: Batch) -> None:
             texts.append((j, f"restart (restarts: {r.restarts}): {r.status}", "WARN"))
         elif status_changed:
             texts.append((j, f"status: {r.status}", "INFO" if r.status == "ok" else "WARN"))
+        if r.defects is not None and r.defects != last.get("defects", ()):
+            texts.append((j, "defects: " + "; ".join(r.defects) if r.defects else "defects cleared",
+                          "WARN" if r.defects else "INFO"))
+        if r.defects is not None:
+            last["defects"] = r.defects
         if r.risk is not None and r.risk != last.get("risk"):
             risks.append((j, r.risk if r.risk in RISK_VALUES else "none"))
             if last.get("risk") is not None:
@@ -487,3 +509,76 @@ def alarm_states_in_force(tw: TwinLayout, states: Mapping[str, str], time_s: flo
     t = np.array([round((time_s + offset_s) * 1e9)], dtype=np.int64)
     return [(f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, [seq]), rr.StateChange.columns(state=[state]))
             for alarm_id, state in active]
+
+
+# ---- vibration (issue 14) ---------------------------------------------------------------------------
+def vibration_columns(tw: TwinLayout, batch: Batch) -> None:
+    """The indicators of every new accelerometer window (a row at the snapshot that first
+    carries it): `vibration/...` Scalars and the envelope bar charts (layout.VIBRATION_SERIES)."""
+    last = tw.last
+    sel, blocks = [], []
+    for j, r in enumerate(batch.rows):
+        v = r.vibration
+        if v is None or v.window_end_s == last.get("window_end_s"):
+            continue
+        last["window_end_s"] = v.window_end_s
+        sel.append(j)
+        blocks.append(v)
+    if not sel:
+        return
+    idx = np.array(sel)
+    root = tw.root
+    n = len(blocks)
+
+    def scalars(leaf: str, values) -> None:
+        v = np.asarray(values, dtype=np.float64).reshape(n, -1)
+        batch.out.append((f"{root}/vibration/{leaf}", batch.index(idx),
+                          rr.Scalars.columns(scalars=v.reshape(-1)).partition(np.full(n, v.shape[1]))))
+
+    scalars("acceleration_rms_peak_m_s2", [[b.rms_m_s2, b.peak_m_s2] for b in blocks])
+    scalars("velocity_rms_mm_s", [[b.velocity_rms_mm_s] for b in blocks])
+    scalars("kurtosis", [[b.kurtosis, b.band_kurtosis, b.crest_factor] for b in blocks])
+    freqs = np.array([[getattr(b.defect_frequencies_hz, k) for k in VIB_LINES] for b in blocks])
+    amps = np.array([[_line_fundamental(b, k) for k in VIB_LINES] for b in blocks])
+    floor = np.array([[b.envelope_noise_floor_m_s2] for b in blocks])
+    scalars("defect_frequencies_hz", freqs)
+    scalars("envelope_lines_m_s2", np.hstack([amps, floor]))
+    # the envelope spectrum as the snapshot has it: its largest peaks, and the defect lines (markers)
+    k = max(1, max(len(b.envelope_peaks_hz) for b in blocks))
+    peak_f = np.zeros((n, k))
+    peak_a = np.zeros((n, k))
+    for i, b in enumerate(blocks):
+        for m, p in enumerate(b.envelope_peaks_hz):
+            peak_f[i, m], peak_a[i, m] = p.frequency_hz, p.amplitude
+    batch.out.append((f"{root}/vibration/envelope/peaks", batch.index(idx), _bar_columns(peak_a, peak_f)))
+    batch.out.append((f"{root}/vibration/envelope/defect_lines", batch.index(idx),
+                      _bar_columns(np.nan_to_num(amps), freqs)))
+
+
+def _line_fundamental(block, name: str) -> float:
+    line = (block.envelope_lines or {}).get(name)
+    return float(line.harmonics[0]) if line is not None and line.harmonics else math.nan
+
+
+@dataclass(slots=True)
+class WaveRow:
+    """Accelerometer samples that came with one snapshot (twin.vibration.sensor.WaveformBlock)."""
+
+    seq: int
+    t0_s: float
+    sample_rate_hz: float
+    samples: np.ndarray              # float32 [m/s^2]
+
+
+def waveform_columns(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> list:
+    """`vibration/acceleration_m_s2`: one Scalars row per sample at its own simulated time (the
+    `seq` of the snapshot it came with), all of a send in one call."""
+    rows = [r for r in rows if r.samples.size]
+    if not rows:
+        return []
+    t = np.concatenate([np.round((r.t0_s + offset_s + np.arange(r.samples.size) / r.sample_rate_hz) * 1e9)
+                        for r in rows]).astype(np.int64)
+    seq = np.concatenate([np.full(r.samples.size, r.seq, dtype=np.int64) for r in rows])
+    x = np.concatenate([r.samples for r in rows]).astype(np.float64)
+    index = [rr.TimeColumn(SIM_TIME, duration=t.astype("timedelta64[ns]")), rr.TimeColumn(SEQ, sequence=seq)]
+    return [(f"{tw.root}/vibration/acceleration_m_s2", index, rr.Scalars.columns(scalars=x))]
