@@ -129,7 +129,7 @@ class ScenarioRun(BaseModel):
 
 
 def _drop_empty_steps(steps: list[ScenarioStep]) -> list[ScenarioStep]:
-    return [s for s in steps if (s.set or s.ramp).model_dump(exclude_none=True)]
+    return [s for s in steps if s.defects is not None or (s.set or s.ramp).model_dump(exclude_none=True)]
 
 
 def _check_steps(steps: list[ScenarioStep], duration_s: float, where: str) -> None:

@@ -16,6 +16,8 @@ import json
 import queue
 import time
 
+import asyncio
+
 import httpx
 import numpy as np
 import pytest
@@ -38,6 +40,7 @@ HOUSING = {"enabled": True, "accelerometer": {"window_s": WINDOW_S, "noise_densi
 def service(support):
     endpoint = support.free_endpoint()
     settings = ServiceSettings(enable_recording=False, zenoh_listen=[endpoint], fast=True, publish_rate_hz=100.0,
+                               opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
                                alarms=AlarmSettings(defect_delay_s=0.0, clear_hold_s=0.1))
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=60.0) as srv, \
             httpx.Client(base_url=srv.url, timeout=60.0) as http:
@@ -181,3 +184,86 @@ def test_defects_over_zenoh_are_validated_and_answered(service, support):
         http.delete("/v1/bearings/vib/defects").raise_for_status()
     finally:
         peer.close()
+
+
+def test_a_severe_outer_spall_raises_the_iso_20816_zone_alarm_and_opc_ua_shows_the_window(service, support):
+    """2 mm along the race, 0.9 of the groove arc across, 0.2 mm deep, at 8 kN: the velocity RMS
+    10-1000 Hz passes ISO 20816-3 Table A.2's C/D boundary (4.5 mm/s, group 2 rigid, the default
+    settings): `vibration_zone` rises as critical. The OPC UA Vibration folder shows the window
+    the HTTP state shows (same window_end_s, same velocity and BPFO)."""
+    pytest.importorskip("asyncua")
+    from asyncua import Client
+
+    from service.opcua.layout import NAMESPACE_URI, ROOT_FOLDER
+
+    srv, http, _endpoint = service
+    outer = race_limits(catalog.bearing("6208").geometry, outer=True)
+    severe = {"kind": "outer", "width_m": 2e-3, "length_m": 0.9 * outer["length_m"], "depth_m": 0.2e-3}
+    assert http.put("/v1/bearings/vib/setpoint", json={"radial_load_n": 8000.0}).status_code == 200
+    assert http.put("/v1/bearings/vib/defects", json={"defects": [severe]}).status_code == 200
+
+    def zone_event():
+        events = http.get("/v1/bearings/vib/alarms", params={"events": 1000}).json()["events"]
+        return [e for e in events if e["alarm_id"] == "vibration_zone" and e["transition"] == "raised"]
+    (raised,) = support.wait_for(zone_event, lambda e: len(e) == 1, WAIT_S)
+    assert raised["severity"] == "critical" and raised["threshold"] == 4.5 and raised["value"] >= 4.5
+    assert "zone D" in raised["message"]
+
+    async def read_window():
+        async with Client(srv.service.opcua.url, timeout=20, watchdog_intervall=10.0) as c:
+            idx = await c.get_namespace_index(NAMESPACE_URI)
+            folder = await c.nodes.objects.get_child([f"{idx}:{ROOT_FOLDER}", f"{idx}:vib", f"{idx}:Vibration"])
+            names = ("window_end_s", "velocity_rms_mm_s", "bpfo_hz", "bpfo_m_s2", "zone", "defect_count")
+            nodes = [await folder.get_child(f"{idx}:{n}") for n in names]
+            for _ in range(400):
+                values = dict(zip(names, await c.read_values(nodes), strict=True))
+                state = (await asyncio.to_thread(http.get, "/v1/bearings/vib/state")).json()
+                v = state["vibration"]
+                if v["window_end_s"] == values["window_end_s"] and values["defect_count"] == 1:
+                    return values, v
+                await asyncio.sleep(0.05)
+            raise AssertionError("the OPC UA window never matched the HTTP one")
+    values, v = asyncio.run(asyncio.wait_for(read_window(), WAIT_S))
+    assert values["velocity_rms_mm_s"] == v["velocity_rms_mm_s"]
+    assert values["bpfo_hz"] == v["defect_frequencies_hz"]["bpfo"]
+    assert values["bpfo_m_s2"] == v["envelope_lines"]["bpfo"]["harmonics"][0]
+    assert values["zone"] == ("D" if v["velocity_rms_mm_s"] >= 4.5 else "C" if v["velocity_rms_mm_s"] >= 2.8 else "B")
+    http.delete("/v1/bearings/vib/defects").raise_for_status()
+    http.put("/v1/bearings/vib/setpoint", json={"radial_load_n": 3000.0}).raise_for_status()
+
+
+def test_a_scenario_step_injects_and_clears_defects(service, support):
+    _srv, http, endpoint = service
+    bad = {"name": "bad_spall", "duration_s": 0.2, "steps": [{"at_s": 0.0, "defects": [{**SPALL, "depth_m": -1e-5}]}]}
+    r = http.post("/v1/bearings/vib/scenario", json={"scenario": bad})
+    assert r.status_code == 422, r.text
+    assert r.json()["detail"][0]["field"] == "scenario.steps[0].defects[0].depth_m"
+    timeline = {"name": "spall_on_off", "duration_s": 0.3, "steps": [
+        {"at_s": 0.0, "phase": "spall", "defects": [SPALL]},
+        {"at_s": 0.1, "phase": "two spalls, heavier", "set": {"radial_load_n": 4000.0},
+         "defects": [SPALL, {**SPALL, "azimuth_deg": 90.0}]},
+        {"at_s": 0.2, "phase": "healthy", "defects": []}]}
+    peer = support.Peer(endpoint)
+    try:
+        peer.subscribe("bearing/vib/state")
+        support.wait_for(lambda: peer.inbox.qsize(), lambda n: n > 0, WAIT_S)   # the subscription is routed
+        r = http.post("/v1/bearings/vib/scenario", json={"scenario": timeline})
+        assert r.status_code == 202, r.text
+        support.wait_for(lambda: http.get("/v1/bearings/vib/scenario").json()["state"],
+                         lambda st: st in ("done", "failed", "cancelled"), WAIT_S)
+        assert http.get("/v1/bearings/vib/scenario").json()["state"] == "done"
+        support.wait_for(lambda: http.get("/v1/bearings/vib/state").json()["defects"], lambda d: d == [], WAIT_S)
+        time.sleep(0.5)                                      # the last states reach the peer
+        states = []
+        while not peer.inbox.empty():
+            states.append(json.loads(peer.inbox.get_nowait().payload))
+    finally:
+        peer.close()
+    counts = [len(x["defects"]) for x in states]
+    changes = [c for k, c in enumerate(counts) if k == 0 or c != counts[k - 1]]
+    assert changes[-3:] == [1, 2, 0], changes                # in order, each published
+    two = [x for x in states if len(x["defects"]) == 2]
+    assert {d["azimuth_deg"] for d in two[0]["defects"]} == {0.0, 90.0}
+    assert all(x["setpoint"]["radial_load_n"] == 4000.0 for x in two[1:])   # the set of the same step
+    assert http.get("/v1/bearings/vib/defects").json()["defects"] == []
+    http.put("/v1/bearings/vib/setpoint", json={"radial_load_n": 3000.0}).raise_for_status()
