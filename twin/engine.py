@@ -30,7 +30,10 @@ from twin.life import LifeMonitor, LifeSettings
 from twin.snapshot import BallState, ContactState, LifeState, Snapshot
 from twin.snapshot import ElectricalState
 from twin.spec import BearingSpec, ModelOptions
-from twin.state import TwinState, make_state
+from twin.state import MAX_DEFECTS, TwinState, make_state
+from twin.vibration.defects import BallDefect, defect_row, validate_defects
+from twin.vibration.housing import housing_equilibrium
+from twin.vibration.sensor import SensorReader, WaveformBlock
 from twin.warmstart import warm_start
 
 FRAME_S = 1e-3  # simulated time per compiled call [s] (1000 steps at dt = 1 us)
@@ -76,6 +79,8 @@ class Twin:
         self._last_restart_time_s = -math.inf
         self._last_good_time_s = 0.0
         self._last_torque_n_m = 0.0
+        self._defects: tuple = ()  # issue 14: the active local defects (twin.vibration.defects)
+        self._sensor = SensorReader(self.model) if self.model.housing_on else None
         self._apply(self.limits.admit(setpoint or self.default_setpoint()))
         self.reset(warm=warm)
 
@@ -244,13 +249,37 @@ class Twin:
             warm_start(self.model, self.state, speed, 0.0, 0.0)
         self.state.scalars[L.X_TIME] = t
         m = self.model
-        evaluate(m.params, m.angle_table, self._setpoint_vector, *self.state.kernel_args())
+        if m.housing_on:
+            self._place_on_housing(sp.radial_load_n if warm else 0.0, sp.axial_load_n if warm else 0.0)
+            self._sensor.reset(t)
+        evaluate(*self._kernel_args())
         if self._setpoint.shaft_current_a > 0.0 or m.spec.thermal.shear_heating:
             # the inlet heating of the warm state (loaded balls, entrainment), not of the state
             # before it (no loaded ball: the current heating at its cap for the first 10 ms)
             self._update_inlet_viscosity(force=True)
-            evaluate(m.params, m.angle_table, self._setpoint_vector, *self.state.kernel_args())
+            evaluate(*self._kernel_args())
         self._update_life(force=True)
+
+    def _kernel_args(self) -> tuple:
+        """Model arrays, setpoint and state in `step_n` / `evaluate` order (without n)."""
+        m, s = self.model, self.state
+        return (m.params, m.angle_table, self._setpoint_vector, *s.kernel_args(), m.housing_params,
+                m.vibration_params, m.decimator_taps, s.active_defect_rows)
+
+    def _place_on_housing(self, radial_load_n: float, axial_load_n: float) -> None:
+        """Warm start on the housing (issue 14): the outer ring at the static equilibrium of its
+        support under the whole load (at the quasi-static equilibrium the balls pass the applied
+        loads to the outer ring; their centrifugal forces cancel over the ring), the balls and the
+        inner ring moved with it; the decimator and the sample ring restart
+        (twin.vibration.housing.housing_equilibrium)."""
+        s = self.state
+        housing_equilibrium(self.model.housing_params, radial_load_n, 0.0, axial_load_n,
+                            s.housing_displacement_m, s.housing_velocity_m_s, s.housing_acceleration_m_s2)
+        shift = s.housing_displacement_m[:3]
+        s.ball_position_m += shift
+        s.ring_position_m += shift
+        s.decimator_state[:] = 0.0
+        s.sample_ring_state[:] = 0.0
 
     # ---- rating life (twin.life) --------------------------------------------------------------
     def _update_life(self, force: bool = False) -> None:
@@ -271,9 +300,9 @@ class Twin:
         s = self.state
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
-        m = self.model
-        status, done = step_n(m.params, m.angle_table, self._setpoint_vector,
-                              *s.kernel_args(), n)
+        status, done = step_n(*self._kernel_args(), n)
+        if self._sensor is not None:
+            self._sensor.drain(s, float(s.scalars[L.X_SHAFT_SPEED]))
         if s.scalars[L.X_TORQUE_COUNT] > 0:
             self._last_torque_n_m = s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT]
         if status != L.STATUS_OK:
@@ -329,10 +358,59 @@ class Twin:
         """Simulated time [s]."""
         return float(self.state.scalars[L.X_TIME])
 
+    # ---- local defects and the accelerometer (issue 14, twin.vibration) ------------------------
+    @property
+    def defects(self) -> tuple:
+        """The active local defects (twin.vibration.defects models)."""
+        return self._defects
+
+    def set_defects(self, defects) -> tuple:
+        """Replace the active local defects (a list of dicts with `kind` outer | inner | ball, or
+        twin.vibration.defects models; [] clears them). Validated against this bearing: raises
+        pydantic.ValidationError naming the field and the bearing's allowed range, or ValueError for
+        more than MAX_DEFECTS. Takes effect at the next step, without recompiling; a ball defect
+        not active before starts with the ball's body axes = the world axes now. Returns the
+        defects in force."""
+        data = [d.model_dump() if hasattr(d, "model_dump") else d for d in defects]
+        if len(data) > MAX_DEFECTS:
+            raise ValueError(f"defects: {len(data)} given, at most {MAX_DEFECTS} at once")
+        items = tuple(validate_defects(data, self.model.spec.geometry))
+        s = self.state
+        geometry = self.model.spec.geometry
+        for d in items:
+            if isinstance(d, BallDefect) and d not in self._defects:
+                s.ball_orientation[d.ball_index] = (1.0, 0.0, 0.0, 0.0)
+        s.defect_rows[:] = 0.0
+        for k, d in enumerate(items):
+            s.defect_rows[k] = defect_row(d, geometry)
+        s.defect_count = len(items)
+        if not items:
+            s.contacts[L.G_DEFECT_DROP] = 0.0
+        self._defects = items
+        return items
+
+    def clear_defects(self) -> tuple:
+        """Remove every local defect (the raceways and balls are healthy again); returns ()."""
+        return self.set_defects([])
+
+    @property
+    def vibration(self):
+        """Indicators of the last complete accelerometer window (twin.snapshot.VibrationState), or
+        None before the first window or with the rigid outer ring."""
+        return None if self._sensor is None else self._sensor.latest
+
+    def drain_waveform(self) -> list[WaveformBlock]:
+        """The accelerometer samples [m/s^2] produced since the last call, as contiguous float32
+        blocks with their start time t0_s [s] and rate (twin.vibration.sensor.WaveformBlock;
+        twin.vibration.waveform encodes them for a bus). At most WAVEFORM_QUEUE_S of signal is
+        kept between calls. [] with the rigid outer ring."""
+        return [] if self._sensor is None else self._sensor.drain_waveform()
+
     # ---- outputs ----------------------------------------------------------------------------
     def ball_azimuths_rad(self) -> np.ndarray:
-        """Ball centre angles from the load line (+x), in (-pi, pi] [rad]."""
-        x = self.state.ball_position_m
+        """Ball centre angles about the outer ring's centre from the load line (+x), in (-pi, pi]
+        [rad]."""
+        x = self.state.ball_position_in_bearing_m
         return np.arctan2(x[:, 1], x[:, 0])
 
     def _contact(self, j: int, r: int, net) -> ContactState:
@@ -370,7 +448,7 @@ class Twin:
     def snapshot(self, real_time_factor: float | None = None) -> Snapshot:
         """An immutable copy of the public state (schema bearing-twin/state/1)."""
         s = self.state
-        x, v, w = s.ball_position_m, s.ball_velocity_m_s, s.ball_angular_velocity_rad_s
+        x, v, w = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s, s.ball_angular_velocity_rad_s
         az = self.ball_azimuths_rad()
         rho2 = x[:, 0] ** 2 + x[:, 1] ** 2
         orbital = (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]) / rho2
@@ -394,7 +472,7 @@ class Twin:
             setpoint=sp,
             shaft_speed_rad_s=float(s.scalars[L.X_SHAFT_SPEED]),
             cage_speed_rad_s=float(s.scalars[L.X_CAGE_SPEED]),
-            inner_ring_displacement_m=tuple(float(a) for a in s.ring_position_m),
+            inner_ring_displacement_m=tuple(float(a) for a in s.inner_ring_offset_m),
             friction_torque_n_m=float(self._last_torque_n_m),
             viscosity_pa_s=float(self._inlet_viscosity_pa_s),
             electrical=ElectricalState(
@@ -410,7 +488,9 @@ class Twin:
                 shear_temperature_rise_k=float(self._shear_heating_k),
                 film_thermal_factor=float(self._film_thermal_factor)),
             balls=balls,
-            life=self._life_state())
+            life=self._life_state(),
+            outer_ring_displacement_m=tuple(float(h) for h in s.housing_displacement_m[:3]),
+            defects=self._defects, vibration=self.vibration)
 
     def _life_state(self) -> LifeState | None:
         block = self.life_monitor.block(self.time_s)

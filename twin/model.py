@@ -27,6 +27,8 @@ from twin.physics.electrical import (ball_raceway_gap_integral_m, coaxial_capaci
 from twin.physics.traction import deformed_surface_radius_m, hertz_strip_table
 from twin.physics.viscosity import dynamic_viscosity_pa_s
 from twin.spec import BearingSpec, ModelOptions
+from twin.vibration.housing import housing_params
+from twin.vibration.signal import DecimatorDesign, design_decimator, integer_ratio_time_step
 
 # ISO 76 static limit for ball bearings: 4.2 GPa; the model refuses loads whose analytic maximum
 # contact pressure would exceed it (plastic flow, beyond Hertz theory; it is also the static load
@@ -58,6 +60,21 @@ class BearingModel:
 
     gap_limit_m: tuple[float, float] = (50e-6, 50e-6)   # inner, outer: geometric gap limit of the contact capacitance
     rest_capacitance_f: float = 0.0                     # the rings' lands across the oil-filled annulus [F]
+    # issue 14 (twin.vibration): housing H_* vector, V_* vector, accelerometer decimator
+    housing_params: np.ndarray | None = None
+    vibration_params: np.ndarray | None = None
+    decimator: DecimatorDesign | None = None  # None with the rigid outer ring
+    decimator_taps: np.ndarray | None = None  # reversed FIR taps (K R,); a dummy (1,) without housing
+
+    @property
+    def housing_on(self) -> bool:
+        """Whether the outer ring rides on the housing and the accelerometer is sampled."""
+        return self.decimator is not None
+
+    @property
+    def sample_rate_hz(self) -> float | None:
+        """Accelerometer output rate [Hz] (None with the rigid outer ring)."""
+        return None if self.decimator is None else self.decimator.output_rate_hz
 
     def stiffness_at(self, race: int, sin_alpha: float) -> float:
         """Hertz K [N/m^1.5] of race `race` (0 inner, 1 outer) at contact angle alpha, interpolated
@@ -308,12 +325,33 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
         p, race, tribology, q_limit,
         dynamic_viscosity_pa_s(spec.lubricant, timestep.REFERENCE_OIL_TEMPERATURE_C), z)
     p[L.P_DT] = timestep.resolve_time_step_s(options.time_step_s, critical)
+    housing = spec.housing
+    decimator = None
+    if housing.enabled:
+        # the accelerometer is sampled by an integer decimation of the step: dt = 1 / (R f_s), the
+        # largest such step not above the one resolved (auto or given; twin.vibration.signal)
+        fs = housing.accelerometer.sample_rate_hz
+        p[L.P_DT] = integer_ratio_time_step(min(p[L.P_DT], 0.5 / fs), fs)[0]
+        decimator = design_decimator(1.0 / p[L.P_DT], fs)
+    taps = decimator.reversed_taps if decimator is not None else np.zeros(1)
+    # the defect drops (twin.kernels.vibration) take the raceway and curvature radii at the
+    # nominal contact angle (the drop is second order in the pit's size over these radii)
+    v = np.zeros(L.N_VIB_PARAMS)
+    v[L.V_HOUSING_ON] = 1.0 if housing.enabled else 0.0
+    v[L.V_DECIMATION_RATIO] = decimator.ratio if decimator is not None else 1.0
+    v[L.V_INNER_RACEWAY_RADIUS] = g.inner_raceway_radius_m
+    v[L.V_OUTER_RACEWAY_RADIUS] = g.outer_raceway_radius_m
+    v[L.V_INNER_GROOVE_RADIUS] = g.inner_groove_radius_m
+    v[L.V_OUTER_GROOVE_RADIUS] = g.outer_groove_radius_m
+    v[L.V_INNER_RX], v[L.V_OUTER_RX] = race[0, L.R_RX], race[1, L.R_RX]
+    v[L.V_INNER_RY], v[L.V_OUTER_RY] = race[0, L.R_RY], race[1, L.R_RY]
     p[L.P_SUBSTEPS] = timestep.steps_per_period(options.tribology_period_s, p[L.P_DT])
     if options.friction_model == "ellipse_traction":
         # the strips' spin moment replaces seed 001's eq. 11, at every contact angle
         tribology[:, T_PIVOT] = 0.0
         angle_table[:, :, L.A_TRIBOLOGY + T_PIVOT] = 0.0
-    for a in (p, race, tribology, angle_table):
+    hp = housing_params(housing)
+    for a in (p, race, tribology, angle_table, v, taps, hp):
         a.setflags(write=False)
     return BearingModel(
         spec=spec, options=options, params=p, race_params=race,
@@ -322,4 +360,5 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
         contact_angle_rad=alpha, inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),
         max_radial_load_n=float(max_radial), max_axial_load_n=float(max_axial),
         max_shaft_speed_rad_s=float(max_speed), time_step=critical, gap_limit_m=(gap_in, gap_out),
-        rest_capacitance_f=rest)
+        rest_capacitance_f=rest, housing_params=hp, vibration_params=v, decimator=decimator,
+        decimator_taps=taps)

@@ -8,6 +8,7 @@ from typing import Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from twin.setpoint import Setpoint
+from twin.vibration.defects import Defect
 
 SCHEMA = "bearing-twin/state/1"
 
@@ -101,6 +102,60 @@ class LifeState(BaseModel):
     reason: str | None = Field(default=None, description="Why values are null, or a caveat; null when there is none.")
 
 
+class EnvelopePeak(BaseModel):
+    """One peak of the envelope spectrum."""
+
+    model_config = _FROZEN
+    frequency_hz: float = Field(description="Peak frequency (parabolic interpolation between bins) [Hz].")
+    amplitude: float = Field(description="Envelope amplitude at the peak [m/s^2].")
+
+
+class DefectFrequenciesHz(BaseModel):
+    """Kinematic defect frequencies at the window's mean shaft speed and loaded contact angle [Hz]
+    (twin.vibration.defect_frequencies)."""
+
+    model_config = _FROZEN
+    ftf: float = Field(description="Cage (fundamental train) frequency [Hz].")
+    bpfo: float = Field(description="Ball pass frequency, outer race [Hz].")
+    bpfi: float = Field(description="Ball pass frequency, inner race [Hz].")
+    bsf: float = Field(description="Ball spin frequency [Hz].")
+    two_bsf: float = Field(description="2 x BSF, the rate at which a ball defect strikes the races [Hz].")
+
+
+class DefectLine(BaseModel):
+    """Envelope amplitudes at one defect frequency (largest bin within +-1 % of each line)."""
+
+    model_config = _FROZEN
+    frequency_hz: float = Field(description="The defect frequency [Hz].")
+    harmonics: tuple[float, ...] = Field(description="Envelope amplitude at 1x, 2x, 3x the frequency [m/s^2].")
+    sidebands: tuple[float, float] | None = Field(
+        default=None, description="Envelope amplitude at the frequency minus and plus the modulation [m/s^2]: "
+        "the shaft frequency for BPFI, FTF for 2 x BSF; null for the others.")
+
+
+class VibrationState(BaseModel):
+    """Indicators of the last complete window of housing acceleration (twin.vibration.indicators)."""
+
+    model_config = _FROZEN
+    window_end_s: float = Field(description="Simulated time of the window's last sample [s].")
+    window_s: float = Field(description="Window length [s].")
+    sample_rate_hz: float = Field(description="Accelerometer sample rate [Hz].")
+    shaft_speed_rad_s: float = Field(description="Mean shaft speed over the window [rad/s].")
+    contact_angle_rad: float = Field(description="Loaded contact angle at the window end (mean over loaded balls) [rad].")
+    rms_m_s2: float = Field(description="RMS acceleration, mean removed [m/s^2].")
+    peak_m_s2: float = Field(description="Peak |acceleration|, mean removed [m/s^2].")
+    crest_factor: float = Field(description="Peak / RMS [-].")
+    kurtosis: float = Field(description="Kurtosis [-] (3 for Gaussian noise).")
+    band_kurtosis: float = Field(description="Kurtosis of the signal band-passed to the envelope band [-].")
+    velocity_rms_mm_s: float = Field(description="RMS velocity over 10-1000 Hz (ISO 20816-1) [mm/s].")
+    defect_frequencies_hz: DefectFrequenciesHz
+    envelope_band_hz: tuple[float, float] = Field(description="Band-pass of the envelope analysis [Hz].")
+    envelope_peaks_hz: tuple[EnvelopePeak, ...] = Field(description="The five largest envelope-spectrum peaks, largest first.")
+    envelope_noise_floor_m_s2: float = Field(description="Median envelope amplitude up to 5 x the highest defect frequency [m/s^2].")
+    envelope_lines: dict[str, DefectLine] = Field(
+        description="Envelope amplitudes at each defect frequency (keys ftf, bpfo, bpfi, bsf, two_bsf).")
+
+
 class Snapshot(BaseModel):
     """Everything the world may see of one twin at one instant."""
 
@@ -118,12 +173,18 @@ class Snapshot(BaseModel):
     setpoint: Setpoint = Field(description="The setpoint in force during the frame that ended at time_s [fields with units].")
     shaft_speed_rad_s: float = Field(description="Current (ramped) shaft speed [rad/s].")
     cage_speed_rad_s: float = Field(description="Cage angular speed [rad/s].")
-    inner_ring_displacement_m: tuple[float, float, float] = Field(description="Inner ring centre (x along the radial load, y, z axial) [m].")
+    inner_ring_displacement_m: tuple[float, float, float] = Field(description="Inner ring centre relative to the outer ring's (x along the radial load, y, z axial) [m].")
     friction_torque_n_m: float = Field(description="Torque the shaft supplies to the bearing, averaged over the last frame [N m].")
     viscosity_pa_s: float = Field(description="Inlet viscosity: the oil at the oil temperature plus the inlet's current and shear heating (Roelands, seed 003 eq. 3) [Pa s].")
     electrical: ElectricalState
     balls: tuple[BallState, ...]
     life: LifeState | None = Field(default=None, description="Rating life and accumulated damage (twin.life); null before the first evaluation.")
+    outer_ring_displacement_m: tuple[float, float, float] = Field(
+        default=(0.0, 0.0, 0.0), description="Outer ring (housing) centre (x, y, z) [m]; zero with the rigid outer ring.")
+    defects: tuple[Defect, ...] = Field(default=(), description="Active local defects (twin.vibration.defects).")
+    vibration: VibrationState | None = Field(
+        default=None, description="Indicators of the last complete accelerometer window; null before the first "
+        "window or with the rigid outer ring.")
 
     def to_json(self) -> str:
         """JSON text with the contract's field names."""

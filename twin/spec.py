@@ -12,6 +12,8 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from twin.vibration.housing import Housing
+
 # the range of an explicit ModelOptions.time_step_s [s] (twin.timestep.TIME_STEP_RANGE_S)
 TIME_STEP_RANGE_S = (1e-8, 2e-5)
 
@@ -246,6 +248,10 @@ class BearingSpec(BaseModel):
     mounting: Mounting = Mounting()
     electrical: Electrical = Electrical()
     thermal: Thermal = Thermal()
+    housing: Housing = Field(
+        default_factory=Housing,
+        description="Outer ring + housing support and the accelerometer (twin.vibration.housing; Sawalhi & "
+        "Randall 2008 defaults); `enabled: false` (the default) keeps the rigid, fixed outer ring.")
 
 
 class ModelOptions(BaseModel):

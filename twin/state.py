@@ -8,6 +8,12 @@ import numpy as np
 
 from twin.kernels import layout as L
 from twin.model import BearingModel
+from twin.vibration.defects import N_DEFECT_PARAMS
+from twin.vibration.housing import N_HOUSING_DOF
+from twin.vibration.signal import N_DD_HEADER, N_RS_HEADER
+
+MAX_DEFECTS = 8          # defect rows a twin holds at once
+SAMPLE_RING_S = 2.0      # the accelerometer's sample ring holds this much signal [s]
 
 
 @dataclass
@@ -26,6 +32,38 @@ class TwinState:
     ring_acceleration: np.ndarray
     lanes: np.ndarray            # flat per-contact lanes, row k of contact c at [k * CW + c]
     cage_load_n: np.ndarray      # (Z, 2) ball j against cage element ahead (0) and behind (1)
+    # issue 14 (twin.vibration); all zero and unused with the rigid outer ring
+    housing_displacement_m: np.ndarray  # (N_HOUSING_DOF,) outer ring x, y, z, sprung mass [m]
+    housing_velocity_m_s: np.ndarray     # [m/s]
+    housing_acceleration_m_s2: np.ndarray  # [m/s^2]
+    ball_orientation: np.ndarray  # (Z, 4) unit quaternions (w, x, y, z), body -> world
+    decimator_state: np.ndarray   # twin.vibration.signal direct-form decimator state
+    sample_ring_m_s2: np.ndarray  # float32 ring of accelerometer samples [m/s^2]
+    sample_ring_state: np.ndarray  # twin.vibration.signal RS_* counters
+    defect_rows: np.ndarray       # (MAX_DEFECTS, N_DEFECT_PARAMS), the first `defect_count` active
+    defect_count: int = 0
+
+    @property
+    def inner_ring_offset_m(self) -> np.ndarray:
+        """Inner ring centre relative to the outer ring's (the bearing's own deflection) [m] (3,);
+        = ring_position_m with the rigid outer ring."""
+        return self.ring_position_m - self.housing_displacement_m[:3]
+
+    @property
+    def ball_position_in_bearing_m(self) -> np.ndarray:
+        """Ball centres relative to the outer ring's centre [m] (Z, 3); = ball_position_m with the
+        rigid outer ring."""
+        return self.ball_position_m - self.housing_displacement_m[:3]
+
+    @property
+    def ball_velocity_in_bearing_m_s(self) -> np.ndarray:
+        """Ball velocities relative to the outer ring [m/s] (Z, 3)."""
+        return self.ball_velocity_m_s - self.housing_velocity_m_s[:3]
+
+    @property
+    def active_defect_rows(self) -> np.ndarray:
+        """The active defect rows (a view; 0 rows when there is none)."""
+        return self.defect_rows[: self.defect_count]
 
     @property
     def contacts(self) -> np.ndarray:
@@ -45,13 +83,17 @@ class TwinState:
         rows[L.C_LAMBDA] = -1.0
         rows[L.C_H_MIN] = -1.0
         rows[L.C_H_C] = -1.0
+        rows[L.G_DEFECT_DROP] = 0.0
 
     def kernel_args(self) -> tuple:
         """The state arrays in `step_n` order."""
         return (self.scalars, self.ball_position_m, self.ball_velocity_m_s,
                 self.ball_angular_velocity_rad_s, self.ball_acceleration,
                 self.ball_angular_acceleration, self.ring_position_m, self.ring_velocity_m_s,
-                self.ring_acceleration, self.lanes, self.cage_load_n)
+                self.ring_acceleration, self.lanes, self.cage_load_n,
+                self.housing_displacement_m, self.housing_velocity_m_s,
+                self.housing_acceleration_m_s2, self.ball_orientation, self.decimator_state,
+                self.sample_ring_m_s2, self.sample_ring_state)
 
 
 def make_state(model: BearingModel) -> TwinState:
@@ -67,7 +109,16 @@ def make_state(model: BearingModel) -> TwinState:
         rows[L.M_GROOVE_CLEARANCE, r:2 * z:2] = (model.race_params[r, L.R_GROOVE_RADIUS]
                                                   - model.ball_radius_m)
         rows[L.M_STIFFNESS, r:2 * z:2] = model.race_params[r, L.R_STIFFNESS]
+    dec = model.decimator
+    ring = int(round(SAMPLE_RING_S * dec.output_rate_hz)) if dec is not None else 1
+    orientation = np.zeros((z, 4))
+    orientation[:, 0] = 1.0
     return TwinState(
+        housing_displacement_m=np.zeros(N_HOUSING_DOF), housing_velocity_m_s=np.zeros(N_HOUSING_DOF),
+        housing_acceleration_m_s2=np.zeros(N_HOUSING_DOF), ball_orientation=orientation,
+        decimator_state=dec.new_direct_state() if dec is not None else np.zeros(N_DD_HEADER + 2),
+        sample_ring_m_s2=np.zeros(ring, dtype=np.float32), sample_ring_state=np.zeros(N_RS_HEADER),
+        defect_rows=np.zeros((MAX_DEFECTS, N_DEFECT_PARAMS)),
         scalars=np.zeros(L.N_SCALARS),
         ball_position_m=np.zeros((z, 3)), ball_velocity_m_s=np.zeros((z, 3)),
         ball_angular_velocity_rad_s=np.zeros((z, 3)), ball_acceleration=np.zeros((z, 3)),

@@ -42,7 +42,7 @@ def _case(designation: str, radial: float, axial: float, settle_s: float, window
     disp = []
     for _ in range(max(1, int(round(window_s / 1e-4)))):
         twin.advance(1e-4, frame_steps=100)
-        disp.append(twin.state.ring_position_m.copy())
+        disp.append(twin.state.inner_ring_offset_m.copy())
     disp = np.array(disp)
     snap = twin.snapshot()
     psi = twin.ball_azimuths_rad()

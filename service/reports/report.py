@@ -196,8 +196,9 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
     from service.reports.angular_contact import angular_contact_section
     from service.reports.friction import friction_section
     from service.reports.ehl import write_ehl_section
+    from service.reports.vibration import vibration_section
 
-    total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 8 + report_ev.study_count(quick)
+    total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 9 + report_ev.study_count(quick)
     with tqdm(total=total, desc="bearing-twin report", unit="study") as progress:
         az_png, az = _fig_azimuth(out, quick)
         progress.update(1)
@@ -226,6 +227,8 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
         bench = run_engine_benchmark(seconds=0.05 if quick else 0.2, cases=False, passes=False)
         progress.update(1)
         step_study = timestep_study.run_all(quick=quick)
+        progress.update(1)
+        vib_md = vibration_section(out, quick)
         progress.update(1)
 
     md = [f"# bearing-twin validation report\n\nGenerated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}"
@@ -272,7 +275,8 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
            "## Time step: the auto step against 1 us (issue 13)\n",
            f"{'Quick subset; `bearing-twin timestep-study` runs the whole envelope. ' if quick else ''}"
            "Outputs averaged over whole cage revolutions (twin.validation.timestep_study).\n",
-           timestep_study.markdown(step_study) + "\n"]
+           timestep_study.markdown(step_study) + "\n",
+           *vib_md]
     path = out / "report.md"
     path.write_text("\n".join(md))
     return path

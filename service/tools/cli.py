@@ -1,5 +1,5 @@
 """`bearing-twin` command line: simulate, bench, timestep-study, report, serve, router, scenario, bench-service,
-monitor, soak, ehl, life.
+monitor, soak, ehl, life, vibration.
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -126,6 +126,44 @@ def _cmd_timestep_study(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_vibration(args: argparse.Namespace) -> int:
+    from pydantic import ValidationError
+
+    from twin.setpoint import SetpointError
+    from twin.vibration.run import simulate_vibration
+
+    try:
+        result, samples = simulate_vibration(
+            args.bearing, args.speed, args.radial_load, args.axial_load, defect=args.defect,
+            defect_size_m=args.defect_size, defect_length_m=args.defect_length, defect_depth_m=args.defect_depth,
+            duration_s=args.duration, noise_density_m_s2_rthz=args.noise_density, sample_rate_hz=args.sample_rate)
+    except (ValidationError, SetpointError, ValueError) as exc:
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    if args.plot:
+        from service.reports.vibration import plot_vibration
+
+        plot_vibration(samples, result, args.plot)
+    if args.json:
+        result.pop("per_window", None)
+        print(json.dumps(result, allow_nan=False))
+        return 0
+    f = result["defect_frequencies_hz"]
+    print(f"{result['bearing']} at {result['shaft_speed_rad_s']:g} rad/s, Fr = {result['radial_load_n']:g} N, "
+          f"Fa = {result['axial_load_n']:g} N, defect: {(result['defect'] or {}).get('kind', 'none')}, "
+          f"{result['duration_s']:g} s at {result['sample_rate_hz']:g} Hz (dt = {result['time_step_s'] * 1e6:.3f} us)")
+    print(f"  FTF {f['ftf']:.2f}, BPFO {f['bpfo']:.2f}, BPFI {f['bpfi']:.2f}, BSF {f['bsf']:.2f} Hz "
+          f"(contact angle {result['contact_angle_deg']:.2f} deg)")
+    print(f"  RMS {result['rms_m_s2']:.4g} m/s2, peak {result['peak_m_s2']:.4g} m/s2, crest {result['crest_factor']:.2f}, "
+          f"kurtosis {result['kurtosis']:.2f} (band {result['band_kurtosis']:.2f}), "
+          f"velocity RMS {result['velocity_rms_mm_s']:.4g} mm/s")
+    peaks = ", ".join(f"{p['frequency_hz']:.1f} Hz ({p['amplitude']:.3g})" for p in result["envelope_peaks_hz"])
+    print(f"  envelope peaks ({result['envelope_band_hz'][0]:.0f}-{result['envelope_band_hz'][1]:.0f} Hz band): {peaks}")
+    if args.plot:
+        print(f"  figure: {args.plot}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog="bearing-twin", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -226,6 +264,30 @@ def build_parser() -> argparse.ArgumentParser:
     bsv.add_argument("--no-record", action="store_true", help="without the rerun recording")
     bsv.add_argument("--json", action="store_true")
     bsv.set_defaults(func=_cmd_bench_service)
+
+    vib = sub.add_parser(
+        "vibration", help="housing acceleration with a local defect: indicators, defect frequencies, envelope peaks",
+        description="Run the twin with its outer ring on the housing (Sawalhi & Randall 2008 support, accelerometer "
+        "sampled in the kernel) and an optional local defect, discard 0.05 s, analyse `--duration` of the signal "
+        "(twin.vibration.run.simulate_vibration).")
+    vib.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    vib.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
+    vib.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
+    vib.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
+    vib.add_argument("--defect", choices=["outer", "inner", "ball"], help="local defect (default: none, healthy)")
+    vib.add_argument("--defect-size", type=float, default=0.5e-3,
+                     help="defect width along the rolling direction, width_m [m] (default 0.5e-3)")
+    vib.add_argument("--defect-length", type=float, default=None,
+                     help="defect length across the rolling direction, length_m [m] (default 0.6 x ball radius)")
+    vib.add_argument("--defect-depth", type=float, default=50e-6, help="defect depth, depth_m [m] (default 50e-6)")
+    vib.add_argument("--duration", type=_positive_float, default=1.0, help="analysed simulated time [s] (default 1)")
+    vib.add_argument("--noise-density", type=float, default=None,
+                     help="sensor noise density [m/s2/sqrt(Hz)] (default: the spec's, 0)")
+    vib.add_argument("--sample-rate", type=float, default=None, help="accelerometer rate [Hz] (default 51200)")
+    vib.add_argument("--json", action="store_true", help="print the result as JSON")
+    vib.add_argument("--plot", metavar="FILE.png", help="waveform, spectrum and envelope spectrum with the defect "
+                     "frequencies marked")
+    vib.set_defaults(func=_cmd_vibration)
 
     _add_monitor(sub)
     from service.tools.router import add_router_command

@@ -168,11 +168,15 @@ def test_bench_json_keys_positive_and_finite():
                 "cpu_real_time_factor", "cpu_real_time_factor_1us"):
         assert math.isfinite(r[key]) and r[key] > 0, key
     assert r["repeats"] >= 5 and r["time_step_s"] > 1e-6
-    assert {c["id"] for c in r["cases"]} == {"ev-5A-heating", "7208-combined", "6208-1700rad-7.5kN"}
+    assert {c["id"] for c in r["cases"]} == {"ev-5A-heating", "7208-combined", "6208-1700rad-7.5kN",
+                                             "vibration-healthy", "vibration-outer-spall"}
     for c in r["cases"]:
         for step in ("default_step", "step_1us"):
             for key in ("real_time_factor", "real_time_factor_median", "ns_per_step", "time_step_s"):
                 assert math.isfinite(c[step][key]) and c[step][key] > 0, (c["id"], step, key)
+            if c["id"].startswith("vibration"):  # issue 14: housing on, the indicators' share included
+                assert c[step]["housing"] and c[step]["indicator_window_s"] > 0 and c[step]["status"] == "ok"
+                assert c[step]["real_time_factor"] < c[step]["real_time_factor_kernel"]
             assert c[step]["repeats"] >= 5 and c[step]["status"] == "ok"
     for name in ("gather", "geometry", "forces", "tribology", "cage", "integration", "total"):
         for key in ("best_ns", "median_ns"):

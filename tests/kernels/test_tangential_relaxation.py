@@ -62,7 +62,7 @@ def test_refresh_rate_is_rolling_plus_spin_sliding():
     twin = Twin("7208", setpoint=Setpoint(shaft_speed_rad_s=500.0, radial_load_n=0.0, axial_load_n=3000.0))
     twin.advance(0.002)
     m = twin.model
-    evaluate(m.params, m.angle_table, twin._setpoint_vector, *twin.state.kernel_args())
+    evaluate(*twin._kernel_args())
     c = twin.state.contacts
     gamma = m.spec.lubricant.limiting_shear_coefficient
     snap = twin.snapshot()

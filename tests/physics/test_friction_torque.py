@@ -59,7 +59,7 @@ def _spin_moments(twin):
     applied = np.clip(c[L.E_SPIN_MOMENT] + c[L.E_SPIN_SLOPE] * (spin - c[L.E_SPIN_RATE]),
                       -c[L.E_SPIN_CAP], c[L.E_SPIN_CAP])[loaded]
     m = twin.model
-    evaluate(m.params, m.angle_table, twin._setpoint_vector, *twin.state.kernel_args())
+    evaluate(*twin._kernel_args())
     return applied, twin.state.contacts[L.E_SPIN_MOMENT][loaded].copy()
 
 

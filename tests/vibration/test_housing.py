@@ -143,6 +143,10 @@ def test_bad_housing_is_refused_naming_the_field():
     with pytest.raises(ValidationError, match="pedestal_mass_kg"):
         Housing(pedestal_mass_kg=-1.0)
     with pytest.raises(ValidationError, match="sample_rate_hz"):
-        Housing(accelerometer=Accelerometer(sample_rate_hz=25600.0))  # 16 kHz > 0.4 x 25.6 kHz
+        Housing(enabled=True, accelerometer=Accelerometer(sample_rate_hz=25600.0))  # 16 kHz > 0.4 x 25.6 kHz
+    Housing(enabled=False, accelerometer=Accelerometer(sample_rate_hz=25600.0))  # no signal: not checked
+    with pytest.raises(ValidationError, match="window_s"):
+        Housing(enabled=True, sprung_stiffness_n_m=1e5,  # a 50 Hz sensed mode: inside 0.4 x 1 kHz
+                accelerometer=Accelerometer(sample_rate_hz=1000.0, window_s=0.5))  # 500 samples < 1024
     with pytest.raises(ValidationError, match="azimuth_deg"):
         Accelerometer(azimuth_deg=400.0)

@@ -167,7 +167,9 @@ E_SCRATCH_SSAT = 68  # slip at which strip k reaches the limiting shear stress [
 E_SCRATCH_EY = 69    # Eyring force coefficient (1 - Qa/Q) A_k tau0 [N]
 E_SCRATCH_SPREAD = 70  # half the spread of the slip across strip k [m/s]
 E_SCRATCH_SIGNED_HALF = 71  # half-width of strip k in t, signed like ds/dt across it [-]
-N_ROWS = 75
+# local defects (twin.kernels.vibration.apply_defects, only while a defect is active)
+G_DEFECT_DROP = 75  # extra radial clearance a defect opens at the contact, taken off G_DELTA [m]
+N_ROWS = 76
 
 # ---- kernel status codes ----------------------------------------------------------------------
 STATUS_OK = 0
@@ -186,3 +188,18 @@ ANGLE_STEP = ANGLE_MAX_SIN / (ANGLE_POINTS - 1)
 ANGLE_INV_STEP = 1.0 / ANGLE_STEP
 A_STIFFNESS = 0    # Hertz K [N/m^1.5]
 A_TRIBOLOGY = 1    # first of the N_TRIBOLOGY coefficients of twin.kernels.tribology (T_* + 1)
+
+# ---- vibration (issue 14): housing, local defects, accelerometer (twin.vibration) --------------
+# Model vector `vibration_params[V_*]` (twin.model); the housing's own vector is
+# twin.vibration.housing.H_*, a defect row twin.vibration.defects.D_*.
+V_HOUSING_ON = 0            # 1: the outer ring rides on the housing model and the sensor is sampled
+V_DECIMATION_RATIO = 1      # R: DEM steps per accelerometer sample (dt = 1 / (R f_s))
+V_INNER_RACEWAY_RADIUS = 2  # raceway radius at the contact, for the arc length over a spall [m]
+V_OUTER_RACEWAY_RADIUS = 3
+V_INNER_GROOVE_RADIUS = 4   # [m]
+V_OUTER_GROOVE_RADIUS = 5
+V_INNER_RX = 6              # relative radius of curvature along the rolling direction [m]
+V_OUTER_RX = 7
+V_INNER_RY = 8              # across it [m]
+V_OUTER_RY = 9
+N_VIB_PARAMS = 10

@@ -29,6 +29,12 @@ from twin.kernels.layout import (
 )
 from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
+# ---- issue 14 (vibration): housing, local defects, accelerometer; hooks marked "issue 14" below --
+from twin.kernels.layout import V_DECIMATION_RATIO, V_HOUSING_ON
+from twin.kernels.vibration import (apply_defects, has_ball_defect, integrate_orientations,
+                                    outer_ring_force, shift_frame)
+from twin.vibration.housing import housing_accelerations, housing_close, housing_kick_drift
+from twin.vibration.signal import sensor_push_direct
 
 
 # Below this entrainment speed [m/s] the rolling resistance (applied as (F_R / u) times the
@@ -62,7 +68,7 @@ def _at_angle(table, r, i, f, col):
 
 @njit(**JIT)
 def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                          tribology_now, electrical_now, traction_now):
+                          tribology_now, electrical_now, traction_now, bq, defects, vp):
     """Forces and torques of every contact at the current positions -> accelerations of the
     balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
 
@@ -71,7 +77,13 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     loaded contacts when `tribology_now` (or when a contact closes), clear opened contacts.
     The refresh takes each contact's Hertz stiffness (its lane M_STIFFNESS, read by the next
     geometry pass) and film constants at its current contact angle from the model's angle table
-    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|). Returns a status code."""
+    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|). Returns a status code.
+
+    Issue 14: positions and velocities are those relative to the outer ring (`step_n` shifts
+    them with the housing on); the active defect rows (`defects`, twin.vibration.defects D_*
+    layout; none: 0 rows) open their clearance between the geometry and the force pass
+    (`twin.kernels.vibration.apply_defects`; bq the balls' orientation quaternions, vp the model's
+    V_* vector)."""
     z = bx.shape[0]
     nc = 2 * z
     rb = p[P_BALL_RADIUS]
@@ -115,6 +127,8 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             w[K_SPIN * CW + c] = ring_speed if inner else 0.0
             w[K_ORBIT * CW + c] = orbital
     raceway_geometry(w, nc)
+    if defects.shape[0] > 0:  # issue 14: local defects
+        apply_defects(w, nc, defects, bq, scal[X_SHAFT_ANGLE], vp, rb)
     raceway_forces(w, nc, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
     # per contact: outputs, tribology refresh, opened contacts
     max_pen = scal[X_MAX_PENETRATION]
@@ -269,10 +283,20 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
 
 
 @njit(**JIT)
-def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n):
+def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx, hv, ha, bq,
+           dec_state, ring, ring_state, hp, vp, taps, defects, n):
     """Advance n steps of dt (seed 000 eq. 10, velocity-Verlet; velocity-dependent forces use the
     half-step velocity turned on by the cage's half-step rotation). The shaft speed moves towards its setpoint at the ramp rate; the torque
-    the shaft supplies is accumulated for averaging. Returns (status, steps done)."""
+    the shaft supplies is accumulated for averaging. Returns (status, steps done).
+
+    Issue 14 (twin.vibration), skipped with the rigid outer ring and no defect: with
+    vp[V_HOUSING_ON] the outer ring rides on the housing (hx, hv, ha: twin.vibration.housing DOFs,
+    hp its H_* vector), leapfrogged with the balls, the forces evaluated in the outer ring's frame
+    (`shift_frame`) and the outer contacts' reaction driving it; the sensed acceleration goes
+    through the anti-aliasing decimator (`taps`, `dec_state`) into the sample ring (`ring`,
+    `ring_state`) every step (twin.vibration.signal.sensor_push_direct; the engine adds the sensor
+    noise between frames). `defects`: the active defect rows (0 rows: none); the orientation bq of
+    a ball carrying a ball defect is integrated."""
     z = bx.shape[0]
     dt = p[P_DT]
     half = 0.5 * dt
@@ -284,6 +308,9 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
     # kick of the next are one full kick; the state holds full-step velocities between frames
     status = STATUS_OK
     done = 0
+    housing_on = vp[V_HOUSING_ON] != 0.0  # issue 14
+    ratio = int(vp[V_DECIMATION_RATIO])
+    orientations = has_ball_defect(defects)
     for it in range(n):
         kick = half if it == 0 else dt
         for j in range(z):
@@ -294,6 +321,10 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
         for k in range(3):
             rv[k] += kick * ra[k]
             rx[k] += dt * rv[k]
+        if housing_on:  # issue 14
+            housing_kick_drift(hx, hv, ha, kick, dt)
+        if orientations:
+            integrate_orientations(bq, bw, defects, dt)
         scal[X_CAGE_SPEED] += kick * scal[X_CAGE_TORQUE] / cage_inertia
         scal[X_CAGE_ANGLE] += dt * scal[X_CAGE_SPEED]
         dw = sp[S_SHAFT_SPEED] - scal[X_SHAFT_SPEED]
@@ -320,10 +351,20 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
             wx = bw[j, 0]
             bw[j, 0] = ct * wx - st * bw[j, 1]
             bw[j, 1] = st * wx + ct * bw[j, 1]
+        if housing_on:  # issue 14: forces in the outer ring's frame
+            shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
         status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w,
                                        cage_load, step % substeps == 0,
                                        step % (substeps * ELECTRICAL_EVERY) == 0,
-                                       step % (substeps * traction_every) == 0)  # a tribology step
+                                       step % (substeps * traction_every) == 0,  # a tribology step
+                                       bq, defects, vp)
+        if housing_on:  # issue 14: back to the world frame; the housing and the accelerometer
+            shift_frame(bx, bv, rx, rv, hx, hv, 1.0)
+            fx, fy, fz = outer_ring_force(w, z)
+            sensed = housing_accelerations(hp, hx, hv, fx, fy, fz, dt, ha)
+            sensor_push_direct(taps, ratio, dec_state, sensed, ring, ring_state)
+            if not math.isfinite(sensed):
+                status = STATUS_NOT_FINITE
         for j in range(z):
             vx = bv[j, 0]
             bv[j, 0] = ct * vx + st * bv[j, 1]
@@ -342,13 +383,25 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
             bw[j, k] += half * balpha[j, k]
     for k in range(3):
         rv[k] += half * ra[k]
+    if housing_on:  # issue 14
+        housing_close(hv, ha, half)
     scal[X_CAGE_SPEED] += half * scal[X_CAGE_TORQUE] / cage_inertia
     return status, done
 
 
 @njit(**JIT)
-def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load):
-    """Contact forces, tribology and accelerations at the current state without advancing time
-    (used after a warm start). Returns the status."""
-    return compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                                 True, True, True)
+def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx, hv, ha, bq,
+             dec_state, ring, ring_state, hp, vp, taps, defects):
+    """Contact forces, tribology and accelerations (balls, rings and, issue 14, the housing) at
+    the current state without advancing time (used after a warm start). Returns the status. Same
+    arguments as `step_n` but n; the accelerometer is not sampled."""
+    housing_on = vp[V_HOUSING_ON] != 0.0
+    if housing_on:
+        shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
+    status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
+                                   True, True, True, bq, defects, vp)
+    if housing_on:
+        shift_frame(bx, bv, rx, rv, hx, hv, 1.0)
+        fx, fy, fz = outer_ring_force(w, bx.shape[0])
+        housing_accelerations(hp, hx, hv, fx, fy, fz, 0.0, ha)
+    return status

@@ -293,9 +293,9 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
 
     def copies():
         args = [a.copy() for a in s.kernel_args()]
-        return args  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load
+        return args  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, then the housing/sensor arrays
 
-    scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load = copies()
+    scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load = copies()[:11]
     runs = {
         "gather": lambda n: _gather(bx, bv, bw, rx, rv, scal, w, n),
         "geometry": lambda n: _geometry(w, nc, n),
@@ -323,9 +323,10 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
                         + (t2[key] - t1[key]) / (substeps * ELECTRICAL_EVERY) for key in ("best_ns", "median_ns")}
     # the real step on a copy of the state
     st = copies()
+    vib = (m.housing_params, m.vibration_params, m.decimator_taps, s.active_defect_rows.copy())
     n_total = max(1000, reps // 10)
-    step_n(p, tr, sp, *st, 10)
-    best, median = _best_median_ns(lambda n: step_n(p, tr, sp, *st, n), n_total, repeats)
+    step_n(p, tr, sp, *st, *vib, 10)
+    best, median = _best_median_ns(lambda n: step_n(p, tr, sp, *st, *vib, n), n_total, repeats)
     out["total"] = {"best_ns": best, "median_ns": median}
     out["sum_of_passes"] = {key: sum(out[k][key] for k in PASSES) for key in ("best_ns", "median_ns")}
     out["tribology_steps_per_refresh"] = substeps

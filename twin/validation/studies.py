@@ -61,7 +61,7 @@ def sample_at_azimuth_zero(shaft_speed_rad_s: float, radial_load_n: float = 3000
         if best is None or abs(az[j]) < abs(best[0]):
             c = twin.state.contacts
             best = (float(az[j]), c[:, 2 * j].copy(), c[:, 2 * j + 1].copy(),
-                    np.hypot(*twin.state.ring_position_m[:2]))
+                    np.hypot(*twin.state.inner_ring_offset_m[:2]))
     az0, ci, co, shift = best
     eps = 0.5 * (1.0 - clearance_m / (2.0 * shift)) if shift > 0 else float("nan")
     return AzimuthZeroSample(

@@ -173,8 +173,8 @@ def run_case(case: Case, time_step_s: float | str, **options) -> _Run:
             break
         torque_sum += s.scalars[L.X_TORQUE_SUM]
         torque_steps += s.scalars[L.X_TORQUE_COUNT]
-        x = s.ball_position_m
-        v = s.ball_velocity_m_s
+        x = s.ball_position_in_bearing_m
+        v = s.ball_velocity_in_bearing_m_s
         az = np.arctan2(x[:, 1], x[:, 0])
         idx = np.floor((az + math.pi) / (2.0 * math.pi) * b).astype(int) % b
         c = s.contacts

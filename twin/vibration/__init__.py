@@ -14,22 +14,16 @@ Modules, one idea each (SI inside, every public quantity carries its unit):
 - `waveform`: compact binary layout of waveform chunks (documented header).
 - `run`: `run_vibration`, the backend of `bearing-twin vibration`.
 
-Kernel integration (next round; nothing here is called by the engine yet):
+- `sensor`: between frames, the kernel's sample ring -> waveform blocks (`Twin.drain_waveform`)
+  and, every window, the snapshot's `vibration` block.
 
-- model: `housing.housing_params(Housing)` (H_* vector), the decimator's polyphase taps
-  (`signal.design_decimator(1/dt, f_out).phases`, dt snapped by `signal.integer_ratio_time_step`),
-  the noise sigma, one defect row per active defect (`defects.defect_row`, D_* layout; a
-  (n_defects, N_DEFECT_PARAMS) array, rows of KIND_NONE when cleared: no recompilation).
-- state: housing x/v/a (3 x N_HOUSING_DOF), ball quaternions (Z, 4), decimator state, sample ring
-  + its counter; the warm start puts the housing at `housing_equilibrium` under the load.
-- step: kick-drift the housing with the balls (`housing_kick_drift`); gather the outer lanes
-  relative to the outer-ring position hx[0:3] with its velocity hv[0:3] (K_OV* rows, now 0);
-  subtract `contact_defect_drop_m` of every defect row from G_DELTA per lane before G_LOAD
-  (between `raceway_geometry` and the force pass, or inside it); sum the outer contacts' forces
-  on the ring (minus the force on the balls) and call `housing_accelerations`; `quat_integrate`
-  each ball with its (half-step) angular velocity; `signal.sensor_push(phases, dec_state,
-  ha[HR], sigma, ring, ring_state)`; `housing_close` with the balls at the end of a frame.
-- between frames (Python): `signal.read_ring` -> waveform chunks (`waveform.encode_chunk`) and,
-  per window, `run.run_vibration`-style indicators with the loaded contact angle from the lanes
-  (`defect_frequencies.loaded_contact_angle_rad(G_NZ row, C_LOAD row)`).
+In the engine (issue 14): the model holds `housing_params` (H_*), `vibration_params`
+(twin.kernels.layout V_*) and the decimator's reversed taps (the step snapped to dt = 1 / (R f_s));
+the state the housing DOFs, ball quaternions, decimator state, sample ring and up to MAX_DEFECTS
+defect rows; `twin.kernels.step.step_n` leapfrogs the housing with the balls, evaluates the forces
+in the outer ring's frame (`twin.kernels.vibration.shift_frame`), takes the defect drops off the deflections between the geometry and
+the force pass (`twin.kernels.vibration`), drives the housing with the outer contacts' forces,
+integrates the quaternion of a ball carrying a defect, and pushes the sensed acceleration into the
+decimator (`signal.sensor_push_direct`) every step. `Twin.set_defects` / `clear_defects` validate
+and write the rows.
 """

@@ -61,7 +61,16 @@ D_HALF_LENGTH = 7   # half length across it [m]
 D_DEPTH = 8         # [m]
 D_EDGE_RADIUS = 9   # [m], 0 = sharp
 D_CENTRE_NZ = 10    # race spall: axial component of the contact normal at the spall's centre line
-N_DEFECT_PARAMS = 11
+# race spall, for the kernel's quick test of which balls can be over it (twin.kernels.vibration):
+D_REACH_COS = 11    # cos of REACH_MARGIN x (half width + edge radius) / raceway radius (-2: every ball)
+D_CENTRE_COS = 12   # cos, sin of the spall centre's angle (outer: azimuth; inner: on the ring)
+D_CENTRE_SIN = 13
+N_DEFECT_PARAMS = 14
+
+# A race spall is looked at by the kernel only for balls within this factor of its angular reach
+# (half width + edge radius over the raceway radius) of its centre: the drop is zero beyond the
+# reach (`pit_drop_m`); the margin only saves the atan2 / asin of the far lanes.
+REACH_MARGIN = 1.5
 
 KIND_NONE = 0
 KIND_OUTER = 1
@@ -221,6 +230,12 @@ def defect_row(defect, geometry) -> np.ndarray:
     row[D_DEPTH] = defect.depth_m
     row[D_EDGE_RADIUS] = defect.edge_radius_m
     sin_a = math.sin(math.radians(geometry.nominal_contact_angle_deg))
+    if defect.kind in ("outer", "inner"):
+        radius = geometry.outer_raceway_radius_m if defect.kind == "outer" else geometry.inner_raceway_radius_m
+        reach = REACH_MARGIN * (0.5 * defect.width_m + defect.edge_radius_m) / radius
+        row[D_REACH_COS] = math.cos(reach) if reach < 0.5 * math.pi else -2.0
+        angle = math.radians(defect.azimuth_deg if defect.kind == "outer" else defect.ring_angle_deg)
+        row[D_CENTRE_COS], row[D_CENTRE_SIN] = math.cos(angle), math.sin(angle)
     if defect.kind == "outer":
         row[D_KIND] = KIND_OUTER
         row[D_ANGLE] = math.radians(defect.azimuth_deg)

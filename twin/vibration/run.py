@@ -1,8 +1,10 @@
 """`run_vibration`: the backend of `bearing-twin vibration` on a sampled housing acceleration.
 
-Takes the waveform [m/s^2] at its sample rate and the bearing, returns the JSON-ready indicator
-dict (twin.vibration.indicators; defect frequencies from twin.vibration.defect_frequencies). The
-engine wiring (the DEM producing the waveform with the housing and a defect) plugs in front of it.
+`run_vibration` takes the waveform [m/s^2] at its sample rate and the bearing, returns the
+JSON-ready indicator dict (twin.vibration.indicators; defect frequencies from
+twin.vibration.defect_frequencies). `simulate_vibration` produces that waveform with the twin (outer
+ring on the housing, a defect from `defect_for`) and analyses it: the backend of
+`bearing-twin vibration`.
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
     Returns sample_rate_hz, duration_s, window_s, windows, defect_frequencies_hz {ftf, bpfo, bpfi,
     bsf, two_bsf}, contact_angle_deg, envelope_band_hz [low, high], band_method,
     envelope_peaks_hz (the `peak_count` largest: frequency_hz, amplitude [m/s^2]) of the
-    window-averaged envelope spectrum, kurtosis, rms_m_s2, peak_m_s2, crest_factor,
+    window-averaged envelope spectrum, kurtosis, band_kurtosis (in the envelope band), rms_m_s2, peak_m_s2, crest_factor,
     velocity_rms_mm_s (window means; RMS as the root of the mean square), noise_floor_m_s2,
     defect_lines (twin.vibration.indicators.defect_line_amplitudes) and per_window."""
     x = np.asarray(signal_m_s2, dtype=float).ravel()
@@ -79,6 +81,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         seg = x[k * n_win:(k + 1) * n_win]
         row = ind.time_indicators(seg)
         row["velocity_rms_mm_s"] = ind.velocity_rms_mm_s(seg, fs)
+        row["band_kurtosis"] = ind.band_kurtosis(seg, fs, (lo, hi))
         windows.append(row)
         freqs, amp = ind.envelope_spectrum(seg, fs, (lo, hi))
         amp_sum = amp if amp_sum is None else amp_sum + amp
@@ -96,6 +99,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         "band_method": band if isinstance(band, str) else "given",
         "envelope_peaks_hz": ind.envelope_peaks(freqs, amp, peak_count, max_hz=max_hz),
         "kurtosis": mean("kurtosis"),
+        "band_kurtosis": mean("band_kurtosis"),
         "rms_m_s2": math.sqrt(float(np.mean([w["rms_m_s2"] ** 2 for w in windows]))),
         "peak_m_s2": max(w["peak_m_s2"] for w in windows),
         "crest_factor": mean("crest_factor"),
@@ -104,3 +108,83 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         "defect_lines": ind.defect_line_amplitudes(freqs, amp, freq),
         "per_window": windows,
     }
+
+
+# ---- the DEM producing the waveform (`bearing-twin vibration`) -----------------------------------
+DEFAULT_DEFECT_SIZE_M = 0.5e-3     # width along the rolling direction [m]
+DEFAULT_DEFECT_DEPTH_M = 50e-6     # [m]
+DEFAULT_LENGTH_OF_BALL_RADIUS = 0.6  # length across the rolling direction, x the ball radius
+SETTLE_S = 0.05                    # simulated time run and discarded before the analysis [s]
+
+
+def defect_for(kind: str, geometry, size_m: float = DEFAULT_DEFECT_SIZE_M, length_m: float | None = None,
+               depth_m: float = DEFAULT_DEFECT_DEPTH_M) -> dict:
+    """The defect of `bearing-twin vibration --defect KIND --defect-size SIZE`: a pit `size_m`
+    wide along the rolling direction, `length_m` across it (default 0.6 x the ball radius, 3.8 mm
+    on the 6208: across the conforming groove the ball only drops into a pit about as long as its
+    contact ellipse; a shorter one is bridged), `depth_m` deep, sharp edges; outer spall at azimuth
+    0 (the centre of the load zone), inner spall at the ring's reference mark, ball defect on ball
+    0's equator (body +x). Plain data for `Twin.set_defects` (validated there)."""
+    if kind not in ("outer", "inner", "ball"):
+        raise ValueError(f"defect = {kind!r}: one of 'outer', 'inner', 'ball'")
+    length = DEFAULT_LENGTH_OF_BALL_RADIUS * geometry.ball_radius_m if length_m is None else length_m
+    return {"kind": kind, "width_m": size_m, "length_m": length, "depth_m": depth_m}
+
+
+def simulate_vibration(bearing="6208", shaft_speed_rad_s: float = 500.0, radial_load_n: float = 3000.0,
+                       axial_load_n: float = 0.0, *, defect: str | None = None,
+                       defect_size_m: float = DEFAULT_DEFECT_SIZE_M, defect_length_m: float | None = None,
+                       defect_depth_m: float = DEFAULT_DEFECT_DEPTH_M, duration_s: float = 1.0,
+                       settle_s: float = SETTLE_S, noise_density_m_s2_rthz: float | None = None,
+                       sample_rate_hz: float | None = None, window_s: float | None = None,
+                       band: str | tuple[float, float] = "resonance") -> tuple[dict, np.ndarray]:
+    """Run the twin with its housing on (and a defect, `defect_for`) and analyse the accelerometer:
+    `settle_s` of simulated time is discarded, then `duration_s` is sampled (in-kernel decimator)
+    and passed to `run_vibration` with the loaded contact angle of the contacts at the end.
+
+    bearing: designation or `BearingSpec` (its housing is switched on; noise density, sample rate
+    and window override the spec's accelerometer when given). Returns (the `run_vibration` dict
+    plus bearing, loads, speed, defect, time_step_s, status; the samples [m/s^2], float64).
+    Raises pydantic.ValidationError / SetpointError / ValueError naming the field and its range."""
+    from twin import catalog
+    from twin.engine import Twin
+    from twin.kernels import layout as L
+    from twin.setpoint import Setpoint
+    from twin.spec import BearingSpec
+    from twin.vibration.sensor import contact_angle_of_lanes_rad
+
+    if not (math.isfinite(duration_s) and duration_s > 0.0):
+        raise ValueError(f"duration_s = {duration_s!r}: must be positive")
+    if not (math.isfinite(settle_s) and settle_s >= 0.0):
+        raise ValueError(f"settle_s = {settle_s!r}: must be >= 0")
+    spec = bearing if isinstance(bearing, BearingSpec) else catalog.bearing(str(bearing))
+    data = spec.model_dump()
+    acc = data["housing"]["accelerometer"]
+    data["housing"]["enabled"] = True
+    for key, value in (("noise_density_m_s2_rthz", noise_density_m_s2_rthz), ("sample_rate_hz", sample_rate_hz),
+                       ("window_s", window_s)):
+        if value is not None:
+            acc[key] = value
+    spec = BearingSpec.model_validate(data)
+    twin = Twin(spec, setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n,
+                                        axial_load_n=axial_load_n))
+    if defect is not None:
+        twin.set_defects([defect_for(defect, spec.geometry, defect_size_m, defect_length_m, defect_depth_m)])
+    twin.advance(settle_s)
+    twin.drain_waveform()
+    twin.advance(duration_s)
+    blocks = twin.drain_waveform()
+    x = np.concatenate([b.samples for b in blocks]).astype(float) if blocks else np.zeros(0)
+    angle = contact_angle_of_lanes_rad(twin.model, twin.state)
+    result = run_vibration(x, twin.model.sample_rate_hz, spec, float(twin.state.scalars[L.X_SHAFT_SPEED]),
+                           contact_angle_rad=angle, housing=spec.housing,
+                           window_s=spec.housing.accelerometer.window_s, band=band)
+    result.update({
+        "bearing": spec.designation, "shaft_speed_rad_s": float(twin.state.scalars[L.X_SHAFT_SPEED]),
+        "radial_load_n": radial_load_n, "axial_load_n": axial_load_n,
+        "defect": twin.defects[0].model_dump() if twin.defects else None,
+        "time_step_s": twin.model.dt_s, "decimation_ratio": twin.model.decimator.ratio,
+        "noise_density_m_s2_rthz": spec.housing.accelerometer.noise_density_m_s2_rthz,
+        "status": twin.status,
+    })
+    return result, x
