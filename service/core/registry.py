@@ -178,7 +178,8 @@ class TwinRegistry:
             self._open_outputs()
             if default_twin and self.settings.start_twin:
                 self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing,
-                                 over_capacity_ok=True)
+                                 over_capacity_ok=True,
+                                 **({"housing": {"enabled": True}} if self.settings.housing else {}))
         except BaseException:
             self.close()
             raise

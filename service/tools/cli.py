@@ -205,6 +205,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "0.0.0.0 exposes the API on every interface) [BEARING_TWIN_HOST]")
     serve.add_argument("--port", type=int, help="HTTP port (default 8000) [BEARING_TWIN_PORT]")
     serve.add_argument("--bearing", help="designation of the `default` twin (default 6208) [BEARING_TWIN_BEARING]")
+    serve.add_argument("--housing", action="store_true", default=None,
+                       help="the `default` twin runs on the housing support with the accelerometer "
+                       "(vibration; default off) [BEARING_TWIN_HOUSING]")
     serve.add_argument("--twin-id", metavar="ID",
                        help="name of the twin started with the service (default `default`; give "
                        "each service on one zenoh network its own) [BEARING_TWIN_TWIN_ID]")
@@ -367,7 +370,7 @@ def _serve_settings(args: argparse.Namespace):
     from service.settings import ServiceSettings
 
     overrides = {}
-    for flag, name in (("host", "host"), ("port", "port"), ("bearing", "bearing"), ("twin_id", "twin_id"),
+    for flag, name in (("host", "host"), ("port", "port"), ("bearing", "bearing"), ("housing", "housing"), ("twin_id", "twin_id"),
                        ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
                        ("zenoh_mode", "zenoh_mode"), ("zenoh_prefix", "zenoh_prefix"), ("record", "record"),
                        ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),

@@ -267,3 +267,18 @@ def test_a_scenario_step_injects_and_clears_defects(service, support):
     assert all(x["setpoint"]["radial_load_n"] == 4000.0 for x in two[1:])   # the set of the same step
     assert http.get("/v1/bearings/vib/defects").json()["defects"] == []
     http.put("/v1/bearings/vib/setpoint", json={"radial_load_n": 3000.0}).raise_for_status()
+
+
+def test_serve_housing_puts_the_default_twin_on_the_housing():
+    from service.core.registry import TwinRegistry
+    from service.tools.cli import _serve_settings, build_parser
+
+    settings = _serve_settings(build_parser().parse_args(["serve", "--housing", "--no-zenoh", "--no-record", "--fast"]))
+    assert settings.housing is True
+    assert _serve_settings(build_parser().parse_args(["serve", "--no-zenoh"])).housing is False
+    registry = TwinRegistry(settings).open()
+    try:
+        entry = registry.get("default")
+        assert entry.twin.model.housing_on is True
+    finally:
+        registry.close()
