@@ -19,7 +19,6 @@ import pyarrow as pa
 import rerun as rr
 
 from service.recording.layout import (
-    VIB_LINES,
     ALARM_LOG_LEVEL,
     ALARM_STATES,
     CONTACT_SERIES,
@@ -30,6 +29,7 @@ from service.recording.layout import (
     SEQ,
     SIDES,
     SIM_TIME,
+    VIB_LINES,
     TwinLayout,
 )
 
