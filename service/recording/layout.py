@@ -87,6 +87,7 @@ _PITCH_RGB = (90, 90, 100)
 RISK_VALUES = ("none", "possible", "likely")
 RISK_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
 VIB_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")          # VibrationState.defect_frequencies_hz keys
+ENVELOPE_BAR_HZ = 12.0            # bar width of the envelope charts [Hz] (visible on a 0-2 kHz axis)
 VIB_LINE_LABELS = ("FTF", "BPFO", "BPFI", "BSF", "2 x BSF")
 VIB_LINE_RGB = ((150, 150, 150), (230, 60, 60), (80, 160, 255), (0, 200, 120), (255, 170, 0))
 VIBRATION_SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
@@ -216,10 +217,11 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
     if tw.vibration:
         for leaf, (names, colors) in VIBRATION_SERIES.items():
             s.log(f"{root}/{leaf}", rr.SeriesLines(names=list(names), colors=list(colors)), static=True)
-        s.log(f"{root}/vibration/envelope/peaks", [rr.components.ColorBatch([(80, 160, 255)]).described(
-            rr.BarChart.descriptor_color())], static=True)
-        s.log(f"{root}/vibration/envelope/defect_lines", [rr.components.ColorBatch([(230, 60, 60)]).described(
-            rr.BarChart.descriptor_color())], static=True)
+        for leaf, rgb in (("peaks", (80, 160, 255)), ("defect_lines", (230, 60, 60))):
+            s.log(f"{root}/vibration/envelope/{leaf}", [
+                rr.components.ColorBatch([rgb]).described(rr.BarChart.descriptor_color()),
+                rr.components.LengthBatch(np.full(len(VIB_LINES), ENVELOPE_BAR_HZ, dtype=np.float32)).described(
+                    rr.BarChart.descriptor_widths())], static=True)
     for alarm_id in ALARM_IDS:
         s.log(f"{root}/alarm_states/{alarm_id}",
               rr.StateConfiguration(values=list(ALARM_STATES), labels=[f"{alarm_id} {v}" for v in ALARM_STATES],
