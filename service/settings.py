@@ -341,6 +341,10 @@ class ServiceSettings(ZenohAccessSettings):
                       description="HTTP port [TCP port number, 0 = any free port].")
     bearing: str = Field(default="6208",
                          description="Catalog designation of the twin started with the service [designation, e.g. 6208].")
+    housing: bool = Field(default=False,
+                          description="The twin started with the service has its outer ring on the housing "
+                          "support with the accelerometer (issue 14: vibration indicators, waveform, defects "
+                          "show in the signal) [bool]; other twins choose with POST /v1/bearings `housing`.")
     twin_id: str = Field(default="default", pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$",
                          description="Name of the twin started with the service [text]; give each "
                          "service on one zenoh network its own (keys are bearing/{id}/...).")

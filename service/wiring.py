@@ -2,7 +2,8 @@
 rerun recorders and the OPC UA facade opened from the settings. This is the ONE module that
 touches `service.bus`, `service.recording` and `service.opcua` for the service (imported lazily,
 so a service with zenoh, recording or OPC UA off never imports them). The alarm hub of the
-registry hands its events to the bus (registry), the recorder and the OPC UA facade (here).
+registry hands its events to the bus (registry), the service-wide recording and each twin's own
+recording, and the OPC UA facade (here).
 
 Every recorder of the service makes its rerun streams through one `RerunStreams` owned by the
 `TwinService` (`rerun_streams()`): a per-twin recording gets a new recorder (its own recording
@@ -135,11 +136,19 @@ class TwinService(TwinRegistry):
         self.bus = open_bus(self.settings)
         if self.settings.recording_path is not None or self.settings.spawn_viewer:
             self.recorder = open_recorder(self.settings, self.rerun_streams())
-        if self.recorder is not None and hasattr(self.recorder, "log_alarm"):
+        if self.recorder is not None:
             self.alarms.subscribe(self.recorder.log_alarm)     # alarm events into the recording
+        self.alarms.subscribe(self._alarm_to_twin_recording)
         self.opcua = open_opcua(self.settings, self)
         if self.opcua is not None:
             self.alarms.subscribe(self.opcua.on_alarm)
+
+    def _alarm_to_twin_recording(self, event) -> None:
+        """An alarm event into the twin's own recording, if it has one (POST .../recording)."""
+        entry = self.find(event.bearing_id)
+        rec = entry.recording if entry is not None else None
+        if rec is not None:
+            rec.log_alarm(event)
 
     def _close_outputs(self) -> None:
         if self.opcua is not None:

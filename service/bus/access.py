@@ -16,10 +16,11 @@ control"):
   ========  ==================================================================================
   role      may (keys under the prefix P, one twin id `*`)
   ========  ==================================================================================
-  readers   subscribe to P/*/state, P/*/ball/*, P/*/setpoint/result; query P/*/snapshot and
+  readers   subscribe to P/*/state, P/*/ball/*, P/*/setpoint/result, P/*/defects/result,
+            P/*/alarm, P/*/vibration, P/*/vibration/waveform; query P/*/snapshot and
             P/*/owner; watch and query the liveliness tokens P/*/alive
-  writers   what readers may, and put P/*/setpoint
-  services  put P/*/state, P/*/ball/*, P/*/setpoint/result; subscribe to P/*/setpoint; declare
+  writers   what readers may, and put P/*/setpoint and P/*/defects
+  services  put what readers subscribe to; subscribe to P/*/setpoint, P/*/defects; declare
             and answer the queryables P/*/snapshot and P/*/owner; declare the liveliness tokens
             P/*/alive; query P/*/owner and the liveliness of P/*/alive (the id clash check)
   ========  ==================================================================================
@@ -54,29 +55,31 @@ from pathlib import Path
 from typing import Any
 
 # what each role may do: (messages, flow, key suffixes under P/*)
+# what a twin publishes (besides its state): results, alarm events, vibration (issue 14, 15)
+_OUT = ["state", "ball/*", "setpoint/result", "defects/result", "alarm", "vibration", "vibration/waveform"]
 _READ_IN = [
-    (["declare_subscriber"], "ingress", ["state", "ball/*", "setpoint/result"]),
+    (["declare_subscriber"], "ingress", _OUT),
     (["query"], "ingress", ["snapshot", "owner"]),
     (["declare_liveliness_subscriber", "liveliness_query"], "ingress", ["alive"]),
 ]
 _READ_OUT = [
-    (["put"], "egress", ["state", "ball/*", "setpoint/result"]),
+    (["put"], "egress", _OUT),
     (["declare_queryable", "reply"], "egress", ["snapshot", "owner"]),
     (["liveliness_token"], "egress", ["alive"]),
 ]
 _WRITE = [
-    (["put"], "ingress", ["setpoint"]),
-    (["declare_subscriber"], "egress", ["setpoint"]),
+    (["put"], "ingress", ["setpoint", "defects"]),
+    (["declare_subscriber"], "egress", ["setpoint", "defects"]),
 ]
 _SERVICE = [
-    (["put"], "ingress", ["state", "ball/*", "setpoint/result"]),
-    (["declare_subscriber"], "ingress", ["setpoint"]),
+    (["put"], "ingress", _OUT),
+    (["declare_subscriber"], "ingress", ["setpoint", "defects"]),
     (["declare_queryable", "reply"], "ingress", ["snapshot", "owner"]),
     (["liveliness_token"], "ingress", ["alive"]),
     (["query"], "ingress", ["owner"]),
     (["liveliness_query"], "ingress", ["alive"]),
-    (["put"], "egress", ["setpoint"]),
-    (["declare_subscriber"], "egress", ["state", "ball/*", "setpoint/result"]),
+    (["put"], "egress", ["setpoint", "defects"]),
+    (["declare_subscriber"], "egress", _OUT),
     (["query"], "egress", ["snapshot", "owner"]),
     (["declare_queryable", "reply"], "egress", ["owner"]),
     (["declare_liveliness_subscriber", "liveliness_query", "liveliness_token"], "egress", ["alive"]),

@@ -16,6 +16,16 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
     P/{id}/owner             queryable: which process runs the twin (pid, host, zenoh id, HTTP)
     P/{id}/alarm             alarm events JSON, schema "bearing-twin/alarm/1" (publisher;
                              service.core.alarms, handed over by the alarm hub)
+    P/{id}/defects           local defects JSON in (subscriber; issue 14): {"defects": [...]}
+                             or the list, [] clears (service.core.defects); same rules as a setpoint
+    P/{id}/defects/result    what became of each defects message, like setpoint/result
+    P/{id}/vibration         the vibration indicators of each new accelerometer window, JSON,
+                             schema "bearing-twin/vibration/1": bearing_id, seq and time_s of the
+                             snapshot, the active defects, and every field of the snapshot's
+                             `vibration` block (twin.snapshot.VibrationState)
+    P/{id}/vibration/waveform  accelerometer samples, binary (twin.vibration.waveform: header
+                             "BTWF" v1, float32 little-endian m/s^2; one chunk per block the twin
+                             produced, its own chunk seq), not JSON numbers
     P/{id}/alive             liveliness token while the twin is attached
 
 One id per prefix in the whole zenoh network: `attach_twin` first asks for the liveliness token
@@ -85,6 +95,16 @@ DEFAULT_PREFIX = "bearing"
 DEFAULT_QUEUE_SIZE = 64
 _CONTROL_QUEUE_SIZE = 256
 _JSON = "application/json"
+VIBRATION_SCHEMA = "bearing-twin/vibration/1"
+
+
+class _Waveform:
+    """Accelerometer blocks queued with the snapshots (publisher thread)."""
+
+    __slots__ = ("blocks",)
+
+    def __init__(self, blocks: list):
+        self.blocks = blocks
 _ID_RE = re.compile(r"^[A-Za-z0-9_.:+=,;~@%-]+$")  # one key-expression chunk, no wildcards/slashes
 
 
@@ -185,7 +205,7 @@ class TwinChannel:
 
     def __init__(self, bus: ZenohBus, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
                  on_setpoint: Callable[[bytes], dict], *, queue_size: int = DEFAULT_QUEUE_SIZE,
-                 flush_timeout_s: float = 2.0):
+                 flush_timeout_s: float = 2.0, on_defects: Callable[[bytes], dict] | None = None):
         if queue_size < 1:
             raise ValueError("queue_size must be >= 1")
         self.bus = bus
@@ -193,6 +213,7 @@ class TwinChannel:
         self.prefix = f"{bus.prefix}/{bearing_id}"   # the twin's key: P/{id}
         self._get_snapshot = get_snapshot
         self._on_setpoint = on_setpoint
+        self._on_defects = on_defects
         self._flush_timeout_s = flush_timeout_s
         session = bus.session
 
@@ -220,6 +241,10 @@ class TwinChannel:
 
         self._ball_publishers: dict[int, zenoh.Publisher] = {}
         self._alarm_pub: zenoh.Publisher | None = None   # declared with the first alarm
+        self._vibration_pub: zenoh.Publisher | None = None   # declared with the first window
+        self._waveform_pub: zenoh.Publisher | None = None    # declared with the first samples
+        self._last_window_end_s: float | None = None
+        self.waveform_chunks = 0    # waveform chunks put on the bus
         self._pub_lock = threading.Lock()
         self._state_pub = session.declare_publisher(
             f"{self.prefix}/state", encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP)
@@ -227,6 +252,11 @@ class TwinChannel:
             f"{self.prefix}/setpoint/result", encoding=_JSON,
             congestion_control=zenoh.CongestionControl.DROP)
         self._setpoint_sub = session.declare_subscriber(f"{self.prefix}/setpoint", self._on_setpoint_sample)
+        self._defects_sub = self._defects_result_pub = None
+        if on_defects is not None:
+            self._defects_result_pub = session.declare_publisher(
+                f"{self.prefix}/defects/result", encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP)
+            self._defects_sub = session.declare_subscriber(f"{self.prefix}/defects", self._on_defects_sample)
         self._queryable = session.declare_queryable(f"{self.prefix}/snapshot", self._on_query)
         self._owner_queryable = session.declare_queryable(f"{self.prefix}/owner", self._on_owner_query)
         self._token = session.liveliness().declare_token(f"{self.prefix}/alive")
@@ -263,6 +293,20 @@ class TwinChannel:
         except Exception:  # noqa: BLE001, S110 - a sink never raises into the physics
             pass
 
+    def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
+        """Queue accelerometer blocks (twin.vibration.sensor.WaveformBlock) for
+        `P/{id}/vibration/waveform`; returns at once, never raises (same queue as the snapshots)."""
+        try:
+            with self._cond:
+                if self._stopping:
+                    return
+                if len(self._queue) == self._queue.maxlen:
+                    self._dropped += 1
+                self._queue.append(_Waveform(list(blocks)))
+                self._cond.notify()
+        except Exception:  # noqa: BLE001, S110 - a sink never raises into the physics
+            pass
+
     def close(self) -> None:
         """Same as `detach`."""
         self.detach()
@@ -275,8 +319,9 @@ class TwinChannel:
             if self._closed:
                 return
             self._closed = True
-        for entity in (self._token, self._setpoint_sub, self._queryable, self._owner_queryable):
-            self._undeclare(entity)
+        for entity in (self._token, self._setpoint_sub, self._defects_sub, self._queryable, self._owner_queryable):
+            if entity is not None:
+                self._undeclare(entity)
         with self._control_cond:
             self._control.append(None)
             self._control_cond.notify()
@@ -289,8 +334,8 @@ class TwinChannel:
         with self._pub_lock:
             self._publishers_gone = True
             publishers = [self._state_pub, self._result_pub, *self._ball_publishers.values()]
-            if self._alarm_pub is not None:
-                publishers.append(self._alarm_pub)
+            publishers += [p for p in (self._alarm_pub, self._defects_result_pub, self._vibration_pub,
+                                       self._waveform_pub) if p is not None]
             self._ball_publishers.clear()
         for pub in publishers:
             self._undeclare(pub)
@@ -313,6 +358,9 @@ class TwinChannel:
                     return  # stopping and drained
                 snapshot = self._queue.popleft()
             try:
+                if isinstance(snapshot, _Waveform):
+                    self._send_waveform(snapshot.blocks)
+                    continue
                 self._send(snapshot)
                 self.published += 1
             except Exception as exc:  # noqa: BLE001 - nothing kills the publisher
@@ -336,6 +384,44 @@ class TwinChannel:
             if pub is None:
                 return  # detaching
             pub.put(_dumps({**head, **ball}))
+        self._send_vibration(snapshot, data)
+
+    def _send_vibration(self, snapshot: Snapshot, data: dict) -> None:
+        """`P/{id}/vibration` when the snapshot carries a new accelerometer window."""
+        vib = data.get("vibration")
+        if not vib:
+            return
+        end = vib.get("window_end_s")
+        if end == self._last_window_end_s:
+            return
+        self._last_window_end_s = end
+        pub = self._lazy_publisher("_vibration_pub", "vibration", _JSON)
+        if pub is not None:
+            pub.put(_dumps({"schema": VIBRATION_SCHEMA, "bearing_id": self.bearing_id, "seq": data.get("seq"),
+                            "time_s": data.get("time_s"), "defects": data.get("defects") or [], **vib}))
+
+    def _send_waveform(self, blocks: list) -> None:
+        """One binary chunk per block on `P/{id}/vibration/waveform` (twin.vibration.waveform)."""
+        from twin.vibration.waveform import encode_chunk
+
+        pub = self._lazy_publisher("_waveform_pub", "vibration/waveform", "application/octet-stream")
+        if pub is None:
+            return
+        for block in blocks:
+            if len(block.samples) == 0:
+                continue
+            pub.put(encode_chunk(self.bearing_id, self.waveform_chunks, block.t0_s, block.sample_rate_hz,
+                                 block.samples))
+            self.waveform_chunks += 1
+
+    def _lazy_publisher(self, attr: str, suffix: str, encoding: str) -> zenoh.Publisher | None:
+        with self._pub_lock:
+            pub = getattr(self, attr)
+            if pub is None and not self._publishers_gone:
+                pub = self.bus.session.declare_publisher(f"{self.prefix}/{suffix}", encoding=encoding,
+                                                         congestion_control=zenoh.CongestionControl.DROP)
+                setattr(self, attr, pub)
+            return pub
 
     def _ball_publisher(self, index: int) -> zenoh.Publisher | None:
         with self._pub_lock:
@@ -366,6 +452,13 @@ class TwinChannel:
             payload = b""
         self._enqueue_control(("setpoint", payload))
 
+    def _on_defects_sample(self, sample: zenoh.Sample) -> None:
+        try:
+            payload = sample.payload.to_bytes()
+        except Exception:  # noqa: BLE001
+            payload = b""
+        self._enqueue_control(("defects", payload))
+
     def _on_query(self, query: zenoh.Query) -> None:
         self._enqueue_control(("query", query))
 
@@ -389,6 +482,14 @@ class TwinChannel:
                         self._busy_marked = 1
                         self._control.append(("busy", None))
                         self._control_cond.notify()
+                elif item[0] == "defects":           # rare: refused at once on its result key
+                    self.setpoints_refused_busy += 1
+                    if not self._publishers_gone and self._defects_result_pub is not None:
+                        with contextlib.suppress(Exception):
+                            self._defects_result_pub.put(_dumps({
+                                "accepted": False, "status": 429, "retry_after_s": 0.1,
+                                "error": f"too many messages waiting for twin {self.bearing_id!r}: refused, retry",
+                                "bearing_id": self.bearing_id}))
                 else:
                     self._finish_query(item, error="busy: too many requests waiting, retry")
                 return
@@ -424,6 +525,8 @@ class TwinChannel:
                     self._refuse_busy()
                 elif kind == "setpoint":
                     self._handle_setpoint(value)
+                elif kind == "defects":
+                    self._handle_write(value, self._on_defects, self._defects_result_pub)
                 elif kind == "owner":
                     self._handle_owner_query(value)
                 else:
@@ -433,17 +536,21 @@ class TwinChannel:
 
     def _handle_setpoint(self, payload: bytes) -> None:
         self.setpoints_received += 1
+        self._handle_write(payload, self._on_setpoint, self._result_pub)
+
+    def _handle_write(self, payload: bytes, handler: Callable[[bytes], dict] | None, result_pub) -> None:
+        """Call the intake, publish what became of the message on its result key."""
         try:
-            result = self._on_setpoint(payload)
+            result = handler(payload)
             if not isinstance(result, dict):
-                raise TypeError(f"setpoint handler returned {type(result).__name__}, not a dict")
+                raise TypeError(f"handler returned {type(result).__name__}, not a dict")
             result = dict(result)
             result.setdefault("accepted", False)
             text = _dumps({**result, "bearing_id": self.bearing_id})
         except Exception as exc:  # noqa: BLE001 - every failure is a refusal
             text = _dumps({"accepted": False, "error": _one_line(exc), "bearing_id": self.bearing_id})
-        if not self._publishers_gone:
-            self._result_pub.put(text)
+        if not self._publishers_gone and result_pub is not None:
+            result_pub.put(text)
 
     def _refuse_busy(self) -> None:
         """Publish one 429 refusal for each setpoint that found the control queue full."""
@@ -560,7 +667,8 @@ class ZenohBus:
 
     def attach_twin(self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
                     on_setpoint: Callable[[bytes], dict], *,
-                    queue_size: int = DEFAULT_QUEUE_SIZE) -> TwinChannel:
+                    queue_size: int = DEFAULT_QUEUE_SIZE,
+                    on_defects: Callable[[bytes], dict] | None = None) -> TwinChannel:
         """Declare the twin's publishers, setpoint subscriber, snapshot and owner queryables and
         liveliness token; return its channel (a SnapshotSink: hand it to the runner).
 
@@ -579,7 +687,8 @@ class ZenohBus:
             key = f"{self.prefix}/{bearing_id}"
             if self._alive_elsewhere(key):
                 raise self._taken(bearing_id, self._owners(key))
-            channel = TwinChannel(self, bearing_id, get_snapshot, on_setpoint, queue_size=queue_size)
+            channel = TwinChannel(self, bearing_id, get_snapshot, on_setpoint, queue_size=queue_size,
+                                  on_defects=on_defects)
             others = [o for o in self._owners(key) if o.get("zid") != self.zid]
             if others:                      # claimed at the same moment elsewhere: withdraw
                 channel.detach()

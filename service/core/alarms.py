@@ -8,7 +8,7 @@ they are absent.
 The alarms (ids are stable; README "Alarms"):
 
 * `vibration_zone` - ISO 20816-3:2022 evaluation zones from the broadband velocity RMS
-  [mm/s] (10-1000 Hz, twin.vibration.indicators.velocity_rms_mm_s). Zone boundaries of Annex A,
+  [mm/s] (10-1000 Hz, snapshot `vibration.velocity_rms_mm_s`, twin.vibration.indicators). Zone boundaries of Annex A,
   Table A.1 (group 1: large machines, 300 kW to 50 MW) and Table A.2 (group 2: medium machines,
   15 kW to 300 kW), rigid / flexible support (clause 4.4). Zone C ("unsatisfactory for long-term
   continuous operation") raises a warning, zone D ("severe enough to cause damage") a critical
@@ -23,10 +23,12 @@ The alarms (ids are stable; README "Alarms"):
 * `electrical_discharge` - snapshot `electrical.discharge_risk`: 'possible' warning, 'likely'
   critical (the value is 0 / 1 / 2 for none / possible / likely; the message quotes the
   engine's reason).
-* `defect_ftf`, `defect_bpfo`, `defect_bpfi`, `defect_bsf` - envelope-spectrum amplitude at the
-  fundamental of a defect frequency [m/s^2] above `defect_amplitude_m_s2` and above
-  `defect_significance` x the envelope noise floor when the floor is known (Randall & Antoni 2011
-  sec. 3.3; twin.vibration.indicators.SIGNIFICANCE).
+* `defect_ftf`, `defect_bpfo`, `defect_bpfi`, `defect_bsf`, `defect_two_bsf` - envelope-spectrum
+  amplitude at the fundamental of a defect frequency [m/s^2] (snapshot
+  `vibration.envelope_lines[name].harmonics[0]`; 2 x BSF is the rate at which a ball defect
+  strikes the races) above `defect_amplitude_m_s2` and above `defect_significance` x the
+  envelope noise floor (`vibration.envelope_noise_floor_m_s2`) when the floor is known (Randall
+  & Antoni 2011 sec. 3.3; twin.vibration.indicators.SIGNIFICANCE).
 * `life_used` - Palmgren-Miner damage fraction (snapshot `life.damage_fraction`) above
   `life_used_warning` (warning) and `life_used_critical` (critical).
 
@@ -76,12 +78,17 @@ ISO_20816_3_ZONES: Mapping[tuple[int, str], tuple[float, float, float]] = {
     (2, "flexible"): (2.3, 4.5, 7.1),
 }
 
-DEFECT_LINES = ("ftf", "bpfo", "bpfi", "bsf")
+DEFECT_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")   # keys of VibrationState.envelope_lines
 _TIME_EPS_S = 1e-9   # a delay of 0.2 s is over at t = 0.3 after 0.1 (0.3 - 0.1 = 0.19999999999999998)
 DISCHARGE_LEVELS = {"none": 0.0, "possible": 1.0, "likely": 2.0}
 
 ALARM_IDS: tuple[str, ...] = ("vibration_zone", "lubrication_kappa", "lubrication_boundary",
                               "electrical_discharge", *(f"defect_{n}" for n in DEFECT_LINES), "life_used")
+
+
+def _line_name(name: str) -> str:
+    """'BPFO', ..., '2 x BSF' for the envelope line keys."""
+    return "2 x BSF" if name == "two_bsf" else name.upper()
 
 
 def zone_boundaries(machine_group: int, support: str) -> tuple[float, float, float]:
@@ -116,6 +123,7 @@ class AlarmInputs:
     """One twin at one instant, as the alarms see it (SI unless the name says otherwise)."""
 
     time_s: float                                     # simulated time [s]
+    seq: int | None = None                            # the snapshot's seq (None: not from a snapshot)
     min_loaded_lambda: float | None = None            # smallest Lambda over the loaded contacts [-]
     boundary_contacts: int = 0                        # loaded contacts with Lambda <= boundary_lambda
     kappa: float | None = None                        # ISO 281 viscosity ratio [-]
@@ -144,41 +152,34 @@ def _finite(value: Any) -> float | None:
 
 
 def _line_amplitude(entry: Any) -> float | None:
-    """A defect line's fundamental amplitude from a number, {'amplitude_m_s2': a}, or the
-    {'harmonics': [a1, a2, ...]} entries of twin.vibration.indicators.defect_line_amplitudes."""
-    direct = _finite(entry)
-    if direct is not None:
-        return direct
+    """A defect line's fundamental amplitude [m/s^2]: `harmonics[0]` of a
+    twin.snapshot.DefectLine (or its dict)."""
     harmonics = _get(entry, "harmonics")
     if isinstance(harmonics, (list, tuple)) and harmonics:
         return _finite(harmonics[0])
-    return _finite(_get(entry, "amplitude_m_s2", "amplitude"))
+    return None
 
 
 def vibration_inputs(block: Any) -> VibrationInputs | None:
-    """`VibrationInputs` from a snapshot's vibration block (a model or a dict): velocity RMS
-    from `velocity_rms_mm_s`; defect lines from `defect_lines` / `envelope_lines` / `lines`
-    ({name: amplitude or indicator entry}) or fields `<name>_m_s2`; the floor from
-    `noise_floor_m_s2` / `envelope_noise_floor_m_s2`. None without a block."""
+    """`VibrationInputs` from a snapshot's `vibration` block (twin.snapshot.VibrationState, or
+    its dict): `velocity_rms_mm_s`, the fundamentals of `envelope_lines` {ftf, bpfo, bpfi, bsf,
+    two_bsf: DefectLine}, `envelope_noise_floor_m_s2`. None without a block."""
     if block is None:
         return None
     lines: dict[str, float] = {}
-    table = _get(block, "defect_lines", "envelope_lines", "lines")
-    if table is not None:
-        items = table.items() if isinstance(table, Mapping) else (
-            (k, getattr(table, k, None)) for k in DEFECT_LINES)
-        for name, entry in items:
+    table = _get(block, "envelope_lines")
+    if isinstance(table, Mapping):
+        for name, entry in table.items():
             a = _line_amplitude(entry)
-            if a is not None:
+            if a is not None and name in DEFECT_LINES:
                 lines[str(name)] = a
-    for name in DEFECT_LINES:
-        if name not in lines:
-            a = _finite(_get(block, f"{name}_m_s2", f"envelope_{name}_m_s2"))
-            if a is not None:
-                lines[name] = a
     return VibrationInputs(velocity_rms_mm_s=_finite(_get(block, "velocity_rms_mm_s")),
                            line_amplitudes_m_s2=lines,
-                           noise_floor_m_s2=_finite(_get(block, "noise_floor_m_s2", "envelope_noise_floor_m_s2")))
+                           noise_floor_m_s2=_finite(_get(block, "envelope_noise_floor_m_s2")))
+
+
+def _seq(value: Any) -> int | None:
+    return int(value) if isinstance(value, int) and not isinstance(value, bool) else None
 
 
 def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -> AlarmInputs:
@@ -209,6 +210,7 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
     life = _get(snapshot, "life")
     return AlarmInputs(
         time_s=float(_get(snapshot, "time_s") or 0.0),
+        seq=_seq(_get(snapshot, "seq")),
         min_loaded_lambda=min_lambda, boundary_contacts=boundary,
         kappa=_finite(_get(life, "kappa")),
         discharge_risk=_get(electrical, "discharge_risk"),
@@ -262,6 +264,8 @@ class AlarmEvent(BaseModel):
     opcua_severity: int = Field(description="OPC UA event severity 1..1000 (warning 500, critical 800, cleared 100) [-].")
     since_s: float | None = Field(description="Simulated time the alarm was raised; null when cleared [s].")
     time_s: float = Field(description="Simulated time of this event [s].")
+    snapshot_seq: int | None = Field(default=None, description="seq of the snapshot that caused the event; null when "
+                                     "the inputs came from elsewhere [-].")
     wall_time_s: float = Field(description="Wall-clock time of this event, seconds since the Unix epoch [s].")
     value: float = Field(description="The watched value at the event [unit].")
     threshold: float = Field(description="Raise threshold of the level concerned [unit].")
@@ -409,7 +413,7 @@ class AlarmEvaluator:
                  "electrical discharge risk: possible (warning), likely (critical); value 0/1/2 = "
                  "none/possible/likely"),
             *(Rule(f"defect_{n}", "defect", "m/s^2", "above", s.defect_delay_s, hold,
-                   f"envelope amplitude at {n.upper()} above {s.defect_amplitude_m_s2:g} m/s^2 and "
+                   f"envelope amplitude at {_line_name(n)} above {s.defect_amplitude_m_s2:g} m/s^2 and "
                    f"{s.defect_significance:g} x the envelope noise floor") for n in DEFECT_LINES),
             Rule("life_used", "life", "-", "above", 0.0, hold,
                  f"Palmgren-Miner damage fraction above {s.life_used_warning:g} (warning), "
@@ -455,7 +459,7 @@ class AlarmEvaluator:
         lines = vib.line_amplitudes_m_s2 if vib is not None else {}
         for n in DEFECT_LINES:
             a = lines.get(n)
-            out[f"defect_{n}"] = (a, "" if a is None else f"envelope amplitude at {n.upper()} {a:.3g} m/s^2")
+            out[f"defect_{n}"] = (a, "" if a is None else f"envelope amplitude at {_line_name(n)} {a:.3g} m/s^2")
         d = x.damage_fraction
         out["life_used"] = (d, "" if d is None else f"damage fraction {d:.3g}")
         return out
@@ -469,10 +473,11 @@ class AlarmEvaluator:
             levels = self._levels(alarm_id, inputs.vibration)
             transition = tracker.update(inputs.time_s, value, levels, message, wall)
             if transition is not None:
-                events.append(self._event(tracker, transition, inputs.time_s, wall))
+                events.append(self._event(tracker, transition, inputs.time_s, wall, inputs.seq))
         return events
 
-    def _event(self, tracker: AlarmTracker, transition: Transition, t: float, wall: float) -> AlarmEvent:
+    def _event(self, tracker: AlarmTracker, transition: Transition, t: float, wall: float,
+               snapshot_seq: int | None = None) -> AlarmEvent:
         self.seq += 1
         rule, level = tracker.rule, tracker.level
         lv = tracker.levels[level] if level >= 0 else tracker.levels[0]   # cleared: the first level
@@ -483,7 +488,7 @@ class AlarmEvaluator:
         return AlarmEvent(seq=self.seq, bearing_id=self.bearing_id, alarm_id=rule.id,
                           category=rule.category, transition=transition, active=level >= 0,
                           severity=severity, opcua_severity=OPCUA_SEVERITY[severity],
-                          since_s=tracker.since_s, time_s=t, wall_time_s=wall,
+                          since_s=tracker.since_s, time_s=t, snapshot_seq=snapshot_seq, wall_time_s=wall,
                           value=float(tracker.value), threshold=lv.threshold, clear_threshold=lv.clear,
                           unit=rule.unit, message=text)
 

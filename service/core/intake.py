@@ -1,4 +1,4 @@
-"""Setpoints that arrive as raw payloads (zenoh `{prefix}/{id}/setpoint`): the admission gate,
+"""Setpoints (and local defects, `DefectIntake`) that arrive as raw payloads (zenoh `{prefix}/{id}/setpoint`): the admission gate,
 then the same validation and mailbox as HTTP.
 
 `SetpointIntake(bearing_id, gate, runner)(payload) -> dict` never raises. In order: whether the
@@ -46,8 +46,7 @@ class SetpointIntake:
                 raise InputError.one(None, "payload is not valid JSON")
             if isinstance(data, dict) and "token" in data:
                 raise InputError.one("token", _TOKEN_FIELD)
-            setpoint = self.runner.submit(parse_update(data, self.runner.limits))
-            return {"accepted": True, "setpoint": setpoint.model_dump()}
+            return {"accepted": True, **self._apply(data)}
         except InputError as exc:
             self._count()
             return {"accepted": False, "status": exc.status_code, "error": str(exc),
@@ -55,6 +54,10 @@ class SetpointIntake:
         except Exception as exc:  # noqa: BLE001 - a refusal, never a crash
             self._count()
             return {"accepted": False, "status": 422, "error": f"{type(exc).__name__}: {exc}"}
+
+    def _apply(self, data: Any) -> dict:
+        setpoint = self.runner.submit(parse_update(data, self.runner.limits))
+        return {"setpoint": setpoint.model_dump()}
 
     def _count(self) -> None:
         with self._lock:
@@ -66,6 +69,17 @@ class SetpointIntake:
         if refusal.retry_after_s is not None:
             out["retry_after_s"] = refusal.retry_after_s
         return out
+
+
+class DefectIntake(SetpointIntake):
+    """Local defects as raw payloads (zenoh `{prefix}/{id}/defects`, issue 14): the same gate
+    (bus writer, size, the twin's setpoint budget), then `TwinRunner.submit_defects` (the
+    bearing's own geometry, 422 naming the field). A payload is {"defects": [...]} or the list
+    itself; [] clears them. The answer carries "defects": [...] when accepted."""
+
+    def _apply(self, data: Any) -> dict:
+        items = self.runner.submit_defects(data)
+        return {"defects": [d.model_dump() for d in items]}
 
 
 _INVALID = object()

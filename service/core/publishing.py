@@ -16,7 +16,11 @@ scenario's samples must all arrive) makes the stepping thread wait instead.
 Sinks (zenoh channel, recorder, table) only enqueue (bounded, drop-oldest, counted: see
 service.core.sinks), so the worker never blocks on I/O; a sink that raises is counted and
 skipped. The runner's own status note (a fallback, a caught error) is written into the
-snapshot's `status` beside the engine's. The first snapshot that reflects an accepted setpoint
+snapshot's `status` beside the engine's. The accelerometer samples the twin produced since the
+last capture (`Twin.drain_waveform`, issue 14) are drained with each capture and handed, after
+the snapshot, to the sinks that have `publish_waveform(bearing_id, blocks, seq=...)` (zenoh
+`.../vibration/waveform`, the recorder); a capture dropped under back-pressure passes its
+samples on to the next one. The first snapshot that reflects an accepted setpoint
 completes its `SetpointTiming` (published = when the worker handed it to the sinks).
 """
 
@@ -44,12 +48,24 @@ log = logging.getLogger(__name__)
 def freeze(twin: Twin) -> Twin:
     """A copy of `twin` that `snapshot()` can read while the original runs on: the object
     shallow-copied (the model, setpoint and fault are immutable; numbers are values) with its
-    mutable state arrays copied."""
+    mutable state arrays copied (plain numbers of the state are values too)."""
     frozen = copy.copy(twin)
     state = twin.state
-    frozen.state = dataclasses.replace(state, **{f.name: getattr(state, f.name).copy()
+    frozen.state = dataclasses.replace(state, **{f.name: _copied(getattr(state, f.name))
                                                  for f in dataclasses.fields(state)})
     return frozen
+
+
+def _copied(value):
+    """An array copied; a plain number (e.g. the state's defect count) as it is."""
+    return value.copy() if hasattr(value, "copy") else value
+
+
+def _drain_waveform(twin: Twin) -> list:
+    """The accelerometer blocks produced since the last capture (stepping thread; [] without
+    the housing or with an engine that has none)."""
+    drain = getattr(twin, "drain_waveform", None)
+    return list(drain()) if drain is not None else []
 
 
 @dataclass
@@ -61,6 +77,7 @@ class Capture:
     late_fraction: float | None
     note: str | None
     timings: list[SetpointTiming] = field(default_factory=list)
+    waveform: list = field(default_factory=list)   # accelerometer blocks drained with it (issue 14)
 
 
 class Publisher:
@@ -185,10 +202,11 @@ class Publisher:
         """Capture `twin` for publication (frozen copy when a worker builds it later)."""
         worker = self._worker
         timings, self._unpublished = self._unpublished, []
+        waveform = _drain_waveform(twin)
         if worker is None or not worker.alive:
-            self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings))
+            self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings, waveform))
             return
-        cap = Capture(freeze(twin), real_time_factor, late_fraction, self.note, timings)
+        cap = Capture(freeze(twin), real_time_factor, late_fraction, self.note, timings, waveform)
         with self._cv:
             if self.lossless:
                 while (len(self._pending) >= self.max_pending and worker.alive
@@ -197,6 +215,7 @@ class Publisher:
             elif len(self._pending) >= self.max_pending:
                 old = self._pending.popleft()
                 cap.timings[:0] = old.timings
+                cap.waveform[:0] = old.waveform       # the samples are not the snapshot's: keep them
                 self.skipped += 1
             self._pending.append(cap)
         if not worker.submit(self._deliver_next):
@@ -241,6 +260,10 @@ class Publisher:
         for sink in self.sinks:
             try:
                 sink.publish(snap)
+                if cap.waveform:
+                    publish_waveform = getattr(sink, "publish_waveform", None)
+                    if publish_waveform is not None:
+                        publish_waveform(self.bearing_id, cap.waveform, seq=snap.seq)
             except Exception as exc:  # noqa: BLE001 - a sink never stops the physics
                 self.sink_errors += 1
                 if self.sink_errors <= 5:

@@ -43,7 +43,7 @@ from service.core.alarm_hub import AlarmHub
 from service.core.alarms import AlarmEvent
 from service.core.capacity import Capacity, TwinCost, calibrate, usable_cores
 from service.core.errors import InputError, field_errors, setpoint_field_errors
-from service.core.intake import SetpointIntake
+from service.core.intake import DefectIntake, SetpointIntake
 from service.core.pool import SteppingPool
 from service.core.runner import TwinRunner
 from service.core.sinks import SnapshotSink
@@ -99,6 +99,8 @@ class Recorder(SnapshotSink, Protocol):
     rows_logged: int
 
     def add_twin_from(self, twin: Twin) -> None: ...
+
+    def log_alarm(self, event: AlarmEvent) -> None: ...
 
 
 @dataclass
@@ -177,7 +179,8 @@ class TwinRegistry:
             self._open_outputs()
             if default_twin and self.settings.start_twin:
                 self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing,
-                                 over_capacity_ok=True)
+                                 over_capacity_ok=True,
+                                 **({"housing": {"enabled": True}} if self.settings.housing else {}))
         except BaseException:
             self.close()
             raise
@@ -248,8 +251,10 @@ class TwinRegistry:
 
     def build_twin(self, bearing_id: str, designation: str = "6208", diametral_clearance_m: float = 0.0,
                    lubricant: str = "seed-000", setpoint: SetpointUpdate | None = None,
-                   thermal: Thermal | None = None) -> Twin:
-        """A warm-started Twin (InputError naming the field if a value is not valid)."""
+                   thermal: Thermal | None = None, housing: Any = None) -> Twin:
+        """A warm-started Twin (InputError naming the field if a value is not valid). `housing`:
+        twin.vibration.housing.Housing (or its dict); `{"enabled": true}` puts the outer ring on
+        the housing support with the accelerometer (issue 14)."""
         wanted = designation
         designation = designation.strip().upper()
         if designation not in catalog.designations():
@@ -259,8 +264,11 @@ class TwinRegistry:
         except ValueError as exc:
             raise InputError.one("lubricant", str(exc).removeprefix("lubricant: ")) from None
         try:
+            extra = {"thermal": thermal} if thermal else {}
+            if housing is not None:
+                extra["housing"] = housing
             spec = catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m,
-                                   lubricant=lub, **({"thermal": thermal} if thermal else {}))
+                                   lubricant=lub, **extra)
         except ValidationError as exc:
             raise InputError(field_errors(exc.errors())) from None
         twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
@@ -275,7 +283,7 @@ class TwinRegistry:
     def create_twin(self, id: str | None = None, designation: str = "6208", *,
                     over_capacity_ok: bool = False, **options: Any) -> TwinEntry:
         """Create, wire and start a twin (`options`: diametral_clearance_m, lubricant, setpoint,
-        thermal). InputError 409 on a duplicate id or at max_twins, 503 when this host cannot
+        thermal, housing). InputError 409 on a duplicate id or at max_twins, 503 when this host cannot
         run it in real time (admission 'measured'; `over_capacity_ok`: start it anyway, with a
         warning: the twin of the configuration), 422 for an invalid value."""
         s = self.settings
@@ -306,7 +314,8 @@ class TwinRegistry:
                               intake=SetpointIntake(bearing_id, self.gate, runner),
                               lubricant=twin.model.spec.lubricant.name)
             if self.bus is not None:
-                entry.channel = self.bus.attach_twin(bearing_id, runner.latest_snapshot, entry.intake)
+                entry.channel = self.bus.attach_twin(bearing_id, runner.latest_snapshot, entry.intake,
+                                                     on_defects=DefectIntake(bearing_id, self.gate, runner))
                 runner.add_sink(entry.channel)
             if self.recorder is not None:
                 self.recorder.add_twin_from(twin)

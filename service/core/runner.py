@@ -47,6 +47,7 @@ from pydantic import ValidationError
 
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.capacity import CpuMeter, TwinCost
+from service.core.defects import DefectBox, parse_defects
 from service.core.faults import Fallback, FaultPolicy
 from service.core.mailbox import Mailbox, SetpointTiming
 from service.core.pacing import PacingClock
@@ -116,6 +117,7 @@ class TwinRunner:
         self._clock = clock
 
         self.mailbox = Mailbox(twin.setpoint, self.limits, clock=clock)
+        self.defect_box = DefectBox()        # local defects waiting for the next frame (issue 14)
         self.faults = FaultPolicy(twin.setpoint, self.limits, safe_after_frames=safe_after_frames,
                                   max_restarts_per_frame=max_restarts_per_frame)
         self.pacing = PacingClock(fast=self.fast, publish_period_s=1.0 / self.publish_rate_hz, clock=clock,
@@ -236,10 +238,21 @@ class TwinRunner:
         self._wake()
         return setpoint
 
+    def submit_defects(self, defects: Any) -> tuple:
+        """Replace the twin's local defects (a list of dicts, see service.core.defects; [] clears
+        them): validated here against the bearing's geometry (InputError 422 naming the field
+        and the bearing's range), applied by the stepping thread at the next frame boundary.
+        Returns the defects that will be in force."""
+        items = parse_defects(defects, self.twin.model.spec.geometry)
+        items = self.defect_box.offer(items)
+        self._wake()
+        return items
+
     def start_scenario(self, run: ResolvedRun, *, restart: bool = False) -> tuple[ScenarioHandle, ScenarioHandle | None]:
         """Hand a scenario run to the runner (a running one is cancelled). Values are checked
         against the bearing's limits first (ScenarioError). Returns (handle, replaced)."""
         run.check_limits(self.limits, where="scenario.")
+        run.check_defects(self.twin.model.spec.geometry, where="scenario.")
         handle, replaced = self.scenarios.start(run, restart=restart)
         self._wake()
         return handle, replaced
@@ -320,9 +333,17 @@ class TwinRunner:
             self.twin.set_setpoint(pending)
         if timings:
             self.publisher.await_snapshot(timings)
-        return pending is not None or bool(timings), bool(timings)
+        defects = self.defect_box.take()
+        if defects is not None:
+            self.twin.set_defects(defects)
+        outside = bool(timings) or defects is not None
+        return pending is not None or outside, outside
 
     # ---- the frame (stepping thread) -----------------------------------------------------------
+    def _offer_scenario_defects(self, defects: list) -> None:
+        """A scenario step's defects (checked when the run started): in force from this frame."""
+        self.defect_box.offer(parse_defects(defects, self.twin.model.spec.geometry))
+
     def _restart_at(self, initial: SetpointUpdate) -> None:
         """A scenario asked to start from the warm start at its initial setpoint."""
         self._offer(initial, timed=False)
@@ -355,7 +376,8 @@ class TwinRunner:
                 pacing.reanchor(self.sim_elapsed_s)
                 self._reanchor = False
             event = self.scenarios.tick(self.sim_elapsed_s, self.mailbox.target,
-                                        lambda u: self._offer(u, timed=False), self._restart_at)
+                                        lambda u: self._offer(u, timed=False), self._restart_at,
+                                        self._offer_scenario_defects)
             changed, outside = self._apply_mailbox()
             if self.idle_without_scenario and not self.scenarios.active:
                 if (event and pacing.last_publish_sim != self.sim_elapsed_s) or changed:

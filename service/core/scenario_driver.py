@@ -39,6 +39,7 @@ class ScenarioExecutor:
     _ramps: dict[str, _ActiveRamp] = field(default_factory=dict)
     _initial_done: bool = False
     phase: str | None = None
+    defects: list | None = None        # the defects of the steps just passed (taken by the driver)
 
     def updates(self, t: float, current: Setpoint) -> SetpointUpdate:
         eps = 1e-9
@@ -52,6 +53,10 @@ class ScenarioExecutor:
             self._next_step += 1
             if step.phase is not None:
                 self.phase = step.phase
+            if step.defects is not None:
+                self.defects = list(step.defects)     # the latest step wins
+            if step.set is None and step.ramp is None:
+                continue
             if step.set is not None:
                 fields = step.set.fields
                 for name in fields:
@@ -192,10 +197,12 @@ class ScenarioDriver:
 
     # ---- runner thread -------------------------------------------------------------------------
     def tick(self, elapsed_s: float, target: Setpoint, offer: Callable[[SetpointUpdate], object],
-             restart_at: Callable[[SetpointUpdate], None]) -> bool:
+             restart_at: Callable[[SetpointUpdate], None],
+             offer_defects: Callable[[list], object] | None = None) -> bool:
         """Before a frame at `elapsed_s` of the runner's simulated time: take over a new scenario
-        (`restart_at(initial)` when it asks for a warm restart), `offer` its updates, finish it
-        when its time is up. Returns whether a scenario started or ended (publish now)."""
+        (`restart_at(initial)` when it asks for a warm restart), `offer` its updates and
+        `offer_defects` its steps' defects, finish it when its time is up. Returns whether a
+        scenario started or ended (publish now)."""
         event = False
         with self._lock:
             request, self._request = self._request, None
@@ -222,6 +229,9 @@ class ScenarioDriver:
             update = self._executor.updates(t, target)
             if update.fields:
                 offer(update)
+            defects, self._executor.defects = self._executor.defects, None
+            if defects is not None and offer_defects is not None:
+                offer_defects(defects)
             handle.phase = self._executor.phase
         except Exception as exc:  # noqa: BLE001 - a bad scenario must not stop the twin
             handle.finish("failed", f"{type(exc).__name__}: {exc}", notify=False)

@@ -27,8 +27,11 @@ Format (schema "bearing-twin/scenario/1"; all times are SIMULATED seconds from t
 
 Rules:
 
-* every step has exactly one of `set` or `ramp`; a ramp needs `over_s` > 0 and must end by
-  `duration_s`; `at_s` is non-decreasing and below `duration_s`;
+* every step has one of `set` or `ramp`, or `defects` (the local defects in force from `at_s`,
+  issue 14: a list in the vocabulary of twin.vibration.defects, `[]` clears them; with `set` or
+  `ramp` beside it, or alone; checked against the bearing's geometry like the setpoint values
+  against its limits); a ramp needs `over_s` > 0 and must end by `duration_s`; `at_s` is
+  non-decreasing and below `duration_s`;
 * setpoint fields are those of `twin.setpoint.SetpointUpdate` (units in the names); an unknown
   field is an error, and so is a value that is not a number (a bool, a quoted "3000");
 * `bearing: 6208` (a YAML integer) is the designation "6208";
@@ -81,11 +84,18 @@ class ScenarioStep(BaseModel):
     ramp: SetpointUpdate | None = Field(default=None, description="Ramp targets: partial setpoint reached linearly at at_s + over_s (fields with units).")
     over_s: float | None = Field(default=None, gt=0.0, description="Ramp duration [s of simulated time]; only with ramp.")
     phase: str | None = Field(default=None, max_length=64, description="Optional label of the phase this step starts [text].")
+    defects: list[dict[str, Any]] | None = Field(
+        default=None, max_length=64,
+        description="Local defects in force from at_s (issue 14; twin.vibration.defects vocabulary: kind outer | "
+        "inner | ball, width_m, length_m, depth_m [m], ...; [] clears them), checked against the bearing's "
+        "geometry before the run starts.")
 
     @model_validator(mode="after")
     def _one_action(self) -> ScenarioStep:
-        if (self.set is None) == (self.ramp is None):
-            raise ValueError("a step needs exactly one of 'set' or 'ramp'")
+        if self.set is not None and self.ramp is not None:
+            raise ValueError("a step has one of 'set' or 'ramp', not both")
+        if self.set is None and self.ramp is None and self.defects is None:
+            raise ValueError("a step needs one of 'set' or 'ramp', or 'defects'")
         if self.ramp is not None and self.over_s is None:
             raise ValueError("a ramp needs over_s > 0 [s]")
         if self.set is not None and self.over_s is not None:
@@ -119,7 +129,7 @@ class ScenarioRun(BaseModel):
 
 
 def _drop_empty_steps(steps: list[ScenarioStep]) -> list[ScenarioStep]:
-    return [s for s in steps if (s.set or s.ramp).model_dump(exclude_none=True)]
+    return [s for s in steps if s.defects is not None or (s.set or s.ramp).model_dump(exclude_none=True)]
 
 
 def _check_steps(steps: list[ScenarioStep], duration_s: float, where: str) -> None:
@@ -220,7 +230,9 @@ class Scenario(BaseModel):
         run, step and field): the check `scenario run` and the service make before running."""
         runs = self.resolved_runs()
         for run in runs:
-            run.check_limits(run.bearing_limits(), where=f"runs[{run.index}]." if len(runs) > 1 else "")
+            where = f"runs[{run.index}]." if len(runs) > 1 else ""
+            run.check_limits(run.bearing_limits(), where=where)
+            run.check_defects(run.spec().geometry, where=where)
 
     @property
     def total_duration_s(self) -> float:
@@ -314,9 +326,26 @@ class ResolvedRun:
         for name, value in self.initial.fields.items():
             yield "initial", name, value
         for i, step in enumerate(self.steps):
+            if step.set is None and step.ramp is None:
+                continue
             kind = "set" if step.set is not None else "ramp"
             for name, value in (step.set or step.ramp).fields.items():
                 yield f"steps[{i}].{kind}", name, value
+
+    def check_defects(self, geometry, where: str = "") -> None:
+        """Raise ScenarioError for the first step whose `defects` this bearing cannot take
+        (service.core.defects: the field and the bearing's own range)."""
+        from service.core.defects import parse_defects
+        from service.core.errors import InputError
+
+        for i, step in enumerate(self.steps):
+            if step.defects is None:
+                continue
+            try:
+                parse_defects(step.defects, geometry, prefix=f"{where}steps[{i}].defects")
+            except InputError as exc:
+                e = exc.errors[0]
+                raise ScenarioError(e.field or f"{where}steps[{i}].defects", e.message, e.allowed) from None
 
     def check_limits(self, limits: SetpointLimits, where: str = "") -> None:
         """Raise ScenarioError for the first value outside the bearing's limits (`Twin.limits`,

@@ -99,6 +99,21 @@ def _zone(v: View) -> str | None:
     return vibration_zone(vib.velocity_rms_mm_s, v.settings.machine_group, v.settings.support)
 
 
+def _vib_field(name: str) -> Callable[[View], Any]:
+    """A field of the snapshot's vibration block (twin.snapshot.VibrationState)."""
+    def read(v: View) -> Any:
+        block = getattr(v.snapshot, "vibration", None) if v.snapshot is not None else None
+        return getattr(block, name, None) if block is not None else None
+    return read
+
+
+def _defect_frequency(name: str) -> Callable[[View], Any]:
+    def read(v: View) -> Any:
+        f = _vib_field("defect_frequencies_hz")(v)
+        return getattr(f, name, None) if f is not None else None
+    return read
+
+
 def _line(name: str) -> Callable[[View], Any]:
     return lambda v: (_vib(v).line_amplitudes_m_s2.get(name) if _vib(v) is not None else None)
 
@@ -172,10 +187,21 @@ FOLDERS: dict[str, tuple[Var, ...]] = {
             lambda v: _vib(v).velocity_rms_mm_s if _vib(v) is not None else None),
         Var("zone", "String", "ISO 20816-3 evaluation zone A | B | C | D for the configured machine "
             "group and support [text].", _zone),
-        *(Var(f"{n}_m_s2", "Double", f"Envelope-spectrum amplitude at {n.upper()} [m/s^2].", _line(n))
-          for n in ("ftf", "bpfo", "bpfi", "bsf")),
+        Var("rms_m_s2", "Double", "Housing acceleration RMS over the last window [m/s^2].", _vib_field("rms_m_s2")),
+        Var("peak_m_s2", "Double", "Peak |acceleration| over the last window [m/s^2].", _vib_field("peak_m_s2")),
+        Var("crest_factor", "Double", "Peak / RMS [-].", _vib_field("crest_factor")),
+        Var("kurtosis", "Double", "Kurtosis of the acceleration [-] (3 for Gaussian noise).", _vib_field("kurtosis")),
+        Var("window_end_s", "Double", "Simulated time of the last window's end [s].", _vib_field("window_end_s")),
+        *(Var(f"{n}_hz", "Double", f"Defect frequency {n.upper().replace('TWO_BSF', '2 x BSF')} at the window's "
+              "speed and loaded contact angle [Hz].", _defect_frequency(n))
+          for n in ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")),
+        *(Var(f"{n}_m_s2", "Double", f"Envelope-spectrum amplitude at {n.upper().replace('TWO_BSF', '2 x BSF')} "
+              "[m/s^2].", _line(n))
+          for n in ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")),
         Var("noise_floor_m_s2", "Double", "Envelope-spectrum noise floor (median) [m/s^2].",
             lambda v: _vib(v).noise_floor_m_s2 if _vib(v) is not None else None),
+        Var("defect_count", "UInt32", "Local defects active (twin.vibration.defects) [-].",
+            lambda v: len(getattr(v.snapshot, "defects", ()) or ()) if v.snapshot is not None else None),
     ),
     "Life": tuple(Var(name, "Double", desc + "; no value without the snapshot's life block.", _life(name)) for name, desc in (
         ("kappa", "Viscosity ratio nu / nu1 (ISO 281:2007 clause 9.3) [-]"),

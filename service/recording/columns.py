@@ -19,6 +19,8 @@ import pyarrow as pa
 import rerun as rr
 
 from service.recording.layout import (
+    ALARM_LOG_LEVEL,
+    ALARM_STATES,
     CONTACT_SERIES,
     LOAD_ZONE,
     REGIME_CODE,
@@ -27,6 +29,7 @@ from service.recording.layout import (
     SEQ,
     SIDES,
     SIM_TIME,
+    VIB_LINES,
     TwinLayout,
 )
 
@@ -60,6 +63,8 @@ class Row:
     context: str | None               # scenario state given with the snapshot (recorder.publish)
     positions_m: np.ndarray | None
     gap_before: str | None = None     # why the line breaks before this row (lost rows, new run)
+    defects: tuple | None = None      # the active local defects as text (None: not in the snapshot)
+    vibration: object | None = None   # the snapshot's vibration block (twin.snapshot.VibrationState)
 
 
 _FIELD_CACHE: dict = {}
@@ -119,6 +124,9 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
         if isinstance(r, str):
             risk = r
             reason = items.get("reason") if isinstance(items.get("reason"), str) else None
+    has_defects, has_vibration = _present(snapshot, ("defects", "vibration"))
+    defects = tuple(_defect_text(d) for d in snapshot.defects or ()) if has_defects else None
+    vibration = snapshot.vibration if has_vibration else None
     sp = getattr(snapshot, "setpoint", None) if _present(snapshot, ("setpoint",))[0] else None
     setpoint = tuple(_num(getattr(sp, f, None)) for f in SETPOINT_FIELDS) if sp is not None else None
     return Row(time_s=float(snapshot.time_s), seq=int(snapshot.seq), status=str(snapshot.status),
@@ -128,7 +136,18 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
                friction_torque_n_m=_num(snapshot.friction_torque_n_m),
                contacts=contacts, regimes=regimes, azimuth_rad=azimuth,
                electrical=electrical, risk=risk, risk_reason=reason, context=context,
-               positions_m=positions_m)
+               positions_m=positions_m, defects=defects, vibration=vibration)
+
+
+def _defect_text(d) -> str:
+    """'outer spall 0.5 x 0.6 mm, 50 um deep at 0 deg' of a twin.vibration.defects model."""
+    get = d.get if isinstance(d, Mapping) else (lambda k, default=None: getattr(d, k, default))
+    kind = get("kind")
+    size = f"{_fmt(get('width_m', 0.0) * 1e3)} x {_fmt(get('length_m', 0.0) * 1e3)} mm, {_fmt(get('depth_m', 0.0) * 1e6)} um deep"
+    where = {"outer": f"outer spall {size} at azimuth {_fmt(get('azimuth_deg', 0.0))} deg",
+             "inner": f"inner spall {size} at ring angle {_fmt(get('ring_angle_deg', 0.0))} deg",
+             "ball": f"ball {get('ball_index', 0)} defect {size}"}
+    return where.get(kind, f"{kind} defect {size}")
 
 
 # ---- arrow helpers ------------------------------------------------------------------------------
@@ -390,6 +409,11 @@ def events(tw: TwinLayout, batch: Batch) -> None:
             texts.append((j, f"restart (restarts: {r.restarts}): {r.status}", "WARN"))
         elif status_changed:
             texts.append((j, f"status: {r.status}", "INFO" if r.status == "ok" else "WARN"))
+        if r.defects is not None and r.defects != last.get("defects", ()):
+            texts.append((j, "defects: " + "; ".join(r.defects) if r.defects else "defects cleared",
+                          "WARN" if r.defects else "INFO"))
+        if r.defects is not None:
+            last["defects"] = r.defects
         if r.risk is not None and r.risk != last.get("risk"):
             risks.append((j, r.risk if r.risk in RISK_VALUES else "none"))
             if last.get("risk") is not None:
@@ -404,3 +428,157 @@ def events(tw: TwinLayout, batch: Batch) -> None:
         sel = np.array([j for j, _ in risks])
         batch.out.append((f"{tw.root}/electrical/discharge_risk", batch.index(sel),
                           rr.StateChange.columns(state=[s for _, s in risks])))
+
+
+# ---- alarms ---------------------------------------------------------------------------------------
+@dataclass(slots=True)
+class AlarmRow:
+    """One alarm event (service.core.alarms.AlarmEvent) as the recorder keeps it."""
+
+    bearing_id: str
+    alarm_id: str
+    transition: str                   # raised | escalated | deescalated | cleared
+    severity: str | None              # warning | critical | None (cleared)
+    time_s: float                     # simulated time of the event [s]
+    seq: int | None                   # seq of the snapshot that caused it
+    value: float
+    threshold: float
+    clear_threshold: float
+    unit: str
+    message: str
+
+    @classmethod
+    def of(cls, event) -> AlarmRow:
+        """From an `AlarmEvent` (or its dict)."""
+        get = event.get if isinstance(event, Mapping) else (lambda k, d=None: getattr(event, k, d))
+        seq = get("snapshot_seq")
+        return cls(bearing_id=str(get("bearing_id")), alarm_id=str(get("alarm_id")),
+                   transition=str(get("transition")), severity=get("severity"),
+                   time_s=float(get("time_s")), seq=int(seq) if isinstance(seq, int) else None,
+                   value=float(get("value")), threshold=float(get("threshold")),
+                   clear_threshold=float(get("clear_threshold")), unit=str(get("unit") or "-"),
+                   message=str(get("message") or ""))
+
+    @property
+    def state(self) -> str:
+        return self.severity if self.severity in ALARM_STATES else "inactive"
+
+    @property
+    def text(self) -> str:
+        unit = "" if self.unit == "-" else f" {self.unit}"
+        return (f"{self.message} [value {_fmt(self.value)}{unit}, raise at {_fmt(self.threshold)}{unit}, "
+                f"clear at {_fmt(self.clear_threshold)}{unit}]")
+
+
+def _alarm_index(times_ns: np.ndarray, seqs: list[int | None]) -> list:
+    """sim_time, and seq when every row has one."""
+    index = [rr.TimeColumn(SIM_TIME, duration=times_ns.astype("timedelta64[ns]"))]
+    if all(s is not None for s in seqs):
+        index.append(rr.TimeColumn(SEQ, sequence=np.array(seqs, dtype=np.int64)))
+    return index
+
+
+def alarm_columns(tw: TwinLayout, rows: list[AlarmRow], offset_s: float) -> list:
+    """(entity path, index columns, component columns) triples of a twin's alarm events: a
+    TextLog row at `alarms/{alarm_id}` and a StateChange row at `alarm_states/{alarm_id}` per
+    event, at the event's simulated time (shifted by the twin's offset) and snapshot seq."""
+    out: list = []
+    by_alarm: dict[str, list[AlarmRow]] = {}
+    for r in rows:
+        by_alarm.setdefault(r.alarm_id, []).append(r)
+    for alarm_id, group in by_alarm.items():
+        # rows with and without a snapshot seq go in separate calls (index columns of one length)
+        for part in ([r for r in group if r.seq is not None], [r for r in group if r.seq is None]):
+            if not part:
+                continue
+            t = np.round((np.array([r.time_s for r in part]) + offset_s) * 1e9).astype(np.int64)
+            seqs = [r.seq for r in part]
+            out.append((f"{tw.root}/alarms/{alarm_id}", _alarm_index(t, seqs),
+                        rr.TextLog.columns(text=[r.text for r in part],
+                                           level=[ALARM_LOG_LEVEL.get(r.severity, "INFO") for r in part])))
+            out.append((f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, seqs),
+                        rr.StateChange.columns(state=[r.state for r in part])))
+    return out
+
+
+def alarm_states_in_force(tw: TwinLayout, states: Mapping[str, str], time_s: float, seq: int | None,
+                          offset_s: float) -> list:
+    """StateChange rows of the alarms active when a new output (a segment) started, at `time_s`
+    (its first row), so that its state timeline does not begin empty."""
+    active = [(k, v) for k, v in states.items() if v != "inactive"]
+    t = np.array([round((time_s + offset_s) * 1e9)], dtype=np.int64)
+    return [(f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, [seq]), rr.StateChange.columns(state=[state]))
+            for alarm_id, state in active]
+
+
+# ---- vibration (issue 14) ---------------------------------------------------------------------------
+def vibration_columns(tw: TwinLayout, batch: Batch) -> None:
+    """The indicators of every new accelerometer window (a row at the snapshot that first
+    carries it): `vibration/...` Scalars and the envelope bar charts (layout.VIBRATION_SERIES)."""
+    last = tw.last
+    sel, blocks = [], []
+    for j, r in enumerate(batch.rows):
+        v = r.vibration
+        if v is None or v.window_end_s == last.get("window_end_s"):
+            continue
+        last["window_end_s"] = v.window_end_s
+        sel.append(j)
+        blocks.append(v)
+    if not sel:
+        return
+    idx = np.array(sel)
+    root = tw.root
+    n = len(blocks)
+
+    def scalars(leaf: str, values) -> None:
+        v = np.asarray(values, dtype=np.float64).reshape(n, -1)
+        batch.out.append((f"{root}/vibration/{leaf}", batch.index(idx),
+                          rr.Scalars.columns(scalars=v.reshape(-1)).partition(np.full(n, v.shape[1]))))
+
+    scalars("acceleration_rms_peak_m_s2", [[b.rms_m_s2, b.peak_m_s2] for b in blocks])
+    scalars("velocity_rms_mm_s", [[b.velocity_rms_mm_s] for b in blocks])
+    scalars("kurtosis", [[b.kurtosis, b.band_kurtosis, b.crest_factor] for b in blocks])
+    freqs = np.array([[getattr(b.defect_frequencies_hz, k) for k in VIB_LINES] for b in blocks])
+    amps = np.array([[_line_fundamental(b, k) for k in VIB_LINES] for b in blocks])
+    floor = np.array([[b.envelope_noise_floor_m_s2] for b in blocks])
+    scalars("defect_frequencies_hz", freqs)
+    scalars("envelope_lines_m_s2", np.hstack([amps, floor]))
+    # the envelope spectrum as the snapshot has it: its largest peaks, and the defect lines (markers)
+    k = max(1, max(len(b.envelope_peaks_hz) for b in blocks))
+    peak_f = np.zeros((n, k))
+    peak_a = np.zeros((n, k))
+    for i, b in enumerate(blocks):
+        for m, p in enumerate(b.envelope_peaks_hz):
+            peak_f[i, m], peak_a[i, m] = p.frequency_hz, p.amplitude
+    batch.out.append((f"{root}/vibration/envelope/peaks", batch.index(idx), _bar_columns(peak_a, peak_f)))
+    batch.out.append((f"{root}/vibration/envelope/defect_lines", batch.index(idx),
+                      _bar_columns(np.nan_to_num(amps), freqs)))
+
+
+def _line_fundamental(block, name: str) -> float:
+    line = (block.envelope_lines or {}).get(name)
+    return float(line.harmonics[0]) if line is not None and line.harmonics else math.nan
+
+
+@dataclass(slots=True)
+class WaveRow:
+    """Accelerometer samples that came with one snapshot (twin.vibration.sensor.WaveformBlock)."""
+
+    seq: int
+    t0_s: float
+    sample_rate_hz: float
+    samples: np.ndarray              # float32 [m/s^2]
+
+
+def waveform_columns(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> list:
+    """`vibration/acceleration_m_s2`: one Scalars row per sample at its own simulated time (the
+    `seq` of the snapshot it came with), all of a send in one call."""
+    rows = [r for r in rows if r.samples.size]
+    if not rows:
+        return []
+    t = np.concatenate([np.round((r.t0_s + offset_s + np.arange(r.samples.size) / r.sample_rate_hz) * 1e9)
+                        for r in rows]).astype(np.int64)
+    seq = np.concatenate([np.full(r.samples.size, r.seq, dtype=np.int64) for r in rows])
+    x = np.concatenate([r.samples for r in rows]).astype(np.float64)
+    index = [rr.TimeColumn(SIM_TIME, duration=t.astype("timedelta64[ns]")), rr.TimeColumn(SEQ, sequence=seq)]
+    return [(f"{tw.root}/vibration/acceleration_m_s2", index, rr.Scalars.columns(scalars=x))]

@@ -27,10 +27,31 @@ electrical/current_density_a_per_mm2                              Scalars
 electrical/discharge_risk     StateChange (none / possible / likely), one row per change
 events                        TextLog: setpoints, scenario state and phase, restarts, fallbacks,
                               status, recording gaps - one row each
+alarms/{alarm_id}             TextLog, one row per alarm event (raised, escalated, deescalated,
+                              cleared; service.core.alarms): level WARN (warning), CRITICAL
+                              (critical), INFO (cleared); the text names the transition, the
+                              value, the raise and clear thresholds with their unit
+alarm_states/{alarm_id}       StateChange inactive / warning / critical, one row per event (and
+                              the active ones again at the start of a new segment)
+vibration/acceleration_m_s2   Scalars: the housing accelerometer, one row per sample at its own
+                              simulated time (twin with the housing on, issue 14; about 1.2 MB per
+                              simulated second at 51.2 kHz)
+vibration/acceleration_rms_peak_m_s2, vibration/velocity_rms_mm_s, vibration/kurtosis
+                              Scalars: the indicators of each window (RMS, peak; ISO 20816 velocity
+                              RMS; kurtosis, band kurtosis, crest factor), a row per new window
+vibration/defect_frequencies_hz   Scalars: FTF, BPFO, BPFI, BSF, 2 x BSF of each window
+vibration/envelope_lines_m_s2 Scalars: envelope amplitude at each of them, and the noise floor
+vibration/envelope/peaks, vibration/envelope/defect_lines
+                              BarChart against frequency [Hz]: the largest envelope peaks of the
+                              window, and the envelope amplitude at each defect frequency (the
+                              markers); the defects themselves are rows of `events`
 contacts/{load_n,lambda,mu,resistance_log10_kohm,capacitance_pf}
                               Scalars, 2 Z instances (ball 0 inner, ball 0 outer, ball 1 inner,
                               ...): the per-contact series, not in the default layout
 ```
+
+Alarm rows are placed at the simulated time of the snapshot that caused them (`sim_time`) and
+at its `seq` (`AlarmEvent.snapshot_seq`), so they line up with the series of that snapshot.
 
 The annotation context at `bearing/{id}` names the regimes (class ids 0-3); the regime colours
 are the same everywhere (balls, `regime_counts`). A value that is undefined (Lambda without
@@ -48,6 +69,8 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from service.core.alarms import ALARM_IDS
+
 SIM_TIME = "sim_time"
 SEQ = "seq"
 
@@ -63,6 +86,22 @@ _RACEWAY_RGB = (170, 170, 180)
 _PITCH_RGB = (90, 90, 100)
 RISK_VALUES = ("none", "possible", "likely")
 RISK_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
+VIB_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")          # VibrationState.defect_frequencies_hz keys
+ENVELOPE_BAR_HZ = 12.0            # bar width of the envelope charts [Hz] (visible on a 0-2 kHz axis)
+VIB_LINE_LABELS = ("FTF", "BPFO", "BPFI", "BSF", "2 x BSF")
+VIB_LINE_RGB = ((150, 150, 150), (230, 60, 60), (80, 160, 255), (0, 200, 120), (255, 170, 0))
+VIBRATION_SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
+    "vibration/acceleration_m_s2": (("acceleration",), ((80, 160, 255),)),
+    "vibration/acceleration_rms_peak_m_s2": (("RMS", "peak"), ((80, 160, 255), (230, 60, 60))),
+    "vibration/velocity_rms_mm_s": (("velocity RMS 10-1000 Hz",), ((255, 200, 0),)),
+    "vibration/kurtosis": (("kurtosis", "band kurtosis", "crest factor"),
+                           ((230, 60, 60), (255, 150, 0), (150, 150, 150))),
+    "vibration/defect_frequencies_hz": (VIB_LINE_LABELS, VIB_LINE_RGB),
+    "vibration/envelope_lines_m_s2": ((*VIB_LINE_LABELS, "noise floor"), (*VIB_LINE_RGB, (90, 90, 100))),
+}
+ALARM_STATES = ("inactive", "warning", "critical")
+ALARM_STATE_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
+ALARM_LOG_LEVEL = {"warning": "WARN", "critical": "CRITICAL", None: "INFO"}
 
 SIDES = ("inner", "outer")
 LOAD_ZONE = (("load_n", "contact load Q [N]"), ("lambda", "film parameter Lambda [-]"),
@@ -114,6 +153,7 @@ class TwinLayout:
     inner_raceway_radius_m: float | None = None
     outer_raceway_radius_m: float | None = None
     load_scale_m_per_n: float | None = None
+    vibration: bool = False           # the twin has the housing and accelerometer (issue 14)
     # state of the event rows, per output segment (reset when a segment starts)
     last: dict = field(default_factory=dict)
 
@@ -174,6 +214,18 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
           rr.StateConfiguration(values=list(RISK_VALUES), labels=["no discharge risk", "discharge possible",
                                                                   "discharge likely"],
                                 colors=np.array(RISK_RGBA, dtype=np.uint32)), static=True)
+    if tw.vibration:
+        for leaf, (names, colors) in VIBRATION_SERIES.items():
+            s.log(f"{root}/{leaf}", rr.SeriesLines(names=list(names), colors=list(colors)), static=True)
+        for leaf, rgb in (("peaks", (80, 160, 255)), ("defect_lines", (230, 60, 60))):
+            s.log(f"{root}/vibration/envelope/{leaf}", [
+                rr.components.ColorBatch([rgb]).described(rr.BarChart.descriptor_color()),
+                rr.components.LengthBatch(np.full(len(VIB_LINES), ENVELOPE_BAR_HZ, dtype=np.float32)).described(
+                    rr.BarChart.descriptor_widths())], static=True)
+    for alarm_id in ALARM_IDS:
+        s.log(f"{root}/alarm_states/{alarm_id}",
+              rr.StateConfiguration(values=list(ALARM_STATES), labels=[f"{alarm_id} {v}" for v in ALARM_STATES],
+                                    colors=np.array(ALARM_STATE_RGBA, dtype=np.uint32)), static=True)
 
 
 # ---- blueprint --------------------------------------------------------------------------------
@@ -186,8 +238,8 @@ def _window(seconds: float | None):
 
 def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Container:
     """The default layout of one twin: top, the bearing in 3D, the load zone now and the
-    bearing-level trends with the setpoint beside them; bottom, the events and the electrical
-    panel. The per-contact series (`contacts/...`) are not in it (add them from the streams)."""
+    bearing-level trends with the setpoint beside them; bottom, the events, the alarms (states
+    and events) and the electrical panel. The per-contact series (`contacts/...`) are not in it (add them from the streams)."""
     root = f"/{tw.root}"
     tag = tw.bearing_id
     window = _window(series_window_s)
@@ -242,9 +294,34 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Contain
             timeline_columns=[rrb.encodings.TimelineColumn(SIM_TIME), rrb.encodings.TimelineColumn(SEQ, visible=False)],
             text_log_columns=[rrb.encodings.TextLogColumn("LogLevel"), rrb.encodings.TextLogColumn("Body"),
                               rrb.encodings.TextLogColumn("EntityPath", visible=False)]))
-    return rrb.Vertical(rrb.Horizontal(*top, column_shares=shares),
-                        rrb.Horizontal(events, electrical, column_shares=[1.0, 1.6]),
-                        row_shares=[1.5, 1.0], name=tag)
+    alarms = rrb.Vertical(
+        rrb.StateTimelineView(name=f"{tag}: alarm states", origin=root, contents=[f"+ {root}/alarm_states/**"],
+                              time_ranges=window),
+        rrb.TextLogView(
+            name=f"{tag}: alarm events", origin=root, contents=[f"+ {root}/alarms/**"],
+            columns=rrb.archetypes.TextLogColumns(
+                timeline_columns=[rrb.encodings.TimelineColumn(SIM_TIME),
+                                  rrb.encodings.TimelineColumn(SEQ, visible=False)],
+                text_log_columns=[rrb.encodings.TextLogColumn("LogLevel"), rrb.encodings.TextLogColumn("Body"),
+                                  rrb.encodings.TextLogColumn("EntityPath", visible=False)])),
+        row_shares=[1.0, 1.0], name="alarms")
+    rows = [rrb.Horizontal(*top, column_shares=shares),
+            rrb.Horizontal(events, alarms, electrical, column_shares=[1.0, 1.0, 1.6])]
+    if tw.vibration:
+        rows.append(rrb.Horizontal(
+            rrb.TimeSeriesView(name="housing acceleration [m/s^2] (last 0.1 s)", origin=root,
+                               contents=[f"+ {root}/vibration/acceleration_m_s2"], time_ranges=_window(0.1),
+                               plot_legend=rrb.PlotLegend(visible=False)),
+            rrb.BarChartView(name="envelope spectrum: largest peaks (blue), at the defect frequencies (red) [Hz]",
+                             origin=root, contents=[f"+ {root}/vibration/envelope/**"],
+                             plot_legend=rrb.PlotLegend(visible=False)),
+            rrb.Grid(ts("acceleration RMS, peak [m/s^2]", "vibration/acceleration_rms_peak_m_s2"),
+                     ts("velocity RMS 10-1000 Hz [mm/s] (ISO 20816)", "vibration/velocity_rms_mm_s", legend=False),
+                     ts("kurtosis, band kurtosis, crest factor [-]", "vibration/kurtosis"),
+                     ts("envelope at the defect frequencies [m/s^2]", "vibration/envelope_lines_m_s2"),
+                     grid_columns=2),
+            column_shares=[1.2, 1.0, 1.6], name="vibration"))
+    return rrb.Vertical(*rows, row_shares=[1.5, 1.0, 1.0][:len(rows)], name=tag)
 
 
 def blueprint(twins: list[TwinLayout], series_window_s: float | None) -> rrb.Blueprint:

@@ -119,6 +119,10 @@ class _Twin(TwinLayout):
     time_offset_s: float = 0.0                        # added to sim_time (a re-created twin)
     continue_after_s: float | None = None             # where the previous run of this id ended
     note: str | None = None                           # logged (with a line break) before the next row
+    alarm_rows: list = field(default_factory=list)    # alarm events not sent yet (columns.AlarmRow)
+    alarm_states: dict = field(default_factory=dict)  # alarm id -> latest state seen (ALARM_STATES)
+    alarm_carry: dict = field(default_factory=dict)   # a new output: the active states to log again
+    wave_rows: list = field(default_factory=list)     # accelerometer samples not sent yet (columns.WaveRow)
 
 
 @dataclass
@@ -191,6 +195,11 @@ class RerunRecorder:
         self._streams = streams if streams is not None else RerunStreams()
 
         self._queue: deque = deque()
+        self._alarm_queue: deque = deque()
+        self._wave_queue: deque = deque()
+        self._waveform_dropped = 0
+        self._alarms_dropped = 0
+        self._alarms_logged = 0
         self._qlock = threading.Lock()
         self._io_lock = threading.RLock()
         self._wake = threading.Event()
@@ -303,6 +312,7 @@ class RerunRecorder:
         for tw in self._twins.values():
             send_static(out.stream, tw)
             tw.last.clear()
+            tw.alarm_carry = {k: v for k, v in tw.alarm_states.items() if v != "inactive"}
         self._send_blueprint([out])
 
     def _outputs(self) -> list[_Output]:
@@ -579,7 +589,8 @@ class RerunRecorder:
     def add_twin(self, bearing_id: str, *, designation: str, pitch_radius_m: float,
                  ball_radius_m: float, inner_raceway_radius_m: float,
                  outer_raceway_radius_m: float, ball_count: int,
-                 load_scale_m_per_n: float | None = None, context: Callable[[], Any] | None = None) -> None:
+                 load_scale_m_per_n: float | None = None, context: Callable[[], Any] | None = None,
+                 vibration: bool = False) -> None:
         """Register a twin: its static geometry goes out now, the blueprint with the next send.
         `load_scale_m_per_n`: arrow length per newton of contact load; by default the largest load
         of the first loaded snapshot is drawn one ball diameter long. `context`: called with each
@@ -589,7 +600,7 @@ class RerunRecorder:
                    pitch_radius_m=float(pitch_radius_m), ball_radius_m=float(ball_radius_m),
                    inner_raceway_radius_m=float(inner_raceway_radius_m),
                    outer_raceway_radius_m=float(outer_raceway_radius_m),
-                   load_scale_m_per_n=load_scale_m_per_n)
+                   load_scale_m_per_n=load_scale_m_per_n, vibration=bool(vibration))
         self._register(tw, context)
 
     def _register(self, tw: _Twin, context) -> None:
@@ -599,6 +610,8 @@ class RerunRecorder:
                 tw.rows, tw.slow_rows, tw.last = old.rows, old.slow_rows, old.last
                 tw.last_time_s, tw.last_seq, tw.time_offset_s = old.last_time_s, old.last_seq, old.time_offset_s
                 tw.prev_time_s, tw.slow_prev_time_s = old.prev_time_s, old.slow_prev_time_s
+                tw.alarm_rows, tw.alarm_states = old.alarm_rows, old.alarm_states
+                tw.wave_rows = old.wave_rows
             else:
                 tw.continue_after_s = self._ended.pop(tw.bearing_id, None)
             self._twins[tw.bearing_id] = tw
@@ -616,7 +629,7 @@ class RerunRecorder:
                       pitch_radius_m=m.pitch_radius_m, ball_radius_m=m.ball_radius_m,
                       inner_raceway_radius_m=g.inner_raceway_radius_m,
                       outer_raceway_radius_m=g.outer_raceway_radius_m, ball_count=m.ball_count,
-                      context=context)
+                      context=context, vibration=bool(getattr(m, "housing_on", False)))
 
     def remove_twin(self, bearing_id: str) -> bool:
         """Forget a twin (its runner has stopped): what it published is sent and written first,
@@ -721,6 +734,61 @@ class RerunRecorder:
         if n >= self._wake_at:
             self._wake.set()
 
+    def log_alarm(self, event) -> None:
+        """Queue an alarm event (`service.core.alarms.AlarmEvent`, or its dict) for the twin's
+        `alarms/{alarm_id}` and `alarm_states/{alarm_id}` entities (`service.recording.layout`);
+        never blocks or raises (an alarm-hub subscriber). Events of a twin this recorder does not
+        record are left out; when `queue_size` events wait, the oldest is dropped and counted."""
+        if self._closed:
+            return
+        try:
+            row = C.AlarmRow.of(event)
+        except Exception as exc:  # noqa: BLE001 - never raise into the alarm hub
+            self._errors += 1
+            log.warning("rerun recorder: alarm event skipped: %s", exc)
+            return
+        with self._qlock:
+            if len(self._alarm_queue) >= self.queue_size:
+                self._alarm_queue.popleft()
+                self._alarms_dropped += 1
+            self._alarm_queue.append(row)
+
+    def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
+        """Queue accelerometer blocks (twin.vibration.sensor.WaveformBlock) of a twin for
+        `vibration/acceleration_m_s2`, at the `seq` of the snapshot they came with (by default
+        the last one queued); never blocks or raises. When `queue_size` batches wait, the oldest
+        is dropped and counted (`waveform_dropped`)."""
+        if self._closed:
+            return
+        try:
+            rows = [C.WaveRow(seq=-1 if seq is None else int(seq), t0_s=float(b.t0_s),
+                              sample_rate_hz=float(b.sample_rate_hz), samples=np.asarray(b.samples, dtype=np.float32))
+                    for b in blocks]
+        except Exception as exc:  # noqa: BLE001 - never raise into the publisher
+            self._errors += 1
+            log.warning("rerun recorder: waveform skipped: %s", exc)
+            return
+        with self._qlock:
+            if len(self._wave_queue) >= self.queue_size:
+                self._wave_queue.popleft()
+                self._waveform_dropped += 1
+            self._wave_queue.append((str(bearing_id), rows))
+
+    @property
+    def waveform_dropped(self) -> int:
+        """Batches of accelerometer samples dropped because their queue was full."""
+        return self._waveform_dropped
+
+    @property
+    def alarms_logged(self) -> int:
+        """Alarm events sent to the outputs."""
+        return self._alarms_logged
+
+    @property
+    def alarms_dropped(self) -> int:
+        """Alarm events dropped because their queue was full."""
+        return self._alarms_dropped
+
     @property
     def dropped(self) -> int:
         """Snapshots dropped because the queue was full (or published after close)."""
@@ -814,6 +882,22 @@ class RerunRecorder:
         with self._qlock:
             items = list(self._queue)
             self._queue.clear()
+            alarms = list(self._alarm_queue)
+            self._alarm_queue.clear()
+            waves = list(self._wave_queue)
+            self._wave_queue.clear()
+        for bearing_id, wave_rows in waves:
+            tw = self._twins.get(bearing_id)
+            if tw is not None:
+                for w in wave_rows:
+                    if w.seq < 0:          # no seq given: the snapshot it came with is the last one seen
+                        w.seq = tw.last_seq if tw.last_seq is not None else 0
+                tw.wave_rows.extend(wave_rows)
+        for row in alarms:
+            tw = self._twins.get(row.bearing_id)
+            if tw is not None:
+                tw.alarm_rows.append(row)
+                tw.alarm_states[row.alarm_id] = row.state
         if not items:
             return
         if not self._outputs():        # nowhere to write (no file, no viewer): nothing to convert
@@ -875,14 +959,27 @@ class RerunRecorder:
         sent = 0
         for tw in self._twins.values():
             rows, tw.rows = tw.rows, []
+            alarm_rows, tw.alarm_rows = tw.alarm_rows, []
+            wave_rows, tw.wave_rows = tw.wave_rows, []
             if not outs:
                 continue
             triples: list = []
             try:
+                if tw.alarm_carry and (rows or alarm_rows):
+                    first = rows[0] if rows else None
+                    carry, tw.alarm_carry = tw.alarm_carry, {}
+                    triples += C.alarm_states_in_force(
+                        tw, carry, first.time_s if first else alarm_rows[0].time_s,
+                        first.seq if first else alarm_rows[0].seq, tw.time_offset_s)
+                if alarm_rows:
+                    triples += C.alarm_columns(tw, alarm_rows, tw.time_offset_s)
+                if wave_rows:
+                    triples += C.waveform_columns(tw, wave_rows, tw.time_offset_s)
                 if rows:
                     batch = C.Batch.of(rows, tw.time_offset_s)
                     C.fast_columns(tw, batch)
                     C.events(tw, batch)
+                    C.vibration_columns(tw, batch)
                     batch.breaks(C.scalar_paths(tw, slow=False), tw.time_offset_s, tw.prev_time_s)
                     triples += batch.out
                     tw.prev_time_s = rows[-1].time_s
@@ -900,6 +997,7 @@ class RerunRecorder:
                     for out in outs:
                         out.stream.send_columns(path, indexes=indexes, columns=columns)
                 sent += len(rows)
+                self._alarms_logged += len(alarm_rows)
             except Exception:
                 self._errors += len(rows)
                 log.exception("rerun recorder: %d rows of %s lost", len(rows), tw.bearing_id)

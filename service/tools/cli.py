@@ -205,6 +205,9 @@ def build_parser() -> argparse.ArgumentParser:
                        "0.0.0.0 exposes the API on every interface) [BEARING_TWIN_HOST]")
     serve.add_argument("--port", type=int, help="HTTP port (default 8000) [BEARING_TWIN_PORT]")
     serve.add_argument("--bearing", help="designation of the `default` twin (default 6208) [BEARING_TWIN_BEARING]")
+    serve.add_argument("--housing", action="store_true", default=None,
+                       help="the `default` twin runs on the housing support with the accelerometer "
+                       "(vibration; default off) [BEARING_TWIN_HOUSING]")
     serve.add_argument("--twin-id", metavar="ID",
                        help="name of the twin started with the service (default `default`; give "
                        "each service on one zenoh network its own) [BEARING_TWIN_TWIN_ID]")
@@ -370,7 +373,7 @@ def _serve_settings(args: argparse.Namespace):
     from service.settings import ServiceSettings
 
     overrides = {}
-    for flag, name in (("host", "host"), ("port", "port"), ("bearing", "bearing"), ("twin_id", "twin_id"),
+    for flag, name in (("host", "host"), ("port", "port"), ("bearing", "bearing"), ("housing", "housing"), ("twin_id", "twin_id"),
                        ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
                        ("zenoh_mode", "zenoh_mode"), ("zenoh_prefix", "zenoh_prefix"), ("record", "record"),
                        ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),
@@ -495,6 +498,16 @@ def _cmd_scenario_check(args: argparse.Namespace) -> int:
     return status
 
 
+def _alarm_settings_from_env():
+    """`BEARING_TWIN_ALARMS` (JSON, as for `serve`), or None for the defaults."""
+    import os
+
+    from service.settings import AlarmSettings
+
+    text = os.environ.get("BEARING_TWIN_ALARMS")
+    return AlarmSettings.model_validate_json(text) if text else None
+
+
 def _cmd_scenario_run(args: argparse.Namespace) -> int:
     from service.tools.offline import TableSink, run_scenario, write_table
     from service.core.scenarios import ScenarioError, load_scenario
@@ -507,6 +520,11 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
         return 2
     for w in scenario.warnings:
         print(f"warning: {w}", file=sys.stderr)
+    try:
+        alarm_settings = _alarm_settings_from_env()
+    except ValueError as exc:                   # pydantic's ValidationError is a ValueError
+        print(f"error: BEARING_TWIN_ALARMS: {' '.join(str(exc).split())[:300]}", file=sys.stderr)
+        return 2
     for path, suffixes in ((args.record, (".rrd",)), (args.table, (".parquet", ".pq", ".csv"))):
         if path is not None and not path.lower().endswith(suffixes):
             print(f"error: {path}: expected a file ending in {' or '.join(suffixes)}", file=sys.stderr)
@@ -531,7 +549,7 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
     try:
         written: list = []
         results = run_scenario(scenario, record=args.record, table=table, progress=progress,
-                               on_recording=written.append)
+                               on_recording=written.append, alarms=alarm_settings)
     except ScenarioError as exc:
         if bar is not None:
             bar.close()
@@ -547,6 +565,8 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
                    f"status {snap.status}") if snap is not None and lam else (f"status {snap.status}" if snap else "")
         print(f"  {r.run.id} ({r.run.label}): {r.state}, {r.rows} samples, {r.wall_s:.1f} s wall; {summary}"
               + (f"; error: {r.error}" if r.error else ""))
+        for e in r.alarms:
+            print(f"    alarm at {e.time_s:.3f} s: {e.message}")
         if r.state != "done":
             status = 1
     if args.table:

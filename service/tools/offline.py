@@ -1,6 +1,9 @@
 """Run a scenario offline in fast mode (`bearing-twin scenario run`): a fresh twin per run, the
 same `TwinRunner` and scenario executor as the service, a per-sample table (pyarrow: Parquet, or
-CSV by extension) and optionally a rerun recording.
+CSV by extension) and optionally a rerun recording. The alarms of `service.core.alarms` follow
+every run as in the service (an `AlarmHub` sink, `AlarmSettings` given or the defaults): their
+events are in `RunResult.alarms` and, with a recording, in its `alarms/` and `alarm_states/`
+entities.
 
 Table: one row per sample (every `sample_every_s` of simulated time, plus the start and the end
 of each run), columns
@@ -17,13 +20,16 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from service.core.alarm_hub import AlarmHub
+from service.core.alarms import AlarmEvent
 from service.core.runner import TwinRunner
 from service.core.scenario_driver import ScenarioHandle
 from service.core.scenarios import ResolvedRun, Scenario
+from service.settings import AlarmSettings
 from twin.engine import Twin
 from twin.snapshot import Snapshot
 
@@ -66,6 +72,7 @@ class RunResult:
     final: Snapshot | None
     state: str
     error: str | None
+    alarms: list[AlarmEvent] = field(default_factory=list)   # the run's alarm events, in order
 
 
 class TableSink:
@@ -124,13 +131,15 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
                  table: TableSink | None = None, frame_s: float = 0.001,
                  progress: Callable[[float], None] | None = None,
                  timeout_factor: float = 200.0, min_timeout_s: float = 120.0,
-                 on_recording: Callable[[Path], None] | None = None) -> list[RunResult]:
+                 on_recording: Callable[[Path], None] | None = None,
+                 alarms: AlarmSettings | None = None) -> list[RunResult]:
     """Run every run of a scenario in fast mode, each on a fresh warm-started twin.
 
     `progress(simulated seconds done over all runs)` is called about 10 times a second.
-    `record`: an .rrd with every run as `bearing/<run id>/...` (lossless queue); an existing file of
-    that name is never overwritten (the recorder writes `<stem>.run2.rrd` beside it), and
-    `on_recording(path)` is told the file actually written."""
+    `record`: an .rrd with every run as `bearing/<run id>/...` (lossless queue), alarm events
+    included; an existing file of that name is never overwritten (the recorder writes
+    `<stem>.run2.rrd` beside it), and `on_recording(path)` is told the file actually written.
+    `alarms`: thresholds and delays of the alarms (default `AlarmSettings()`)."""
     table = table if table is not None else TableSink()
     recorder = None
     if record is not None:
@@ -139,6 +148,10 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
         recorder = RerunRecorder(record, queue_size=1_000_000)
         if on_recording is not None and recorder.path is not None:
             on_recording(recorder.path)
+    settings = alarms or AlarmSettings()
+    hub = AlarmHub(settings, queue_size=1_000_000)     # lossless: every sample is judged
+    if recorder is not None:
+        hub.subscribe(recorder.log_alarm)
     scenario.check_bearing_limits()        # every run, before any runs (as `scenario check`)
     runs = scenario.resolved_runs()
     results: list[RunResult] = []
@@ -151,6 +164,8 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
             runner = TwinRunner(twin, fast=True, publish_rate_hz=1.0 / run.sample_every_s,
                                 frame_s=min(frame_s, run.sample_every_s), idle_without_scenario=True)
             runner.add_sink(table)
+            hub.add_twin(bearing_id)
+            runner.add_sink(hub)
             if recorder is not None:
                 recorder.add_twin_from(twin, context=lambda runner=runner: runner.scenario)
                 runner.add_sink(recorder)
@@ -171,6 +186,7 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
                         break
             finally:
                 runner.stop(timeout=10.0)
+                hub.wait_idle(60.0)
             done_s += run.duration_s
             if progress is not None:
                 progress(done_s)
@@ -178,8 +194,10 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
             state = handle.state if not runner.failed else "failed"
             results.append(RunResult(run=run, rows=len(table.rows) - rows_before,
                                      wall_s=time.perf_counter() - t_wall, final=runner.latest,
-                                     state=state, error=error))
+                                     state=state, error=error, alarms=hub.events(bearing_id)))
+            hub.forget(bearing_id)
     finally:
+        hub.close()
         if recorder is not None:
             recorder.close()
     return results

@@ -140,14 +140,16 @@ def test_acl_rules_are_default_deny_and_per_role():
     def allowed(role, message, flow):
         return {k for r in by_role[role] if message in r["messages"] and flow in r["flows"] for k in r["key_exprs"]}
     # canonical keys: `**/*` is written `*/**`
-    assert allowed("writers", "put", "ingress") == {"plant1/*/**/setpoint"}
+    assert allowed("writers", "put", "ingress") == {"plant1/*/**/setpoint", "plant1/*/**/defects"}
     assert allowed("readers", "put", "ingress") == set()                # a reader never writes
     assert "plant1/*/**/setpoint" not in allowed("readers", "put", "egress")  # nor sees setpoints
     assert allowed("readers", "liveliness_token", "ingress") == set()   # nor declares a twin
     assert allowed("readers", "reply", "ingress") == set()              # nor answers a query
     assert allowed("services", "liveliness_token", "ingress") == {"plant1/*/**/alive"}
-    assert allowed("services", "put", "ingress") == {"plant1/*/**/state", "plant1/*/**/ball/*",
-                                                     "plant1/*/**/setpoint/result"}
+    assert allowed("services", "put", "ingress") == {
+        "plant1/*/**/state", "plant1/*/**/ball/*", "plant1/*/**/setpoint/result", "plant1/*/**/defects/result",
+        "plant1/*/**/alarm", "plant1/*/**/vibration", "plant1/*/**/vibration/waveform"}
+    assert "plant1/*/**/defects" not in allowed("readers", "put", "egress")   # nor sees defect writes
     assert {s["id"] for s in acl["subjects"]} >= {"writers-users", "writers-certs"}
     assert set(ROLE_RULES) == {"services", "writers", "readers"}
     # an empty role grants nothing (no rule, no subject)

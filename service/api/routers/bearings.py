@@ -49,7 +49,7 @@ def create_bearing(body: BearingCreate, registry: RegistryDep) -> BearingInfo:
     lubricant (warm-started at the optional initial setpoint)."""
     return bearing_info(registry.create_twin(
         id=body.id, designation=body.designation, diametral_clearance_m=body.diametral_clearance_m,
-        lubricant=body.lubricant, setpoint=body.setpoint, thermal=body.thermal))
+        lubricant=body.lubricant, setpoint=body.setpoint, thermal=body.thermal, housing=body.housing))
 
 
 @write.delete("/{bearing_id}", responses={**UNKNOWN_TWIN, **INVALID})

@@ -190,28 +190,38 @@ def test_life_used_alarm():
 
 # ---- defect lines and vibration from synthetic indicator inputs --------------------------------
 def _indicator_lines(bpfo: float, others: float = 0.05) -> dict:
-    """The shape of twin.vibration.indicators.defect_line_amplitudes (fundamental first)."""
+    """The snapshot's `vibration.envelope_lines` (twin.snapshot.DefectLine as dicts, fundamental first)."""
     return {name: {"frequency_hz": f, "harmonics": [a, 0.5 * a, 0.25 * a]}
             for name, f, a in (("ftf", 15.0, others), ("bpfo", 107.0, bpfo), ("bpfi", 162.0, others),
                                ("bsf", 70.0, others), ("two_bsf", 140.0, others))}
 
 
-def test_vibration_inputs_read_the_indicator_shapes():
-    v = vibration_inputs({"velocity_rms_mm_s": 3.2, "defect_lines": _indicator_lines(2.0), "noise_floor_m_s2": 0.1})
+def test_vibration_inputs_read_the_snapshot_fields():
+    v = vibration_inputs({"velocity_rms_mm_s": 3.2, "envelope_lines": _indicator_lines(2.0),
+                          "envelope_noise_floor_m_s2": 0.1})
     assert v.velocity_rms_mm_s == 3.2 and v.noise_floor_m_s2 == 0.1
-    assert v.line_amplitudes_m_s2["bpfo"] == 2.0 and v.line_amplitudes_m_s2["bpfi"] == 0.05
-    flat = vibration_inputs(SimpleNamespace(velocity_rms_mm_s=None, bpfo_m_s2=1.5))
-    assert flat.velocity_rms_mm_s is None and flat.line_amplitudes_m_s2 == {"bpfo": 1.5}
+    assert v.line_amplitudes_m_s2 == {"ftf": 0.05, "bpfo": 2.0, "bpfi": 0.05, "bsf": 0.05, "two_bsf": 0.05}
     assert vibration_inputs(None) is None
+    # the pydantic block itself (twin.snapshot.VibrationState) reads the same
+    from twin.snapshot import VibrationState
+
+    block = VibrationState.model_validate({
+        "window_end_s": 1.0, "window_s": 1.0, "sample_rate_hz": 51200.0, "shaft_speed_rad_s": 500.0,
+        "contact_angle_rad": 0.0, "rms_m_s2": 1.0, "peak_m_s2": 4.0, "crest_factor": 4.0, "kurtosis": 3.0,
+        "band_kurtosis": 3.0, "velocity_rms_mm_s": 3.2,
+        "defect_frequencies_hz": {"ftf": 15.0, "bpfo": 107.0, "bpfi": 162.0, "bsf": 70.0, "two_bsf": 140.0},
+        "envelope_band_hz": [10000.0, 20000.0], "envelope_peaks_hz": [],
+        "envelope_noise_floor_m_s2": 0.1, "envelope_lines": _indicator_lines(2.0)})
+    assert vibration_inputs(block) == v
 
 
 def test_outer_race_defect_raises_the_vibration_and_bpfo_alarms_only():
     """An outer-race spall: broadband velocity up to zone D and the BPFO envelope line 20x the
     floor; the other lines at the floor stay quiet."""
     ev = AlarmEvaluator("b1", AlarmSettings(defect_amplitude_m_s2=0.5, defect_significance=4.0))
-    healthy = {"velocity_rms_mm_s": 1.0, "defect_lines": _indicator_lines(0.1, 0.1), "noise_floor_m_s2": 0.1}
+    healthy = {"velocity_rms_mm_s": 1.0, "envelope_lines": _indicator_lines(0.1, 0.1), "envelope_noise_floor_m_s2": 0.1}
     assert ev.update(inputs_from_snapshot({**_snapshot(0.0, 2.0), "vibration": healthy})) == []
-    faulty = {"velocity_rms_mm_s": 5.0, "defect_lines": _indicator_lines(2.0, 0.1), "noise_floor_m_s2": 0.1}
+    faulty = {"velocity_rms_mm_s": 5.0, "envelope_lines": _indicator_lines(2.0, 0.1), "envelope_noise_floor_m_s2": 0.1}
     events = {e.alarm_id: e for e in ev.update(inputs_from_snapshot({**_snapshot(0.1, 2.0), "vibration": faulty}))}
     assert set(events) == {"vibration_zone", "defect_bpfo"}
     assert events["vibration_zone"].severity == "critical"
@@ -221,7 +231,7 @@ def test_outer_race_defect_raises_the_vibration_and_bpfo_alarms_only():
 
 def test_defect_threshold_rises_with_the_noise_floor():
     ev = AlarmEvaluator("b1", AlarmSettings(defect_amplitude_m_s2=0.5, defect_significance=4.0))
-    noisy = {"defect_lines": _indicator_lines(2.0), "noise_floor_m_s2": 0.6}    # 4 x 0.6 = 2.4 > 2.0
+    noisy = {"envelope_lines": _indicator_lines(2.0), "envelope_noise_floor_m_s2": 0.6}    # 4 x 0.6 = 2.4 > 2.0
     assert [e for e in ev.update(inputs_from_snapshot({**_snapshot(0.0, 2.0), "vibration": noisy}))
             if e.alarm_id == "defect_bpfo"] == []
     (state,) = [a for a in ev.states() if a.alarm_id == "defect_bpfo"]
