@@ -45,7 +45,7 @@ def groove_penetration(px, py, pz, groove_centre_radius, groove_centre_z, groove
     return d - (groove_radius - ball_radius), dx * inv_d, dy * inv_d, dz * inv_d
 
 
-@njit(**JIT_VECTOR)
+@njit(inline="always", **JIT_VECTOR)
 def raceway_geometry(w, nc):
     """`groove_penetration` for every contact lane at once (vectorised, branch-free): reads
     K_PX..K_PZ and the M_* groove rows, writes G_DELTA, G_NX..G_NZ, G_SQRT_DELTA and
@@ -72,7 +72,7 @@ def raceway_geometry(w, nc):
         w[G_LOAD * CW + c] = w[M_STIFFNESS * CW + c] * pos * sq
 
 
-@njit(**JIT_VECTOR)
+@njit(inline="always", **JIT_VECTOR)
 def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     """Seed 000 eq. 8 for every contact lane at once (vectorised, branch-free):
 

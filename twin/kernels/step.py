@@ -9,7 +9,7 @@ import math
 
 from numba import njit
 
-from twin.jit import JIT
+from twin.jit import JIT, JIT_STEP
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
     A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, G_NZ,
@@ -49,7 +49,9 @@ SPIN_CREEP_FACTOR = 1.3
 # budget). A contact that has just closed gets its RC at once.
 ELECTRICAL_EVERY = 10
 
-FRICTION_ELLIPSE = 2  # P_FRICTION_MODEL code of the friction over the contact ellipse
+FRICTION_ELLIPSE = 2
+
+SMALL_ANGLE = 1e-2  # [rad] below it `_cos_sin` takes the series  # P_FRICTION_MODEL code of the friction over the contact ellipse
 
 
 @njit(inline="always", **JIT)
@@ -60,7 +62,20 @@ def _at_angle(table, r, i, f, col):
     return lo + f * (table[r, i + 1, col] - lo)
 
 
-@njit(**JIT)
+@njit(inline="always", **JIT)
+def _cos_sin(x):
+    """(cos x, sin x); for |x| <= SMALL_ANGLE their Taylor series to x^7, exact to the last bit
+    there (the next terms are below 3e-21), without the library call: the step's half turn of
+    the cage is ~3e-4 rad at the auto step (a sincos call was ~2 % of the step)."""
+    if abs(x) <= SMALL_ANGLE:
+        x2 = x * x
+        c = 1.0 - x2 * (0.5 - x2 * (1.0 / 24.0 - x2 * (1.0 / 720.0)))
+        s = x * (1.0 - x2 * (1.0 / 6.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 5040.0))))
+        return c, s
+    return math.cos(x), math.sin(x)
+
+
+@njit(inline="always", **JIT_STEP)
 def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
                           tribology_now, electrical_now, traction_now):
     """Forces and torques of every contact at the current positions -> accelerations of the
@@ -199,6 +214,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         if traction_now:
             ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
         apply_traction_moments(w, nc)
+    inv_inertia = 1.0 / inertia  # multiplications, not 6 Z divisions per step
     ring_fx = 0.0
     ring_fy = 0.0
     ring_fz = 0.0
@@ -209,9 +225,9 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         ba[j, 0] = w[O_FX * CW + ci] + w[O_FX * CW + co]
         ba[j, 1] = w[O_FY * CW + ci] + w[O_FY * CW + co]
         ba[j, 2] = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
-        balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) / inertia
-        balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) / inertia
-        balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) / inertia
+        balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) * inv_inertia
+        balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) * inv_inertia
+        balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) * inv_inertia
         ring_fx -= w[O_FX * CW + ci]
         ring_fy -= w[O_FY * CW + ci]
         ring_fz -= w[O_FZ * CW + ci]
@@ -230,6 +246,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     first_c = prev_c
     first_s = prev_s
     cage_tz = 0.0
+    inv_m = 1.0 / m
     for j in range(z):
         fx = ba[j, 0]
         fy = ba[j, 1]
@@ -251,13 +268,13 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             cage_tz -= ex * f * ny - ey * f * nx
         prev_c = next_c
         prev_s = next_s
-        ba[j, 0] = fx / m
-        ba[j, 1] = fy / m
-        ba[j, 2] = fz / m
-    mr = p[P_RING_MASS]
-    ra[0] = (ring_fx + sp[S_RADIAL_LOAD]) / mr
-    ra[1] = ring_fy / mr
-    ra[2] = (ring_fz + sp[S_AXIAL_LOAD]) / mr
+        ba[j, 0] = fx * inv_m
+        ba[j, 1] = fy * inv_m
+        ba[j, 2] = fz * inv_m
+    inv_mr = 1.0 / p[P_RING_MASS]
+    ra[0] = (ring_fx + sp[S_RADIAL_LOAD]) * inv_mr
+    ra[1] = ring_fy * inv_mr
+    ra[2] = (ring_fz + sp[S_AXIAL_LOAD]) * inv_mr
     scal[X_DRIVE_TORQUE] = -ring_tz
     scal[X_CAGE_TORQUE] = cage_tz
     if not (math.isfinite(ra[0]) and math.isfinite(ra[1]) and math.isfinite(ra[2])
@@ -268,7 +285,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     return STATUS_OK
 
 
-@njit(**JIT)
+@njit(**JIT_STEP)
 def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n):
     """Advance n steps of dt (seed 000 eq. 10, velocity-Verlet; velocity-dependent forces use the
     half-step velocity turned on by the cage's half-step rotation). The shaft speed moves towards its setpoint at the ramp rate; the torque
@@ -310,9 +327,7 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
         # the cage's rotation (exact for the steady orbit): without it the velocities and spin
         # axes lag the positions by half a step of the orbit, an O(dt) error (3 % of the 7208's
         # friction torque at 1 us, 10 % at 4 us); the rotation is undone after the forces
-        turn = half * scal[X_CAGE_SPEED]
-        ct = math.cos(turn)
-        st = math.sin(turn)
+        ct, st = _cos_sin(half * scal[X_CAGE_SPEED])
         for j in range(z):
             vx = bv[j, 0]
             bv[j, 0] = ct * vx - st * bv[j, 1]
@@ -346,7 +361,7 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
     return status, done
 
 
-@njit(**JIT)
+@njit(**JIT_STEP)
 def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load):
     """Contact forces, tribology and accelerations at the current state without advancing time
     (used after a warm start). Returns the status."""
