@@ -67,6 +67,9 @@ def make_state(model: BearingModel) -> TwinState:
         rows[L.M_GROOVE_CLEARANCE, r:2 * z:2] = (model.race_params[r, L.R_GROOVE_RADIUS]
                                                   - model.ball_radius_m)
         rows[L.M_STIFFNESS, r:2 * z:2] = model.race_params[r, L.R_STIFFNESS]
+    # pad lanes (layout.LANE_BLOCK): outer-race constants, like the last contact they copy
+    rows[L.M_GROOVE_CENTRE_RADIUS:L.M_STIFFNESS + 1, 2 * z:L.padded_lane_count(2 * z)] = \
+        rows[L.M_GROOVE_CENTRE_RADIUS:L.M_STIFFNESS + 1, 2 * z - 1:2 * z]
     return TwinState(
         scalars=np.zeros(L.N_SCALARS),
         ball_position_m=np.zeros((z, 3)), ball_velocity_m_s=np.zeros((z, 3)),

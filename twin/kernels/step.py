@@ -22,7 +22,7 @@ from twin.kernels.layout import (
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
     P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
-    P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
+    P_RING_MASS, P_ROLLING, LANE_BLOCK, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
@@ -77,7 +77,7 @@ def _cos_sin(x):
 
 @njit(inline="always", **JIT_STEP)
 def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                          tribology_now, electrical_now, traction_now):
+                          tribology_now, electrical_now, traction_now, ct, st):
     """Forces and torques of every contact at the current positions -> accelerations of the
     balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
 
@@ -86,7 +86,12 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     loaded contacts when `tribology_now` (or when a contact closes), clear opened contacts.
     The refresh takes each contact's Hertz stiffness (its lane M_STIFFNESS, read by the next
     geometry pass) and film constants at its current contact angle from the model's angle table
-    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|). Returns a status code."""
+    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|).
+
+    The forces see the balls' velocities and angular velocities turned about the axis by the
+    angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
+    (1, 0) for none), as they are read: bv and bw themselves are left as they are.
+    Returns a status code."""
     z = bx.shape[0]
     nc = 2 * z
     rb = p[P_BALL_RADIUS]
@@ -101,36 +106,68 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     ring_speed = scal[X_SHAFT_SPEED]
     cage_speed = scal[X_CAGE_SPEED]
     eta = sp[S_VISCOSITY]
-    # gather (c = 2 j + r; r = 0 inner ring, r = 1 fixed outer ring)
+    # gather (c = 2 j + r; r = 0 inner ring, r = 1 fixed outer ring); the ring's state is read
+    # once (the compiler cannot keep it in registers across stores to w, which it may alias)
+    rx0 = rx[0]
+    rx1 = rx[1]
+    rx2 = rx[2]
+    rv0 = rv[0]
+    rv1 = rv[1]
+    rv2 = rv[2]
     for j in range(z):
         x0 = bx[j, 0]
         x1 = bx[j, 1]
         x2 = bx[j, 2]
-        v0 = bv[j, 0]
-        v1 = bv[j, 1]
+        v0 = ct * bv[j, 0] - st * bv[j, 1]  # turned velocities (docstring)
+        v1 = st * bv[j, 0] + ct * bv[j, 1]
+        v2 = bv[j, 2]
+        w0 = ct * bw[j, 0] - st * bw[j, 1]
+        w1 = st * bw[j, 0] + ct * bw[j, 1]
+        w2 = bw[j, 2]
         rho2 = x0 * x0 + x1 * x1
         orbital = (x0 * v1 - x1 * v0) / rho2 if rho2 > 0.0 else 0.0
-        for r in range(2):
-            c = 2 * j + r
-            inner = r == 0
-            w[K_PX * CW + c] = x0 - rx[0] if inner else x0
-            w[K_PY * CW + c] = x1 - rx[1] if inner else x1
-            w[K_PZ * CW + c] = x2 - rx[2] if inner else x2
-            w[K_BX * CW + c] = x0
-            w[K_BY * CW + c] = x1
-            w[K_VX * CW + c] = v0
-            w[K_VY * CW + c] = v1
-            w[K_VZ * CW + c] = bv[j, 2]
-            w[K_WX * CW + c] = bw[j, 0]
-            w[K_WY * CW + c] = bw[j, 1]
-            w[K_WZ * CW + c] = bw[j, 2]
-            w[K_OVX * CW + c] = rv[0] if inner else 0.0
-            w[K_OVY * CW + c] = rv[1] if inner else 0.0
-            w[K_OVZ * CW + c] = rv[2] if inner else 0.0
-            w[K_SPIN * CW + c] = ring_speed if inner else 0.0
-            w[K_ORBIT * CW + c] = orbital
-    raceway_geometry(w, nc)
-    raceway_forces(w, nc, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
+        ci = 2 * j
+        co = ci + 1
+        w[K_PX * CW + ci] = x0 - rx0
+        w[K_PX * CW + co] = x0
+        w[K_PY * CW + ci] = x1 - rx1
+        w[K_PY * CW + co] = x1
+        w[K_PZ * CW + ci] = x2 - rx2
+        w[K_PZ * CW + co] = x2
+        w[K_BX * CW + ci] = x0
+        w[K_BX * CW + co] = x0
+        w[K_BY * CW + ci] = x1
+        w[K_BY * CW + co] = x1
+        w[K_VX * CW + ci] = v0
+        w[K_VX * CW + co] = v0
+        w[K_VY * CW + ci] = v1
+        w[K_VY * CW + co] = v1
+        w[K_VZ * CW + ci] = v2
+        w[K_VZ * CW + co] = v2
+        w[K_WX * CW + ci] = w0
+        w[K_WX * CW + co] = w0
+        w[K_WY * CW + ci] = w1
+        w[K_WY * CW + co] = w1
+        w[K_WZ * CW + ci] = w2
+        w[K_WZ * CW + co] = w2
+        w[K_OVX * CW + ci] = rv0
+        w[K_OVX * CW + co] = 0.0
+        w[K_OVY * CW + ci] = rv1
+        w[K_OVY * CW + co] = 0.0
+        w[K_OVZ * CW + ci] = rv2
+        w[K_OVZ * CW + co] = 0.0
+        w[K_SPIN * CW + ci] = ring_speed
+        w[K_SPIN * CW + co] = 0.0
+        w[K_ORBIT * CW + ci] = orbital
+        w[K_ORBIT * CW + co] = orbital
+    # pad lanes up to a whole number of vectors: a copy of the last contact, so that the lane
+    # passes run without a scalar remainder on finite values nobody reads (twin.kernels.layout)
+    nl = (nc + LANE_BLOCK - 1) // LANE_BLOCK * LANE_BLOCK  # layout.padded_lane_count
+    for c in range(nc, nl):
+        for k in range(K_PX, K_ORBIT + 1):
+            w[k * CW + c] = w[k * CW + nc - 1]
+    raceway_geometry(w, nl)
+    raceway_forces(w, nl, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
     # per contact: outputs, tribology refresh, opened contacts
     max_pen = scal[X_MAX_PENETRATION]
     for c in range(nc):
@@ -213,7 +250,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     if friction_model == FRICTION_ELLIPSE:  # friction over the contact ellipse (twin.kernels.traction)
         if traction_now:
             ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
-        apply_traction_moments(w, nc)
+        apply_traction_moments(w, nl)
     inv_inertia = 1.0 / inertia  # multiplications, not 6 Z divisions per step
     ring_fx = 0.0
     ring_fy = 0.0
@@ -251,6 +288,8 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         fx = ba[j, 0]
         fy = ba[j, 1]
         fz = ba[j, 2]
+        v0 = ct * bv[j, 0] - st * bv[j, 1]
+        v1 = st * bv[j, 0] + ct * bv[j, 1]
         next_c = prev_c * c_step - prev_s * s_step
         next_s = prev_s * c_step + prev_c * s_step
         if j == z - 1:
@@ -259,7 +298,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         for slot in range(2):
             ex = rc * (next_c if slot == 0 else prev_c)
             ey = rc * (next_s if slot == 0 else prev_s)
-            f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], bv[j, 0], bv[j, 1],
+            f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], v0, v1,
                                          bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage)
             cage_load[j, slot] = f
             fx += f * nx
@@ -326,26 +365,13 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, n)
         # the forces at x(n+1) see the balls' velocities at n+1/2 turned on by the half step of
         # the cage's rotation (exact for the steady orbit): without it the velocities and spin
         # axes lag the positions by half a step of the orbit, an O(dt) error (3 % of the 7208's
-        # friction torque at 1 us, 10 % at 4 us); the rotation is undone after the forces
+        # friction torque at 1 us, 10 % at 4 us); compute_accelerations turns them as it reads
+        # them (the state's velocities stay unturned)
         ct, st = _cos_sin(half * scal[X_CAGE_SPEED])
-        for j in range(z):
-            vx = bv[j, 0]
-            bv[j, 0] = ct * vx - st * bv[j, 1]
-            bv[j, 1] = st * vx + ct * bv[j, 1]
-            wx = bw[j, 0]
-            bw[j, 0] = ct * wx - st * bw[j, 1]
-            bw[j, 1] = st * wx + ct * bw[j, 1]
         status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w,
                                        cage_load, step % substeps == 0,
                                        step % (substeps * ELECTRICAL_EVERY) == 0,
-                                       step % (substeps * traction_every) == 0)  # a tribology step
-        for j in range(z):
-            vx = bv[j, 0]
-            bv[j, 0] = ct * vx + st * bv[j, 1]
-            bv[j, 1] = -st * vx + ct * bv[j, 1]
-            wx = bw[j, 0]
-            bw[j, 0] = ct * wx + st * bw[j, 1]
-            bw[j, 1] = -st * wx + ct * bw[j, 1]
+                                       step % (substeps * traction_every) == 0, ct, st)  # a tribology step
         scal[X_TORQUE_SUM] += scal[X_DRIVE_TORQUE]
         scal[X_TORQUE_COUNT] += 1.0
         done = it + 1
@@ -366,4 +392,4 @@ def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load):
     """Contact forces, tribology and accelerations at the current state without advancing time
     (used after a warm start). Returns the status."""
     return compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                                 True, True, True)
+                                 True, True, True, 1.0, 0.0)
