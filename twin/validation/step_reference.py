@@ -38,7 +38,7 @@ def reference_outputs(case: tuple, settle_s: float = 0.01, window_s: float = 0.0
     twin = Twin(catalog.bearing(designation), options=ModelOptions(time_step_s=dt),
                 setpoint=Setpoint(shaft_speed_rad_s=speed, radial_load_n=fr, axial_load_n=fa))
     twin.advance(settle_s)
-    frames = int(round(window_s / 1e-3))
+    frames = round(window_s / 1e-3)
     loads, lams, torque, cage, ring = [], [], [], [], []
     for _ in range(frames):
         twin.advance(1e-3)

@@ -1,17 +1,23 @@
-"""Per-pass timing of one step (issue 13): gather, geometry, forces, tribology, cage, integration.
+"""Per-pass timing of one step (issue 13): gather, geometry, forces, tribology, traction, cage,
+integration.
 
 `twin.kernels.step.compute_accelerations` runs its passes inline in one compiled function, so a
 profiler cannot split them. This harness times each pass on its own, on a copy of a settled
-twin's state, each in its own compiled loop of `reps` calls (no Python between calls):
+twin's state, each in its own compiled loop of `reps` calls (no Python between calls), in CPU
+time of the calling thread (what the pass costs, not the waits for a core on a shared machine):
 
-- geometry, forces: the kernel's own `raceway_geometry` and `raceway_forces` on the lanes;
+- geometry, forces: the kernel's own `raceway_geometry` and `raceway_forces` on the lanes padded
+  to whole vectors as the step runs them (`layout.padded_lane_count`);
 - tribology: the kernel's per-contact pass (copy of its loop) with the kernel's own
   `contact_tribology` and `contact_electrical`, timed without refresh, with the tribology
   refresh and with the electrical refresh too; per step it costs the first plus the refreshes
   divided by their periods in steps (the model's tribology sub-rate, x ELECTRICAL_EVERY);
+- traction: the kernel's own `apply_traction_moments` (every step) plus its `ellipse_traction`
+  (the strip solve) divided by its period in steps (tribology sub-rate x P_TRACTION_EVERY);
 - gather (the lanes filled from the ball and ring state), cage (the per-ball force sums and the
-  ball-cage contacts with the kernel's own `cage_contact`) and integration (the leapfrog kicks and
-  drifts of `step_n` with its co-rotating velocity turn): copies of the kernel's inline loops.
+  ball-cage contacts with the kernel's own `cage_contact`, on the velocities turned by the half
+  step of the cage) and integration (the leapfrog kicks and drifts of `step_n` and the turn's
+  cosine and sine): copies of the kernel's inline loops.
 
 The copies mirror `twin/kernels/step.py` as of this writing; `total` is `step_n` itself, so the
 sum of the passes against `total` shows how far the harness is from the real step (call
@@ -27,26 +33,27 @@ import time
 
 from numba import njit
 
-from twin.jit import JIT_STEP
+from twin.jit import JIT, JIT_STEP
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
     A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, C_XI_DECAY, G_NX, G_NY, G_NZ,
     C_CAPACITANCE, C_ENTRAINMENT, C_FLUID_DAMPING, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
     C_RESISTANCE, C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT,
-    C_SRR, C_TANGENT_DAMPING, CW, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
+    C_SRR, C_TANGENT_DAMPING, CW, E_SLIP, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
     K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, O_EX, O_EY,
     O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, P_ALPHA_E,
     P_ASPERITY_RESISTANCE, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS, P_CAGE_STIFFNESS,
-    P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_GAP_LIMIT, P_KT_RATIO, P_OIL_PERMITTIVITY,
-    P_OIL_RESISTIVITY, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED,
-    X_CAGE_TORQUE, X_SHAFT_SPEED,
+    P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_KT_RATIO, P_LIMITING_SHEAR,
+    P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY,
+    S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED, X_CAGE_TORQUE, X_SHAFT_SPEED, padded_lane_count,
 )
-from twin.kernels.step import (ELECTRICAL_EVERY, ROLLING_REGULARISATION_SPEED, SPIN_CREEP_FACTOR, _at_angle,
-                               _cos_sin, step_n)
+from twin.kernels.step import (ELECTRICAL_EVERY, FRICTION_ELLIPSE, ROLLING_REGULARISATION_SPEED,
+                               SPIN_CREEP_FACTOR, _at_angle, _cos_sin, step_n)
+from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 
-PASSES = ("gather", "geometry", "forces", "tribology", "cage", "integration")
+PASSES = ("gather", "geometry", "forces", "tribology", "traction", "cage", "integration")
 
 
 @njit(**JIT_STEP)
@@ -147,7 +154,9 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
                 w[C_H_C * CW + c] = tri[1]
                 w[C_LAMBDA * CW + c] = tri[2]
                 w[C_REGIME * CW + c] = tri[3]
-                w[C_MU * CW + c] = tri[4]
+                mu_lim = (limiting_traction_coefficient(tri[2], p[P_LIMITING_SHEAR])
+                          if friction_model == FRICTION_ELLIPSE else tri[4])
+                w[C_MU * CW + c] = mu_lim
                 w[C_SEMI_MAJOR * CW + c] = tri[5]
                 w[C_SEMI_MINOR * CW + c] = tri[6]
                 w[C_FLUID_DAMPING * CW + c] = tri[7]
@@ -160,7 +169,7 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
                 ab = math.sqrt(tri[5] * tri[6])
                 spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
                                + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
-                relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * tri[4] * q_el, 1e-12)
+                relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
                 w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
                 w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
                                       + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
@@ -170,13 +179,33 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
                     res_ohm, cap_f = contact_electrical(
                         q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
                         _at_angle(tr, r, ia, fa, t + T_RY),
-                        p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT], p[P_ASPERITY_RESISTANCE],
+                        p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER],
+                        p[P_ASPERITY_RESISTANCE],
                         p[P_OIL_RESISTIVITY])
                 else:
                     res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
                 w[C_RESISTANCE * CW + c] = res_ohm
                 w[C_CAPACITANCE * CW + c] = cap_f
     return max_pen
+
+
+@njit(**JIT_STEP)
+def _traction_moments(w, nl, reps):
+    for _ in range(reps):
+        apply_traction_moments(w, nl)
+    return w[O_TX * CW]
+
+
+@njit(**JIT)
+def _traction_solve(w, nc, p, eta, reps):
+    # every solve from the same warm start (the last solution of the running twin), not from the
+    # previous solve's own solution, which would converge at once
+    start = w[E_SLIP * CW:E_SLIP * CW + nc].copy()
+    for _ in range(reps):
+        for c in range(nc):
+            w[E_SLIP * CW + c] = start[c]
+        ellipse_traction(w, nc, p, eta, p[P_KT_RATIO], p[P_BALL_INERTIA], p[P_DT])
+    return w[O_TX * CW]
 
 
 @njit(**JIT_STEP)
@@ -278,7 +307,9 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     m, s = twin.model, twin.state
     p, tr, sp = m.params, m.angle_table, twin._setpoint_vector
     nc = 2 * m.ball_count
+    nl = padded_lane_count(nc)
     substeps = int(p[P_SUBSTEPS])
+    traction_steps = substeps * max(int(p[P_TRACTION_EVERY]), 1)
 
     def copies():
         args = [a.copy() for a in s.kernel_args()]
@@ -288,8 +319,10 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     ct, st = math.cos(0.5 * p[P_DT] * scal[X_CAGE_SPEED]), math.sin(0.5 * p[P_DT] * scal[X_CAGE_SPEED])
     runs = {
         "gather": lambda n: _gather(bx, bv, bw, rx, rv, scal, w, ct, st, n),
-        "geometry": lambda n: _geometry(w, nc, n),
-        "forces": lambda n: _forces(w, nc, p[P_BALL_RADIUS], p[P_DT], p[P_KT_RATIO], p[P_ALPHA_E], n),
+        "geometry": lambda n: _geometry(w, nl, n),
+        "forces": lambda n: _forces(w, nl, p[P_BALL_RADIUS], p[P_DT], p[P_KT_RATIO], p[P_ALPHA_E], n),
+        "traction_moments": lambda n: _traction_moments(w, nl, n),
+        "traction_solve": lambda n: _traction_solve(w, nc, p, sp[S_VISCOSITY], n),
         "tribology_no_refresh": lambda n: _tribology(p, tr, sp, w, nc, False, False, n),
         "tribology_refresh": lambda n: _tribology(p, tr, sp, w, nc, True, False, n),
         "tribology_refresh_electrical": lambda n: _tribology(p, tr, sp, w, nc, True, True, n),
@@ -299,7 +332,10 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
         fn(1)
     out = {}
     for name, fn in runs.items():
-        best, median = _best_median_ns(fn, reps, repeats)
+        if name == "traction_solve":  # a solve costs ~100 steps: a hundredth of the calls, per call
+            best, median = _best_median_ns(fn, max(reps // 100, 1), repeats)
+        else:
+            best, median = _best_median_ns(fn, reps, repeats)
         out[name] = {"best_ns": best, "median_ns": median}
     ig = copies()
     _integration(p, ig[0], ig[1], ig[2], ig[3], ig[4], ig[5], ig[6], ig[7], ig[8], 1)
@@ -311,6 +347,8 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     t0, t1, t2 = (out[k] for k in ("tribology_no_refresh", "tribology_refresh", "tribology_refresh_electrical"))
     out["tribology"] = {key: t0[key] + (t1[key] - t0[key]) / substeps
                         + (t2[key] - t1[key]) / (substeps * ELECTRICAL_EVERY) for key in ("best_ns", "median_ns")}
+    out["traction"] = {key: out["traction_moments"][key] + out["traction_solve"][key] / traction_steps
+                       for key in ("best_ns", "median_ns")}
     # the real step on a copy of the state
     st = copies()
     n_total = max(1000, reps // 10)
@@ -320,5 +358,6 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     out["sum_of_passes"] = {key: sum(out[k][key] for k in PASSES) for key in ("best_ns", "median_ns")}
     out["tribology_steps_per_refresh"] = substeps
     out["electrical_steps_per_refresh"] = substeps * ELECTRICAL_EVERY
+    out["traction_steps_per_solve"] = traction_steps
     return out
 
