@@ -40,3 +40,12 @@ JIT = dict(nogil=True, cache=True)
 # zero check and LLVM can vectorise them; their inputs never divide by zero (the ball centre is
 # never on the bearing axis nor on the groove-centre circle).
 JIT_VECTOR = dict(JIT, error_model="numpy")
+
+# The step (`twin.kernels.step.step_n`): numpy's error model too, so that the lane passes inlined
+# into it (numba-level `inline="always"`: no array crosses a call inside the loop, hence no
+# reference counting per pass) keep their vectorised form, and without numba's reference-counted
+# runtime (`_nrt=False`: the step allocates nothing, and the arrays it is given outlive the call;
+# with it, every inlined pass counted its array arguments up and down with atomic operations,
+# ~6 % of the step); a division by zero gives inf / NaN,
+# which the step's finiteness check reports as a status (python's model would raise instead).
+JIT_STEP = dict(JIT_VECTOR, _nrt=False)

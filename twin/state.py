@@ -123,6 +123,9 @@ def make_state(model: BearingModel) -> TwinState:
     ring = int(round(SAMPLE_RING_S * dec.output_rate_hz)) if dec is not None else 1
     orientation = workspace[L.W_ORIENTATION:L.W_ORIENTATION + 4 * z].reshape(z, 4)
     orientation[:, 0] = 1.0
+    # pad lanes (layout.LANE_BLOCK): outer-race constants, like the last contact they copy
+    rows[L.M_GROOVE_CENTRE_RADIUS:L.M_STIFFNESS + 1, 2 * z:L.padded_lane_count(2 * z)] = \
+        rows[L.M_GROOVE_CENTRE_RADIUS:L.M_STIFFNESS + 1, 2 * z - 1:2 * z]
     return TwinState(
         housing_displacement_m=np.zeros(N_HOUSING_DOF), housing_velocity_m_s=np.zeros(N_HOUSING_DOF),
         housing_acceleration_m_s2=np.zeros(N_HOUSING_DOF), ball_orientation=orientation,

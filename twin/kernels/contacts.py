@@ -45,7 +45,7 @@ def groove_penetration(px, py, pz, groove_centre_radius, groove_centre_z, groove
     return d - (groove_radius - ball_radius), dx * inv_d, dy * inv_d, dz * inv_d
 
 
-@njit(**JIT_VECTOR)
+@njit(inline="always", **JIT_VECTOR)
 def raceway_geometry(w, nc):
     """`groove_penetration` for every contact lane at once (vectorised, branch-free): reads
     K_PX..K_PZ and the M_* groove rows, writes G_DELTA, G_NX..G_NZ, G_SQRT_DELTA and
@@ -55,24 +55,23 @@ def raceway_geometry(w, nc):
         py = w[K_PY * CW + c]
         pz = w[K_PZ * CW + c]
         rho = math.sqrt(px * px + py * py)
-        scale = 1.0 - w[M_GROOVE_CENTRE_RADIUS * CW + c] / rho
-        dx = px * scale
-        dy = py * scale
+        # (dx, dy) = p (1 - R / rho), of length rho - R: one division, 1 / (rho d), for both
+        radial = rho - w[M_GROOVE_CENTRE_RADIUS * CW + c]
         dz = pz - w[M_GROOVE_CENTRE_Z * CW + c]
-        d = math.sqrt(dx * dx + dy * dy + dz * dz)
-        inv_d = 1.0 / d
+        d = math.sqrt(radial * radial + dz * dz)
+        inv = 1.0 / (rho * d)
         delta = d - w[M_GROOVE_CLEARANCE * CW + c]
         pos = max(delta, 0.0)
         sq = math.sqrt(pos)
         w[G_DELTA * CW + c] = delta
-        w[G_NX * CW + c] = dx * inv_d
-        w[G_NY * CW + c] = dy * inv_d
-        w[G_NZ * CW + c] = dz * inv_d
+        w[G_NX * CW + c] = px * radial * inv
+        w[G_NY * CW + c] = py * radial * inv
+        w[G_NZ * CW + c] = dz * rho * inv
         w[G_SQRT_DELTA * CW + c] = sq
         w[G_LOAD * CW + c] = w[M_STIFFNESS * CW + c] * pos * sq
 
 
-@njit(**JIT_VECTOR)
+@njit(inline="always", **JIT_VECTOR)
 def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     """Seed 000 eq. 8 for every contact lane at once (vectorised, branch-free):
 
@@ -166,11 +165,12 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         limit = w[C_MU * CW + c] * fn
         ft = math.sqrt(ftx * ftx + fty * fty + ftz * ftz)
         sliding = ft > limit
-        scale = limit / (ft + 1e-300) if sliding else 1.0
+        inv = 1.0 / ((ft + 1e-150) * (kt + 1e-150))  # one division for limit / ft and 1 / kt
+        scale = limit * (kt + 1e-150) * inv if sliding else 1.0
         ftx *= scale
         fty *= scale
         ftz *= scale
-        inv_kt = 1.0 / (kt + 1e-300)
+        inv_kt = (ft + 1e-150) * inv
         xix = -ftx * inv_kt if sliding else xix
         xiy = -fty * inv_kt if sliding else xiy
         xiz = -ftz * inv_kt if sliding else xiz
@@ -202,7 +202,7 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         w[T_XI2 * CW + c] = loaded * xiz
 
 
-@njit(**JIT)
+@njit(inline="always", **JIT)
 def cage_contact(bx, by, bz, bvx, bvy, bvz, ex, ey, cage_speed, contact_distance, k_cage,
                  reduced_mass):
     """Ball (centre b, velocity bv) against a cage element centred at (ex, ey, 0) on the cage
@@ -216,9 +216,10 @@ def cage_contact(bx, by, bz, bvx, bvy, bvz, ex, ey, cage_speed, contact_distance
     if d2 >= contact_distance * contact_distance or d2 <= 0.0:
         return 0.0, 0.0, 0.0, 0.0
     d = math.sqrt(d2)
-    nx = dx / d
-    ny = dy / d
-    nz = dz / d
+    inv_d = 1.0 / d
+    nx = dx * inv_d
+    ny = dy * inv_d
+    nz = dz * inv_d
     delta = contact_distance - d
     vrel_n = (bvx + cage_speed * ey) * nx + (bvy - cage_speed * ex) * ny + bvz * nz
     sq = math.sqrt(delta)

@@ -87,6 +87,17 @@ N_SCALARS = 12
 # it LLVM proves that rows never overlap and vectorises the geometry and force passes (measured
 # 3x faster than 2-D arrays, whose runtime row stride blocks vectorisation). Z <= CW / 2 = 16.
 CW = 32
+# The lane passes run over the contacts padded to a whole number of LANE_BLOCK lanes (4 float64
+# in a 256-bit vector), so that they have no scalar remainder (2 remainder lanes of the 6208's
+# 18 cost as much as 4 vector lanes); the pad lanes hold a copy of the last contact's kinematics
+# and the outer race's constants (twin.state.make_state), their results are never read.
+LANE_BLOCK = 4
+
+
+def padded_lane_count(nc):
+    """Contacts nc rounded up to a whole number of LANE_BLOCK lanes (<= CW)."""
+    return (nc + LANE_BLOCK - 1) // LANE_BLOCK * LANE_BLOCK
+
 
 # persistent outputs and cached tribology (refreshed at the tribology sub-rate)
 C_LOAD = 0           # elastic normal load [N]

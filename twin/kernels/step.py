@@ -9,7 +9,7 @@ import math
 
 from numba import njit
 
-from twin.jit import JIT
+from twin.jit import JIT, JIT_STEP
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
     A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, G_NZ,
@@ -22,7 +22,7 @@ from twin.kernels.layout import (
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
     P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
-    P_RING_MASS, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
+    P_RING_MASS, P_ROLLING, LANE_BLOCK, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
@@ -55,7 +55,9 @@ SPIN_CREEP_FACTOR = 1.3
 # budget). A contact that has just closed gets its RC at once.
 ELECTRICAL_EVERY = 10
 
-FRICTION_ELLIPSE = 2  # P_FRICTION_MODEL code of the friction over the contact ellipse
+FRICTION_ELLIPSE = 2
+
+SMALL_ANGLE = 1e-2  # [rad] below it `_cos_sin` takes the series  # P_FRICTION_MODEL code of the friction over the contact ellipse
 
 
 @njit(inline="always", **JIT)
@@ -66,9 +68,22 @@ def _at_angle(table, r, i, f, col):
     return lo + f * (table[r, i + 1, col] - lo)
 
 
-@njit(**JIT)
+@njit(inline="always", **JIT)
+def _cos_sin(x):
+    """(cos x, sin x); for |x| <= SMALL_ANGLE their Taylor series to x^7, exact to the last bit
+    there (the next terms are below 3e-21), without the library call: the step's half turn of
+    the cage is ~3e-4 rad at the auto step (a sincos call was ~2 % of the step)."""
+    if abs(x) <= SMALL_ANGLE:
+        x2 = x * x
+        c = 1.0 - x2 * (0.5 - x2 * (1.0 / 24.0 - x2 * (1.0 / 720.0)))
+        s = x * (1.0 - x2 * (1.0 / 6.0 - x2 * (1.0 / 120.0 - x2 * (1.0 / 5040.0))))
+        return c, s
+    return math.cos(x), math.sin(x)
+
+
+@njit(inline="always", **JIT_STEP)
 def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                          tribology_now, electrical_now, traction_now):
+                          tribology_now, electrical_now, traction_now, ct, st):
     """Forces and torques of every contact at the current positions -> accelerations of the
     balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
 
@@ -77,12 +92,17 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     loaded contacts when `tribology_now` (or when a contact closes), clear opened contacts.
     The refresh takes each contact's Hertz stiffness (its lane M_STIFFNESS, read by the next
     geometry pass) and film constants at its current contact angle from the model's angle table
-    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|). Returns a status code.
+    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|).
+
+    The forces see the balls' velocities and angular velocities turned about the axis by the
+    angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
+    (1, 0) for none), as they are read: bv and bw themselves are left as they are.
 
     Issue 14: positions and velocities are those relative to the outer ring (`step_n` shifts
     them with the housing on); the active defect rows (scal[X_DEFECT_COUNT] of them in the
     workspace after the lanes, twin.kernels.layout W_DEFECTS) open their clearance between the
-    geometry and the force pass (`twin.kernels.vibration.apply_defects`)."""
+    geometry and the force pass (`twin.kernels.vibration.apply_defects`).
+    Returns a status code."""
     z = bx.shape[0]
     nc = 2 * z
     rb = p[P_BALL_RADIUS]
@@ -97,38 +117,70 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     ring_speed = scal[X_SHAFT_SPEED]
     cage_speed = scal[X_CAGE_SPEED]
     eta = sp[S_VISCOSITY]
-    # gather (c = 2 j + r; r = 0 inner ring, r = 1 fixed outer ring)
+    # gather (c = 2 j + r; r = 0 inner ring, r = 1 fixed outer ring); the ring's state is read
+    # once (the compiler cannot keep it in registers across stores to w, which it may alias)
+    rx0 = rx[0]
+    rx1 = rx[1]
+    rx2 = rx[2]
+    rv0 = rv[0]
+    rv1 = rv[1]
+    rv2 = rv[2]
     for j in range(z):
         x0 = bx[j, 0]
         x1 = bx[j, 1]
         x2 = bx[j, 2]
-        v0 = bv[j, 0]
-        v1 = bv[j, 1]
+        v0 = ct * bv[j, 0] - st * bv[j, 1]  # turned velocities (docstring)
+        v1 = st * bv[j, 0] + ct * bv[j, 1]
+        v2 = bv[j, 2]
+        w0 = ct * bw[j, 0] - st * bw[j, 1]
+        w1 = st * bw[j, 0] + ct * bw[j, 1]
+        w2 = bw[j, 2]
         rho2 = x0 * x0 + x1 * x1
         orbital = (x0 * v1 - x1 * v0) / rho2 if rho2 > 0.0 else 0.0
-        for r in range(2):
-            c = 2 * j + r
-            inner = r == 0
-            w[K_PX * CW + c] = x0 - rx[0] if inner else x0
-            w[K_PY * CW + c] = x1 - rx[1] if inner else x1
-            w[K_PZ * CW + c] = x2 - rx[2] if inner else x2
-            w[K_BX * CW + c] = x0
-            w[K_BY * CW + c] = x1
-            w[K_VX * CW + c] = v0
-            w[K_VY * CW + c] = v1
-            w[K_VZ * CW + c] = bv[j, 2]
-            w[K_WX * CW + c] = bw[j, 0]
-            w[K_WY * CW + c] = bw[j, 1]
-            w[K_WZ * CW + c] = bw[j, 2]
-            w[K_OVX * CW + c] = rv[0] if inner else 0.0
-            w[K_OVY * CW + c] = rv[1] if inner else 0.0
-            w[K_OVZ * CW + c] = rv[2] if inner else 0.0
-            w[K_SPIN * CW + c] = ring_speed if inner else 0.0
-            w[K_ORBIT * CW + c] = orbital
-    raceway_geometry(w, nc)
+        ci = 2 * j
+        co = ci + 1
+        w[K_PX * CW + ci] = x0 - rx0
+        w[K_PX * CW + co] = x0
+        w[K_PY * CW + ci] = x1 - rx1
+        w[K_PY * CW + co] = x1
+        w[K_PZ * CW + ci] = x2 - rx2
+        w[K_PZ * CW + co] = x2
+        w[K_BX * CW + ci] = x0
+        w[K_BX * CW + co] = x0
+        w[K_BY * CW + ci] = x1
+        w[K_BY * CW + co] = x1
+        w[K_VX * CW + ci] = v0
+        w[K_VX * CW + co] = v0
+        w[K_VY * CW + ci] = v1
+        w[K_VY * CW + co] = v1
+        w[K_VZ * CW + ci] = v2
+        w[K_VZ * CW + co] = v2
+        w[K_WX * CW + ci] = w0
+        w[K_WX * CW + co] = w0
+        w[K_WY * CW + ci] = w1
+        w[K_WY * CW + co] = w1
+        w[K_WZ * CW + ci] = w2
+        w[K_WZ * CW + co] = w2
+        w[K_OVX * CW + ci] = rv0
+        w[K_OVX * CW + co] = 0.0
+        w[K_OVY * CW + ci] = rv1
+        w[K_OVY * CW + co] = 0.0
+        w[K_OVZ * CW + ci] = rv2
+        w[K_OVZ * CW + co] = 0.0
+        w[K_SPIN * CW + ci] = ring_speed
+        w[K_SPIN * CW + co] = 0.0
+        w[K_ORBIT * CW + ci] = orbital
+        w[K_ORBIT * CW + co] = orbital
+    # pad lanes up to a whole number of vectors: a copy of the last contact, so that the lane
+    # passes run without a scalar remainder on finite values nobody reads (twin.kernels.layout)
+    nl = (nc + LANE_BLOCK - 1) // LANE_BLOCK * LANE_BLOCK  # layout.padded_lane_count
+    for c in range(nc, nl):
+        for k in range(K_PX, K_ORBIT + 1):
+            w[k * CW + c] = w[k * CW + nc - 1]
+    raceway_geometry(w, nl)
     if scal[X_DEFECT_COUNT] > 0.0:  # issue 14: local defects
         apply_defects(w, nc, int(scal[X_DEFECT_COUNT]), scal[X_SHAFT_ANGLE], p, rb)
-    raceway_forces(w, nc, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
+    raceway_forces(w, nl, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
     # per contact: outputs, tribology refresh, opened contacts
     max_pen = scal[X_MAX_PENETRATION]
     for c in range(nc):
@@ -211,7 +263,8 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     if friction_model == FRICTION_ELLIPSE:  # friction over the contact ellipse (twin.kernels.traction)
         if traction_now:
             ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
-        apply_traction_moments(w, nc)
+        apply_traction_moments(w, nl)
+    inv_inertia = 1.0 / inertia  # multiplications, not 6 Z divisions per step
     ring_fx = 0.0
     ring_fy = 0.0
     ring_fz = 0.0
@@ -222,9 +275,9 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         ba[j, 0] = w[O_FX * CW + ci] + w[O_FX * CW + co]
         ba[j, 1] = w[O_FY * CW + ci] + w[O_FY * CW + co]
         ba[j, 2] = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
-        balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) / inertia
-        balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) / inertia
-        balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) / inertia
+        balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) * inv_inertia
+        balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) * inv_inertia
+        balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) * inv_inertia
         ring_fx -= w[O_FX * CW + ci]
         ring_fy -= w[O_FY * CW + ci]
         ring_fz -= w[O_FZ * CW + ci]
@@ -243,10 +296,13 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     first_c = prev_c
     first_s = prev_s
     cage_tz = 0.0
+    inv_m = 1.0 / m
     for j in range(z):
         fx = ba[j, 0]
         fy = ba[j, 1]
         fz = ba[j, 2]
+        v0 = ct * bv[j, 0] - st * bv[j, 1]
+        v1 = st * bv[j, 0] + ct * bv[j, 1]
         next_c = prev_c * c_step - prev_s * s_step
         next_s = prev_s * c_step + prev_c * s_step
         if j == z - 1:
@@ -255,7 +311,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         for slot in range(2):
             ex = rc * (next_c if slot == 0 else prev_c)
             ey = rc * (next_s if slot == 0 else prev_s)
-            f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], bv[j, 0], bv[j, 1],
+            f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], v0, v1,
                                          bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage)
             cage_load[j, slot] = f
             fx += f * nx
@@ -264,13 +320,13 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
             cage_tz -= ex * f * ny - ey * f * nx
         prev_c = next_c
         prev_s = next_s
-        ba[j, 0] = fx / m
-        ba[j, 1] = fy / m
-        ba[j, 2] = fz / m
-    mr = p[P_RING_MASS]
-    ra[0] = (ring_fx + sp[S_RADIAL_LOAD]) / mr
-    ra[1] = ring_fy / mr
-    ra[2] = (ring_fz + sp[S_AXIAL_LOAD]) / mr
+        ba[j, 0] = fx * inv_m
+        ba[j, 1] = fy * inv_m
+        ba[j, 2] = fz * inv_m
+    inv_mr = 1.0 / p[P_RING_MASS]
+    ra[0] = (ring_fx + sp[S_RADIAL_LOAD]) * inv_mr
+    ra[1] = ring_fy * inv_mr
+    ra[2] = (ring_fz + sp[S_AXIAL_LOAD]) * inv_mr
     scal[X_DRIVE_TORQUE] = -ring_tz
     scal[X_CAGE_TORQUE] = cage_tz
     if not (math.isfinite(ra[0]) and math.isfinite(ra[1]) and math.isfinite(ra[2])
@@ -281,7 +337,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     return STATUS_OK
 
 
-@njit(**JIT)
+@njit(**JIT_STEP)
 def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx, hv, ha,
            dec_state, ring, ring_state, hp, taps, n):
     """Advance n steps of dt (seed 000 eq. 10, velocity-Verlet; velocity-dependent forces use the
@@ -341,23 +397,15 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
         # the forces at x(n+1) see the balls' velocities at n+1/2 turned on by the half step of
         # the cage's rotation (exact for the steady orbit): without it the velocities and spin
         # axes lag the positions by half a step of the orbit, an O(dt) error (3 % of the 7208's
-        # friction torque at 1 us, 10 % at 4 us); the rotation is undone after the forces
-        turn = half * scal[X_CAGE_SPEED]
-        ct = math.cos(turn)
-        st = math.sin(turn)
-        for j in range(z):
-            vx = bv[j, 0]
-            bv[j, 0] = ct * vx - st * bv[j, 1]
-            bv[j, 1] = st * vx + ct * bv[j, 1]
-            wx = bw[j, 0]
-            bw[j, 0] = ct * wx - st * bw[j, 1]
-            bw[j, 1] = st * wx + ct * bw[j, 1]
+        # friction torque at 1 us, 10 % at 4 us); compute_accelerations turns them as it reads
+        # them (the state's velocities stay unturned)
+        ct, st = _cos_sin(half * scal[X_CAGE_SPEED])
         if housing_on:  # issue 14: forces in the outer ring's frame
             shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
         status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w,
                                        cage_load, step % substeps == 0,
                                        step % (substeps * ELECTRICAL_EVERY) == 0,
-                                       step % (substeps * traction_every) == 0)  # a tribology step
+                                       step % (substeps * traction_every) == 0, ct, st)  # a tribology step
         if housing_on:  # issue 14: back to the world frame; the housing and the accelerometer
             shift_frame(bx, bv, rx, rv, hx, hv, 1.0)
             fx, fy, fz = outer_ring_force(w, z)
@@ -365,13 +413,6 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
             sensor_push_direct(taps, ratio, dec_state, sensed, ring, ring_state)
             if not math.isfinite(sensed):
                 status = STATUS_NOT_FINITE
-        for j in range(z):
-            vx = bv[j, 0]
-            bv[j, 0] = ct * vx + st * bv[j, 1]
-            bv[j, 1] = -st * vx + ct * bv[j, 1]
-            wx = bw[j, 0]
-            bw[j, 0] = ct * wx + st * bw[j, 1]
-            bw[j, 1] = -st * wx + ct * bw[j, 1]
         scal[X_TORQUE_SUM] += scal[X_DRIVE_TORQUE]
         scal[X_TORQUE_COUNT] += 1.0
         done = it + 1
@@ -389,7 +430,7 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
     return status, done
 
 
-@njit(**JIT)
+@njit(**JIT_STEP)
 def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx, hv, ha,
              dec_state, ring, ring_state, hp, taps):
     """Contact forces, tribology and accelerations (balls, rings and, issue 14, the housing) at
@@ -399,7 +440,7 @@ def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, 
     if housing_on:
         shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
     status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                                   True, True, True)
+                                   True, True, True, 1.0, 0.0)
     if housing_on:
         shift_frame(bx, bv, rx, rv, hx, hv, 1.0)
         fx, fy, fz = outer_ring_force(w, bx.shape[0])

@@ -289,7 +289,7 @@ def _rolling_direction(w, c, nx, ny, nz):
     return ex * inv, ey * inv, ez * inv
 
 
-@njit(**JIT_VECTOR)
+@njit(inline="always", **JIT_VECTOR)
 def apply_traction_moments(w, nc):
     """Every step (vectorised, branch-free): add the strips' moment about the contact centre to
     the ball torque (O_T*) and its reaction to the ring's torque about its axis (O_RING_TZ):

@@ -101,7 +101,7 @@ def contact_tribology(load_n, entrainment_m_s, viscosity_pa_s, roughness_m, t0, 
     h_c = math.exp(t3 + t4 * ln_eu + t5 * ln_q)
     lam = h_min / roughness_m
     mu = _mu(lam, friction_model)
-    c_fluid = t8 * viscosity_pa_s * a * math.exp(-1.5 * ln_h)
+    c_fluid = t8 * viscosity_pa_s * a / (h_min * math.sqrt(h_min))  # h^-1.5 without an exp
     fr = 0.0
     mp = 0.0
     if rolling_on:

@@ -208,7 +208,8 @@ def asperity_load_share(film_parameter_lambda):
         return 1.0
     if lam >= LAMBDA_ASPERITY_FIT_MIN:
         return 0.0
-    share = 1.0 - 1.21 * lam ** 0.64 / (1.0 + 0.37 * lam ** 1.26)
+    ln_lam = math.log(lam)  # one log and two exps: cheaper than two general powers
+    share = 1.0 - 1.21 * math.exp(0.64 * ln_lam) / (1.0 + 0.37 * math.exp(1.26 * ln_lam))
     if share < 0.0:
         return 0.0
     if share > 1.0:

@@ -16,8 +16,9 @@ further cases, and the per-pass timing of the step.
   runs of `seconds` simulated seconds each, and ns per step; `cpu_real_time_factor`: simulated s
   per CPU s of the stepping thread (what the twin would run at with a core to itself: on a
   shared, loaded machine the wall-clock figure also counts the time the thread waited for a core);
-- `passes`: ns per step of gather, geometry, forces, tribology, cage and integration
-  (`twin.validation.step_timing`, a harness that times each pass alone), at the default step.
+- `passes`: ns per step (CPU time of the thread) of gather, geometry, forces, tribology,
+  traction, cage and integration (`twin.validation.step_timing`, a harness that times each pass
+  alone), at the default step.
 
 Wall-clock figures belong here and in README, never in tests (machines are shared and noisy).
 """
@@ -181,7 +182,7 @@ def summary_text(result: dict) -> str:
     p = result.get("passes")
     if p:
         parts = ", ".join(f"{k} {p[k]['best_ns']:.0f}" for k in ("gather", "geometry", "forces", "tribology",
-                                                                  "cage", "integration"))
+                                                                  "traction", "cage", "integration"))
         lines.append(f"  per pass, ns per step (best): {parts}; sum {p['sum_of_passes']['best_ns']:.0f}, "
                      f"step_n {p['total']['best_ns']:.0f}")
     lines.append(f"  load average (1 min) before / after: {result['load_average_1min'][0]:.2f} / "

@@ -1,17 +1,23 @@
-"""Per-pass timing of one step (issue 13): gather, geometry, forces, tribology, cage, integration.
+"""Per-pass timing of one step (issue 13): gather, geometry, forces, tribology, traction, cage,
+integration.
 
 `twin.kernels.step.compute_accelerations` runs its passes inline in one compiled function, so a
 profiler cannot split them. This harness times each pass on its own, on a copy of a settled
-twin's state, each in its own compiled loop of `reps` calls (no Python between calls):
+twin's state, each in its own compiled loop of `reps` calls (no Python between calls), in CPU
+time of the calling thread (what the pass costs, not the waits for a core on a shared machine):
 
-- geometry, forces: the kernel's own `raceway_geometry` and `raceway_forces` on the lanes;
+- geometry, forces: the kernel's own `raceway_geometry` and `raceway_forces` on the lanes padded
+  to whole vectors as the step runs them (`layout.padded_lane_count`);
 - tribology: the kernel's per-contact pass (copy of its loop) with the kernel's own
   `contact_tribology` and `contact_electrical`, timed without refresh, with the tribology
   refresh and with the electrical refresh too; per step it costs the first plus the refreshes
   divided by their periods in steps (the model's tribology sub-rate, x ELECTRICAL_EVERY);
+- traction: the kernel's own `apply_traction_moments` (every step) plus its `ellipse_traction`
+  (the strip solve) divided by its period in steps (tribology sub-rate x P_TRACTION_EVERY);
 - gather (the lanes filled from the ball and ring state), cage (the per-ball force sums and the
-  ball-cage contacts with the kernel's own `cage_contact`) and integration (the leapfrog kicks and
-  drifts of `step_n` with its co-rotating velocity turn): copies of the kernel's inline loops.
+  ball-cage contacts with the kernel's own `cage_contact`, on the velocities turned by the half
+  step of the cage) and integration (the leapfrog kicks and drifts of `step_n` and the turn's
+  cosine and sine): copies of the kernel's inline loops.
 
 The copies mirror `twin/kernels/step.py` as of this writing; `total` is `step_n` itself, so the
 sum of the passes against `total` shows how far the harness is from the real step (call
@@ -27,30 +33,31 @@ import time
 
 from numba import njit
 
-from twin.jit import JIT
+from twin.jit import JIT, JIT_STEP
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
     A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, C_XI_DECAY, G_NX, G_NY, G_NZ,
     C_CAPACITANCE, C_ENTRAINMENT, C_FLUID_DAMPING, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
     C_RESISTANCE, C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT,
-    C_SRR, C_TANGENT_DAMPING, CW, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
+    C_SRR, C_TANGENT_DAMPING, CW, E_SLIP, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
     K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, O_EX, O_EY,
     O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, P_ALPHA_E,
     P_ASPERITY_RESISTANCE, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS, P_CAGE_STIFFNESS,
-    P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_GAP_LIMIT, P_KT_RATIO, P_OIL_PERMITTIVITY,
-    P_OIL_RESISTIVITY, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED,
-    X_CAGE_TORQUE, X_SHAFT_SPEED,
+    P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_KT_RATIO, P_LIMITING_SHEAR,
+    P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY,
+    S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED, X_CAGE_TORQUE, X_SHAFT_SPEED, padded_lane_count,
 )
-from twin.kernels.step import (ELECTRICAL_EVERY, ROLLING_REGULARISATION_SPEED, SPIN_CREEP_FACTOR, _at_angle,
-                               step_n)
+from twin.kernels.step import (ELECTRICAL_EVERY, FRICTION_ELLIPSE, ROLLING_REGULARISATION_SPEED,
+                               SPIN_CREEP_FACTOR, _at_angle, _cos_sin, step_n)
+from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 
-PASSES = ("gather", "geometry", "forces", "tribology", "cage", "integration")
+PASSES = ("gather", "geometry", "forces", "tribology", "traction", "cage", "integration")
 
 
-@njit(**JIT)
-def _gather(bx, bv, bw, rx, rv, scal, w, reps):
+@njit(**JIT_STEP)
+def _gather(bx, bv, bw, rx, rv, scal, w, ct, st, reps):
     z = bx.shape[0]
     acc = 0.0
     for _ in range(reps):
@@ -59,8 +66,10 @@ def _gather(bx, bv, bw, rx, rv, scal, w, reps):
             x0 = bx[j, 0]
             x1 = bx[j, 1]
             x2 = bx[j, 2]
-            v0 = bv[j, 0]
-            v1 = bv[j, 1]
+            v0 = ct * bv[j, 0] - st * bv[j, 1]
+            v1 = st * bv[j, 0] + ct * bv[j, 1]
+            w0 = ct * bw[j, 0] - st * bw[j, 1]
+            w1 = st * bw[j, 0] + ct * bw[j, 1]
             rho2 = x0 * x0 + x1 * x1
             orbital = (x0 * v1 - x1 * v0) / rho2 if rho2 > 0.0 else 0.0
             for r in range(2):
@@ -74,8 +83,8 @@ def _gather(bx, bv, bw, rx, rv, scal, w, reps):
                 w[K_VX * CW + c] = v0
                 w[K_VY * CW + c] = v1
                 w[K_VZ * CW + c] = bv[j, 2]
-                w[K_WX * CW + c] = bw[j, 0]
-                w[K_WY * CW + c] = bw[j, 1]
+                w[K_WX * CW + c] = w0
+                w[K_WY * CW + c] = w1
                 w[K_WZ * CW + c] = bw[j, 2]
                 w[K_OVX * CW + c] = rv[0] if inner else 0.0
                 w[K_OVY * CW + c] = rv[1] if inner else 0.0
@@ -86,21 +95,21 @@ def _gather(bx, bv, bw, rx, rv, scal, w, reps):
     return acc
 
 
-@njit(**JIT)
+@njit(**JIT_STEP)
 def _geometry(w, nc, reps):
     for _ in range(reps):
         raceway_geometry(w, nc)
     return w[G_DELTA * CW]
 
 
-@njit(**JIT)
+@njit(**JIT_STEP)
 def _forces(w, nc, rb, dt, kt_ratio, alpha_e, reps):
     for _ in range(reps):
         raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e)
     return w[O_FX * CW]
 
 
-@njit(**JIT)
+@njit(**JIT_STEP)
 def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
     kt_ratio = p[P_KT_RATIO]
     ct_ratio = p[P_CT_RATIO]
@@ -145,7 +154,9 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
                 w[C_H_C * CW + c] = tri[1]
                 w[C_LAMBDA * CW + c] = tri[2]
                 w[C_REGIME * CW + c] = tri[3]
-                w[C_MU * CW + c] = tri[4]
+                mu_lim = (limiting_traction_coefficient(tri[2], p[P_LIMITING_SHEAR])
+                          if friction_model == FRICTION_ELLIPSE else tri[4])
+                w[C_MU * CW + c] = mu_lim
                 w[C_SEMI_MAJOR * CW + c] = tri[5]
                 w[C_SEMI_MINOR * CW + c] = tri[6]
                 w[C_FLUID_DAMPING * CW + c] = tri[7]
@@ -158,7 +169,7 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
                 ab = math.sqrt(tri[5] * tri[6])
                 spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
                                + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
-                relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * tri[4] * q_el, 1e-12)
+                relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
                 w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
                 w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
                                       + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
@@ -168,7 +179,8 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
                     res_ohm, cap_f = contact_electrical(
                         q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
                         _at_angle(tr, r, ia, fa, t + T_RY),
-                        p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT], p[P_ASPERITY_RESISTANCE],
+                        p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER],
+                        p[P_ASPERITY_RESISTANCE],
                         p[P_OIL_RESISTIVITY])
                 else:
                     res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
@@ -177,11 +189,30 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
     return max_pen
 
 
+@njit(**JIT_STEP)
+def _traction_moments(w, nl, reps):
+    for _ in range(reps):
+        apply_traction_moments(w, nl)
+    return w[O_TX * CW]
+
+
 @njit(**JIT)
-def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, reps):
+def _traction_solve(w, nc, p, eta, reps):
+    # every solve from the same warm start (the last solution of the running twin), not from the
+    # previous solve's own solution, which would converge at once
+    start = w[E_SLIP * CW:E_SLIP * CW + nc].copy()
+    for _ in range(reps):
+        for c in range(nc):
+            w[E_SLIP * CW + c] = start[c]
+        ellipse_traction(w, nc, p, eta, p[P_KT_RATIO], p[P_BALL_INERTIA], p[P_DT])
+    return w[O_TX * CW]
+
+
+@njit(**JIT_STEP)
+def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st, reps):
     z = bx.shape[0]
-    m = p[P_BALL_MASS]
-    inertia = p[P_BALL_INERTIA]
+    inv_m = 1.0 / p[P_BALL_MASS]
+    inv_inertia = 1.0 / p[P_BALL_INERTIA]
     rc = p[P_CAGE_RADIUS]
     s_cage = p[P_CAGE_CONTACT_DISTANCE]
     k_cage = p[P_CAGE_STIFFNESS]
@@ -199,9 +230,9 @@ def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, reps):
             ba[j, 0] = w[O_FX * CW + ci] + w[O_FX * CW + co]
             ba[j, 1] = w[O_FY * CW + ci] + w[O_FY * CW + co]
             ba[j, 2] = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
-            balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) / inertia
-            balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) / inertia
-            balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) / inertia
+            balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) * inv_inertia
+            balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) * inv_inertia
+            balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) * inv_inertia
             ring_tz += w[O_RING_TZ * CW + ci]
         theta = scal[X_CAGE_ANGLE] - 0.5 * step_angle
         prev_c = math.cos(theta)
@@ -213,6 +244,8 @@ def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, reps):
             fx = ba[j, 0]
             fy = ba[j, 1]
             fz = ba[j, 2]
+            v0 = ct * bv[j, 0] - st * bv[j, 1]
+            v1 = st * bv[j, 0] + ct * bv[j, 1]
             next_c = prev_c * c_step - prev_s * s_step
             next_s = prev_s * c_step + prev_c * s_step
             if j == z - 1:
@@ -221,7 +254,7 @@ def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, reps):
             for slot in range(2):
                 ex = rc * (next_c if slot == 0 else prev_c)
                 ey = rc * (next_s if slot == 0 else prev_s)
-                f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], bv[j, 0], bv[j, 1],
+                f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], v0, v1,
                                              bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage)
                 cage_load[j, slot] = f
                 fx += f * nx
@@ -230,14 +263,14 @@ def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, reps):
                 cage_tz -= ex * f * ny - ey * f * nx
             prev_c = next_c
             prev_s = next_s
-            ba[j, 0] = fx / m
-            ba[j, 1] = fy / m
-            ba[j, 2] = fz / m
+            ba[j, 0] = fx * inv_m
+            ba[j, 1] = fy * inv_m
+            ba[j, 2] = fz * inv_m
         acc += cage_tz + ring_tz
     return acc
 
 
-@njit(**JIT)
+@njit(**JIT_STEP)
 def _integration(p, scal, bx, bv, bw, ba, balpha, rx, rv, ra, reps):
     z = bx.shape[0]
     dt = p[P_DT]
@@ -254,32 +287,17 @@ def _integration(p, scal, bx, bv, bw, ba, balpha, rx, rv, ra, reps):
             rx[k] += dt * rv[k]
         scal[X_CAGE_SPEED] += dt * scal[X_CAGE_TORQUE] / cage_inertia
         scal[X_CAGE_ANGLE] += dt * scal[X_CAGE_SPEED]
-        turn = half * scal[X_CAGE_SPEED]
-        ct = math.cos(turn)
-        st = math.sin(turn)
-        for j in range(z):
-            vx = bv[j, 0]
-            bv[j, 0] = ct * vx - st * bv[j, 1]
-            bv[j, 1] = st * vx + ct * bv[j, 1]
-            wx = bw[j, 0]
-            bw[j, 0] = ct * wx - st * bw[j, 1]
-            bw[j, 1] = st * wx + ct * bw[j, 1]
-        for j in range(z):
-            vx = bv[j, 0]
-            bv[j, 0] = ct * vx + st * bv[j, 1]
-            bv[j, 1] = -st * vx + ct * bv[j, 1]
-            wx = bw[j, 0]
-            bw[j, 0] = ct * wx + st * bw[j, 1]
-            bw[j, 1] = -st * wx + ct * bw[j, 1]
+        ct, st = _cos_sin(half * scal[X_CAGE_SPEED])  # the turn, applied as gather and cage read
+        scal[X_CAGE_TORQUE] += 1e-300 * (ct + st)
     return bx[0, 0]
 
 
 def _best_median_ns(fn, reps: int, repeats: int) -> tuple[float, float]:
     times = []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
+    for _ in range(repeats):  # CPU time of this thread: what the pass costs, not the waits for a core
+        t0 = time.thread_time()
         fn(reps)
-        times.append((time.perf_counter() - t0) / reps * 1e9)
+        times.append((time.thread_time() - t0) / reps * 1e9)
     return min(times), statistics.median(times)
 
 
@@ -289,27 +307,35 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     m, s = twin.model, twin.state
     p, tr, sp = m.params, m.angle_table, twin._setpoint_vector
     nc = 2 * m.ball_count
+    nl = padded_lane_count(nc)
     substeps = int(p[P_SUBSTEPS])
+    traction_steps = substeps * max(int(p[P_TRACTION_EVERY]), 1)
 
     def copies():
         args = [a.copy() for a in s.kernel_args()]
         return args  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, then the housing/sensor arrays
 
     scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load = copies()[:11]
+    ct, st = math.cos(0.5 * p[P_DT] * scal[X_CAGE_SPEED]), math.sin(0.5 * p[P_DT] * scal[X_CAGE_SPEED])
     runs = {
-        "gather": lambda n: _gather(bx, bv, bw, rx, rv, scal, w, n),
-        "geometry": lambda n: _geometry(w, nc, n),
-        "forces": lambda n: _forces(w, nc, p[P_BALL_RADIUS], p[P_DT], p[P_KT_RATIO], p[P_ALPHA_E], n),
+        "gather": lambda n: _gather(bx, bv, bw, rx, rv, scal, w, ct, st, n),
+        "geometry": lambda n: _geometry(w, nl, n),
+        "forces": lambda n: _forces(w, nl, p[P_BALL_RADIUS], p[P_DT], p[P_KT_RATIO], p[P_ALPHA_E], n),
+        "traction_moments": lambda n: _traction_moments(w, nl, n),
+        "traction_solve": lambda n: _traction_solve(w, nc, p, sp[S_VISCOSITY], n),
         "tribology_no_refresh": lambda n: _tribology(p, tr, sp, w, nc, False, False, n),
         "tribology_refresh": lambda n: _tribology(p, tr, sp, w, nc, True, False, n),
         "tribology_refresh_electrical": lambda n: _tribology(p, tr, sp, w, nc, True, True, n),
-        "cage": lambda n: _cage(p, scal, bx, bv, ba, balpha, w, cage_load, n),
+        "cage": lambda n: _cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st, n),
     }
     for fn in runs.values():  # compile
         fn(1)
     out = {}
     for name, fn in runs.items():
-        best, median = _best_median_ns(fn, reps, repeats)
+        if name == "traction_solve":  # a solve costs ~100 steps: a hundredth of the calls, per call
+            best, median = _best_median_ns(fn, max(reps // 100, 1), repeats)
+        else:
+            best, median = _best_median_ns(fn, reps, repeats)
         out[name] = {"best_ns": best, "median_ns": median}
     ig = copies()
     _integration(p, ig[0], ig[1], ig[2], ig[3], ig[4], ig[5], ig[6], ig[7], ig[8], 1)
@@ -321,15 +347,18 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     t0, t1, t2 = (out[k] for k in ("tribology_no_refresh", "tribology_refresh", "tribology_refresh_electrical"))
     out["tribology"] = {key: t0[key] + (t1[key] - t0[key]) / substeps
                         + (t2[key] - t1[key]) / (substeps * ELECTRICAL_EVERY) for key in ("best_ns", "median_ns")}
+    out["traction"] = {key: out["traction_moments"][key] + out["traction_solve"][key] / traction_steps
+                       for key in ("best_ns", "median_ns")}
     # the real step on a copy of the state
-    st = copies()
+    full = copies()
     vib = (m.housing_params, m.decimator_taps)
     n_total = max(1000, reps // 10)
-    step_n(p, tr, sp, *st, *vib, 10)
-    best, median = _best_median_ns(lambda n: step_n(p, tr, sp, *st, *vib, n), n_total, repeats)
+    step_n(p, tr, sp, *full, *vib, 10)
+    best, median = _best_median_ns(lambda n: step_n(p, tr, sp, *full, *vib, n), n_total, repeats)
     out["total"] = {"best_ns": best, "median_ns": median}
     out["sum_of_passes"] = {key: sum(out[k][key] for k in PASSES) for key in ("best_ns", "median_ns")}
     out["tribology_steps_per_refresh"] = substeps
     out["electrical_steps_per_refresh"] = substeps * ELECTRICAL_EVERY
+    out["traction_steps_per_solve"] = traction_steps
     return out
 
