@@ -292,7 +292,6 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_ASPERITY_RESISTANCE] = el.metallic_contact_resistance_ohm
     p[L.P_OIL_RESISTIVITY] = el.oil_resistivity_ohm_m
     p[L.P_TRACTION_STRIPS] = options.traction_strips
-    p[L.P_TRACTION_EVERY] = options.traction_every
     p[L.P_EYRING_STRESS] = spec.lubricant.eyring_stress_pa
     p[L.P_LIMITING_SHEAR] = spec.lubricant.limiting_shear_coefficient
     p[L.P_PRESSURE_VISCOSITY] = spec.lubricant.pressure_viscosity_pa_inv
@@ -350,6 +349,8 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     v[L.V_INNER_RX], v[L.V_OUTER_RX] = race[0, L.R_RX], race[1, L.R_RX]
     v[L.V_INNER_RY], v[L.V_OUTER_RY] = race[0, L.R_RY], race[1, L.R_RY]
     p[L.P_SUBSTEPS] = timestep.steps_per_period(options.tribology_period_s, p[L.P_DT])
+    # the strip solve's period as a whole number of tribology refreshes (nearest, at least 1)
+    p[L.P_TRACTION_EVERY] = timestep.steps_per_period(options.traction_period_s, p[L.P_SUBSTEPS] * p[L.P_DT])
     if options.friction_model == "ellipse_traction":
         # the strips' spin moment replaces seed 001's eq. 11, at every contact angle
         tribology[:, T_PIVOT] = 0.0

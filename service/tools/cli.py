@@ -118,11 +118,13 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 
 def _cmd_timestep_study(args: argparse.Namespace) -> int:
-    from twin.validation import timestep_study
+    from twin.validation import subrate_study, timestep_study
 
-    result = timestep_study.run_all(quick=args.quick, progress=lambda case, step: print(
-        f"{case.id}: {step}", file=sys.stderr, flush=True))
-    print(timestep_study.as_json(result) if args.json else timestep_study.markdown(result))
+    study = subrate_study if args.subrates else timestep_study
+    options = {"against_1us": True} if args.subrates else {}
+    result = study.run_all(quick=args.quick, progress=lambda case, step: print(
+        f"{case.id}: {step}", file=sys.stderr, flush=True), **options)
+    print(study.as_json(result) if args.json else study.markdown(result))
     return 0
 
 
@@ -190,6 +192,8 @@ def build_parser() -> argparse.ArgumentParser:
     bench.set_defaults(func=_cmd_bench)
     study = sub.add_parser("timestep-study", help="the auto time step against 1 us over the operating envelope")
     study.add_argument("--quick", action="store_true", help="a subset of the cases (the test suite's)")
+    study.add_argument("--subrates", action="store_true",
+                       help="the tribology and traction sub-rates (periods) at the auto step instead of the step")
     study.add_argument("--json", action="store_true")
     study.set_defaults(func=_cmd_timestep_study)
     report = sub.add_parser("report", help="validation report against the seeds (Markdown + PNG plots)")

@@ -64,33 +64,40 @@ def _spin_moments(twin):
 
 
 def test_traction_sub_rate_is_converged():
-    # numerical choice: the strip integration every traction_every = 20 tribology refreshes
-    # (200 us at 1 us, 178 us at the 7208's auto step of 4.44 us). Measured (6208; 3000 N /
+    # numerical choice: the strip integration every traction_period_s = 200 us (a whole number of
+    # tribology refreshes: 10 of 20 us at 1 us; the 7208's auto step of 4.44 us gave 178 us when the
+    # period was 20 refreshes of 8.9 us). Measured (6208; 3000 N /
     # 500 rad/s, 750 N / 1700 rad/s, 7500 N / 100 rad/s): the torque with a solve every 10 us,
     # 100 us, 200 us and 500 us agrees within 0.04 %. 7208 B (40 deg, Fr = Fa = 3000 N, spin up to
     # 800 rad/s), against a solve at every refresh (8.9 us), at the auto step: the spin moments
     # solved at the final state, i.e. the sub-rate's effect on the state, move by 0.9, 1.8, 3.1,
     # 6.3 % on the worst contact (0.5, 0.9, 1.6, 3.3 % of the largest moment) at 44, 89, 178,
     # 444 us, first order in the period; the moments applied between solves within 2.7 % of the
-    # largest; the torque within 0.02 %. Bounded here at 0.5 % (torque) and 5 %. (The stored
+    # largest; the torque within 0.02 %. Bounded here at 0.5 % (torque) and 5 %. With the tribology
+    # period at 20 us (twin.validation.subrate_study; 22.2 us = 5 steps on the 7208, the solve every
+    # 9 refreshes = 200 us) the moments applied at this test's last step differ from the reference's
+    # by 11.5 % of the largest on one contact, the one entering the loaded zone (its last solve saw it
+    # nearly unloaded), and by 1.2-5.6 % at six other end instants 22-111 us apart (the former 10 us /
+    # 178 us: 0.9-4.0 %): the applied moments' bound is 15 % since, the solved ones stay at 5 %; the
+    # outputs of this case move by under 0.4 % (torque) in the sub-rate study. (The stored
     # solution itself is up to one period old: a ball at the edge of the loaded zone has moved
     # 2 deg since, 10-15 % of its moment; comparing those, as this test did at first, measured
     # when the last solve fell before the end of the run, not the sub-rate.)
-    fast, _ = studies.mean_friction_torque_n_m(500.0, 3000.0, options=ModelOptions(traction_every=1))
+    fast, _ = studies.mean_friction_torque_n_m(500.0, 3000.0, options=ModelOptions(traction_period_s=1e-6))
     default, _ = studies.mean_friction_torque_n_m(500.0, 3000.0)
-    assert ModelOptions().traction_every == 20
+    assert ModelOptions().traction_period_s == 2e-4
     assert default == pytest.approx(fast, rel=0.005)
     runs = []
-    for every in (1, 20):
+    for period in (1e-6, ModelOptions().traction_period_s):  # every refresh, the default
         torque, twin = studies.mean_friction_torque_n_m(500.0, 3000.0, designation="7208",
-                                                        options=ModelOptions(traction_every=every),
+                                                        options=ModelOptions(traction_period_s=period),
                                                         axial_load_n=3000.0)
         runs.append((torque, *_spin_moments(twin)))
     (torque1, applied1, solved1), (torque20, applied20, solved20) = runs
     largest = np.max(np.abs(solved1))
     assert torque20 == pytest.approx(torque1, rel=0.005)
     np.testing.assert_allclose(solved20, solved1, rtol=0.05, atol=0.01 * largest)
-    assert np.max(np.abs(applied20 - applied1)) <= 0.05 * largest
+    assert np.max(np.abs(applied20 - applied1)) <= 0.15 * largest  # see above: one solve old at the zone's edge
     assert largest > 0.01  # N m: the angular-contact balls spin, the moment matters (0.032 N m)
 
 

@@ -53,7 +53,7 @@ SPIN_CREEP_FACTOR = 1.3
 # dt = 1 us): it only feeds the network evaluated between frames (1 ms) and the 10 ms
 # electro-thermal coupling, and refreshing it every 10 us cost ~90 ns per step (10 % of the
 # budget). A contact that has just closed gets its RC at once.
-ELECTRICAL_EVERY = 10
+ELECTRICAL_EVERY = 5
 
 FRICTION_ELLIPSE = 2
 
