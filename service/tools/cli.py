@@ -472,14 +472,40 @@ def _cmd_serve(args: argparse.Namespace) -> int:
 
     config = uvicorn_config(create_app(settings, service=service), settings, host=host,
                             log_level=args.log_level, timeout_graceful_shutdown=3)
-    server = uvicorn.Server(config)
+    server = _InterruptibleServer(config)
     try:
         server.run()
     except KeyboardInterrupt:
         # uvicorn re-raises a captured SIGINT (Ctrl-C) once its graceful shutdown - our lifespan
         # `finally`: runners stopped, zenoh closed, recordings flushed - is complete
         return 130
+    if server.interrupted:   # the re-raise can be absorbed by asyncio's own SIGINT handling
+        return 130
     return 0 if server.started else 1
+
+
+def _interruptible_server_class():
+    import signal
+
+    import uvicorn
+
+    class InterruptibleServer(uvicorn.Server):
+        """uvicorn's server that remembers a SIGINT (Ctrl-C), so that `serve` exits with 130 after
+        its graceful shutdown whether or not uvicorn's re-raised signal reaches us as
+        KeyboardInterrupt (asyncio.Runner's own SIGINT handler may turn it into a cancellation)."""
+
+        interrupted = False
+
+        def handle_exit(self, sig, frame) -> None:
+            if sig == signal.SIGINT:
+                self.interrupted = True
+            super().handle_exit(sig, frame)
+
+    return InterruptibleServer
+
+
+def _InterruptibleServer(config):  # noqa: N802 - a class made on demand (uvicorn imported lazily)
+    return _interruptible_server_class()(config)
 
 
 def _cmd_scenario_check(args: argparse.Namespace) -> int:
