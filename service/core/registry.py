@@ -140,7 +140,8 @@ class TwinRegistry:
         self._admitting: dict[str, TwinCost] = {}   # costs of twins admitted, not yet running
         threads = settings.stepping_threads or usable_cores()
         self.pool = SteppingPool(threads, name="step")
-        self.capacity = Capacity(threads, settings.capacity_core_fraction)
+        self.capacity = Capacity(threads, settings.capacity_core_fraction,
+                                 reserve_cores=settings.capacity_reserve_cores)
         self.last_calibration: TwinCost | None = None
         self.over_capacity: str | None = None     # why the configured twin runs over capacity
         self._over_capacity_id: str | None = None
@@ -390,7 +391,7 @@ class TwinRegistry:
         return {
             "admission": "off" if self.settings.fast else self.settings.admission,
             "cores": cap.cores, "stepping_threads": cap.stepping_threads,
-            "core_fraction": cap.core_fraction, "budget_cpu_s_per_s": cap.budget_cpu_s_per_s,
+            "core_fraction": cap.core_fraction, "reserve_cores": cap.reserve_cores, "budget_cpu_s_per_s": cap.budget_cpu_s_per_s,
             "used_cpu_s_per_s": used, "over_budget": used > cap.budget_cpu_s_per_s, "max_twins": estimate, "max_twins_set": self.settings.max_twins,
             "last_calibration": typical.as_dict() if typical is not None else None,
             "over_capacity": self.over_capacity,

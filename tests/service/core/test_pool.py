@@ -289,6 +289,16 @@ def test_capacity_rule():
     # more threads than cores buy nothing; fewer threads than cores limit the budget
     assert Capacity(8, 0.85, cores=2).budget_cpu_s_per_s == pytest.approx(1.7)
     assert Capacity(1, 0.85, cores=2).budget_cpu_s_per_s == pytest.approx(0.85)
+    # the service's reserve comes off the budget, never below one twin's share
+    reserved = Capacity(2, 0.85, cores=2, reserve_cores=0.5)
+    assert reserved.budget_cpu_s_per_s == pytest.approx(1.2)
+    twin = TwinCost(0.68, 0.06)                                    # a default 6208 on this VM: 0.74
+    assert reserved.check(twin, []).admitted
+    second = reserved.check(twin, [twin])                          # 1.48 > 1.2
+    assert not second.admitted and "less 0.5 reserved for the service" in second.reason
+    assert Capacity(1, 0.85, cores=1, reserve_cores=0.5).budget_cpu_s_per_s == pytest.approx(0.85)
+    with pytest.raises(ValueError, match="reserve_cores"):
+        Capacity(2, 0.85, reserve_cores=-1.0)
 
 
 def test_calibration_measures_thread_cpu_per_simulated_second():
@@ -317,7 +327,8 @@ def test_registry_refuses_a_twin_beyond_the_measured_capacity(monkeypatch):
     # the running twins' costs as calibrated (not as this machine's speed would measure them)
     monkeypatch.setattr(TwinRunner, "cost", property(lambda self: self.calibration))
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, admission="measured",
-                               stepping_threads=2, capacity_core_fraction=0.85, start_twin=False)
+                               stepping_threads=2, capacity_core_fraction=0.85, start_twin=False,
+                               capacity_reserve_cores=0.0)   # the arithmetic below without the reserve
     reg = TwinRegistry(settings)
     reg.capacity.cores = 2                       # this test's host has 2 cores, whatever runs it
     reg.open()
