@@ -63,7 +63,7 @@ class BearingModel:
     # issue 14 (twin.vibration): housing H_* vector, V_* vector, accelerometer decimator
     housing_params: np.ndarray | None = None
     decimator: DecimatorDesign | None = None  # None with the rigid outer ring
-    decimator_taps: np.ndarray | None = None  # reversed FIR taps (K R,); a dummy (1,) without housing
+    decimator_taps: np.ndarray | None = None  # reversed FIR taps (K R,); without the housing a (1,) zero array, as the kernel's signature takes an array
 
     @property
     def vibration_params(self) -> np.ndarray:

@@ -282,13 +282,17 @@ class TwinChannel:
         """Queue a snapshot for publication; returns at once, never raises.
 
         No rate limiting: the caller (runner) decides the publish rate."""
+        self._enqueue(snapshot)
+
+    def _enqueue(self, item) -> None:
+        """Append to the publish queue (the oldest item drops out when full, counted); never raises."""
         try:
             with self._cond:
                 if self._stopping:
                     return
                 if len(self._queue) == self._queue.maxlen:
                     self._dropped += 1
-                self._queue.append(snapshot)
+                self._queue.append(item)
                 self._cond.notify()
         except Exception:  # noqa: BLE001, S110 - a sink never raises into the physics
             pass
@@ -296,16 +300,7 @@ class TwinChannel:
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
         """Queue accelerometer blocks (twin.vibration.sensor.WaveformBlock) for
         `P/{id}/vibration/waveform`; returns at once, never raises (same queue as the snapshots)."""
-        try:
-            with self._cond:
-                if self._stopping:
-                    return
-                if len(self._queue) == self._queue.maxlen:
-                    self._dropped += 1
-                self._queue.append(_Waveform(list(blocks)))
-                self._cond.notify()
-        except Exception:  # noqa: BLE001, S110 - a sink never raises into the physics
-            pass
+        self._enqueue(_Waveform(list(blocks)))
 
     def close(self) -> None:
         """Same as `detach`."""
