@@ -6,6 +6,7 @@ It owns one immutable `BearingModel` and one mutable `TwinState` and calls the c
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -81,6 +82,7 @@ class Twin:
         self._last_torque_n_m = 0.0
         self._defects: tuple = ()  # issue 14: the active local defects (twin.vibration.defects)
         self._sensor = SensorReader(self.model) if self.model.housing_on else None
+        self._frozen_vibration = None  # a frozen copy's last window (`frozen`); the live twin reads its sensor
         self._apply(self.limits.admit(setpoint or self.default_setpoint()))
         self.reset(warm=warm)
 
@@ -400,9 +402,23 @@ class Twin:
         """Indicators of the last complete accelerometer window (twin.snapshot.VibrationState), or
         None before the first window or with the rigid outer ring."""
         if self._sensor is None:
-            return None
+            return self._frozen_vibration
         self._sensor.flush(self.state)
         return self._sensor.latest
+
+    def frozen(self) -> Twin:
+        """A copy that `snapshot()` can read in another thread while this twin steps on: the
+        object shallow-copied (the model, setpoint, defects and fault are immutable; numbers are
+        values), its state arrays copied, and the accelerometer reader replaced by its last window.
+        Call it from the thread that steps this twin: the copy never touches the live reader (its
+        cursor, waveform queue and window are the stepping thread's alone), so the samples it
+        drains stay contiguous."""
+        latest = self.vibration           # flushes the live reader here, in the stepping thread
+        frozen = copy.copy(self)
+        frozen.state = self.state.copy()
+        frozen._sensor = None
+        frozen._frozen_vibration = latest
+        return frozen
 
     def drain_waveform(self) -> list[WaveformBlock]:
         """The accelerometer samples [m/s^2] produced since the last call, as contiguous float32

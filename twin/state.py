@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 
 import numpy as np
@@ -93,6 +94,11 @@ class TwinState:
         rows[L.C_H_MIN] = -1.0
         rows[L.C_H_C] = -1.0
         rows[L.G_DEFECT_DROP] = 0.0
+
+    def copy(self) -> TwinState:
+        """An independent copy: every array copied, plain numbers (the defect count) as they are."""
+        return dataclasses.replace(self, **{f.name: (v.copy() if isinstance(v := getattr(self, f.name), np.ndarray) else v)
+                                            for f in dataclasses.fields(self)})
 
     def kernel_args(self) -> tuple:
         """The state arrays in `step_n` order."""

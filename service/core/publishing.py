@@ -28,7 +28,6 @@ from __future__ import annotations
 
 import collections
 import copy
-import dataclasses
 import logging
 import threading
 import time
@@ -46,19 +45,10 @@ log = logging.getLogger(__name__)
 
 
 def freeze(twin: Twin) -> Twin:
-    """A copy of `twin` that `snapshot()` can read while the original runs on: the object
-    shallow-copied (the model, setpoint and fault are immutable; numbers are values) with its
-    mutable state arrays copied (plain numbers of the state are values too)."""
-    frozen = copy.copy(twin)
-    state = twin.state
-    frozen.state = dataclasses.replace(state, **{f.name: _copied(getattr(state, f.name))
-                                                 for f in dataclasses.fields(state)})
-    return frozen
-
-
-def _copied(value):
-    """An array copied; a plain number (e.g. the state's defect count) as it is."""
-    return value.copy() if hasattr(value, "copy") else value
+    """A copy of `twin` that `snapshot()` can read while the original runs on (`Twin.frozen`:
+    state arrays copied, the accelerometer reader left to the stepping thread)."""
+    frozen = getattr(twin, "frozen", None)
+    return frozen() if frozen is not None else copy.copy(twin)
 
 
 def _drain_waveform(twin: Twin) -> list:

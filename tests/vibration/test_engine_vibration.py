@@ -233,6 +233,34 @@ def test_waveform_blocks_are_contiguous_float32():
     assert np.all(np.isfinite(a.samples)) and np.std(b.samples) > 0.0
 
 
+def test_a_frozen_copys_snapshot_leaves_the_live_waveform_intact():
+    """The service builds snapshots from `Twin.frozen()` copies in its publishing thread while the
+    twin steps on (service.core.publishing). A copy's snapshot must not drain the live
+    accelerometer reader with the copy's older sample ring: it once moved the reader's cursor back
+    (samples read twice; a CI run published a waveform chunk at t0 = 0.0005 s right after one
+    ending at 0.1695 s). Here the copy's snapshot runs after the live twin moved on and drained
+    part of it (the race, made deterministic): the live samples are exactly those of the same run
+    without the copy (noise off, so bit for bit), and the copy carries the window of its moment."""
+    def run(with_copy: bool):
+        twin = Twin(_spec(noise=0.0, window=0.05))
+        twin.advance(0.06)
+        (a,) = twin.drain_waveform()
+        frozen = twin.frozen()
+        twin.advance(0.053)                 # ends between two drains of the reader (DRAIN_EVERY_S)
+        snap = frozen.snapshot() if with_copy else None
+        (b,) = twin.drain_waveform()
+        return twin, frozen, snap, a, b
+
+    twin, frozen, snap, a, b = run(True)
+    _, _, _, a_ref, b_ref = run(False)
+    fs = twin.model.sample_rate_hz
+    assert b.t0_s == pytest.approx(a.t0_s + a.samples.size / fs, abs=1e-9)
+    assert b.samples.size == b_ref.samples.size and np.array_equal(b.samples, b_ref.samples)
+    assert snap.vibration is not None and snap.vibration.window_end_s <= frozen.time_s < twin.time_s
+    assert frozen.drain_waveform() == []
+    assert twin.snapshot().vibration.window_end_s > snap.vibration.window_end_s
+
+
 def test_defects_set_and_cleared_without_recompiling():
     """set_defects / clear_defects while the twin runs: the kernel is not compiled again (same numba
     signatures), the snapshot lists the active defects, the contact lanes' drop row follows."""
