@@ -423,6 +423,11 @@ class ServiceSettings(ZenohAccessSettings):
         default=None, ge=1, le=64,
         description="Threads that advance the twins, earliest deadline first [count]; unset = one per "
         "core this process may use.")
+    io_thread_nice: int = Field(
+        default=10, ge=0, le=19,
+        description="Nice value given to every thread of the service but the stepping threads and the publish "
+        "worker (Linux, per thread; service.core.priority) [-]: HTTP floods, zenoh, recording and OPC UA then "
+        "yield the cores to real time. 0: all threads at the same priority.")
     admission: Literal["measured", "off"] = Field(
         default="measured",
         description="'measured': a twin created over the API that this host cannot run in real time "

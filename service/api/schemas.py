@@ -187,6 +187,16 @@ class TwinHealth(BaseModel):
     cost: TwinCost | None = Field(default=None, description="CPU this twin needs in real time, as measured (its calibration until measured while running) [CPU s / s]; null when not measured.")
 
 
+class ThreadPriorityHealth(BaseModel):
+    """Scheduling priority of the service's threads (service.core.priority)."""
+
+    active: bool = Field(description="Whether the service's other threads run below the stepping threads (Linux) [bool].")
+    io_thread_nice: int = Field(description="Nice value of every thread but the stepping threads and the publish worker [-]; 0 when not active.")
+    stepping_thread_nice: list[int] = Field(description="Nice values found on the stepping threads and the publish worker [-].")
+    threads_reniced: int = Field(description="Threads given io_thread_nice since the start [-].")
+    errors: int = Field(description="Nice changes the system refused [-].")
+
+
 class Health(BaseModel):
     """Service health."""
 
@@ -203,6 +213,7 @@ class Health(BaseModel):
     recording_write_errors: int = Field(default=0, description="Recording writes that failed [-].")
     recording_rows_lost: int = Field(default=0, description="Snapshots that could not be written to a recording [-].")
     reads_rate_limited: int = Field(default=0, description="API reads refused with 429 by the per-client read rate [-].")
+    thread_priority: ThreadPriorityHealth | None = Field(default=None, description="Priority of the stepping threads over the service's I/O threads [nice values, counts].")
     http_slow_closed: int = Field(default=0, description="HTTP connections closed (408) because their headers or body were not complete in time, in this process [-].")
     pid: int | None = Field(default=None, description="Process id of the service [-] (for soak tests and monitoring).")
     rss_bytes: int | None = Field(default=None, description="Resident memory of the service process [bytes]; null where /proc is unavailable.")

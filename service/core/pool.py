@@ -220,6 +220,11 @@ class SteppingPool:
     def thread_names(self) -> list[str]:
         return [t.name for t in self._threads]
 
+    def native_ids(self) -> set[int]:
+        """Kernel thread ids of the stepping threads and the publish worker (started ones)."""
+        threads = [*self._threads, self.publisher._thread]
+        return {t.native_id for t in threads if t is not None and t.native_id is not None}
+
     def start(self) -> SteppingPool:
         with self._cond:
             if self._started or self._closing:

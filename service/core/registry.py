@@ -45,6 +45,7 @@ from service.core.capacity import Capacity, TwinCost, calibrate, usable_cores
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import DefectIntake, SetpointIntake
 from service.core.pool import SteppingPool
+from service.core.priority import ThreadPriority
 from service.core.runner import TwinRunner
 from service.core.sinks import SnapshotSink
 from service.settings import ServiceSettings
@@ -140,6 +141,7 @@ class TwinRegistry:
         self._admitting: dict[str, TwinCost] = {}   # costs of twins admitted, not yet running
         threads = settings.stepping_threads or usable_cores()
         self.pool = SteppingPool(threads, name="step")
+        self.priority = ThreadPriority(self.pool.native_ids, settings.io_thread_nice)
         self.capacity = Capacity(threads, settings.capacity_core_fraction,
                                  reserve_cores=settings.capacity_reserve_cores)
         self.last_calibration: TwinCost | None = None
@@ -177,6 +179,7 @@ class TwinRegistry:
             sys.setswitchinterval(self.settings.gil_switch_interval_s)  # process-wide, see settings
         try:
             self.pool.start()
+            self.priority.start()              # after the pool: its threads keep their nice
             self._open_outputs()
             if default_twin and self.settings.start_twin:
                 self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing,
@@ -206,6 +209,7 @@ class TwinRegistry:
         for e in entries:
             self._unwire(e)
         self.alarms.close()
+        self.priority.close()
         if not self.pool.close(timeout=5.0):
             log.error("the stepping pool did not stop within 5 s")
         self._close_outputs()
@@ -478,6 +482,7 @@ class TwinRegistry:
             "status": "degraded" if degraded else "ok",
             "capacity": self.capacity_record(),
             "reads_rate_limited": self.gate.reads_limited,
+            "thread_priority": self.priority.record(),
             "uptime_s": time.monotonic() - self.started_wall_s,
             "twins": twins,
             "zenoh": self.bus is not None and not getattr(self.bus, "closed", False),

@@ -1,0 +1,108 @@
+"""service.core.priority: the stepping threads before the service's I/O threads (Linux per-thread
+nice values, read back from the kernel with getpriority on each thread id)."""
+
+from __future__ import annotations
+
+import os
+import sys
+import threading
+
+import pytest
+
+from service.core.priority import BASE_NICE, ThreadPriority, process_threads, thread_nice
+
+pytestmark = pytest.mark.skipif(not sys.platform.startswith("linux"), reason="per-thread nice is Linux's")
+
+
+def _now_and_restored() -> tuple[int, int]:
+    """(this thread's nice now, the nice a kept thread created now ends with): an earlier test
+    in this process may have reniced this thread already; a thread inherits its creator's nice,
+    and only root may lower it back to the process's."""
+    now = thread_nice(threading.get_native_id())
+    return now, (BASE_NICE if os.geteuid() == 0 else now)
+
+
+class _Parked:
+    """A thread that waits until released, with its kernel id."""
+
+    def __init__(self, spawn_child: bool = False):
+        self.release = threading.Event()
+        self.ready = threading.Event()
+        self.child: _Parked | None = None
+        self._spawn_child = spawn_child
+        self.thread = threading.Thread(target=self._run, daemon=True)
+        self.thread.start()
+        assert self.ready.wait(10.0)
+
+    def _run(self) -> None:
+        self.release.wait(0.0)
+        self.ready.set()
+        self.release.wait(30.0)
+        if self._spawn_child:
+            self.child = _Parked()
+
+    @property
+    def tid(self) -> int:
+        return self.thread.native_id
+
+
+def test_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_swept():
+    now, restored = _now_and_restored()
+    io = now + 3
+    kept, other = _Parked(), _Parked(spawn_child=True)
+    prio = ThreadPriority(lambda: {kept.tid}, io_nice=io, sweep_s=3600.0)
+    try:
+        assert prio.sweep() >= 1
+        assert thread_nice(other.tid) == io
+        assert thread_nice(threading.get_native_id()) == io   # this (main) thread too
+        assert thread_nice(kept.tid) == restored
+        assert prio.sweep() == 0                                          # each thread once
+        # a thread created by a reniced thread inherits its nice (Linux clone semantics)
+        other.release.set()
+        other.thread.join(10.0)
+        assert other.child is not None and thread_nice(other.child.tid) == io
+        record = prio.record()
+        assert record["active"] and record["io_thread_nice"] == io
+        assert record["stepping_thread_nice"] == [restored] and record["errors"] == 0
+        assert set(process_threads()) >= {kept.tid, threading.get_native_id()}
+    finally:
+        kept.release.set()
+        if other.child is not None:
+            other.child.release.set()
+
+
+def test_io_nice_zero_changes_nothing():
+    t = _Parked()
+    before = thread_nice(t.tid)
+    prio = ThreadPriority(lambda: set(), io_nice=0)
+    try:
+        assert not prio.active and prio.sweep() == 0 and thread_nice(t.tid) == before
+        assert prio.record()["io_thread_nice"] == 0
+    finally:
+        t.release.set()
+
+
+def test_a_service_keeps_its_stepping_threads_above_its_other_threads():
+    """TwinRegistry.open: the pool's stepping threads and publish worker at the process's nice,
+    every other thread at `io_thread_nice`; /health carries the record."""
+    from service.core.registry import TwinRegistry
+    from service.settings import ServiceSettings
+
+    now, restored = _now_and_restored()
+    io = now + 5
+    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
+                               stepping_threads=2, io_thread_nice=io)
+    reg = TwinRegistry(settings).open()
+    try:
+        stepping = reg.pool.native_ids()
+        assert len(stepping) == 3                                    # 2 stepping + the publish worker
+        for tid in stepping:
+            assert thread_nice(tid) == restored
+        assert thread_nice(threading.get_native_id()) == io
+        others = [t for t in process_threads() if t not in stepping]
+        assert others and all(thread_nice(t) >= io for t in others if thread_nice(t) is not None)
+        health = reg.health()["thread_priority"]
+        assert health["active"] and health["io_thread_nice"] == io
+        assert health["stepping_thread_nice"] == [restored]
+    finally:
+        reg.close()
