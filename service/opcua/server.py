@@ -29,16 +29,20 @@ Security (service.opcua.security; setting `opcua_security`, `auto` = `both` with
 `none`). The secure modes offer Basic256Sha256, Aes128_Sha256_RsaOaep and Aes256_Sha256_RsaPss in
 Sign and/or SignAndEncrypt with the server certificate `opcua_certificate` / `opcua_private_key`,
 or a self-signed one made once in `opcua_pki_dir` (key 0600, never overwritten; its SHA-1
-thumbprint is logged at start and kept in `pki.thumbprint_sha1`). Every endpoint's user-name
-policy asks the client to encrypt the password with the server's key (the endpoint's own policy;
-on the None endpoint of `all` asyncua's choice, the first SignAndEncrypt policy), and `TokenUserManager` refuses, with
-BadIdentityTokenRejected, a password that came unencrypted and a user name on a None channel: so
-with security on the token never crosses the network in clear and writes only come over a signed
-channel. The None policy itself is refused at OpenSecureChannel unless the mode offers it.
-With `opcua_trusted_dir`, only clients whose certificate (or its CA) is in that folder may open
-a session: asyncua's CertificateValidator (TrustStore) checks the certificate announced at
-CreateSession, and `TokenUserManager` checks again, at ActivateSession, the certificate the secure
-channel was really opened with (asyncua does not compare the two): BadCertificateUntrusted.
+thumbprint is logged at start and kept in `facade.pki`). Rules of a secure server:
+- Every secure endpoint's user-name policy asks for the password RSA-encrypted with the server's
+  key under the endpoint's own policy (`_Server`; asyncua would leave it in clear inside
+  SignAndEncrypt); `TokenUserManager` refuses a password that came unencrypted
+  (BadIdentityTokenRejected, the password is not tried).
+- asyncua opens a None channel even when None is not offered (discovery needs one): no session
+  is activated on it (BadSecurityPolicyRejected). In mode `all` None is offered for anonymous
+  read-only sessions; a user name there is refused (BadIdentityTokenRejected): writes only come
+  over a signed channel.
+- With `opcua_trusted_dir`, only clients whose certificate (or its CA) is in that folder get a
+  session (BadCertificateUntrusted): asyncua's CertificateValidator + TrustStore check the
+  certificate announced at CreateSession, and `TokenUserManager` checks again, at
+  ActivateSession, the certificate the secure channel was really opened with (asyncua does not
+  compare the two).
 `opcua_security = none` with a token is the old behaviour, password in clear: an explicit choice,
 warned about in the log.
 """
