@@ -517,6 +517,32 @@ class ServiceSettings(ZenohAccessSettings):
         default=None, pattern=r"^opc\.tcp://[^/\s]+:\d{1,5}(/\S*)?$",
         description="OPC UA endpoint to serve the twins on [opc.tcp://HOST:PORT[/path]], e.g. "
         "opc.tcp://127.0.0.1:4840; unset (default) = no OPC UA server.")
+    opcua_security: Literal["auto", "none", "sign", "sign_and_encrypt", "both", "all"] = Field(
+        default="auto",
+        description="OPC UA message security the endpoint offers [choice]: `sign` / "
+        "`sign_and_encrypt` = the Basic256Sha256, Aes128_Sha256_RsaOaep and Aes256_Sha256_RsaPss "
+        "policies in that mode; `both` = both modes; `all` = both modes plus the None policy for "
+        "anonymous read-only sessions (a user name is refused there); `none` = only the None policy "
+        "(no certificate; with a token the password then crosses the network in clear). `auto` "
+        "(default) = `both` when a token is set, else `none`.")
+    opcua_certificate: Path | None = Field(
+        default=None,
+        description="The OPC UA server's certificate [path, DER or PEM], with opcua_private_key; its "
+        "subjectAltName must hold the URI urn:bearing-twin:server (OPC UA Part 6). Unset (default) = "
+        "a self-signed one made once in opcua_pki_dir and reused.")
+    opcua_private_key: Path | None = Field(
+        default=None,
+        description="Private key of opcua_certificate [path, PEM or DER, unencrypted RSA].")
+    opcua_pki_dir: Path = Field(
+        default=Path("opcua-pki"),
+        description="Folder of the generated self-signed OPC UA server certificate "
+        "(server-cert.der) and key (server-key.pem, mode 0600, never overwritten) [path]; made when "
+        "a secure policy is on and opcua_certificate is unset. Default ./opcua-pki.")
+    opcua_trusted_dir: Path | None = Field(
+        default=None,
+        description="Folder of trusted OPC UA client certificates (or CA certificates that signed "
+        "them) [path to a folder of .der / .pem files]: when set, only those clients may open a "
+        "session. Unset (default) = any client certificate (the token still guards writes).")
 
     @field_validator("zenoh_listen", "zenoh_connect", mode="before")
     @classmethod
@@ -574,6 +600,42 @@ class ServiceSettings(ZenohAccessSettings):
     def token_value(self) -> str | None:
         """The token in clear (None when authentication is off)."""
         return self.token.get_secret_value() if self.token is not None else None
+
+    @field_validator("opcua_certificate", "opcua_private_key", "opcua_trusted_dir", mode="before")
+    @classmethod
+    def _opcua_optional_path(cls, value):
+        if isinstance(value, str) and value.strip().lower() in ("", "none", "off"):
+            return None
+        return value
+
+    @property
+    def opcua_security_mode(self) -> str:
+        """The OPC UA security actually offered: `auto` resolved (both with a token, else none)."""
+        if self.opcua_security != "auto":
+            return self.opcua_security
+        return "both" if self.token is not None else "none"
+
+    @model_validator(mode="after")
+    def _opcua_security(self):
+        """The OPC UA certificate and trust settings (README "OPC UA", "Secure connections")."""
+        if (self.opcua_certificate is None) != (self.opcua_private_key is None):
+            missing = "opcua_private_key" if self.opcua_private_key is None else "opcua_certificate"
+            raise ValueError(f"{missing}: the OPC UA server certificate and its private key go together "
+                             "(or give neither: a self-signed one is made in opcua_pki_dir)")
+        for name in ("opcua_certificate", "opcua_private_key"):
+            path = getattr(self, name)
+            if path is not None and not Path(path).is_file():
+                raise ValueError(f"{name}: {str(path)!r} is not a file")
+        if self.opcua_trusted_dir is not None:
+            if not Path(self.opcua_trusted_dir).is_dir():
+                raise ValueError(f"opcua_trusted_dir: {str(self.opcua_trusted_dir)!r} is not a folder")
+            if self.opcua_security_mode in ("none", "all"):
+                raise ValueError(
+                    "opcua_trusted_dir: trusting clients by certificate needs every session on a "
+                    "secure channel: opcua_security sign, sign_and_encrypt or both (it is "
+                    f"{self.opcua_security!r}" + (", and `auto` without a token is none" if
+                                                  self.opcua_security == "auto" else "") + ")")
+        return self
 
     @field_validator("record", mode="before")
     @classmethod

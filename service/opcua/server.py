@@ -23,9 +23,28 @@ range, or not finite). The OPC UA write response carries only the status code, s
 Users. The bearer token is the password of a user-name identity (any user name); a wrong
 password refuses the session (BadUserAccessDenied at ActivateSession). With a token set,
 anonymous sessions read (unless `read_requires_token`, then they are refused) but cannot write.
-Without a token anyone may write, as over HTTP. Only the None security policy is offered, so the
-password crosses the network in clear, like the bearer token over plain HTTP: keep the endpoint
-on loopback or a trusted network.
+Without a token anyone may write, as over HTTP.
+
+Security (service.opcua.security; setting `opcua_security`, `auto` = `both` with a token, else
+`none`). The secure modes offer Basic256Sha256, Aes128_Sha256_RsaOaep and Aes256_Sha256_RsaPss in
+Sign and/or SignAndEncrypt with the server certificate `opcua_certificate` / `opcua_private_key`,
+or a self-signed one made once in `opcua_pki_dir` (key 0600, never overwritten; its SHA-1
+thumbprint is logged at start and kept in `facade.pki`). Rules of a secure server:
+- Every secure endpoint's user-name policy asks for the password RSA-encrypted with the server's
+  key under the endpoint's own policy (`_Server`; asyncua would leave it in clear inside
+  SignAndEncrypt); `TokenUserManager` refuses a password that came unencrypted
+  (BadIdentityTokenRejected, the password is not tried).
+- asyncua opens a None channel even when None is not offered (discovery needs one): no session
+  is activated on it (BadSecurityPolicyRejected). In mode `all` None is offered for anonymous
+  read-only sessions; a user name there is refused (BadIdentityTokenRejected): writes only come
+  over a signed channel.
+- With `opcua_trusted_dir`, only clients whose certificate (or its CA) is in that folder get a
+  session (BadCertificateUntrusted): asyncua's CertificateValidator + TrustStore check the
+  certificate announced at CreateSession, and `TokenUserManager` checks again, at
+  ActivateSession, the certificate the secure channel was really opened with (asyncua does not
+  compare the two).
+`opcua_security = none` with a token is the old behaviour, password in clear: an explicit choice,
+warned about in the log.
 """
 
 from __future__ import annotations
@@ -41,6 +60,7 @@ from typing import Any
 from urllib.parse import urlparse
 
 from asyncua import Server, ua
+from asyncua.common.utils import ServiceError
 from asyncua.crypto.permission_rules import User, UserRole
 from asyncua.server.address_space import AttributeService
 from asyncua.server.event_generator import EventGenerator
@@ -49,6 +69,7 @@ from service.core.alarms import AlarmEvent, inputs_from_snapshot
 from service.core.errors import InputError
 from service.opcua.layout import (APPLICATION_URI, EVENT_TYPE, FOLDERS, LAST_RESULT, NAMESPACE_URI, ROOT_FOLDER, SETPOINT_VARS,
                                   View, identification)
+from service.opcua.security import POLICIES, ClientTrust, PkiError, ServerPki, given_pki, self_signed_pki
 
 log = logging.getLogger(__name__)
 
@@ -77,22 +98,74 @@ class TwinUser(User):
 
 
 class TokenUserManager:
-    """asyncua user manager: the service token is the password (see the module docstring)."""
+    """asyncua user manager: the service token is the password (see the module docstring).
 
-    def __init__(self, gate: Any, read_requires_token: bool = False):
+    `secure`: the server offers secure policies (has a certificate); then a password must come
+    encrypted with the server's key and a user name is refused on a None channel. `trust`: the
+    trusted client certificates, checked against the secure channel's certificate."""
+
+    def __init__(self, gate: Any, read_requires_token: bool = False, *, secure: bool = False,
+                 none_offered: bool = True, trust: ClientTrust | None = None):
         self.gate, self.read_requires_token = gate, read_requires_token
+        self.secure, self.none_offered, self.trust = secure, none_offered, trust
+        self.password_encrypted: bool | None = None     # set by `decrypt_user_token` just before get_user
+
+    def wrap(self, iserver: Any) -> None:
+        """Watch asyncua's InternalServer.decrypt_user_token: it runs in ActivateSession right before
+        get_user (same call, no await between), so `password_encrypted` is that token's."""
+        decrypt = iserver.decrypt_user_token
+
+        def decrypt_user_token(isession: Any, token: ua.UserNameIdentityToken):
+            self.password_encrypted = bool(token.EncryptionAlgorithm)
+            return decrypt(isession, token)
+        iserver.decrypt_user_token = decrypt_user_token
 
     def get_user(self, iserver: Any, username: str | None = None, password: str | None = None,
                  certificate: Any = None) -> User | None:
+        encrypted, self.password_encrypted = self.password_encrypted, None
+        if not certificate and not self.none_offered:      # asyncua gives b"" on a None channel
+            # asyncua opens a None channel even when None is not offered (discovery needs one);
+            # no session may be activated on it
+            log.warning("OPC UA: a session on the None security policy is refused (not offered)")
+            raise ServiceError(ua.StatusCodes.BadSecurityPolicyRejected)
+        if self.trust is not None:
+            refusal = self.trust.refusal(certificate)
+            if refusal is not None:
+                log.warning("OPC UA: session refused (%s): the client certificate is not in %s", refusal,
+                            self.trust.folder)
+                raise ServiceError(getattr(ua.StatusCodes, refusal))
         if username is None and password is None:
             if self.gate.requires_token and self.read_requires_token:
                 self.gate.check_token(None)            # counted as unauthorized
                 return None
             # role User: asyncua's ruleset gives the Anonymous role nothing, not even reads
             return TwinUser(role=UserRole.User, name=None, authenticated=not self.gate.requires_token)
+        if self.secure and not certificate:
+            log.warning("OPC UA: a user name on the None security policy is refused (only anonymous reads there)")
+            raise ServiceError(ua.StatusCodes.BadIdentityTokenRejected)
+        if self.secure and encrypted is False:
+            log.warning("OPC UA: a password sent unencrypted is refused (the endpoint asks for it encrypted "
+                        "with the server certificate); the token may have been exposed")
+            raise ServiceError(ua.StatusCodes.BadIdentityTokenRejected)
         if self.gate.check_token(password or "") is not None:
             return None                                # BadUserAccessDenied at ActivateSession
         return TwinUser(role=UserRole.User, name=username or "user", authenticated=True)
+
+
+class _Server(Server):
+    """asyncua's Server with the password always encrypted with the server's key: on a secure
+    endpoint by the endpoint's own policy (asyncua leaves it in clear inside SignAndEncrypt). The
+    None endpoint of a secure server keeps asyncua's choice (the first SignAndEncrypt policy), so
+    a client that tries a user name there still sends no password in clear before the refusal."""
+
+    secure: bool = False
+
+    def _set_endpoints(self, policy: Any, mode: ua.MessageSecurityMode, level: int) -> None:
+        super()._set_endpoints(policy, mode, level)
+        if self.secure and mode != ua.MessageSecurityMode.None_:
+            for t in self.iserver.endpoints[-1].UserIdentityTokens:
+                if t.TokenType == ua.UserTokenType.UserName:
+                    t.SecurityPolicyUri = policy.URI
 
 
 _ADMIN = User(role=UserRole.Admin)       # asyncua's default user of a server-side write
@@ -139,11 +212,18 @@ class OpcUaFacade:
     """The OPC UA server of a service (see the module docstring)."""
 
     def __init__(self, registry: Any, endpoint: str, *, period_s: float | None = None,
-                 read_requires_token: bool | None = None, server_name: str = "bearing-twin"):
+                 read_requires_token: bool | None = None, server_name: str = "bearing-twin",
+                 security: str | None = None):
         parsed = urlparse(endpoint)
         if parsed.scheme != "opc.tcp" or not parsed.hostname or parsed.port is None:
             raise ValueError(f"opcua = {endpoint!r}: expected opc.tcp://HOST:PORT[/path]")
         settings = registry.settings
+        # security: the mode (README "OPC UA"); the certificate, key and folders from the settings
+        self.security = security if security is not None else settings.opcua_security_mode
+        if self.security not in POLICIES:
+            raise ValueError(f"opcua_security = {self.security!r}: expected one of {', '.join(POLICIES)}")
+        self.pki: ServerPki | None = None        # the server certificate in use (secure modes)
+        self.trust: ClientTrust | None = None
         self.registry = registry
         self.endpoint = endpoint
         # one publish period (of wall time; in fast mode of simulated time, at least 10 ms)
@@ -169,6 +249,8 @@ class OpcUaFacade:
     def start(self, timeout_s: float = 60.0) -> OpcUaFacade:
         """Start the server thread; return once it listens (OpcUaError if it cannot)."""
         logging.getLogger("asyncua").setLevel(max(logging.WARNING, logging.getLogger("asyncua").level))
+        # asyncua's TrustStore logs each untrusted certificate with a traceback; the facade logs one line
+        logging.getLogger("asyncuagds.validate").setLevel(logging.CRITICAL)
         self._thread = threading.Thread(target=self._thread_main, name="opcua", daemon=True)
         self._thread.start()
         if not self._ready.wait(timeout_s):
@@ -219,12 +301,29 @@ class OpcUaFacade:
         self._loop = asyncio.get_running_loop()
         self._alarms = asyncio.Queue()
         self._stop = asyncio.Event()
-        server = self.server = Server(user_manager=TokenUserManager(self.registry.gate, self.read_requires_token))
+        secure = self.security != "none"
+        settings = self.registry.settings
+        if secure:
+            await self._load_pki(settings)
+        elif self.registry.gate.requires_token:
+            log.warning("OPC UA: opcua_security = none with a token: the token (the OPC UA password) "
+                        "crosses the network in clear")
+        users = TokenUserManager(self.registry.gate, self.read_requires_token, secure=secure,
+                                 none_offered=ua.SecurityPolicyType.NoSecurity in POLICIES[self.security],
+                                 trust=self.trust)
+        server = self.server = _Server(user_manager=users)
+        server.secure = secure
         await server.init()
+        users.wrap(server.iserver)
         server.set_endpoint(self.endpoint)
         server.set_server_name(self.server_name)
         await server.set_application_uri(APPLICATION_URI)
-        server.set_security_policy([ua.SecurityPolicyType.NoSecurity])
+        if self.pki is not None:
+            await server.load_certificate(str(self.pki.certificate))
+            await server.load_private_key(str(self.pki.private_key))
+        if self.trust is not None:
+            server.set_certificate_validator(self.trust.validator())
+        server.set_security_policy(list(POLICIES[self.security]))
         server.set_identity_tokens([ua.AnonymousIdentityToken, ua.UserNameIdentityToken])
         server.iserver.attribute_service = _GatedAttributeService(server.iserver.aspace, self)
         idx = self.namespace_index = await server.register_namespace(NAMESPACE_URI)
@@ -237,7 +336,7 @@ class OpcUaFacade:
             self.url = f"opc.tcp://{urlparse(self.endpoint).hostname}:{sock[1]}{urlparse(self.endpoint).path}"
         except Exception:  # noqa: BLE001
             self.url = self.endpoint
-        log.info("OPC UA server on %s (namespace %s)", self.url, NAMESPACE_URI)
+        log.info("OPC UA server on %s (namespace %s), security %s", self.url, NAMESPACE_URI, self.security)
         self._ready.set()
         try:
             while not self._stop.is_set():
@@ -252,6 +351,29 @@ class OpcUaFacade:
                     pass
         finally:
             await server.stop()
+
+    async def _load_pki(self, settings: Any) -> None:
+        """The server certificate (given or self-signed in opcua_pki_dir) and the trusted clients."""
+        given = getattr(settings, "opcua_certificate", None)
+        host = urlparse(self.endpoint).hostname or ""
+        try:
+            if given is not None:
+                self.pki = await asyncio.to_thread(given_pki, given, settings.opcua_private_key, APPLICATION_URI)
+            else:
+                self.pki = await asyncio.to_thread(self_signed_pki, settings.opcua_pki_dir, APPLICATION_URI,
+                                                   [host] if host not in ("0.0.0.0", "::") else [])
+            trusted = getattr(settings, "opcua_trusted_dir", None)
+            if trusted is not None:
+                self.trust = await ClientTrust(trusted).load()
+        except PkiError as exc:
+            raise OpcUaError(str(exc)) from None
+        pki = self.pki
+        made = " (made now)" if pki.generated_certificate else ""
+        log.info("OPC UA server certificate %s%s: SHA-1 thumbprint %s, valid until %s; key %s", pki.certificate,
+                 made, pki.thumbprint_sha1, f"{pki.not_after:%Y-%m-%d}", pki.private_key)
+        if self.trust is not None:
+            log.info("OPC UA: only clients with a certificate in %s (%d file(s)) may open a session",
+                     self.trust.folder, self.trust.count)
 
     # ---- twins ---------------------------------------------------------------------------------
     async def _sync(self) -> None:

@@ -241,6 +241,22 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--opcua", metavar="opc.tcp://HOST:PORT",
                        help="also serve the twins over OPC UA on this endpoint, e.g. "
                        "opc.tcp://127.0.0.1:4840 (default off) [BEARING_TWIN_OPCUA]")
+    serve.add_argument("--opcua-security", choices=["auto", "none", "sign", "sign_and_encrypt", "both", "all"],
+                       help="OPC UA message security: Basic256Sha256, Aes128_Sha256_RsaOaep, "
+                       "Aes256_Sha256_RsaPss in Sign, SignAndEncrypt or both; all = both + None for "
+                       "anonymous reads; none = no certificate, password in clear (default auto: both "
+                       "with a token, else none) [BEARING_TWIN_OPCUA_SECURITY]")
+    serve.add_argument("--opcua-certificate", metavar="CERT.der",
+                       help="OPC UA server certificate, DER or PEM, with --opcua-private-key (default: "
+                       "self-signed in --opcua-pki-dir) [BEARING_TWIN_OPCUA_CERTIFICATE]")
+    serve.add_argument("--opcua-private-key", metavar="KEY.pem",
+                       help="its private key, PEM or DER [BEARING_TWIN_OPCUA_PRIVATE_KEY]")
+    serve.add_argument("--opcua-pki-dir", metavar="DIR",
+                       help="folder of the generated OPC UA server certificate and key (default "
+                       "./opcua-pki) [BEARING_TWIN_OPCUA_PKI_DIR]")
+    serve.add_argument("--opcua-trusted-dir", metavar="DIR",
+                       help="folder of trusted OPC UA client certificates (.der/.pem): only those "
+                       "clients may connect (default: any client certificate) [BEARING_TWIN_OPCUA_TRUSTED_DIR]")
     serve.add_argument("--no-zenoh", action="store_true", help="debugging: do not start the zenoh bus")
     serve.add_argument("--no-record", action="store_true", help="debugging: do not record")
     serve.add_argument("--log-level", default="info", choices=["critical", "error", "warning", "info", "debug"])
@@ -381,7 +397,10 @@ def _serve_settings(args: argparse.Namespace):
                        ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
                        ("zenoh_mode", "zenoh_mode"), ("zenoh_prefix", "zenoh_prefix"), ("record", "record"),
                        ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),
-                       ("publish_rate", "publish_rate_hz"), ("opcua", "opcua")):
+                       ("publish_rate", "publish_rate_hz"), ("opcua", "opcua"),
+                       ("opcua_security", "opcua_security"), ("opcua_certificate", "opcua_certificate"),
+                       ("opcua_private_key", "opcua_private_key"), ("opcua_pki_dir", "opcua_pki_dir"),
+                       ("opcua_trusted_dir", "opcua_trusted_dir")):
         value = getattr(args, flag, None)
         if value is not None:
             overrides[name] = value
@@ -446,8 +465,16 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     else:
         print("bearing-twin: zenoh off", flush=True)
     if settings.opcua:
+        security = settings.opcua_security_mode
         print(f"bearing-twin: OPC UA on {settings.opcua} (namespace urn:bearing-twin:opcua; "
               + ("user name + the token as password to write" if settings.token else "anonymous writes allowed")
+              + "; security " + {"none": "None only" + (": the password crosses in clear" if settings.token else ""),
+                                  "sign": "Sign", "sign_and_encrypt": "SignAndEncrypt",
+                                  "both": "Sign and SignAndEncrypt",
+                                  "all": "Sign, SignAndEncrypt and None (anonymous reads)"}[security]
+              + (" with Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss" if security != "none" else "")
+              + (f"; clients trusted: the certificates in {settings.opcua_trusted_dir}"
+                 if settings.opcua_trusted_dir is not None else "")
               + ")", flush=True)
     from service.core.errors import InputError
     from service.wiring import TwinService, WiringError
@@ -461,6 +488,10 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         return 2
     except KeyboardInterrupt:
         return 130
+    pki = getattr(getattr(service, "opcua", None), "pki", None)
+    if pki is not None:
+        print(f"bearing-twin: OPC UA server certificate {pki.certificate} (SHA-1 thumbprint "
+              f"{pki.thumbprint_sha1}, valid until {pki.not_after:%Y-%m-%d}): trust it in the clients", flush=True)
     recorder = getattr(service, "recorder", None)
     written = getattr(recorder, "path", None) if recorder is not None else None
     if written is not None:     # the file actually written: <stem>.run2.rrd when the name was taken

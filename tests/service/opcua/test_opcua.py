@@ -1,6 +1,8 @@
 """The OPC UA facade (service.opcua) against a REAL service: uvicorn + the twins + an asyncua server
 on 127.0.0.1 (free ports), browsed, read and written with asyncua's own client. A bearer token is
-set: it is the OPC UA password. Every wait is bounded; no wall-clock figure is asserted except the
+set: it is the OPC UA password. These tests run on the None security policy, asked for
+explicitly (with a token the default offers only signed and encrypted endpoints: see
+test_opcua_security.py). Every wait is bounded; no wall-clock figure is asserted except the
 contract's own "within one publish period", counted in publications (seq)."""
 
 from __future__ import annotations
@@ -28,7 +30,8 @@ PUBLISH_HZ = 20.0
 @pytest.fixture(scope="module")
 def server(support):
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, token=TOKEN, max_twins=3,
-                               publish_rate_hz=PUBLISH_HZ, opcua=f"opc.tcp://127.0.0.1:{support.free_port()}")
+                               publish_rate_hz=PUBLISH_HZ, opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
+                               opcua_security="none")
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=30.0) as srv:
         yield srv
 

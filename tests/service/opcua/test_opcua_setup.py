@@ -59,3 +59,65 @@ def test_a_busy_port_is_a_one_line_wiring_error():
             TwinService(settings).open()
     text = str(err.value)
     assert "\n" not in text and "address already in use" in text and "--opcua" in text
+
+
+def test_the_security_settings_and_flags(tmp_path):
+    """opcua_security `auto`: Sign + SignAndEncrypt with a token, None without; the certificate and
+    key go together; a trusted-clients folder needs every session on a secure channel. Each bad
+    value is an error naming its field; the serve flags set the same fields."""
+    assert ServiceSettings().opcua_security == "auto" and ServiceSettings().opcua_security_mode == "none"
+    assert ServiceSettings(token="s3cret").opcua_security_mode == "both"
+    assert ServiceSettings(token="s3cret", opcua_security="none").opcua_security_mode == "none"
+    assert ServiceSettings().opcua_pki_dir.name == "opcua-pki"
+    with pytest.raises(ValidationError, match="opcua_security"):
+        ServiceSettings(opcua_security="encrypt")
+    cert = tmp_path / "c.der"
+    cert.write_bytes(b"x")
+    with pytest.raises(ValidationError, match="opcua_private_key: the OPC UA server certificate and its private key"):
+        ServiceSettings(opcua_certificate=cert)
+    with pytest.raises(ValidationError, match="opcua_certificate: .* is not a file"):
+        ServiceSettings(opcua_certificate=tmp_path / "missing.der", opcua_private_key=cert)
+    with pytest.raises(ValidationError, match="opcua_trusted_dir: .* is not a folder"):
+        ServiceSettings(token="s3cret", opcua_trusted_dir=cert)
+    with pytest.raises(ValidationError, match="opcua_trusted_dir: trusting clients by certificate"):
+        ServiceSettings(opcua_trusted_dir=tmp_path)                      # auto without a token: None
+    with pytest.raises(ValidationError, match="opcua_trusted_dir: trusting clients by certificate"):
+        ServiceSettings(token="s3cret", opcua_security="all", opcua_trusted_dir=tmp_path)
+    assert ServiceSettings(opcua_security="sign", opcua_trusted_dir=tmp_path).opcua_trusted_dir == tmp_path
+    from service.tools.cli import _serve_settings, build_parser
+
+    args = build_parser().parse_args(["serve", "--opcua", "opc.tcp://127.0.0.1:4841", "--opcua-security",
+                                      "sign_and_encrypt", "--opcua-pki-dir", str(tmp_path / "pki"),
+                                      "--opcua-trusted-dir", str(tmp_path)])
+    settings = _serve_settings(args)
+    assert (settings.opcua_security, settings.opcua_pki_dir, settings.opcua_trusted_dir) == \
+        ("sign_and_encrypt", tmp_path / "pki", tmp_path)
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["serve", "--opcua-security", "encrypt"])
+
+
+def test_the_security_rules_of_the_user_manager():
+    """TokenUserManager on a secure server: no session on a None channel unless None is offered, no
+    user name on a None channel, no password that came unencrypted (asyncua's decrypt hook sets
+    `password_encrypted`), BadIdentityTokenRejected / BadSecurityPolicyRejected raised."""
+    from asyncua import ua
+    from asyncua.common.utils import ServiceError
+
+    gate = AdmissionGate(token="s3cret")
+    strict = TokenUserManager(gate, secure=True, none_offered=False)
+    with pytest.raises(ServiceError) as err:
+        strict.get_user(None, certificate=b"")                              # anonymous on None
+    assert err.value.code == ua.StatusCodes.BadSecurityPolicyRejected
+    relaxed = TokenUserManager(gate, secure=True, none_offered=True)
+    assert relaxed.get_user(None, certificate=b"").authenticated is False    # anonymous reads on None
+    relaxed.password_encrypted = True
+    with pytest.raises(ServiceError) as err:
+        relaxed.get_user(None, username="op", password="s3cret", certificate=b"")
+    assert err.value.code == ua.StatusCodes.BadIdentityTokenRejected
+    relaxed.password_encrypted = False
+    with pytest.raises(ServiceError) as err:
+        relaxed.get_user(None, username="op", password="s3cret", certificate=b"DER")
+    assert err.value.code == ua.StatusCodes.BadIdentityTokenRejected
+    relaxed.password_encrypted = True
+    assert relaxed.get_user(None, username="op", password="s3cret", certificate=b"DER").authenticated
+    assert gate.unauthorized == 0                                          # refused before the password
