@@ -345,8 +345,10 @@ def test_secured_router_fleet(hostile, users):
                   what="the twin's liveliness token through the router")
             assert sorted(set(alive)) == [f"{key}/alive"], alive
             time.sleep(0.5)
+            # a liveliness subscriber with history can get the same token twice (once from the
+            # history query, once as the declaration arrives): the point is that no other key shows
             op_alive = [k for k, p in op.seen if k.endswith("/alive")]
-            assert op_alive == [f"{key}/alive"], op_alive
+            assert sorted(set(op_alive)) == [f"{key}/alive"], op_alive
             assert not any("ghost-anon" in k or "ghost-wrong" in k for k, p in viewer.seen)
             results = [json.loads(p) for k, p in op.seen if k.endswith("/setpoint/result")]
             assert [r["setpoint"]["radial_load_n"] for r in results] == [3500.0]
