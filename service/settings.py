@@ -7,6 +7,7 @@ accept a JSON list (`'["tcp/127.0.0.1:7447"]'`) or a comma-separated string
 
 from __future__ import annotations
 
+import ipaddress
 import json
 import re
 from datetime import UTC, datetime
@@ -15,6 +16,20 @@ from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
+
+
+def is_loopback_host(host: str | None) -> bool:
+    """Whether `host` (an IP address, bracketed or not, or a host name) is this machine's
+    loopback: 127.0.0.0/8, ::1 or `localhost`."""
+    if not host:
+        return False
+    host = host.strip("[]")
+    if host.lower() == "localhost":
+        return True
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return False
 
 
 def default_recording_path() -> Path:
@@ -83,6 +98,12 @@ def read_usersfile(path: Path) -> list[str]:
     if not users:
         raise ValueError(f"{str(path)!r} holds no `user:password` line")
     return users
+
+
+def zenoh_access_enabled(usersfile: Path | None, user: str | None, tls_certificate: Path | None) -> bool:
+    """zenoh authentication (and, where links are accepted, access control) is on: a users file, a
+    user of one's own, or mutual TLS (a certificate)."""
+    return usersfile is not None or user is not None or tls_certificate is not None
 
 
 class ZenohAccessSettings(BaseSettings):
@@ -217,7 +238,7 @@ class ZenohAccessSettings(BaseSettings):
     @property
     def zenoh_access_control(self) -> bool:
         """zenoh authentication (and, where links are accepted, access control) is on."""
-        return self.zenoh_usersfile is not None or self.zenoh_user is not None or self.zenoh_tls
+        return zenoh_access_enabled(self.zenoh_usersfile, self.zenoh_user, self.zenoh_tls_certificate)
 
     @property
     def zenoh_prefix_is_pattern(self) -> bool:

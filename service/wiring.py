@@ -13,6 +13,7 @@ their threads, forever: see the recorder's module doc).
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import re
 from datetime import UTC, datetime
@@ -34,17 +35,23 @@ class WiringError(RuntimeError):
     """A component the settings ask for is missing or failed to start."""
 
 
+@contextlib.contextmanager
+def _importing(feature: str, package: str, remedy: str):
+    """The imports of an enabled `feature`: a WiringError saying `remedy` when they fail."""
+    try:
+        yield
+    except ImportError as exc:
+        raise WiringError(f"{feature} is enabled but {package} cannot be imported ({exc}); {remedy}") from exc
+
+
 def open_bus(settings: ServiceSettings):
     """The service's zenoh bus, or None when zenoh is disabled. WiringError (one line) when it
     cannot be opened (e.g. the listen port is taken)."""
     if not settings.enable_zenoh:
         return None
-    try:
+    with _importing("zenoh", "service.bus", "install eclipse-zenoh or run with --no-zenoh"):
         from service.bus.access import ZenohAccess
         from service.bus.zenoh_bus import ZenohBus
-    except ImportError as exc:
-        raise WiringError(f"zenoh is enabled but service.bus cannot be imported ({exc}); "
-                          "install eclipse-zenoh or run with --no-zenoh") from exc
     owner = {"http": f"http://{settings.host}:{settings.port}"} if settings.port else {}
     try:
         return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode,
@@ -58,11 +65,8 @@ def open_bus(settings: ServiceSettings):
 
 
 def _recorder_class():
-    try:
+    with _importing("recording", "service.recording", "install rerun-sdk or run with --no-record"):
         from service.recording import RerunRecorder
-    except ImportError as exc:
-        raise WiringError(f"recording is enabled but service.recording cannot be imported ({exc}); "
-                          "install rerun-sdk or run with --no-record") from exc
     return RerunRecorder
 
 
@@ -101,11 +105,8 @@ def open_opcua(settings: ServiceSettings, registry: TwinRegistry):
     WiringError (one line) when it cannot start (e.g. the port is taken)."""
     if not settings.opcua:
         return None
-    try:
+    with _importing("OPC UA", "service.opcua", "install asyncua or run without --opcua"):
         from service.opcua import OpcUaError, OpcUaFacade
-    except ImportError as exc:
-        raise WiringError(f"OPC UA is enabled but service.opcua cannot be imported ({exc}); "
-                          "install asyncua or run without --opcua") from exc
     try:
         return OpcUaFacade(registry, settings.opcua).start()
     except (OpcUaError, ValueError) as exc:

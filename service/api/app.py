@@ -36,15 +36,11 @@ from service.api.middleware import BodySizeLimit, ReadRateLimit
 from service.api.routers import alarms, bearings, defects, docs, health, recording, scenarios, setpoint, state
 from service.api.schemas import ErrorResponse
 from service.core.registry import TwinRegistry, admission_gate
-from service.settings import ServiceSettings
+from service.settings import ServiceSettings, is_loopback_host
 
 log = logging.getLogger(__name__)
 
 _UNAUTHORIZED = {401: {"model": ErrorResponse, "description": "Missing or wrong bearer token"}}
-
-
-def _loopback(host: str) -> bool:
-    return host in ("127.0.0.1", "localhost", "::1") or host.startswith("127.")
 
 
 def access_summary(settings: ServiceSettings) -> str:
@@ -65,7 +61,7 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
     @asynccontextmanager
     async def lifespan(app: FastAPI):
         log.info("bearing-twin: HTTP bound to %s:%s (%s); %s", settings.host, settings.port,
-                 "loopback only" if _loopback(settings.host) else "reachable from other machines",
+                 "loopback only" if is_loopback_host(settings.host) else "reachable from other machines",
                  access_summary(settings))
         opened = service
         if opened is None:

@@ -54,6 +54,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from service.settings import zenoh_access_enabled
+
 # what each role may do: (messages, flow, key suffixes under P/*)
 # what a twin publishes (besides its state): results, alarm events, vibration (issue 14, 15)
 _OUT = ["state", "ball/*", "setpoint/result", "defects/result", "alarm", "vibration", "vibration/waveform"]
@@ -156,7 +158,7 @@ class ZenohAccess:
 
     @property
     def enabled(self) -> bool:
-        return self.usersfile is not None or self.user is not None or self.tls
+        return zenoh_access_enabled(self.usersfile, self.user, self.tls_certificate)
 
     @classmethod
     def from_settings(cls, s: Any, *, enforce: bool = False) -> ZenohAccess:

@@ -200,6 +200,14 @@ def _dumps(obj: Any) -> str:
     return json.dumps(obj, allow_nan=False, separators=(",", ":"))
 
 
+def _payload(sample: zenoh.Sample) -> bytes:
+    """A sample's payload bytes; b"" when they cannot be read (the intake refuses those)."""
+    try:
+        return sample.payload.to_bytes()
+    except Exception:  # noqa: BLE001
+        return b""
+
+
 class TwinChannel:
     """One twin on the bus; a `SnapshotSink`. Created by `ZenohBus.attach_twin`."""
 
@@ -441,18 +449,10 @@ class TwinChannel:
 
     # ---- zenoh callbacks: hand off only -----------------------------------------------------
     def _on_setpoint_sample(self, sample: zenoh.Sample) -> None:
-        try:
-            payload = sample.payload.to_bytes()
-        except Exception:  # noqa: BLE001
-            payload = b""
-        self._enqueue_control(("setpoint", payload))
+        self._enqueue_control(("setpoint", _payload(sample)))
 
     def _on_defects_sample(self, sample: zenoh.Sample) -> None:
-        try:
-            payload = sample.payload.to_bytes()
-        except Exception:  # noqa: BLE001
-            payload = b""
-        self._enqueue_control(("defects", payload))
+        self._enqueue_control(("defects", _payload(sample)))
 
     def _on_query(self, query: zenoh.Query) -> None:
         self._enqueue_control(("query", query))
@@ -481,10 +481,7 @@ class TwinChannel:
                     self.setpoints_refused_busy += 1
                     if not self._publishers_gone and self._defects_result_pub is not None:
                         with contextlib.suppress(Exception):
-                            self._defects_result_pub.put(_dumps({
-                                "accepted": False, "status": 429, "retry_after_s": 0.1,
-                                "error": f"too many messages waiting for twin {self.bearing_id!r}: refused, retry",
-                                "bearing_id": self.bearing_id}))
+                            self._defects_result_pub.put(self._busy_refusal("messages"))
                 else:
                     self._finish_query(item, error="busy: too many requests waiting, retry")
                 return
@@ -547,14 +544,19 @@ class TwinChannel:
         if not self._publishers_gone and result_pub is not None:
             result_pub.put(text)
 
+    def _busy_refusal(self, what: str) -> str:
+        """The result-key refusal (status 429) of a message of kind `what` (plural) that found
+        the control queue full."""
+        return _dumps({"accepted": False, "status": 429, "retry_after_s": 0.1,
+                       "error": f"too many {what} waiting for twin {self.bearing_id!r} "
+                       f"({_CONTROL_QUEUE_SIZE} queued, the most this twin queues): refused, retry",
+                       "bearing_id": self.bearing_id})
+
     def _refuse_busy(self) -> None:
         """Publish one 429 refusal for each setpoint that found the control queue full."""
         with self._control_cond:
             count, self._busy_pending, self._busy_marked = self._busy_pending, 0, 0
-        text = _dumps({"accepted": False, "status": 429, "retry_after_s": 0.1,
-                       "error": f"too many setpoints waiting for twin {self.bearing_id!r} "
-                       f"({_CONTROL_QUEUE_SIZE} queued, the most this twin queues): refused, retry",
-                       "bearing_id": self.bearing_id})
+        text = self._busy_refusal("setpoints")
         self.setpoints_received += count
         for _ in range(count):
             if self._publishers_gone:

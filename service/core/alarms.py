@@ -144,7 +144,8 @@ def _get(obj: Any, *names: str) -> Any:
     return None
 
 
-def _finite(value: Any) -> float | None:
+def finite_number(value: Any) -> float | None:
+    """A JSON or model value as a finite float; None for anything else (None, bool, text, NaN, inf)."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
         return None
     value = float(value)
@@ -156,7 +157,7 @@ def _line_amplitude(entry: Any) -> float | None:
     twin.snapshot.DefectLine (or its dict)."""
     harmonics = _get(entry, "harmonics")
     if isinstance(harmonics, (list, tuple)) and harmonics:
-        return _finite(harmonics[0])
+        return finite_number(harmonics[0])
     return None
 
 
@@ -173,9 +174,9 @@ def vibration_inputs(block: Any) -> VibrationInputs | None:
             a = _line_amplitude(entry)
             if a is not None and name in DEFECT_LINES:
                 lines[str(name)] = a
-    return VibrationInputs(velocity_rms_mm_s=_finite(_get(block, "velocity_rms_mm_s")),
+    return VibrationInputs(velocity_rms_mm_s=finite_number(_get(block, "velocity_rms_mm_s")),
                            line_amplitudes_m_s2=lines,
-                           noise_floor_m_s2=_finite(_get(block, "envelope_noise_floor_m_s2")))
+                           noise_floor_m_s2=finite_number(_get(block, "envelope_noise_floor_m_s2")))
 
 
 def _seq(value: Any) -> int | None:
@@ -192,7 +193,7 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
             c = _get(ball, side)
             if c is not None:
                 contacts.append(c)
-    loads = [(_finite(_get(c, "load_n")) or 0.0) for c in contacts]
+    loads = [(finite_number(_get(c, "load_n")) or 0.0) for c in contacts]
     peak = max(loads, default=0.0)
     min_lambda, boundary = None, 0
     if peak > 0.0:
@@ -200,7 +201,7 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
         for c, load in zip(contacts, loads, strict=True):
             if load <= 0.0 or load < cut:
                 continue
-            lam = _finite(_get(c, "lambda_", "lambda"))
+            lam = finite_number(_get(c, "lambda_", "lambda"))
             if lam is None:
                 continue
             min_lambda = lam if min_lambda is None else min(min_lambda, lam)
@@ -212,10 +213,10 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
         time_s=float(_get(snapshot, "time_s") or 0.0),
         seq=_seq(_get(snapshot, "seq")),
         min_loaded_lambda=min_lambda, boundary_contacts=boundary,
-        kappa=_finite(_get(life, "kappa")),
+        kappa=finite_number(_get(life, "kappa")),
         discharge_risk=_get(electrical, "discharge_risk"),
         discharge_reason=str(_get(electrical, "reason") or ""),
-        damage_fraction=_finite(_get(life, "damage_fraction")),
+        damage_fraction=finite_number(_get(life, "damage_fraction")),
         vibration=vibration_inputs(_get(snapshot, "vibration")),
     )
 

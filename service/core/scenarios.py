@@ -56,6 +56,7 @@ from typing import Any
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
+from service.core.errors import loc_text
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointLimits, SetpointUpdate
 from twin.spec import BearingSpec, Thermal
@@ -381,23 +382,13 @@ _PATH_PREFIX = re.compile(r"^([A-Za-z_][\w.\[\]]*): (.*)$", re.DOTALL)
 def _locate(error: dict) -> tuple[str, str]:
     """(field path, message) of a pydantic error; model-level errors carry the path in front of
     their message ('steps[2].at_s: ...')."""
-    where = _loc_text(error.get("loc", ()))
+    where = loc_text(error.get("loc", ()), skip=()) or ""
     msg = str(error.get("msg", "")).removeprefix("Value error, ")
     match = _PATH_PREFIX.match(msg)
     if match:
         path, rest = match.groups()
         return (f"{where}.{path}" if where else path), rest
     return where, msg
-
-
-def _loc_text(loc) -> str:
-    out = ""
-    for part in loc:
-        if isinstance(part, int):
-            out += f"[{part}]"
-        else:
-            out += ("." if out else "") + str(part)
-    return out
 
 
 def load_scenario(path: str | Path) -> Scenario:

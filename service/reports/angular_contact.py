@@ -14,6 +14,7 @@ from pathlib import Path
 
 import numpy as np
 
+from service.reports.figures import pyplot, save
 from twin.validation import analytic
 from twin.engine import Twin
 from twin.setpoint import Setpoint
@@ -22,15 +23,6 @@ FAMILY = (("7208", 40.0), ("7208AC", 25.0), ("7208C", 15.0))
 LOADS = ((3000.0, 3000.0), (0.0, 3000.0))  # (Fr, Fa) [N]
 SPEED_RAD_S = 500.0
 SEED_004_EPS = 2.46
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _case(designation: str, radial: float, axial: float, settle_s: float, window_s: float) -> dict:
@@ -76,7 +68,7 @@ def angular_contact_section(out_dir: Path, quick: bool) -> list[str]:
     out.mkdir(parents=True, exist_ok=True)
     settle, window = (0.02, 0.01) if quick else (0.03, 0.05)
     cases = [_case(name, fr, fa, settle, window) for name, _ in FAMILY for fr, fa in LOADS]
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     for col, (fr, fa) in enumerate(LOADS):
         for k, (name, angle) in enumerate(FAMILY):
@@ -98,9 +90,7 @@ def angular_contact_section(out_dir: Path, quick: bool) -> list[str]:
                          ylabel="contact angle [deg] (inner o, outer s)")
     axes[0, 0].legend(fontsize=7)
     fig.suptitle("7208 family: DEM (markers) against Jones' quasi-static solution (lines)")
-    fig.tight_layout()
-    fig.savefig(out / "angular_contact_jones.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "angular_contact_jones.png")
     lines = [
         "## Angular-contact 7208 family against Jones' quasi-static solution\n",
         "7208 (B, 40 deg), 7208AC (25 deg), 7208C (15 deg) with seed 004's internal geometry "

@@ -22,6 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
+from service.reports.figures import pyplot, save
 from twin.ehl_solver import params as prm
 from twin.ehl_solver import solve_point_contact
 
@@ -31,15 +32,6 @@ CENTRE_LINE_PNG = "ehl_centre_line_isothermal.png"
 CURRENT_PNG = "ehl_centre_line_current.png"
 SPEED_PNG = "ehl_film_vs_speed.png"
 HD_TOLERANCE = 0.08  # seed 003 Fig. 1: "maximum relative error ... less than 8 %"
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _centre(res):
@@ -83,9 +75,7 @@ def _line_plot(plt, cases, labels, title, path: Path) -> None:
     ax_h.set(xlabel="X = x / a [-] (rolling direction ->)", ylabel="film h [nm] (y = 0)",
              ylim=(0.0, 1.4 * top), xlim=(-1.8, 1.4))
     ax_h.annotate("exit constriction (^)", xy=(0.02, 0.9), xycoords="axes fraction", fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path)
 
 
 def _speed_plot(plt, speeds, results, path: Path) -> None:
@@ -107,9 +97,7 @@ def _speed_plot(plt, speeds, results, path: Path) -> None:
     ax.set(xlabel="entrainment speed [m/s]", ylabel="film thickness [nm]",
            title="Isothermal film vs speed, seed 003 Appendix 2 (Fig. 1)")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
+    save(fig, path)
 
 
 def write_ehl_section(out_dir: Path, *, grid: int = 129, progress: bool = True) -> str:
@@ -137,7 +125,7 @@ def write_ehl_section(out_dir: Path, *, grid: int = 129, progress: bool = True) 
         if bar is not None:
             bar.close()
 
-    plt = _plt()
+    plt = pyplot()
     _line_plot(plt, [iso[u] for u in REPORT_SPEEDS_M_S],
                [f"{u:g} m/s ({u * prm.RPM_PER_M_S:,.0f} rpm)" for u in REPORT_SPEEDS_M_S],
                f"Isothermal centre line y = 0 ({grid} x {grid}), seed 003 Fig. 5 (0 A)", out / CENTRE_LINE_PNG)

@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+from service.reports.figures import pyplot, save
 from twin.validation import studies
 from twin.validation import thermal_law_fit as tcal
 from twin.ehl_solver import params as prm
@@ -23,15 +24,6 @@ from twin.spec import Thermal
 
 BAND = (0.576, 0.848)  # seed 003 Fig. 2: reduction of the minimum film
 CURRENTS_A = (0.0, 10.0, 20.0, 30.0)
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _fig_reduction(out: Path) -> tuple[str, list]:
@@ -46,7 +38,7 @@ def _fig_reduction(out: Path) -> tuple[str, list]:
         rise = prm.current_temperature_rise_k(current, u, th.equivalent_resistance_ohm)
         law = tcal.law_factor(rise, u, inputs, th.film_temperature_exponent)
         rows.append((current, rise, 1.0 - table["h_min_factor"][i][j], 1.0 - law))
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
     c = [r[0] for r in rows]
     ax.plot(c, [100 * r[2] for r in rows], "o-", label="thermal EHL solver (seed 003 eqs. 1-11), 257 x 257")
@@ -55,9 +47,7 @@ def _fig_reduction(out: Path) -> tuple[str, list]:
     ax.set(xlabel="shaft current [A]", ylabel="minimum-film reduction [%]",
            title=f"Appendix 2 contact, {u} m/s (30 000 rpm), 40 degC, R_b = {th.equivalent_resistance_ohm:g} ohm")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "seed003_reduction.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "seed003_reduction.png")
     return "seed003_reduction.png", rows
 
 
@@ -74,7 +64,7 @@ def _fig_speed(out: Path, rpms, currents, progress) -> tuple[str, dict]:
                 progress.update(1)
         samples[current] = row
         films[current] = [s.h_min_inner_m for s in row]
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
     thickest = {}
     for current in currents:
@@ -86,9 +76,7 @@ def _fig_speed(out: Path, rpms, currents, progress) -> tuple[str, dict]:
     ax.set(xscale="log", xlabel="shaft speed [rpm]", ylabel="h_min, inner contact at psi = 0 [nm]",
            title="6200 EV twin, 200 N, seed-000 oil at 40 degC, shear + current heating")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "seed003_fig7_speed.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "seed003_fig7_speed.png")
     return "seed003_fig7_speed.png", {"films": films, "thickest": thickest, "samples": samples}
 
 
@@ -106,7 +94,7 @@ def _fig_temperature_resistance(out: Path, temps, resistances, progress) -> tupl
         r_rows.append((r, s.h_min_inner_m, s.current_temperature_rise_k))
         if progress:
             progress.update(1)
-    plt = _plt()
+    plt = pyplot()
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(9, 3.6))
     for current in (0.0, 10.0):
         pts = [(t, h) for t, c, h in t_rows if c == current]
@@ -116,9 +104,7 @@ def _fig_temperature_resistance(out: Path, temps, resistances, progress) -> tupl
     a2.plot([1e3 * r[0] for r in r_rows], [1e9 * r[1] for r in r_rows], "o-")
     a2.set(xlabel="equivalent bearing resistance R_b [mohm]", ylabel="h_min [nm]",
            title="seed 003 Fig. 10 trend, 10 A")
-    fig.tight_layout()
-    fig.savefig(out / "seed003_temperature_resistance.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "seed003_temperature_resistance.png")
     return "seed003_temperature_resistance.png", t_rows, r_rows
 
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-
+from service.reports.figures import pyplot, save
 from twin import catalog
 from twin.validation import skf_friction
 from twin.validation import studies
@@ -19,15 +19,6 @@ from twin.spec import ModelOptions
 # designation: (bore mm, outside diameter mm); the seed oil at 40 degC
 BEARINGS = {"6208": (40.0, 80.0), "6210": (50.0, 90.0)}
 OIL_TEMPERATURE_C = 40.0
-
-
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _grids(quick: bool):
@@ -67,7 +58,7 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
     if not quick:  # the former centre-point friction on the 6208's load sweep, for the slope
         centre = [studies.mean_friction_torque_n_m(500.0, f, options=ModelOptions(friction_model="stribeck_line"))[0]
                   for f in loads]
-    plt = _plt()
+    plt = pyplot()
     fig, axes = plt.subplots(len(designations), 2, figsize=(10, 3.6 * len(designations)), squeeze=False)
     for i, d in enumerate(designations):
         for j, (key, x_label, xs) in enumerate((("speed", "shaft speed [rad/s] (3000 N)", speeds),
@@ -83,10 +74,8 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
             ax.set(xlabel=x_label, ylabel="friction torque [mN m]", title=f"{d}, seed oil at 40 degC")
             ax.grid(True, which="both", alpha=0.3)
             ax.legend(fontsize=7)
-    fig.tight_layout()
     png = "friction_torque_skf.png"
-    fig.savefig(out_dir / png, dpi=120)
-    plt.close(fig)
+    save(fig, out_dir / png)
 
     md = ["## Friction torque against the SKF model (issue 11)\n",
           "The twin's shaft torque with the traction integrated over strips of every contact ellipse (Heathcote and "

@@ -10,6 +10,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from service.reports.figures import pyplot, save
 from twin.validation import studies, timestep_study
 from twin.validation.bench import run_engine_benchmark
 from twin.engine import Twin
@@ -28,15 +29,6 @@ TABLE_3 = {  # seed 000 Table 3: (inner band, outer band) of Lambda at psi = 0
 }
 
 
-def _plt():
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def _band(w: float):
     if w <= 100:
         return TABLE_3["w <= 100"]
@@ -47,7 +39,7 @@ def _band(w: float):
 
 def _fig_azimuth(out: Path, quick: bool) -> tuple[str, dict]:
     rev = studies.lambda_over_revolution(500.0, 3000.0, samples=120 if quick else 400)
-    plt = _plt()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(7, 4))
     deg = np.degrees(rev["azimuth_rad"])
     ax.plot(deg, rev["lambda_outer"], ".", ms=2, label="twin, outer contact")
@@ -58,15 +50,13 @@ def _fig_azimuth(out: Path, quick: bool) -> tuple[str, dict]:
     ax.set(xlabel="azimuth psi [deg]", ylabel="film parameter Lambda [-]",
            title="6208, 500 rad/s, Fr = 3000 N, Pd = 0")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "lambda_azimuth_500.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "lambda_azimuth_500.png")
     lam = rev["lambda_outer"]
     return "lambda_azimuth_500.png", {"outer_min": float(np.nanmin(lam)), "outer_max": float(np.nanmax(lam))}
 
 
 def _fig_speed(out: Path, samples) -> tuple[str, float, float]:
-    plt = _plt()
+    plt = pyplot()
     w = np.array([s.shaft_speed_rad_s for s in samples])
     li = np.array([s.lambda_inner for s in samples])
     lo = np.array([s.lambda_outer for s in samples])
@@ -80,14 +70,12 @@ def _fig_speed(out: Path, samples) -> tuple[str, float, float]:
     ax.set(xlabel="shaft speed omega [rad/s]", ylabel="Lambda at psi = 0 [-]",
            title="Speed sweep, Fr = 3000 N, Pd = 0 (seed 000 Figs. 11-12)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / "lambda_speed.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "lambda_speed.png")
     return "lambda_speed.png", si, so
 
 
 def _fig_load(out: Path, samples) -> tuple[str, float]:
-    plt = _plt()
+    plt = pyplot()
     q = np.array([s.load_outer_n for s in samples])
     lo = np.array([s.lambda_outer for s in samples])
     slope = studies.log_slope(q, lo)
@@ -97,14 +85,12 @@ def _fig_load(out: Path, samples) -> tuple[str, float]:
     ax.set(xlabel="Qmax at psi = 0 [N]", ylabel="Lambda_out at psi = 0 [-]",
            title="Radial load 750-7500 N at 500 rad/s (seed 000 Fig. 9)")
     ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / "lambda_load.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "lambda_load.png")
     return "lambda_load.png", slope
 
 
 def _fig_clearance(out: Path, quick: bool, progress) -> tuple[str, list]:
-    plt = _plt()
+    plt = pyplot()
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(10, 4))
     rows = []
     for pd_um in CLEARANCES_UM:
@@ -122,9 +108,7 @@ def _fig_clearance(out: Path, quick: bool, progress) -> tuple[str, list]:
     ax2.set(xlabel="Qmax at psi = 0 [N]", ylabel="load parameter eps [-]", title="seed 000 Fig. 10b")
     ax1.legend(fontsize=7)
     ax2.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "lambda_clearance.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "lambda_clearance.png")
     return "lambda_clearance.png", rows
 
 
@@ -147,7 +131,7 @@ def _fig_startup(out: Path, quick: bool) -> tuple[str, dict]:
             c = twin.state.contacts[:, 1]
             srr.append(float(twin.state.contacts[L.C_SRR, 0]))
             lam.append(float(c[L.C_LAMBDA]) if c[L.C_LOAD] > 0 else math.nan)
-    plt = _plt()
+    plt = pyplot()
     fig, (ax1, ax2, ax3) = plt.subplots(3, 1, figsize=(7, 8), sharex=True)
     ax1.plot(t, shaft, label="shaft omega")
     ax1.plot(t, ball, "--", label="ball 0 |omega_ball|")
@@ -158,15 +142,13 @@ def _fig_startup(out: Path, quick: bool) -> tuple[str, dict]:
     ax2.set(ylabel="SRR inner, ball 0 [-]")
     ax3.set(ylabel="Lambda_out, ball 0 [-]", xlabel="time [s]")
     ax1.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "startup.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "startup.png")
     steady = [b for tt, b in zip(t, ball) if 0.15 < tt < 0.2]
     return "startup.png", {"steady_ball_spin": float(np.mean(steady))}
 
 
 def _fig_seed001(out: Path) -> tuple[str, list]:
-    plt = _plt()
+    plt = pyplot()
     rows = []
     fig, ax = plt.subplots(figsize=(6, 4))
     cases = [("d = 6.35 mm, Q = 0.125 N, IVR (Table 2)", 6.35e-3, 0.125, "ivr", s001.TABLE_2_D635MM_Q0125N),
@@ -182,9 +164,7 @@ def _fig_seed001(out: Path) -> tuple[str, list]:
     ax.plot([], [], "k^", label="seed 001 measured, K* omega^n")
     ax.set(xlabel="speed [rpm]", ylabel="friction torque [uN m]", title="Seed 001: 3-ball 51205 thrust bearing")
     ax.legend(fontsize=7)
-    fig.tight_layout()
-    fig.savefig(out / "seed001_torque.png", dpi=120)
-    plt.close(fig)
+    save(fig, out / "seed001_torque.png")
     return "seed001_torque.png", rows
 
 

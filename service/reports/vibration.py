@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from service.reports.figures import pyplot, save
+
 _LINES = (("ftf", "FTF", "tab:gray"), ("bpfo", "BPFO", "tab:red"), ("bpfi", "BPFI", "tab:green"),
           ("two_bsf", "2xBSF", "tab:purple"))
 
@@ -14,12 +16,9 @@ def plot_vibration(samples_m_s2: np.ndarray, result: dict, path: str, waveform_s
     log scale, the envelope band shaded) and the envelope spectrum of the band
     (twin.vibration.indicators.envelope_spectrum) up to 5 x the highest defect frequency, with FTF,
     BPFO, BPFI and 2 x BSF and their first harmonics marked, and the five largest peaks."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     from twin.vibration.indicators import envelope_spectrum
+
+    plt = pyplot()
 
     x = np.asarray(samples_m_s2, dtype=float)
     fs = float(result["sample_rate_hz"])
@@ -52,9 +51,7 @@ def plot_vibration(samples_m_s2: np.ndarray, result: dict, path: str, waveform_s
     ax[2].set(xlabel="frequency [Hz]", ylabel="envelope amplitude [m/s$^2$]",
               title=f"envelope spectrum, band {lo:.0f}-{hi:.0f} Hz (circles: five largest peaks)")
     ax[2].legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
+    save(fig, path, dpi=100)
 
 
 # ---- report section (`bearing-twin report`) --------------------------------------------------------

@@ -46,52 +46,28 @@ import threading
 import time
 from dataclasses import dataclass, field
 from typing import Any
-from urllib.parse import urlparse
+
+from service.tools.client import (TargetConfig, add_target_arguments, check_loopback, strict_json,
+                                  target_arguments)
 
 MAX_SECONDS = 600.0
 MAX_CONCURRENCY = 64
 TARGET_RTF = 0.95
 TARGET_HEALTH_P99_MS = 100.0
-_LOOPBACK = ("127.0.0.1", "localhost", "::1")
 _OVER_CAP = 70 * 1024          # a body just above the default 64 KiB cap
 
 
 @dataclass
-class AttackConfig:
+class AttackConfig(TargetConfig):
+    """The attack's figures; the service attacked: `TargetConfig` (loopback only)."""
+
     seconds: float
-    url: str = "http://127.0.0.1:8000"
-    zenoh_connect: str | None = None
-    token: str | None = None
-    start: bool = False
-    bearing_id: str = "default"
     concurrency: int = 32
     readers: int = 4
     zenoh_rate_hz: float = 500.0
     baseline_s: float = 3.0
     probe_every_s: float = 0.05
-    seed: int | None = None
-    record: bool = False          # with start: the service records (off by default: the figures are the API's)
-    log: Any = field(default=None, repr=False)
-
-
-def _strict(text: bytes | str):
-    def reject(name):
-        raise ValueError(f"non-finite {name}")
-    return json.loads(text, parse_constant=reject)
-
-
-def _loopback_host(host: str | None) -> bool:
-    return host is not None and (host in _LOOPBACK or host.startswith("127."))
-
-
-def check_loopback(url: str, zenoh_connect: str | None) -> None:
-    """ValueError unless the URL and the zenoh endpoint are on this machine's loopback."""
-    if not _loopback_host(urlparse(url).hostname):
-        raise ValueError(f"url = {url!r}: the attack runs against loopback only (127.0.0.1, ::1, localhost)")
-    if zenoh_connect:
-        locator = zenoh_connect.split("/", 1)[-1].rsplit(":", 1)[0].strip("[]")
-        if not _loopback_host(locator):
-            raise ValueError(f"zenoh_connect = {zenoh_connect!r}: loopback endpoints only")
+    record: bool = field(default=False, kw_only=True)   # with start: off by default (the figures are the API's)
 
 
 def _percentile(values: list[float], q: float) -> float | None:
@@ -203,7 +179,7 @@ async def _http_flood_async(spec: dict, go) -> dict:
                 if code == 200 and r.headers.get("content-type", "").startswith("application/json"):
                     counts["nan_checked"] += 1
                     try:
-                        _strict(r.content)
+                        strict_json(r.content)
                     except ValueError:
                         counts["non_finite"] += 1
 
@@ -237,7 +213,7 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
 
     def on_result(sample) -> None:
         try:
-            msg = _strict(sample.payload.to_bytes())
+            msg = strict_json(sample.payload.to_bytes())
             key = "accepted" if msg.get("accepted") else f"refused_{msg.get('status', 'other')}"
         except Exception:   # noqa: BLE001
             key = "unreadable"
@@ -246,7 +222,7 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
 
     def on_state(sample) -> None:
         try:
-            _strict(sample.payload.to_bytes())
+            strict_json(sample.payload.to_bytes())
             bad = 0
         except ValueError:
             bad = 1
@@ -531,15 +507,14 @@ def add_attack_command(sub) -> None:
                        "zenoh flood; real-time factor and /health latency under load",
                        description=__doc__.split("\n\n")[0])
     p.add_argument("--seconds", type=float, required=True, help=f"length of the floods [s] (<= {MAX_SECONDS:g})")
-    p.add_argument("--url", default="http://127.0.0.1:8000", help="service URL, loopback only (ignored with --start)")
-    p.add_argument("--zenoh-connect", metavar="ENDPOINT", help="zenoh endpoint of the service for the zenoh "
-                   "flood, loopback only (credentials: BEARING_TWIN_ZENOH_USER / _PASSWORD)")
-    p.add_argument("--token", help="the service's bearer token (default: $BEARING_TWIN_TOKEN; with --start a "
-                   "random one is generated)")
-    p.add_argument("--start", action="store_true", help="launch an own `bearing-twin serve` on free loopback "
-                   "ports (token, zenoh access control, no recording unless --record) and flood zenoh too")
+    add_target_arguments(
+        p, url_help="service URL, loopback only (ignored with --start)",
+        zenoh_help="zenoh endpoint of the service for the zenoh flood, loopback only (credentials: "
+        "BEARING_TWIN_ZENOH_USER / _PASSWORD)",
+        start_help="launch an own `bearing-twin serve` on free loopback ports (token, zenoh access control, no "
+        "recording unless --record) and flood zenoh too",
+        twin_help="twin to attack and measure (default `default`)")
     p.add_argument("--record", action="store_true", help="with --start: the service records as `serve` does")
-    p.add_argument("--twin-id", default="default", help="twin to attack and measure (default `default`)")
     p.add_argument("--concurrency", type=int, default=32, help="hostile HTTP requests in flight (default 32)")
     p.add_argument("--readers", type=int, default=4, help="unauthenticated GET state readers (default 4; 0: none)")
     p.add_argument("--zenoh-rate", type=float, default=500.0, help="zenoh setpoints per second (default 500)")
@@ -550,10 +525,8 @@ def add_attack_command(sub) -> None:
 
 
 def _cmd_attack(args) -> int:
-    cfg = AttackConfig(seconds=args.seconds, url=args.url, zenoh_connect=args.zenoh_connect,
-                       token=args.token or os.environ.get("BEARING_TWIN_TOKEN") or None, start=args.start,
-                       bearing_id=args.twin_id, concurrency=args.concurrency, readers=args.readers,
-                       zenoh_rate_hz=args.zenoh_rate, baseline_s=args.baseline, seed=args.seed,
+    cfg = AttackConfig(seconds=args.seconds, **target_arguments(args), concurrency=args.concurrency,
+                       readers=args.readers, zenoh_rate_hz=args.zenoh_rate, baseline_s=args.baseline,
                        record=args.record, log=lambda line: print(line, file=sys.stderr, flush=True))
     try:
         report = run_attack(cfg)

@@ -436,12 +436,13 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     import uvicorn
 
     from service.api.app import create_app
+    from service.settings import is_loopback_host
 
     logging.basicConfig(level=getattr(logging, args.log_level.upper()),
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s")
     host = settings.host
-    where = "loopback only; --host 0.0.0.0 to expose it" if host in ("127.0.0.1", "localhost", "::1") \
-        else "reachable from other machines"
+    where = ("loopback only; --host 0.0.0.0 to expose it" if is_loopback_host(host)
+             else "reachable from other machines")
     port = settings.port if settings.port else "<a free port, see uvicorn's line below>"
     print(f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
           f"twin `{settings.twin_id}` = {settings.bearing.upper()}, {'fast' if settings.fast else 'real-time'} mode",

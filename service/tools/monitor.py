@@ -19,12 +19,14 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import json
 import math
 import queue
 import sys
 import time
 from typing import Any
+
+from service.core.alarms import finite_number
+from service.tools.client import strict_json
 
 DEFAULT_PREFIX = "bearing"
 DEFAULT_KEYEXPR = "bearing/*/state"
@@ -42,10 +44,6 @@ _REFRESH_S = 0.25
 _ONCE_SETTLE_S = 0.5
 
 
-def _reject_constant(name: str) -> float:
-    raise ValueError(f"non-finite JSON constant {name}")
-
-
 def twin_name(key: str, prefix: str = DEFAULT_PREFIX) -> str | None:
     """The twin of a `.../{id}/state` or `.../{id}/alive` key: its id when the key is under the
     concrete `prefix`, else its whole key (`plant1/line2/motor7/de`)."""
@@ -55,13 +53,6 @@ def twin_name(key: str, prefix: str = DEFAULT_PREFIX) -> str | None:
     if "*" not in prefix and head.startswith(prefix + "/") and "/" not in head[len(prefix) + 1:]:
         return head[len(prefix) + 1:]
     return head
-
-
-def _finite(value: Any) -> float | None:
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    value = float(value)
-    return value if math.isfinite(value) else None
 
 
 class TwinTable:
@@ -89,7 +80,7 @@ class TwinTable:
 
     def on_state(self, key: str, payload: bytes) -> None:
         try:
-            data = json.loads(payload, parse_constant=_reject_constant)
+            data = strict_json(payload)
         except (ValueError, UnicodeDecodeError):
             data = None
         if not isinstance(data, dict):
@@ -112,7 +103,7 @@ class TwinTable:
             if data.get(field) is not None:
                 row[field] = data[field]
         for field in ("time_s", "shaft_speed_rad_s", "friction_torque_n_m"):
-            row[field] = _finite(data.get(field))
+            row[field] = finite_number(data.get(field))
         seq = data.get("seq")
         if isinstance(seq, int) and not isinstance(seq, bool):
             last = row["seq"]
@@ -129,7 +120,7 @@ class TwinTable:
                 contact = ball.get(side)
                 if not isinstance(contact, dict):
                     continue
-                lam = _finite(contact.get("lambda"))
+                lam = finite_number(contact.get("lambda"))
                 if lam is not None:
                     lambdas.append(lam)
                 regime = contact.get("regime")
@@ -144,7 +135,7 @@ class TwinTable:
     def on_alarm(self, key: str, payload: bytes) -> None:
         """An alarm event (schema bearing-twin/alarm/1): keep the twin's active alarms."""
         try:
-            data = json.loads(payload, parse_constant=_reject_constant)
+            data = strict_json(payload)
         except (ValueError, UnicodeDecodeError):
             data = None
         alarm_id = data.get("alarm_id") if isinstance(data, dict) else None

@@ -61,10 +61,11 @@ import sys
 import tempfile
 import threading
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
-from urllib.parse import urlparse
+
+from service.tools.client import TargetConfig, add_target_arguments, strict_json, target_arguments, url_is_loopback
 
 _FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c")
 # valid values stay well inside what the DEM holds (the limits allow loads it cannot hold)
@@ -75,23 +76,18 @@ _BIG = 128 * 1024
 
 
 @dataclass
-class SoakConfig:
+class SoakConfig(TargetConfig):
+    """The soak's own settings; the service driven: `TargetConfig` (with start: `record` also
+    checks the recording)."""
+
     minutes: float
-    url: str = "http://127.0.0.1:8000"
-    zenoh_connect: str | None = None
-    token: str | None = None
-    start: bool = False
-    bearing_id: str = "default"
     rate_hz: float = 10.0
     invalid_fraction: float = 0.3
     sample_s: float = 2.0
-    seed: int | None = None
     max_memory_growth_pct: float = 5.0
     publish_rate_hz: float | None = None
     keep_dir: bool = False
-    record: bool = True            # with start: record (and check the recording) or --no-record
     record_segment_s: float | None = None   # with start: the service's BEARING_TWIN_RECORD_SEGMENT_S [s]
-    log: Any = field(default=None, repr=False)   # callable(str) for progress lines, or None
 
 
 def _free_port() -> int:
@@ -117,12 +113,6 @@ def _rss_bytes(pid: int) -> tuple[int | None, str]:
     except (OSError, ValueError, IndexError):
         pass
     return None, "proc"
-
-
-def _strict(text: bytes | str):
-    def reject(name):
-        raise ValueError(f"non-finite {name}")
-    return json.loads(text, parse_constant=reject)
 
 
 class _Started:
@@ -223,7 +213,7 @@ class _Stream:
 
     def _on_state(self, sample) -> None:
         try:
-            msg = _strict(sample.payload.to_bytes())
+            msg = strict_json(sample.payload.to_bytes())
             bid, seq = str(msg["bearing_id"]), int(msg["seq"])
         except ValueError:
             with self.lock:
@@ -247,7 +237,7 @@ class _Stream:
 
     def _on_result(self, sample) -> None:
         try:
-            msg = _strict(sample.payload.to_bytes())
+            msg = strict_json(sample.payload.to_bytes())
         except Exception:
             msg = {"accepted": None}
         with self.lock:
@@ -386,7 +376,7 @@ def run_soak(cfg: SoakConfig) -> dict:
             report["zenoh_access"] = access.describe(listening=False) if access.enabled else "none"
         health0 = client.get(f"{url}/health", headers=headers).json()
         pid = started.proc.pid if started is not None else health0.get("pid")
-        local = started is not None or (urlparse(url).hostname in ("127.0.0.1", "localhost", "::1"))
+        local = started is not None or url_is_loopback(url)
         body = _drive(cfg, client, url, headers, driver, stream, pid if local else None, log, report)
         report.update(body)
         if stream is not None:
@@ -511,7 +501,7 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
                         unexpected.append(f"GET state: {r.status_code} {r.text[:200]}")
                     else:
                         try:
-                            _strict(r.content)
+                            strict_json(r.content)
                         except ValueError as exc:
                             counts["non_finite_states"] += 1
                             unexpected.append(f"GET state: {exc}")
@@ -776,15 +766,12 @@ def add_soak_command(sub) -> None:
                        "memory growth, seq gaps, real-time factor, overruns, errors, recording check",
                        description=__doc__.split("\n\n")[0])
     p.add_argument("--minutes", type=float, required=True, help="wall-clock length of the run [min] (bounded: <= 10080)")
-    p.add_argument("--url", default="http://127.0.0.1:8000", help="service URL (ignored with --start)")
-    p.add_argument("--zenoh-connect", metavar="ENDPOINT",
-                   help="zenoh endpoint of the service, e.g. tcp/127.0.0.1:7447 (default: no zenoh unless --start)")
-    p.add_argument("--token", help="the service's bearer token (default: $BEARING_TWIN_TOKEN; with --start a "
-                   "random one is generated)")
-    p.add_argument("--start", action="store_true",
-                   help="launch an own `bearing-twin serve` on free loopback ports, recording into a temp "
-                   "dir; stop it with SIGTERM at the end and read the recording back")
-    p.add_argument("--twin-id", default="default", help="twin to drive (default `default`)")
+    add_target_arguments(
+        p, url_help="service URL (ignored with --start)",
+        zenoh_help="zenoh endpoint of the service, e.g. tcp/127.0.0.1:7447 (default: no zenoh unless --start)",
+        start_help="launch an own `bearing-twin serve` on free loopback ports, recording into a temp dir; stop "
+        "it with SIGTERM at the end and read the recording back",
+        twin_help="twin to drive (default `default`)")
     p.add_argument("--rate", type=float, default=10.0, help="setpoints per second, HTTP and zenoh together (default 10)")
     p.add_argument("--invalid", type=float, default=0.3, help="share of invalid setpoints (default 0.3)")
     p.add_argument("--sample", type=float, default=2.0, help="health / memory sampling period [s] (default 2)")
@@ -810,11 +797,10 @@ def _cmd_soak(args) -> int:
     if not (0.0 <= args.invalid <= 1.0):
         print("error: --invalid is a share in [0, 1]", file=sys.stderr)
         return 2
-    cfg = SoakConfig(minutes=args.minutes, url=args.url, zenoh_connect=args.zenoh_connect,
-                     token=args.token or os.environ.get("BEARING_TWIN_TOKEN") or None, start=args.start,
-                     bearing_id=args.twin_id, rate_hz=args.rate, invalid_fraction=args.invalid,
-                     sample_s=args.sample, seed=args.seed, max_memory_growth_pct=args.max_memory_growth,
-                     keep_dir=args.keep, record=not args.no_record, record_segment_s=args.record_segment_s, log=lambda line: print(line, file=sys.stderr, flush=True))
+    cfg = SoakConfig(minutes=args.minutes, **target_arguments(args), rate_hz=args.rate,
+                     invalid_fraction=args.invalid, sample_s=args.sample,
+                     max_memory_growth_pct=args.max_memory_growth, keep_dir=args.keep, record=not args.no_record,
+                     record_segment_s=args.record_segment_s, log=lambda line: print(line, file=sys.stderr, flush=True))
     try:
         report = run_soak(cfg)
     except (RuntimeError, ValueError) as exc:

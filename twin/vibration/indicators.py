@@ -58,12 +58,9 @@ def time_indicators(a_m_s2: np.ndarray) -> dict[str, float]:
             "kurtosis": kurt}
 
 
-def band_kurtosis(a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[float, float]) -> float:
-    """Kurtosis [-] of the window band-passed to band_hz (the envelope band: 4th-order Butterworth,
-    zero phase, as `envelope_spectrum`): the impulsiveness where the impacts ring the structure,
-    which a strong low-frequency response (a lightly damped shaft mode, the load-zone modulation)
-    hides from the broadband kurtosis (Antoni & Randall 2006: the kurtosis as a function of the
-    band, the idea of the spectral kurtosis)."""
+def band_pass(a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[float, float]) -> np.ndarray:
+    """The window [m/s^2], mean removed, band-passed to band_hz: the envelope band's filter
+    (module docstring: 4th-order Butterworth, zero phase)."""
     import scipy.signal
 
     x = np.asarray(a_m_s2, dtype=float)
@@ -72,7 +69,16 @@ def band_kurtosis(a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[floa
     if not 0.0 < lo < hi < 0.5 * fs:
         raise ValueError(f"band_hz = ({lo:g}, {hi:g}): need 0 < low < high < fs / 2 = {0.5 * fs:g} Hz")
     sos = scipy.signal.butter(4, [lo, hi], btype="bandpass", fs=fs, output="sos")
-    return time_indicators(scipy.signal.sosfiltfilt(sos, x - x.mean()))["kurtosis"]
+    return scipy.signal.sosfiltfilt(sos, x - x.mean())
+
+
+def band_kurtosis(a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[float, float]) -> float:
+    """Kurtosis [-] of the window band-passed to band_hz (`band_pass`: the envelope band's filter,
+    as in `envelope_spectrum`): the impulsiveness where the impacts ring the structure,
+    which a strong low-frequency response (a lightly damped shaft mode, the load-zone modulation)
+    hides from the broadband kurtosis (Antoni & Randall 2006: the kurtosis as a function of the
+    band, the idea of the spectral kurtosis)."""
+    return time_indicators(band_pass(a_m_s2, sample_rate_hz, band_hz))["kurtosis"]
 
 
 def velocity_rms_mm_s(a_m_s2: np.ndarray, sample_rate_hz: float,
@@ -146,18 +152,12 @@ def envelope_spectrum(a_m_s2: np.ndarray, sample_rate_hz: float,
     (module docstring: Butterworth 4 zero-phase, Hilbert, Hann, amplitude-corrected)."""
     import scipy.signal
 
-    x = np.asarray(a_m_s2, dtype=float)
-    fs = float(sample_rate_hz)
-    lo, hi = band_hz
-    if not 0.0 < lo < hi < 0.5 * fs:
-        raise ValueError(f"band_hz = ({lo:g}, {hi:g}): need 0 < low < high < fs / 2 = {0.5 * fs:g} Hz")
-    sos = scipy.signal.butter(4, [lo, hi], btype="bandpass", fs=fs, output="sos")
-    y = scipy.signal.sosfiltfilt(sos, x - x.mean())
+    y = band_pass(a_m_s2, sample_rate_hz, band_hz)
     env = np.abs(scipy.signal.hilbert(y))
     env -= env.mean()
     w = np.hanning(env.size)
     amp = 2.0 * np.abs(np.fft.rfft(env * w)) / np.sum(w)
-    return np.fft.rfftfreq(env.size, 1.0 / fs), amp
+    return np.fft.rfftfreq(env.size, 1.0 / float(sample_rate_hz)), amp
 
 
 def _refine(freqs: np.ndarray, amp: np.ndarray, i: int) -> tuple[float, float]:
