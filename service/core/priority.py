@@ -132,7 +132,7 @@ class ThreadPriority:
         self.sweep()
         self._thread = threading.Thread(target=self._run, name="thread-priority", daemon=True)
         self._thread.start()
-        log.info("stepping threads at nice %s, the service's other threads at nice %d",
+        log.debug("stepping threads at nice %s, the service's other threads at nice %d",
                  sorted({thread_nice(t) for t in self.keep()} - {None}), self.io_nice)
         return self
 
