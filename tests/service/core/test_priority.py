@@ -1,11 +1,17 @@
 """service.core.priority: the stepping threads before the service's I/O threads (Linux per-thread
-nice values, read back from the kernel with getpriority on each thread id)."""
+nice values, read back from the kernel with getpriority on each thread id).
+
+Each check runs in a fresh Python process (`_run`): renicing is one-way for an unprivileged
+process, and the functional tests run with BEARING_TWIN_IO_THREAD_NICE=0 (tests/conftest.py), so
+the pytest process's own threads must keep their priority."""
 
 from __future__ import annotations
 
 import os
+import subprocess
 import sys
 import threading
+from pathlib import Path
 
 import pytest
 
@@ -46,7 +52,7 @@ class _Parked:
         return self.thread.native_id
 
 
-def test_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_swept():
+def check_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_swept():
     now, restored = _now_and_restored()
     io = now + 3
     kept, other = _Parked(), _Parked(spawn_child=True)
@@ -71,7 +77,7 @@ def test_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_swe
             other.child.release.set()
 
 
-def test_io_nice_zero_changes_nothing():
+def check_io_nice_zero_changes_nothing():
     t = _Parked()
     before = thread_nice(t.tid)
     prio = ThreadPriority(lambda: set(), io_nice=0)
@@ -82,16 +88,18 @@ def test_io_nice_zero_changes_nothing():
         t.release.set()
 
 
-def test_a_service_keeps_its_stepping_threads_above_its_other_threads():
-    """TwinRegistry.open: the pool's stepping threads and publish worker at the process's nice,
-    every other thread at `io_thread_nice`; /health carries the record."""
+def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
+    """TwinRegistry.open with the default settings: the pool's stepping threads and publish worker
+    at the process's nice, every other thread at `io_thread_nice` (10 by default); /health
+    carries the record."""
     from service.core.registry import TwinRegistry
     from service.settings import ServiceSettings
 
     now, restored = _now_and_restored()
-    io = now + 5
+    io = ServiceSettings().io_thread_nice
+    assert io == 10 and now < io
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
-                               stepping_threads=2, io_thread_nice=io)
+                               stepping_threads=2)
     reg = TwinRegistry(settings).open()
     try:
         stepping = reg.pool.native_ids()
@@ -106,3 +114,24 @@ def test_a_service_keeps_its_stepping_threads_above_its_other_threads():
         assert health["stepping_thread_nice"] == [restored]
     finally:
         reg.close()
+
+
+def _run(check: str) -> None:
+    env = {k: v for k, v in os.environ.items() if k != "BEARING_TWIN_IO_THREAD_NICE"}
+    root = str(Path(__file__).resolve().parents[3])
+    env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
+    code = f"import runpy; runpy.run_path({str(Path(__file__))!r})[{check!r}]()"
+    res = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, timeout=300)
+    assert res.returncode == 0, res.stderr[-3000:]
+
+
+def test_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_swept():
+    _run("check_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_swept")
+
+
+def test_io_nice_zero_changes_nothing():
+    _run("check_io_nice_zero_changes_nothing")
+
+
+def test_a_service_keeps_its_stepping_threads_above_its_other_threads():
+    _run("check_a_service_keeps_its_stepping_threads_above_its_other_threads")
