@@ -449,6 +449,12 @@ class ServiceSettings(ZenohAccessSettings):
         description="Nice value given to every thread of the service but the stepping threads and the publish "
         "worker (Linux, per thread; service.core.priority) [-]: HTTP floods, zenoh, recording and OPC UA then "
         "yield the cores to real time. 0: all threads at the same priority.")
+    stepping_thread_nice: int = Field(
+        default=-10, ge=-20, le=0,
+        description="Nice value asked for the stepping threads and the publish worker (Linux, per thread; "
+        "service.core.priority) [-]: real time before every other process of the host. A priority above the "
+        "process's own needs root or CAP_SYS_NICE; without it they keep the process's nice (/health "
+        "thread_priority says which). 0: not raised.")
     admission: Literal["measured", "off"] = Field(
         default="measured",
         description="'measured': a twin created over the API that this host cannot run in real time "

@@ -24,11 +24,12 @@ _SUPPORT = _load_support()
 # (tests/service/core/test_pool.py checks it with given costs). Served subprocesses that clear the
 # BEARING_TWIN_* environment pass this one on (tests/hostile/conftest.py, test_end_to_end.py).
 os.environ.setdefault("BEARING_TWIN_ADMISSION", "off")
-# Nor do the I/O threads of in-process services drop below the stepping threads (service.core.priority):
+# Nor do in-process services set their threads' priorities (service.core.priority):
 # renicing is one-way, and the pytest process's own threads (clients, waits) would stay reniced behind
 # fast-mode twins that keep both cores busy. tests/service/core/test_priority.py checks the priority, with
 # its default, in processes of its own.
 os.environ.setdefault("BEARING_TWIN_IO_THREAD_NICE", "0")
+os.environ.setdefault("BEARING_TWIN_STEPPING_THREAD_NICE", "0")
 
 
 @pytest.fixture(scope="session")

@@ -25,6 +25,7 @@ Run ONE uvicorn worker per service: each worker would run its own lifespan and i
 from __future__ import annotations
 
 import logging
+import threading
 from contextlib import asynccontextmanager
 
 from fastapi import Depends, FastAPI
@@ -70,6 +71,7 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
             opened = TwinService(settings, gate=gate)
             await run_in_threadpool(opened.open)
         app.state.service = opened
+        opened.priority.keep_thread(threading.get_native_id())   # the event loop answers /health in time
         try:
             yield
         finally:

@@ -192,9 +192,11 @@ class ThreadPriorityHealth(BaseModel):
 
     active: bool = Field(description="Whether the service's other threads run below the stepping threads (Linux) [bool].")
     io_thread_nice: int = Field(description="Nice value of every thread but the stepping threads and the publish worker [-]; 0 when not active.")
-    stepping_thread_nice: list[int] = Field(description="Nice values found on the stepping threads and the publish worker [-].")
+    stepping_thread_nice_asked: int = Field(description="Nice value asked for the stepping threads and the publish worker [-].")
+    stepping_thread_nice: list[int] = Field(description="Nice values found on the stepping threads and the publish worker [-] (the process's own where raising a priority is not permitted).")
     threads_reniced: int = Field(description="Threads given io_thread_nice since the start [-].")
-    errors: int = Field(description="Nice changes the system refused [-].")
+    errors: int = Field(description="io_thread_nice changes the system refused [-].")
+    stepping_priority_refused: int = Field(description="Raises of a stepping thread's priority refused (no root or CAP_SYS_NICE) [-].")
 
 
 class Health(BaseModel):

@@ -7,18 +7,26 @@ rerun recorder, the OPC UA server, the HTTP worker threads) and other processes 
 them for the same cores, and under the kernel's fair scheduler every runnable thread of equal
 nice gets an equal share: a hostile HTTP flood at concurrency 32 took the default twin from
 1.00 to 0.46 of real time on the 2-core VM. A real-time system puts its control loop above its
-I/O. Here that is the nice value, which Linux keeps per thread: every thread of the process
-except the stepping threads and the publish worker (their output is the product: snapshots,
-waveform, alarms) gets nice +`io_thread_nice` (CFS weight 110 at nice 10 against 1024 at 0:
-about 9 % of a contended core). Raising one's own nice needs no privilege. New threads appear
-all the time (a twin's zenoh publisher, a recording's writer, asyncio's executor), so a sweep
-every `sweep_s` renices the ones it has not seen yet. A thread inherits the nice of the thread
-that creates it, and an unprivileged process cannot lower a nice value again, so the stepping
-pool is started before the first sweep (TwinRegistry.open) and its threads are never reniced.
+I/O. Here that is the nice value, which Linux keeps per thread:
 
-Not done: real-time scheduling classes (SCHED_FIFO / SCHED_RR) for the stepping threads. They
-need CAP_SYS_NICE, and a FIFO thread that never sleeps (a twin behind the wall clock steps
-without pause) would lock the other threads out of its core on a 2-core host.
+- the stepping threads and the publish worker (their output is the product: snapshots, waveform,
+  alarms) get nice `stepping_thread_nice` (-10: CFS weight 9548 against 1024 at nice 0, about
+  90 % of a core contended with one other thread) where the process may raise a priority (root
+  or CAP_SYS_NICE, e.g. systemd's `AmbientCapabilities=CAP_SYS_NICE`); elsewhere they keep the
+  process's nice and `/health` says so. An attacker on the same host (the `attack` tool's own
+  processes) or any other busy process then cannot take their core;
+- the HTTP event loop keeps the process's nice (`keep_thread`: /health answers in time);
+- every other thread of the process (zenoh's runtime and callbacks, the recorder, the OPC UA
+  server, the HTTP worker threads) gets nice +`io_thread_nice` (10: weight 110). Raising one's own
+  nice needs no privilege. New threads appear all the time (a twin's zenoh publisher, a
+  recording's writer, asyncio's executor), so a sweep every `sweep_s` renices the ones it has not
+  seen yet. A thread inherits the nice of the thread that creates it, and an unprivileged process
+  cannot lower a nice value again, so the stepping pool is started before the first sweep
+  (TwinRegistry.open).
+
+Not done: real-time scheduling classes (SCHED_FIFO / SCHED_RR) for the stepping threads. A FIFO
+thread that never sleeps (a twin behind the wall clock steps without pause) would lock every
+other thread out of its core on a 2-core host; a nice value only weights the fair share.
 
 Elsewhere than Linux (no per-thread nice) this is a no-op; `/health` says which.
 """
@@ -64,51 +72,72 @@ def process_threads() -> list[int]:
 
 
 class ThreadPriority:
-    """Keeps every thread of the process but `keep()` at nice `io_nice` (module docstring).
+    """Stepping threads at `stepping_nice`, kept threads at the process's nice, every other thread
+    of the process at `io_nice` (module docstring).
 
-    `keep` returns the native ids of the threads left alone (the stepping threads and the publish
-    worker); `sweep()` renices the others once (returns how many it changed); `start()` sweeps now
-    and then every `sweep_s` [s] in a daemon thread (itself reniced); `close()` stops it."""
+    `keep` returns the native ids of the stepping threads and the publish worker; `keep_thread`
+    adds one left at the process's nice (the event loop); `sweep()` renices the threads it has not
+    seen (returns how many it changed); `start()` sweeps now and then every `sweep_s` [s] in a
+    daemon thread (itself reniced); `close()` stops it."""
 
     _live: weakref.WeakSet[ThreadPriority] = weakref.WeakSet()   # several services in one process (tests)
 
-    def __init__(self, keep: Callable[[], set[int]], io_nice: int, sweep_s: float = 1.0):
+    def __init__(self, keep: Callable[[], set[int]], io_nice: int, stepping_nice: int = 0, sweep_s: float = 1.0):
         self.keep = keep
         self.io_nice = int(io_nice)
+        self.stepping_nice = int(stepping_nice)
         self.sweep_s = float(sweep_s)
         self.supported = sys.platform.startswith("linux") and hasattr(os, "setpriority")
         self.reniced = 0                  # threads given io_nice so far
-        self.errors = 0                   # setpriority refused (counted, never raised)
-        self._seen: set[int] = set()
-        self._kept: set[int] = set()
+        self.errors = 0                   # io_nice refused (counted, never raised)
+        self.raise_refused = 0            # stepping_nice refused: no CAP_SYS_NICE (counted)
+        self._seen: set[int] = set()      # threads given io_nice (or found at it)
+        self._placed: set[int] = set()    # stepping and kept threads already placed
+        self._extra: set[int] = set()     # keep_thread
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
     @property
     def active(self) -> bool:
-        return self.supported and self.io_nice > 0
+        return self.supported and (self.io_nice > 0 or self.stepping_nice < BASE_NICE)
+
+    def keep_thread(self, native_id: int) -> None:
+        """Leave this thread at the process's nice (the HTTP event loop: /health answers in time)."""
+        self._extra.add(native_id)
+        self._seen.discard(native_id)
+        self._placed.discard(native_id)
+        if self.active:
+            self._place(native_id, BASE_NICE)
+
+    def _place(self, tid: int, nice: int) -> None:
+        current = thread_nice(tid)
+        if current is None or current == nice:
+            return
+        try:
+            os.setpriority(os.PRIO_PROCESS, tid, nice)
+        except OSError:                   # a higher priority needs CAP_SYS_NICE: keeps its own
+            self.raise_refused += 1
 
     def sweep(self) -> int:
-        """Renice the threads not kept and not seen before; returns the number changed."""
+        """Place the stepping and kept threads not placed yet; renice the other threads not seen
+        before to io_nice; returns the number reniced."""
         if not self.active:
             return 0
-        keep = self.keep()
-        for tid in keep - self._kept:       # created by an already reniced thread (tests): back to
-            self._kept.add(tid)             # the process's nice where permitted (root)
-            current = thread_nice(tid)
-            if current is not None and current > BASE_NICE:
-                try:
-                    os.setpriority(os.PRIO_PROCESS, tid, BASE_NICE)
-                except OSError:
-                    pass                    # unprivileged: it keeps the nice it inherited
-        spared = set(keep)
+        stepping = self.keep()
+        for tid in stepping - self._placed:
+            self._placed.add(tid)
+            self._place(tid, self.stepping_nice)
+        for tid in self._extra - self._placed:
+            self._placed.add(tid)
+            self._place(tid, BASE_NICE)
+        spared = stepping | self._extra
         for other in list(ThreadPriority._live):     # another service's stepping threads
             if other is not self:
-                spared |= other.keep()
+                spared |= other.keep() | other._extra
         changed = 0
         tids = process_threads()
         for tid in tids:
-            if tid in self._seen or tid in spared:
+            if tid in self._seen or tid in spared or self.io_nice <= 0:
                 continue
             self._seen.add(tid)
             current = thread_nice(tid)
@@ -121,7 +150,9 @@ class ThreadPriority:
                 self.errors += 1
                 if self.errors <= 3:
                     log.debug("thread %d: nice %d refused: %s", tid, self.io_nice, exc)
-        self._seen.intersection_update(tids)    # ids are reused after a thread ends
+        live = set(tids)
+        self._seen &= live             # ids are reused after a thread ends
+        self._placed &= live
         self.reniced += changed
         return changed
 
@@ -133,7 +164,7 @@ class ThreadPriority:
         self._thread = threading.Thread(target=self._run, name="thread-priority", daemon=True)
         self._thread.start()
         log.debug("stepping threads at nice %s, the service's other threads at nice %d",
-                 sorted({thread_nice(t) for t in self.keep()} - {None}), self.io_nice)
+                  sorted({thread_nice(t) for t in self.keep()} - {None}), self.io_nice)
         return self
 
     def _run(self) -> None:
@@ -150,7 +181,9 @@ class ThreadPriority:
             self._thread.join(2.0)
 
     def record(self) -> dict:
-        """For /health: whether it acts, the nice values, the counts."""
+        """For /health: whether it acts, the nice values asked and found, the counts."""
         return {"active": self.active, "io_thread_nice": self.io_nice if self.active else 0,
+                "stepping_thread_nice_asked": self.stepping_nice if self.active else BASE_NICE,
                 "stepping_thread_nice": sorted({thread_nice(t) for t in self.keep()} - {None}),
-                "threads_reniced": self.reniced, "errors": self.errors}
+                "threads_reniced": self.reniced, "errors": self.errors,
+                "stepping_priority_refused": self.raise_refused}

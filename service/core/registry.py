@@ -141,7 +141,7 @@ class TwinRegistry:
         self._admitting: dict[str, TwinCost] = {}   # costs of twins admitted, not yet running
         threads = settings.stepping_threads or usable_cores()
         self.pool = SteppingPool(threads, name="step")
-        self.priority = ThreadPriority(self.pool.native_ids, settings.io_thread_nice)
+        self.priority = ThreadPriority(self.pool.native_ids, settings.io_thread_nice, settings.stepping_thread_nice)
         self.capacity = Capacity(threads, settings.capacity_core_fraction,
                                  reserve_cores=settings.capacity_reserve_cores)
         self.last_calibration: TwinCost | None = None

@@ -95,9 +95,10 @@ def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
     from service.core.registry import TwinRegistry
     from service.settings import ServiceSettings
 
-    now, restored = _now_and_restored()
-    io = ServiceSettings().io_thread_nice
-    assert io == 10 and now < io
+    now, _ = _now_and_restored()
+    io, asked = ServiceSettings().io_thread_nice, ServiceSettings().stepping_thread_nice
+    assert io == 10 and asked == -10 and now < io
+    raised = asked if os.geteuid() == 0 else now      # a higher priority needs root / CAP_SYS_NICE
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
                                stepping_threads=2)
     reg = TwinRegistry(settings).open()
@@ -105,19 +106,24 @@ def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
         stepping = reg.pool.native_ids()
         assert len(stepping) == 3                                    # 2 stepping + the publish worker
         for tid in stepping:
-            assert thread_nice(tid) == restored
+            assert thread_nice(tid) == raised
         assert thread_nice(threading.get_native_id()) == io
         others = [t for t in process_threads() if t not in stepping]
         assert others and all(thread_nice(t) >= io for t in others if thread_nice(t) is not None)
+        # the event loop's thread (here this one) is given back the process's nice
+        reg.priority.keep_thread(threading.get_native_id())
+        assert thread_nice(threading.get_native_id()) == (now if os.geteuid() == 0 else io)
         health = reg.health()["thread_priority"]
-        assert health["active"] and health["io_thread_nice"] == io
-        assert health["stepping_thread_nice"] == [restored]
+        assert health["active"] and health["io_thread_nice"] == io and health["stepping_thread_nice_asked"] == asked
+        assert health["stepping_thread_nice"] == [raised]
+        assert health["stepping_priority_refused"] == (0 if os.geteuid() == 0 else len(stepping))
     finally:
         reg.close()
 
 
 def _run(check: str) -> None:
-    env = {k: v for k, v in os.environ.items() if k != "BEARING_TWIN_IO_THREAD_NICE"}
+    env = {k: v for k, v in os.environ.items()
+           if k not in ("BEARING_TWIN_IO_THREAD_NICE", "BEARING_TWIN_STEPPING_THREAD_NICE")}
     root = str(Path(__file__).resolve().parents[3])
     env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
     code = f"import runpy; runpy.run_path({str(Path(__file__))!r})[{check!r}]()"
