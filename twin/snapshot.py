@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Literal
 
+import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
 from twin.setpoint import Setpoint
@@ -133,8 +134,31 @@ class DefectLine(BaseModel):
         "the shaft frequency for BPFI, FTF for 2 x BSF; null for the others.")
 
 
+class Spectrum(BaseModel):
+    """A one-sided amplitude spectrum on a uniform frequency axis: bin k at start_hz + k step_hz."""
+
+    model_config = _FROZEN
+    start_hz: float = Field(description="Frequency of bin 0 (the centre of the FFT bins it stands for) [Hz].")
+    step_hz: float = Field(description="Bin spacing, the frequency resolution [Hz].")
+    amplitude_m_s2: tuple[float, ...] = Field(description="Amplitude of each bin [m/s^2].")
+
+    @property
+    def frequencies_hz(self) -> np.ndarray:
+        """Bin frequencies [Hz]."""
+        return self.start_hz + self.step_hz * np.arange(len(self.amplitude_m_s2))
+
+    @property
+    def max_hz(self) -> float:
+        """Frequency of the last bin [Hz]."""
+        return self.start_hz + self.step_hz * (len(self.amplitude_m_s2) - 1)
+
+
 class VibrationState(BaseModel):
-    """Indicators of the last complete window of housing acceleration (twin.vibration.indicators)."""
+    """Indicators of the last complete window of housing acceleration (twin.vibration.indicators).
+
+    The window's full spectra (`envelope_spectrum`, `amplitude_spectrum`) ride on the object for the
+    sinks that show them (zenoh `.../vibration`, the rerun recording) but are left out of its JSON
+    (exclude=True): the state message (50 Hz, HTTP state) does not grow by ~4000 numbers."""
 
     model_config = _FROZEN
     window_end_s: float = Field(description="Simulated time of the window's last sample [s].")
@@ -154,6 +178,16 @@ class VibrationState(BaseModel):
     envelope_noise_floor_m_s2: float = Field(description="Median envelope amplitude up to 5 x the highest defect frequency [m/s^2].")
     envelope_lines: dict[str, DefectLine] = Field(
         description="Envelope amplitudes at each defect frequency (keys ftf, bpfo, bpfi, bsf, two_bsf).")
+    envelope_spectrum: Spectrum | None = Field(
+        default=None, exclude=True,
+        description="The window's envelope spectrum [m/s^2], the one the peaks, lines and noise floor come from: "
+        "0 Hz to min(half the envelope band width, 5 x max(BPFI, 2 x BSF)), the window's resolution 1 / window_s "
+        "(peak-held into 4096 bins beyond; twin.vibration.indicators.envelope_spectrum_view). Not serialised.")
+    amplitude_spectrum: Spectrum | None = Field(
+        default=None, exclude=True,
+        description="The window's acceleration amplitude spectrum [m/s^2], 0 to sample_rate_hz / 2, FFT bins "
+        "power-summed into at most 2000 (13 Hz for 1 s at 51.2 kHz; Parseval: sum A^2 / 2 = rms_m_s2^2; "
+        "twin.vibration.indicators.amplitude_spectrum). Not serialised.")
 
 
 class Snapshot(BaseModel):

@@ -106,6 +106,37 @@ def test_outer_race_spall_envelope_peak_is_bpfo_with_harmonics(runs):
     assert twin.snapshot().defects[0].kind == "outer"
 
 
+def test_outer_race_spall_full_spectra_of_the_window(runs):
+    """The window's full spectra (VibrationState.envelope_spectrum / amplitude_spectrum, left out
+    of the snapshot's JSON). Envelope: 0 Hz to the peak search's limit min(half the envelope band,
+    5 x max(BPFI, 2 x BSF)) at 1 / window = 2 Hz; its largest bin within one bin of BPFO; at each
+    of the five published peaks, the parabolic refinement of its own bins (the peaks' computation,
+    twin.vibration.indicators._refine) gives the published frequency and amplitude (rel 1e-9).
+    Acceleration: 0 - fs/2 in at most 2000 power-summed bins; Parseval (Oppenheim & Schafer Table
+    8.2, one-sided): sum A^2 / 2 = rms_m_s2^2 (rel 1e-9: the same samples, rounding only)."""
+    from twin.vibration.indicators import _refine
+
+    twin, v = runs("outer")
+    env, acc = v.envelope_spectrum, v.amplitude_spectrum
+    assert "envelope_spectrum" not in v.model_dump() and "amplitude_spectrum" not in twin.snapshot().to_json()
+    f = v.defect_frequencies_hz
+    lo, hi = v.envelope_band_hz
+    limit = min(0.5 * (hi - lo), 5.0 * max(f.bpfi, f.two_bsf))
+    assert env.start_hz == 0.0 and env.step_hz == pytest.approx(1.0 / WINDOW, rel=1e-9)
+    assert env.max_hz <= limit < env.max_hz + env.step_hz
+    freqs, amp = env.frequencies_hz, np.array(env.amplitude_m_s2)
+    assert abs(freqs[np.argmax(amp)] - f.bpfo) <= env.step_hz
+    for peak in v.envelope_peaks_hz:
+        i = int(np.rint((peak.frequency_hz - env.start_hz) / env.step_hz))
+        i = max((i - 1, i, i + 1), key=lambda k: amp[k])        # the local maximum it was refined from
+        got_f, got_a = _refine(freqs, amp, i)
+        assert (got_f, got_a) == pytest.approx((peak.frequency_hz, peak.amplitude), rel=1e-9)
+    fs = v.sample_rate_hz
+    assert acc.start_hz == pytest.approx(0.5 * (acc.step_hz * WINDOW - 1.0) / WINDOW, rel=1e-9)
+    assert len(acc.amplitude_m_s2) <= 2000 and acc.max_hz - 0.5 * acc.step_hz < 0.5 * fs <= acc.max_hz + 0.5 * acc.step_hz
+    assert np.sum(np.square(acc.amplitude_m_s2)) / 2.0 == pytest.approx(v.rms_m_s2 ** 2, rel=1e-9)
+
+
 def test_inner_race_spall_bpfi_with_shaft_sidebands(runs):
     """Inner-race spall (turning with the shaft through the load zone): the largest envelope peak
     within 1 % of BPFI (eq. 2), sidebands at BPFI -+ the shaft frequency present (load-zone

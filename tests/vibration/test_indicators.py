@@ -129,3 +129,43 @@ def test_resonance_band_and_bad_band():
     assert (lo, hi) == pytest.approx((13600.0, 18400.0))
     with pytest.raises(ValueError, match="band_hz"):
         ind.envelope_spectrum(np.zeros(4096), FS, (100.0, 30000.0))
+
+
+def test_amplitude_spectrum_parseval_and_a_line_reads_its_amplitude():
+    """The window's acceleration spectrum (0 - fs/2, power-summed bins): 1 s at 51.2 kHz gives
+    ceil(25601 / 2000) = 13 FFT bins per bin (13 Hz, 1970 bins). Parseval (Oppenheim & Schafer,
+    Table 8.2, one-sided): sum A^2 / 2 = the mean-removed window's mean square, to rounding
+    (rel 1e-9). A sine of 2 m/s^2 off the FFT grid (1234.37 Hz) in noise: its bin and the two
+    beside it hold its power, sqrt(sum A^2) = 2 within 1 % (the rectangular window's leakage beyond
+    +-13 FFT bins is ~2/(pi^2 13) = 1.6 % of the power; the noise adds 0.05 %), and the largest bin
+    is the one holding 1234.37 Hz."""
+    rng = np.random.default_rng(5)
+    t = np.arange(int(FS)) / FS
+    x = 2.0 * np.sin(2 * np.pi * 1234.37 * t + 0.3) + rng.normal(0.0, 0.2, t.size) + 4.0
+    start, step, a = ind.amplitude_spectrum(x, FS)
+    assert (a.size, step, start) == (1970, 13.0, 6.0)
+    ms = ind.time_indicators(x)["rms_m_s2"] ** 2
+    assert np.sum(a ** 2) / 2.0 == pytest.approx(ms, rel=1e-9)
+    j = int(np.argmax(a))
+    assert abs(start + j * step - 1234.37) <= 0.5 * step
+    assert math.sqrt(np.sum(a[j - 1:j + 2] ** 2)) == pytest.approx(2.0, rel=0.01)
+    # no binning below max_bins: 2 |X_k| / N on the FFT grid, Parseval with the Nyquist bin's weight
+    y = x[:4096]
+    start, step, b = ind.amplitude_spectrum(y, FS, max_bins=5000)
+    assert (start, step, b.size) == (0.0, FS / 4096, 2049)
+    spec = np.fft.rfft(y - y.mean())
+    assert b[1:-1] == pytest.approx(2.0 * np.abs(spec[1:-1]) / y.size, rel=1e-12)
+    assert np.sum(b ** 2) / 2.0 == pytest.approx(np.mean((y - y.mean()) ** 2), rel=1e-9)
+
+
+def test_envelope_spectrum_view_keeps_the_bins_up_to_the_limit_or_peak_holds():
+    """Up to max_hz the envelope spectrum's own values (same array, same bins); more than max_bins
+    bins are peak-held (a line keeps its height)."""
+    f = np.arange(3001) * 0.5
+    a = np.random.default_rng(1).random(f.size)
+    a[2001] = 7.0                                  # 1000.5 Hz
+    start, step, v = ind.envelope_spectrum_view(f, a, 1200.0)
+    assert (start, step, v.size) == (0.0, 0.5, 2401) and np.array_equal(v, a[:2401])
+    start, step, v = ind.envelope_spectrum_view(f, a, 1200.0, max_bins=1000)
+    assert (step, v.size, start) == (1.5, 801, 0.5)
+    assert v.max() == 7.0 and abs(start + np.argmax(v) * step - 1000.5) <= 0.5 * step

@@ -20,6 +20,17 @@ machines", MSSP 20(2) 308-331, eq. 5 estimator SK(f) = <|X(t,f)|^4> / <|X(t,f)|^
 set of window lengths; sec. 4 kurtogram), the band of highest SK wins (a simpler stand-in for the
 fast kurtogram of Antoni 2007, MSSP 21, 108-124).
 
+Full spectra of a window (`amplitude_spectrum`, `envelope_spectrum_view`), for the snapshot's
+`vibration` block and the sinks, never its JSON: the acceleration amplitude spectrum from 0 to
+fs / 2 (no window: the whole window is the record, mean removed), its FFT bins power-summed into at
+most AMPLITUDE_MAX_BINS bins, so that Parseval holds on it (sum A_j^2 / 2 = mean square of the
+window: Parseval's relation of the DFT, sum |x[n]|^2 = (1/N) sum |X[k]|^2, Oppenheim & Schafer,
+"Discrete-Time Signal Processing", Table 8.2, taken one-sided as in `velocity_rms_mm_s`) and a line of amplitude A reads A (its leakage falls in the bin or the next); the
+envelope spectrum (the one the peaks, lines and noise floor come from, same bins and values) from
+0 Hz to the limit of the peak search and the noise floor, min(half the envelope band width,
+5 x max(BPFI, 2 x BSF)), peak-held (max of each group) into at most ENVELOPE_MAX_BINS bins only
+for windows longer than ~1.8 s.
+
 Defect lines: the envelope amplitude at FTF, BPFO, BPFI, BSF, 2 x BSF, their harmonics, and the
 sidebands that mark each fault (Randall & Antoni 2011 sec. 2.1: BPFI +- shaft frequency (the
 inner-race spall moves through the load zone), 2 x BSF +- FTF (the ball defect does, with the
@@ -42,6 +53,12 @@ ISO_20816_BAND_HZ = (10.0, 1000.0)
 # exp(-(4 x 1.1774)^2 / 2) = 1.5e-5 per bin, i.e. ~1 % of false alarms over the ~700 bins the 15
 # defect lines and harmonics inspect in a 1 s window (+-1 % each).
 SIGNIFICANCE = 4.0
+
+# at most this many bins in the full spectra of a window (module docstring): the acceleration
+# spectrum of a 1 s window at 51.2 kHz has 25 601 FFT bins, summed 13 by 13 into 1970 of 13 Hz;
+# the envelope spectrum of a 1 s window (1 Hz bins up to ~2.3 kHz) is kept as computed.
+AMPLITUDE_MAX_BINS = 2000
+ENVELOPE_MAX_BINS = 4096
 
 
 def time_indicators(a_m_s2: np.ndarray) -> dict[str, float]:
@@ -158,6 +175,51 @@ def envelope_spectrum(a_m_s2: np.ndarray, sample_rate_hz: float,
     w = np.hanning(env.size)
     amp = 2.0 * np.abs(np.fft.rfft(env * w)) / np.sum(w)
     return np.fft.rfftfreq(env.size, 1.0 / float(sample_rate_hz)), amp
+
+
+def amplitude_spectrum(a_m_s2: np.ndarray, sample_rate_hz: float,
+                       max_bins: int = AMPLITUDE_MAX_BINS) -> tuple[float, float, np.ndarray]:
+    """(start [Hz], step [Hz], amplitude [m/s^2]) of the window's one-sided amplitude spectrum
+    from 0 to fs / 2 (module docstring): the mean-removed window's DFT X_k, power P_k = w_k
+    |X_k|^2 / N^2 (w = 2, 1 at 0 Hz and at fs / 2 for even N: sum P_k = mean square, Parseval),
+    summed over groups of g = ceil((N // 2 + 1) / max_bins) bins, amplitude sqrt(2 sum P_k)
+    (2 |X_k| / N for g = 1). Bin j stands for the g FFT bins from j g: centre start + j step with
+    start = (g - 1) / 2 df, step = g df (df = fs / N)."""
+    x = np.asarray(a_m_s2, dtype=float)
+    n = x.size
+    if n < 4:
+        raise ValueError(f"a window needs at least 4 samples, got {n}")
+    if max_bins < 1:
+        raise ValueError(f"max_bins = {max_bins}: must be >= 1")
+    spec = np.fft.rfft(x - x.mean())
+    power = (spec.real ** 2 + spec.imag ** 2) * (2.0 / (n * n))
+    power[0] *= 0.5
+    if n % 2 == 0:
+        power[-1] *= 0.5
+    g = -(-power.size // max_bins)
+    m = -(-power.size // g)
+    padded = np.zeros(m * g)
+    padded[:power.size] = power
+    df = float(sample_rate_hz) / n
+    return 0.5 * (g - 1) * df, g * df, np.sqrt(2.0 * padded.reshape(m, g).sum(axis=1))
+
+
+def envelope_spectrum_view(freqs: np.ndarray, amp: np.ndarray, max_hz: float,
+                           max_bins: int = ENVELOPE_MAX_BINS) -> tuple[float, float, np.ndarray]:
+    """(start [Hz], step [Hz], amplitude [m/s^2]) of an envelope spectrum (`envelope_spectrum`)
+    from 0 Hz to max_hz (the bins at or below it): the values themselves when they are at most
+    max_bins, else the largest of each group of g = ceil(bins / max_bins) (peak hold: a line keeps
+    its height), centre start + j step as in `amplitude_spectrum`."""
+    df = float(freqs[1] - freqs[0])
+    keep = int(np.searchsorted(freqs, max_hz, side="right"))
+    a = np.asarray(amp[:max(keep, 1)], dtype=float)
+    g = -(-a.size // max_bins)
+    if g == 1:
+        return 0.0, df, a.copy()
+    m = -(-a.size // g)
+    padded = np.zeros(m * g)
+    padded[:a.size] = a
+    return 0.5 * (g - 1) * df, g * df, padded.reshape(m, g).max(axis=1)
 
 
 def _refine(freqs: np.ndarray, amp: np.ndarray, i: int) -> tuple[float, float]:

@@ -33,7 +33,7 @@ def _geometry(bearing):
 def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s: float, *,
                   contact_angle_rad: float | None = None, housing: Housing | None = None,
                   window_s: float = 1.0, band: str | tuple[float, float] = "resonance",
-                  peak_count: int = 5) -> dict:
+                  peak_count: int = 5, spectra: bool = False) -> dict:
     """Indicators of a housing-acceleration waveform (JSON-ready; every number finite).
 
     signal_m_s2: samples [m/s^2] at sample_rate_hz [Hz]; bearing: a designation ('6208'), a
@@ -48,7 +48,12 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
     envelope_peaks_hz (the `peak_count` largest: frequency_hz, amplitude [m/s^2]) of the
     window-averaged envelope spectrum, kurtosis, band_kurtosis (in the envelope band), rms_m_s2, peak_m_s2, crest_factor,
     velocity_rms_mm_s (window means; RMS as the root of the mean square), noise_floor_m_s2,
-    defect_lines (twin.vibration.indicators.defect_line_amplitudes) and per_window."""
+    defect_lines (twin.vibration.indicators.defect_line_amplitudes) and per_window. With
+    spectra=True also (not JSON-ready: numpy arrays) envelope_spectrum and amplitude_spectrum,
+    each {start_hz, step_hz, amplitude_m_s2}: the envelope spectrum the peaks come from, 0 Hz to
+    the peak search's limit (`indicators.envelope_spectrum_view`), and the acceleration amplitude
+    spectrum 0 - fs / 2 (`indicators.amplitude_spectrum`; over several windows the root of the
+    mean power of each bin)."""
     x = np.asarray(signal_m_s2, dtype=float).ravel()
     fs = float(sample_rate_hz)
     if not (fs > 0.0 and math.isfinite(fs)):
@@ -77,6 +82,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         lo, hi = (float(band[0]), float(band[1]))
     windows = []
     amp_sum = None
+    power_sum = None
     for k in range(count):
         seg = x[k * n_win:(k + 1) * n_win]
         row = ind.time_indicators(seg)
@@ -85,10 +91,13 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         windows.append(row)
         freqs, amp = ind.envelope_spectrum(seg, fs, (lo, hi))
         amp_sum = amp if amp_sum is None else amp_sum + amp
+        if spectra:
+            a_start, a_step, a_amp = ind.amplitude_spectrum(seg, fs)
+            power_sum = a_amp ** 2 if power_sum is None else power_sum + a_amp ** 2
     amp = amp_sum / count
     max_hz = min(0.5 * (hi - lo), 5.0 * top)
     mean = lambda key: float(np.mean([w[key] for w in windows]))  # noqa: E731
-    return {
+    out = {
         "sample_rate_hz": fs,
         "duration_s": x.size / fs,
         "window_s": n_win / fs,
@@ -108,6 +117,12 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         "defect_lines": ind.defect_line_amplitudes(freqs, amp, freq),
         "per_window": windows,
     }
+    if spectra:
+        e_start, e_step, e_amp = ind.envelope_spectrum_view(freqs, amp, max_hz)
+        out["envelope_spectrum"] = {"start_hz": e_start, "step_hz": e_step, "amplitude_m_s2": e_amp}
+        out["amplitude_spectrum"] = {"start_hz": a_start, "step_hz": a_step,
+                                     "amplitude_m_s2": np.sqrt(power_sum / count)}
+    return out
 
 
 # ---- the DEM producing the waveform (`bearing-twin vibration`) -----------------------------------

@@ -13,7 +13,8 @@ one-sided density rho (variance rho^2 f_s / 2, `signal.noise_sigma`) is added he
 generator per twin seeded with `Accelerometer.noise_seed` (reproducible whatever the thread).
 
 Every `Accelerometer.window_s` of samples the indicators are computed (`run_vibration`, envelope
-band around the housing's sensed resonance) with the defect frequencies of the window's mean shaft
+band around the housing's sensed resonance; with the window's full envelope and amplitude spectra,
+`VibrationState.envelope_spectrum` / `amplitude_spectrum`, kept out of the snapshot's JSON) with the defect frequencies of the window's mean shaft
 speed and the loaded contact angle measured on the contact lanes at the window's end
 (`defect_frequencies.loaded_contact_angle_rad`; the nominal angle while no ball is loaded).
 """
@@ -190,13 +191,13 @@ def contact_angle_of_lanes_rad(model, state) -> float:
 
 def window_indicators(model, window_m_s2: np.ndarray, shaft_speed_rad_s: float, state, end_time_s: float):
     """`twin.snapshot.VibrationState` of one window (module docstring)."""
-    from twin.snapshot import DefectFrequenciesHz, DefectLine, EnvelopePeak, VibrationState
+    from twin.snapshot import DefectFrequenciesHz, DefectLine, EnvelopePeak, Spectrum, VibrationState
     from twin.vibration.run import run_vibration
 
     fs = model.decimator.output_rate_hz
     angle = contact_angle_of_lanes_rad(model, state)
     r = run_vibration(window_m_s2, fs, model.spec, shaft_speed_rad_s, contact_angle_rad=angle,
-                      housing=model.spec.housing, window_s=window_m_s2.size / fs)
+                      housing=model.spec.housing, window_s=window_m_s2.size / fs, spectra=True)
     lines = {name: DefectLine(frequency_hz=v["frequency_hz"], harmonics=tuple(v["harmonics"]),
                               sidebands=(v["sidebands"]["lower"], v["sidebands"]["upper"]) if "sidebands" in v else None)
              for name, v in r["defect_lines"].items()}
@@ -208,4 +209,11 @@ def window_indicators(model, window_m_s2: np.ndarray, shaft_speed_rad_s: float, 
         defect_frequencies_hz=DefectFrequenciesHz(**r["defect_frequencies_hz"]),
         envelope_band_hz=tuple(r["envelope_band_hz"]),
         envelope_peaks_hz=tuple(EnvelopePeak(**p) for p in r["envelope_peaks_hz"]),
-        envelope_noise_floor_m_s2=r["noise_floor_m_s2"], envelope_lines=lines)
+        envelope_noise_floor_m_s2=r["noise_floor_m_s2"], envelope_lines=lines,
+        envelope_spectrum=_spectrum(Spectrum, r["envelope_spectrum"]),
+        amplitude_spectrum=_spectrum(Spectrum, r["amplitude_spectrum"]))
+
+
+def _spectrum(cls, s: dict):
+    return cls(start_hz=float(s["start_hz"]), step_hz=float(s["step_hz"]),
+               amplitude_m_s2=tuple(np.asarray(s["amplitude_m_s2"], dtype=float).tolist()))
