@@ -22,7 +22,14 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
     P/{id}/vibration         the vibration indicators of each new accelerometer window, JSON,
                              schema "bearing-twin/vibration/1": bearing_id, seq and time_s of the
                              snapshot, the active defects, and every field of the snapshot's
-                             `vibration` block (twin.snapshot.VibrationState)
+                             `vibration` block (twin.snapshot.VibrationState), plus the window's
+                             full spectra, which the state message leaves out:
+                             `envelope_spectrum` and `amplitude_spectrum`, each {"start_hz",
+                             "step_hz", "bins", "units": "m/s^2", "amplitude_m_s2": [...]}
+                             (bin k at start_hz + k step_hz; 6 significant digits). Envelope: 0 Hz
+                             to min(half the envelope band, 5 x max(BPFI, 2 x BSF)) at
+                             1 / window_s; acceleration: 0 - fs/2, power-summed into <= 2000 bins
+                             (twin.vibration.indicators). ~25 kB per window for 1 s windows
     P/{id}/vibration/waveform  accelerometer samples, binary (twin.vibration.waveform: header
                              "BTWF" v1, float32 little-endian m/s^2; one chunk per block the twin
                              produced, its own chunk seq), not JSON numbers
@@ -198,6 +205,16 @@ def _one_line(exc: BaseException) -> str:
 def _dumps(obj: Any) -> str:
     """Contract JSON: compact, never NaN/Infinity (raises ValueError instead)."""
     return json.dumps(obj, allow_nan=False, separators=(",", ":"))
+
+
+def _spectrum_json(spectrum: Any) -> dict | None:
+    """A window's spectrum (twin.snapshot.Spectrum) for `P/{id}/vibration`: its axis and the
+    amplitudes rounded to 6 significant digits (half the text of full doubles); None without one."""
+    if spectrum is None:
+        return None
+    amp = spectrum.amplitude_m_s2
+    return {"start_hz": spectrum.start_hz, "step_hz": spectrum.step_hz, "bins": len(amp), "units": "m/s^2",
+            "amplitude_m_s2": [float(f"{a:.6g}") for a in amp]}
 
 
 def _payload(sample: zenoh.Sample) -> bytes:
@@ -400,8 +417,12 @@ class TwinChannel:
         self._last_window_end_s = end
         pub = self._lazy_publisher("_vibration_pub", "vibration", _JSON)
         if pub is not None:
+            block = getattr(snapshot, "vibration", None)
+            spectra = {key: _spectrum_json(getattr(block, key, None))
+                       for key in ("envelope_spectrum", "amplitude_spectrum")}
             pub.put(_dumps({"schema": VIBRATION_SCHEMA, "bearing_id": self.bearing_id, "seq": data.get("seq"),
-                            "time_s": data.get("time_s"), "defects": data.get("defects") or [], **vib}))
+                            "time_s": data.get("time_s"), "defects": data.get("defects") or [], **vib,
+                            **{k: v for k, v in spectra.items() if v is not None}}))
 
     def _send_waveform(self, blocks: list) -> None:
         """One binary chunk per block on `P/{id}/vibration/waveform` (twin.vibration.waveform)."""

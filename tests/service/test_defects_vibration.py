@@ -134,6 +134,17 @@ def test_an_outer_spall_raises_the_defect_alarm_and_bpfo_leads_the_envelope(serv
     assert top == pytest.approx(bpfo, rel=0.01)            # the largest envelope peak is BPFO (1 %)
     line = v["envelope_lines"]["bpfo"]["harmonics"][0]
     assert line > 4.0 * v["envelope_noise_floor_m_s2"]      # twin.vibration.indicators.SIGNIFICANCE
+    # the window's full spectra ride on .../vibration (not on the state): arrays with their axis
+    env, acc = v["envelope_spectrum"], v["amplitude_spectrum"]
+    for spectrum in (env, acc):
+        assert spectrum["units"] == "m/s^2" and len(spectrum["amplitude_m_s2"]) == spectrum["bins"]
+    assert env["start_hz"] == 0.0 and env["step_hz"] == pytest.approx(1.0 / WINDOW_S)   # 4 Hz
+    amp = np.array(env["amplitude_m_s2"])
+    assert abs(env["start_hz"] + env["step_hz"] * np.argmax(amp) - bpfo) <= env["step_hz"]
+    assert amp.max() <= v["envelope_peaks_hz"][0]["amplitude"] * (1.0 + 1e-5)   # the peak is refined from these bins
+    # 0.25 s at 51.2 kHz: 6401 FFT bins summed 4 by 4 (16 Hz) up to 25.6 kHz; Parseval to the 6 digits sent
+    assert (acc["bins"], acc["step_hz"]) == (1601, 16.0)
+    assert np.sum(np.square(acc["amplitude_m_s2"])) / 2.0 == pytest.approx(v["rms_m_s2"] ** 2, rel=1e-5)
 
     events = [json.loads(p) for p in got["bearing/vib/alarm"]]
     (raised,) = [e for e in events if e["alarm_id"] == "defect_bpfo"]
@@ -160,6 +171,32 @@ def test_an_outer_spall_raises_the_defect_alarm_and_bpfo_leads_the_envelope(serv
     assert sel.sum() == round(WINDOW_S * 51200.0)
     window = x[sel]
     assert np.sqrt(np.mean((window - window.mean()) ** 2)) == pytest.approx(windows[0]["rms_m_s2"], rel=1e-3)
+
+
+def test_the_spectra_are_on_vibration_and_not_in_the_state(service, support):
+    """The 100 Hz state message (and GET state) carries the `vibration` block without the window's
+    spectra: ~2200 numbers (0.25 s windows; ~4000 for 1 s) once per window on `.../vibration` only."""
+    _srv, http, endpoint = service
+    peer = support.Peer(endpoint)
+    try:
+        for key in ("state", "vibration"):
+            peer.subscribe(f"bearing/vib/{key}")
+        got = _collect(peer, lambda g: g.get("bearing/vib/vibration") and any(
+            json.loads(p)["vibration"] for p in g.get("bearing/vib/state", [])))
+    finally:
+        peer.close()
+    states = [p for p in got["bearing/vib/state"] if json.loads(p)["vibration"]]
+    vibration = got["bearing/vib/vibration"][-1]
+    assert all(b"spectrum" not in p for p in got["bearing/vib/state"])
+    assert set(json.loads(vibration)) >= {"envelope_spectrum", "amplitude_spectrum"}
+    block = json.loads(states[-1])["vibration"]
+    assert set(block) == set(json.loads(vibration)) - {"schema", "bearing_id", "seq", "time_s", "defects",
+                                                      "envelope_spectrum", "amplitude_spectrum"}
+    # the spectra alone would more than double the state message (with its vibration block)
+    spectra = json.loads(vibration)
+    text = len(json.dumps({k: spectra[k] for k in ("envelope_spectrum", "amplitude_spectrum")}, separators=(",", ":")))
+    assert len(states[-1]) < text
+    assert "envelope_spectrum" not in http.get("/v1/bearings/vib/state").json()["vibration"]
 
 
 def test_defects_over_zenoh_are_validated_and_answered(service, support):
