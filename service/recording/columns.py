@@ -29,6 +29,10 @@ from service.recording.layout import (
     SEQ,
     SIDES,
     SIM_TIME,
+    CURSOR_HARMONICS,
+    CURSOR_NAMES,
+    CURSOR_WIDTH_FRACTION,
+    SPECTRUM_PIXELS,
     VIB_LINES,
     TwinLayout,
 )
@@ -164,18 +168,27 @@ class _Arrow:
 _TENSOR_TYPE = None
 
 
-def _tensor_rows(values: np.ndarray) -> pa.Array:
-    """One rerun TensorData (1-D, float32) per row of `values` (n, k), built as one arrow array
-    (rerun's own `BarChart.columns` takes one tensor for all rows)."""
+def _tensor_rows(values) -> pa.Array:
+    """One rerun TensorData (1-D, float32) per row of `values` (n, k), or per array of a list of
+    1-D arrays (rows of different lengths), built as one arrow array (rerun's own
+    `BarChart.columns` takes one tensor for all rows)."""
     global _TENSOR_TYPE
     if _TENSOR_TYPE is None:
         _TENSOR_TYPE = rr.components.TensorDataBatch(
             rr.encodings.TensorData(array=np.zeros(1, np.float32))).as_arrow_array().type
-    values = np.ascontiguousarray(values, dtype=np.float32)
-    n, k = values.shape
+    if isinstance(values, np.ndarray):
+        values = np.ascontiguousarray(values, dtype=np.float32)
+        n, k = values.shape
+        sizes = np.full(n, k, dtype=np.int64)
+    else:
+        sizes = np.array([len(v) for v in values], dtype=np.int64)
+        n = sizes.size
+        values = np.concatenate([np.asarray(v, dtype=np.float32) for v in values]) if n else np.zeros(0, np.float32)
+    offsets = np.zeros(n + 1, dtype=np.int32)
+    np.cumsum(sizes, out=offsets[1:])
     f_shape, f_names, f_buffer = _TENSOR_TYPE[0], _TENSOR_TYPE[1], _TENSOR_TYPE[2]
     shape = pa.ListArray.from_arrays(pa.array(np.arange(n + 1, dtype=np.int32)),
-                                     pa.array(np.full(n, k, dtype=np.uint64)), type=f_shape.type)
+                                     pa.array(sizes.astype(np.uint64)), type=f_shape.type)
     utype = f_buffer.type
     children = []
     code = None
@@ -183,8 +196,7 @@ def _tensor_rows(values: np.ndarray) -> pa.Array:
         ft = utype.field(i)
         if ft.name == "F32":
             code = utype.type_codes[i]
-            children.append(pa.ListArray.from_arrays(pa.array(np.arange(0, n * k + 1, k, dtype=np.int32)),
-                                                     pa.array(values.reshape(-1)), type=ft.type))
+            children.append(pa.ListArray.from_arrays(pa.array(offsets), pa.array(values.reshape(-1)), type=ft.type))
         else:
             children.append(pa.array([], type=ft.type))
     buffer = pa.Array.from_buffers(utype, n, [None, pa.py_buffer(np.full(n, code, dtype=np.int8).tobytes()),
@@ -194,9 +206,16 @@ def _tensor_rows(values: np.ndarray) -> pa.Array:
                                       fields=[f_shape, f_names, f_buffer])
 
 
-def _bar_columns(values: np.ndarray, abscissa: np.ndarray) -> list:
-    return [rr.ComponentColumn(rr.BarChart.descriptor_values(), _Arrow(_tensor_rows(values))),
-            rr.ComponentColumn(rr.BarChart.descriptor_abscissa(), _Arrow(_tensor_rows(abscissa)))]
+def _bar_columns(values, abscissa, widths=None) -> list:
+    """BarChart columns, a row per row of values / abscissa (arrays (n, k) or lists of 1-D
+    arrays); widths: the bar widths of each row (a list of 1-D arrays), else the static ones."""
+    out = [rr.ComponentColumn(rr.BarChart.descriptor_values(), _Arrow(_tensor_rows(values))),
+           rr.ComponentColumn(rr.BarChart.descriptor_abscissa(), _Arrow(_tensor_rows(abscissa)))]
+    if widths is not None:
+        out.append(rr.ComponentColumn(rr.BarChart.descriptor_widths(),
+                                      rr.components.LengthBatch(np.concatenate(widths).astype(np.float32)),
+                                      lengths=np.array([len(w) for w in widths])))
+    return out
 
 
 # ---- columns ------------------------------------------------------------------------------------
@@ -553,6 +572,51 @@ def vibration_columns(tw: TwinLayout, batch: Batch) -> None:
     batch.out.append((f"{root}/vibration/envelope/peaks", batch.index(idx), _bar_columns(peak_a, peak_f)))
     batch.out.append((f"{root}/vibration/envelope/defect_lines", batch.index(idx),
                       _bar_columns(np.nan_to_num(amps), freqs)))
+    _spectrum_columns(tw, batch, idx, blocks)
+
+
+def _spectrum_columns(tw: TwinLayout, batch: Batch, idx: np.ndarray, blocks: list) -> None:
+    """The windows' full spectra (VibrationState.envelope_spectrum / amplitude_spectrum; windows
+    without them are skipped) as bar charts against frequency [Hz], bars a bin wide or (range /
+    SPECTRUM_PIXELS), whichever is wider:
+    `vibration/envelope/spectrum` with the defect-frequency cursors
+    `vibration/envelope/cursor/{FTF,BPFO,BPFI,BSF,2xBSF}` (1x, 2x, 3x each, as tall as the spectrum), and
+    `vibration/spectrum` with the envelope band `vibration/spectrum_envelope_band`."""
+    root = tw.root
+    env = [(j, b.envelope_spectrum) for j, b in enumerate(blocks) if getattr(b, "envelope_spectrum", None) is not None]
+    if env:
+        sel = idx[[j for j, _ in env]]
+        amps = [np.asarray(e.amplitude_m_s2) for _, e in env]
+        tops = [float(a.max()) if a.size else 0.0 for a in amps]
+        batch.out.append((f"{root}/vibration/envelope/spectrum", batch.index(sel),
+                          _bar_columns(amps, [e.frequencies_hz for _, e in env],
+                                       [np.full(a.size, _bar_width(e)) for a, (_, e) in zip(amps, env, strict=True)])))
+        for name, label in zip(VIB_LINES, CURSOR_NAMES, strict=True):
+            fs, hs, ws = [], [], []
+            for (j, e), top in zip(env, tops, strict=True):
+                f0 = getattr(blocks[j].defect_frequencies_hz, name)
+                f = np.array([k * f0 for k in range(1, CURSOR_HARMONICS + 1) if k * f0 <= e.max_hz])
+                fs.append(f)
+                hs.append(np.full(f.size, top))
+                ws.append(np.full(f.size, max(2.0 * e.step_hz, e.max_hz / CURSOR_WIDTH_FRACTION)))
+            batch.out.append((f"{root}/vibration/envelope/cursor/{label}", batch.index(sel), _bar_columns(hs, fs, ws)))
+    acc = [(j, b.amplitude_spectrum) for j, b in enumerate(blocks) if getattr(b, "amplitude_spectrum", None) is not None]
+    if acc:
+        sel = idx[[j for j, _ in acc]]
+        amps = [np.asarray(a.amplitude_m_s2) for _, a in acc]
+        batch.out.append((f"{root}/vibration/spectrum", batch.index(sel),
+                          _bar_columns(amps, [a.frequencies_hz for _, a in acc],
+                                       [np.full(x.size, _bar_width(a)) for x, (_, a) in zip(amps, acc, strict=True)])))
+        band = [blocks[j].envelope_band_hz for j, _ in acc]
+        batch.out.append((f"{root}/vibration/spectrum_envelope_band", batch.index(sel),
+                          _bar_columns([np.array([float(a.max()) if a.size else 0.0]) for a in amps],
+                                       [np.array([0.5 * (lo + hi)]) for lo, hi in band],
+                                       [np.array([hi - lo]) for lo, hi in band])))
+
+
+def _bar_width(spectrum) -> float:
+    """Bar width [Hz] of a spectrum's bins: a bin, or (its range / SPECTRUM_PIXELS) when wider."""
+    return max(spectrum.step_hz, (spectrum.max_hz + 0.5 * spectrum.step_hz) / SPECTRUM_PIXELS)
 
 
 def _line_fundamental(block, name: str) -> float:

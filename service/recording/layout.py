@@ -45,6 +45,16 @@ vibration/envelope/peaks, vibration/envelope/defect_lines
                               BarChart against frequency [Hz]: the largest envelope peaks of the
                               window, and the envelope amplitude at each defect frequency (the
                               markers); the defects themselves are rows of `events`
+vibration/envelope/spectrum   BarChart against frequency [Hz]: the window's full envelope spectrum
+                              [m/s^2] (VibrationState.envelope_spectrum: 0 Hz to the peak search's
+                              limit at 1 / window_s), a row per new window, bars one bin wide
+                              or (range / SPECTRUM_PIXELS), whichever is wider
+vibration/envelope/cursor/{FTF,BPFO,BPFI,BSF,2xBSF}
+                              BarChart: cursors at 1x, 2x, 3x each defect frequency of the window,
+                              as tall as the envelope spectrum (colours of VIB_LINE_RGB)
+vibration/spectrum            BarChart: the window's acceleration amplitude spectrum [m/s^2]
+                              (VibrationState.amplitude_spectrum: 0 - fs/2, power-summed bins)
+vibration/spectrum_envelope_band   BarChart: one translucent bar over the envelope band [Hz]
 contacts/{load_n,lambda,mu,resistance_log10_kohm,capacitance_pf}
                               Scalars, 2 Z instances (ball 0 inner, ball 0 outer, ball 1 inner,
                               ...): the per-contact series, not in the default layout
@@ -90,6 +100,16 @@ VIB_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")          # VibrationState.
 ENVELOPE_BAR_HZ = 12.0            # bar width of the envelope charts [Hz] (visible on a 0-2 kHz axis)
 VIB_LINE_LABELS = ("FTF", "BPFO", "BPFI", "BSF", "2 x BSF")
 VIB_LINE_RGB = ((150, 150, 150), (230, 60, 60), (80, 160, 255), (0, 200, 120), (255, 170, 0))
+CURSOR_NAMES = ("FTF", "BPFO", "BPFI", "BSF", "2xBSF")   # entity names of the envelope cursors (VIB_LINES order)
+CURSOR_HARMONICS = 3              # cursors at 1x .. 3x each defect frequency
+CURSOR_WIDTH_FRACTION = 400.0     # a cursor is (spectrum range / this) wide, at least 2 bins (~1.5 px)
+CURSOR_ALPHA = 150
+SPECTRUM_RGB = (40, 70, 150)      # the full spectra's bars
+# a spectrum's bars are at least (its range / this) wide: a 1 Hz bin of a 0-2.3 kHz envelope
+# spectrum is a quarter of a pixel and would not show; wider bars overlap, the tallest shows
+# (what an analyser's display does: the peak of the bins under each pixel)
+SPECTRUM_PIXELS = 700.0
+ENVELOPE_BAND_RGBA = (255, 170, 0, 40)
 VIBRATION_SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
     "vibration/acceleration_m_s2": (("acceleration",), ((80, 160, 255),)),
     "vibration/acceleration_rms_peak_m_s2": (("RMS", "peak"), ((80, 160, 255), (230, 60, 60))),
@@ -222,6 +242,15 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
                 rr.components.ColorBatch([rgb]).described(rr.BarChart.descriptor_color()),
                 rr.components.LengthBatch(np.full(len(VIB_LINES), ENVELOPE_BAR_HZ, dtype=np.float32)).described(
                     rr.BarChart.descriptor_widths())], static=True)
+        for leaf in ("vibration/envelope/spectrum", "vibration/spectrum"):
+            s.log(f"{root}/{leaf}", [rr.components.ColorBatch([SPECTRUM_RGB]).described(rr.BarChart.descriptor_color())],
+                  static=True)
+        for name, rgb in zip(CURSOR_NAMES, VIB_LINE_RGB, strict=True):
+            s.log(f"{root}/vibration/envelope/cursor/{name}",
+                  [rr.components.ColorBatch([(*rgb, CURSOR_ALPHA)]).described(rr.BarChart.descriptor_color())],
+                  static=True)
+        s.log(f"{root}/vibration/spectrum_envelope_band",
+              [rr.components.ColorBatch([ENVELOPE_BAND_RGBA]).described(rr.BarChart.descriptor_color())], static=True)
     for alarm_id in ALARM_IDS:
         s.log(f"{root}/alarm_states/{alarm_id}",
               rr.StateConfiguration(values=list(ALARM_STATES), labels=[f"{alarm_id} {v}" for v in ALARM_STATES],
@@ -309,19 +338,27 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Contain
             rrb.Horizontal(events, alarms, electrical, column_shares=[1.0, 1.0, 1.6])]
     if tw.vibration:
         rows.append(rrb.Horizontal(
-            rrb.TimeSeriesView(name="housing acceleration [m/s^2] (last 0.1 s)", origin=root,
-                               contents=[f"+ {root}/vibration/acceleration_m_s2"], time_ranges=_window(0.1),
-                               plot_legend=rrb.PlotLegend(visible=False)),
-            rrb.BarChartView(name="envelope spectrum: largest peaks (blue), at the defect frequencies (red) [Hz]",
-                             origin=root, contents=[f"+ {root}/vibration/envelope/**"],
+            rrb.Vertical(
+                rrb.TimeSeriesView(name="housing acceleration [m/s^2] (last 0.1 s)", origin=root,
+                                   contents=[f"+ {root}/vibration/acceleration_m_s2"], time_ranges=_window(0.1),
+                                   plot_legend=rrb.PlotLegend(visible=False)),
+                rrb.BarChartView(name="acceleration spectrum [m/s^2] vs [Hz]; envelope band orange",
+                                 origin=root, contents=[f"+ {root}/vibration/spectrum",
+                                                        f"+ {root}/vibration/spectrum_envelope_band"],
+                                 plot_legend=rrb.PlotLegend(visible=False))),
+            # no legend: it would show the cursors' full entity paths over the spectrum
+            rrb.BarChartView(name="envelope spectrum [m/s^2] vs [Hz]; 1-3x BPFO red, BPFI blue, 2xBSF orange, "
+                                  "BSF green, FTF grey",
+                             origin=root, contents=[f"+ {root}/vibration/envelope/spectrum",
+                                                    f"+ {root}/vibration/envelope/cursor/**"],
                              plot_legend=rrb.PlotLegend(visible=False)),
             rrb.Grid(ts("acceleration RMS, peak [m/s^2]", "vibration/acceleration_rms_peak_m_s2"),
                      ts("velocity RMS 10-1000 Hz [mm/s] (ISO 20816)", "vibration/velocity_rms_mm_s", legend=False),
                      ts("kurtosis, band kurtosis, crest factor [-]", "vibration/kurtosis"),
                      ts("envelope at the defect frequencies [m/s^2]", "vibration/envelope_lines_m_s2"),
                      grid_columns=2),
-            column_shares=[1.2, 1.0, 1.6], name="vibration"))
-    return rrb.Vertical(*rows, row_shares=[1.5, 1.0, 1.0][:len(rows)], name=tag)
+            column_shares=[1.1, 1.9, 1.0], name="vibration"))
+    return rrb.Vertical(*rows, row_shares=[1.5, 1.0, 1.3][:len(rows)], name=tag)
 
 
 def blueprint(twins: list[TwinLayout], series_window_s: float | None) -> rrb.Blueprint:

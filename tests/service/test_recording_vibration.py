@@ -1,6 +1,7 @@
 """The vibration of a twin with the housing on in the rerun recording (issue 14): the accelerometer
 samples (`vibration/acceleration_m_s2`, one row per sample at its own simulated time, sent with
-send_columns), the indicators of each window, the envelope bar charts at the defect frequencies,
+send_columns), the indicators of each window, the envelope bar charts at the defect frequencies, the window's full
+envelope and acceleration spectra (bar charts, a row per window, with the defect-frequency cursors),
 and the defects as event rows. A real 6208 twin (housing on, outer spall, 0.05 s windows); the
 .rrd is read back."""
 
@@ -82,6 +83,31 @@ def test_samples_indicators_and_defects_are_recorded(tmp_path, run):
         [s.vibration.envelope_lines["bpfo"].harmonics[0] for s in windows.values()])   # BPFO second
     bars = read_column(path, "bearing/v/vibration/envelope/defect_lines", "BarChart:abscissa")
     assert len(bars) == len(windows)
+    # the full spectra, a bar chart row per window: the window's own bins on their frequency axis
+    for leaf, key in (("envelope/spectrum", "envelope_spectrum"), ("spectrum", "amplitude_spectrum")):
+        entity_ = f"bearing/v/vibration/{leaf}"
+        assert read_column(path, entity_, "seq") == [s.seq for s in windows.values()]
+        values = read_column(path, entity_, "BarChart:values")
+        abscissa = read_column(path, entity_, "BarChart:abscissa")
+        widths = read_column(path, entity_, "BarChart:widths")
+        for snap, got_v, got_f, got_w in zip(windows.values(), values, abscissa, widths, strict=True):
+            want = getattr(snap.vibration, key)
+            got_v, got_f = _tensor(got_v), _tensor(got_f)
+            assert got_v.size == got_f.size == len(want.amplitude_m_s2) == len(got_w)
+            assert np.array_equal(got_v, np.float32(want.amplitude_m_s2))
+            assert np.array_equal(got_f, np.float32(want.frequencies_hz))
+            # a bar is a bin wide, or 1/700 of the range when that is wider (layout.SPECTRUM_PIXELS)
+            width = max(want.step_hz, (want.max_hz + 0.5 * want.step_hz) / 700.0)
+            assert np.all(np.float32(got_w) == np.float32(width))
+    # 0.05 s windows at 51.2 kHz: 2560 samples, 1281 bins of 20 Hz up to 25.6 kHz (no summing below 2000)
+    acc = next(iter(windows.values())).vibration.amplitude_spectrum
+    assert (len(acc.amplitude_m_s2), acc.start_hz, acc.step_hz) == (1281, 0.0, 20.0)
+    # the BPFO cursors of the first faulty window: 1x, 2x, 3x BPFO, as tall as its envelope spectrum
+    faulty = [s for s in windows.values() if s.defects][0]
+    rows = dict(zip(read_column(path, "bearing/v/vibration/envelope/cursor/BPFO", "seq"),
+                    read_column(path, "bearing/v/vibration/envelope/cursor/BPFO", "BarChart:abscissa"), strict=True))
+    bpfo = faulty.vibration.defect_frequencies_hz.bpfo
+    assert _tensor(rows[faulty.seq]) == pytest.approx([bpfo, 2 * bpfo, 3 * bpfo], rel=1e-6)
 
     events = list(zip(read_column(path, "bearing/v/events", "seq"),
                       [t[0] for t in read_column(path, "bearing/v/events", "TextLog:text")], strict=True))
@@ -90,6 +116,13 @@ def test_samples_indicators_and_defects_are_recorded(tmp_path, run):
     assert defect_rows[1] == (frames[12][0].seq, "defects cleared")
     info = describe_recording(path)["entities"]
     assert info[entity]["rows"] == samples.size
+
+
+def _tensor(cell) -> np.ndarray:
+    """The numbers of a TensorData cell as read back (`read_column`)."""
+    cell = cell[0] if isinstance(cell, list) and len(cell) == 1 and isinstance(cell[0], dict) else cell
+    buffer = cell["buffer"] if isinstance(cell, dict) else cell
+    return np.asarray(buffer, dtype=np.float32).ravel()
 
 
 def test_the_vibration_views_only_with_the_housing():
@@ -110,5 +143,6 @@ def test_the_vibration_views_only_with_the_housing():
         return out
     with_housing = names(TwinLayout("v", "6208", 9, vibration=True))
     assert "housing acceleration [m/s^2] (last 0.1 s)" in with_housing
-    assert any(n.startswith("envelope spectrum") for n in with_housing)
+    assert any(n.startswith("envelope spectrum [m/s^2] vs [Hz]") for n in with_housing)
+    assert any(n.startswith("acceleration spectrum [m/s^2] vs [Hz]") for n in with_housing)
     assert not [n for n in names(TwinLayout("v", "6208", 9)) if "acceleration" in n or "envelope" in n]
