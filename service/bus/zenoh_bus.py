@@ -29,7 +29,7 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
                              (bin k at start_hz + k step_hz; 6 significant digits). Envelope: 0 Hz
                              to min(half the envelope band, 5 x max(BPFI, 2 x BSF)) at
                              1 / window_s; acceleration: 0 - fs/2, power-summed into <= 2000 bins
-                             (twin.vibration.indicators). ~25 kB per window for 1 s windows
+                             (twin.vibration.indicators). ~42 kB per 1 s window (6208)
     P/{id}/vibration/waveform  accelerometer samples, binary (twin.vibration.waveform: header
                              "BTWF" v1, float32 little-endian m/s^2; one chunk per block the twin
                              produced, its own chunk seq), not JSON numbers
