@@ -103,7 +103,7 @@ def test_samples_indicators_and_defects_are_recorded(tmp_path, run):
     acc = next(iter(windows.values())).vibration.amplitude_spectrum
     assert (len(acc.amplitude_m_s2), acc.start_hz, acc.step_hz) == (1281, 0.0, 20.0)
     # the BPFO cursors of the first faulty window: 1x, 2x, 3x BPFO, as tall as its envelope spectrum
-    faulty = [s for s in windows.values() if s.defects][0]
+    faulty = next(s for s in windows.values() if s.defects)
     rows = dict(zip(read_column(path, "bearing/v/vibration/envelope/cursor/BPFO", "seq"),
                     read_column(path, "bearing/v/vibration/envelope/cursor/BPFO", "BarChart:abscissa"), strict=True))
     bpfo = faulty.vibration.defect_frequencies_hz.bpfo
