@@ -436,6 +436,11 @@ class ServiceSettings(ZenohAccessSettings):
         description="Real-time mode: the frame that applies an outside setpoint (HTTP, zenoh) lasts this "
         "long when shorter than frame_s, and a twin waiting for its next frame starts it at once, so "
         "the state carrying the setpoint is published sooner [s].")
+    frame_lead_s: float = Field(
+        default=0.005, ge=0.0, le=0.1,
+        description="Real-time mode: a frame is released this long before the wall clock reaches its start, so "
+        "the twin runs up to this much ahead of the wall clock and a wait for the GIL or the CPU between frames "
+        "is absorbed instead of making a late frame [s] (service.core.pacing). 0: frames start on the wall clock.")
     lateness_s: float = Field(
         default=0.005, ge=0.0, le=1.0,
         description="A frame is late (counted in /health `overruns` and `late_fraction`) when it ends "
@@ -449,6 +454,11 @@ class ServiceSettings(ZenohAccessSettings):
         description="Nice value given to every thread of the service but the stepping threads and the publish "
         "worker (Linux, per thread; service.core.priority) [-]: HTTP floods, zenoh, recording and OPC UA then "
         "yield the cores to real time. 0: all threads at the same priority.")
+    gc_freeze: bool = Field(
+        default=True,
+        description="Freeze the start-up heap out of Python's cyclic garbage collector once the service is open "
+        "(gc.freeze; service.core.priority.freeze_heap): full collections then walk only what was made since, "
+        "instead of stalling every thread for ~70 ms every ~10 s [bool].")
     stepping_thread_nice: int = Field(
         default=-10, ge=-20, le=0,
         description="Nice value asked for the stepping threads and the publish worker (Linux, per thread; "

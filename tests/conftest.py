@@ -30,6 +30,7 @@ os.environ.setdefault("BEARING_TWIN_ADMISSION", "off")
 # its default, in processes of its own.
 os.environ.setdefault("BEARING_TWIN_IO_THREAD_NICE", "0")
 os.environ.setdefault("BEARING_TWIN_STEPPING_THREAD_NICE", "0")
+os.environ.setdefault("BEARING_TWIN_GC_FREEZE", "0")   # process-wide too: each in-process service would freeze the pytest heap
 
 
 @pytest.fixture(scope="session")

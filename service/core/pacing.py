@@ -10,6 +10,13 @@ schedule is released at once and catches up; if it falls more than `resync_after
 stall, a cold JIT compile) the schedule is re-anchored (`resyncs`) instead of racing to catch
 up. Fast mode never waits and is never late.
 
+Lead (`lead_s`, one frame by default in the service): a frame is released that long BEFORE the
+wall clock reaches its start, so the simulated clock runs up to `lead_s` ahead of the wall clock,
+a buffer that absorbs a wait for the GIL or the CPU between frames (the Python between frames
+needs the GIL, which the publish worker, zenoh, the recorder and HTTP hold in turn) instead of
+turning it into a late frame. A setpoint still applies at the next frame boundary; what a viewer
+sees is at most `lead_s` ahead of the wall clock. 0: frames start on the wall clock.
+
 Real-time factor: simulated / wall time over a sliding window (`rtf_window_s`, 1 s).
 Late fraction: late frames / frames over a sliding window of wall time (`late_window_s`, 10 s).
 
@@ -34,9 +41,12 @@ class PacingClock:
     def __init__(self, *, fast: bool, publish_period_s: float, clock: Callable[[], float],
                  rtf_window_s: float = 1.0, resync_after_s: float = 0.25,
                  setpoint_publish_min_interval_s: float = 0.002, lateness_s: float = 0.005,
-                 late_window_s: float = 10.0):
+                 late_window_s: float = 10.0, lead_s: float = 0.0):
         if not (lateness_s >= 0.0 and math.isfinite(lateness_s)):
             raise ValueError(f"lateness_s = {lateness_s!r}: must be >= 0 [s]")
+        if not (lead_s >= 0.0 and math.isfinite(lead_s)):
+            raise ValueError(f"lead_s = {lead_s!r}: must be >= 0 [s]")
+        self.lead_s = lead_s
         self.fast = fast
         self.publish_period_s = publish_period_s
         self.rtf_window_s = rtf_window_s
@@ -127,8 +137,9 @@ class PacingClock:
 
     def frame_done(self, now: float, sim_s: float) -> float:
         """A frame ended at `now` with the simulated clock at `sim_s`: count it late or not
-        (real-time mode) and return when the next frame may start [wall-clock s]: its release,
-        `now` itself when the twin is behind (and always in fast mode)."""
+        (real-time mode) and return when the next frame may start [wall-clock s]: its release
+        (`lead_s` before the wall clock reaches `sim_s`), `now` itself when the twin is behind
+        (and always in fast mode)."""
         if self.fast:
             return now
         behind = now - self.deadline(sim_s)
@@ -140,7 +151,7 @@ class PacingClock:
             self.resyncs += 1
             self._anchor_wall, self._anchor_sim = now, sim_s
             return now
-        return max(now, self.deadline(sim_s))
+        return max(now, self.deadline(sim_s) - self.lead_s)
 
     def _count_late(self, now: float, late: bool) -> None:
         w = self._late

@@ -45,7 +45,7 @@ from service.core.capacity import Capacity, TwinCost, calibrate, usable_cores
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import DefectIntake, SetpointIntake
 from service.core.pool import SteppingPool
-from service.core.priority import ThreadPriority
+from service.core.priority import ThreadPriority, freeze_heap
 from service.core.runner import TwinRunner
 from service.core.sinks import SnapshotSink
 from service.settings import ServiceSettings
@@ -185,6 +185,8 @@ class TwinRegistry:
                 self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing,
                                  over_capacity_ok=True,
                                  **({"housing": {"enabled": True}} if self.settings.housing else {}))
+            if self.settings.gc_freeze:
+                freeze_heap()
         except BaseException:
             self.close()
             raise
@@ -313,7 +315,7 @@ class TwinRegistry:
             twin = self.build_twin(bearing_id, designation, **options)
             cost = self._admit(bearing_id, twin, over_capacity_ok)
             runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s,
-                                setpoint_frame_s=s.setpoint_frame_s, lateness_s=s.lateness_s,
+                                setpoint_frame_s=s.setpoint_frame_s, lateness_s=s.lateness_s, lead_s=s.frame_lead_s,
                                 pool=self.pool, cost=cost)
             entry = TwinEntry(id=bearing_id, twin=twin, runner=runner,
                               intake=SetpointIntake(bearing_id, self.gate, runner),

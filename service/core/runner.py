@@ -92,7 +92,7 @@ class TwinRunner:
                  idle_without_scenario: bool = False, max_consecutive_errors: int = 20,
                  setpoint_publish_min_interval_s: float = 0.002, timing_history: int = 10000,
                  safe_after_frames: int = 20, max_restarts_per_frame: int = 2,
-                 lateness_s: float = 0.005, setpoint_frame_s: float | None = 0.001,
+                 lateness_s: float = 0.005, setpoint_frame_s: float | None = 0.001, lead_s: float = 0.0,
                  pool: SteppingPool | None = None, cost: TwinCost | None = None,
                  clock: Callable[[], float] = time.perf_counter):
         if not (publish_rate_hz > 0 and math.isfinite(publish_rate_hz)):
@@ -123,7 +123,7 @@ class TwinRunner:
         self.pacing = PacingClock(fast=self.fast, publish_period_s=1.0 / self.publish_rate_hz, clock=clock,
                                   rtf_window_s=rtf_window_s, resync_after_s=resync_after_s,
                                   setpoint_publish_min_interval_s=setpoint_publish_min_interval_s,
-                                  lateness_s=lateness_s)
+                                  lateness_s=lateness_s, lead_s=lead_s)
         self.publisher = Publisher(self.bearing_id, sinks, timing_history=timing_history,
                                    lossless=self.fast, clock=clock)
         self.scenarios = ScenarioDriver()

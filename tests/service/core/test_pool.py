@@ -182,6 +182,23 @@ def test_lateness_counts_frames_ending_beyond_it_not_every_microsecond():
     assert p.resyncs == 1 and p.frame_done(20.5, 0.030) == pytest.approx(20.5)
 
 
+def test_a_lead_releases_frames_before_the_wall_clock_and_absorbs_a_stall():
+    """service.core.pacing lead_s: the next frame is released lead_s before the wall clock reaches
+    its start, so a 5 ms frame that took 3.4 ms and then waited 8 ms (a GIL or CPU stall) ends
+    within the lateness instead of 8 - 1.6 = 6.4 ms behind."""
+    for lead, late in ((0.0, 1), (0.005, 0)):
+        clock = {"now": 0.0}
+        p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda c=clock: c["now"], lateness_s=0.005,
+                        lead_s=lead)
+        p.start(0.0)
+        release = p.frame_done(0.0034, 0.005)            # 5 ms of simulated time in 3.4 ms
+        assert release == pytest.approx(max(0.0034, 0.005 - lead))   # never before now
+        p.frame_done(release + 0.0034 + 0.008, 0.010)    # the next frame, started at its release, stalls 8 ms
+        assert p.overruns == late, lead
+    with pytest.raises(ValueError, match="lead_s"):
+        PacingClock(fast=False, publish_period_s=0.02, clock=lambda: 0.0, lead_s=-1.0)
+
+
 def test_fast_mode_is_never_late():
     p = PacingClock(fast=True, publish_period_s=0.02, clock=lambda: 0.0)
     p.start(0.0)

@@ -121,9 +121,32 @@ def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
         reg.close()
 
 
+def check_an_open_service_freezes_its_start_up_heap():
+    """service.core.priority.freeze_heap at TwinRegistry.open (default gc_freeze): the objects alive
+    then are out of the collector's generations (gc.get_freeze_count), objects made later are not."""
+    import gc
+
+    from service.core.registry import TwinRegistry
+    from service.settings import ServiceSettings
+
+    assert gc.get_freeze_count() == 0
+    reg = TwinRegistry(ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
+                                       gc_freeze=False)).open()
+    reg.close()
+    assert gc.get_freeze_count() == 0
+    reg = TwinRegistry(ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False)).open()
+    try:
+        frozen = gc.get_freeze_count()
+        assert frozen > 10_000                    # the imported modules at least
+        later = [[i] for i in range(1000)]
+        assert gc.get_freeze_count() == frozen and gc.is_tracked(later[0])
+    finally:
+        reg.close()
+
+
 def _run(check: str) -> None:
     env = {k: v for k, v in os.environ.items()
-           if k not in ("BEARING_TWIN_IO_THREAD_NICE", "BEARING_TWIN_STEPPING_THREAD_NICE")}
+           if k not in ("BEARING_TWIN_IO_THREAD_NICE", "BEARING_TWIN_STEPPING_THREAD_NICE", "BEARING_TWIN_GC_FREEZE")}
     root = str(Path(__file__).resolve().parents[3])
     env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
     code = f"import runpy; runpy.run_path({str(Path(__file__))!r})[{check!r}]()"
@@ -141,3 +164,7 @@ def test_io_nice_zero_changes_nothing():
 
 def test_a_service_keeps_its_stepping_threads_above_its_other_threads():
     _run("check_a_service_keeps_its_stepping_threads_above_its_other_threads")
+
+
+def test_an_open_service_freezes_its_start_up_heap():
+    _run("check_an_open_service_freezes_its_start_up_heap")
