@@ -2,7 +2,7 @@
 stepping threads.
 
 After a frame that is due to publish, the stepping thread only CAPTURES the twin: a frozen copy
-(`freeze`: the twin object shallow-copied with its state arrays copied, some microseconds) with
+(`Twin.frozen`: the twin object shallow-copied with its state arrays copied, some microseconds) with
 the real-time factor, the late fraction and the runner's status note of that moment. The
 pool's `PublishWorker` thread builds the `Snapshot` from it (pydantic, about a millisecond) and
 hands it to the sinks, in capture order. Without a worker (before the runner starts) a capture
@@ -27,7 +27,6 @@ completes its `SetpointTiming` (published = when the worker handed it to the sin
 from __future__ import annotations
 
 import collections
-import copy
 import logging
 import threading
 import time
@@ -42,20 +41,6 @@ from twin.engine import Twin
 from twin.snapshot import Snapshot
 
 log = logging.getLogger(__name__)
-
-
-def freeze(twin: Twin) -> Twin:
-    """A copy of `twin` that `snapshot()` can read while the original runs on (`Twin.frozen`:
-    state arrays copied, the accelerometer reader left to the stepping thread)."""
-    frozen = getattr(twin, "frozen", None)
-    return frozen() if frozen is not None else copy.copy(twin)
-
-
-def _drain_waveform(twin: Twin) -> list:
-    """The accelerometer blocks produced since the last capture (stepping thread; [] without
-    the housing or with an engine that has none)."""
-    drain = getattr(twin, "drain_waveform", None)
-    return list(drain()) if drain is not None else []
 
 
 @dataclass
@@ -192,11 +177,11 @@ class Publisher:
         """Capture `twin` for publication (frozen copy when a worker builds it later)."""
         worker = self._worker
         timings, self._unpublished = self._unpublished, []
-        waveform = _drain_waveform(twin)
+        waveform = twin.drain_waveform()      # [] without the housing
         if worker is None or not worker.alive:
             self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings, waveform))
             return
-        cap = Capture(freeze(twin), real_time_factor, late_fraction, self.note, timings, waveform)
+        cap = Capture(twin.frozen(), real_time_factor, late_fraction, self.note, timings, waveform)
         with self._cv:
             if self.lossless:
                 while (len(self._pending) >= self.max_pending and worker.alive
