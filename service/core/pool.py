@@ -164,6 +164,11 @@ class PublishWorker:
     def thread_name(self) -> str | None:
         return self._thread.name if self._thread is not None else None
 
+    @property
+    def native_id(self) -> int | None:
+        """Kernel thread id of the worker thread (None before it starts)."""
+        return self._thread.native_id if self._thread is not None else None
+
     def start(self) -> None:
         with self._lock:
             if self._thread is None and not self._closed:
@@ -222,8 +227,8 @@ class SteppingPool:
 
     def native_ids(self) -> set[int]:
         """Kernel thread ids of the stepping threads and the publish worker (started ones)."""
-        threads = [*self._threads, self.publisher._thread]
-        return {t.native_id for t in threads if t is not None and t.native_id is not None}
+        ids = [t.native_id for t in self._threads] + [self.publisher.native_id]
+        return {i for i in ids if i is not None}
 
     def start(self) -> SteppingPool:
         with self._cond:
