@@ -457,7 +457,7 @@ class ServiceSettings(ZenohAccessSettings):
     gc_freeze: bool = Field(
         default=True,
         description="Freeze the start-up heap out of Python's cyclic garbage collector once the service is open "
-        "(gc.freeze; service.core.priority.freeze_heap): full collections then walk only what was made since, "
+        "(gc.freeze; service.core.heap.freeze_heap): full collections then walk only what was made since, "
         "instead of stalling every thread for ~70 ms every ~10 s [bool].")
     stepping_thread_nice: int = Field(
         default=-10, ge=-20, le=0,

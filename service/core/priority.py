@@ -33,30 +33,17 @@ Elsewhere than Linux (no per-thread nice) this is a no-op; `/health` says which.
 
 from __future__ import annotations
 
-import gc
 import logging
 import os
 import sys
 import threading
 import weakref
 from collections.abc import Callable
+from typing import ClassVar
 
 log = logging.getLogger(__name__)
 
 TASKS_DIR = "/proc/self/task"
-
-
-def freeze_heap() -> int:
-    """Move every object alive now (the imported modules, the compiled engine, the twins of the
-    start) out of the cyclic garbage collector's reach (`gc.freeze`, Python docs: "to avoid
-    ... full collections"); returns how many. Why: a full (generation 2) collection walks every
-    object and holds the GIL throughout; with the recording on it ran every ~10 s and took
-    73 ms on the 2-core VM, which stalls every stepping thread between frames (measured: 2.2 % of
-    5 ms frames more than 5 ms late, every one of them in such a stall; none with the heap
-    frozen). Objects made later are collected as before."""
-    gc.collect()
-    gc.freeze()
-    return gc.get_freeze_count()
 
 
 def _process_nice() -> int:
@@ -94,7 +81,7 @@ class ThreadPriority:
     seen (returns how many it changed); `start()` sweeps now and then every `sweep_s` [s] in a
     daemon thread (itself reniced); `close()` stops it."""
 
-    _live: weakref.WeakSet[ThreadPriority] = weakref.WeakSet()   # several services in one process (tests)
+    _live: ClassVar[weakref.WeakSet[ThreadPriority]] = weakref.WeakSet()   # several services in one process (tests)
 
     def __init__(self, keep: Callable[[], set[int]], io_nice: int, stepping_nice: int = 0, sweep_s: float = 1.0):
         self.keep = keep

@@ -45,7 +45,8 @@ from service.core.capacity import Capacity, TwinCost, calibrate, usable_cores
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import DefectIntake, SetpointIntake
 from service.core.pool import SteppingPool
-from service.core.priority import ThreadPriority, freeze_heap
+from service.core.heap import freeze_heap
+from service.core.priority import ThreadPriority
 from service.core.runner import TwinRunner
 from service.core.sinks import SnapshotSink
 from service.settings import ServiceSettings

@@ -122,7 +122,7 @@ def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
 
 
 def check_an_open_service_freezes_its_start_up_heap():
-    """service.core.priority.freeze_heap at TwinRegistry.open (default gc_freeze): the objects alive
+    """service.core.heap.freeze_heap at TwinRegistry.open (default gc_freeze): the objects alive
     then are out of the collector's generations (gc.get_freeze_count), objects made later are not."""
     import gc
 
