@@ -12,7 +12,6 @@ import json
 import math
 from collections.abc import Awaitable
 
-import httpx
 import pytest
 
 asyncua = pytest.importorskip("asyncua")
@@ -37,17 +36,7 @@ def server(support):
 
 
 @pytest.fixture(scope="module")
-def http(server):
-    with httpx.Client(base_url=server.url, timeout=30.0, headers={"Authorization": f"Bearer {TOKEN}"}) as c:
-        yield c
-
-
-@pytest.fixture(scope="module")
-def url(server, http, support):
-    facade = server.service.opcua
-    assert facade is not None and facade.running
-    # the default twin has started stepping (its snapshots count up)
-    support.wait_for(lambda: http.get("/v1/bearings/default/state").json()["seq"], lambda s: s >= 3, timeout=WAIT_S)
+def url(facade):
     return facade.url
 
 

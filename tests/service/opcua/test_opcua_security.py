@@ -14,7 +14,6 @@ import stat
 from collections.abc import Awaitable
 from pathlib import Path
 
-import httpx
 import pytest
 
 asyncua = pytest.importorskip("asyncua")
@@ -75,20 +74,6 @@ def server(support, pki):
         yield srv
 
 
-@pytest.fixture(scope="module")
-def http(server):
-    with httpx.Client(base_url=server.url, timeout=30.0, headers={"Authorization": f"Bearer {TOKEN}"}) as c:
-        yield c
-
-
-@pytest.fixture(scope="module")
-def facade(server, http, support):
-    facade = server.service.opcua
-    assert facade is not None and facade.running and facade.security == "both"
-    support.wait_for(lambda: http.get("/v1/bearings/default/state").json()["seq"], lambda s: s >= 3, timeout=WAIT_S)
-    return facade
-
-
 async def secure_client(facade, who, policy=B256, mode=SE, password: str | None = TOKEN) -> Client:
     cert, key, uri = who
     c = Client(facade.url, timeout=20, watchdog_intervall=10.0)
@@ -143,6 +128,8 @@ def test_every_offered_policy_and_mode_authenticates_and_writes(facade, pki, pol
 
 
 def test_the_endpoints_offer_six_secure_policies_and_encrypt_the_password(facade):
+    assert facade.security == "both"    # the default `auto` with a token: Sign and SignAndEncrypt
+
     async def main():
         return await Client(facade.url, timeout=20).connect_and_get_server_endpoints()
     endpoints = run(main())
