@@ -450,10 +450,12 @@ class ServiceSettings(ZenohAccessSettings):
         description="Threads that advance the twins, earliest deadline first [count]; unset = one per "
         "core this process may use.")
     io_thread_nice: int = Field(
-        default=10, ge=0, le=19,
+        default=0, ge=-20, le=19,
         description="Nice value given to every thread of the service but the stepping threads and the publish "
-        "worker (Linux, per thread; service.core.priority) [-]: HTTP floods, zenoh, recording and OPC UA then "
-        "yield the cores to real time. 0: all threads at the same priority.")
+        "worker (Linux, per thread; service.core.priority) [-]; the HTTP event loop gets the lower of this and the "
+        "process's nice. Not above the load's (0): these threads hold the GIL the stepping threads wait for, and at "
+        "nice 10 beside a flood at nice 0 they were preempted while holding it (attack: real-time factor 0.78-0.86 "
+        "against 1.00 at 0). Negative (root or CAP_SYS_NICE): above the host's other processes too.")
     gc_freeze: bool = Field(
         default=True,
         description="Freeze the start-up heap out of Python's cyclic garbage collector once the service is open "
