@@ -544,6 +544,24 @@ class ServiceSettings(ZenohAccessSettings):
         default=256, ge=8, le=100_000,
         description="Open HTTP connections (or running requests) beyond which a new request gets 503 "
         "(uvicorn limit_concurrency) [count].")
+    client_error_rate_hz: float = Field(
+        default=5.0, ge=0.0, le=1e6,
+        description="Sustained rate of refused HTTP requests (any 4xx answer: wrong or missing token, over a rate "
+        "limit, invalid, unknown) a client address may cause before its refusals are held in the tarpit "
+        "(tarpit_delay_s) [1/s]; 0 = no tarpit. /health is never counted nor held.")
+    client_error_burst: int = Field(
+        default=20, ge=1, le=1_000_000,
+        description="Refused requests a client may cause in a burst before client_error_rate_hz applies [count].")
+    tarpit_delay_s: float = Field(
+        default=2.0, ge=0.0, le=60.0,
+        description="A client over its error budget (client_error_rate_hz) gets each refusal this long after it "
+        "was decided, with Retry-After; the wait is an asyncio timer (no thread, no CPU), so a client that waits "
+        "for its answers before sending more (a closed-loop flood) slows itself down [s]; 0 = no tarpit.")
+    tarpit_max_held: int = Field(
+        default=64, ge=1, le=100_000,
+        description="Refusals held in the tarpit at one time, at most [count]; beyond it a refusal is answered at "
+        "once (counted in /health http_tarpit). Below http_max_connections: the held connections count "
+        "against it.")
     scenario_dir: Path | None = Field(
         default=None,
         description="Directory of named scenarios [path]; default ./scenarios if it exists, else "
@@ -653,6 +671,14 @@ class ServiceSettings(ZenohAccessSettings):
         if self.opcua_security != "auto":
             return self.opcua_security
         return "both" if self.token is not None else "none"
+
+    @model_validator(mode="after")
+    def _tarpit(self):
+        if self.tarpit_max_held >= self.http_max_connections:
+            raise ValueError(f"tarpit_max_held: {self.tarpit_max_held} held refusals would take every one of the "
+                             f"http_max_connections ({self.http_max_connections}); allowed [1, "
+                             f"{self.http_max_connections - 1}]")
+        return self
 
     @model_validator(mode="after")
     def _opcua_security(self):
