@@ -450,12 +450,14 @@ class ServiceSettings(ZenohAccessSettings):
         description="Threads that advance the twins, earliest deadline first [count]; unset = one per "
         "core this process may use.")
     io_thread_nice: int = Field(
-        default=0, ge=-20, le=19,
+        default=-5, ge=-20, le=19,
         description="Nice value given to every thread of the service but the stepping threads and the publish "
-        "worker (Linux, per thread; service.core.priority) [-]; the HTTP event loop gets the lower of this and the "
-        "process's nice. Not above the load's (0): these threads hold the GIL the stepping threads wait for, and at "
-        "nice 10 beside a flood at nice 0 they were preempted while holding it (attack: real-time factor 0.78-0.86 "
-        "against 1.00 at 0). Negative (root or CAP_SYS_NICE): above the host's other processes too.")
+        "worker, the HTTP event loop included (Linux, per thread; service.core.priority) [-]. Between the stepping "
+        "threads' (-10) and the host's other processes' (0): these threads hold the GIL the stepping threads wait "
+        "for, and below the load (nice 10 before 2026-11-23) they were preempted while holding it (attack: real-time "
+        "factor 0.78-0.86 at 10, 0.998-1.000 at 0 on a quiet host; at 0 against -5 with other processes busy: "
+        "0.68-0.81 against 0.80-0.91, /health p99 214-317 against 52-89 ms). Below the process's nice needs root or "
+        "CAP_SYS_NICE (refused: counted in /health thread_priority errors). 0: the process's nice.")
     gc_freeze: bool = Field(
         default=True,
         description="Freeze the start-up heap out of Python's cyclic garbage collector once the service is open "

@@ -16,24 +16,28 @@ I/O. Here that is the nice value, which Linux keeps per thread:
   process's nice and `/health` says so. An attacker on the same host (the `attack` tool's own
   processes) or any other busy process then cannot take their core;
 - every other thread of the process (the HTTP event loop, zenoh's runtime and callbacks, the
-  recorder, the OPC UA server, the HTTP worker threads) gets nice `io_thread_nice` (0 by default:
-  the process's own), and the HTTP event loop is kept at the lower (higher-priority) of that and
-  the process's nice (`keep_thread`: /health answers in time). New threads appear all the time (a
-  twin's zenoh publisher, a recording's writer, asyncio's executor), so a sweep every `sweep_s`
-  renices the ones it has not seen yet. A thread inherits the nice of the thread that creates it,
-  and an unprivileged process cannot lower a nice value again, so the stepping pool is started
-  before the first sweep (TwinRegistry.open).
+  recorder, the OPC UA server, the HTTP worker threads) gets nice `io_thread_nice` (-5: between
+  the stepping threads and the host's other processes; CFS weight 3121), and the HTTP event loop
+  is kept at the lower (higher-priority) of that and the process's nice (`keep_thread`). New
+  threads appear all the time (a twin's zenoh publisher, a recording's writer, asyncio's
+  executor), so a sweep every `sweep_s` renices the ones it has not seen yet. A thread inherits
+  the nice of the thread that creates it, so the stepping pool is started before the first sweep
+  (TwinRegistry.open).
 
-Why the I/O threads are NOT put below the load (io_thread_nice 10 was the default until
+Why the I/O threads are above the load and not below it (io_thread_nice was 10 until
 2026-11-23). The stepping threads need the GIL for the Python between frames, and whoever holds
 the GIL when they ask is an I/O thread (the event loop, a zenoh callback, the zenoh publisher).
-A thread at nice 10 beside processes at nice 0 (an attacker on the same host: the `attack` tool's
-own processes) gets a tenth of their CPU share: preempted while holding the GIL, it keeps every
-stepping thread waiting for as long as the kernel leaves it off the CPU (priority inversion; the
-GIL has no priority inheritance). Measured with `attack --seconds 30` on the 2-core VM: median
-real-time factor under the flood 0.78-0.86 with nice 10, 0.998-1.000 with nice 0; /health p99
-258-480 ms against 110-122 ms. A negative `io_thread_nice` (root or CAP_SYS_NICE) puts every
-thread that takes the GIL above the other processes of the host as well.
+A thread at nice 10 beside processes at nice 0 (an attacker on the same host, like the `attack`
+tool's own processes, or any busy process) gets a tenth of their CPU share: preempted while
+holding the GIL, it keeps every stepping thread waiting for as long as the kernel leaves it off
+the CPU (priority inversion; the GIL has no priority inheritance). Measured with `attack
+--seconds 30` on the 2-core VM: median real-time factor under the flood 0.78-0.86 at nice 10,
+0.998-1.000 at 0 (quiet host); with other processes busy as well, 0.68-0.81 at 0 and 0.80-0.91
+at -5, /health p99 214-317 ms against 52-89 ms. The I/O work they can do is bounded by the
+per-client budgets and the tarpit (service.api.middleware), so their priority does not let a
+flood take more than the budgets allow; the stepping threads (-10, weight 9548) still come first.
+Raising a priority needs root or CAP_SYS_NICE; without it these threads keep the process's nice
+(counted in `errors`).
 
 Not done: real-time scheduling classes (SCHED_FIFO / SCHED_RR) for the stepping threads. A FIFO
 thread that never sleeps (a twin behind the wall clock steps without pause) would lock every
