@@ -190,8 +190,8 @@ class TwinHealth(BaseModel):
 class ThreadPriorityHealth(BaseModel):
     """Scheduling priority of the service's threads (service.core.priority)."""
 
-    active: bool = Field(description="Whether the service's other threads run below the stepping threads (Linux) [bool].")
-    io_thread_nice: int = Field(description="Nice value of every thread but the stepping threads and the publish worker [-]; 0 when not active.")
+    active: bool = Field(description="Whether the service sets its threads' priorities (Linux) [bool].")
+    io_thread_nice: int = Field(description="Nice value asked for every thread but the stepping threads and the publish worker, the HTTP event loop included [-]; 0 when not active.")
     stepping_thread_nice_asked: int = Field(description="Nice value asked for the stepping threads and the publish worker [-].")
     stepping_thread_nice: list[int] = Field(description="Nice values found on the stepping threads and the publish worker [-] (the process's own where raising a priority is not permitted).")
     threads_reniced: int = Field(description="Threads given io_thread_nice since the start [-].")
