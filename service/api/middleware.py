@@ -157,10 +157,11 @@ class Tarpit:
         self.gate = gate
         self.delay_s = float(delay_s)
         self.max_held = int(max_held)
-        self.stats = stats if stats is not None else TarpitStats()
-        self.stats.delay_s, self.stats.max_held = self.delay_s, self.max_held
         self.exempt = exempt
         self.active = self.delay_s > 0 and gate.error_rate_hz is not None
+        self.stats = stats if stats is not None else TarpitStats()
+        self.stats.delay_s = self.delay_s if self.active else 0.0      # record(): active = delay_s > 0
+        self.stats.max_held = self.max_held
 
     async def __call__(self, scope, receive, send) -> None:
         if not self.active or scope["type"] != "http" or scope.get("path") in self.exempt:
