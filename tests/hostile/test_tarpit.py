@@ -224,3 +224,30 @@ def test_tarpit_defaults():
     assert f["tarpit_delay_s"].default == 2.0 and f["client_error_rate_hz"].default == 5.0
     assert f["client_error_burst"].default == 20 and f["tarpit_max_held"].default == 64
     assert f["tarpit_max_held"].default < f["http_max_connections"].default
+
+
+def test_no_error_budget_or_no_delay_means_no_tarpit():
+    """client_error_rate_hz 0 (no budget) or tarpit_delay_s 0: nothing is held, /health says inactive."""
+    import asyncio
+
+    from service.api.middleware import Tarpit
+    from service.core.admission import AdmissionGate
+
+    async def refuse(scope, receive, send):
+        await send({"type": "http.response.start", "status": 401, "headers": []})
+        await send({"type": "http.response.body", "body": b"{}"})
+
+    for gate, delay in ((AdmissionGate(error_rate_hz=None), 5.0), (AdmissionGate(error_rate_hz=0.001, error_burst=1), 0.0)):
+        tarpit = Tarpit(refuse, gate=gate, delay_s=delay, max_held=3)
+        sent = []
+
+        async def send(message, sent=sent):
+            sent.append(message)
+
+        async def main(tarpit=tarpit, send=send):
+            for _ in range(5):
+                await tarpit({"type": "http", "path": "/v1/x", "method": "PUT", "client": ("10.9.9.9", 1)}, None, send)
+        asyncio.run(main())
+        assert not tarpit.active and tarpit.stats.record()["active"] is False
+        assert tarpit.stats.held == 0 and len(sent) == 10
+        assert all(b"retry-after" not in dict(m.get("headers") or ()) for m in sent if m["type"] == "http.response.start")
