@@ -450,10 +450,14 @@ class ServiceSettings(ZenohAccessSettings):
         description="Threads that advance the twins, earliest deadline first [count]; unset = one per "
         "core this process may use.")
     io_thread_nice: int = Field(
-        default=10, ge=0, le=19,
+        default=-5, ge=-20, le=19,
         description="Nice value given to every thread of the service but the stepping threads and the publish "
-        "worker (Linux, per thread; service.core.priority) [-]: HTTP floods, zenoh, recording and OPC UA then "
-        "yield the cores to real time. 0: all threads at the same priority.")
+        "worker, the HTTP event loop included (Linux, per thread; service.core.priority) [-]. Between the stepping "
+        "threads' (-10) and the host's other processes' (0): these threads hold the GIL the stepping threads wait "
+        "for, and below the load (nice 10 before 2026-11-23) they were preempted while holding it (attack: real-time "
+        "factor 0.78-0.86 at 10, 0.998-1.000 at 0 on a quiet host; at 0 against -5 with other processes busy: "
+        "0.68-0.81 against 0.80-0.91, /health p99 214-317 against 52-89 ms). Below the process's nice needs root or "
+        "CAP_SYS_NICE (refused: counted in /health thread_priority errors). 0: the process's nice.")
     gc_freeze: bool = Field(
         default=True,
         description="Freeze the start-up heap out of Python's cyclic garbage collector once the service is open "
@@ -542,6 +546,24 @@ class ServiceSettings(ZenohAccessSettings):
         default=256, ge=8, le=100_000,
         description="Open HTTP connections (or running requests) beyond which a new request gets 503 "
         "(uvicorn limit_concurrency) [count].")
+    client_error_rate_hz: float = Field(
+        default=5.0, ge=0.0, le=1e6,
+        description="Sustained rate of refused HTTP requests (any 4xx answer: wrong or missing token, over a rate "
+        "limit, invalid, unknown) a client address may cause before its refusals are held in the tarpit "
+        "(tarpit_delay_s) [1/s]; 0 = no tarpit. /health is never counted nor held.")
+    client_error_burst: int = Field(
+        default=20, ge=1, le=1_000_000,
+        description="Refused requests a client may cause in a burst before client_error_rate_hz applies [count].")
+    tarpit_delay_s: float = Field(
+        default=2.0, ge=0.0, le=60.0,
+        description="A client over its error budget (client_error_rate_hz) gets each refusal this long after it "
+        "was decided, with Retry-After; the wait is an asyncio timer (no thread, no CPU), so a client that waits "
+        "for its answers before sending more (a closed-loop flood) slows itself down [s]; 0 = no tarpit.")
+    tarpit_max_held: int = Field(
+        default=64, ge=1, le=100_000,
+        description="Refusals held in the tarpit at one time, at most [count]; beyond it a refusal is answered at "
+        "once (counted in /health http_tarpit). Below http_max_connections: the held connections count "
+        "against it.")
     scenario_dir: Path | None = Field(
         default=None,
         description="Directory of named scenarios [path]; default ./scenarios if it exists, else "
@@ -651,6 +673,14 @@ class ServiceSettings(ZenohAccessSettings):
         if self.opcua_security != "auto":
             return self.opcua_security
         return "both" if self.token is not None else "none"
+
+    @model_validator(mode="after")
+    def _tarpit(self):
+        if self.tarpit_max_held >= self.http_max_connections:
+            raise ValueError(f"tarpit_max_held: {self.tarpit_max_held} held refusals would take every one of the "
+                             f"http_max_connections ({self.http_max_connections}); allowed [1, "
+                             f"{self.http_max_connections - 1}]")
+        return self
 
     @model_validator(mode="after")
     def _opcua_security(self):

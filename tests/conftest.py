@@ -30,7 +30,11 @@ os.environ.setdefault("BEARING_TWIN_ADMISSION", "off")
 # its default, in processes of its own.
 os.environ.setdefault("BEARING_TWIN_IO_THREAD_NICE", "0")
 os.environ.setdefault("BEARING_TWIN_STEPPING_THREAD_NICE", "0")
-os.environ.setdefault("BEARING_TWIN_GC_FREEZE", "0")   # process-wide too: each in-process service would freeze the pytest heap
+os.environ.setdefault("BEARING_TWIN_GC_FREEZE", "0")
+# Nor do in-process services hold refusals in the tarpit (service.api.middleware.Tarpit): the functional tests
+# send invalid requests from one address on purpose, far above a client's error budget.
+# tests/hostile/test_tarpit.py checks the tarpit with settings of its own.
+os.environ.setdefault("BEARING_TWIN_TARPIT_DELAY_S", "0")   # process-wide too: each in-process service would freeze the pytest heap
 
 
 @pytest.fixture(scope="session")

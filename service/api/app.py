@@ -14,7 +14,8 @@ template (one `APIRouter` per resource, `Depends` in `deps.py`):
   /health never) - so the OpenAPI document declares the bearer scheme exactly where it applies,
   without patching;
 * dependencies (service.api.deps): the registry, the twin, the token, the setpoint rate;
-  middleware (service.api.middleware): the body size cap and the per-client read rate;
+  middleware (service.api.middleware): the body size cap, the per-client read rate, the token
+  of writes answered before routing and the tarpit for clients over their error budget;
 * the server (service.api.server): uvicorn with header/body deadlines for slow clients, a
   connection cap and an access log that never shows a token;
 * errors (service.api.errors): always {"detail": [{"field", "message", "allowed"}]}.
@@ -33,7 +34,7 @@ from starlette.concurrency import run_in_threadpool
 
 from service.api.deps import require_token
 from service.api.errors import install_error_handlers
-from service.api.middleware import BodySizeLimit, ReadRateLimit
+from service.api.middleware import BodySizeLimit, ReadRateLimit, Tarpit, TarpitStats, TokenGate
 from service.api.routers import alarms, bearings, defects, docs, health, recording, scenarios, setpoint, state
 from service.api.schemas import ErrorResponse
 from service.core.registry import TwinRegistry, admission_gate
@@ -90,8 +91,12 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
     app.state.settings = settings
     app.state.gate = gate
     app.state.service = None
+    app.state.tarpit = TarpitStats()
     app.add_middleware(BodySizeLimit, gate=gate)
-    app.add_middleware(ReadRateLimit, gate=gate)      # outermost: a refused read costs the least
+    app.add_middleware(ReadRateLimit, gate=gate)      # a refused read costs the least
+    app.add_middleware(TokenGate, gate=gate, reads=settings.read_requires_token)
+    app.add_middleware(Tarpit, gate=gate, delay_s=settings.tarpit_delay_s, max_held=settings.tarpit_max_held,
+                       stats=app.state.tarpit)        # outermost: sees every refusal
     install_error_handlers(app)
 
     token = [Depends(require_token)] if gate.requires_token else []

@@ -8,16 +8,33 @@
   with Retry-After and the limit named, answered before routing, the token check or any
   serialisation, so a read flood costs little. /health and the docs are not counted.
 
-Tokens and setpoint rates are dependencies (service.api.deps); slow clients are the server's
-job (service.api.server)."""
+* `TokenGate` refuses an API write (POST/PUT/PATCH/DELETE under /v1/; reads too with
+  read_requires_token) without the service's token: 401 with WWW-Authenticate, answered before
+  routing, the body or any validation (the cheapest refusal of the commonest hostile request).
+  The routers keep their token dependency (service.api.deps), which also documents it in OpenAPI.
+* `Tarpit` (outermost) holds the refusals of a client over its error budget: every 4xx answer
+  takes one from its address's budget (the admission gate's `take_error`, `client_error_rate_hz`
+  / `client_error_burst`); once that is empty, each further 4xx answer is sent `tarpit_delay_s`
+  after it was decided, with Retry-After. The wait is an asyncio timer: no thread, no CPU. A
+  flood that waits for its answers before sending more (any closed-loop client: 32 requests in
+  flight make at most 32 / delay refusals a second) slows itself down, and its CPU, which on a
+  shared host is taken from the twins, falls with its rate. At most `tarpit_max_held` refusals
+  are held at once (beyond: answered at once, counted), so the tarpit cannot hold every
+  connection the server allows. /health is never counted nor held; a client within its budget
+  (a few mistakes a second) is never held.
+
+Setpoint rates are a dependency (service.api.deps); slow clients are the server's job
+(service.api.server)."""
 
 from __future__ import annotations
 
+import asyncio
 import json
 import math
 from collections.abc import Awaitable, Callable
+from dataclasses import dataclass
 
-from service.core.admission import AdmissionGate
+from service.core.admission import AdmissionGate, bearer_token
 
 _READ_METHODS = frozenset({"GET", "HEAD", "OPTIONS"})
 
@@ -88,6 +105,105 @@ class ReadRateLimit:
                               [(b"retry-after", retry.encode())])
                 return
         await self.app(scope, receive, send)
+
+
+_WRITE_METHODS = frozenset({"POST", "PUT", "PATCH", "DELETE"})
+_MISSING_TOKEN = "missing bearer token: send 'Authorization: Bearer <token>'"
+
+
+class TokenGate:
+    """See the module docstring."""
+
+    def __init__(self, app, *, gate: AdmissionGate, reads: bool = False, prefix: str = "/v1/"):
+        self.app = app
+        self.gate = gate
+        self.methods = _WRITE_METHODS | ({"GET", "HEAD"} if reads else frozenset())
+        self.prefix = prefix
+
+    async def __call__(self, scope, receive, send) -> None:
+        if (scope["type"] == "http" and self.gate.requires_token
+                and scope.get("method", "GET").upper() in self.methods
+                and scope.get("path", "").startswith(self.prefix)):
+            given = bearer_token(_headers(scope).get(b"authorization"))
+            refusal = self.gate.check_token(given, missing=_MISSING_TOKEN, field="Authorization")
+            if refusal is not None:
+                await _answer(send, 401, error_body(refusal.message, refusal.field, refusal.allowed),
+                              [(b"www-authenticate", b'Bearer realm="bearing-twin"')])
+                return
+        await self.app(scope, receive, send)
+
+
+@dataclass
+class TarpitStats:
+    """What the tarpit did (one event loop: no lock): for /health `http_tarpit`."""
+
+    delay_s: float = 0.0
+    max_held: int = 0
+    held_now: int = 0            # refusals being held now
+    held: int = 0                # refusals held so far
+    answered_at_once: int = 0    # over budget, but max_held were held already
+
+    def record(self) -> dict:
+        return {"active": self.delay_s > 0, "delay_s": self.delay_s, "max_held": self.max_held,
+                "held_now": self.held_now, "held": self.held, "answered_at_once": self.answered_at_once}
+
+
+class Tarpit:
+    """See the module docstring. `stats`: shared with /health."""
+
+    def __init__(self, app, *, gate: AdmissionGate, delay_s: float, max_held: int,
+                 stats: TarpitStats | None = None, exempt: frozenset[str] = frozenset({"/health"})):
+        self.app = app
+        self.gate = gate
+        self.delay_s = float(delay_s)
+        self.max_held = int(max_held)
+        self.exempt = exempt
+        self.active = self.delay_s > 0 and gate.error_rate_hz is not None
+        self.stats = stats if stats is not None else TarpitStats()
+        self.stats.delay_s = self.delay_s if self.active else 0.0      # record(): active = delay_s > 0
+        self.stats.max_held = self.max_held
+
+    async def __call__(self, scope, receive, send) -> None:
+        if not self.active or scope["type"] != "http" or scope.get("path") in self.exempt:
+            await self.app(scope, receive, send)
+            return
+        client = scope.get("client")
+        address = client[0] if client else "unknown"
+        stats = self.stats
+
+        async def send_held(message) -> None:
+            if (message["type"] == "http.response.start" and 400 <= message.get("status", 200) < 500
+                    and not self.gate.take_error(address)):
+                if stats.held_now < self.max_held:
+                    message = _with_retry_after(message, self.delay_s)
+                    stats.held_now += 1
+                    stats.held += 1
+                    try:
+                        await asyncio.sleep(self.delay_s)
+                    finally:
+                        stats.held_now -= 1
+                else:
+                    stats.answered_at_once += 1
+            await send(message)
+
+        await self.app(scope, receive, send_held)
+
+
+def _with_retry_after(message: dict, delay_s: float) -> dict:
+    """The response start with a Retry-After of at least `delay_s` (whole seconds)."""
+    headers = list(message.get("headers") or ())
+    wait = max(1, math.ceil(delay_s))
+    for i, (name, value) in enumerate(headers):
+        if name.lower() == b"retry-after":
+            try:
+                wait = max(wait, int(value))
+            except ValueError:
+                pass
+            headers[i] = (b"retry-after", str(wait).encode())
+            break
+    else:
+        headers.append((b"retry-after", str(wait).encode()))
+    return {**message, "headers": headers}
 
 
 def _headers(scope) -> dict[bytes, bytes]:

@@ -190,8 +190,8 @@ class TwinHealth(BaseModel):
 class ThreadPriorityHealth(BaseModel):
     """Scheduling priority of the service's threads (service.core.priority)."""
 
-    active: bool = Field(description="Whether the service's other threads run below the stepping threads (Linux) [bool].")
-    io_thread_nice: int = Field(description="Nice value of every thread but the stepping threads and the publish worker [-]; 0 when not active.")
+    active: bool = Field(description="Whether the service sets its threads' priorities (Linux) [bool].")
+    io_thread_nice: int = Field(description="Nice value asked for every thread but the stepping threads and the publish worker, the HTTP event loop included [-]; 0 when not active.")
     stepping_thread_nice_asked: int = Field(description="Nice value asked for the stepping threads and the publish worker [-].")
     stepping_thread_nice: list[int] = Field(description="Nice values found on the stepping threads and the publish worker [-] (the process's own where raising a priority is not permitted).")
     threads_reniced: int = Field(description="Threads given io_thread_nice since the start [-].")
@@ -216,6 +216,7 @@ class Health(BaseModel):
     recording_rows_lost: int = Field(default=0, description="Snapshots that could not be written to a recording [-].")
     reads_rate_limited: int = Field(default=0, description="API reads refused with 429 by the per-client read rate [-].")
     thread_priority: ThreadPriorityHealth | None = Field(default=None, description="Priority of the stepping threads over the service's I/O threads [nice values, counts].")
+    http_tarpit: dict[str, bool | int | float] | None = Field(default=None, description="The tarpit for HTTP clients over their error budget (service.api.middleware.Tarpit): `active`, `delay_s` [s], `max_held`, `held_now`, `held` (refusals held so far), `answered_at_once` (over budget with max_held held already), `errors_over_budget` [counts].")
     http_slow_closed: int = Field(default=0, description="HTTP connections closed (408) because their headers or body were not complete in time, in this process [-].")
     pid: int | None = Field(default=None, description="Process id of the service [-] (for soak tests and monitoring).")
     rss_bytes: int | None = Field(default=None, description="Resident memory of the service process [bytes]; null where /proc is unavailable.")

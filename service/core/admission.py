@@ -4,9 +4,9 @@
   bytes), so the time an answer takes does not tell how much of a guessed token was right.
 * `TokenBucket`: a rate limit (sustained `rate_hz`, bursts of `burst`).
 * `AdmissionGate`: the service's HTTP token, body/payload size cap, per-twin setpoint rate (one
-  token bucket per twin, shared by HTTP and zenoh), per-client read rate (one token bucket per
-  client address, the most recently seen `MAX_READ_CLIENTS` kept) and whether setpoints from the
-  bus are taken at all. Each check returns None (admitted) or a `Refusal` with the status the transport
+  token bucket per twin, shared by HTTP and zenoh), per-client read rate and per-client error
+  budget (one token bucket per client address each, the most recently seen `MAX_READ_CLIENTS`
+  kept) and whether setpoints from the bus are taken at all. Each check returns None (admitted) or a `Refusal` with the status the transport
   answers with (401, 403, 413, 429), the field and a message; the HTTP layer turns it into its
   error answer (service.api.deps), the zenoh intake into a refusal on the result key
   (service.core.intake).
@@ -109,7 +109,8 @@ class AdmissionGate:
     def __init__(self, *, token: str | None = None, setpoint_rate_hz: float | None = None,
                  setpoint_burst: int = 100, max_payload_bytes: int | None = None,
                  bus_writes: str | None = None, read_rate_hz: float | None = None,
-                 read_burst: int = 200, clock: Callable[[], float] = time.monotonic):
+                 read_burst: int = 200, error_rate_hz: float | None = None, error_burst: int = 20,
+                 clock: Callable[[], float] = time.monotonic):
         self.token = token
         if bus_writes is None:
             bus_writes = "closed" if token is not None else "open"
@@ -126,6 +127,12 @@ class AdmissionGate:
             TokenBucket(self.read_rate_hz, self.read_burst)           # ValueError on bad settings
         self._readers: collections.OrderedDict[str, TokenBucket] = collections.OrderedDict()
         self.reads_limited = 0
+        self.error_rate_hz = float(error_rate_hz) if error_rate_hz else None
+        self.error_burst = int(error_burst)
+        if self.error_rate_hz is not None:
+            TokenBucket(self.error_rate_hz, self.error_burst)         # ValueError on bad settings
+        self._failing: collections.OrderedDict[str, TokenBucket] = collections.OrderedDict()
+        self.errors_over_budget = 0
         self.max_payload_bytes = max_payload_bytes
         self._clock = clock
         self._buckets: dict[str, TokenBucket] = {}
@@ -191,16 +198,7 @@ class AdmissionGate:
         the limit, with retry_after_s."""
         if self.read_rate_hz is None:
             return None
-        with self._lock:
-            bucket = self._readers.get(client)
-            if bucket is None:
-                bucket = self._readers[client] = TokenBucket(self.read_rate_hz, self.read_burst,
-                                                             clock=self._clock)
-                if len(self._readers) > self.MAX_READ_CLIENTS:
-                    self._readers.popitem(last=False)
-            else:
-                self._readers.move_to_end(client)
-        ok, retry_after = bucket.take()
+        ok, retry_after = self._client_bucket(self._readers, client, self.read_rate_hz, self.read_burst).take()
         if ok:
             return None
         with self._lock:
@@ -209,6 +207,33 @@ class AdmissionGate:
                        f"second per client (read_rate_hz, bursts of {self.read_burst}: read_burst); "
                        f"retry after {retry_after:.3f} s", [0, self.read_rate_hz],
                        retry_after_s=retry_after)
+
+    def take_error(self, client: str) -> bool:
+        """Count one refused request (an HTTP 4xx answer) of `client` (its address) against its
+        error budget (`error_rate_hz`, bursts of `error_burst`): True while within it, False for
+        a client over it (the HTTP layer holds its refusals: service.api.middleware.Tarpit). No
+        budget configured: always True."""
+        if self.error_rate_hz is None:
+            return True
+        ok, _ = self._client_bucket(self._failing, client, self.error_rate_hz, self.error_burst).take()
+        if not ok:
+            with self._lock:
+                self.errors_over_budget += 1
+        return ok
+
+    def _client_bucket(self, buckets: collections.OrderedDict[str, TokenBucket], client: str,
+                       rate_hz: float, burst: int) -> TokenBucket:
+        """The bucket of `client` in `buckets` (made on first sight; the least recently seen of
+        more than MAX_READ_CLIENTS dropped)."""
+        with self._lock:
+            bucket = buckets.get(client)
+            if bucket is None:
+                bucket = buckets[client] = TokenBucket(rate_hz, burst, clock=self._clock)
+                if len(buckets) > self.MAX_READ_CLIENTS:
+                    buckets.popitem(last=False)
+            else:
+                buckets.move_to_end(client)
+            return bucket
 
     def rate_limited(self, bearing_id: str) -> int:
         """Setpoints of this twin refused by the rate limit so far."""

@@ -1,5 +1,5 @@
-"""The stepping threads before everything else: the service's other threads run at a lower
-scheduling priority (Linux thread nice values).
+"""The stepping threads before everything else: they run at a higher scheduling priority than the
+service's other threads and the host's other processes (Linux thread nice values).
 
 Why. Real time is the stepping threads' job (service.core.pool). On a small host the other
 threads of the process (uvicorn's event loop answering a flood of requests, zenoh's runtime, the
@@ -15,14 +15,29 @@ I/O. Here that is the nice value, which Linux keeps per thread:
   or CAP_SYS_NICE, e.g. systemd's `AmbientCapabilities=CAP_SYS_NICE`); elsewhere they keep the
   process's nice and `/health` says so. An attacker on the same host (the `attack` tool's own
   processes) or any other busy process then cannot take their core;
-- the HTTP event loop keeps the process's nice (`keep_thread`: /health answers in time);
-- every other thread of the process (zenoh's runtime and callbacks, the recorder, the OPC UA
-  server, the HTTP worker threads) gets nice +`io_thread_nice` (10: weight 110). Raising one's own
-  nice needs no privilege. New threads appear all the time (a twin's zenoh publisher, a
-  recording's writer, asyncio's executor), so a sweep every `sweep_s` renices the ones it has not
-  seen yet. A thread inherits the nice of the thread that creates it, and an unprivileged process
-  cannot lower a nice value again, so the stepping pool is started before the first sweep
+- every other thread of the process (the HTTP event loop, zenoh's runtime and callbacks, the
+  recorder, the OPC UA server, the HTTP worker threads) gets nice `io_thread_nice` (-5: between
+  the stepping threads and the host's other processes; CFS weight 3121), and the HTTP event loop
+  is kept at the lower (higher-priority) of that and the process's nice (`keep_thread`). New
+  threads appear all the time (a twin's zenoh publisher, a recording's writer, asyncio's
+  executor), so a sweep every `sweep_s` renices the ones it has not seen yet. A thread inherits
+  the nice of the thread that creates it, so the stepping pool is started before the first sweep
   (TwinRegistry.open).
+
+Why the I/O threads are above the load and not below it (io_thread_nice was 10 until
+2026-11-23). The stepping threads need the GIL for the Python between frames, and whoever holds
+the GIL when they ask is an I/O thread (the event loop, a zenoh callback, the zenoh publisher).
+A thread at nice 10 beside processes at nice 0 (an attacker on the same host, like the `attack`
+tool's own processes, or any busy process) gets a tenth of their CPU share: preempted while
+holding the GIL, it keeps every stepping thread waiting for as long as the kernel leaves it off
+the CPU (priority inversion; the GIL has no priority inheritance). Measured with `attack
+--seconds 30` on the 2-core VM: median real-time factor under the flood 0.78-0.86 at nice 10,
+0.998-1.000 at 0 (quiet host); with other processes busy as well, 0.68-0.81 at 0 and 0.80-0.91
+at -5, /health p99 214-317 ms against 52-89 ms. The I/O work they can do is bounded by the
+per-client budgets and the tarpit (service.api.middleware), so their priority does not let a
+flood take more than the budgets allow; the stepping threads (-10, weight 9548) still come first.
+Raising a priority needs root or CAP_SYS_NICE; without it these threads keep the process's nice
+(counted in `errors`).
 
 Not done: real-time scheduling classes (SCHED_FIFO / SCHED_RR) for the stepping threads. A FIFO
 thread that never sleeps (a twin behind the wall clock steps without pause) would lock every
@@ -73,11 +88,11 @@ def process_threads() -> list[int]:
 
 
 class ThreadPriority:
-    """Stepping threads at `stepping_nice`, kept threads at the process's nice, every other thread
-    of the process at `io_nice` (module docstring).
+    """Stepping threads at `stepping_nice`, kept threads at `kept_nice`, every other thread of the
+    process at `io_nice` (module docstring).
 
     `keep` returns the native ids of the stepping threads and the publish worker; `keep_thread`
-    adds one left at the process's nice (the event loop); `sweep()` renices the threads it has not
+    adds one kept at `kept_nice` (the event loop); `sweep()` renices the threads it has not
     seen (returns how many it changed); `start()` sweeps now and then every `sweep_s` [s] in a
     daemon thread (itself reniced); `close()` stops it."""
 
@@ -100,15 +115,21 @@ class ThreadPriority:
 
     @property
     def active(self) -> bool:
-        return self.supported and (self.io_nice > 0 or self.stepping_nice < BASE_NICE)
+        return self.supported and (self.io_nice != BASE_NICE or self.stepping_nice < BASE_NICE)
+
+    @property
+    def kept_nice(self) -> int:
+        """The nice of a kept thread (the event loop): the process's, or io_nice when that is lower
+        (a higher priority)."""
+        return min(BASE_NICE, self.io_nice)
 
     def keep_thread(self, native_id: int) -> None:
-        """Leave this thread at the process's nice (the HTTP event loop: /health answers in time)."""
+        """Keep this thread at `kept_nice` (the HTTP event loop: /health answers in time)."""
         self._extra.add(native_id)
         self._seen.discard(native_id)
         self._placed.discard(native_id)
         if self.active:
-            self._place(native_id, BASE_NICE)
+            self._place(native_id, self.kept_nice)
 
     def _place(self, tid: int, nice: int) -> None:
         current = thread_nice(tid)
@@ -130,7 +151,7 @@ class ThreadPriority:
             self._place(tid, self.stepping_nice)
         for tid in self._extra - self._placed:
             self._placed.add(tid)
-            self._place(tid, BASE_NICE)
+            self._place(tid, self.kept_nice)
         spared = stepping | self._extra
         for other in list(ThreadPriority._live):     # another service's stepping threads
             if other is not self:
@@ -138,11 +159,11 @@ class ThreadPriority:
         changed = 0
         tids = process_threads()
         for tid in tids:
-            if tid in self._seen or tid in spared or self.io_nice <= 0:
+            if tid in self._seen or tid in spared:
                 continue
             self._seen.add(tid)
             current = thread_nice(tid)
-            if current is None or current >= self.io_nice:
+            if current is None or current == self.io_nice:
                 continue
             try:
                 os.setpriority(os.PRIO_PROCESS, tid, self.io_nice)

@@ -72,7 +72,8 @@ def admission_gate(settings: ServiceSettings) -> AdmissionGate:
     return AdmissionGate(token=settings.token_value, setpoint_rate_hz=settings.setpoint_rate_hz or None,
                          setpoint_burst=settings.setpoint_burst, max_payload_bytes=settings.max_body_bytes,
                          bus_writes=bus_writes, read_rate_hz=settings.read_rate_hz or None,
-                         read_burst=settings.read_burst)
+                         read_burst=settings.read_burst, error_rate_hz=settings.client_error_rate_hz or None,
+                         error_burst=settings.client_error_burst)
 
 
 class Channel(SnapshotSink, Protocol):

@@ -17,6 +17,8 @@ flood's client work does not show up as the service's latency in another's figur
 * optionally (`--zenoh-connect`, or `--start`) a zenoh setpoint flood at `zenoh_rate` per second
   (valid and invalid payloads), counting one result per setpoint (an unanswered one is reported)
   and checking every state message for non-finite numbers;
+* each flood process measures its own CPU time (`attacker_cpu_cores`: on a shared host the
+  attackers' CPU is taken from the twin too);
 * in this process, a /health probe every 50 ms: its latency (p50, p99, max) and the default
   twin's real-time factor; the flood's figures use the probes from 1 s after the flood started
   (the real-time factor is measured over the last second). The same probe runs for `baseline_s`
@@ -79,15 +81,35 @@ def _percentile(values: list[float], q: float) -> float | None:
 
 
 # ---- the HTTP floods (child processes) ---------------------------------------------------------
-def _hostile_request(rng: random.Random, bid: str, token: str | None, valid: dict) -> tuple[str, str, str, bytes | None, dict, bool | None]:
-    """(kind, method, path, body, headers, valid?) of one flood request: valid True = a valid
-    setpoint (200 or 429 expected), False = hostile (4xx expected), None = a read (200 or 4xx)."""
+_KINDS = ("valid", "valid", "nan", "inf", "range", "type", "unknown-field", "garbage", "malformed", "big",
+          "no-token", "wrong-token", "unknown-twin", "unknown-path", "bad-method", "create-invalid",
+          "delete-unknown", "state", "state", "bearings")
+
+
+class _Deck:
+    """The kinds of hostile request, dealt from shuffled decks of `_KINDS`: the mix's proportions,
+    and every kind in each run of len(_KINDS) requests (a short or slowed-down flood still sends
+    them all)."""
+
+    def __init__(self, rng: random.Random):
+        self.rng, self.cards = rng, []
+
+    def deal(self) -> str:
+        if not self.cards:
+            self.cards = list(_KINDS)
+            self.rng.shuffle(self.cards)
+        return self.cards.pop()
+
+
+def _hostile_request(rng: random.Random, bid: str, token: str | None, valid: dict,
+                     kind: str | None = None) -> tuple[str, str, str, bytes | None, dict, bool | None]:
+    """(kind, method, path, body, headers, valid?) of one flood request (`kind`: one of `_KINDS`,
+    default a random one): valid True = a valid setpoint (200 or 429 expected), False = hostile
+    (4xx expected), None = a read (200 or 4xx)."""
     auth = {"Authorization": f"Bearer {token}"} if token else {}
     js = {"content-type": "application/json"}
     sp = f"/v1/bearings/{bid}/setpoint"
-    kind = rng.choice(["valid", "valid", "nan", "inf", "range", "type", "unknown-field", "garbage",
-                       "malformed", "big", "no-token", "wrong-token", "unknown-twin", "unknown-path",
-                       "bad-method", "create-invalid", "delete-unknown", "state", "state", "bearings"])
+    kind = kind or rng.choice(_KINDS)
     if kind == "valid":
         return kind, "PUT", sp, json.dumps(valid).encode(), {**auth, **js}, True
     bodies = {"nan": b'{"shaft_speed_rad_s": NaN}', "inf": b'{"radial_load_n": Infinity}',
@@ -135,6 +157,7 @@ async def _http_flood_async(spec: dict, go) -> dict:
     mode, url, bid, token = spec["mode"], spec["url"], spec["bearing_id"], spec["token"]
     workers = spec["workers"]
     rng = random.Random(spec["seed"])
+    deck = _Deck(rng)
     ranges = spec["ranges"]
     status: collections.Counter = collections.Counter()
     kinds: collections.Counter = collections.Counter()
@@ -143,7 +166,7 @@ async def _http_flood_async(spec: dict, go) -> dict:
     limits = httpx.Limits(max_connections=workers, max_keepalive_connections=workers)
     async with httpx.AsyncClient(base_url=url, timeout=30.0, limits=limits) as client:
         await asyncio.get_running_loop().run_in_executor(None, go.wait, 120.0)
-        t0 = time.monotonic()
+        t0, cpu0 = time.monotonic(), time.process_time()
         end = t0 + spec["seconds"]
 
         async def worker() -> None:
@@ -154,7 +177,8 @@ async def _http_flood_async(spec: dict, go) -> dict:
                 else:
                     setpoint = {n: round(rng.uniform(lo, hi), 3) for n, (lo, hi) in ranges.items()
                                 if rng.random() < 0.6} or {"oil_temperature_c": 40.0}
-                    kind, method, path, body, headers, valid = _hostile_request(rng, bid, token, setpoint)
+                    kind, method, path, body, headers, valid = _hostile_request(rng, bid, token, setpoint,
+                                                                                deck.deal())
                 kinds[kind] += 1
                 try:
                     r = await client.request(method, path, content=body, headers=headers)
@@ -184,8 +208,8 @@ async def _http_flood_async(spec: dict, go) -> dict:
                         counts["non_finite"] += 1
 
         await asyncio.gather(*(worker() for _ in range(workers)))
-        elapsed = time.monotonic() - t0
-    return {"mode": mode, "workers": workers, "seconds": round(elapsed, 2), "status": dict(status),
+        elapsed, cpu = time.monotonic() - t0, time.process_time() - cpu0
+    return {"mode": mode, "workers": workers, "seconds": round(elapsed, 2), "cpu_s": round(cpu, 2), "status": dict(status),
             "kinds": dict(kinds), "counts": dict(counts), "unexpected": unexpected}
 
 
@@ -241,7 +265,7 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
                                         congestion_control=zenoh.CongestionControl.BLOCK)
         time.sleep(0.5)      # routes
         go.wait(120.0)
-        t0 = time.monotonic()
+        t0, cpu0 = time.monotonic(), time.process_time()
         end, period, next_t = t0 + spec["seconds"], 1.0 / spec["rate_hz"], t0
         payloads = [b'{"shaft_speed_rad_s": NaN}', b'{"radial_load_n": -5}', b'{"warp": 1}', b"\xff\xfe",
                     b'{"shaft_speed_rad_s": 400.0, "token": "x"}']
@@ -257,7 +281,7 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
                 time.sleep(delay)
             elif delay < -1.0:
                 next_t = time.monotonic()
-        elapsed = time.monotonic() - t0
+        elapsed, cpu = time.monotonic() - t0, time.process_time() - cpu0
         deadline = time.monotonic() + 5.0         # the last results
         while time.monotonic() < deadline:
             with lock:
@@ -271,7 +295,8 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
         session.close()
     with lock:
         answered = sum(results.values())
-        return {"mode": "zenoh", "seconds": round(elapsed, 2), "sent": sent, "results": dict(results),
+        return {"mode": "zenoh", "seconds": round(elapsed, 2), "cpu_s": round(cpu, 2), "sent": sent,
+                "results": dict(results),
                 "unanswered": max(0, sent - answered), "state_messages": state["messages"],
                 "non_finite": state["non_finite"]}
 
@@ -401,7 +426,8 @@ def run_attack(cfg: AttackConfig) -> dict:
         report["zenoh_flood"] = parts.get("zenoh") if zenoh_endpoint else None
         report["missing_parts"] = [s.get("mode", "zenoh") for _, s in specs if s.get("mode", "zenoh") not in parts]
         health = client.get(f"{url}/health").json()
-        report["service"] = {"status": health.get("status"),
+        report["service"] = {"status": health.get("status"), "http_tarpit": health.get("http_tarpit"),
+                             "thread_priority": health.get("thread_priority"),
                              "twins": [{k: t.get(k) for k in ("id", "real_time_factor", "late_fraction",
                                                               "errors", "restarts", "overruns", "frames")}
                                        for t in health.get("twins", [])]}
@@ -436,6 +462,12 @@ def _totals(report: dict) -> None:
         if part.get("seconds"):
             part["rate_hz"] = round(sum((part.get("status") or {}).values()) / part["seconds"], 1)
     z = report.get("zenoh_flood") or {}
+    cpu = {}
+    for name in ("http_flood", "read_flood", "zenoh_flood"):     # the attackers' own CPU [cores]: taken from the twin too
+        part = report.get(name) or {}
+        if part.get("seconds") and part.get("cpu_s") is not None:
+            cpu[name] = round(part["cpu_s"] / part["seconds"], 3)
+    report["attacker_cpu_cores"] = {**cpu, "total": round(sum(cpu.values()), 3)} if cpu else None
     totals["nan_checked"] += z.get("state_messages", 0)
     totals["non_finite"] += z.get("non_finite", 0)
     report["totals"] = {k: totals.get(k, 0) for k in ("2xx", "4xx", "5xx", "transport_errors", "valid_refused",
@@ -490,6 +522,12 @@ def format_report(r: dict) -> str:
         lines.append(f"  zenoh: {z['sent']} setpoints, results {z['results']}, unanswered {z['unanswered']}")
     lines.append(f"  totals: 2xx {t['2xx']}, 4xx {t['4xx']}, 5xx {t['5xx']}; NaN checks {t['nan_checked']}, "
                  f"non-finite {t['non_finite']}")
+    if r.get("attacker_cpu_cores"):
+        lines.append(f"  attackers' own CPU [cores]: {r['attacker_cpu_cores']}")
+    tarpit = (r.get("service") or {}).get("http_tarpit")
+    if tarpit:
+        lines.append(f"  tarpit: {tarpit.get('held', 0)} refusals held {tarpit.get('delay_s')} s, "
+                     f"{tarpit.get('answered_at_once', 0)} answered at once")
     lines.append(f"  idle:  real-time factor median {b.get('real_time_factor_median')}, /health p50 "
                  f"{b.get('health_p50_ms')} ms, p99 {b.get('health_p99_ms')} ms")
     lines.append(f"  flood: real-time factor median {f.get('real_time_factor_median')} (min "

@@ -11,7 +11,9 @@ from service.tools.attack import AttackConfig, check_loopback, format_report, ru
 
 
 def test_attack_short_run_with_its_own_service():
-    r = run_attack(AttackConfig(seconds=4.0, start=True, baseline_s=1.0, seed=7, zenoh_rate_hz=200.0))
+    # 8 s: the tarpit (on by default in the served process) slows the hostile flood down; it deals its
+    # kinds from shuffled decks of 20, so every kind is sent once it has made 20 requests
+    r = run_attack(AttackConfig(seconds=8.0, start=True, baseline_s=1.0, seed=7, zenoh_rate_hz=200.0))
     print("\n" + format_report(r))
     assert r["ok"], r["failures"]
     t = r["totals"]
@@ -20,6 +22,7 @@ def test_attack_short_run_with_its_own_service():
     hostile, reads, z = r["http_flood"], r["read_flood"], r["zenoh_flood"]
     assert hostile["workers"] == 32 and reads["workers"] == 4
     # the hostile mix was sent and refused as it should be
+    assert sum(hostile["kinds"].values()) >= 20
     assert {"valid", "nan", "big", "no-token", "unknown-twin"} <= set(hostile["kinds"])
     assert {401, 413, 422} <= {int(code) for code in hostile["status"]}
     assert hostile["counts"].get("valid_refused", 0) == 0 and hostile["counts"].get("hostile_accepted", 0) == 0
@@ -33,6 +36,11 @@ def test_attack_short_run_with_its_own_service():
     assert set(r["targets"]) == {"real_time_factor_median_min", "health_p99_ms_max", "real_time_factor_median",
                                  "health_p99_ms", "met"}
     assert r["shutdown"]["clean"]
+    # the attackers' own CPU and the service's tarpit (on by default in a served process) are reported
+    cpu = r["attacker_cpu_cores"]
+    assert set(cpu) == {"http_flood", "read_flood", "zenoh_flood", "total"} and all(v >= 0 for v in cpu.values())
+    tarpit = r["service"]["http_tarpit"]
+    assert tarpit["active"] and tarpit["held_now"] >= 0 and tarpit["max_held"] == 64
 
 
 @pytest.mark.parametrize("url, zenoh", [("http://10.0.0.8:8000", None), ("http://example.org", None),

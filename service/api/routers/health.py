@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from fastapi import APIRouter
+from fastapi import APIRouter, Request
 
 from service.api.deps import RegistryDep
 from service.api.schemas import Health
@@ -12,6 +12,9 @@ router = APIRouter(tags=["service"])
 
 
 @router.get("/health", response_model=Health)
-def health(registry: RegistryDep) -> Health:
+def health(registry: RegistryDep, request: Request) -> Health:
     """Service status, uptime and per-twin real-time factor, overruns and drops."""
-    return Health(**registry.health(), http_slow_closed=closures.headers + closures.body)
+    tarpit = getattr(request.app.state, "tarpit", None)
+    return Health(**registry.health(), http_slow_closed=closures.headers + closures.body,
+                  http_tarpit={**tarpit.record(), "errors_over_budget": registry.gate.errors_over_budget}
+                  if tarpit is not None else None)

@@ -89,6 +89,8 @@ def test_state_and_ball_messages_reach_a_remote_session(bus, client, twin):
     assert ball["schema"] == "bearing-twin/state/1"
     assert ball["bearing_id"] == "t1" and ball["time_s"] == snap.time_s and ball["index"] == 0
     assert ball["inner"] == state["balls"][0]["inner"]
+    # the ball message is the head's three fields and the ball's, nothing else (pydantic-serialised, spliced)
+    assert ball == {"schema": state["schema"], "bearing_id": "t1", "time_s": snap.time_s, **state["balls"][0]}
     assert wait_until(lambda: channel.published >= 1, 5.0) and channel.errors == 0
 
 
@@ -469,10 +471,12 @@ class _Blocker:
         self.entered = threading.Event()
         self.release = threading.Event()
 
-    def to_dict(self):
+    def to_json(self):
         self.entered.set()
         self.release.wait(10.0)
         raise RuntimeError("not a real snapshot")  # must not kill the publisher thread
+
+    to_dict = to_json
 
 
 def test_publish_never_blocks_and_counts_drops(bus, client, twin):

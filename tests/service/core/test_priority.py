@@ -90,15 +90,17 @@ def check_io_nice_zero_changes_nothing():
 
 def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
     """TwinRegistry.open with the default settings: the pool's stepping threads and publish worker
-    at the process's nice, every other thread at `io_thread_nice` (10 by default); /health
-    carries the record."""
+    at `stepping_thread_nice` (-10), every other thread at `io_thread_nice` (-5: above the load,
+    since those threads hold the GIL the stepping threads wait for), both granted to root only;
+    /health carries the record."""
     from service.core.registry import TwinRegistry
     from service.settings import ServiceSettings
 
     now, _ = _now_and_restored()
     io, asked = ServiceSettings().io_thread_nice, ServiceSettings().stepping_thread_nice
-    assert io == 10 and asked == -10 and now < io
+    assert io == -5 and asked == -10 and now == BASE_NICE == 0
     raised = asked if os.geteuid() == 0 else now      # a higher priority needs root / CAP_SYS_NICE
+    io_got = io if os.geteuid() == 0 else now
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
                                stepping_threads=2)
     reg = TwinRegistry(settings).open()
@@ -107,16 +109,38 @@ def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
         assert len(stepping) == 3                                    # 2 stepping + the publish worker
         for tid in stepping:
             assert thread_nice(tid) == raised
-        assert thread_nice(threading.get_native_id()) == io
+        assert thread_nice(threading.get_native_id()) == io_got
         others = [t for t in process_threads() if t not in stepping]
-        assert others and all(thread_nice(t) >= io for t in others if thread_nice(t) is not None)
-        # the event loop's thread (here this one) is given back the process's nice
-        reg.priority.keep_thread(threading.get_native_id())
-        assert thread_nice(threading.get_native_id()) == (now if os.geteuid() == 0 else io)
+        assert others and all(thread_nice(t) == io_got for t in others if thread_nice(t) is not None)
+        reg.priority.keep_thread(threading.get_native_id())          # the event loop's thread
+        assert reg.priority.kept_nice == io and thread_nice(threading.get_native_id()) == io_got
         health = reg.health()["thread_priority"]
         assert health["active"] and health["io_thread_nice"] == io and health["stepping_thread_nice_asked"] == asked
         assert health["stepping_thread_nice"] == [raised]
         assert health["stepping_priority_refused"] == (0 if os.geteuid() == 0 else len(stepping))
+    finally:
+        reg.close()
+
+
+def check_a_negative_io_nice_raises_the_io_threads_and_the_event_loop_with_them():
+    """io_thread_nice -5 (root): every thread but the stepping ones at -5, the kept thread (the
+    event loop) too (kept_nice = min(process nice, io_nice)); unprivileged: refused and counted."""
+    from service.core.registry import TwinRegistry
+    from service.settings import ServiceSettings
+
+    reg = TwinRegistry(ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
+                                       stepping_threads=1, io_thread_nice=-5)).open()
+    try:
+        stepping = reg.pool.native_ids()
+        reg.priority.keep_thread(threading.get_native_id())
+        assert reg.priority.kept_nice == -5
+        others = [t for t in process_threads() if t not in stepping]
+        if os.geteuid() == 0:
+            assert all(thread_nice(t) == -5 for t in others if thread_nice(t) is not None)
+            assert all(thread_nice(t) == -10 for t in stepping)
+            assert reg.priority.errors == 0
+        else:
+            assert reg.priority.errors > 0
     finally:
         reg.close()
 
@@ -164,6 +188,10 @@ def test_io_nice_zero_changes_nothing():
 
 def test_a_service_keeps_its_stepping_threads_above_its_other_threads():
     _run("check_a_service_keeps_its_stepping_threads_above_its_other_threads")
+
+
+def test_a_negative_io_nice_raises_the_io_threads_and_the_event_loop_with_them():
+    _run("check_a_negative_io_nice_raises_the_io_threads_and_the_event_loop_with_them")
 
 
 def test_an_open_service_freezes_its_start_up_heap():
