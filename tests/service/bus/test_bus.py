@@ -463,11 +463,15 @@ def test_monitor_command_registers_with_argparse():
 
 # ---- (f) publish never blocks ----------------------------------------------------------------
 class _Blocker:
-    """A 'snapshot' whose serialisation blocks the publisher thread until released."""
+    """A 'snapshot' whose state message goes out (`publish` puts it on the caller's thread) and
+    whose ball messages block the publisher thread until released."""
 
     def __init__(self):
         self.entered = threading.Event()
         self.release = threading.Event()
+
+    def to_json(self):
+        return "{}"
 
     def to_dict(self):
         self.entered.set()
@@ -488,11 +492,11 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin):
         worst = max(worst, time.perf_counter() - t)
     assert channel.dropped == 200 - 8
     assert worst < 0.05
-    channel.publish(object())  # garbage is accepted without raising
-    assert channel.dropped == 200 - 8 + 1
+    channel.publish(object())  # garbage is refused without raising: counted, not queued
+    assert channel.dropped == 200 - 8 and channel.errors == 1
     blocker.release.set()
-    # the thread survives the failures and drains the queue
-    assert wait_until(lambda: channel.published == 7 and channel.errors == 2, 5.0), \
+    # the thread survives the failure and drains the queue
+    assert wait_until(lambda: channel.published == 8 and channel.errors == 2, 5.0), \
         (channel.published, channel.errors)
     client.subscribe("bearing/t1/state")
     client.wait_for(lambda item: True, poke=lambda: channel.publish(snap))
