@@ -75,6 +75,7 @@ class Twin:
         """Allowed [low, high] of each setpoint field for this bearing (twin.setpoint)."""
         self.seq = 0
         self.restarts = 0
+        self.frame_interrupted = False   # the last advance ended early (interrupt_frame)
         self.fault: Fault | None = None   # the last fault (None: none since start or the last new setpoint)
         self.halted = False
         self._last_restart_time_s = -math.inf
@@ -303,6 +304,8 @@ class Twin:
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
         status, done = step_n(*self._kernel_args(), n)
+        if done < n and status == L.STATUS_OK:    # interrupted (interrupt_frame): n - done not run
+            self._since_coupling_s -= (n - done) * self.model.dt_s
         if self._sensor is not None:
             self._sensor.after_frame(s, done, float(s.scalars[L.X_SHAFT_SPEED]))
             if status != L.STATUS_OK:
@@ -350,12 +353,29 @@ class Twin:
         if frame_steps is None:
             frame_steps = max(1, int(round(FRAME_S / self.model.dt_s)))
         first = self.restarts
+        self.frame_interrupted = False
         while remaining > 0:
             n = min(frame_steps, remaining)
             remaining -= max(self._frame(n), 1)  # a failing frame still consumes a step: no hang
             if max_restarts is not None and self.restarts - first >= max_restarts:
                 return max(remaining, 0)
+            if remaining > 0 and self._setpoint_vector[L.S_STOP] != 0.0:
+                self.frame_interrupted = True    # interrupt_frame: the caller has input waiting
+                return remaining
         return 0
+
+    def interrupt_frame(self) -> None:
+        """Ask the frame in progress to end at its next step boundary (after at least one step;
+        any thread, without waiting): `advance` then returns the steps left undone with
+        `frame_interrupted` set. A real-time runner asks it when a setpoint arrives mid-frame,
+        so the setpoint applies within a step instead of at the end of a 5 ms frame. Stays
+        asked (every later frame ends after one step) until `clear_frame_interrupt`."""
+        self._setpoint_vector[L.S_STOP] = 1.0
+
+    def clear_frame_interrupt(self) -> None:
+        """Withdraw `interrupt_frame` (call it BEFORE taking the input the interrupt was for, so
+        that an input arriving after the take still interrupts the next frame)."""
+        self._setpoint_vector[L.S_STOP] = 0.0
 
     @property
     def time_s(self) -> float:

@@ -277,8 +277,10 @@ class TwinChannel:
         self._last_window_end_s: float | None = None
         self.waveform_chunks = 0    # waveform chunks put on the bus
         self._pub_lock = threading.Lock()
+        # express: the state message is sent at once, not held for a batch with other messages
         self._state_pub = session.declare_publisher(
-            f"{self.prefix}/state", encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP)
+            f"{self.prefix}/state", encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP,
+            express=True)
         self._result_pub = session.declare_publisher(
             f"{self.prefix}/setpoint/result", encoding=_JSON,
             congestion_control=zenoh.CongestionControl.DROP)

@@ -504,6 +504,30 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin):
     channel.publish(snap)  # after detach: a no-op, no exception
 
 
+def test_the_state_message_goes_out_on_the_callers_thread(bus, client, twin):
+    """TwinChannel.publish puts the state message itself (the publish worker's thread), so it
+    reaches a subscriber while the channel's own thread is held (here inside a snapshot's ball
+    messages): no wait for that thread's wake-up between a snapshot and its state message."""
+    snap = twin.snapshot()
+    channel = bus.attach_twin("t1", lambda: snap, lambda p: {})
+    client.subscribe("bearing/t1/state")
+    blocker = _Blocker()
+    channel.publish(blocker)
+    assert blocker.entered.wait(5.0)        # the channel thread is held from now on
+    try:
+        got = []
+
+        def state(item):
+            got.append(loads(item[2]))
+            return got[-1].get("seq") == snap.seq
+
+        client.wait_for(state, poke=lambda: channel.publish(snap))
+        assert got[-1] == json.loads(snap.to_json())
+        assert not blocker.release.is_set() and channel.published == 0
+    finally:
+        blocker.release.set()
+
+
 def test_publish_burst_is_cheap_and_close_is_prompt(bus, twin):
     snaps = [twin.snapshot() for _ in range(5)]
     channel = bus.attach_twin("t1", lambda: snaps[-1], lambda p: {}, queue_size=64)
