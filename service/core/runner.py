@@ -300,8 +300,8 @@ class TwinRunner:
     def request_stop(self) -> None:
         """Ask the runner to stop at the end of its frame (does not wait; a real-time frame in
         progress ends at its next step)."""
+        self._interrupt()        # before the stop flag: `left_pool` withdraws it after
         self._stop.set()
-        self._interrupt()
         self._wake()
 
     def stop(self, timeout: float = 5.0) -> bool:
@@ -325,8 +325,10 @@ class TwinRunner:
 
     def _interrupt(self) -> None:
         """An outside input waits (real time): end the frame in progress at its next step
-        (Twin.interrupt_frame); withdrawn by `step` before it takes the mailbox."""
-        if not self.fast:
+        (Twin.interrupt_frame); withdrawn by `step` before it takes the mailbox and when the
+        twin leaves the pool. Only while the runner runs: a twin stepped by anyone else (the
+        calibration before the start, a caller after the stop) is never cut."""
+        if not self.fast and self._job is not None and not self._done.is_set():
             self.twin.interrupt_frame()
 
     # ---- mailbox -------------------------------------------------------------------------------
@@ -437,6 +439,7 @@ class TwinRunner:
 
     def left_pool(self) -> None:
         """The pool let the twin go: done once its last capture is delivered."""
+        self.twin.clear_frame_interrupt()
         self.publisher.after_pending(self._done.set)
 
     def _on_error(self, exc: BaseException, consecutive: int) -> None:
