@@ -420,15 +420,13 @@ class TwinChannel:
     def _send(self, snapshot: Snapshot) -> None:
         """The ball and vibration messages of a snapshot whose state `publish` has put."""
         data = snapshot.to_dict()
-        balls = data.get("balls") or []
-        head = {"schema": data.get("schema"), "bearing_id": data.get("bearing_id", self.bearing_id),
-                "time_s": data.get("time_s")}
-        for position, ball in enumerate(balls):
-            index = ball.get("index", position)
-            pub = self._ball_publisher(int(index))
+        head = _dumps({"schema": data.get("schema"), "bearing_id": data.get("bearing_id", self.bearing_id),
+                       "time_s": data.get("time_s")})[:-1]
+        for ball in snapshot.balls:      # the head's fields, then the ball's, as one JSON object
+            pub = self._ball_publisher(int(ball.index))
             if pub is None:
                 return  # detaching
-            pub.put(_dumps({**head, **ball}))
+            pub.put(head + "," + ball.model_dump_json(by_alias=True)[1:])
         self._send_vibration(snapshot, data)
 
     def _send_vibration(self, snapshot: Snapshot, data: dict) -> None:

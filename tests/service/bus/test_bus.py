@@ -89,6 +89,7 @@ def test_state_and_ball_messages_reach_a_remote_session(bus, client, twin):
     assert ball["schema"] == "bearing-twin/state/1"
     assert ball["bearing_id"] == "t1" and ball["time_s"] == snap.time_s and ball["index"] == 0
     assert ball["inner"] == state["balls"][0]["inner"]
+    assert ball == {"schema": state["schema"], "bearing_id": "t1", "time_s": snap.time_s, **state["balls"][0]}
     assert wait_until(lambda: channel.published >= 1, 5.0) and channel.errors == 0
 
 
