@@ -402,3 +402,21 @@ def test_a_setpoint_ends_the_frame_in_progress(twin, make_runner):
     assert snap.time_s < t_init + runner.frame_s        # within the first long frame
     assert runner.stop(timeout=10.0)                     # stop interrupts the frame as well
     assert runner.sim_elapsed_s == pytest.approx(twin.time_s - t_init, abs=0.5 * dt)
+
+
+def test_a_setpoint_is_published_at_the_end_of_the_frame_that_applied_it(twin, make_runner):
+    """No 50 Hz tick involved (one tick every 1000 s here): the state carrying a setpoint is
+    published because its frame applied it, once, right after that frame (counted in
+    publications and in steps of simulated time, not in wall time)."""
+    sink = ListSink()
+    runner = make_runner(twin, publish_rate_hz=0.001, frame_s=0.005, setpoint_frame_s=0.001,
+                         sinks=[sink]).start()
+    assert wait_until(lambda: runner.frames >= 5)
+    assert runner.published == 1                       # the initial snapshot only
+    runner.submit(radial_load_n=4321.0)
+    snap = sink.wait_for(lambda s: s.setpoint.radial_load_n == 4321.0)
+    assert snap is not None and snap.seq == sink.snapshots[0].seq + 1
+    assert wait_until(lambda: runner.frames >= 20)
+    assert runner.published == 2                       # no other publication since
+    (timing,) = runner.setpoint_latencies()
+    assert timing.seq == snap.seq and timing.published_wall_s >= timing.applied_wall_s
