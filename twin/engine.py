@@ -75,6 +75,7 @@ class Twin:
         """Allowed [low, high] of each setpoint field for this bearing (twin.setpoint)."""
         self.seq = 0
         self.restarts = 0
+        self.frame_interrupted = False   # the last advance ended early (interrupt_frame)
         self.fault: Fault | None = None   # the last fault (None: none since start or the last new setpoint)
         self.halted = False
         self._last_restart_time_s = -math.inf
@@ -303,6 +304,8 @@ class Twin:
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
         status, done = step_n(*self._kernel_args(), n)
+        if done < n and status == L.STATUS_OK:    # interrupted (interrupt_frame): n - done not run
+            self._since_coupling_s -= (n - done) * self.model.dt_s
         if self._sensor is not None:
             self._sensor.after_frame(s, done, float(s.scalars[L.X_SHAFT_SPEED]))
             if status != L.STATUS_OK:
@@ -350,12 +353,29 @@ class Twin:
         if frame_steps is None:
             frame_steps = max(1, int(round(FRAME_S / self.model.dt_s)))
         first = self.restarts
+        self.frame_interrupted = False
         while remaining > 0:
             n = min(frame_steps, remaining)
             remaining -= max(self._frame(n), 1)  # a failing frame still consumes a step: no hang
             if max_restarts is not None and self.restarts - first >= max_restarts:
                 return max(remaining, 0)
+            if remaining > 0 and self._setpoint_vector[L.S_STOP] != 0.0:
+                self.frame_interrupted = True    # interrupt_frame: the caller has input waiting
+                return remaining
         return 0
+
+    def interrupt_frame(self) -> None:
+        """Ask the frame in progress to end at its next step boundary (after at least one step;
+        any thread, without waiting): `advance` then returns the steps left undone with
+        `frame_interrupted` set. A real-time runner asks it when a setpoint arrives mid-frame,
+        so the setpoint applies within a step instead of at the end of a 5 ms frame. Stays
+        asked (every later frame ends after one step) until `clear_frame_interrupt`."""
+        self._setpoint_vector[L.S_STOP] = 1.0
+
+    def clear_frame_interrupt(self) -> None:
+        """Withdraw `interrupt_frame` (call it BEFORE taking the input the interrupt was for, so
+        that an input arriving after the take still interrupts the next frame)."""
+        self._setpoint_vector[L.S_STOP] = 0.0
 
     @property
     def time_s(self) -> float:
@@ -437,8 +457,16 @@ class Twin:
         x = self.state.ball_position_in_bearing_m
         return np.arctan2(x[:, 1], x[:, 0])
 
-    def _contact(self, j: int, r: int, net) -> ContactState:
-        c = self.state.contacts[:, 2 * j + r]
+    def _contact(self, j: int, r: int, net, columns: list | None = None,
+                 resistance: list | None = None, capacitance: list | None = None) -> ContactState:
+        """Contact r (0 inner, 1 outer) of ball j. `columns` (the contact lanes as lists of floats,
+        `contacts.T.tolist()`), `resistance` and `capacitance` (the network's per-contact values as
+        lists): the same values read once for the whole snapshot instead of element by element
+        from the arrays (a third of the snapshot's time)."""
+        k = 2 * j + r
+        c = self.state.contacts[:, k] if columns is None else columns[k]
+        resistance = net.contact_resistance_ohm if resistance is None else resistance
+        capacitance = net.contact_capacitance_f if capacitance is None else capacitance
         loaded = c[L.C_LOAD] > 0.0
         regime = REGIME_NAMES[int(c[L.C_REGIME])] if loaded else "no_contact"
         return ContactState(
@@ -451,11 +479,11 @@ class Twin:
             slide_roll_ratio=float(c[L.C_SRR]) if loaded else 0.0,
             contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.G_NZ])))) if loaded else 0.0,
             max_pressure_pa=float(max_pressure_pa(c[L.C_LOAD], c[L.C_SEMI_MAJOR], c[L.C_SEMI_MINOR])),
-            resistance_ohm=_finite_or_none(net.contact_resistance_ohm[2 * j + r]),
-            capacitance_f=float(net.contact_capacitance_f[2 * j + r]),
+            resistance_ohm=_finite_or_none(resistance[k]),
+            capacitance_f=float(capacitance[k]),
         )
 
-    def _contact_mu(self, c: np.ndarray) -> float:
+    def _contact_mu(self, c) -> float:
         """Published mu of one contact's lane column: with the ellipse friction the effective
         coefficient |F_t| / Q (the tangential spring's elastic force, which the strips transmit,
         over the normal load); with the centre-point laws their Coulomb coefficient."""
@@ -478,11 +506,16 @@ class Twin:
         orbital = (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]) / rho2
         spin = np.linalg.norm(w, axis=1)
         net = self.electrical()
+        columns = s.contacts.T.tolist()
+        resistance = np.asarray(net.contact_resistance_ohm, dtype=float).tolist()
+        capacitance = np.asarray(net.contact_capacitance_f, dtype=float).tolist()
+        az, spin, orbital = az.tolist(), spin.tolist(), orbital.tolist()
+        cage = s.cage_load_n.max(axis=1).tolist()
         balls = tuple(
-            BallState(index=j, azimuth_rad=float(az[j]), spin_rad_s=float(spin[j]),
-                      orbital_speed_rad_s=float(orbital[j]),
-                      cage_load_n=float(s.cage_load_n[j].max()),
-                      inner=self._contact(j, 0, net), outer=self._contact(j, 1, net),
+            BallState(index=j, azimuth_rad=az[j], spin_rad_s=spin[j], orbital_speed_rad_s=orbital[j],
+                      cage_load_n=cage[j],
+                      inner=self._contact(j, 0, net, columns, resistance, capacitance),
+                      outer=self._contact(j, 1, net, columns, resistance, capacitance),
                       resistance_ohm=_finite_or_none(net.ball_resistance_ohm[j]),
                       capacitance_f=float(net.ball_capacitance_f[j]))
             for j in range(self.model.ball_count))

@@ -197,6 +197,8 @@ class ThreadPriorityHealth(BaseModel):
     threads_reniced: int = Field(description="Threads given io_thread_nice since the start [-].")
     errors: int = Field(description="io_thread_nice changes the system refused [-].")
     stepping_priority_refused: int = Field(description="Raises of a stepping thread's priority refused (no root or CAP_SYS_NICE) [-].")
+    egress_threads: list[int] = Field(default_factory=list, description="Nice values found on zenoh's transmit threads, kept at the lower of io_thread_nice and the process's nice like the event loop (they send the state messages) [-]; empty without a zenoh link.")
+    egress_priority_refused: int = Field(default=0, description="Transmit threads that could not be brought to that nice (no root or CAP_SYS_NICE) [-].")
 
 
 class Health(BaseModel):

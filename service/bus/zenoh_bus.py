@@ -43,10 +43,16 @@ answers (two processes claiming the same id at once: neither, or only one, keeps
 Threads. zenoh runs its callbacks on its own threads; ours only hand work off (append to a
 Python queue) and return. Each channel owns two daemon threads:
 
-* the publisher thread serialises queued snapshots and puts them (state + one message per
-  ball). `TwinChannel.publish` only appends to a bounded deque (drop-oldest, counted in
-  `dropped`), so the runner (physics) never waits on the network. There is NO rate limiter
-  here: the runner decides how often it calls `publish` (e.g. 50 Hz); every call is published.
+* `TwinChannel.publish` puts the STATE message itself, on the caller's thread (the runner's
+  publish worker, service.core.publishing): the snapshot's contract JSON (`Snapshot.to_json`,
+  pydantic's serialiser, ~0.06 ms for a 9-ball twin) and one `put` on a publisher with
+  congestion control DROP, which never waits on the network (a full transmission queue drops
+  the message). Handing it to a thread of ours first cost a wake-up of a thread at the I/O
+  priority (service.core.priority) and a slower serialisation there: 1.4 ms at the median and
+  up to 12 ms of the PUT -> zenoh state latency. Then it appends the snapshot to a bounded deque
+  (drop-oldest, counted in `dropped`) for the publisher thread, which puts the rest (one message
+  per ball, the vibration window). There is NO rate limiter here: the runner decides how often
+  it calls `publish` (e.g. 50 Hz); every call is published.
 * the control thread answers setpoints (calls `on_setpoint(payload)`, publishes the result)
   and snapshot queries (calls `get_snapshot()`, replies on the concrete key). Every exception
   from the callee is caught and reported as a refusal; nothing kills the thread.
@@ -271,8 +277,10 @@ class TwinChannel:
         self._last_window_end_s: float | None = None
         self.waveform_chunks = 0    # waveform chunks put on the bus
         self._pub_lock = threading.Lock()
+        # express: the state message is sent at once, not held for a batch with other messages
         self._state_pub = session.declare_publisher(
-            f"{self.prefix}/state", encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP)
+            f"{self.prefix}/state", encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP,
+            express=True)
         self._result_pub = session.declare_publisher(
             f"{self.prefix}/setpoint/result", encoding=_JSON,
             congestion_control=zenoh.CongestionControl.DROP)
@@ -304,10 +312,30 @@ class TwinChannel:
         return self._closed
 
     def publish(self, snapshot: Snapshot) -> None:
-        """Queue a snapshot for publication; returns at once, never raises.
+        """Put the snapshot's state message now and queue the rest (balls, vibration) for the
+        publisher thread; never waits on the network or on that thread, never raises. A
+        snapshot that cannot be serialised is counted in `errors` and not queued.
 
         No rate limiting: the caller (runner) decides the publish rate."""
+        try:
+            self._send_state(snapshot)
+        except Exception as exc:  # noqa: BLE001 - a sink never raises into the physics
+            self.errors += 1
+            if self.errors <= 3 or self.errors % 1000 == 0:
+                log.warning("%s: state not published (%d so far): %s", self.prefix, self.errors, _one_line(exc))
+            return
         self._enqueue(snapshot)
+
+    def _send_state(self, snapshot: Snapshot) -> None:
+        """The state message, serialised once (kept for the snapshot queryable) and put."""
+        with self._pub_lock:
+            if self._publishers_gone or self._stopping:
+                return
+            pub = self._state_pub
+        state_json = snapshot.to_json()
+        with self._last_lock:
+            self._last = (snapshot, state_json)
+        pub.put(state_json)
 
     def _enqueue(self, item) -> None:
         """Append to the publish queue (the oldest item drops out when full, counted); never raises."""
@@ -390,15 +418,10 @@ class TwinChannel:
                                 self.prefix, self.errors, _one_line(exc))
 
     def _send(self, snapshot: Snapshot) -> None:
-        """The state, one message per ball and (when new) the vibration window. The JSON comes from
-        pydantic's serialiser (`Snapshot.to_json`, the same text as `_dumps(snapshot.to_dict())`:
-        a Snapshot never holds NaN/Infinity, its models refuse them): about 0.17 ms for a 9-ball
-        twin against 1.0 ms through json.dumps, which holds the GIL throughout, the stepping
+        """The ball and vibration messages of a snapshot whose state `publish` has put. The JSON
+        comes from pydantic's serialiser (a Snapshot never holds NaN/Infinity, its models refuse
+        them): json.dumps of the merged dicts held the GIL about five times longer, the stepping
         threads waiting (service.core.priority)."""
-        state_json = snapshot.to_json()
-        with self._last_lock:
-            self._last = (snapshot, state_json)
-        self._state_pub.put(state_json)
         # each ball's message is the head's fields then the ball's: {"schema":..,"bearing_id":..,"time_s":..,<ball>}
         head = _dumps({"schema": snapshot.schema_, "bearing_id": snapshot.bearing_id or self.bearing_id,
                        "time_s": snapshot.time_s})[:-1] + ","
@@ -597,7 +620,7 @@ class TwinChannel:
                 return
             with self._last_lock:
                 last = self._last
-            text = last[1] if last is not None and last[0] is snapshot else _dumps(snapshot.to_dict())
+            text = last[1] if last is not None and last[0] is snapshot else snapshot.to_json()
             query.reply(f"{self.prefix}/snapshot", text, encoding=_JSON)  # concrete key
             self.queries_answered += 1
         except Exception as exc:  # noqa: BLE001

@@ -53,6 +53,7 @@ class FaultPolicy:
         self.limits = limits
         self.safe_after_frames = max(1, int(safe_after_frames))
         self.max_restarts_per_frame = max(1, int(max_restarts_per_frame))
+        self.steps_left = 0      # steps of the last frame not run: it was interrupted (Twin.interrupt_frame)
         self._safe: collections.deque[Setpoint] = collections.deque([initial], maxlen=8)
         self._held_setpoint = initial
         self._held_frames = 0
@@ -70,7 +71,10 @@ class FaultPolicy:
         """One frame of physics; on a setpoint the twin cannot hold, fall back (`on_fallback(safe)`
         is called before the twin goes on at the safe setpoint) and return what happened."""
         before = twin.restarts
+        self.steps_left = 0
         left = twin.advance(frame_s, frame_steps=frame_steps, max_restarts=self.max_restarts_per_frame) or 0
+        if getattr(twin, "frame_interrupted", False):   # ended early for waiting input: not a fault
+            self.steps_left, left = left, 0
         if twin.restarts == before:
             self._restart_streak = 0
             self._held(twin.setpoint)
@@ -81,7 +85,9 @@ class FaultPolicy:
             return None
         fallback = self._fall_back(twin, on_fallback)
         if left > 0:   # the rest of the frame at the safe setpoint (bounded as well)
-            twin.advance(left * twin.model.dt_s, frame_steps=frame_steps, max_restarts=1)
+            rest = twin.advance(left * twin.model.dt_s, frame_steps=frame_steps, max_restarts=1) or 0
+            if getattr(twin, "frame_interrupted", False):
+                self.steps_left = rest
         return fallback
 
     def _held(self, sp: Setpoint) -> None:

@@ -22,8 +22,11 @@ Late fraction: late frames / frames over a sliding window of wall time (`late_wi
 
 Publishing (choice): in real-time mode every 1/publish_rate_hz of WALL time (what a viewer or a
 zenoh subscriber sees stays steady even if the twin falls behind), plus right after a frame that
-applied a new setpoint (at most every `setpoint_publish_min_interval_s`; a closer one waits for
-the next frame after that interval); in fast mode every 1/publish_rate_hz of SIMULATED time (a
+applied a new setpoint (at most one such extra publication every `setpoint_publish_min_interval_s`:
+a closer one waits for the next frame after that interval). The regular ticks do not hold a
+setpoint's publication back: the state carrying a fresh setpoint goes out at the end of the
+frame that applied it even right after a tick (it used to wait one more frame when a tick had
+been published less than the interval before, one setpoint in ten at 50 Hz). In fast mode every 1/publish_rate_hz of SIMULATED time (a
 scenario's samples sit on a regular grid of simulated time however fast the machine is).
 """
 
@@ -66,6 +69,7 @@ class PacingClock:
         self._publish_soon = False
         self.last_publish_wall = -math.inf
         self.last_publish_sim = -math.inf
+        self.last_setpoint_publish_wall = -math.inf   # the last publication asked by publish_soon
 
     @property
     def real_time_factor(self) -> float | None:
@@ -129,7 +133,10 @@ class PacingClock:
             if self._next_publish_wall <= now:
                 self._next_publish_wall = now + self.publish_period_s
             return True
-        return self._publish_soon and now - self.last_publish_wall >= self.setpoint_publish_min_interval_s
+        if self._publish_soon and now - self.last_setpoint_publish_wall >= self.setpoint_publish_min_interval_s:
+            self.last_setpoint_publish_wall = now
+            return True
+        return False
 
     def publish_soon(self) -> None:
         """Publish at the next frame (subject to the minimum interval)."""

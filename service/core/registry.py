@@ -46,7 +46,7 @@ from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import DefectIntake, SetpointIntake
 from service.core.pool import SteppingPool
 from service.core.heap import freeze_heap
-from service.core.priority import ThreadPriority
+from service.core.priority import EGRESS_THREAD_NAMES, ThreadPriority
 from service.core.runner import TwinRunner
 from service.core.sinks import SnapshotSink
 from service.settings import ServiceSettings
@@ -143,7 +143,8 @@ class TwinRegistry:
         self._admitting: dict[str, TwinCost] = {}   # costs of twins admitted, not yet running
         threads = settings.stepping_threads or usable_cores()
         self.pool = SteppingPool(threads, name="step")
-        self.priority = ThreadPriority(self.pool.native_ids, settings.io_thread_nice, settings.stepping_thread_nice)
+        self.priority = ThreadPriority(self.pool.native_ids, settings.io_thread_nice, settings.stepping_thread_nice,
+                                       keep_names=EGRESS_THREAD_NAMES)
         self.capacity = Capacity(threads, settings.capacity_core_fraction,
                                  reserve_cores=settings.capacity_reserve_cores)
         self.last_calibration: TwinCost | None = None

@@ -20,9 +20,11 @@ Frame semantics. A setpoint (from the mailbox or a scenario at scenario time t) 
 the whole frame [t, t + frame_s); a snapshot taken at the end of a frame shows the setpoint that
 was in force during it (so a ramp sampled at t shows the ramp's value at t - frame_s). A
 setpoint that arrives mid-frame applies at the next frame. In real-time mode an outside
-setpoint also releases a twin that waits for its next frame at once, and the frame that applies
-it lasts `setpoint_frame_s` (1 ms, when shorter than `frame_s`), so the state that reflects it
-is published within about a millisecond of simulated time instead of a whole frame.
+setpoint (or defects) also ends the frame in progress at its next step (Twin.interrupt_frame:
+the frame is shorter, the simulated clock counts the steps it ran) and releases a twin that
+waits for its next frame at once, and the frame that applies it lasts `setpoint_frame_s` (1 ms,
+when shorter than `frame_s`), so the state that reflects it is published within about a
+millisecond of simulated time of its arrival instead of up to two frames.
 
 Errors. An exception in the loop is caught, counted (`errors`), logged, shown in the snapshots'
 `status`, and the twin is warm-restarted at the setpoint in force; after
@@ -235,6 +237,7 @@ class TwinRunner:
         naming each field and the bearing's range."""
         update = parse_update(fields if update is None else update, self.limits)
         setpoint = self._offer(update, timed=True)
+        self._interrupt()
         self._wake()
         return setpoint
 
@@ -245,6 +248,7 @@ class TwinRunner:
         Returns the defects that will be in force."""
         items = parse_defects(defects, self.twin.model.spec.geometry)
         items = self.defect_box.offer(items)
+        self._interrupt()
         self._wake()
         return items
 
@@ -294,7 +298,9 @@ class TwinRunner:
         return self
 
     def request_stop(self) -> None:
-        """Ask the runner to stop at the end of its frame (does not wait)."""
+        """Ask the runner to stop at the end of its frame (does not wait; a real-time frame in
+        progress ends at its next step)."""
+        self._interrupt()        # before the stop flag: `left_pool` withdraws it after
         self._stop.set()
         self._wake()
 
@@ -316,6 +322,14 @@ class TwinRunner:
     def _wake(self) -> None:
         if self._pool is not None and self._job is not None:
             self._pool.wake(self._job)
+
+    def _interrupt(self) -> None:
+        """An outside input waits (real time): end the frame in progress at its next step
+        (Twin.interrupt_frame); withdrawn by `step` before it takes the mailbox and when the
+        twin leaves the pool. Only while the runner runs: a twin stepped by anyone else (the
+        calibration before the start, a caller after the stop) is never cut."""
+        if not self.fast and self._job is not None and not self._done.is_set():
+            self.twin.interrupt_frame()
 
     # ---- mailbox -------------------------------------------------------------------------------
     def _offer(self, update: SetpointUpdate, *, timed: bool) -> Setpoint:
@@ -359,11 +373,12 @@ class TwinRunner:
         dt = self.twin.model.dt_s
         c0 = time.thread_time()
         fallback = self.faults.advance_frame(self.twin, steps * dt, steps, on_fallback=self.mailbox.reset)
-        self.engine_cpu.add(time.thread_time() - c0, steps * dt)
+        done = steps - self.faults.steps_left        # fewer when an outside input interrupted it
+        self.engine_cpu.add(time.thread_time() - c0, done * dt)
         if fallback is not None:
             self._on_fallback(fallback)
         self.counters.frames += 1
-        self._sim_steps += steps
+        self._sim_steps += done
 
     def step(self, now: float) -> Schedule | None:
         """One frame (or one idle look at the mailbox); returns when the pool should run the
@@ -371,6 +386,8 @@ class TwinRunner:
         if self._stop.is_set():
             return None
         pacing = self.pacing
+        if not self.fast:
+            self.twin.clear_frame_interrupt()   # before the mailbox: a later input interrupts again
         try:
             if self._reanchor:
                 pacing.reanchor(self.sim_elapsed_s)
@@ -422,6 +439,7 @@ class TwinRunner:
 
     def left_pool(self) -> None:
         """The pool let the twin go: done once its last capture is delivered."""
+        self.twin.clear_frame_interrupt()
         self.publisher.after_pending(self._done.set)
 
     def _on_error(self, exc: BaseException, consecutive: int) -> None:

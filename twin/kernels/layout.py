@@ -64,7 +64,8 @@ S_SHAFT_SPEED = 0     # target [rad/s]
 S_RADIAL_LOAD = 1     # [N], applied on the inner ring along +x
 S_AXIAL_LOAD = 2      # [N], along +z
 S_VISCOSITY = 3       # dynamic viscosity at the oil temperature [Pa s]
-N_SETPOINT = 4
+S_STOP = 4            # nonzero: end the frame at the next step boundary (Twin.interrupt_frame) [-]
+N_SETPOINT = 5
 
 # ---- state scalars ---------------------------------------------------------------------------
 X_TIME = 0

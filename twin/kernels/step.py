@@ -23,7 +23,7 @@ from twin.kernels.layout import (
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
     P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
     P_RING_MASS, P_ROLLING, LANE_BLOCK, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
-    S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
+    S_STOP, S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
 )
@@ -351,7 +351,12 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
     through the anti-aliasing decimator (`taps`, `dec_state`) into the sample ring (`ring`,
     `ring_state`) every step (twin.vibration.signal.sensor_push_direct; the engine adds the sensor
     noise between frames). The orientation of a ball carrying one of the active defects (in the
-    workspace `w`, twin.kernels.layout W_DEFECTS, W_ORIENTATION) is integrated."""
+    workspace `w`, twin.kernels.layout W_DEFECTS, W_ORIENTATION) is integrated.
+
+    A nonzero sp[S_STOP] (written by another thread while this one runs without the GIL:
+    Twin.interrupt_frame) ends the frame at the next step boundary, after at least one step, with
+    status OK and done < n; the closing half kick is the same, so frames of k and n - k steps
+    give the state of one frame of n (the sub-rates count the steps in scal[X_STEP])."""
     z = bx.shape[0]
     dt = p[P_DT]
     half = 0.5 * dt
@@ -369,6 +374,8 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
     bq = orientations(w, z)
     turning = has_ball_defect(defects)
     for it in range(n):
+        if it > 0 and sp[S_STOP] != 0.0:
+            break
         kick = half if it == 0 else dt
         for j in range(z):
             for k in range(3):

@@ -465,18 +465,21 @@ def test_monitor_command_registers_with_argparse():
 
 # ---- (f) publish never blocks ----------------------------------------------------------------
 class _Blocker:
-    """A 'snapshot' whose serialisation blocks the publisher thread until released."""
+    """A 'snapshot' whose state message goes out (`publish` puts it on the caller's thread) and
+    whose ball messages block the publisher thread until released."""
 
     def __init__(self):
         self.entered = threading.Event()
         self.release = threading.Event()
 
     def to_json(self):
+        return "{}"
+
+    @property
+    def schema_(self):        # the first thing the publisher thread reads for the ball messages
         self.entered.set()
         self.release.wait(10.0)
         raise RuntimeError("not a real snapshot")  # must not kill the publisher thread
-
-    to_dict = to_json
 
 
 def test_publish_never_blocks_and_counts_drops(bus, client, twin):
@@ -492,16 +495,40 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin):
         worst = max(worst, time.perf_counter() - t)
     assert channel.dropped == 200 - 8
     assert worst < 0.05
-    channel.publish(object())  # garbage is accepted without raising
-    assert channel.dropped == 200 - 8 + 1
+    channel.publish(object())  # garbage is refused without raising: counted, not queued
+    assert channel.dropped == 200 - 8 and channel.errors == 1
     blocker.release.set()
-    # the thread survives the failures and drains the queue
-    assert wait_until(lambda: channel.published == 7 and channel.errors == 2, 5.0), \
+    # the thread survives the failure and drains the queue
+    assert wait_until(lambda: channel.published == 8 and channel.errors == 2, 5.0), \
         (channel.published, channel.errors)
     client.subscribe("bearing/t1/state")
     client.wait_for(lambda item: True, poke=lambda: channel.publish(snap))
     channel.detach()
     channel.publish(snap)  # after detach: a no-op, no exception
+
+
+def test_the_state_message_goes_out_on_the_callers_thread(bus, client, twin):
+    """TwinChannel.publish puts the state message itself (the publish worker's thread), so it
+    reaches a subscriber while the channel's own thread is held (here inside a snapshot's ball
+    messages): no wait for that thread's wake-up between a snapshot and its state message."""
+    snap = twin.snapshot()
+    channel = bus.attach_twin("t1", lambda: snap, lambda p: {})
+    client.subscribe("bearing/t1/state")
+    blocker = _Blocker()
+    channel.publish(blocker)
+    assert blocker.entered.wait(5.0)        # the channel thread is held from now on
+    try:
+        got = []
+
+        def state(item):
+            got.append(loads(item[2]))
+            return got[-1].get("seq") == snap.seq
+
+        client.wait_for(state, poke=lambda: channel.publish(snap))
+        assert got[-1] == json.loads(snap.to_json())
+        assert not blocker.release.is_set() and channel.published == 0
+    finally:
+        blocker.release.set()
 
 
 def test_publish_burst_is_cheap_and_close_is_prompt(bus, twin):

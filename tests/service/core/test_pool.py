@@ -199,6 +199,26 @@ def test_a_lead_releases_frames_before_the_wall_clock_and_absorbs_a_stall():
         PacingClock(fast=False, publish_period_s=0.02, clock=lambda: 0.0, lead_s=-1.0)
 
 
+def test_a_setpoint_is_published_at_the_end_of_its_frame_even_right_after_a_tick():
+    """service.core.pacing: the state carrying a fresh setpoint goes out at the end of the frame
+    that applied it, not one frame later because a regular 50 Hz tick went out less than
+    setpoint_publish_min_interval_s before; that interval still spaces the setpoint
+    publications themselves (a closer one is deferred, not dropped); the ticks keep their grid."""
+    p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: 0.0, setpoint_publish_min_interval_s=0.002)
+    p.start(0.0)
+    assert not p.publish_due(0.019, 0.019, False)
+    assert p.publish_due(0.020, 0.020, False)            # the tick
+    p.published(0.020, 0.020)
+    assert p.publish_due(0.0205, 0.0205, True)           # a setpoint frame 0.5 ms after it: at once
+    p.published(0.0205, 0.0205)
+    assert not p.publish_due(0.021, 0.021, True)         # another, 0.5 ms later: deferred
+    assert not p.publish_due(0.022, 0.022, False)
+    assert p.publish_due(0.0226, 0.0226, False)          # ... to the first frame 2 ms after the last
+    p.published(0.0226, 0.0226)
+    assert not p.publish_due(0.030, 0.030, False)
+    assert p.publish_due(0.040, 0.040, False)            # the 50 Hz grid is unchanged
+
+
 def test_fast_mode_is_never_late():
     p = PacingClock(fast=True, publish_period_s=0.02, clock=lambda: 0.0)
     p.start(0.0)

@@ -77,6 +77,42 @@ def check_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_sw
             other.child.release.set()
 
 
+def _named(name: str) -> _Parked:
+    """A parked thread whose kernel name (comm) is `name`, like zenoh's transmit threads."""
+    t = _Parked()
+    with open(f"/proc/self/task/{t.tid}/comm", "w") as f:
+        f.write(name)
+    return t
+
+
+def check_zenohs_transmit_threads_keep_the_process_nice():
+    """EGRESS_THREAD_NAMES: a thread named like zenoh's transmit threads ("tx-0") stays at (or,
+    with the privilege, is brought back to) the process's nice when the sweep gives every other
+    thread the I/O nice; a receive thread ("rx-0") is not spared."""
+    from service.core.priority import EGRESS_THREAD_NAMES
+
+    now, restored = _now_and_restored()
+    io = now + 3
+    tx, rx = _named("tx-0"), _named("rx-0")
+    prio = ThreadPriority(lambda: set(), io_nice=io, sweep_s=3600.0, keep_names=EGRESS_THREAD_NAMES)
+    try:
+        prio.sweep()
+        assert thread_nice(rx.tid) == io
+        assert thread_nice(tx.tid) == restored
+        assert prio.record()["egress_threads"] == [restored]
+        refused = prio.egress_refused
+        # created by a reniced thread it inherits the I/O nice; only the privilege brings it back
+        late = _named("tx-1")
+        assert thread_nice(late.tid) == io
+        prio.sweep()
+        assert thread_nice(late.tid) == (restored if os.geteuid() == 0 else io)
+        assert prio.egress_refused == refused + (0 if os.geteuid() == 0 else 1)
+        late.release.set()
+    finally:
+        tx.release.set()
+        rx.release.set()
+
+
 def check_io_nice_zero_changes_nothing():
     t = _Parked()
     before = thread_nice(t.tid)
@@ -180,6 +216,10 @@ def _run(check: str) -> None:
 
 def test_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_swept():
     _run("check_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_swept")
+
+
+def test_zenohs_transmit_threads_keep_the_process_nice():
+    _run("check_zenohs_transmit_threads_keep_the_process_nice")
 
 
 def test_io_nice_zero_changes_nothing():

@@ -379,3 +379,44 @@ def test_repeated_exceptions_stop_the_runner_with_a_status(twin, make_runner):
     assert wait_until(lambda: not runner.running)
     assert runner.failed and runner.errors == 3
     assert runner.latest.status.startswith("failed")
+
+
+def test_a_setpoint_ends_the_frame_in_progress(twin, make_runner):
+    """Real time, frames of 2 s of simulated time (seconds of wall time): a setpoint submitted
+    while one runs ends it at its next step (Twin.interrupt_frame), so the setpoint frame that
+    applies it starts off the grid of whole frames, and the first snapshot carrying it is not
+    held back to the end of the long frame. Counted in steps, no wall-clock threshold."""
+    from twin.kernels import layout as L
+
+    sink = ListSink()
+    t_init = twin.time_s
+    runner = make_runner(twin, frame_s=2.0, setpoint_frame_s=0.001, sinks=[sink]).start()
+    step0 = int(twin.state.scalars[L.X_STEP])
+    assert wait_until(lambda: int(twin.state.scalars[L.X_STEP]) > step0 + 10, interval=0.001)
+    runner.submit(radial_load_n=4321.0)
+    snap = sink.wait_for(lambda s: s.setpoint.radial_load_n == 4321.0)
+    assert snap is not None
+    dt = twin.model.dt_s
+    cut_steps = round((snap.time_s - runner.setpoint_frame_steps * dt - t_init) / dt)
+    assert cut_steps % runner.frame_steps != 0          # the frame was cut short
+    assert snap.time_s < t_init + runner.frame_s        # within the first long frame
+    assert runner.stop(timeout=10.0)                     # stop interrupts the frame as well
+    assert runner.sim_elapsed_s == pytest.approx(twin.time_s - t_init, abs=0.5 * dt)
+
+
+def test_a_setpoint_is_published_at_the_end_of_the_frame_that_applied_it(twin, make_runner):
+    """No 50 Hz tick involved (one tick every 1000 s here): the state carrying a setpoint is
+    published because its frame applied it, once, right after that frame (counted in
+    publications and in steps of simulated time, not in wall time)."""
+    sink = ListSink()
+    runner = make_runner(twin, publish_rate_hz=0.001, frame_s=0.005, setpoint_frame_s=0.001,
+                         sinks=[sink]).start()
+    assert wait_until(lambda: runner.frames >= 5)
+    assert runner.published == 1                       # the initial snapshot only
+    runner.submit(radial_load_n=4321.0)
+    snap = sink.wait_for(lambda s: s.setpoint.radial_load_n == 4321.0)
+    assert snap is not None and snap.seq == sink.snapshots[0].seq + 1
+    assert wait_until(lambda: runner.frames >= 20)
+    assert runner.published == 2                       # no other publication since
+    (timing,) = runner.setpoint_latencies()
+    assert timing.seq == snap.seq and timing.published_wall_s >= timing.applied_wall_s
