@@ -278,6 +278,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_E_PRIME] = e_prime
     p[L.P_G_PARAM] = spec.lubricant.pressure_viscosity_pa_inv * e_prime
     p[L.P_ROUGHNESS] = spec.surface.composite_roughness_m
+    p[L.P_LN_ROUGHNESS] = math.log(spec.surface.composite_roughness_m)
     p[L.P_KT_RATIO] = options.tangential_stiffness_ratio
     p[L.P_CT_RATIO] = options.tangential_damping_ratio
     p[L.P_ALPHA_E] = options.restitution_coefficient_s_m

@@ -45,7 +45,8 @@ MAX_STRIPS = 32
 # issue 14 (twin.vibration): the model's V_* vector (end of this file) at p[P_VIB + V_*]
 P_VIB = P_STRIP_TABLE + 4 * MAX_STRIPS
 N_VIB_PARAMS = 10
-N_PARAMS = P_VIB + N_VIB_PARAMS
+P_LN_ROUGHNESS = P_VIB + N_VIB_PARAMS  # ln(P_ROUGHNESS / 1 m): ln Lambda = ln h_min - this (issue 13)
+N_PARAMS = P_LN_ROUGHNESS + 1
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]

@@ -21,14 +21,15 @@ from twin.kernels.layout import (
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
-    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
+    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_LN_ROUGHNESS, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
     P_RING_MASS, P_ROLLING, LANE_BLOCK, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
 )
-from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient
+from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient_share
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
+from twin.physics.rolling import asperity_load_share_ln
 # ---- issue 14 (vibration): housing, local defects, accelerometer; hooks marked "issue 14" below --
 from twin.kernels.layout import P_VIB, V_DECIMATION_RATIO, V_HOUSING_ON, X_DEFECT_COUNT
 from twin.kernels.vibration import (apply_defects, defect_table, has_ball_defect, integrate_orientations,
@@ -82,6 +83,86 @@ def _cos_sin(x):
 
 
 @njit(inline="always", **JIT_STEP)
+def refresh_contact(p, tr, w, c, q_el, eta, electrical_now):
+    """Tribology refresh of loaded contact c (load q_el [N], viscosity eta [Pa s]): its Hertz
+    stiffness (lane M_STIFFNESS, read by the next geometry pass) and film constants at its
+    current contact angle from the model's angle table `tr` (`twin.model.make_angle_table`,
+    linear in |sin alpha| = |n_z|), then `contact_tribology` (seed 000 eqs. 5-7, Table 2, seed
+    001 eqs. 1-5, 9, 11), the limiting friction coefficient, the tangential damping and spring
+    relaxation, the slide-to-roll ratio and, when `electrical_now` (or the contact has just
+    closed), its parallel RC (`contact_electrical`). Writes the contact's C_* lanes.
+
+    With the ellipse friction the asperity share (seed 001 eq. A2) takes ln Lambda = ln h_min -
+    ln sigma from the film's own logarithm (`contact_tribology`'s last output), not another
+    logarithm (issue 13)."""
+    friction_model = int(p[P_FRICTION_MODEL])
+    r = c & 1
+    # Hertz and film constants at the contact's current angle (angle table row i, i + 1)
+    xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
+    ia = min(int(xa), ANGLE_POINTS - 2)
+    fa = xa - ia
+    w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
+    ex = w[O_EX * CW + c]
+    ey = w[O_EY * CW + c]
+    ez = w[O_EZ * CW + c]
+    u2 = ex * ex + ey * ey + ez * ez
+    u = math.sqrt(u2)
+    t = A_TRIBOLOGY
+    tri = contact_tribology(
+        q_el, u, eta, p[P_ROUGHNESS], _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
+        _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
+        _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
+        _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
+        _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
+        _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
+        _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
+        _at_angle(tr, r, ia, fa, t + 14), friction_model, p[P_ROLLING] != 0.0)
+    w[C_H_MIN * CW + c] = tri[0]
+    w[C_H_C * CW + c] = tri[1]
+    w[C_LAMBDA * CW + c] = tri[2]
+    w[C_REGIME * CW + c] = tri[3]
+    # the contact's limiting friction coefficient: the Coulomb law's mu, or with the ellipse
+    # friction its traction capacity over Q (not the effective |F_t| / Q it publishes)
+    if friction_model == FRICTION_ELLIPSE:
+        share = asperity_load_share_ln(tri[2], tri[10] - p[P_LN_ROUGHNESS])
+        mu_lim = limiting_traction_coefficient_share(tri[2], share, p[P_LIMITING_SHEAR])
+    else:
+        mu_lim = tri[4]
+    w[C_MU * CW + c] = mu_lim
+    w[C_SEMI_MAJOR * CW + c] = tri[5]
+    w[C_SEMI_MINOR * CW + c] = tri[6]
+    w[C_FLUID_DAMPING * CW + c] = tri[7]
+    w[C_ROLLING_FORCE * CW + c] = tri[8]
+    w[C_ROLLING_PER_SPEED * CW + c] = tri[8] / max(u, ROLLING_REGULARISATION_SPEED)
+    w[C_SPIN_MOMENT * CW + c] = tri[9]
+    kt = p[P_KT_RATIO] * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
+    w[C_TANGENT_DAMPING * CW + c] = p[P_CT_RATIO] * 2.0 * math.sqrt(kt * p[P_BALL_REDUCED_TANGENT_MASS])
+    w[C_ENTRAINMENT * CW + c] = u
+    # tangential spring relaxation (contacts.raceway_forces): by rolling over L = sqrt(a b)
+    # and by the spin sliding of the contact, kt |w_spin| sqrt(a b) / (1.3 mu Q) with mu the
+    # limiting coefficient of the fully sliding traction (mu_lim)
+    ab = math.sqrt(tri[5] * tri[6])
+    spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
+                   + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
+    relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
+    w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
+    w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
+                          + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
+    if not (electrical_now or w[C_CAPACITANCE * CW + c] == 0.0):
+        return  # the RC keeps its last value between electrical refreshes
+    if tri[1] > 0.0:
+        res_ohm, cap_f = contact_electrical(
+            q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
+            _at_angle(tr, r, ia, fa, t + T_RY),
+            p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER], p[P_ASPERITY_RESISTANCE],
+            p[P_OIL_RESISTIVITY])
+    else:  # no film (no entrainment): metallic contact, no dielectric
+        res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
+    w[C_RESISTANCE * CW + c] = res_ohm
+    w[C_CAPACITANCE * CW + c] = cap_f
+
+
+@njit(inline="always", **JIT_STEP)
 def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
                           tribology_now, electrical_now, traction_now, ct, st):
     """Forces and torques of every contact at the current positions -> accelerations of the
@@ -89,10 +170,8 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
 
     Ball-raceway contacts: gather the kinematics into the lanes of `w`, one vectorised geometry
     pass, one vectorised force pass, then per ball: sum the forces, refresh the tribology of
-    loaded contacts when `tribology_now` (or when a contact closes), clear opened contacts.
-    The refresh takes each contact's Hertz stiffness (its lane M_STIFFNESS, read by the next
-    geometry pass) and film constants at its current contact angle from the model's angle table
-    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|).
+    loaded contacts when `tribology_now` (or when a contact closes, `refresh_contact`), clear
+    opened contacts.
 
     The forces see the balls' velocities and angular velocities turned about the axis by the
     angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
@@ -109,11 +188,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     m = p[P_BALL_MASS]
     inertia = p[P_BALL_INERTIA]
     kt_ratio = p[P_KT_RATIO]
-    ct_ratio = p[P_CT_RATIO]
-    tangent_mass = p[P_BALL_REDUCED_TANGENT_MASS]
     friction_model = int(p[P_FRICTION_MODEL])
-    rolling_on = p[P_ROLLING] != 0.0
-    roughness = p[P_ROUGHNESS]
     ring_speed = scal[X_SHAFT_SPEED]
     cage_speed = scal[X_CAGE_SPEED]
     eta = sp[S_VISCOSITY]
@@ -198,67 +273,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         q_el = w[G_LOAD * CW + c]
         w[C_LOAD * CW + c] = q_el
         if tribology_now or w[C_LAMBDA * CW + c] < 0.0:
-            r = c & 1
-            # Hertz and film constants at the contact's current angle (angle table row i, i + 1)
-            xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
-            ia = min(int(xa), ANGLE_POINTS - 2)
-            fa = xa - ia
-            w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
-            ex = w[O_EX * CW + c]
-            ey = w[O_EY * CW + c]
-            ez = w[O_EZ * CW + c]
-            u2 = ex * ex + ey * ey + ez * ez
-            u = math.sqrt(u2)
-            t = A_TRIBOLOGY
-            tri = contact_tribology(
-                q_el, u, eta, roughness, _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
-                _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
-                _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
-                _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
-                _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
-                _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
-                _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
-                _at_angle(tr, r, ia, fa, t + 14), friction_model, rolling_on)
-            w[C_H_MIN * CW + c] = tri[0]
-            w[C_H_C * CW + c] = tri[1]
-            w[C_LAMBDA * CW + c] = tri[2]
-            w[C_REGIME * CW + c] = tri[3]
-            # the contact's limiting friction coefficient: the Coulomb law's mu, or with the ellipse
-            # friction its traction capacity over Q (not the effective |F_t| / Q it publishes)
-            mu_lim = (limiting_traction_coefficient(tri[2], p[P_LIMITING_SHEAR])
-                      if friction_model == FRICTION_ELLIPSE else tri[4])
-            w[C_MU * CW + c] = mu_lim
-            w[C_SEMI_MAJOR * CW + c] = tri[5]
-            w[C_SEMI_MINOR * CW + c] = tri[6]
-            w[C_FLUID_DAMPING * CW + c] = tri[7]
-            w[C_ROLLING_FORCE * CW + c] = tri[8]
-            w[C_ROLLING_PER_SPEED * CW + c] = tri[8] / max(u, ROLLING_REGULARISATION_SPEED)
-            w[C_SPIN_MOMENT * CW + c] = tri[9]
-            kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
-            w[C_TANGENT_DAMPING * CW + c] = ct_ratio * 2.0 * math.sqrt(kt * tangent_mass)
-            w[C_ENTRAINMENT * CW + c] = u
-            # tangential spring relaxation (contacts.raceway_forces): by rolling over L = sqrt(a b)
-            # and by the spin sliding of the contact, kt |w_spin| sqrt(a b) / (1.3 mu Q) with mu the
-            # limiting coefficient of the fully sliding traction (mu_lim)
-            ab = math.sqrt(tri[5] * tri[6])
-            spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
-                           + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
-            relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
-            w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
-            w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
-                                  + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
-            if not (electrical_now or w[C_CAPACITANCE * CW + c] == 0.0):
-                continue  # the RC keeps its last value between electrical refreshes
-            if tri[1] > 0.0:
-                res_ohm, cap_f = contact_electrical(
-                    q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
-                    _at_angle(tr, r, ia, fa, t + T_RY),
-                    p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER], p[P_ASPERITY_RESISTANCE],
-                    p[P_OIL_RESISTIVITY])
-            else:  # no film (no entrainment): metallic contact, no dielectric
-                res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
-            w[C_RESISTANCE * CW + c] = res_ohm
-            w[C_CAPACITANCE * CW + c] = cap_f
+            refresh_contact(p, tr, w, c, q_el, eta, electrical_now)
     scal[X_MAX_PENETRATION] = max_pen
     if friction_model == FRICTION_ELLIPSE:  # friction over the contact ellipse (twin.kernels.traction)
         if traction_now:

@@ -65,10 +65,18 @@ def limiting_traction_coefficient(film_parameter, limiting_shear_coefficient):
     coefficient: the tangential spring's Coulomb limit (C_MU) and the mu of the fully sliding
     traction that the spin-creep relaxation linearises (twin.kernels.step). In full film
     (Lambda >= 2.26, no asperity share) it is gamma without evaluating a power."""
-    share = asperity_load_share(film_parameter)
-    if share == 0.0:
+    return limiting_traction_coefficient_share(film_parameter, asperity_load_share(film_parameter),
+                                               limiting_shear_coefficient)
+
+
+@njit(inline="always", **JIT)
+def limiting_traction_coefficient_share(film_parameter, asperity_share, limiting_shear_coefficient):
+    """`limiting_traction_coefficient` given the asperity load share Qa/Q(Lambda) (seed 001
+    eq. A2) the caller already holds (the tribology refresh takes it from ln Lambda, the strip
+    solve needs it anyway): Qa/Q mu(Lambda) + (1 - Qa/Q) gamma, gamma itself without a share."""
+    if asperity_share == 0.0:
         return limiting_shear_coefficient
-    return traction_capacity(share, stribeck_line_mu(film_parameter), limiting_shear_coefficient)
+    return traction_capacity(asperity_share, stribeck_line_mu(film_parameter), limiting_shear_coefficient)
 
 
 @njit(**JIT)
@@ -95,7 +103,7 @@ def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
         lam = w[C_LAMBDA * CW + c]
         share = asperity_load_share(lam)
         mu_a = stribeck_line_mu(lam)
-        capacity = limiting_traction_coefficient(lam, gamma)  # as the tribology refresh set it
+        capacity = limiting_traction_coefficient_share(lam, share, gamma)  # as the tribology refresh set it
         w[C_MU * CW + c] = capacity
         q = w[C_LOAD * CW + c]
         # net tangential force on the ball: the elastic part of the tangential spring

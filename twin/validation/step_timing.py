@@ -9,8 +9,9 @@ time of the calling thread (what the pass costs, not the waits for a core on a s
 - geometry, forces: the kernel's own `raceway_geometry` and `raceway_forces` on the lanes padded
   to whole vectors as the step runs them (`layout.padded_lane_count`);
 - tribology: the kernel's per-contact pass (copy of its loop) with the kernel's own
-  `contact_tribology` and `contact_electrical`, timed without refresh, with the tribology
-  refresh and with the electrical refresh too; per step it costs the first plus the refreshes
+  `refresh_contact`, timed without refresh, with the tribology refresh and with the electrical
+  refresh too (every refreshed contact gets its RC then: with `electrical_now` False the
+  kernel still refreshes an RC that is 0); per step it costs the first plus the refreshes
   divided by their periods in steps (the model's tribology sub-rate, x ELECTRICAL_EVERY);
 - traction: the kernel's own `apply_traction_moments` (every step) plus its `ellipse_traction`
   (the strip solve) divided by its period in steps (tribology sub-rate x P_TRACTION_EVERY);
@@ -36,22 +37,14 @@ from numba import njit
 from twin.jit import JIT, JIT_STEP
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
-    A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, C_XI_DECAY, G_NX, G_NY, G_NZ,
-    C_CAPACITANCE, C_ENTRAINMENT, C_FLUID_DAMPING, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
-    C_RESISTANCE, C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT,
-    C_SRR, C_TANGENT_DAMPING, CW, E_SLIP, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
-    K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, O_EX, O_EY,
-    O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, P_ALPHA_E,
-    P_ASPERITY_RESISTANCE, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
-    P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS, P_CAGE_STIFFNESS,
-    P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_KT_RATIO, P_LIMITING_SHEAR,
-    P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY,
+    C_LOAD, CW, E_SLIP, G_DELTA, G_LOAD, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
+    K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_TX, O_TY, O_TZ, P_ALPHA_E,
+    P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS, P_CAGE_STIFFNESS,
+    P_DT, P_KT_RATIO, P_SUBSTEPS, P_TRACTION_EVERY,
     S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED, X_CAGE_TORQUE, X_SHAFT_SPEED, padded_lane_count,
 )
-from twin.kernels.step import (ELECTRICAL_EVERY, FRICTION_ELLIPSE, ROLLING_REGULARISATION_SPEED,
-                               SPIN_CREEP_FACTOR, _at_angle, _cos_sin, step_n)
-from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient
-from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
+from twin.kernels.step import ELECTRICAL_EVERY, _cos_sin, refresh_contact, step_n
+from twin.kernels.traction import apply_traction_moments, ellipse_traction
 
 PASSES = ("gather", "geometry", "forces", "tribology", "traction", "cage", "integration")
 
@@ -111,12 +104,6 @@ def _forces(w, nc, rb, dt, kt_ratio, alpha_e, reps):
 
 @njit(**JIT_STEP)
 def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
-    kt_ratio = p[P_KT_RATIO]
-    ct_ratio = p[P_CT_RATIO]
-    tangent_mass = p[P_BALL_REDUCED_TANGENT_MASS]
-    friction_model = int(p[P_FRICTION_MODEL])
-    rolling_on = p[P_ROLLING] != 0.0
-    roughness = p[P_ROUGHNESS]
     eta = sp[S_VISCOSITY]
     max_pen = 0.0
     for _ in range(reps):
@@ -129,63 +116,7 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
             q_el = w[G_LOAD * CW + c]
             w[C_LOAD * CW + c] = q_el
             if tribology_now:
-                r = c & 1
-                # Hertz and film constants at the contact's current angle (angle table rows i, i + 1)
-                xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
-                ia = min(int(xa), ANGLE_POINTS - 2)
-                fa = xa - ia
-                w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
-                ex = w[O_EX * CW + c]
-                ey = w[O_EY * CW + c]
-                ez = w[O_EZ * CW + c]
-                u2 = ex * ex + ey * ey + ez * ez
-                u = math.sqrt(u2)
-                t = A_TRIBOLOGY
-                tri = contact_tribology(
-                    q_el, u, eta, roughness, _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
-                    _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
-                    _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
-                    _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
-                    _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
-                    _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
-                    _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
-                    _at_angle(tr, r, ia, fa, t + 14), friction_model, rolling_on)
-                w[C_H_MIN * CW + c] = tri[0]
-                w[C_H_C * CW + c] = tri[1]
-                w[C_LAMBDA * CW + c] = tri[2]
-                w[C_REGIME * CW + c] = tri[3]
-                mu_lim = (limiting_traction_coefficient(tri[2], p[P_LIMITING_SHEAR])
-                          if friction_model == FRICTION_ELLIPSE else tri[4])
-                w[C_MU * CW + c] = mu_lim
-                w[C_SEMI_MAJOR * CW + c] = tri[5]
-                w[C_SEMI_MINOR * CW + c] = tri[6]
-                w[C_FLUID_DAMPING * CW + c] = tri[7]
-                w[C_ROLLING_FORCE * CW + c] = tri[8]
-                w[C_ROLLING_PER_SPEED * CW + c] = tri[8] / max(u, ROLLING_REGULARISATION_SPEED)
-                w[C_SPIN_MOMENT * CW + c] = tri[9]
-                kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
-                w[C_TANGENT_DAMPING * CW + c] = ct_ratio * 2.0 * math.sqrt(kt * tangent_mass)
-                w[C_ENTRAINMENT * CW + c] = u
-                ab = math.sqrt(tri[5] * tri[6])
-                spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
-                               + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
-                relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
-                w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
-                w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
-                                      + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
-                if not electrical_now:
-                    continue
-                if tri[1] > 0.0:
-                    res_ohm, cap_f = contact_electrical(
-                        q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
-                        _at_angle(tr, r, ia, fa, t + T_RY),
-                        p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER],
-                        p[P_ASPERITY_RESISTANCE],
-                        p[P_OIL_RESISTIVITY])
-                else:
-                    res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
-                w[C_RESISTANCE * CW + c] = res_ohm
-                w[C_CAPACITANCE * CW + c] = cap_f
+                refresh_contact(p, tr, w, c, q_el, eta, electrical_now)
     return max_pen
 
 
