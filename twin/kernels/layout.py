@@ -46,7 +46,9 @@ MAX_STRIPS = 32
 P_VIB = P_STRIP_TABLE + 4 * MAX_STRIPS
 N_VIB_PARAMS = 10
 P_LN_ROUGHNESS = P_VIB + N_VIB_PARAMS  # ln(P_ROUGHNESS / 1 m): ln Lambda = ln h_min - this (issue 13)
-N_PARAMS = P_LN_ROUGHNESS + 1
+P_CAGE_STEP_COS = P_LN_ROUGHNESS + 1   # cos(2 pi / Z): turns one cage element's unit vector to the next
+P_CAGE_STEP_SIN = P_LN_ROUGHNESS + 2   # sin(2 pi / Z)
+N_PARAMS = P_CAGE_STEP_SIN + 1
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]
@@ -140,7 +142,7 @@ K_VZ = 31
 K_WX = 32     # ball angular velocity [rad/s]
 K_WY = 33
 K_WZ = 34
-K_OVX = 35    # ring centre velocity [m/s]
+K_OVX = 35    # ring centre velocity [m/s] (0 in the outer lanes, never written there: step.gather_lanes)
 K_OVY = 36
 K_OVZ = 37
 K_SPIN = 38   # ring spin about +z [rad/s]

@@ -19,7 +19,7 @@ from twin.kernels.layout import (
     G_NX, G_NY, K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, N_CACHED,
     O_EX, O_EY, O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ,
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
-    P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
+    P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_STEP_COS, P_CAGE_STEP_SIN, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
     P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_LN_ROUGHNESS, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
     P_RING_MASS, P_ROLLING, LANE_BLOCK, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
@@ -163,37 +163,19 @@ def refresh_contact(p, tr, w, c, q_el, eta, electrical_now):
 
 
 @njit(inline="always", **JIT_STEP)
-def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                          tribology_now, electrical_now, traction_now, ct, st):
-    """Forces and torques of every contact at the current positions -> accelerations of the
-    balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
-
-    Ball-raceway contacts: gather the kinematics into the lanes of `w`, one vectorised geometry
-    pass, one vectorised force pass, then per ball: sum the forces, refresh the tribology of
-    loaded contacts when `tribology_now` (or when a contact closes, `refresh_contact`), clear
-    opened contacts.
-
-    The forces see the balls' velocities and angular velocities turned about the axis by the
-    angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
-    (1, 0) for none), as they are read: bv and bw themselves are left as they are.
-
-    Issue 14: positions and velocities are those relative to the outer ring (`step_n` shifts
-    them with the housing on); the active defect rows (scal[X_DEFECT_COUNT] of them in the
-    workspace after the lanes, twin.kernels.layout W_DEFECTS) open their clearance between the
-    geometry and the force pass (`twin.kernels.vibration.apply_defects`).
-    Returns a status code."""
+def gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st):
+    """The kinematics of every ball-raceway contact into its lanes of `w` (K_* rows, c = 2 j + r;
+    r = 0 inner ring, r = 1 fixed outer ring): ball centre relative to the ring and in the world
+    frame, the ball's velocity and angular velocity turned by (ct, st) (`compute_accelerations`),
+    the ring's velocity and spin, the ball's orbital speed; then the pad lanes. Returns the
+    padded lane count. The outer lanes' ring velocity and spin (K_OVX..K_SPIN) are not written:
+    the outer ring is fixed (or the frame is its own, issue 14), they hold the 0 that
+    `twin.state.make_state` and `TwinState.clear_contacts` put there (issue 13: 4 Z stores per
+    step fewer)."""
     z = bx.shape[0]
     nc = 2 * z
-    rb = p[P_BALL_RADIUS]
-    m = p[P_BALL_MASS]
-    inertia = p[P_BALL_INERTIA]
-    kt_ratio = p[P_KT_RATIO]
-    friction_model = int(p[P_FRICTION_MODEL])
     ring_speed = scal[X_SHAFT_SPEED]
-    cage_speed = scal[X_CAGE_SPEED]
-    eta = sp[S_VISCOSITY]
-    # gather (c = 2 j + r; r = 0 inner ring, r = 1 fixed outer ring); the ring's state is read
-    # once (the compiler cannot keep it in registers across stores to w, which it may alias)
+    # the ring's state is read once (the compiler cannot keep it in registers across stores to w, which it may alias)
     rx0 = rx[0]
     rx1 = rx[1]
     rx2 = rx[2]
@@ -237,13 +219,9 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         w[K_WZ * CW + ci] = w2
         w[K_WZ * CW + co] = w2
         w[K_OVX * CW + ci] = rv0
-        w[K_OVX * CW + co] = 0.0
         w[K_OVY * CW + ci] = rv1
-        w[K_OVY * CW + co] = 0.0
         w[K_OVZ * CW + ci] = rv2
-        w[K_OVZ * CW + co] = 0.0
         w[K_SPIN * CW + ci] = ring_speed
-        w[K_SPIN * CW + co] = 0.0
         w[K_ORBIT * CW + ci] = orbital
         w[K_ORBIT * CW + co] = orbital
     # pad lanes up to a whole number of vectors: a copy of the last contact, so that the lane
@@ -252,6 +230,104 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     for c in range(nc, nl):
         for k in range(K_PX, K_ORBIT + 1):
             w[k * CW + c] = w[k * CW + nc - 1]
+    return nl
+
+
+@njit(inline="always", **JIT_STEP)
+def ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st):
+    """Per ball, in one pass: the raceway contacts' forces and torques summed into the ball's
+    accelerations (seed 000 eq. 9; ba, balpha), its two cage contacts (`cage_contact`, seed 000
+    eq. 3: the cage elements on either side of it, element e at the cage angle + (e + 1/2) 2 pi / Z,
+    their unit vectors turned along by the model's P_CAGE_STEP_COS/SIN), loads in `cage_load`.
+    The balls' velocities are turned by (ct, st) as `compute_accelerations` reads them.
+    Returns the force of the balls on the inner ring (x, y, z) [N], the contacts' torque on the
+    inner ring about its axis [N m] and the cage torque [N m]."""
+    z = bx.shape[0]
+    inv_inertia = 1.0 / p[P_BALL_INERTIA]  # multiplications, not 6 Z divisions per step
+    inv_m = 1.0 / p[P_BALL_MASS]
+    rc = p[P_CAGE_RADIUS]
+    s_cage = p[P_CAGE_CONTACT_DISTANCE]
+    k_cage = p[P_CAGE_STIFFNESS]
+    m_cage = p[P_CAGE_REDUCED_MASS]
+    cage_speed = scal[X_CAGE_SPEED]
+    c_step = p[P_CAGE_STEP_COS]
+    s_step = p[P_CAGE_STEP_SIN]
+    theta = scal[X_CAGE_ANGLE] - 0.5 * (2.0 * math.pi / z)  # element j - 1 of ball 0
+    prev_c = math.cos(theta)
+    prev_s = math.sin(theta)
+    first_c = prev_c
+    first_s = prev_s
+    ring_fx = 0.0
+    ring_fy = 0.0
+    ring_fz = 0.0
+    ring_tz = 0.0
+    cage_tz = 0.0
+    for j in range(z):
+        ci = 2 * j
+        co = ci + 1
+        fx = w[O_FX * CW + ci] + w[O_FX * CW + co]
+        fy = w[O_FY * CW + ci] + w[O_FY * CW + co]
+        fz = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
+        balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) * inv_inertia
+        balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) * inv_inertia
+        balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) * inv_inertia
+        ring_fx -= w[O_FX * CW + ci]
+        ring_fy -= w[O_FY * CW + ci]
+        ring_fz -= w[O_FZ * CW + ci]
+        ring_tz += w[O_RING_TZ * CW + ci]
+        v0 = ct * bv[j, 0] - st * bv[j, 1]
+        v1 = st * bv[j, 0] + ct * bv[j, 1]
+        next_c = prev_c * c_step - prev_s * s_step
+        next_s = prev_s * c_step + prev_c * s_step
+        if j == z - 1:
+            next_c = first_c
+            next_s = first_s
+        for slot in range(2):
+            ex = rc * (next_c if slot == 0 else prev_c)
+            ey = rc * (next_s if slot == 0 else prev_s)
+            f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], v0, v1,
+                                         bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage)
+            cage_load[j, slot] = f
+            fx += f * nx
+            fy += f * ny
+            fz += f * nz
+            cage_tz -= ex * f * ny - ey * f * nx
+        prev_c = next_c
+        prev_s = next_s
+        ba[j, 0] = fx * inv_m
+        ba[j, 1] = fy * inv_m
+        ba[j, 2] = fz * inv_m
+    return ring_fx, ring_fy, ring_fz, ring_tz, cage_tz
+
+
+@njit(inline="always", **JIT_STEP)
+def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
+                          tribology_now, electrical_now, traction_now, ct, st):
+    """Forces and torques of every contact at the current positions -> accelerations of the
+    balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
+
+    Ball-raceway contacts: gather the kinematics into the lanes of `w`, one vectorised geometry
+    pass, one vectorised force pass, then per ball: sum the forces, refresh the tribology of
+    loaded contacts when `tribology_now` (or when a contact closes, `refresh_contact`), clear
+    opened contacts.
+
+    The forces see the balls' velocities and angular velocities turned about the axis by the
+    angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
+    (1, 0) for none), as they are read: bv and bw themselves are left as they are.
+
+    Issue 14: positions and velocities are those relative to the outer ring (`step_n` shifts
+    them with the housing on); the active defect rows (scal[X_DEFECT_COUNT] of them in the
+    workspace after the lanes, twin.kernels.layout W_DEFECTS) open their clearance between the
+    geometry and the force pass (`twin.kernels.vibration.apply_defects`).
+    Returns a status code."""
+    z = bx.shape[0]
+    nc = 2 * z
+    rb = p[P_BALL_RADIUS]
+    inertia = p[P_BALL_INERTIA]
+    kt_ratio = p[P_KT_RATIO]
+    friction_model = int(p[P_FRICTION_MODEL])
+    eta = sp[S_VISCOSITY]
+    nl = gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st)
     raceway_geometry(w, nl)
     if scal[X_DEFECT_COUNT] > 0.0:  # issue 14: local defects
         apply_defects(w, nc, int(scal[X_DEFECT_COUNT]), scal[X_SHAFT_ANGLE], p, rb)
@@ -279,65 +355,8 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         if traction_now:
             ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
         apply_traction_moments(w, nl)
-    inv_inertia = 1.0 / inertia  # multiplications, not 6 Z divisions per step
-    ring_fx = 0.0
-    ring_fy = 0.0
-    ring_fz = 0.0
-    ring_tz = 0.0
-    for j in range(z):
-        ci = 2 * j
-        co = ci + 1
-        ba[j, 0] = w[O_FX * CW + ci] + w[O_FX * CW + co]
-        ba[j, 1] = w[O_FY * CW + ci] + w[O_FY * CW + co]
-        ba[j, 2] = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
-        balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) * inv_inertia
-        balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) * inv_inertia
-        balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) * inv_inertia
-        ring_fx -= w[O_FX * CW + ci]
-        ring_fy -= w[O_FY * CW + ci]
-        ring_fz -= w[O_FZ * CW + ci]
-        ring_tz += w[O_RING_TZ * CW + ci]
-    # cage elements: element e sits at theta + (e + 1/2) step; rotate a unit vector along
-    rc = p[P_CAGE_RADIUS]
-    s_cage = p[P_CAGE_CONTACT_DISTANCE]
-    k_cage = p[P_CAGE_STIFFNESS]
-    m_cage = p[P_CAGE_REDUCED_MASS]
-    step_angle = 2.0 * math.pi / z
-    c_step = math.cos(step_angle)
-    s_step = math.sin(step_angle)
-    theta = scal[X_CAGE_ANGLE] - 0.5 * step_angle  # element j - 1 of ball 0
-    prev_c = math.cos(theta)
-    prev_s = math.sin(theta)
-    first_c = prev_c
-    first_s = prev_s
-    cage_tz = 0.0
-    inv_m = 1.0 / m
-    for j in range(z):
-        fx = ba[j, 0]
-        fy = ba[j, 1]
-        fz = ba[j, 2]
-        v0 = ct * bv[j, 0] - st * bv[j, 1]
-        v1 = st * bv[j, 0] + ct * bv[j, 1]
-        next_c = prev_c * c_step - prev_s * s_step
-        next_s = prev_s * c_step + prev_c * s_step
-        if j == z - 1:
-            next_c = first_c
-            next_s = first_s
-        for slot in range(2):
-            ex = rc * (next_c if slot == 0 else prev_c)
-            ey = rc * (next_s if slot == 0 else prev_s)
-            f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], v0, v1,
-                                         bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage)
-            cage_load[j, slot] = f
-            fx += f * nx
-            fy += f * ny
-            fz += f * nz
-            cage_tz -= ex * f * ny - ey * f * nx
-        prev_c = next_c
-        prev_s = next_s
-        ba[j, 0] = fx * inv_m
-        ba[j, 1] = fy * inv_m
-        ba[j, 2] = fz * inv_m
+    ring_fx, ring_fy, ring_fz, ring_tz, cage_tz = ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w,
+                                                                      cage_load, ct, st)
     inv_mr = 1.0 / p[P_RING_MASS]
     ra[0] = (ring_fx + sp[S_RADIAL_LOAD]) * inv_mr
     ra[1] = ring_fy * inv_mr
