@@ -19,6 +19,7 @@ from twin.kernels.layout import (
     M_GROOVE_CENTRE_Z, M_GROOVE_CLEARANCE, M_STIFFNESS, O_EX, O_EY, O_EZ, O_FX, O_FY, O_FZ,
     O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, T_XI0, T_XI1, T_XI2,
 )
+from twin.kernels.traction import traction_moment_lane
 
 
 @njit(**JIT)
@@ -72,7 +73,7 @@ def raceway_geometry(w, nc):
 
 
 @njit(inline="always", **JIT_VECTOR)
-def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
+def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e, traction_moments):
     """Seed 000 eq. 8 for every contact lane at once (vectorised, branch-free):
 
     - kinematics: slip (ball minus ring surface velocity, tangential) and entrainment (mean
@@ -96,6 +97,10 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
       settles within about one contact length of rolling); at rest (u = 0) it is Cundall-Strack's;
     - seed 001 rolling resistance at the ball centre along the entrainment, and the pivoting
       moment against the spin of the ball relative to the ring about the normal.
+
+    With `traction_moments` (the friction over the contact ellipse between two strip solves) the
+    strips' moments of the last solve, `twin.kernels.traction.traction_moment_lane`, go into the
+    ball and ring torques in the same loop (issue 13: no second pass over the lanes).
 
     Reads the G_*, K_*, M_STIFFNESS rows and the cached C_* rows; writes the O_* rows and the
     spring T_XI* (reset where the contact is open)."""
@@ -176,7 +181,8 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         xiz = -ftz * inv_kt if sliding else xiz
         # rolling resistance (seed 001) and pivoting moment
         roll = w[C_ROLLING_PER_SPEED * CW + c]
-        spin_rel = (wx * nx + wy * ny + wz * nz) - spin * nz
+        wn = wx * nx + wy * ny
+        spin_rel = (wn + wz * nz) - spin * nz
         ms = w[C_SPIN_MOMENT * CW + c]
         mp = -ms if spin_rel > 0.0 else ms
         mp = loaded * (0.0 if spin_rel == 0.0 else mp)
@@ -186,11 +192,21 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         w[O_FX * CW + c] = fx
         w[O_FY * CW + c] = fy
         w[O_FZ * CW + c] = fz
-        w[O_TX * CW + c] = loaded * rb * (ny * ftz - nz * fty) + mp * nx
-        w[O_TY * CW + c] = loaded * rb * (nz * ftx - nx * ftz) + mp * ny
-        w[O_TZ * CW + c] = loaded * rb * (nx * fty - ny * ftx) + mp * nz
+        ox = loaded * rb * (ny * ftz - nz * fty) + mp * nx
+        oy = loaded * rb * (nz * ftx - nx * ftz) + mp * ny
+        oz = loaded * rb * (nx * fty - ny * ftx) + mp * nz
         # reaction on the ring: -F at the contact point and -M, about the ring axis
-        w[O_RING_TZ * CW + c] = -(qx * fy - qy * fx) - mp * nz
+        oring = -(qx * fy - qy * fx) - mp * nz
+        if traction_moments:
+            mx, my, mz = traction_moment_lane(w, c, loaded, nx, ny, nz, wn + (wz - spin) * nz)
+            ox += mx
+            oy += my
+            oz += mz
+            oring -= mz
+        w[O_TX * CW + c] = ox
+        w[O_TY * CW + c] = oy
+        w[O_TZ * CW + c] = oz
+        w[O_RING_TZ * CW + c] = oring
         w[O_EX * CW + c] = ex
         w[O_EY * CW + c] = ey
         w[O_EZ * CW + c] = ez

@@ -298,13 +298,29 @@ def _rolling_direction(w, c, nx, ny, nz):
 
 
 @njit(inline="always", **JIT_VECTOR)
+def traction_moment_lane(w, c, loaded, nx, ny, nz, spin):
+    """The strips' moment on the ball of lane c (module docstring), branch-free: the moment
+    along t2 as solved (world frame; the contact frame turns by the ball's orbit, about 1 deg,
+    between two solves) plus the spin moment along the current normal n, linear in the current
+    relative spin rate `spin` (ball minus ring, about n) about its value at the last solve and
+    clipped to the all-sliding moment. `loaded`: 1.0 for a closed contact, 0.0 for an open one.
+    Returns (mx, my, mz) [N m]; the ring takes -mz about its axis."""
+    cap = w[E_SPIN_CAP * CW + c]
+    mn = w[E_SPIN_MOMENT * CW + c] + w[E_SPIN_SLOPE * CW + c] * (spin - w[E_SPIN_RATE * CW + c])
+    mn = min(max(mn, -cap), cap)
+    mx = loaded * (w[E_M2X * CW + c] + mn * nx)
+    my = loaded * (w[E_M2Y * CW + c] + mn * ny)
+    mz = loaded * (w[E_M2Z * CW + c] + mn * nz)
+    return mx, my, mz
+
+
+@njit(inline="always", **JIT_VECTOR)
 def apply_traction_moments(w, nc):
-    """Every step (vectorised, branch-free): add the strips' moment about the contact centre to
-    the ball torque (O_T*) and its reaction to the ring's torque about its axis (O_RING_TZ):
-    the moment along t2 as solved (world frame; the contact frame turns by the ball's orbit,
-    about 1 deg, between two solves) plus the spin moment along the current n, linear in the
-    current relative spin rate about its value at the last solve and clipped to the all-sliding
-    moment."""
+    """Every lane (vectorised, branch-free): add the strips' moment about the contact centre
+    (`traction_moment_lane`) to the ball torque (O_T*) and its reaction to the ring's torque
+    about its axis (O_RING_TZ). The step runs it as its own pass only right after a strip solve;
+    between solves `twin.kernels.contacts.raceway_forces` adds the same moments in its own loop
+    (issue 13: one pass over the lanes instead of two)."""
     for c in range(nc):
         loaded = 1.0 if w[G_DELTA * CW + c] > 0.0 else 0.0
         nx = w[G_NX * CW + c]
@@ -312,12 +328,7 @@ def apply_traction_moments(w, nc):
         nz = w[G_NZ * CW + c]
         spin = (w[K_WX * CW + c] * nx + w[K_WY * CW + c] * ny
                 + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * nz)
-        cap = w[E_SPIN_CAP * CW + c]
-        mn = w[E_SPIN_MOMENT * CW + c] + w[E_SPIN_SLOPE * CW + c] * (spin - w[E_SPIN_RATE * CW + c])
-        mn = min(max(mn, -cap), cap)
-        mx = loaded * (w[E_M2X * CW + c] + mn * nx)
-        my = loaded * (w[E_M2Y * CW + c] + mn * ny)
-        mz = loaded * (w[E_M2Z * CW + c] + mn * nz)
+        mx, my, mz = traction_moment_lane(w, c, loaded, nx, ny, nz, spin)
         w[O_TX * CW + c] += mx
         w[O_TY * CW + c] += my
         w[O_TZ * CW + c] += mz
