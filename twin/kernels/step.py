@@ -168,7 +168,7 @@ def gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st):
     r = 0 inner ring, r = 1 fixed outer ring): ball centre relative to the ring and in the world
     frame, the ball's velocity and angular velocity turned by (ct, st) (`compute_accelerations`),
     the ring's velocity and spin, the ball's orbital speed; then the pad lanes. Returns the
-    padded lane count. The outer lanes' ring velocity and spin (K_OVX..K_SPIN) are not written:
+    padded lane count. The outer and pad lanes' ring velocity and spin (K_OVX..K_SPIN) are not written:
     the outer ring is fixed (or the frame is its own, issue 14), they hold the 0 that
     `twin.state.make_state` and `TwinState.clear_contacts` put there (issue 13: 4 Z stores per
     step fewer)."""
@@ -224,12 +224,23 @@ def gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st):
         w[K_SPIN * CW + ci] = ring_speed
         w[K_ORBIT * CW + ci] = orbital
         w[K_ORBIT * CW + co] = orbital
-    # pad lanes up to a whole number of vectors: a copy of the last contact, so that the lane
-    # passes run without a scalar remainder on finite values nobody reads (twin.kernels.layout)
+    # pad lanes up to a whole number of vectors: a copy of the last contact (the last ball's
+    # outer one, from the registers), so that the lane passes run without a scalar remainder on
+    # finite values nobody reads (twin.kernels.layout); their ring velocity and spin are 0 too
     nl = (nc + LANE_BLOCK - 1) // LANE_BLOCK * LANE_BLOCK  # layout.padded_lane_count
     for c in range(nc, nl):
-        for k in range(K_PX, K_ORBIT + 1):
-            w[k * CW + c] = w[k * CW + nc - 1]
+        w[K_PX * CW + c] = x0
+        w[K_PY * CW + c] = x1
+        w[K_PZ * CW + c] = x2
+        w[K_BX * CW + c] = x0
+        w[K_BY * CW + c] = x1
+        w[K_VX * CW + c] = v0
+        w[K_VY * CW + c] = v1
+        w[K_VZ * CW + c] = v2
+        w[K_WX * CW + c] = w0
+        w[K_WY * CW + c] = w1
+        w[K_WZ * CW + c] = w2
+        w[K_ORBIT * CW + c] = orbital
     return nl
 
 
