@@ -189,7 +189,8 @@ E_SCRATCH_SPREAD = 70  # half the spread of the slip across strip k [m/s]
 E_SCRATCH_SIGNED_HALF = 71  # half-width of strip k in t, signed like ds/dt across it [-]
 # local defects (twin.kernels.vibration.apply_defects, only while a defect is active)
 G_DEFECT_DROP = 75  # extra radial clearance a defect opens at the contact, taken off G_DELTA [m]
-N_ROWS = 76
+O_NORMAL_RATE = 76  # d(delta)/dt of the force pass: ball minus ring centre velocity along n [m/s]
+N_ROWS = 77
 
 # ---- the kernel workspace `w`: the N_ROWS x CW contact lanes, then (issue 14) the local defects ---
 # The defect table and the balls' orientations ride in the workspace after the lanes, so that the
