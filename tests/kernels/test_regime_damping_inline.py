@@ -24,7 +24,7 @@ def test_inline_table2_damping_equals_the_law():
         w[L.K_VX * L.CW + c] = rate
         w[L.C_LAMBDA * L.CW + c] = lam
         w[L.C_FLUID_DAMPING * L.CW + c] = c_fluid
-    raceway_forces(w, nc, 6.35e-3, 1e-6, 0.0, alpha_e, False)
+    raceway_forces(w, nc, 6.35e-3, 1e-6, 0.0, alpha_e)
     for c, (lam, c_fluid) in enumerate(CASES):
         c_n = regime_damping_n_s_m(lam, 1.5 * alpha_e * q_el, c_fluid)
         fn = max(q_el + c_n * rate, 0.0)

@@ -38,7 +38,7 @@ def test_steady_force_under_constant_slip_is_a_creep_law(dt):
     kt_ratio, slip, rate = 0.8, 1e-3, 2e5  # [-], [m/s], [1/s]
     w = _one_contact(1.0 / (1.0 + rate * dt), slip)
     for _ in range(400):  # at least 80 relaxation times
-        raceway_forces(w, 1, 6.3e-3, dt, kt_ratio, 0.08, False)
+        raceway_forces(w, 1, 6.3e-3, dt, kt_ratio, 0.08)
     kt = kt_ratio * 1.5 * 3e10 * 3e-3
     assert -w[L.O_FY * L.CW] == pytest.approx(kt * slip / rate, rel=1e-9)
 
@@ -47,7 +47,7 @@ def test_without_relaxation_the_spring_keeps_growing():
     kt_ratio, slip = 0.8, 1e-3
     w = _one_contact(1.0, slip)
     for _ in range(200):
-        raceway_forces(w, 1, 6.3e-3, DT, kt_ratio, 0.08, False)
+        raceway_forces(w, 1, 6.3e-3, DT, kt_ratio, 0.08)
     kt = kt_ratio * 1.5 * 3e10 * 3e-3
     assert -w[L.O_FY * L.CW] == pytest.approx(kt * slip * 200 * DT, rel=1e-9)
 

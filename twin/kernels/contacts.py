@@ -19,7 +19,6 @@ from twin.kernels.layout import (
     M_GROOVE_CENTRE_Z, M_GROOVE_CLEARANCE, M_STIFFNESS, O_EX, O_NORMAL_RATE, O_EY, O_EZ, O_FX, O_FY, O_FZ,
     O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, T_XI0, T_XI1, T_XI2,
 )
-from twin.kernels.traction import traction_moment_lane
 
 
 @njit(**JIT)
@@ -73,7 +72,7 @@ def raceway_geometry(w, nc):
 
 
 @njit(inline="always", **JIT_VECTOR)
-def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e, traction_moments):
+def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     """Seed 000 eq. 8 for every contact lane at once (vectorised, branch-free):
 
     - kinematics: slip (ball minus ring surface velocity, tangential) and entrainment (mean
@@ -97,10 +96,6 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e, traction_moments):
       settles within about one contact length of rolling); at rest (u = 0) it is Cundall-Strack's;
     - seed 001 rolling resistance at the ball centre along the entrainment, and the pivoting
       moment against the spin of the ball relative to the ring about the normal.
-
-    With `traction_moments` (the friction over the contact ellipse between two strip solves) the
-    strips' moments of the last solve, `twin.kernels.traction.traction_moment_lane`, go into the
-    ball and ring torques in the same loop (issue 13: no second pass over the lanes).
 
     Reads the G_*, K_*, M_STIFFNESS rows and the cached C_* rows; writes the O_* rows (with
     O_NORMAL_RATE between its two loops) and the spring T_XI* (reset where the contact is
@@ -218,12 +213,6 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e, traction_moments):
         qx = w[K_PX * CW + c] + rb * nx
         qy = w[K_PY * CW + c] + rb * ny
         oring = -(qx * fy - qy * fx) - mp * nz
-        if traction_moments:
-            mx, my, mz = traction_moment_lane(w, c, loaded, nx, ny, nz, wn + (wz - spin) * nz)
-            ox += mx
-            oy += my
-            oz += mz
-            oring -= mz
         w[O_TX * CW + c] = ox
         w[O_TY * CW + c] = oy
         w[O_TZ * CW + c] = oz

@@ -342,10 +342,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     raceway_geometry(w, nl)
     if scal[X_DEFECT_COUNT] > 0.0:  # issue 14: local defects
         apply_defects(w, nc, int(scal[X_DEFECT_COUNT]), scal[X_SHAFT_ANGLE], p, rb)
-    # the strips' moments (friction over the ellipse) ride in the force pass, except right after
-    # a strip solve, which comes later in this step: then their own pass after it
-    raceway_forces(w, nl, rb, p[P_DT], kt_ratio, p[P_ALPHA_E],
-                   friction_model == FRICTION_ELLIPSE and not traction_now)
+    raceway_forces(w, nl, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
     # per contact: outputs, tribology refresh, opened contacts
     max_pen = scal[X_MAX_PENETRATION]
     for c in range(nc):
@@ -365,8 +362,9 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         if tribology_now or w[C_LAMBDA * CW + c] < 0.0:
             refresh_contact(p, tr, w, c, q_el, eta, electrical_now)
     scal[X_MAX_PENETRATION] = max_pen
-    if friction_model == FRICTION_ELLIPSE and traction_now:  # friction over the ellipse (twin.kernels.traction)
-        ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
+    if friction_model == FRICTION_ELLIPSE:  # friction over the contact ellipse (twin.kernels.traction)
+        if traction_now:
+            ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
         apply_traction_moments(w, nl)
     ring_fx, ring_fy, ring_fz, ring_tz, cage_tz = ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w,
                                                                       cage_load, ct, st)

@@ -318,9 +318,8 @@ def traction_moment_lane(w, c, loaded, nx, ny, nz, spin):
 def apply_traction_moments(w, nc):
     """Every lane (vectorised, branch-free): add the strips' moment about the contact centre
     (`traction_moment_lane`) to the ball torque (O_T*) and its reaction to the ring's torque
-    about its axis (O_RING_TZ). The step runs it as its own pass only right after a strip solve;
-    between solves `twin.kernels.contacts.raceway_forces` adds the same moments in its own loop
-    (issue 13: one pass over the lanes instead of two)."""
+    about its axis (O_RING_TZ). A pass of its own: carried in the force pass's loop (with the
+    force pass's runtime flag) it cost more than it saved (issue 13)."""
     for c in range(nc):
         loaded = 1.0 if w[G_DELTA * CW + c] > 0.0 else 0.0
         nx = w[G_NX * CW + c]

@@ -7,16 +7,14 @@ twin's state, each in its own compiled loop of `reps` calls (no Python between c
 time of the calling thread (what the pass costs, not the waits for a core on a shared machine):
 
 - geometry, forces: the kernel's own `raceway_geometry` and `raceway_forces` on the lanes padded
-  to whole vectors as the step runs them (`layout.padded_lane_count`), the force pass with the
-  strips' moments (friction over the ellipse) as the step runs it between two strip solves;
+  to whole vectors as the step runs them (`layout.padded_lane_count`);
 - tribology: the kernel's per-contact pass (copy of its loop) with the kernel's own
   `refresh_contact`, timed without refresh, with the tribology refresh and with the electrical
   refresh too (every refreshed contact gets its RC then: with `electrical_now` False the
   kernel still refreshes an RC that is 0); per step it costs the first plus the refreshes
   divided by their periods in steps (the model's tribology sub-rate, x ELECTRICAL_EVERY);
-- traction: the kernel's own `ellipse_traction` (the strip solve) and the pass that applies its
-  moments right after it (`apply_traction_moments`), divided by their period in steps
-  (tribology sub-rate x P_TRACTION_EVERY);
+- traction: the kernel's own `apply_traction_moments` (every step) plus its `ellipse_traction`
+  (the strip solve) divided by its period in steps (tribology sub-rate x P_TRACTION_EVERY);
 - cage: the kernel's own `ball_loads_and_cage` (the per-ball force sums and the ball-cage
   contacts, on the velocities turned by the half step of the cage);
 - gather: the kernel's own `gather_lanes` (the lanes filled from the ball and ring state, with
@@ -42,10 +40,10 @@ from twin.jit import JIT, JIT_STEP
 from twin.kernels.contacts import raceway_forces, raceway_geometry
 from twin.kernels.layout import (
     C_LOAD, CW, E_SLIP, G_DELTA, G_LOAD, K_ORBIT, O_FX, O_TX, P_ALPHA_E,
-    P_BALL_INERTIA, P_BALL_RADIUS, P_CAGE_INERTIA, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_SUBSTEPS, P_TRACTION_EVERY,
+    P_BALL_INERTIA, P_BALL_RADIUS, P_CAGE_INERTIA, P_DT, P_KT_RATIO, P_SUBSTEPS, P_TRACTION_EVERY,
     S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED, X_CAGE_TORQUE, padded_lane_count,
 )
-from twin.kernels.step import ELECTRICAL_EVERY, FRICTION_ELLIPSE, _cos_sin, ball_loads_and_cage, gather_lanes, refresh_contact, step_n
+from twin.kernels.step import ELECTRICAL_EVERY, _cos_sin, ball_loads_and_cage, gather_lanes, refresh_contact, step_n
 from twin.kernels.traction import apply_traction_moments, ellipse_traction
 
 PASSES = ("gather", "geometry", "forces", "tribology", "traction", "cage", "integration")
@@ -68,9 +66,9 @@ def _geometry(w, nc, reps):
 
 
 @njit(**JIT_STEP)
-def _forces(w, nc, rb, dt, kt_ratio, alpha_e, traction_moments, reps):
+def _forces(w, nc, rb, dt, kt_ratio, alpha_e, reps):
     for _ in range(reps):
-        raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e, traction_moments)
+        raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e)
     return w[O_FX * CW]
 
 
@@ -167,12 +165,11 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
         return args  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, then the housing/sensor arrays
 
     scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load = copies()[:11]
-    ellipse = int(p[P_FRICTION_MODEL]) == FRICTION_ELLIPSE
     ct, st = math.cos(0.5 * p[P_DT] * scal[X_CAGE_SPEED]), math.sin(0.5 * p[P_DT] * scal[X_CAGE_SPEED])
     runs = {
         "gather": lambda n: _gather(bx, bv, bw, rx, rv, scal, w, ct, st, n),
         "geometry": lambda n: _geometry(w, nl, n),
-        "forces": lambda n: _forces(w, nl, p[P_BALL_RADIUS], p[P_DT], p[P_KT_RATIO], p[P_ALPHA_E], ellipse, n),
+        "forces": lambda n: _forces(w, nl, p[P_BALL_RADIUS], p[P_DT], p[P_KT_RATIO], p[P_ALPHA_E], n),
         "traction_moments": lambda n: _traction_moments(w, nl, n),
         "traction_solve": lambda n: _traction_solve(w, nc, p, sp[S_VISCOSITY], n),
         "tribology_no_refresh": lambda n: _tribology(p, tr, sp, w, nc, False, False, n),
@@ -199,9 +196,7 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     t0, t1, t2 = (out[k] for k in ("tribology_no_refresh", "tribology_refresh", "tribology_refresh_electrical"))
     out["tribology"] = {key: t0[key] + (t1[key] - t0[key]) / substeps
                         + (t2[key] - t1[key]) / (substeps * ELECTRICAL_EVERY) for key in ("best_ns", "median_ns")}
-    # between solves the force pass carries the strips' moments (timed with it); their own pass
-    # runs after each solve
-    out["traction"] = {key: (out["traction_moments"][key] + out["traction_solve"][key]) / traction_steps
+    out["traction"] = {key: out["traction_moments"][key] + out["traction_solve"][key] / traction_steps
                        for key in ("best_ns", "median_ns")}
     # the real step on a copy of the state
     full = copies()
