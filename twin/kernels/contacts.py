@@ -102,8 +102,8 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     open)."""
     # two loops, not one (issue 13): the kinematics (slip, entrainment, normal rate, kept in
     # their rows), then the forces; one loop held more values than the 16 vector registers and
-    # went to the stack 77 times per 4 lanes, two go 40 times (the pass 458 -> 429 ns, same
-    # operations, bitwise the same results; a third loop for the outputs was slower)
+    # went to the stack 77 times per 4 lanes, two go 40 times (with the moment pass 504 -> 461 ns
+    # in one process, same operations, bitwise the same results; a third loop was slower)
     for c in range(nc):
         nx = w[G_NX * CW + c]
         ny = w[G_NY * CW + c]
@@ -195,8 +195,7 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         wy = w[K_WY * CW + c]
         wz = w[K_WZ * CW + c]
         spin = w[K_SPIN * CW + c]
-        wn = wx * nx + wy * ny
-        spin_rel = (wn + wz * nz) - spin * nz
+        spin_rel = (wx * nx + wy * ny + wz * nz) - spin * nz
         ms = w[C_SPIN_MOMENT * CW + c]
         mp = -ms if spin_rel > 0.0 else ms
         mp = loaded * (0.0 if spin_rel == 0.0 else mp)
