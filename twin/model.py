@@ -275,9 +275,12 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_CAGE_STIFFNESS] = hertz.ball_ball_stiffness_n_m15(rb, g.cage_element_radius_m, shear,
                                                            mat.poisson_ratio)
     p[L.P_CAGE_REDUCED_MASS] = ball_mass * cage_mass_at_pitch / (ball_mass + cage_mass_at_pitch)
+    p[L.P_CAGE_STEP_COS] = math.cos(2.0 * math.pi / z)  # the step's cage pass turns element to element
+    p[L.P_CAGE_STEP_SIN] = math.sin(2.0 * math.pi / z)
     p[L.P_E_PRIME] = e_prime
     p[L.P_G_PARAM] = spec.lubricant.pressure_viscosity_pa_inv * e_prime
     p[L.P_ROUGHNESS] = spec.surface.composite_roughness_m
+    p[L.P_LN_ROUGHNESS] = math.log(spec.surface.composite_roughness_m)
     p[L.P_KT_RATIO] = options.tangential_stiffness_ratio
     p[L.P_CT_RATIO] = options.tangential_damping_ratio
     p[L.P_ALPHA_E] = options.restitution_coefficient_s_m

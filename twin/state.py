@@ -94,6 +94,10 @@ class TwinState:
         rows[L.C_H_MIN] = -1.0
         rows[L.C_H_C] = -1.0
         rows[L.G_DEFECT_DROP] = 0.0
+        # the outer ring's velocity and spin in its contacts' lanes and in the pad lanes: 0,
+        # which the gather leaves unwritten (twin.kernels.step.gather_lanes)
+        rows[L.K_OVX:L.K_SPIN + 1, 1::2] = 0.0
+        rows[L.K_OVX:L.K_SPIN + 1, 2 * self.ball_position_m.shape[0]:] = 0.0
 
     def copy(self) -> TwinState:
         """An independent copy: every array copied, plain numbers (the defect count) as they are."""

@@ -51,4 +51,33 @@ def test_no_entrainment_is_boundary_without_film_force():
     model = make_model(catalog.bearing("6208"))
     out = contact_tribology(1000.0, 0.0, 0.04, 3.75e-7, *model.race_tribology[0, :15], 0, True)
     assert out[0] == 0.0 and out[2] == 0.0 and out[3] == 1 and out[4] == 0.1
-    assert all(math.isfinite(v) for v in out)
+    # every output finite but ln h_min (issue 13: the refresh's ln Lambda), -inf for h_min = 0
+    assert all(math.isfinite(v) for v in out[:10]) and out[10] == -math.inf
+
+
+def test_asperity_share_from_the_film_logarithm():
+    """Issue 13: the refresh takes ln Lambda = ln h_min - ln sigma from contact_tribology's last
+    output (no log of Lambda). It is the logarithm of the h_min it returns (to rounding: 1e-15 of
+    |ln h| ~ 14, abs 1e-13), and the asperity share (seed 001 eq. A2) and the limiting traction
+    coefficient through it equal those from Lambda itself to 1e-13 across Lambda = 0.1-3."""
+    from twin.kernels.traction import limiting_traction_coefficient, limiting_traction_coefficient_share
+    from twin.physics.rolling import asperity_load_share, asperity_load_share_ln
+
+    model = make_model(catalog.bearing("6208"))
+    p = model.params
+    sigma = p[L.P_ROUGHNESS]
+    assert p[L.P_LN_ROUGHNESS] == math.log(sigma)
+    tr = model.race_tribology[1]
+    for q in (50.0, 700.0, 3000.0):
+        for u in (0.05, 0.5, 2.0, 7.0, 20.0):
+            out = contact_tribology(q, u, 0.02, sigma, *tr[:15], 2, True)
+            assert out[10] == pytest.approx(math.log(out[0]), abs=1e-13)
+            lam, ln_lam = out[2], out[10] - p[L.P_LN_ROUGHNESS]
+            share = asperity_load_share_ln(lam, ln_lam)
+            assert share == pytest.approx(asperity_load_share(lam), rel=1e-13, abs=1e-15)
+            assert limiting_traction_coefficient_share(lam, share, 0.06) == pytest.approx(
+                limiting_traction_coefficient(lam, 0.06), rel=1e-13)
+    lams = [float(x) for x in np.linspace(0.1, 3.0, 30)]
+    assert any(0.0 < asperity_load_share(x) < 1.0 for x in lams)
+    for x in lams:
+        assert asperity_load_share_ln(x, math.log(x)) == asperity_load_share(x)

@@ -16,7 +16,7 @@ from twin.kernels.layout import (
     C_FLUID_DAMPING, C_LAMBDA, C_MU, C_ROLLING_PER_SPEED, C_SPIN_MOMENT, C_TANGENT_DAMPING, CW,
     C_XI_DECAY, G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY, K_OVZ,
     K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_GROOVE_CENTRE_RADIUS,
-    M_GROOVE_CENTRE_Z, M_GROOVE_CLEARANCE, M_STIFFNESS, O_EX, O_EY, O_EZ, O_FX, O_FY, O_FZ,
+    M_GROOVE_CENTRE_Z, M_GROOVE_CLEARANCE, M_STIFFNESS, O_EX, O_NORMAL_RATE, O_EY, O_EZ, O_FX, O_FY, O_FZ,
     O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, T_XI0, T_XI1, T_XI2,
 )
 
@@ -97,10 +97,14 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     - seed 001 rolling resistance at the ball centre along the entrainment, and the pivoting
       moment against the spin of the ball relative to the ring about the normal.
 
-    Reads the G_*, K_*, M_STIFFNESS rows and the cached C_* rows; writes the O_* rows and the
-    spring T_XI* (reset where the contact is open)."""
+    Reads the G_*, K_*, M_STIFFNESS rows and the cached C_* rows; writes the O_* rows (with
+    O_NORMAL_RATE between its two loops) and the spring T_XI* (reset where the contact is
+    open)."""
+    # two loops, not one (issue 13): the kinematics (slip, entrainment, normal rate, kept in
+    # their rows), then the forces; one loop held more values than the 16 vector registers and
+    # went to the stack 77 times per 4 lanes, two go 40 times (with the moment pass 504 -> 461 ns
+    # in one process, same operations, bitwise the same results; a third loop was slower)
     for c in range(nc):
-        loaded = 1.0 if w[G_DELTA * CW + c] > 0.0 else 0.0
         nx = w[G_NX * CW + c]
         ny = w[G_NY * CW + c]
         nz = w[G_NZ * CW + c]
@@ -127,17 +131,26 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         sy = vby - vry
         sz = vbz - vrz
         sn = sx * nx + sy * ny + sz * nz
-        tx = sx - sn * nx
-        ty = sy - sn * ny
-        tz = sz - sn * nz
         orbit = w[K_ORBIT * CW + c]
         ex = 0.5 * (vbx + vrx) + orbit * (w[K_BY * CW + c] + rb * ny)
         ey = 0.5 * (vby + vry) - orbit * (w[K_BX * CW + c] + rb * nx)
         ez = 0.5 * (vbz + vrz)
         en = ex * nx + ey * ny + ez * nz
-        ex -= en * nx
-        ey -= en * ny
-        ez -= en * nz
+        w[O_EX * CW + c] = ex - en * nx
+        w[O_EY * CW + c] = ey - en * ny
+        w[O_EZ * CW + c] = ez - en * nz
+        w[O_SX * CW + c] = sx - sn * nx
+        w[O_SY * CW + c] = sy - sn * ny
+        w[O_SZ * CW + c] = sz - sn * nz
+        w[O_NORMAL_RATE * CW + c] = (bvx - ovx) * nx + (bvy - ovy) * ny + (bvz - ovz) * nz
+    for c in range(nc):
+        loaded = 1.0 if w[G_DELTA * CW + c] > 0.0 else 0.0
+        nx = w[G_NX * CW + c]
+        ny = w[G_NY * CW + c]
+        nz = w[G_NZ * CW + c]
+        tx = w[O_SX * CW + c]
+        ty = w[O_SY * CW + c]
+        tz = w[O_SZ * CW + c]
         # normal force with the regime damping of Table 2
         q_el = w[G_LOAD * CW + c]
         lam = w[C_LAMBDA * CW + c]
@@ -146,8 +159,7 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         c_series = c_hyst * c_fluid / (c_hyst + c_fluid + 1e-300)
         c_n = c_fluid if lam > 3.0 else c_series
         c_n = c_hyst if (lam <= 1.0 or c_fluid <= 0.0) else c_n
-        rate = (bvx - ovx) * nx + (bvy - ovy) * ny + (bvz - ovz) * nz
-        fn = loaded * max(q_el + c_n * rate, 0.0)
+        fn = loaded * max(q_el + c_n * w[O_NORMAL_RATE * CW + c], 0.0)
         # tangential spring with Coulomb limit
         kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
         xix = w[T_XI0 * CW + c]
@@ -174,32 +186,36 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         xix = -ftx * inv_kt if sliding else xix
         xiy = -fty * inv_kt if sliding else xiy
         xiz = -ftz * inv_kt if sliding else xiz
+        w[T_XI0 * CW + c] = loaded * xix
+        w[T_XI1 * CW + c] = loaded * xiy
+        w[T_XI2 * CW + c] = loaded * xiz
         # rolling resistance (seed 001) and pivoting moment
         roll = w[C_ROLLING_PER_SPEED * CW + c]
+        wx = w[K_WX * CW + c]
+        wy = w[K_WY * CW + c]
+        wz = w[K_WZ * CW + c]
+        spin = w[K_SPIN * CW + c]
         spin_rel = (wx * nx + wy * ny + wz * nz) - spin * nz
         ms = w[C_SPIN_MOMENT * CW + c]
         mp = -ms if spin_rel > 0.0 else ms
         mp = loaded * (0.0 if spin_rel == 0.0 else mp)
-        fx = -fn * nx + loaded * (ftx + roll * ex)
-        fy = -fn * ny + loaded * (fty + roll * ey)
-        fz = -fn * nz + loaded * (ftz + roll * ez)
+        fx = -fn * nx + loaded * (ftx + roll * w[O_EX * CW + c])
+        fy = -fn * ny + loaded * (fty + roll * w[O_EY * CW + c])
+        fz = -fn * nz + loaded * (ftz + roll * w[O_EZ * CW + c])
         w[O_FX * CW + c] = fx
         w[O_FY * CW + c] = fy
         w[O_FZ * CW + c] = fz
-        w[O_TX * CW + c] = loaded * rb * (ny * ftz - nz * fty) + mp * nx
-        w[O_TY * CW + c] = loaded * rb * (nz * ftx - nx * ftz) + mp * ny
-        w[O_TZ * CW + c] = loaded * rb * (nx * fty - ny * ftx) + mp * nz
-        # reaction on the ring: -F at the contact point and -M, about the ring axis
-        w[O_RING_TZ * CW + c] = -(qx * fy - qy * fx) - mp * nz
-        w[O_EX * CW + c] = ex
-        w[O_EY * CW + c] = ey
-        w[O_EZ * CW + c] = ez
-        w[O_SX * CW + c] = tx
-        w[O_SY * CW + c] = ty
-        w[O_SZ * CW + c] = tz
-        w[T_XI0 * CW + c] = loaded * xix
-        w[T_XI1 * CW + c] = loaded * xiy
-        w[T_XI2 * CW + c] = loaded * xiz
+        ox = loaded * rb * (ny * ftz - nz * fty) + mp * nx
+        oy = loaded * rb * (nz * ftx - nx * ftz) + mp * ny
+        oz = loaded * rb * (nx * fty - ny * ftx) + mp * nz
+        # reaction on the ring: -F at the contact point q and -M, about the ring axis
+        qx = w[K_PX * CW + c] + rb * nx
+        qy = w[K_PY * CW + c] + rb * ny
+        oring = -(qx * fy - qy * fx) - mp * nz
+        w[O_TX * CW + c] = ox
+        w[O_TY * CW + c] = oy
+        w[O_TZ * CW + c] = oz
+        w[O_RING_TZ * CW + c] = oring
 
 
 @njit(inline="always", **JIT)

@@ -45,7 +45,10 @@ MAX_STRIPS = 32
 # issue 14 (twin.vibration): the model's V_* vector (end of this file) at p[P_VIB + V_*]
 P_VIB = P_STRIP_TABLE + 4 * MAX_STRIPS
 N_VIB_PARAMS = 10
-N_PARAMS = P_VIB + N_VIB_PARAMS
+P_LN_ROUGHNESS = P_VIB + N_VIB_PARAMS  # ln(P_ROUGHNESS / 1 m): ln Lambda = ln h_min - this (issue 13)
+P_CAGE_STEP_COS = P_LN_ROUGHNESS + 1   # cos(2 pi / Z): turns one cage element's unit vector to the next
+P_CAGE_STEP_SIN = P_LN_ROUGHNESS + 2   # sin(2 pi / Z)
+N_PARAMS = P_CAGE_STEP_SIN + 1
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]
@@ -140,7 +143,7 @@ K_VZ = 31
 K_WX = 32     # ball angular velocity [rad/s]
 K_WY = 33
 K_WZ = 34
-K_OVX = 35    # ring centre velocity [m/s]
+K_OVX = 35    # ring centre velocity [m/s] (0 in the outer and pad lanes, never written there: step.gather_lanes)
 K_OVY = 36
 K_OVZ = 37
 K_SPIN = 38   # ring spin about +z [rad/s]
@@ -187,7 +190,8 @@ E_SCRATCH_SPREAD = 70  # half the spread of the slip across strip k [m/s]
 E_SCRATCH_SIGNED_HALF = 71  # half-width of strip k in t, signed like ds/dt across it [-]
 # local defects (twin.kernels.vibration.apply_defects, only while a defect is active)
 G_DEFECT_DROP = 75  # extra radial clearance a defect opens at the contact, taken off G_DELTA [m]
-N_ROWS = 76
+O_NORMAL_RATE = 76  # d(delta)/dt of the force pass: ball minus ring centre velocity along n [m/s]
+N_ROWS = 77
 
 # ---- the kernel workspace `w`: the N_ROWS x CW contact lanes, then (issue 14) the local defects ---
 # The defect table and the balls' orientations ride in the workspace after the lanes, so that the

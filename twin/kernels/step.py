@@ -19,16 +19,17 @@ from twin.kernels.layout import (
     G_NX, G_NY, K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, N_CACHED,
     O_EX, O_EY, O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ,
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
-    P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
+    P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_STEP_COS, P_CAGE_STEP_SIN, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
     P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
-    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
+    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_LN_ROUGHNESS, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
     P_RING_MASS, P_ROLLING, LANE_BLOCK, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_STOP, S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
     X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
     X_TORQUE_COUNT, X_TORQUE_SUM,
 )
-from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient
+from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient_share
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
+from twin.physics.rolling import asperity_load_share_ln
 # ---- issue 14 (vibration): housing, local defects, accelerometer; hooks marked "issue 14" below --
 from twin.kernels.layout import P_VIB, V_DECIMATION_RATIO, V_HOUSING_ON, X_DEFECT_COUNT
 from twin.kernels.vibration import (apply_defects, defect_table, has_ball_defect, integrate_orientations,
@@ -82,43 +83,99 @@ def _cos_sin(x):
 
 
 @njit(inline="always", **JIT_STEP)
-def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                          tribology_now, electrical_now, traction_now, ct, st):
-    """Forces and torques of every contact at the current positions -> accelerations of the
-    balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
+def refresh_contact(p, tr, w, c, q_el, eta, electrical_now):
+    """Tribology refresh of loaded contact c (load q_el [N], viscosity eta [Pa s]): its Hertz
+    stiffness (lane M_STIFFNESS, read by the next geometry pass) and film constants at its
+    current contact angle from the model's angle table `tr` (`twin.model.make_angle_table`,
+    linear in |sin alpha| = |n_z|), then `contact_tribology` (seed 000 eqs. 5-7, Table 2, seed
+    001 eqs. 1-5, 9, 11), the limiting friction coefficient, the tangential damping and spring
+    relaxation, the slide-to-roll ratio and, when `electrical_now` (or the contact has just
+    closed), its parallel RC (`contact_electrical`). Writes the contact's C_* lanes.
 
-    Ball-raceway contacts: gather the kinematics into the lanes of `w`, one vectorised geometry
-    pass, one vectorised force pass, then per ball: sum the forces, refresh the tribology of
-    loaded contacts when `tribology_now` (or when a contact closes), clear opened contacts.
-    The refresh takes each contact's Hertz stiffness (its lane M_STIFFNESS, read by the next
-    geometry pass) and film constants at its current contact angle from the model's angle table
-    `tr` (`twin.model.make_angle_table`, linear in |sin alpha| = |n_z|).
+    With the ellipse friction the asperity share (seed 001 eq. A2) takes ln Lambda = ln h_min -
+    ln sigma from the film's own logarithm (`contact_tribology`'s last output), not another
+    logarithm (issue 13)."""
+    friction_model = int(p[P_FRICTION_MODEL])
+    r = c & 1
+    # Hertz and film constants at the contact's current angle (angle table row i, i + 1)
+    xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
+    ia = min(int(xa), ANGLE_POINTS - 2)
+    fa = xa - ia
+    w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
+    ex = w[O_EX * CW + c]
+    ey = w[O_EY * CW + c]
+    ez = w[O_EZ * CW + c]
+    u2 = ex * ex + ey * ey + ez * ez
+    u = math.sqrt(u2)
+    t = A_TRIBOLOGY
+    tri = contact_tribology(
+        q_el, u, eta, p[P_ROUGHNESS], _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
+        _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
+        _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
+        _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
+        _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
+        _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
+        _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
+        _at_angle(tr, r, ia, fa, t + 14), friction_model, p[P_ROLLING] != 0.0)
+    w[C_H_MIN * CW + c] = tri[0]
+    w[C_H_C * CW + c] = tri[1]
+    w[C_LAMBDA * CW + c] = tri[2]
+    w[C_REGIME * CW + c] = tri[3]
+    # the contact's limiting friction coefficient: the Coulomb law's mu, or with the ellipse
+    # friction its traction capacity over Q (not the effective |F_t| / Q it publishes)
+    if friction_model == FRICTION_ELLIPSE:
+        share = asperity_load_share_ln(tri[2], tri[10] - p[P_LN_ROUGHNESS])
+        mu_lim = limiting_traction_coefficient_share(tri[2], share, p[P_LIMITING_SHEAR])
+    else:
+        mu_lim = tri[4]
+    w[C_MU * CW + c] = mu_lim
+    w[C_SEMI_MAJOR * CW + c] = tri[5]
+    w[C_SEMI_MINOR * CW + c] = tri[6]
+    w[C_FLUID_DAMPING * CW + c] = tri[7]
+    w[C_ROLLING_FORCE * CW + c] = tri[8]
+    w[C_ROLLING_PER_SPEED * CW + c] = tri[8] / max(u, ROLLING_REGULARISATION_SPEED)
+    w[C_SPIN_MOMENT * CW + c] = tri[9]
+    kt = p[P_KT_RATIO] * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
+    w[C_TANGENT_DAMPING * CW + c] = p[P_CT_RATIO] * 2.0 * math.sqrt(kt * p[P_BALL_REDUCED_TANGENT_MASS])
+    w[C_ENTRAINMENT * CW + c] = u
+    # tangential spring relaxation (contacts.raceway_forces): by rolling over L = sqrt(a b)
+    # and by the spin sliding of the contact, kt |w_spin| sqrt(a b) / (1.3 mu Q) with mu the
+    # limiting coefficient of the fully sliding traction (mu_lim)
+    ab = math.sqrt(tri[5] * tri[6])
+    spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
+                   + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
+    relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
+    w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
+    w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
+                          + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
+    if not (electrical_now or w[C_CAPACITANCE * CW + c] == 0.0):
+        return  # the RC keeps its last value between electrical refreshes
+    if tri[1] > 0.0:
+        res_ohm, cap_f = contact_electrical(
+            q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
+            _at_angle(tr, r, ia, fa, t + T_RY),
+            p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER], p[P_ASPERITY_RESISTANCE],
+            p[P_OIL_RESISTIVITY])
+    else:  # no film (no entrainment): metallic contact, no dielectric
+        res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
+    w[C_RESISTANCE * CW + c] = res_ohm
+    w[C_CAPACITANCE * CW + c] = cap_f
 
-    The forces see the balls' velocities and angular velocities turned about the axis by the
-    angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
-    (1, 0) for none), as they are read: bv and bw themselves are left as they are.
 
-    Issue 14: positions and velocities are those relative to the outer ring (`step_n` shifts
-    them with the housing on); the active defect rows (scal[X_DEFECT_COUNT] of them in the
-    workspace after the lanes, twin.kernels.layout W_DEFECTS) open their clearance between the
-    geometry and the force pass (`twin.kernels.vibration.apply_defects`).
-    Returns a status code."""
+@njit(inline="always", **JIT_STEP)
+def gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st):
+    """The kinematics of every ball-raceway contact into its lanes of `w` (K_* rows, c = 2 j + r;
+    r = 0 inner ring, r = 1 fixed outer ring): ball centre relative to the ring and in the world
+    frame, the ball's velocity and angular velocity turned by (ct, st) (`compute_accelerations`),
+    the ring's velocity and spin, the ball's orbital speed; then the pad lanes. Returns the
+    padded lane count. The outer and pad lanes' ring velocity and spin (K_OVX..K_SPIN) are not written:
+    the outer ring is fixed (or the frame is its own, issue 14), they hold the 0 that
+    `twin.state.make_state` and `TwinState.clear_contacts` put there (issue 13: 4 Z stores per
+    step fewer)."""
     z = bx.shape[0]
     nc = 2 * z
-    rb = p[P_BALL_RADIUS]
-    m = p[P_BALL_MASS]
-    inertia = p[P_BALL_INERTIA]
-    kt_ratio = p[P_KT_RATIO]
-    ct_ratio = p[P_CT_RATIO]
-    tangent_mass = p[P_BALL_REDUCED_TANGENT_MASS]
-    friction_model = int(p[P_FRICTION_MODEL])
-    rolling_on = p[P_ROLLING] != 0.0
-    roughness = p[P_ROUGHNESS]
     ring_speed = scal[X_SHAFT_SPEED]
-    cage_speed = scal[X_CAGE_SPEED]
-    eta = sp[S_VISCOSITY]
-    # gather (c = 2 j + r; r = 0 inner ring, r = 1 fixed outer ring); the ring's state is read
-    # once (the compiler cannot keep it in registers across stores to w, which it may alias)
+    # the ring's state is read once (the compiler cannot keep it in registers across stores to w, which it may alias)
     rx0 = rx[0]
     rx1 = rx[1]
     rx2 = rx[2]
@@ -162,119 +219,66 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         w[K_WZ * CW + ci] = w2
         w[K_WZ * CW + co] = w2
         w[K_OVX * CW + ci] = rv0
-        w[K_OVX * CW + co] = 0.0
         w[K_OVY * CW + ci] = rv1
-        w[K_OVY * CW + co] = 0.0
         w[K_OVZ * CW + ci] = rv2
-        w[K_OVZ * CW + co] = 0.0
         w[K_SPIN * CW + ci] = ring_speed
-        w[K_SPIN * CW + co] = 0.0
         w[K_ORBIT * CW + ci] = orbital
         w[K_ORBIT * CW + co] = orbital
-    # pad lanes up to a whole number of vectors: a copy of the last contact, so that the lane
-    # passes run without a scalar remainder on finite values nobody reads (twin.kernels.layout)
+    # pad lanes up to a whole number of vectors: a copy of the last contact (the last ball's
+    # outer one, from the registers), so that the lane passes run without a scalar remainder on
+    # finite values nobody reads (twin.kernels.layout); their ring velocity and spin are 0 too
     nl = (nc + LANE_BLOCK - 1) // LANE_BLOCK * LANE_BLOCK  # layout.padded_lane_count
     for c in range(nc, nl):
-        for k in range(K_PX, K_ORBIT + 1):
-            w[k * CW + c] = w[k * CW + nc - 1]
-    raceway_geometry(w, nl)
-    if scal[X_DEFECT_COUNT] > 0.0:  # issue 14: local defects
-        apply_defects(w, nc, int(scal[X_DEFECT_COUNT]), scal[X_SHAFT_ANGLE], p, rb)
-    raceway_forces(w, nl, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
-    # per contact: outputs, tribology refresh, opened contacts
-    max_pen = scal[X_MAX_PENETRATION]
-    for c in range(nc):
-        delta = w[G_DELTA * CW + c]
-        if delta <= 0.0:
-            if w[C_LAMBDA * CW + c] != -1.0 or w[C_LOAD * CW + c] != 0.0:
-                for k in range(N_CACHED):
-                    w[k * CW + c] = 0.0
-                w[C_LAMBDA * CW + c] = -1.0
-                w[C_H_MIN * CW + c] = -1.0
-                w[C_H_C * CW + c] = -1.0
-            continue
-        if delta > max_pen:
-            max_pen = delta
-        q_el = w[G_LOAD * CW + c]
-        w[C_LOAD * CW + c] = q_el
-        if tribology_now or w[C_LAMBDA * CW + c] < 0.0:
-            r = c & 1
-            # Hertz and film constants at the contact's current angle (angle table row i, i + 1)
-            xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
-            ia = min(int(xa), ANGLE_POINTS - 2)
-            fa = xa - ia
-            w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
-            ex = w[O_EX * CW + c]
-            ey = w[O_EY * CW + c]
-            ez = w[O_EZ * CW + c]
-            u2 = ex * ex + ey * ey + ez * ez
-            u = math.sqrt(u2)
-            t = A_TRIBOLOGY
-            tri = contact_tribology(
-                q_el, u, eta, roughness, _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
-                _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
-                _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
-                _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
-                _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
-                _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
-                _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
-                _at_angle(tr, r, ia, fa, t + 14), friction_model, rolling_on)
-            w[C_H_MIN * CW + c] = tri[0]
-            w[C_H_C * CW + c] = tri[1]
-            w[C_LAMBDA * CW + c] = tri[2]
-            w[C_REGIME * CW + c] = tri[3]
-            # the contact's limiting friction coefficient: the Coulomb law's mu, or with the ellipse
-            # friction its traction capacity over Q (not the effective |F_t| / Q it publishes)
-            mu_lim = (limiting_traction_coefficient(tri[2], p[P_LIMITING_SHEAR])
-                      if friction_model == FRICTION_ELLIPSE else tri[4])
-            w[C_MU * CW + c] = mu_lim
-            w[C_SEMI_MAJOR * CW + c] = tri[5]
-            w[C_SEMI_MINOR * CW + c] = tri[6]
-            w[C_FLUID_DAMPING * CW + c] = tri[7]
-            w[C_ROLLING_FORCE * CW + c] = tri[8]
-            w[C_ROLLING_PER_SPEED * CW + c] = tri[8] / max(u, ROLLING_REGULARISATION_SPEED)
-            w[C_SPIN_MOMENT * CW + c] = tri[9]
-            kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
-            w[C_TANGENT_DAMPING * CW + c] = ct_ratio * 2.0 * math.sqrt(kt * tangent_mass)
-            w[C_ENTRAINMENT * CW + c] = u
-            # tangential spring relaxation (contacts.raceway_forces): by rolling over L = sqrt(a b)
-            # and by the spin sliding of the contact, kt |w_spin| sqrt(a b) / (1.3 mu Q) with mu the
-            # limiting coefficient of the fully sliding traction (mu_lim)
-            ab = math.sqrt(tri[5] * tri[6])
-            spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
-                           + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
-            relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
-            w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
-            w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
-                                  + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
-            if not (electrical_now or w[C_CAPACITANCE * CW + c] == 0.0):
-                continue  # the RC keeps its last value between electrical refreshes
-            if tri[1] > 0.0:
-                res_ohm, cap_f = contact_electrical(
-                    q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
-                    _at_angle(tr, r, ia, fa, t + T_RY),
-                    p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER], p[P_ASPERITY_RESISTANCE],
-                    p[P_OIL_RESISTIVITY])
-            else:  # no film (no entrainment): metallic contact, no dielectric
-                res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
-            w[C_RESISTANCE * CW + c] = res_ohm
-            w[C_CAPACITANCE * CW + c] = cap_f
-    scal[X_MAX_PENETRATION] = max_pen
-    if friction_model == FRICTION_ELLIPSE:  # friction over the contact ellipse (twin.kernels.traction)
-        if traction_now:
-            ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
-        apply_traction_moments(w, nl)
-    inv_inertia = 1.0 / inertia  # multiplications, not 6 Z divisions per step
+        w[K_PX * CW + c] = x0
+        w[K_PY * CW + c] = x1
+        w[K_PZ * CW + c] = x2
+        w[K_BX * CW + c] = x0
+        w[K_BY * CW + c] = x1
+        w[K_VX * CW + c] = v0
+        w[K_VY * CW + c] = v1
+        w[K_VZ * CW + c] = v2
+        w[K_WX * CW + c] = w0
+        w[K_WY * CW + c] = w1
+        w[K_WZ * CW + c] = w2
+        w[K_ORBIT * CW + c] = orbital
+    return nl
+
+
+@njit(inline="always", **JIT_STEP)
+def ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st):
+    """Per ball, in one pass: the raceway contacts' forces and torques summed into the ball's
+    accelerations (seed 000 eq. 9; ba, balpha), its two cage contacts (`cage_contact`, seed 000
+    eq. 3: the cage elements on either side of it, element e at the cage angle + (e + 1/2) 2 pi / Z,
+    their unit vectors turned along by the model's P_CAGE_STEP_COS/SIN), loads in `cage_load`.
+    The balls' velocities are turned by (ct, st) as `compute_accelerations` reads them.
+    Returns the force of the balls on the inner ring (x, y, z) [N], the contacts' torque on the
+    inner ring about its axis [N m] and the cage torque [N m]."""
+    z = bx.shape[0]
+    inv_inertia = 1.0 / p[P_BALL_INERTIA]  # multiplications, not 6 Z divisions per step
+    inv_m = 1.0 / p[P_BALL_MASS]
+    rc = p[P_CAGE_RADIUS]
+    s_cage = p[P_CAGE_CONTACT_DISTANCE]
+    k_cage = p[P_CAGE_STIFFNESS]
+    m_cage = p[P_CAGE_REDUCED_MASS]
+    cage_speed = scal[X_CAGE_SPEED]
+    c_step = p[P_CAGE_STEP_COS]
+    s_step = p[P_CAGE_STEP_SIN]
+    theta = scal[X_CAGE_ANGLE] - 0.5 * (2.0 * math.pi / z)  # element j - 1 of ball 0
+    prev_c = math.cos(theta)
+    prev_s = math.sin(theta)
+    first_c = prev_c
+    first_s = prev_s
     ring_fx = 0.0
     ring_fy = 0.0
     ring_fz = 0.0
     ring_tz = 0.0
+    cage_tz = 0.0
     for j in range(z):
         ci = 2 * j
         co = ci + 1
-        ba[j, 0] = w[O_FX * CW + ci] + w[O_FX * CW + co]
-        ba[j, 1] = w[O_FY * CW + ci] + w[O_FY * CW + co]
-        ba[j, 2] = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
+        fx = w[O_FX * CW + ci] + w[O_FX * CW + co]
+        fy = w[O_FY * CW + ci] + w[O_FY * CW + co]
+        fz = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
         balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) * inv_inertia
         balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) * inv_inertia
         balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) * inv_inertia
@@ -282,25 +286,6 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         ring_fy -= w[O_FY * CW + ci]
         ring_fz -= w[O_FZ * CW + ci]
         ring_tz += w[O_RING_TZ * CW + ci]
-    # cage elements: element e sits at theta + (e + 1/2) step; rotate a unit vector along
-    rc = p[P_CAGE_RADIUS]
-    s_cage = p[P_CAGE_CONTACT_DISTANCE]
-    k_cage = p[P_CAGE_STIFFNESS]
-    m_cage = p[P_CAGE_REDUCED_MASS]
-    step_angle = 2.0 * math.pi / z
-    c_step = math.cos(step_angle)
-    s_step = math.sin(step_angle)
-    theta = scal[X_CAGE_ANGLE] - 0.5 * step_angle  # element j - 1 of ball 0
-    prev_c = math.cos(theta)
-    prev_s = math.sin(theta)
-    first_c = prev_c
-    first_s = prev_s
-    cage_tz = 0.0
-    inv_m = 1.0 / m
-    for j in range(z):
-        fx = ba[j, 0]
-        fy = ba[j, 1]
-        fz = ba[j, 2]
         v0 = ct * bv[j, 0] - st * bv[j, 1]
         v1 = st * bv[j, 0] + ct * bv[j, 1]
         next_c = prev_c * c_step - prev_s * s_step
@@ -323,6 +308,66 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         ba[j, 0] = fx * inv_m
         ba[j, 1] = fy * inv_m
         ba[j, 2] = fz * inv_m
+    return ring_fx, ring_fy, ring_fz, ring_tz, cage_tz
+
+
+@njit(inline="always", **JIT_STEP)
+def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
+                          tribology_now, electrical_now, traction_now, ct, st):
+    """Forces and torques of every contact at the current positions -> accelerations of the
+    balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
+
+    Ball-raceway contacts: gather the kinematics into the lanes of `w`, one vectorised geometry
+    pass, one vectorised force pass, then per ball: sum the forces, refresh the tribology of
+    loaded contacts when `tribology_now` (or when a contact closes, `refresh_contact`), clear
+    opened contacts.
+
+    The forces see the balls' velocities and angular velocities turned about the axis by the
+    angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
+    (1, 0) for none), as they are read: bv and bw themselves are left as they are.
+
+    Issue 14: positions and velocities are those relative to the outer ring (`step_n` shifts
+    them with the housing on); the active defect rows (scal[X_DEFECT_COUNT] of them in the
+    workspace after the lanes, twin.kernels.layout W_DEFECTS) open their clearance between the
+    geometry and the force pass (`twin.kernels.vibration.apply_defects`).
+    Returns a status code."""
+    z = bx.shape[0]
+    nc = 2 * z
+    rb = p[P_BALL_RADIUS]
+    inertia = p[P_BALL_INERTIA]
+    kt_ratio = p[P_KT_RATIO]
+    friction_model = int(p[P_FRICTION_MODEL])
+    eta = sp[S_VISCOSITY]
+    nl = gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st)
+    raceway_geometry(w, nl)
+    if scal[X_DEFECT_COUNT] > 0.0:  # issue 14: local defects
+        apply_defects(w, nc, int(scal[X_DEFECT_COUNT]), scal[X_SHAFT_ANGLE], p, rb)
+    raceway_forces(w, nl, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
+    # per contact: outputs, tribology refresh, opened contacts
+    max_pen = scal[X_MAX_PENETRATION]
+    for c in range(nc):
+        delta = w[G_DELTA * CW + c]
+        if delta <= 0.0:
+            if w[C_LAMBDA * CW + c] != -1.0 or w[C_LOAD * CW + c] != 0.0:
+                for k in range(N_CACHED):
+                    w[k * CW + c] = 0.0
+                w[C_LAMBDA * CW + c] = -1.0
+                w[C_H_MIN * CW + c] = -1.0
+                w[C_H_C * CW + c] = -1.0
+            continue
+        if delta > max_pen:
+            max_pen = delta
+        q_el = w[G_LOAD * CW + c]
+        w[C_LOAD * CW + c] = q_el
+        if tribology_now or w[C_LAMBDA * CW + c] < 0.0:
+            refresh_contact(p, tr, w, c, q_el, eta, electrical_now)
+    scal[X_MAX_PENETRATION] = max_pen
+    if friction_model == FRICTION_ELLIPSE:  # friction over the contact ellipse (twin.kernels.traction)
+        if traction_now:
+            ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
+        apply_traction_moments(w, nl)
+    ring_fx, ring_fy, ring_fz, ring_tz, cage_tz = ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w,
+                                                                      cage_load, ct, st)
     inv_mr = 1.0 / p[P_RING_MASS]
     ra[0] = (ring_fx + sp[S_RADIAL_LOAD]) * inv_mr
     ra[1] = ring_fy * inv_mr

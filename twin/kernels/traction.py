@@ -65,10 +65,18 @@ def limiting_traction_coefficient(film_parameter, limiting_shear_coefficient):
     coefficient: the tangential spring's Coulomb limit (C_MU) and the mu of the fully sliding
     traction that the spin-creep relaxation linearises (twin.kernels.step). In full film
     (Lambda >= 2.26, no asperity share) it is gamma without evaluating a power."""
-    share = asperity_load_share(film_parameter)
-    if share == 0.0:
+    return limiting_traction_coefficient_share(film_parameter, asperity_load_share(film_parameter),
+                                               limiting_shear_coefficient)
+
+
+@njit(inline="always", **JIT)
+def limiting_traction_coefficient_share(film_parameter, asperity_share, limiting_shear_coefficient):
+    """`limiting_traction_coefficient` given the asperity load share Qa/Q(Lambda) (seed 001
+    eq. A2) the caller already holds (the tribology refresh takes it from ln Lambda, the strip
+    solve needs it anyway): Qa/Q mu(Lambda) + (1 - Qa/Q) gamma, gamma itself without a share."""
+    if asperity_share == 0.0:
         return limiting_shear_coefficient
-    return traction_capacity(share, stribeck_line_mu(film_parameter), limiting_shear_coefficient)
+    return traction_capacity(asperity_share, stribeck_line_mu(film_parameter), limiting_shear_coefficient)
 
 
 @njit(**JIT)
@@ -95,7 +103,7 @@ def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
         lam = w[C_LAMBDA * CW + c]
         share = asperity_load_share(lam)
         mu_a = stribeck_line_mu(lam)
-        capacity = limiting_traction_coefficient(lam, gamma)  # as the tribology refresh set it
+        capacity = limiting_traction_coefficient_share(lam, share, gamma)  # as the tribology refresh set it
         w[C_MU * CW + c] = capacity
         q = w[C_LOAD * CW + c]
         # net tangential force on the ball: the elastic part of the tangential spring
@@ -290,13 +298,28 @@ def _rolling_direction(w, c, nx, ny, nz):
 
 
 @njit(inline="always", **JIT_VECTOR)
+def traction_moment_lane(w, c, loaded, nx, ny, nz, spin):
+    """The strips' moment on the ball of lane c (module docstring), branch-free: the moment
+    along t2 as solved (world frame; the contact frame turns by the ball's orbit, about 1 deg,
+    between two solves) plus the spin moment along the current normal n, linear in the current
+    relative spin rate `spin` (ball minus ring, about n) about its value at the last solve and
+    clipped to the all-sliding moment. `loaded`: 1.0 for a closed contact, 0.0 for an open one.
+    Returns (mx, my, mz) [N m]; the ring takes -mz about its axis."""
+    cap = w[E_SPIN_CAP * CW + c]
+    mn = w[E_SPIN_MOMENT * CW + c] + w[E_SPIN_SLOPE * CW + c] * (spin - w[E_SPIN_RATE * CW + c])
+    mn = min(max(mn, -cap), cap)
+    mx = loaded * (w[E_M2X * CW + c] + mn * nx)
+    my = loaded * (w[E_M2Y * CW + c] + mn * ny)
+    mz = loaded * (w[E_M2Z * CW + c] + mn * nz)
+    return mx, my, mz
+
+
+@njit(inline="always", **JIT_VECTOR)
 def apply_traction_moments(w, nc):
-    """Every step (vectorised, branch-free): add the strips' moment about the contact centre to
-    the ball torque (O_T*) and its reaction to the ring's torque about its axis (O_RING_TZ):
-    the moment along t2 as solved (world frame; the contact frame turns by the ball's orbit,
-    about 1 deg, between two solves) plus the spin moment along the current n, linear in the
-    current relative spin rate about its value at the last solve and clipped to the all-sliding
-    moment."""
+    """Every lane (vectorised, branch-free): add the strips' moment about the contact centre
+    (`traction_moment_lane`) to the ball torque (O_T*) and its reaction to the ring's torque
+    about its axis (O_RING_TZ). A pass of its own: carried in the force pass's loop (with the
+    force pass's runtime flag) it cost more than it saved (issue 13)."""
     for c in range(nc):
         loaded = 1.0 if w[G_DELTA * CW + c] > 0.0 else 0.0
         nx = w[G_NX * CW + c]
@@ -304,12 +327,7 @@ def apply_traction_moments(w, nc):
         nz = w[G_NZ * CW + c]
         spin = (w[K_WX * CW + c] * nx + w[K_WY * CW + c] * ny
                 + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * nz)
-        cap = w[E_SPIN_CAP * CW + c]
-        mn = w[E_SPIN_MOMENT * CW + c] + w[E_SPIN_SLOPE * CW + c] * (spin - w[E_SPIN_RATE * CW + c])
-        mn = min(max(mn, -cap), cap)
-        mx = loaded * (w[E_M2X * CW + c] + mn * nx)
-        my = loaded * (w[E_M2Y * CW + c] + mn * ny)
-        mz = loaded * (w[E_M2Z * CW + c] + mn * nz)
+        mx, my, mz = traction_moment_lane(w, c, loaded, nx, ny, nz, spin)
         w[O_TX * CW + c] += mx
         w[O_TY * CW + c] += my
         w[O_TZ * CW + c] += mz

@@ -86,15 +86,16 @@ def contact_tribology(load_n, entrainment_m_s, viscosity_pa_s, roughness_m, t0, 
     A1-A2); t0..t14 = race_tribology[r, :].
 
     Returns (h_min [m], h_c [m], Lambda, regime code, mu, a [m], b [m], C_fluid [N s/m],
-    rolling force [N], pivoting moment [N m]). Without entrainment (u <= 0) the film is zero:
-    boundary lubrication, hysteretic damping only."""
+    rolling force [N], pivoting moment [N m], ln(h_min / 1 m)); the last lets the caller take
+    ln Lambda = ln h_min - ln sigma without another logarithm (issue 13). Without entrainment
+    (u <= 0) the film is zero: boundary lubrication, hysteretic damping only (ln h_min = -inf)."""
     ln_q = math.log(load_n)
     cube = math.exp(ln_q / 3.0)
     a = t6 * cube
     b = t7 * cube
     eu = viscosity_pa_s * entrainment_m_s
     if not (eu > 0.0):
-        return 0.0, 0.0, 0.0, regime_code(0.0), _mu(0.0, friction_model), a, b, 0.0, 0.0, 0.0
+        return 0.0, 0.0, 0.0, regime_code(0.0), _mu(0.0, friction_model), a, b, 0.0, 0.0, 0.0, -math.inf
     ln_eu = math.log(eu)
     ln_h = t0 + t1 * ln_eu + t2 * ln_q
     h_min = math.exp(ln_h)
@@ -111,7 +112,7 @@ def contact_tribology(load_n, entrainment_m_s, viscosity_pa_s, roughness_m, t0, 
         share = m / (1.0 + m)
         fr = (1.0 - share) * f_ivr + share * f_ehl + math.exp(t12 + t13 * ln_q)
         mp = t14 * mu * load_n * a
-    return h_min, h_c, lam, regime_code(lam), mu, a, b, c_fluid, fr, mp
+    return h_min, h_c, lam, regime_code(lam), mu, a, b, c_fluid, fr, mp, ln_h
 
 
 @njit(**JIT)

@@ -208,8 +208,20 @@ def asperity_load_share(film_parameter_lambda):
         return 1.0
     if lam >= LAMBDA_ASPERITY_FIT_MIN:
         return 0.0
-    ln_lam = math.log(lam)  # one log and two exps: cheaper than two general powers
-    share = 1.0 - 1.21 * math.exp(0.64 * ln_lam) / (1.0 + 0.37 * math.exp(1.26 * ln_lam))
+    return asperity_load_share_ln(lam, math.log(lam))
+
+
+@njit(**JIT)
+def asperity_load_share_ln(film_parameter_lambda, ln_lambda):
+    """`asperity_load_share` (seed 001 eq. A2) given ln Lambda as well: the tribology refresh has
+    it from the film's logarithm (twin.kernels.tribology), and saves the logarithm (issue 13).
+    Two exps: cheaper than two general powers."""
+    lam = film_parameter_lambda
+    if not (lam > 0.0):
+        return 1.0
+    if lam >= LAMBDA_ASPERITY_FIT_MIN:
+        return 0.0
+    share = 1.0 - 1.21 * math.exp(0.64 * ln_lambda) / (1.0 + 0.37 * math.exp(1.26 * ln_lambda))
     if share < 0.0:
         return 0.0
     if share > 1.0:

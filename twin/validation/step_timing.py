@@ -9,17 +9,20 @@ time of the calling thread (what the pass costs, not the waits for a core on a s
 - geometry, forces: the kernel's own `raceway_geometry` and `raceway_forces` on the lanes padded
   to whole vectors as the step runs them (`layout.padded_lane_count`);
 - tribology: the kernel's per-contact pass (copy of its loop) with the kernel's own
-  `contact_tribology` and `contact_electrical`, timed without refresh, with the tribology
-  refresh and with the electrical refresh too; per step it costs the first plus the refreshes
+  `refresh_contact`, timed without refresh, with the tribology refresh and with the electrical
+  refresh too (every refreshed contact gets its RC then: with `electrical_now` False the
+  kernel still refreshes an RC that is 0); per step it costs the first plus the refreshes
   divided by their periods in steps (the model's tribology sub-rate, x ELECTRICAL_EVERY);
 - traction: the kernel's own `apply_traction_moments` (every step) plus its `ellipse_traction`
   (the strip solve) divided by its period in steps (tribology sub-rate x P_TRACTION_EVERY);
-- gather (the lanes filled from the ball and ring state), cage (the per-ball force sums and the
-  ball-cage contacts with the kernel's own `cage_contact`, on the velocities turned by the half
-  step of the cage) and integration (the leapfrog kicks and drifts of `step_n` and the turn's
-  cosine and sine): copies of the kernel's inline loops.
+- cage: the kernel's own `ball_loads_and_cage` (the per-ball force sums and the ball-cage
+  contacts, on the velocities turned by the half step of the cage);
+- gather: the kernel's own `gather_lanes` (the lanes filled from the ball and ring state, with
+  the pad lanes);
+- integration (the leapfrog kicks and drifts of `step_n` and the turn's cosine and sine): a copy
+  of the kernel's inline loop.
 
-The copies mirror `twin/kernels/step.py` as of this writing; `total` is `step_n` itself, so the
+The integration copy mirrors `twin/kernels/step.py` as of this writing; `total` is `step_n` itself, so the
 sum of the passes against `total` shows how far the harness is from the real step (call
 overheads and what LLVM fuses or hoists across passes).
 """
@@ -34,63 +37,23 @@ import time
 from numba import njit
 
 from twin.jit import JIT, JIT_STEP
-from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
+from twin.kernels.contacts import raceway_forces, raceway_geometry
 from twin.kernels.layout import (
-    A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, C_XI_DECAY, G_NX, G_NY, G_NZ,
-    C_CAPACITANCE, C_ENTRAINMENT, C_FLUID_DAMPING, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
-    C_RESISTANCE, C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT,
-    C_SRR, C_TANGENT_DAMPING, CW, E_SLIP, G_DELTA, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
-    K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, O_EX, O_EY,
-    O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, P_ALPHA_E,
-    P_ASPERITY_RESISTANCE, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
-    P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS, P_CAGE_STIFFNESS,
-    P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_KT_RATIO, P_LIMITING_SHEAR,
-    P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY, P_ROLLING, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY,
-    S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED, X_CAGE_TORQUE, X_SHAFT_SPEED, padded_lane_count,
+    C_LOAD, CW, E_SLIP, G_DELTA, G_LOAD, K_ORBIT, O_FX, O_TX, P_ALPHA_E,
+    P_BALL_INERTIA, P_BALL_RADIUS, P_CAGE_INERTIA, P_DT, P_KT_RATIO, P_SUBSTEPS, P_TRACTION_EVERY,
+    S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED, X_CAGE_TORQUE, padded_lane_count,
 )
-from twin.kernels.step import (ELECTRICAL_EVERY, FRICTION_ELLIPSE, ROLLING_REGULARISATION_SPEED,
-                               SPIN_CREEP_FACTOR, _at_angle, _cos_sin, step_n)
-from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient
-from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
+from twin.kernels.step import ELECTRICAL_EVERY, _cos_sin, ball_loads_and_cage, gather_lanes, refresh_contact, step_n
+from twin.kernels.traction import apply_traction_moments, ellipse_traction
 
 PASSES = ("gather", "geometry", "forces", "tribology", "traction", "cage", "integration")
 
 
 @njit(**JIT_STEP)
 def _gather(bx, bv, bw, rx, rv, scal, w, ct, st, reps):
-    z = bx.shape[0]
     acc = 0.0
     for _ in range(reps):
-        ring_speed = scal[X_SHAFT_SPEED]
-        for j in range(z):
-            x0 = bx[j, 0]
-            x1 = bx[j, 1]
-            x2 = bx[j, 2]
-            v0 = ct * bv[j, 0] - st * bv[j, 1]
-            v1 = st * bv[j, 0] + ct * bv[j, 1]
-            w0 = ct * bw[j, 0] - st * bw[j, 1]
-            w1 = st * bw[j, 0] + ct * bw[j, 1]
-            rho2 = x0 * x0 + x1 * x1
-            orbital = (x0 * v1 - x1 * v0) / rho2 if rho2 > 0.0 else 0.0
-            for r in range(2):
-                c = 2 * j + r
-                inner = r == 0
-                w[K_PX * CW + c] = x0 - rx[0] if inner else x0
-                w[K_PY * CW + c] = x1 - rx[1] if inner else x1
-                w[K_PZ * CW + c] = x2 - rx[2] if inner else x2
-                w[K_BX * CW + c] = x0
-                w[K_BY * CW + c] = x1
-                w[K_VX * CW + c] = v0
-                w[K_VY * CW + c] = v1
-                w[K_VZ * CW + c] = bv[j, 2]
-                w[K_WX * CW + c] = w0
-                w[K_WY * CW + c] = w1
-                w[K_WZ * CW + c] = bw[j, 2]
-                w[K_OVX * CW + c] = rv[0] if inner else 0.0
-                w[K_OVY * CW + c] = rv[1] if inner else 0.0
-                w[K_OVZ * CW + c] = rv[2] if inner else 0.0
-                w[K_SPIN * CW + c] = ring_speed if inner else 0.0
-                w[K_ORBIT * CW + c] = orbital
+        gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st)
         acc += w[K_ORBIT * CW]
     return acc
 
@@ -111,12 +74,6 @@ def _forces(w, nc, rb, dt, kt_ratio, alpha_e, reps):
 
 @njit(**JIT_STEP)
 def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
-    kt_ratio = p[P_KT_RATIO]
-    ct_ratio = p[P_CT_RATIO]
-    tangent_mass = p[P_BALL_REDUCED_TANGENT_MASS]
-    friction_model = int(p[P_FRICTION_MODEL])
-    rolling_on = p[P_ROLLING] != 0.0
-    roughness = p[P_ROUGHNESS]
     eta = sp[S_VISCOSITY]
     max_pen = 0.0
     for _ in range(reps):
@@ -129,63 +86,7 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
             q_el = w[G_LOAD * CW + c]
             w[C_LOAD * CW + c] = q_el
             if tribology_now:
-                r = c & 1
-                # Hertz and film constants at the contact's current angle (angle table rows i, i + 1)
-                xa = min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN) * ANGLE_INV_STEP
-                ia = min(int(xa), ANGLE_POINTS - 2)
-                fa = xa - ia
-                w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
-                ex = w[O_EX * CW + c]
-                ey = w[O_EY * CW + c]
-                ez = w[O_EZ * CW + c]
-                u2 = ex * ex + ey * ey + ez * ez
-                u = math.sqrt(u2)
-                t = A_TRIBOLOGY
-                tri = contact_tribology(
-                    q_el, u, eta, roughness, _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
-                    _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
-                    _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
-                    _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
-                    _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
-                    _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
-                    _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
-                    _at_angle(tr, r, ia, fa, t + 14), friction_model, rolling_on)
-                w[C_H_MIN * CW + c] = tri[0]
-                w[C_H_C * CW + c] = tri[1]
-                w[C_LAMBDA * CW + c] = tri[2]
-                w[C_REGIME * CW + c] = tri[3]
-                mu_lim = (limiting_traction_coefficient(tri[2], p[P_LIMITING_SHEAR])
-                          if friction_model == FRICTION_ELLIPSE else tri[4])
-                w[C_MU * CW + c] = mu_lim
-                w[C_SEMI_MAJOR * CW + c] = tri[5]
-                w[C_SEMI_MINOR * CW + c] = tri[6]
-                w[C_FLUID_DAMPING * CW + c] = tri[7]
-                w[C_ROLLING_FORCE * CW + c] = tri[8]
-                w[C_ROLLING_PER_SPEED * CW + c] = tri[8] / max(u, ROLLING_REGULARISATION_SPEED)
-                w[C_SPIN_MOMENT * CW + c] = tri[9]
-                kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]
-                w[C_TANGENT_DAMPING * CW + c] = ct_ratio * 2.0 * math.sqrt(kt * tangent_mass)
-                w[C_ENTRAINMENT * CW + c] = u
-                ab = math.sqrt(tri[5] * tri[6])
-                spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
-                               + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
-                relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
-                w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
-                w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
-                                      + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
-                if not electrical_now:
-                    continue
-                if tri[1] > 0.0:
-                    res_ohm, cap_f = contact_electrical(
-                        q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
-                        _at_angle(tr, r, ia, fa, t + T_RY),
-                        p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER],
-                        p[P_ASPERITY_RESISTANCE],
-                        p[P_OIL_RESISTIVITY])
-                else:
-                    res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
-                w[C_RESISTANCE * CW + c] = res_ohm
-                w[C_CAPACITANCE * CW + c] = cap_f
+                refresh_contact(p, tr, w, c, q_el, eta, electrical_now)
     return max_pen
 
 
@@ -210,63 +111,11 @@ def _traction_solve(w, nc, p, eta, reps):
 
 @njit(**JIT_STEP)
 def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st, reps):
-    z = bx.shape[0]
-    inv_m = 1.0 / p[P_BALL_MASS]
-    inv_inertia = 1.0 / p[P_BALL_INERTIA]
-    rc = p[P_CAGE_RADIUS]
-    s_cage = p[P_CAGE_CONTACT_DISTANCE]
-    k_cage = p[P_CAGE_STIFFNESS]
-    m_cage = p[P_CAGE_REDUCED_MASS]
-    cage_speed = scal[X_CAGE_SPEED]
-    step_angle = 2.0 * math.pi / z
-    c_step = math.cos(step_angle)
-    s_step = math.sin(step_angle)
     acc = 0.0
     for _ in range(reps):
-        ring_tz = 0.0
-        for j in range(z):
-            ci = 2 * j
-            co = ci + 1
-            ba[j, 0] = w[O_FX * CW + ci] + w[O_FX * CW + co]
-            ba[j, 1] = w[O_FY * CW + ci] + w[O_FY * CW + co]
-            ba[j, 2] = w[O_FZ * CW + ci] + w[O_FZ * CW + co]
-            balpha[j, 0] = (w[O_TX * CW + ci] + w[O_TX * CW + co]) * inv_inertia
-            balpha[j, 1] = (w[O_TY * CW + ci] + w[O_TY * CW + co]) * inv_inertia
-            balpha[j, 2] = (w[O_TZ * CW + ci] + w[O_TZ * CW + co]) * inv_inertia
-            ring_tz += w[O_RING_TZ * CW + ci]
-        theta = scal[X_CAGE_ANGLE] - 0.5 * step_angle
-        prev_c = math.cos(theta)
-        prev_s = math.sin(theta)
-        first_c = prev_c
-        first_s = prev_s
-        cage_tz = 0.0
-        for j in range(z):
-            fx = ba[j, 0]
-            fy = ba[j, 1]
-            fz = ba[j, 2]
-            v0 = ct * bv[j, 0] - st * bv[j, 1]
-            v1 = st * bv[j, 0] + ct * bv[j, 1]
-            next_c = prev_c * c_step - prev_s * s_step
-            next_s = prev_s * c_step + prev_c * s_step
-            if j == z - 1:
-                next_c = first_c
-                next_s = first_s
-            for slot in range(2):
-                ex = rc * (next_c if slot == 0 else prev_c)
-                ey = rc * (next_s if slot == 0 else prev_s)
-                f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], v0, v1,
-                                             bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage)
-                cage_load[j, slot] = f
-                fx += f * nx
-                fy += f * ny
-                fz += f * nz
-                cage_tz -= ex * f * ny - ey * f * nx
-            prev_c = next_c
-            prev_s = next_s
-            ba[j, 0] = fx * inv_m
-            ba[j, 1] = fy * inv_m
-            ba[j, 2] = fz * inv_m
-        acc += cage_tz + ring_tz
+        ring_fx, ring_fy, ring_fz, ring_tz, cage_tz = ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w,
+                                                                          cage_load, ct, st)
+        acc += cage_tz + ring_tz + ring_fx + 1e-300 * (ring_fy + ring_fz)
     return acc
 
 
