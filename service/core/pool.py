@@ -243,13 +243,17 @@ class SteppingPool:
         return self
 
     def add(self, task: Steppable, release: float | None = None) -> Job:
-        """Schedule a job (released now unless `release` is given); starts the pool if needed."""
+        """Schedule a job (released now unless `release` is given); starts the pool if needed.
+        Its first step is due at its release: without a deadline it would come after every
+        released real-time job, so in an overloaded pool, whose twins are always released,
+        a twin created later would never run its first frame."""
         self.start()
         job = Job(task)
         with self._cond:
             if self._closing:
                 raise RuntimeError("the stepping pool is closed")
-            self._queue.put(job, Schedule(self.clock() if release is None else release))
+            at = self.clock() if release is None else release
+            self._queue.put(job, Schedule(at, at))
             self._cond.notify_all()
         return job
 

@@ -421,7 +421,8 @@ class TwinRunner:
                 self._safe_publish()
                 return None
             self._reanchor = True
-            return Schedule(self._clock() + ERROR_PAUSE_S)
+            retry = self._clock() + ERROR_PAUSE_S    # due then (not after every other twin's frames)
+            return Schedule(retry, math.inf if self.fast else retry)
         now = self._clock()
         sim = self.sim_elapsed_s
         pacing.measure(now, sim)

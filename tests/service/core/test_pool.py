@@ -102,17 +102,23 @@ class FakeTwin:
         return end, Schedule(release, release + self.frame_s)
 
 
-def simulate(twins, workers, until):
-    """Discrete event simulation of `workers` stepping threads under the pool's rule."""
+def simulate(twins, workers, until, joins=()):
+    """Discrete event simulation of `workers` stepping threads under the pool's rule; `joins`:
+    (wall time, twin) added to the pool then (a twin created while the others run)."""
     clock = {"now": 0.0}
     q = EdfQueue()
     for t in twins:
         q.put(Job(t), Schedule(0.0, t.frame_s))
+    joins = sorted(joins, key=lambda jt: jt[0])
     running = []            # heap of (end, n, job, schedule)
     n = 0
     now = 0.0
     while now < until:
         clock["now"] = now
+        while joins and joins[0][0] <= now:
+            t_join, t = joins.pop(0)
+            t.pacing.start(t_join)
+            q.put(Job(t), Schedule(t_join, t_join + t.frame_s))
         while running and running[0][0] <= now:
             _, _, job, sched = heapq.heappop(running)
             q.put(job, sched)
@@ -124,6 +130,8 @@ def simulate(twins, workers, until):
             n += 1
             heapq.heappush(running, (end, n, job, sched))
         nexts = [running[0][0]] if running else []
+        if joins:
+            nexts.append(joins[0][0])
         nr = q.next_release()
         if nr is not None and len(running) < workers:
             nexts.append(max(nr, now))
@@ -156,6 +164,22 @@ def test_overloaded_twins_fall_behind_together():
         assert t.sim_s / 3.0 == pytest.approx(2.0 / 2.4, abs=0.02)
         assert t.pacing.late_fraction > 0.5                  # and they say so
     # a twin alone on a thread beside them would have been on time: the pool, not the twin, is full
+
+
+def test_a_twin_added_to_an_overloaded_pool_gets_its_share():
+    # 3 twins of 0.8 of a core on 2 threads, each behind the wall clock; a 4th joins at 1 s. Its
+    # first deadline (join + one frame) is later than theirs (in the past, up to the pacing's
+    # resync_after_s), so by deadline alone it would wait until they re-anchor. A released job is
+    # queued by max(deadline, release time): late jobs share round robin, the newcomer included.
+    # 4 x 0.8 = 3.2 cores of work on 2: each should run at 2 / 3.2 = 0.625 of real time.
+    twins = _fake_twins([0.004] * 3)
+    late = _fake_twins([0.004])[0]
+    late.name = "late"
+    simulate(twins, 2, until=3.0, joins=[(1.0, late)])
+    assert late.frames > 0
+    assert late.sim_s / 2.0 == pytest.approx(2.0 / 3.2, abs=0.05)     # its share from its first second on
+    for t in twins:                                                   # and theirs after it joined
+        assert t.sim_s == pytest.approx(1.0 * 2.0 / 2.4 + 2.0 * 2.0 / 3.2, abs=0.05)
 
 
 def test_lateness_counts_frames_ending_beyond_it_not_every_microsecond():
@@ -264,6 +288,45 @@ def test_pool_runs_each_job_on_one_thread_at_a_time():
             assert j.steps == 200 and j.overlaps == 0
             assert j.threads <= set(pool.thread_names)
     finally:
+        assert pool.close(timeout=10.0)
+
+
+class LateJob:
+    """Real time, always behind the wall clock: released again at once, its deadline past."""
+
+    def __init__(self, name):
+        self.name = name
+        self.steps = 0
+
+    def step(self, now):
+        self.steps += 1
+        time.sleep(0.0005)
+        return Schedule(now - 1.0, now - 0.5)
+
+    def left_pool(self):
+        pass
+
+
+def test_a_twin_added_to_a_pool_of_late_twins_runs():
+    # Every twin of an overloaded pool is released at once with a deadline in the past (up to the
+    # pacing's resync_after_s). A job added then is due at its release; with no deadline it came
+    # after all of them and never ran its first frame (found with bench-service --twins 4 --force:
+    # the 4th twin ran 0 frames in 20 s, the 3rd none in its first 15 s).
+    pool = SteppingPool(1, name="t-late").start()
+    hogs = [LateJob(f"hog{i}") for i in range(2)]
+    newcomer = CountingJob("new", 1)              # its first frame, then it leaves
+    try:
+        for h in hogs:
+            pool.add(h)
+        deadline = time.monotonic() + WAIT_S
+        while sum(h.steps for h in hogs) < 20 and time.monotonic() < deadline:
+            time.sleep(0.001)
+        handle = pool.add(newcomer)
+        assert newcomer.left.wait(WAIT_S) and handle.done.wait(WAIT_S)
+        assert newcomer.steps == 1
+    finally:
+        for h in hogs:
+            h.step = lambda now: None            # leave the pool at their next frame
         assert pool.close(timeout=10.0)
 
 
