@@ -60,7 +60,7 @@ class Sample(NamedTuple):
 
 class Peer:
     """A separate zenoh session (another process in real life): peer mode (or `mode`), connected
-    to `endpoint` on loopback, multicast scouting off (service.bus.make_config), with the zenoh
+    to `endpoint` on loopback, multicast scouting off (service.bus.zenoh_bus.make_config), with the zenoh
     credentials of `access` (service.bus.access.ZenohAccess; default none). Subscriptions put a
     `Sample` per message in `inbox`; `wait_for` waits at most `timeout_s`. `prefix`: the twins'
     key prefix (result keys)."""

@@ -1,6 +1,6 @@
 """The friction-torque section of `bearing-twin report` (issue 11): the twin's friction torque
 (traction integrated over the contact ellipses, seed 001 rolling resistance) against the SKF
-model for the frictional moment (twin.skf_friction, the public catalogue formula), for the 6208
+model for the frictional moment (twin.validation.skf_friction, the public catalogue formula), for the 6208
 of seed 000 and the 6210, over 100-1700 rad/s and 750-7500 N, isothermal and with the inlet
 shear heating (twin: Murch-Wilson film factor; SKF: its phi_ish).
 """
@@ -81,7 +81,7 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
           "The twin's shaft torque with the traction integrated over strips of every contact ellipse (Heathcote and "
           "spin slip; seed 000 mu(Lambda) x seed 001 eq. A2 asperity share + Eyring / limiting-shear film) and seed "
           "001's rolling resistance, averaged over whole ball passages, against the SKF model for the frictional "
-          "moment (catalogue formula, `twin.skf_friction`: M_rr + M_sl, no seals, no oil bath drag; "
+          "moment (catalogue formula, `twin.validation.skf_friction`: M_rr + M_sl, no seals, no oil bath drag; "
           f"kinematic replenishment for oil jet, K_rs = 3e-8), seed oil at 40 degC ({nu:.1f} mm^2/s). "
           "Isothermal: the twin without inlet heating against phi_ish = 1; with inlet heating: the twin's "
           "Murch-Wilson film factor against the catalogue's phi_ish.\n",

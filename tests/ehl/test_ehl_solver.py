@@ -376,7 +376,7 @@ def test_cli_solve_json_carries_the_required_fields():
 # --- report section (seed 003 Figs. 1 and 5) ------------------------------------------------------
 
 def test_report_section_writes_the_figures_and_the_table(tmp_path):
-    """service/report_ehl.write_ehl_section on a small grid (33 x 33, for speed): the three PNGs
+    """service/reports/ehl.py write_ehl_section on a small grid (33 x 33, for speed): the three PNGs
     (centre line isothermal and with 0/10/20/30 A: seed 003 Fig. 5; film vs speed: Fig. 1) exist,
     are real images (PNG signature, > 10 kB) and the Markdown embeds them and names the figures."""
     from service.reports import ehl as report_ehl

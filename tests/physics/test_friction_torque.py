@@ -1,5 +1,5 @@
 """The bearing's friction torque with the friction over the contact ellipse against the SKF model
-for the frictional moment (an independent, public catalogue formula, twin.skf_friction)."""
+for the frictional moment (an independent, public catalogue formula, twin.validation.skf_friction)."""
 
 import numpy as np
 import pytest

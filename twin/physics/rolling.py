@@ -9,8 +9,8 @@ Notation of seed 001 (read with README, "Readings of garbled seed formulas", see
       E' = E / (1 - nu^2), the same modulus as seed 000's E');
   Rx  equivalent radius in the rolling direction, Ry transverse;
   k   the RADII RATIO Ry/Rx (seed 001 below eq. 7). Careful: this is NOT the ellipticity
-      (Ry/Rx)^(2/pi) that twin.physics.hertz.ellipticity returns; every argument named
-      `k_radii_ratio` below wants Ry/Rx itself;
+      (Ry/Rx)^(2/pi) that twin.physics.hertz.brewe_hamrock_ellipticity returns; every argument
+      named `k_radii_ratio` below wants Ry/Rx itself;
   U = eta0 u / (E* Rx) (eq. 6), W = Q / (E* Rx^2) (eq. 7), u = (v1 + v2)/2 the mean entrainment
       speed of the two surfaces relative to the contact.
 """

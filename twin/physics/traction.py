@@ -92,7 +92,7 @@ def asperity_slip_fraction(slip_m_s, regularisation_slip_m_s):
     """sgn_reg(s) = s / sqrt(s^2 + s_a^2): Coulomb's sign of the asperity friction, smoothed over
     the slip s_a so that the traction is a continuous, monotone function of the slip (needed to
     locate the no-slip lines; results are insensitive to s_a well below the differential slip,
-    tests/physics/test_traction.py)."""
+    tests/kernels/test_traction.py)."""
     return slip_m_s / math.sqrt(slip_m_s * slip_m_s + regularisation_slip_m_s * regularisation_slip_m_s)
 
 

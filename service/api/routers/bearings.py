@@ -43,7 +43,9 @@ def get_bearing(entry: TwinDep) -> BearingInfo:
 
 
 @write.post("", response_model=BearingInfo, status_code=201,
-            responses={409: {"model": ErrorResponse, "description": "Duplicate id or service full"}, **INVALID})
+            responses={409: {"model": ErrorResponse, "description": "Duplicate id or service full"}, **INVALID,
+                       503: {"model": ErrorResponse, "description": "This host cannot run the twin in real time "
+                             "(measured capacity: the reason and the figures), or the service is stopping"}})
 def create_bearing(body: BearingCreate, registry: RegistryDep) -> BearingInfo:
     """Create and start a twin from a catalog designation, a diametral clearance and a
     lubricant (warm-started at the optional initial setpoint)."""

@@ -144,7 +144,10 @@ def test_docs_are_served_without_a_cdn(client):
         assert f"/docs/assets/{asset}" in page.text
         r = client.get(f"/docs/assets/{asset}")
         assert r.status_code == 200 and len(r.content) > 10_000
-    assert client.get("/openapi.json").json()["openapi"].startswith("3.1")
+    spec = client.get("/openapi.json").json()
+    assert spec["openapi"].startswith("3.1")
+    # POST /v1/bearings documents what it answers (README, HTTP API): 409 duplicate, 503 no capacity
+    assert {"201", "409", "422", "503"} <= set(spec["paths"]["/v1/bearings"]["post"]["responses"])
 
 
 @pytest.mark.parametrize("raw", [b'{"shaft_speed_rad_s": NaN}', b'{"shaft_speed_rad_s": Infinity}',
