@@ -86,7 +86,7 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
             q_el = w[G_LOAD * CW + c]
             w[C_LOAD * CW + c] = q_el
             if tribology_now:
-                refresh_contact(p, tr, w, c, q_el, eta, electrical_now)
+                refresh_contact(p, tr, w, c, q_el, eta, electrical_now, 0.0)
     return max_pen
 
 
