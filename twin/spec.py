@@ -305,6 +305,12 @@ class ModelOptions(BaseModel):
     speed_ramp_rad_s2: float = Field(
         default=5000.0, gt=0.0, le=1e6, description="Shaft acceleration limit towards the speed setpoint [rad/s^2].")
     rolling_resistance: bool = Field(default=True, description="Apply seed 001 rolling force and moments.")
+    centred_refresh: bool = Field(
+        default=True,
+        description="Evaluate each tribology refresh at the load, entrainment speed and contact angle of the middle of "
+        "the period it is held for (extrapolated from the previous refresh and the step's rates, "
+        "twin.kernels.step.centred_inputs): the held values' error becomes second order in tribology_period_s "
+        "instead of first. False: at the refresh's own step (the engine before it; tests/engine/test_step_reference.py).")
 
     @field_validator("time_step_s", mode="before")
     @classmethod

@@ -48,7 +48,8 @@ N_VIB_PARAMS = 10
 P_LN_ROUGHNESS = P_VIB + N_VIB_PARAMS  # ln(P_ROUGHNESS / 1 m): ln Lambda = ln h_min - this (issue 13)
 P_CAGE_STEP_COS = P_LN_ROUGHNESS + 1   # cos(2 pi / Z): turns one cage element's unit vector to the next
 P_CAGE_STEP_SIN = P_LN_ROUGHNESS + 2   # sin(2 pi / Z)
-N_PARAMS = P_CAGE_STEP_SIN + 1
+P_CENTRED_REFRESH = P_LN_ROUGHNESS + 3 # 1: the tribology refresh's inputs centred on its period (twin.kernels.step.centred_inputs)
+N_PARAMS = P_CENTRED_REFRESH + 1
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]

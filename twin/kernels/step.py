@@ -20,7 +20,7 @@ from twin.kernels.layout import (
     O_EX, O_EY, O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ,
     P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
     P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_STEP_COS, P_CAGE_STEP_SIN, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
-    P_CAGE_STIFFNESS, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
+    P_CAGE_STIFFNESS, P_CENTRED_REFRESH, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
     P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_LN_ROUGHNESS, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
     P_RING_MASS, P_ROLLING, LANE_BLOCK, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
     S_STOP, S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
@@ -113,7 +113,7 @@ def centred_inputs(p, w, c, q_el, u_now, s_now, stamp):
     at hand, takes the secant.
     The lanes H_* take this refresh's own inputs (not extrapolated) and its stamp (1 + k).
 
-    No extrapolation (the inputs as they are) when the contact has just closed (H_STAMP = 0: no
+    No extrapolation (the inputs as they are) with p[P_CENTRED_REFRESH] = 0, when the contact has just closed (H_STAMP = 0: no
     previous refresh; its refresh holds until the next regular one, fewer than N steps) or when the
     previous refresh is not 1 .. 2N steps back (a restart, a restored state). Clamps: the load and
     the speed stay within [1/2, 2] x their current values (the extrapolation of a jump -- a ball
@@ -131,7 +131,7 @@ def centred_inputs(p, w, c, q_el, u_now, s_now, stamp):
     w[H_SIN_ANGLE * CW + c] = s_now
     n = p[P_SUBSTEPS]
     d = stamp - prev
-    if prev <= 0.0 or not (0.0 < d <= 2.0 * n):
+    if prev <= 0.0 or not (0.0 < d <= 2.0 * n) or p[P_CENTRED_REFRESH] == 0.0:
         return q_el, u_now, s_now
     lag = 0.5 * (n - 1.0)  # steps from this one to the middle of the held period
     dt = p[P_DT]
