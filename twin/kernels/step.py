@@ -113,9 +113,10 @@ def centred_inputs(p, w, c, q_el, u_now, s_now, stamp):
     at hand, takes the secant.
     The lanes H_* take this refresh's own inputs (not extrapolated) and its stamp (1 + k).
 
-    No extrapolation (the inputs as they are) with p[P_CENTRED_REFRESH] = 0, when the contact has just closed (H_STAMP = 0: no
-    previous refresh; its refresh holds until the next regular one, fewer than N steps) or when the
-    previous refresh is not 1 .. 2N steps back (a restart, a restored state). Clamps: the load and
+    No extrapolation (the inputs as they are) with p[P_CENTRED_REFRESH] = 0, when the contact has
+    just closed (H_STAMP = 0: no previous refresh; its refresh holds until the next regular one,
+    fewer than N steps), for `evaluate` (stamp 0, and none from it) or when the previous refresh is
+    not 1 .. 2N steps back (a restart, a restored state). Clamps: the load and
     the speed stay within [1/2, 2] x their current values (the extrapolation of a jump -- a ball
     over a spall edge, an impact -- is bounded by the jump itself: it is at most a factor 2 on a
     film that goes as Q^-0.073, and it holds for one period; a setpoint step moves the ring over
@@ -562,12 +563,14 @@ def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, 
              dec_state, ring, ring_state, hp, taps):
     """Contact forces, tribology and accelerations (balls, rings and, issue 14, the housing) at
     the current state without advancing time (used after a warm start). Returns the status. Same
-    arguments as `step_n` but n; the accelerometer is not sampled."""
+    arguments as `step_n` but n; the accelerometer is not sampled. The tribology is refreshed at
+    the state as it is, not centred (stamp 0: a warm-started state has no history to extrapolate
+    from, and the next regular refresh takes none from this one)."""
     housing_on = p[P_VIB + V_HOUSING_ON] != 0.0
     if housing_on:
         shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
     status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                                   True, True, True, 1.0, 0.0, scal[X_STEP])
+                                   True, True, True, 1.0, 0.0, 0.0)
     if housing_on:
         shift_frame(bx, bv, rx, rv, hx, hv, 1.0)
         fx, fy, fz = outer_ring_force(w, bx.shape[0])
