@@ -18,7 +18,7 @@ inputs of its own step lags by half a period, an error first order in the period
 0.64 % at 30 us, 0.95 % at 40 us on the 7208 at 1700 rad/s, 7500 N + 3000 N, before the centred
 refresh); `ModelOptions.centred_refresh` (twin.kernels.step.centred_inputs) evaluates each refresh
 at the load, entrainment speed and contact angle of the middle of its period, second order: 0.15,
-0.14, 0.31, 0.41 % at 20, 30, 40, 60 us on the same case, where the steep ends of the loaded zone
+0.14, 0.31, 0.41 % at 20, 30, 40, 60 us (largest over the cases), where the steep ends of the loaded zone
 (the load levels off at the centrifugal load within a period) and the rattling of the unloaded balls
 (0.2-0.3 % on the loads whatever the period: the noise floor of the comparison) remain. The RC (with
 10 refreshes per RC refresh, the 6208's impedance at 750 N moved by 1.5 % at 20 us, i.e. an RC every
