@@ -352,6 +352,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     v[L.V_INNER_RX], v[L.V_OUTER_RX] = race[0, L.R_RX], race[1, L.R_RX]
     v[L.V_INNER_RY], v[L.V_OUTER_RY] = race[0, L.R_RY], race[1, L.R_RY]
     p[L.P_SUBSTEPS] = timestep.steps_per_period(options.tribology_period_s, p[L.P_DT])
+    p[L.P_CENTRED_REFRESH] = 1.0 if options.centred_refresh else 0.0
     # the strip solve's period as a whole number of tribology refreshes (nearest, at least 1)
     p[L.P_TRACTION_EVERY] = timestep.steps_per_period(options.traction_period_s, p[L.P_SUBSTEPS] * p[L.P_DT])
     if options.friction_model == "ellipse_traction":

@@ -277,24 +277,26 @@ class ModelOptions(BaseModel):
         description="Strips across the major axis of each contact ellipse (ellipse_traction) [-]; 12: moments within 0.5 % "
         "(spin moment 2 %) of 32 strips (tests/kernels/test_traction.py).")
     traction_period_s: float = Field(
-        default=2e-4, ge=1e-6, le=1e-3,
+        default=4e-4, ge=1e-6, le=1e-3,
         description="Strip integration (ellipse_traction) every this period [s], a whole number of tribology "
-        "refreshes (the nearest, at least 1); 200 us: the torque moves by under 0.04 % from a solve every 10 us up "
-        "to every 500 us (6208, 100-1700 rad/s, 750-7500 N); on the 7208 B (Fr = Fa = 3000 N) the spin moments of "
-        "the state by under 3.1 % (1.6 % of the largest) at 178 us, first order in the period "
-        "(tests/physics/test_friction_torque.py); over the envelope (twin.validation.subrate_study) 400 us holds "
-        "issue 13's tolerances, 800 us does not (loads 1.3 %, torque 3.1 % on the 7208 at 1700 rad/s).")
+        "refreshes (the nearest, at least 1); 400 us (10 refreshes of 40 us): over the envelope at the auto step "
+        "(twin.validation.subrate_study) every output stays within issue 13's tolerances of the former 10 us / "
+        "200 us and of the 1 us step (torque 1.14 % of 2 % on the 7208 at 1700 rad/s, 7500 N + 3000 N); 800 us "
+        "did not (loads 1.3 %, torque 3.1 % there). The torque moves by under 0.5 % from a solve at every "
+        "refresh, the 7208 B's spin moments (Fr = Fa = 3000 N) by under 5 % (tests/physics/test_friction_torque.py), "
+        "first order in the period.")
     asperity_regularisation_slip_m_s: float = Field(
         default=1e-3, gt=0.0, le=0.1,
         description="Slip over which the asperity (Coulomb) friction develops in ellipse_traction [m/s].")
     tribology_period_s: float = Field(
-        default=2e-5, ge=1e-7, le=2e-4,
-        description="Film/Lambda/mu/damping/rolling resistance refreshed every this period [s], a whole number of "
-        "steps (the nearest, at least 1; 6 steps at the 6208's auto step of 3.3 us); the contacts' RC every 5 "
-        "refreshes (100 us). 20 us: over the envelope at the auto step (twin.validation.subrate_study, "
-        "`bearing-twin timestep-study --subrates`) every output stays within issue 13's tolerances of the "
-        "former 10 us and of the 1 us step (largest: Lambda 0.30 % of 0.5 % on the 7208 at 1700 rad/s, "
-        "7500 N + 3000 N); 30 us leaves them there (0.64 %).")
+        default=4e-5, ge=1e-7, le=2e-4,
+        description="Film/Lambda/mu/damping/rolling resistance/Hertz stiffness refreshed every this period [s], a "
+        "whole number of steps (the nearest, at least 1; 12 steps at the 6208's auto step of 3.3 us), each refresh "
+        "centred on its period (centred_refresh); the contacts' RC every 5 refreshes (200 us). 40 us: over the "
+        "envelope at the auto step (twin.validation.subrate_study, `bearing-twin timestep-study --subrates`) every "
+        "output stays within issue 13's tolerances of the former 10 us / 200 us and of the 1 us step (closest: "
+        "loads 0.32 % of 0.5 %, Lambda 0.24 %, on the 7208 at 1700 rad/s, 7500 N + 3000 N). Without the centring "
+        "20 us was the limit (Lambda 0.30 % there, 30 us 0.64 %).")
     tangential_stiffness_ratio: float = Field(
         default=0.8, ge=2.0 / 3.0, le=1.0, description="Kt/Kn [-] (seed 000 section 2.1: [2/3, 1]).")
     tangential_damping_ratio: float = Field(
@@ -305,6 +307,12 @@ class ModelOptions(BaseModel):
     speed_ramp_rad_s2: float = Field(
         default=5000.0, gt=0.0, le=1e6, description="Shaft acceleration limit towards the speed setpoint [rad/s^2].")
     rolling_resistance: bool = Field(default=True, description="Apply seed 001 rolling force and moments.")
+    centred_refresh: bool = Field(
+        default=True,
+        description="Evaluate each tribology refresh at the load, entrainment speed and contact angle of the middle of "
+        "the period it is held for (extrapolated from the previous refresh and the step's rates, "
+        "twin.kernels.step.centred_inputs): the held values' error becomes second order in tribology_period_s "
+        "instead of first. False: at the refresh's own step (the engine before it; tests/engine/test_step_reference.py).")
 
     @field_validator("time_step_s", mode="before")
     @classmethod

@@ -94,6 +94,7 @@ class TwinState:
         rows[L.C_H_MIN] = -1.0
         rows[L.C_H_C] = -1.0
         rows[L.G_DEFECT_DROP] = 0.0
+        rows[L.H_STAMP:L.H_SIN_ANGLE + 1] = 0.0  # no previous refresh to extrapolate from
         # the outer ring's velocity and spin in its contacts' lanes and in the pad lanes: 0,
         # which the gather leaves unwritten (twin.kernels.step.gather_lanes)
         rows[L.K_OVX:L.K_SPIN + 1, 1::2] = 0.0

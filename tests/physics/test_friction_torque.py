@@ -64,7 +64,12 @@ def _spin_moments(twin):
 
 
 def test_traction_sub_rate_is_converged():
-    # numerical choice: the strip integration every traction_period_s = 200 us (a whole number of
+    # numerical choice: the strip integration every traction_period_s = 400 us since the centred
+    # tribology refresh (twin.validation.subrate_study: 40 us / 400 us; 10 refreshes of 40 us at 1 us,
+    # of 9 steps of 4.44 us on the 7208). Measured at these defaults on the 7208 B
+    # below, against a solve at every refresh: torque within 0.003 %, the solved spin moments within
+    # 3.0 % of the largest (inside rtol 5 % + atol 1 % of the largest), the applied ones within 11.3 %
+    # of the largest. History: 200 us (a whole number of
     # tribology refreshes: 10 of 20 us at 1 us; the 7208's auto step of 4.44 us gave 178 us when the
     # period was 20 refreshes of 8.9 us). Measured (6208; 3000 N /
     # 500 rad/s, 750 N / 1700 rad/s, 7500 N / 100 rad/s): the torque with a solve every 10 us,
@@ -85,7 +90,7 @@ def test_traction_sub_rate_is_converged():
     # when the last solve fell before the end of the run, not the sub-rate.)
     fast, _ = studies.mean_friction_torque_n_m(500.0, 3000.0, options=ModelOptions(traction_period_s=1e-6))
     default, _ = studies.mean_friction_torque_n_m(500.0, 3000.0)
-    assert ModelOptions().traction_period_s == 2e-4
+    assert ModelOptions().traction_period_s == 4e-4
     assert default == pytest.approx(fast, rel=0.005)
     runs = []
     for period in (1e-6, ModelOptions().traction_period_s):  # every refresh, the default

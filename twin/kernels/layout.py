@@ -48,7 +48,8 @@ N_VIB_PARAMS = 10
 P_LN_ROUGHNESS = P_VIB + N_VIB_PARAMS  # ln(P_ROUGHNESS / 1 m): ln Lambda = ln h_min - this (issue 13)
 P_CAGE_STEP_COS = P_LN_ROUGHNESS + 1   # cos(2 pi / Z): turns one cage element's unit vector to the next
 P_CAGE_STEP_SIN = P_LN_ROUGHNESS + 2   # sin(2 pi / Z)
-N_PARAMS = P_CAGE_STEP_SIN + 1
+P_CENTRED_REFRESH = P_LN_ROUGHNESS + 3 # 1: the tribology refresh's inputs centred on its period (twin.kernels.step.centred_inputs)
+N_PARAMS = P_CENTRED_REFRESH + 1
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]
@@ -191,7 +192,14 @@ E_SCRATCH_SIGNED_HALF = 71  # half-width of strip k in t, signed like ds/dt acro
 # local defects (twin.kernels.vibration.apply_defects, only while a defect is active)
 G_DEFECT_DROP = 75  # extra radial clearance a defect opens at the contact, taken off G_DELTA [m]
 O_NORMAL_RATE = 76  # d(delta)/dt of the force pass: ball minus ring centre velocity along n [m/s]
-N_ROWS = 77
+# the inputs of the contact's last tribology refresh as they were (not extrapolated), for the
+# centred refresh (twin.kernels.step.refresh_contact): the next refresh extrapolates its inputs
+# to the middle of its period from them; zeroed when the contact opens (TwinState.clear_contacts)
+H_STAMP = 77       # 1 + the step index of that refresh; 0: none (the contact has just closed) [-]
+H_LOAD = 78        # its elastic load q_el [N]
+H_SPEED = 79       # its entrainment speed u [m/s]
+H_SIN_ANGLE = 80   # its |sin(contact angle)| = |n_z|, within the angle table [-]
+N_ROWS = 81
 
 # ---- the kernel workspace `w`: the N_ROWS x CW contact lanes, then (issue 14) the local defects ---
 # The defect table and the balls' orientations ride in the workspace after the lanes, so that the

@@ -29,7 +29,7 @@ spin moment is applied every step from its value and slope at the solution, clip
 all-sliding value, so that it follows the spin rate without a sign chatter.
 
 Cost: the strip solve (a few exponentials per strip pair, one to three Newton passes from the
-last solution) runs every `P_TRACTION_EVERY` tribology refreshes (200 us): the torque moves by
+last solution) runs every `P_TRACTION_EVERY` tribology refreshes (400 us by default; it was 200 us): the torque moves by
 under 0.04 % between a solve every 10 us and every 500 us (tests/physics/test_friction_torque.py),
 and 12 strips hold the moments within 0.5 % of 32 (tests/kernels/test_traction.py). No allocation: the per-strip values of the contact being solved
 live in scratch rows of the lane array.

@@ -76,7 +76,8 @@ def _forces(w, nc, rb, dt, kt_ratio, alpha_e, reps):
 def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
     eta = sp[S_VISCOSITY]
     max_pen = 0.0
-    for _ in range(reps):
+    for i in range(reps):
+        stamp = (i + 1.0) * p[P_SUBSTEPS]  # a refresh every P_SUBSTEPS steps: the centring is timed too
         for c in range(nc):
             delta = w[G_DELTA * CW + c]
             if delta <= 0.0:
@@ -86,7 +87,7 @@ def _tribology(p, tr, sp, w, nc, tribology_now, electrical_now, reps):
             q_el = w[G_LOAD * CW + c]
             w[C_LOAD * CW + c] = q_el
             if tribology_now:
-                refresh_contact(p, tr, w, c, q_el, eta, electrical_now)
+                refresh_contact(p, tr, w, c, q_el, eta, electrical_now, stamp)
     return max_pen
 
 
