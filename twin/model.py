@@ -60,14 +60,14 @@ class BearingModel:
 
     gap_limit_m: tuple[float, float] = (50e-6, 50e-6)   # inner, outer: geometric gap limit of the contact capacitance
     rest_capacitance_f: float = 0.0                     # the rings' lands across the oil-filled annulus [F]
-    # issue 14 (twin.vibration): housing H_* vector, V_* vector, accelerometer decimator
+    # vibration (twin.vibration): housing H_* vector, V_* vector, accelerometer decimator
     housing_params: np.ndarray | None = None
     decimator: DecimatorDesign | None = None  # None with the rigid outer ring
     decimator_taps: np.ndarray | None = None  # reversed FIR taps (K R,); without the housing a (1,) zero array, as the kernel's signature takes an array
 
     @property
     def vibration_params(self) -> np.ndarray:
-        """The V_* vector of issue 14 (twin.kernels.layout), a view of params[P_VIB:]."""
+        """The vibration V_* vector (twin.kernels.layout), a view of params[P_VIB:]."""
         return self.params[L.P_VIB:L.P_VIB + L.N_VIB_PARAMS]
 
     @property
