@@ -83,3 +83,32 @@ def save(result: dict, kind: str, command: str, directory: Path = DEFAULT_DIRECT
         path = directory / f"{stem}-{n}.json"
     path.write_text(json.dumps({"environment": env, "result": result}, indent=1) + "\n")
     return path
+
+
+def newest(directory: Path = DEFAULT_DIRECTORY, kind: str = "bench") -> Path | None:
+    """The newest `*-<kind>*.json` of `directory` by its measured time (None: there is none)."""
+    files = list(directory.glob(f"*-{slug(kind)}*.json"))
+    if not files:
+        return None
+    return max(files, key=lambda f: (json.loads(f.read_text())["environment"]["measured_utc"], f.name))
+
+
+def bench_table(saved: dict) -> str:
+    """The Markdown table of a saved `bearing-twin bench` result (docs/performance.md): per case the
+    auto step, the real-time factor best / median at it and at 1 us, and ns per step (best)."""
+    r = saved["result"]
+    rows = [("serve-default", r["designation"], r["time_step_s"], r["real_time_factor"],
+             r["real_time_factor_median"], r["ns_per_step"], r["real_time_factor_1us"],
+             r["real_time_factor_1us_median"], r["ns_per_step_1us"])]
+    for c in r.get("cases", []):
+        a, one = c["default_step"], c["step_1us"]
+        rows.append((c["id"], c["designation"], a["time_step_s"], a["real_time_factor"],
+                     a["real_time_factor_median"], a["ns_per_step"], one["real_time_factor"],
+                     one["real_time_factor_median"], one["ns_per_step"]))
+    lines = ["| case | bearing | auto step [us] | real-time factor at auto, best / median | ns per step at auto "
+             "| real-time factor at 1 us, best / median | ns per step at 1 us |",
+             "|---|---|---|---|---|---|---|"]
+    for case, des, dt, rtf, rtf_med, ns, rtf1, rtf1_med, ns1 in rows:
+        lines.append(f"| {case} | {des} | {dt * 1e6:.3f} | {rtf:.2f} / {rtf_med:.2f} | {ns:.0f} "
+                     f"| {rtf1:.2f} / {rtf1_med:.2f} | {ns1:.0f} |")
+    return "\n".join(lines)
