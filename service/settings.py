@@ -107,7 +107,7 @@ def zenoh_access_enabled(usersfile: Path | None, user: str | None, tls_certifica
 
 
 class ZenohAccessSettings(BaseSettings):
-    """Who may do what on zenoh (README "zenoh access control"), read by the service, the router
+    """Who may do what on zenoh (docs/operations.md "zenoh access control"), read by the service, the router
     and the bundled clients (`monitor`, `soak`, benchmarks) from `BEARING_TWIN_ZENOH_*`.
 
     Access control is on when a users file, credentials or TLS client certificates are
@@ -278,7 +278,7 @@ def _check_tls_endpoints(s) -> None:
 
 
 class AlarmSettings(BaseModel):
-    """Alarm thresholds and timing (service.core.alarms; README "Alarms"). Times are simulated
+    """Alarm thresholds and timing (service.core.alarms; docs/service.md "Alarms"). Times are simulated
     seconds (the twin's clock). Give them in the environment as JSON:
     `BEARING_TWIN_ALARMS='{"machine_group": 1, "support": "flexible"}'`."""
 
@@ -430,7 +430,7 @@ class ServiceSettings(ZenohAccessSettings):
         default=0.005, ge=1e-5, le=0.1,
         description="Simulated time per frame: setpoints and scenario steps apply between frames [s]. "
         "A stepping thread runs one frame of one twin at a time; 5 ms keeps the Python between frames "
-        "a small share of the work (README \"Runner pool\").")
+        "a small share of the work (docs/service.md \"Runner pool\").")
     setpoint_frame_s: float = Field(
         default=0.001, ge=1e-5, le=0.1,
         description="Real-time mode: the frame that applies an outside setpoint (HTTP, zenoh) lasts this "
@@ -498,7 +498,7 @@ class ServiceSettings(ZenohAccessSettings):
         default=None, ge=1, le=256,
         description="Most twins one service runs at a time [count]; unset = as many as the measured "
         "capacity admits (admission 'measured'), at most 256.")
-    # ---- hardening (README "Hardening") -------------------------------------------------------
+    # ---- hardening (docs/operations.md) -------------------------------------------------------
     token: SecretStr | None = Field(
         default=None,
         description="Bearer token [text]: when set, every mutating HTTP request (POST, PUT, DELETE) "
@@ -568,7 +568,7 @@ class ServiceSettings(ZenohAccessSettings):
         description="Directory of named scenarios [path]; default ./scenarios if it exists, else "
         "the scenarios/ folder of the source tree.")
 
-    # ---- alarms and the OPC UA facade (README "Alarms", "OPC UA") -------------------------------
+    # ---- alarms and the OPC UA facade (docs/service.md "Alarms", "OPC UA") -------------------------------
     alarms: AlarmSettings = Field(default_factory=AlarmSettings,
                                   description="Alarm thresholds and timing [see AlarmSettings].")
     opcua: str | None = Field(
@@ -612,7 +612,7 @@ class ServiceSettings(ZenohAccessSettings):
     @model_validator(mode="after")
     def _zenoh(self):
         """Resolve the listen default and the mode; refuse what zenoh's access control cannot
-        guard (README "zenoh access control")."""
+        guard (docs/operations.md "zenoh access control")."""
         if self.zenoh_listen is None:
             self.zenoh_listen = [] if self.zenoh_connect else list(DEFAULT_ZENOH_LISTEN)
         if self.zenoh_mode is None:
@@ -683,7 +683,7 @@ class ServiceSettings(ZenohAccessSettings):
 
     @model_validator(mode="after")
     def _opcua_security(self):
-        """The OPC UA certificate and trust settings (README "OPC UA", "Secure connections")."""
+        """The OPC UA certificate and trust settings (docs/service.md "OPC UA")."""
         if (self.opcua_certificate is None) != (self.opcua_private_key is None):
             missing = "opcua_private_key" if self.opcua_private_key is None else "opcua_certificate"
             raise ValueError(f"{missing}: the OPC UA server certificate and its private key go together "

@@ -142,7 +142,7 @@ class TwinCost(BaseModel):
 
 
 class Capacity(BaseModel):
-    """The host's capacity for twins in real time, as measured (admission rule: README "Runner pool")."""
+    """The host's capacity for twins in real time, as measured (admission rule: docs/service.md "Runner pool")."""
 
     admission: Literal["measured", "off"] = Field(description="Whether new twins are checked against the capacity [text].")
     cores: int = Field(description="Cores this process may use [-].")

@@ -1,6 +1,6 @@
 """zenoh's own security for the bus: authentication of every link and access-control rules.
 
-Nothing of the HTTP token travels on zenoh. When access control is on (README "zenoh access
+Nothing of the HTTP token travels on zenoh. When access control is on (docs/operations.md "zenoh access
 control"):
 
 * every link is authenticated by zenoh itself when it opens: the user-password handshake

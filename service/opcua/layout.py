@@ -1,5 +1,5 @@
 """The address space of the OPC UA facade: namespace URI, folders and browse names, and how each
-variable is read from a twin's latest snapshot (README "OPC UA").
+variable is read from a twin's latest snapshot (docs/service.md "OPC UA").
 
 Browse names are the service's own field names (units in the name, as in the JSON contract and
 the setpoint vocabulary twin.setpoint), so one vocabulary serves HTTP, zenoh and OPC UA. Node ids

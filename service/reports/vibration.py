@@ -99,5 +99,5 @@ def vibration_section(out_dir, quick: bool = False) -> list[str]:
                      f"{result['rms_m_s2']:.3g} | {result['defect_lines']['bpfo']['harmonics'][0]:.3g} |")
     lines += ["", "A large spall can drive seed 000's 0.5 kg rotor into its radial mode (~3.1 kHz, ~0.5 % damping), "
               "which then carries the broadband signal: compare the broadband and the band kurtosis columns "
-              "(README, Vibration limits).\n"]
+              "(docs/physics.md, Vibration).\n"]
     return lines

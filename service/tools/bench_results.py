@@ -1,7 +1,7 @@
 """Benchmark results as data: a result dict with the machine, the versions and the git commit it
 was measured with, written as dated JSON (`bearing-twin bench --save`).
 
-File name: `<UTC date>-<cpu slug>-<kind>.json` (e.g. `2026-11-28-amd-epyc-bench.json`) under
+File name: `<UTC date>-<cpu slug>-<kind>.json` (e.g. `YYYY-MM-DD-amd-epyc-bench.json`) under
 `benchmarks/results/` of the current directory by default; a second run on the same day and CPU
 gets a `-2`, `-3`, ... suffix rather than overwriting the first. docs/performance.md quotes the
 newest file.

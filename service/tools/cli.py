@@ -236,7 +236,7 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--zenoh-prefix", metavar="PREFIX",
                        help="key prefix of the twins on zenoh: site / line / asset, e.g. "
                        "plant1/line2/motor7 (default bearing) [BEARING_TWIN_ZENOH_PREFIX]; zenoh "
-                       "credentials and access rules come from the environment (README \"zenoh "
+                       "credentials and access rules come from the environment (docs/operations.md \"zenoh "
                        "access control\")")
     serve.add_argument("--record", metavar="PATH.rrd",
                        help="rerun recording (default recordings/bearing-twin-<UTC timestamp>.rrd) "

@@ -76,7 +76,7 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     """Seed 000 eq. 8 for every contact lane at once (vectorised, branch-free):
 
     - kinematics: slip (ball minus ring surface velocity, tangential) and entrainment (mean
-      surface velocity relative to the contact point, which orbits with the ball; README
+      surface velocity relative to the contact point, which orbits with the ball; docs/physics.md
       reading of eq. 6, ~7.25 m/s for the 6208 at 500 rad/s);
     - Fn = K delta^1.5 + C_n(Lambda) d(delta)/dt, never adhesive, C_n per Table 2: C_hyst =
       3 alpha_e K delta^1.5 / 2 (eq. 4) for Lambda <= 1, C_hyst C_fluid / (C_hyst + C_fluid) for

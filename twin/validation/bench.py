@@ -20,7 +20,8 @@ further cases, and the per-pass timing of the step.
   traction, cage and integration (`twin.validation.step_timing`, a harness that times each pass
   alone), at the default step.
 
-Wall-clock figures belong here and in README, never in tests (machines are shared and noisy).
+Wall-clock figures belong here and in benchmarks/results/ (`bench --save`), never in tests (machines are
+shared and noisy).
 """
 
 from __future__ import annotations
