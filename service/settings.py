@@ -364,7 +364,7 @@ class ServiceSettings(ZenohAccessSettings):
                          description="Catalog designation of the twin started with the service [designation, e.g. 6208].")
     housing: bool = Field(default=False,
                           description="The twin started with the service has its outer ring on the housing "
-                          "support with the accelerometer (issue 14: vibration indicators, waveform, defects "
+                          "support with the accelerometer (vibration indicators, waveform, defects "
                           "show in the signal) [bool]; other twins choose with POST /v1/bearings `housing`.")
     twin_id: str = Field(default="default", pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$",
                          description="Name of the twin started with the service [text]; give each "
@@ -454,9 +454,8 @@ class ServiceSettings(ZenohAccessSettings):
         description="Nice value given to every thread of the service but the stepping threads and the publish "
         "worker, the HTTP event loop included (Linux, per thread; service.core.priority) [-]. Between the stepping "
         "threads' (-10) and the host's other processes' (0): these threads hold the GIL the stepping threads wait "
-        "for, and below the load (nice 10 before 2026-11-23) they were preempted while holding it (attack: real-time "
-        "factor 0.78-0.86 at 10, 0.998-1.000 at 0 on a quiet host; at 0 against -5 with other processes busy: "
-        "0.68-0.81 against 0.80-0.91, /health p99 214-317 against 52-89 ms). Below the process's nice needs root or "
+        "for, and below the load they are preempted while holding it (priority inversion; `attack` measures the "
+        "real-time factor under a flood). Below the process's nice needs root or "
         "CAP_SYS_NICE (refused: counted in /health thread_priority errors). 0: the process's nice.")
     gc_freeze: bool = Field(
         default=True,

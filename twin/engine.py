@@ -83,7 +83,7 @@ class Twin:
         self._last_restart_time_s = -math.inf
         self._last_good_time_s = 0.0
         self._last_torque_n_m = 0.0
-        self._defects: tuple = ()  # issue 14: the active local defects (twin.vibration.defects)
+        self._defects: tuple = ()  # the active local defects (twin.vibration.defects)
         self._sensor = SensorReader(self.model) if self.model.housing_on else None
         self._frozen_vibration = None  # a frozen copy's last window (`frozen`); the live twin reads its sensor
         self._apply(self.limits.admit(setpoint or self.default_setpoint()))
@@ -270,7 +270,7 @@ class Twin:
         return self.model.arrays(), self.state.arrays(), self._setpoint_vector
 
     def _place_on_housing(self, radial_load_n: float, axial_load_n: float) -> None:
-        """Warm start on the housing (issue 14): the outer ring at the static equilibrium of its
+        """Warm start on the housing: the outer ring at the static equilibrium of its
         support under the whole load (at the quasi-static equilibrium the balls pass the applied
         loads to the outer ring; their centrifugal forces cancel over the ring), the balls and the
         inner ring moved with it; the decimator and the sample ring restart
@@ -382,7 +382,7 @@ class Twin:
         """Simulated time [s]."""
         return float(self.state.scalars[L.X_TIME])
 
-    # ---- local defects and the accelerometer (issue 14, twin.vibration) ------------------------
+    # ---- local defects and the accelerometer (twin.vibration) ----------------------------------
     @property
     def defects(self) -> tuple:
         """The active local defects (twin.vibration.defects models)."""

@@ -35,7 +35,7 @@ class TwinState:
     workspace: np.ndarray        # the kernel's `w` (layout.N_WORKSPACE): the lanes, then the defects
     lanes: np.ndarray            # flat per-contact lanes, row k of contact c at [k * CW + c] (a view)
     cage_load_n: np.ndarray      # (Z, 2) ball j against cage element ahead (0) and behind (1)
-    # issue 14 (twin.vibration); all zero and unused with the rigid outer ring
+    # vibration (twin.vibration); all zero and unused with the rigid outer ring
     housing_displacement_m: np.ndarray  # (N_HOUSING_DOF,) outer ring x, y, z, sprung mass [m]
     housing_velocity_m_s: np.ndarray     # [m/s]
     housing_acceleration_m_s2: np.ndarray  # [m/s^2]

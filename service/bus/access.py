@@ -57,7 +57,7 @@ from typing import Any
 from service.settings import zenoh_access_enabled
 
 # what each role may do: (messages, flow, key suffixes under P/*)
-# what a twin publishes (besides its state): results, alarm events, vibration (issue 14, 15)
+# what a twin publishes (besides its state): results, alarm events, vibration
 _OUT = ["state", "ball/*", "setpoint/result", "defects/result", "alarm", "vibration", "vibration/waveform"]
 _READ_IN = [
     (["declare_subscriber"], "ingress", _OUT),

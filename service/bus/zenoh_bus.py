@@ -16,7 +16,7 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
     P/{id}/owner             queryable: which process runs the twin (pid, host, zenoh id, HTTP)
     P/{id}/alarm             alarm events JSON, schema "bearing-twin/alarm/1" (publisher;
                              service.core.alarms, handed over by the alarm hub)
-    P/{id}/defects           local defects JSON in (subscriber; issue 14): {"defects": [...]}
+    P/{id}/defects           local defects JSON in (subscriber): {"defects": [...]}
                              or the list, [] clears (service.core.defects); same rules as a setpoint
     P/{id}/defects/result    what became of each defects message, like setpoint/result
     P/{id}/vibration         the vibration indicators of each new accelerometer window, JSON,

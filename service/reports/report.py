@@ -252,7 +252,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
            f"`bearing-twin bench` (6208, 3000 N, 500 rad/s): real-time factor {bench['real_time_factor']:.2f} "
            f"(best of {bench['repeats']}, {bench['ns_per_step']:.0f} ns per step) at the auto step "
            f"dt = {bench['time_step_s'] * 1e6:.3f} us, {bench['real_time_factor_1us']:.2f} at dt = 1 us.\n",
-           "## Time step: the auto step against 1 us (issue 13)\n",
+           "## Time step: the auto step against 1 us\n",
            f"{'Quick subset; `bearing-twin timestep-study` runs the whole envelope. ' if quick else ''}"
            "Outputs averaged over whole cage revolutions (twin.validation.timestep_study).\n",
            timestep_study.markdown(step_study) + "\n",

@@ -100,7 +100,7 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     Reads the G_*, K_*, M_STIFFNESS rows and the cached C_* rows; writes the O_* rows (with
     O_NORMAL_RATE between its two loops) and the spring T_XI* (reset where the contact is
     open)."""
-    # two loops, not one (issue 13): the kinematics (slip, entrainment, normal rate, kept in
+    # two loops, not one: the kinematics (slip, entrainment, normal rate, kept in
     # their rows), then the forces; one loop held more values than the 16 vector registers and
     # went to the stack 77 times per 4 lanes, two go 40 times (with the moment pass 504 -> 461 ns
     # in one process, same operations, bitwise the same results; a third loop was slower)

@@ -214,7 +214,7 @@ def asperity_load_share(film_parameter_lambda):
 @njit(**JIT)
 def asperity_load_share_ln(film_parameter_lambda, ln_lambda):
     """`asperity_load_share` (seed 001 eq. A2) given ln Lambda as well: the tribology refresh has
-    it from the film's logarithm (twin.kernels.tribology), and saves the logarithm (issue 13).
+    it from the film's logarithm (twin.kernels.tribology), and saves the logarithm.
     Two exps: cheaper than two general powers."""
     lam = film_parameter_lambda
     if not (lam > 0.0):

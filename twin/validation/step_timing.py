@@ -1,4 +1,4 @@
-"""Per-pass timing of one step (issue 13): gather, geometry, forces, tribology, traction, cage,
+"""Per-pass timing of one step: gather, geometry, forces, tribology, traction, cage,
 integration.
 
 `twin.kernels.step.compute_accelerations` runs its passes inline in one compiled function, so a
