@@ -399,7 +399,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
     (1, 0) for none), as they are read: bv and bw themselves are left as they are.
 
-    With the housing on, positions and velocities are those relative to the outer ring (`step_n` shifts
+    Positions and velocities are those relative to the outer ring (`step_n` shifts
     them with the housing on); the active defect rows (scal[X_DEFECT_COUNT] of them in the
     workspace after the lanes, twin.kernels.layout W_DEFECTS) open their clearance between the
     geometry and the force pass (`twin.kernels.vibration.apply_defects`).
