@@ -22,9 +22,9 @@ enforced, is what the facade's server creates for every client session (`OpcUaGu
   subscription per second, and all sessions at most `max_sessions` times that.
 * Failed logins (`LoginThrottle`): per client address, the first `login_free_failures` failures
   are answered at once; after them, for `login_backoff_s` x 2^k (k = failures beyond the free
-  ones, at most `login_backoff_max_s`) after the last failure, every activation from that address
-  is refused with BadUserAccessDenied WITHOUT trying the password, so guessing is slowed to one
-  try per backoff. Each burst is logged twice: at its first failure and, once it stops
+  ones, at most `login_backoff_max_s`) after the last failure, every session from that address
+  is refused with BadUserAccessDenied at CreateSession (before the server signs its answer) or
+  ActivateSession, WITHOUT trying the password, so guessing is slowed to one try per backoff. Each burst is logged twice: at its first failure and, once it stops
   (a success, or `login_backoff_max_s` without a failure), a summary with the counts. asyncua's
   own ERROR line per refusal is filtered out (`QuietRefusals`).
 """
@@ -123,8 +123,9 @@ class LoginThrottle:
                     "not tried)", burst.failures, address, burst.last_s - burst.first_s, burst.refused)
 
     def figures(self) -> dict:
+        """Counts since start (any thread: reads a copy of the addresses)."""
         return {"failed_logins": self.failures, "refused_in_backoff": self.refused, "addresses_in_backoff":
-                sum(1 for a in self._bursts if self.wait_s(a) > 0)}
+                sum(1 for a in list(self._bursts) if self.wait_s(a) > 0)}
 
 
 class QuietRefusals(logging.Filter):
@@ -198,6 +199,7 @@ class OpcUaGuard:
         return ServiceError(getattr(ua.StatusCodes, status))
 
     def figures(self) -> dict:
+        """For /health `opcua_guard`: open sessions, refusals by status, failed logins [counts]."""
         return {"sessions": len(self.sessions), "refused": dict(self.refused), **self.logins.figures()}
 
 
@@ -212,7 +214,10 @@ class GuardedSession(InternalSession):
         self.item_rates: dict[int, tuple[int, int, float]] = {}
 
     async def create_session(self, params: ua.CreateSessionParameters, sockname: Any = None) -> ua.CreateSessionResult:
-        limits = self.guard.limits
+        limits, logins = self.guard.limits, self.guard.logins
+        if logins.wait_s(self.address) > 0:          # refused before the server signs anything for it
+            logins.refuse(self.address)
+            raise ServiceError(ua.StatusCodes.BadUserAccessDenied)
         if len(self.guard.sessions) >= limits.max_sessions:
             raise self.guard.refuse("BadTooManySessions", "session from %s refused: %d open (opcua_max_sessions)",
                                     self.address, limits.max_sessions)

@@ -120,6 +120,12 @@ def test_failed_logins_back_off_per_address_and_log_once(facade, server, caplog)
     assert not [r for r in caplog.records if r.levelno >= logging.ERROR and r.name.startswith("asyncua")]
 
 
+def test_health_counts_what_the_limits_refused(facade, http):
+    guard = http.get("/health").json()["opcua_guard"]
+    assert set(guard) == {"sessions", "refused", "failed_logins", "refused_in_backoff", "addresses_in_backoff"}
+    assert guard == {**facade.guard.figures(), "sessions": guard["sessions"]}
+
+
 def test_sessions_are_capped(facade):
     async def main():
         clients = [client(facade.url) for _ in range(3)]
