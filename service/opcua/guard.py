@@ -22,9 +22,9 @@ enforced, is what the facade's server creates for every client session (`OpcUaGu
   subscription per second, and all sessions at most `max_sessions` times that.
 * Failed logins (`LoginThrottle`): per client address, the first `login_free_failures` failures
   are answered at once; after them, for `login_backoff_s` x 2^k (k = failures beyond the free
-  ones, at most `login_backoff_max_s`) after the last failure, every session from that address
-  is refused with BadUserAccessDenied at CreateSession (before the server signs its answer) or
-  ActivateSession, WITHOUT trying the password, so guessing is slowed to one try per backoff. Each burst is logged twice: at its first failure and, once it stops
+  ones, at most `login_backoff_max_s`) after the last failure, every password from that address
+  is refused with BadUserAccessDenied at ActivateSession WITHOUT being tried, so guessing is
+  slowed to one try per backoff; anonymous sessions (read-only, they guess nothing) still open. Each burst is logged twice: at its first failure and, once it stops
   (a success, or `login_backoff_max_s` without a failure), a summary with the counts. asyncua's
   own ERROR line per refusal is filtered out (`QuietRefusals`).
 """
@@ -214,10 +214,7 @@ class GuardedSession(InternalSession):
         self.item_rates: dict[int, tuple[int, int, float]] = {}
 
     async def create_session(self, params: ua.CreateSessionParameters, sockname: Any = None) -> ua.CreateSessionResult:
-        limits, logins = self.guard.limits, self.guard.logins
-        if logins.wait_s(self.address) > 0:          # refused before the server signs anything for it
-            logins.refuse(self.address)
-            raise ServiceError(ua.StatusCodes.BadUserAccessDenied)
+        limits = self.guard.limits
         if len(self.guard.sessions) >= limits.max_sessions:
             raise self.guard.refuse("BadTooManySessions", "session from %s refused: %d open (opcua_max_sessions)",
                                     self.address, limits.max_sessions)
@@ -232,7 +229,8 @@ class GuardedSession(InternalSession):
     def activate_session(self, params: ua.ActivateSessionParameters, peer_certificate: bytes | None
                          ) -> ua.ActivateSessionResult:
         logins = self.guard.logins
-        if logins.wait_s(self.address) > 0:
+        password = isinstance(params.UserIdentityToken, ua.UserNameIdentityToken)
+        if password and logins.wait_s(self.address) > 0:
             logins.refuse(self.address)
             raise ServiceError(ua.StatusCodes.BadUserAccessDenied)
         try:
@@ -241,7 +239,8 @@ class GuardedSession(InternalSession):
             if exc.code == ua.StatusCodes.BadUserAccessDenied:
                 logins.failed(self.address)
             raise
-        logins.succeeded(self.address)
+        if password:                                 # an anonymous session ends no burst of guesses
+            logins.succeeded(self.address)
         return result
 
     # ---- subscriptions and monitored items -----------------------------------------------------

@@ -26,7 +26,7 @@ WAIT_S = 60.0
 PUBLISH_HZ = 20.0
 LIMITS = dict(opcua_max_sessions=3, opcua_max_subscriptions_per_session=2, opcua_max_monitored_items_per_session=6,
               opcua_max_notifications_per_s=40.0, opcua_min_publishing_interval_ms=100.0, opcua_max_queue_size=4,
-              opcua_login_free_failures=1, opcua_login_backoff_s=1.0, opcua_login_backoff_max_s=4.0)
+              opcua_login_free_failures=1, opcua_login_backoff_s=3.0, opcua_login_backoff_max_s=6.0)
 
 
 @pytest.fixture(scope="module")
@@ -98,15 +98,19 @@ def test_an_item_costs_what_it_may_send():
 
 
 def test_failed_logins_back_off_per_address_and_log_once(facade, server, caplog):
-    """After one free failure the address waits 1 s: the next guesses and even the right password
-    are refused without being tried until the backoff passed; then it opens a session. One warning
-    for the burst and one summary, no asyncua ERROR line per refusal."""
+    """After one free failure the address waits 3 s: the next guesses and even the right password
+    are refused without being tried until the backoff passed (an anonymous read-only session still
+    opens); then it opens a session. One warning for the burst and one summary, no asyncua ERROR
+    line per refusal."""
     caplog.set_level(logging.INFO)
     guard = facade.guard
 
     async def main():
         codes = [await refused(client(facade.url, password=f"guess-{i}")) for i in range(4)]
         in_backoff = await refused(client(facade.url))              # the token, during the backoff
+        async with client(facade.url, password=None) as c:           # anonymous (read-only): not slowed
+            await c.nodes.objects.read_browse_name()
+        assert guard.logins.wait_s("127.0.0.1") > 0                  # ... and it does not end the backoff
         await asyncio.sleep(guard.logins.wait_s("127.0.0.1") + 0.2)
         async with client(facade.url) as c:                          # after it: accepted
             await c.nodes.objects.read_browse_name()
