@@ -24,7 +24,8 @@ enforced, is what the facade's server creates for every client session (`OpcUaGu
   are answered at once; after them, for `login_backoff_s` x 2^k (k = failures beyond the free
   ones, at most `login_backoff_max_s`) after the last failure, every password from that address
   is refused with BadUserAccessDenied at ActivateSession WITHOUT being tried, so guessing is
-  slowed to one try per backoff; anonymous sessions (read-only, they guess nothing) still open. Each burst is logged twice: at its first failure and, once it stops
+  slowed to one try per backoff; anonymous sessions (read-only, they guess nothing) still open.
+  Each burst is logged twice: at its first failure and, once it stops
   (a success, or `login_backoff_max_s` without a failure), a summary with the counts. asyncua's
   own ERROR line per refusal is filtered out (`QuietRefusals`).
 """
@@ -65,7 +66,8 @@ class LoginThrottle:
 
     def __init__(self, free_failures: int = 3, backoff_s: float = 1.0, backoff_max_s: float = 60.0,
                  clock: Callable[[], float] = time.monotonic):
-        self.free_failures, self.backoff_s, self.backoff_max_s = int(free_failures), float(backoff_s), float(backoff_max_s)
+        self.free_failures = int(free_failures)
+        self.backoff_s, self.backoff_max_s = float(backoff_s), float(backoff_max_s)
         self.clock = clock
         self._bursts: collections.OrderedDict[str, _Burst] = collections.OrderedDict()
         self.failures = 0                  # since start, all addresses
@@ -151,7 +153,8 @@ class GuardLimits:
 
     @classmethod
     def from_settings(cls, s: Any) -> GuardLimits:
-        return cls(max_sessions=s.opcua_max_sessions, max_subscriptions_per_session=s.opcua_max_subscriptions_per_session,
+        return cls(max_sessions=s.opcua_max_sessions,
+                   max_subscriptions_per_session=s.opcua_max_subscriptions_per_session,
                    max_monitored_items_per_session=s.opcua_max_monitored_items_per_session,
                    max_notifications_per_s=s.opcua_max_notifications_per_s,
                    min_publishing_interval_ms=s.opcua_min_publishing_interval_ms,
