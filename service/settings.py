@@ -601,6 +601,28 @@ class ServiceSettings(ZenohAccessSettings):
         description="Folder of trusted OPC UA client certificates (or CA certificates that signed "
         "them) [path to a folder of .der / .pem files]: when set, only those clients may open a "
         "session. Unset (default) = any client certificate (the token still guards writes).")
+    opcua_max_sessions: int = Field(
+        default=16, ge=1, le=10_000, description="OPC UA sessions open at once, at most [count] (BadTooManySessions).")
+    opcua_max_subscriptions_per_session: int = Field(
+        default=8, ge=1, le=10_000, description="OPC UA subscriptions per session, at most [count].")
+    opcua_max_monitored_items_per_session: int = Field(
+        default=500, ge=1, le=1_000_000, description="OPC UA monitored items per session, at most [count].")
+    opcua_max_notifications_per_s: float = Field(
+        default=1000.0, gt=0, le=1e7, description="Notifications one OPC UA session's items may send, at most "
+        "[1/s] (each item counted at min(publish_rate_hz, queue size x 1000 / publishing interval ms)).")
+    opcua_min_publishing_interval_ms: float = Field(
+        default=50.0, ge=1.0, le=3_600_000.0, description="Shortest OPC UA publishing interval granted [ms].")
+    opcua_max_queue_size: int = Field(
+        default=10, ge=1, le=10_000, description="Longest queue of an OPC UA monitored item [values].")
+    opcua_login_free_failures: int = Field(
+        default=3, ge=0, le=1000, description="Failed OPC UA logins per client address answered before the backoff "
+        "starts [count].")
+    opcua_login_backoff_s: float = Field(
+        default=1.0, gt=0, le=3600.0, description="First OPC UA login backoff of a client address, doubling at "
+        "each further failure [s].")
+    opcua_login_backoff_max_s: float = Field(
+        default=60.0, gt=0, le=86_400.0, description="Longest OPC UA login backoff; a burst of failures ends "
+        "after this long without one [s].")
 
     @field_validator("zenoh_listen", "zenoh_connect", mode="before")
     @classmethod

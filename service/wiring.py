@@ -56,7 +56,10 @@ def open_bus(settings: ServiceSettings):
     try:
         return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode,
                         prefix=settings.zenoh_prefix, owner=owner,
-                        access=ZenohAccess.from_settings(settings, enforce=True))
+                        access=ZenohAccess.from_settings(settings, enforce=True),
+                        # another peer's claim on a twin id counts when zenoh authenticated it, or
+                        # when nothing is secured; never when only the HTTP API is (service.bus.zenoh_bus)
+                        trust_claims=settings.zenoh_access_control or settings.token is None)
     except (RuntimeError, ValueError) as exc:
         text = re.sub(r"\s+at \S+\.rs:\d+\.?", "", " ".join(str(exc).split()))   # zenoh's Rust source lines
         hint = (" (is another service listening there? choose another with --zenoh-listen, or --no-zenoh)"

@@ -219,6 +219,7 @@ class Health(BaseModel):
     reads_rate_limited: int = Field(default=0, description="API reads refused with 429 by the per-client read rate [-].")
     thread_priority: ThreadPriorityHealth | None = Field(default=None, description="Priority of the stepping threads over the service's I/O threads [nice values, counts].")
     http_tarpit: dict[str, bool | int | float] | None = Field(default=None, description="The tarpit for HTTP clients over their error budget (service.api.middleware.Tarpit): `active`, `delay_s` [s], `max_held`, `held_now`, `held` (refusals held so far), `answered_at_once` (over budget with max_held held already), `errors_over_budget` [counts].")
+    opcua_guard: dict[str, Any] | None = Field(default=None, description="What the OPC UA limits refused (service.opcua.guard): `sessions` open, `refused` by status name, `failed_logins`, `refused_in_backoff`, `addresses_in_backoff` [counts]; null without OPC UA.")
     http_slow_closed: int = Field(default=0, description="HTTP connections closed (408) because their headers or body were not complete in time, in this process [-].")
     pid: int | None = Field(default=None, description="Process id of the service [-] (for soak tests and monitoring).")
     rss_bytes: int | None = Field(default=None, description="Resident memory of the service process [bytes]; null where /proc is unavailable.")

@@ -36,9 +36,16 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
     P/{id}/alive             liveliness token while the twin is attached
 
 One id per prefix in the whole zenoh network: `attach_twin` first asks for the liveliness token
-P/{id}/alive and refuses (InputError 409 naming the owner, from P/{id}/owner) when another process
-has it; after declaring its own, it asks P/{id}/owner again and withdraws if another process
-answers (two processes claiming the same id at once: neither, or only one, keeps it).
+P/{id}/alive and refuses (InputError 409) when another process has it; after declaring its own,
+it asks P/{id}/owner again and withdraws if another process answers (two processes claiming the
+same id at once: neither, or only one, keeps it). Only claims the bus may trust refuse an id
+(`trust_claims`): with zenoh access control on, zenoh authenticated every peer and only services
+may declare P/*/alive or answer P/*/owner (service.bus.access); with nothing secured (no HTTP
+token either) every peer is as trusted as any HTTP client. With an HTTP token but no zenoh access
+control, anyone who reaches the endpoint could squat an id, so a claim there is logged and the
+twin starts anyway. The 409 never repeats what the other peer said (its pid, host, URL are remote
+text): it names the zenoh id zenoh itself reports for the reply; the service log names the rest,
+quoted.
 
 Threads. zenoh runs its callbacks on its own threads; ours only hand work off (append to a
 Python queue) and return. Each channel owns two daemon threads:
@@ -119,6 +126,7 @@ class _Waveform:
     def __init__(self, blocks: list):
         self.blocks = blocks
 _ID_RE = re.compile(r"^[A-Za-z0-9_.:+=,;~@%-]+$")  # one key-expression chunk, no wildcards/slashes
+_ZID_RE = re.compile(r"^[0-9a-f]{1,32}$")            # a zenoh id as zenoh writes it (hex)
 
 
 def make_config(listen: Iterable[str] | None = None, connect: Iterable[str] | None = None,
@@ -189,6 +197,12 @@ def check_endpoint(endpoint: str) -> str:
         if not sep or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
             raise ValueError(f"not a zenoh endpoint: {endpoint!r} (expected {proto}/HOST:PORT)")
     return endpoint.strip()
+
+
+def _quoted(value: Any, limit: int = 80) -> str:
+    """Remote text for a log line: at most `limit` characters, quoted with control characters
+    escaped (repr), so a peer cannot forge or split log lines."""
+    return repr(str(value)[:limit])
 
 
 def _one_line(exc: BaseException) -> str:
@@ -665,17 +679,20 @@ class ZenohBus:
     def __init__(self, listen: Iterable[str] | None = None, connect: Iterable[str] | None = None,
                  mode: str = "peer", *, gossip: bool = True, prefix: str = DEFAULT_PREFIX,
                  access: ZenohAccess | None = None, owner: dict | None = None,
-                 claim_timeout_s: float = 2.0):
+                 claim_timeout_s: float = 2.0, trust_claims: bool = True):
         """`prefix`: the key prefix P of every twin (docs/service.md "A fleet"); `access`: zenoh's
         authentication and access-control rules (service.bus.access); `owner`: what P/{id}/owner
         tells about this process besides pid, host and zenoh id (e.g. {"http": url});
-        `claim_timeout_s`: how long the id clash check waits for answers [s]."""
+        `claim_timeout_s`: how long the id clash check waits for answers [s]; `trust_claims`:
+        whether another peer's liveliness token or owner answer may refuse an id (see the module
+        docstring; False: such a claim is only logged)."""
         self.listen = list(DEFAULT_LISTEN if listen is None else listen)
         self.connect = list(connect or [])
         self.mode = mode
         self.prefix = check_prefix(prefix)
         self.access = access if access is not None else ZenohAccess()
         self.claim_timeout_s = float(claim_timeout_s)
+        self.trust_claims = bool(trust_claims)
         self._owner = {"pid": os.getpid(), "host": socket.gethostname(), **(owner or {})}
         self._channels: dict[str, TwinChannel] = {}
         self._claiming: set[str] = set()
@@ -735,10 +752,14 @@ class ZenohBus:
         try:
             key = f"{self.prefix}/{bearing_id}"
             if self._alive_elsewhere(key):
-                raise self._taken(bearing_id, self._owners(key))
+                if self.trust_claims:
+                    raise self._taken(bearing_id, self._claimants(key))
+                log.warning("twin %r: a zenoh peer holds the liveliness token %s/alive, but zenoh did not "
+                            "authenticate it (zenoh access control is off while the HTTP API needs a token): "
+                            "the claim is not trusted and the twin starts here", bearing_id, key)
             channel = TwinChannel(self, bearing_id, get_snapshot, on_setpoint, queue_size=queue_size,
                                   on_defects=on_defects)
-            others = [o for o in self._owners(key) if o.get("zid") != self.zid]
+            others = self._claimants(key) if self.trust_claims else []
             if others:                      # claimed at the same moment elsewhere: withdraw
                 channel.detach()
                 raise self._taken(bearing_id, others)
@@ -769,7 +790,12 @@ class ZenohBus:
             return False
 
     def _owners(self, key: str) -> list[dict]:
-        """Every answer of `key`/owner (all queryables, no consolidation)."""
+        """Every answer of `key`/owner (all queryables, no consolidation), as the peers sent it."""
+        return [owner for _zid, owner in self._answers(key)]
+
+    def _answers(self, key: str) -> list[tuple[str | None, dict]]:
+        """(zenoh id of the replier as zenoh reports it, or None; the answer) for every answer of
+        `key`/owner."""
         out = []
         try:
             replies = self.session.get(f"{key}/owner", target=zenoh.QueryTarget.ALL,
@@ -781,23 +807,28 @@ class ZenohBus:
                 with contextlib.suppress(Exception):
                     data = json.loads(reply.ok.payload.to_bytes())
                     if isinstance(data, dict):
-                        out.append(data)
+                        replier = str(reply.replier_id.zid) if reply.replier_id is not None else None
+                        out.append((replier if replier and _ZID_RE.match(replier) else None, data))
         except Exception as exc:  # noqa: BLE001
             log.warning("%s: owner query failed: %s", key, _one_line(exc))
         return out
 
-    def _taken(self, bearing_id: str, owners: list[dict]) -> InputError:
-        others = [o for o in owners if o.get("zid") != self.zid]
-        if others:
-            o = others[0]
-            who = (f"process {o.get('pid', '?')} on {o.get('host', '?')}"
-                   + (f" (HTTP {o['http']})" if o.get("http") else "")
-                   + f", zenoh id {o.get('zid', '?')}")
-        else:
-            who = "another process (it did not say which)"
+    def _claimants(self, key: str) -> list[tuple[str | None, dict]]:
+        """The answers of `key`/owner from other processes than this one."""
+        return [(zid, o) for zid, o in self._answers(key) if (zid or o.get("zid")) != self.zid]
+
+    def _taken(self, bearing_id: str, claimants: list[tuple[str | None, dict]]) -> InputError:
+        """The 409: the words are ours and the replier's zenoh id as zenoh reports it; what the
+        other peer says about itself (pid, host, URL) goes to the log only, quoted."""
+        zid = next((z for z, _o in claimants if z), None)
+        who = f"another process (zenoh id {zid})" if zid else "another process"
+        for z, o in claimants[:4]:
+            log.warning("twin %r already runs under %r in process %s on %s%s, zenoh id %s (as its owner answer "
+                        "says)", bearing_id, self.prefix, _quoted(o.get("pid")), _quoted(o.get("host")),
+                        f" (HTTP {_quoted(o['http'])})" if o.get("http") else "", z or _quoted(o.get("zid")))
         return InputError.one("id", f"twin {bearing_id!r} already runs under {self.prefix!r} in {who}; "
                               "twin ids are unique per key prefix across the zenoh network: choose "
-                              "another id or prefix", status_code=409)
+                              "another id or prefix (this service's log names the process)", status_code=409)
 
     def detach_twin(self, bearing_id: str) -> None:
         channel = self.channels.get(bearing_id)

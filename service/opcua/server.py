@@ -45,6 +45,10 @@ thumbprint is logged at start and kept in `facade.pki`). Rules of a secure serve
   compare the two).
 `opcua_security = none` with a token is the old behaviour, password in clear: an explicit choice,
 warned about in the log.
+
+Limits (service.opcua.guard): sessions, subscriptions and monitored items per session, the
+notifications a session may cause per second, and a backoff of failed logins per client
+address; `facade.guard.figures()` counts what was refused.
 """
 
 from __future__ import annotations
@@ -69,6 +73,7 @@ from service.core.alarms import AlarmEvent, inputs_from_snapshot
 from service.core.errors import InputError
 from service.opcua.layout import (APPLICATION_URI, EVENT_TYPE, FOLDERS, LAST_RESULT, NAMESPACE_URI, ROOT_FOLDER, SETPOINT_VARS,
                                   View, identification)
+from service.opcua.guard import OpcUaGuard
 from service.opcua.security import POLICIES, ClientTrust, PkiError, ServerPki, given_pki, self_signed_pki
 
 log = logging.getLogger(__name__)
@@ -224,6 +229,7 @@ class OpcUaFacade:
             raise ValueError(f"opcua_security = {self.security!r}: expected one of {', '.join(POLICIES)}")
         self.pki: ServerPki | None = None        # the server certificate in use (secure modes)
         self.trust: ClientTrust | None = None
+        self.guard = OpcUaGuard.from_settings(settings)
         self.registry = registry
         self.endpoint = endpoint
         # one publish period (of wall time; in fast mode of simulated time, at least 10 ms)
@@ -315,6 +321,7 @@ class OpcUaFacade:
         server.secure = secure
         await server.init()
         users.wrap(server.iserver)
+        self.guard.install(server.iserver)
         server.set_endpoint(self.endpoint)
         server.set_server_name(self.server_name)
         await server.set_application_uri(APPLICATION_URI)
@@ -343,6 +350,7 @@ class OpcUaFacade:
                 try:
                     await self._sync()
                     await self._send_alarms()
+                    self.guard.logins.sweep()
                 except Exception:  # noqa: BLE001 - the server keeps serving
                     log.exception("OPC UA update failed")
                 try:

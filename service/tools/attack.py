@@ -19,6 +19,9 @@ flood's client work does not show up as the service's latency in another's figur
   and checking every state message for non-finite numbers;
 * each flood process measures its own CPU time (`attacker_cpu_cores`: on a shared host the
   attackers' CPU is taken from the twin too);
+* on what watchers use (service.tools.attack_watchers): zenoh twin-id squatting by an anonymous
+  peer (`squat`, on by default with zenoh) and, with an OPC UA endpoint (`--opcua`, or `--start`),
+  password guessing, a session flood and a subscription flood (`opcua_*`);
 * in this process, a /health probe every 50 ms: its latency (p50, p99, max) and the default
   twin's real-time factor; the flood's figures use the probes from 1 s after the flood started
   (the real-time factor is measured over the last second). The same probe runs for `baseline_s`
@@ -26,7 +29,8 @@ flood's client work does not show up as the service's latency in another's figur
 
 Every 200 answer with JSON is parsed strictly (NaN/Infinity refused): `nan_checks`. `ok` means no
 5xx, no non-finite number, no valid setpoint refused other than by the rate limit (429), no
-hostile request accepted, every /health probe answered, and (with --start) a clean exit. The
+hostile request accepted, no create blocked by a squatter or answered with its text, no guessed
+OPC UA password accepted, every /health probe answered, and (with --start) a clean exit. The
 real-time factor and /health p99 are reported beside the issue's targets (median real-time
 factor >= 0.95, /health p99 <= 100 ms) in `targets`; they are figures of the host, not part of
 `ok`. Loopback only: a URL or zenoh endpoint on another host is refused.
@@ -49,8 +53,9 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
+from service.tools import attack_watchers
 from service.tools.client import (TargetConfig, add_target_arguments, check_loopback, strict_json,
-                                  target_arguments)
+                                  target_arguments, url_is_loopback)
 
 MAX_SECONDS = 600.0
 MAX_CONCURRENCY = 64
@@ -69,6 +74,8 @@ class AttackConfig(TargetConfig):
     zenoh_rate_hz: float = 500.0
     baseline_s: float = 3.0
     probe_every_s: float = 0.05
+    opcua_url: str | None = None          # OPC UA endpoint of the service (loopback), None: no OPC UA floods
+    squat: bool = True                     # with zenoh: the twin-id squatting
     record: bool = field(default=False, kw_only=True)   # with start: off by default (the figures are the API's)
 
 
@@ -353,6 +360,8 @@ def run_attack(cfg: AttackConfig) -> dict:
         raise ValueError(f"zenoh_rate_hz = {cfg.zenoh_rate_hz!r}: must be in (0, 100000] [1/s]")
     if not cfg.start:
         check_loopback(cfg.url, cfg.zenoh_connect)
+        if cfg.opcua_url and not url_is_loopback(cfg.opcua_url.replace("opc.tcp://", "http://", 1)):
+            raise ValueError(f"opcua_url = {cfg.opcua_url!r}: the attack runs against loopback only")
     log = cfg.log or (lambda _line: None)
     rng = random.Random(cfg.seed)
     token = cfg.token
@@ -371,7 +380,7 @@ def run_attack(cfg: AttackConfig) -> dict:
             from service.tools.soak import _Started
 
             started = _Started(token, None, lambda line: log(line.replace("soak: ", "attack: ", 1)),
-                               record=cfg.record)
+                               record=cfg.record, opcua=True)
             url, zenoh_endpoint = started.url, started.zenoh_endpoint
             zuser, zpass = started.zenoh_user, started.zenoh_password
             started.wait_ready(client)
@@ -401,6 +410,7 @@ def run_attack(cfg: AttackConfig) -> dict:
                                          os.environ.get("BEARING_TWIN_ZENOH_PREFIX", "bearing"),
                                          "user": zuser, "password": zpass, "seconds": cfg.seconds,
                                          "rate_hz": cfg.zenoh_rate_hz, "seed": rng.randrange(2**32)}))
+        specs += attack_watchers.specs(cfg, started, url, zenoh_endpoint, token)
         for target, spec in specs:
             p = ctx.Process(target=target, args=(spec, go, out), daemon=True)
             p.start()
@@ -424,6 +434,8 @@ def run_attack(cfg: AttackConfig) -> dict:
         report["http_flood"] = parts.get("hostile")
         report["read_flood"] = parts.get("reads")
         report["zenoh_flood"] = parts.get("zenoh") if zenoh_endpoint else None
+        for name in attack_watchers.WATCHERS:
+            report[name] = parts.get(name)
         report["missing_parts"] = [s.get("mode", "zenoh") for _, s in specs if s.get("mode", "zenoh") not in parts]
         health = client.get(f"{url}/health").json()
         report["service"] = {"status": health.get("status"), "http_tarpit": health.get("http_tarpit"),
@@ -492,9 +504,10 @@ def _verdict(report: dict) -> None:
         failures.append(f"{f.get('failed', 0)} /health probes failed during the flood")
     for name in report.get("missing_parts") or ():
         failures.append(f"the {name} flood reported nothing")
-    for name in ("http_flood", "read_flood", "zenoh_flood"):
+    for name in ("http_flood", "read_flood", "zenoh_flood", *attack_watchers.WATCHERS):
         if (report.get(name) or {}).get("crashed"):
             failures.append(f"{name}: {report[name]['crashed']}")
+    failures += attack_watchers.failures(report)
     sd = report.get("shutdown")
     if sd is not None and not sd.get("clean"):
         failures.append(f"service shutdown not clean: {sd}")
@@ -524,6 +537,7 @@ def format_report(r: dict) -> str:
                  f"non-finite {t['non_finite']}")
     if r.get("attacker_cpu_cores"):
         lines.append(f"  attackers' own CPU [cores]: {r['attacker_cpu_cores']}")
+    lines += attack_watchers.summary_lines(r)
     tarpit = (r.get("service") or {}).get("http_tarpit")
     if tarpit:
         lines.append(f"  tarpit: {tarpit.get('held', 0)} refusals held {tarpit.get('delay_s')} s, "
@@ -553,6 +567,10 @@ def add_attack_command(sub) -> None:
         "recording unless --record) and flood zenoh too",
         twin_help="twin to attack and measure (default `default`)")
     p.add_argument("--record", action="store_true", help="with --start: the service records as `serve` does")
+    p.add_argument("--opcua", metavar="opc.tcp://127.0.0.1:PORT",
+                   help="OPC UA endpoint of the service for the login, session and subscription floods (loopback "
+                   "only; with --start: its own)")
+    p.add_argument("--no-squat", action="store_true", help="no zenoh twin-id squatting")
     p.add_argument("--concurrency", type=int, default=32, help="hostile HTTP requests in flight (default 32)")
     p.add_argument("--readers", type=int, default=4, help="unauthenticated GET state readers (default 4; 0: none)")
     p.add_argument("--zenoh-rate", type=float, default=500.0, help="zenoh setpoints per second (default 500)")
@@ -565,7 +583,8 @@ def add_attack_command(sub) -> None:
 def _cmd_attack(args) -> int:
     cfg = AttackConfig(seconds=args.seconds, **target_arguments(args), concurrency=args.concurrency,
                        readers=args.readers, zenoh_rate_hz=args.zenoh_rate, baseline_s=args.baseline,
-                       record=args.record, log=lambda line: print(line, file=sys.stderr, flush=True))
+                       record=args.record, opcua_url=args.opcua, squat=not args.no_squat,
+                       log=lambda line: print(line, file=sys.stderr, flush=True))
     try:
         report = run_attack(cfg)
     except (RuntimeError, ValueError) as exc:

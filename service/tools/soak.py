@@ -65,6 +65,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import service
 from service.tools.client import TargetConfig, add_target_arguments, strict_json, target_arguments, url_is_loopback
 
 _FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c")
@@ -120,7 +121,8 @@ class _Started:
     (a users file with the writer `soak`, its password in `zenoh_password`) in its environment."""
 
     def __init__(self, token: str, publish_rate_hz: float | None, log, record: bool = True,
-                 record_segment_s: float | None = None):
+                 record_segment_s: float | None = None, opcua: bool = False):
+        """`opcua`: serve OPC UA too, on a free loopback port (`opcua_url`; security `auto`)."""
         self.dir = Path(tempfile.mkdtemp(prefix="bearing-twin-soak-"))
         self.zenoh_user, self.zenoh_password = "soak", secrets.token_urlsafe(18)
         users = self.dir / "zenoh-users.txt"
@@ -134,9 +136,15 @@ class _Started:
         cmd = [sys.executable, "-m", "service.cli", "serve", "--host", "127.0.0.1", "--port", str(self.port),
                "--zenoh-listen", self.zenoh_endpoint, "--log-level", "warning"]
         cmd += ["--record", str(self.rrd)] if self.rrd is not None else ["--no-record"]
+        self.opcua_url = f"opc.tcp://127.0.0.1:{_free_port()}" if opcua else None
+        if self.opcua_url:
+            cmd += ["--opcua", self.opcua_url]
         if publish_rate_hz:
             cmd += ["--publish-rate", str(publish_rate_hz)]
         env = {k: v for k, v in os.environ.items() if not k.startswith("BEARING_TWIN_")}
+        # the service of this source tree, not whichever one the temporary folder would import
+        source = str(Path(service.__file__).resolve().parents[1])
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [source, os.environ.get("PYTHONPATH")]))
         env.update({"BEARING_TWIN_TOKEN": token, "PYTHONUNBUFFERED": "1",
                     "BEARING_TWIN_ZENOH_USERSFILE": str(users), "BEARING_TWIN_ZENOH_WRITERS": self.zenoh_user})
         if record_segment_s is not None:

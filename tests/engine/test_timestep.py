@@ -170,7 +170,12 @@ def test_bench_json_keys_positive_and_finite():
         assert math.isfinite(r[key]) and r[key] > 0, key
     assert r["repeats"] >= 5 and r["time_step_s"] > 1e-6
     assert {c["id"] for c in r["cases"]} == {"ev-5A-heating", "7208-combined", "6208-1700rad-7.5kN",
-                                             "vibration-healthy", "vibration-outer-spall"}
+                                             "vibration-healthy", "vibration-outer-spall", "ev-6200-20krpm"}
+    # seed 003's EV case: the 6200 at 20 000 rpm; the auto step (twin.timestep) is about 1.3 us there
+    ev = next(c for c in r["cases"] if c["id"] == "ev-6200-20krpm")
+    assert ev["designation"] == "6200" and ev["shaft_speed_rad_s"] == pytest.approx(20000.0 * math.pi / 30.0)
+    assert 1.1e-6 <= ev["default_step"]["time_step_s"] <= 1.5e-6
+    assert r["passes_ev"]["ns_per_step_for_real_time"] == pytest.approx(ev["default_step"]["time_step_s"] * 1e9)
     for c in r["cases"]:
         for step in ("default_step", "step_1us"):
             for key in ("real_time_factor", "real_time_factor_median", "ns_per_step", "time_step_s"):
@@ -181,6 +186,7 @@ def test_bench_json_keys_positive_and_finite():
             assert c[step]["repeats"] >= 5 and c[step]["status"] == "ok"
     for name in ("gather", "geometry", "forces", "tribology", "cage", "integration", "total"):
         for key in ("best_ns", "median_ns"):
-            assert math.isfinite(r["passes"][name][key]) and r["passes"][name][key] > 0, (name, key)
+            for passes in ("passes", "passes_ev"):
+                assert math.isfinite(r[passes][name][key]) and r[passes][name][key] > 0, (passes, name, key)
     res = _run_cli("bench", "--json", "--seconds", "0.01", "--repeats", "3")
     assert res.returncode == 2 and "at least 5" in res.stderr

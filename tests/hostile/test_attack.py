@@ -1,7 +1,8 @@
 """`bearing-twin attack` (issue 16): a short run against its own real service on loopback (token,
 zenoh access control): the report's structure, and no 5xx and no non-finite number in the
 hostile HTTP flood, the unauthenticated read flood and the zenoh flood, every zenoh setpoint
-answered. The real-time factor and /health latency are reported, never asserted (shared host)."""
+answered; the zenoh squatter blocks nothing, no guessed OPC UA password is accepted, the OPC UA
+session and subscription floods meet the guard's limits. The real-time factor and /health latency are reported, never asserted (shared host)."""
 
 from __future__ import annotations
 
@@ -36,6 +37,16 @@ def test_attack_short_run_with_its_own_service():
     assert set(r["targets"]) == {"real_time_factor_median_min", "health_p99_ms_max", "real_time_factor_median",
                                  "health_p99_ms", "met"}
     assert r["shutdown"]["clean"]
+    # the floods on what watchers use (service.tools.attack_watchers): the squatter (refused a link by
+    # zenoh access control) blocks no create and no answer repeats it; no guessed password opens a
+    # session; sessions, subscriptions and items stay within the default limits (service.opcua.guard)
+    sq, logins, sessions, subs = (r[k] for k in ("squat", "opcua_logins", "opcua_sessions", "opcua_subscriptions"))
+    assert sq["attempts"] >= 1 and sq["created"] == sq["attempts"] and sq["blocked"] == sq["echoed"] == 0
+    assert logins["tried"] >= 1 and logins["accepted"] == 0
+    assert 1 <= sessions["opened"] <= 16
+    assert subs["subscriptions"] == 8 and subs["refused"]["BadTooManySubscriptions"] == 42
+    assert subs["publishing_interval_ms"] == [50.0] and subs["items"] == 50     # 1000/s at 20/s per item
+    assert subs["notifications_per_s"] <= 1000.0 * 1.2
     # the attackers' own CPU and the service's tarpit (on by default in a served process) are reported
     cpu = r["attacker_cpu_cores"]
     assert set(cpu) == {"http_flood", "read_flood", "zenoh_flood", "total"} and all(v >= 0 for v in cpu.values())

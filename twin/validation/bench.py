@@ -11,14 +11,18 @@ further cases, and the per-pass timing of the step.
   spall (defect drops); each at its default step and at 1 us (snapped to 1 / (20 x 51.2 kHz) with
   the housing on). With the housing on, the indicators of a window (Python, once per
   `Accelerometer.window_s`) are timed apart (`indicator_window_s`, best of `repeats`) and
-  `real_time_factor` includes their share, `real_time_factor_kernel` does not;
+  `real_time_factor` includes their share, `real_time_factor_kernel` does not; and seed 003's EV
+  case (`EV_20K`: the 6200 at 20 000 rpm, 200 N, 10 A with current and shear heating, as
+  `twin.validation.studies.ev_operating_point` runs it for Figs. 8 and 10), whose auto step is the
+  shortest of all;
 - every figure: best and median real-time factor (simulated s per wall s) of `repeats` (>= 5)
   runs of `seconds` simulated seconds each, and ns per step; `cpu_real_time_factor`: simulated s
   per CPU s of the stepping thread (what the twin would run at with a core to itself: on a
   shared, loaded machine the wall-clock figure also counts the time the thread waited for a core);
 - `passes`: ns per step (CPU time of the thread) of gather, geometry, forces, tribology,
   traction, cage and integration (`twin.validation.step_timing`, a harness that times each pass
-  alone), at the default step.
+  alone), at the default step; `passes_ev`: the same for the EV case, with what its step would
+  have to cost for real time (`ns_per_step_for_real_time` = its auto step).
 
 Wall-clock figures belong here and in benchmarks/results/ (`bench --save`), never in tests (machines are
 shared and noisy).
@@ -26,6 +30,7 @@ shared and noisy).
 
 from __future__ import annotations
 
+import math
 import os
 import statistics
 import time
@@ -37,6 +42,7 @@ from twin import catalog
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 from twin.spec import BearingSpec, ModelOptions
+from twin.validation.studies import EV_BEARING, EV_RADIAL_LOAD_N
 
 MIN_REPEATS = 5
 
@@ -64,6 +70,9 @@ CASES = (
     BenchCase("vibration-healthy", housing=True),
     BenchCase("vibration-outer-spall", housing=True, defect="outer"),
 )
+EV_20K = BenchCase("ev-6200-20krpm", designation=EV_BEARING, shaft_speed_rad_s=20000.0 * math.pi / 30.0,
+                   radial_load_n=EV_RADIAL_LOAD_N, shaft_current_a=10.0, shear_heating=True)
+CASES = (*CASES, EV_20K)
 
 
 def _twin(case: BenchCase, time_step_s: float | str) -> Twin:
@@ -160,9 +169,21 @@ def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, ca
         twin = _twin(SERVE_DEFAULT, "auto")
         twin.advance(0.005)
         result["passes"] = time_passes(twin, repeats=repeats)
+        result["passes_ev"] = ev_passes(repeats)
     result["load_average_1min"] = [load_before[0], os.getloadavg()[0]]  # before, after
     result["cpu_count"] = os.cpu_count()
     return result
+
+
+def ev_passes(repeats: int = MIN_REPEATS) -> dict:
+    """The step of the EV case pass by pass (`step_timing.time_passes`), with the cost per step
+    that real time allows (its auto step) [ns]."""
+    from twin.validation.step_timing import time_passes
+
+    twin = _twin(EV_20K, "auto")
+    twin.advance(0.005)
+    return {**time_passes(twin, repeats=repeats), "time_step_s": twin.model.dt_s,
+            "ns_per_step_for_real_time": twin.model.dt_s * 1e9}
 
 
 def summary_text(result: dict) -> str:
@@ -180,12 +201,15 @@ def summary_text(result: dict) -> str:
     for c in result.get("cases", []):
         d, o = c["default_step"], c["step_1us"]
         lines.append(f"  {c['id']}: dt = {d['time_step_s'] * 1e6:.3f} us: {fig(d)}; 1 us: {fig(o)}")
-    p = result.get("passes")
-    if p:
-        parts = ", ".join(f"{k} {p[k]['best_ns']:.0f}" for k in ("gather", "geometry", "forces", "tribology",
-                                                                  "traction", "cage", "integration"))
-        lines.append(f"  per pass, ns per step (best): {parts}; sum {p['sum_of_passes']['best_ns']:.0f}, "
-                     f"step_n {p['total']['best_ns']:.0f}")
+    for key, what in (("passes", ""), ("passes_ev", f" of {EV_20K.id}")):
+        p = result.get(key)
+        if p:
+            parts = ", ".join(f"{k} {p[k]['best_ns']:.0f}" for k in ("gather", "geometry", "forces", "tribology",
+                                                                      "traction", "cage", "integration"))
+            budget = (f"; real time needs <= {p['ns_per_step_for_real_time']:.0f}"
+                      if "ns_per_step_for_real_time" in p else "")
+            lines.append(f"  per pass{what}, ns per step (best): {parts}; sum {p['sum_of_passes']['best_ns']:.0f}, "
+                         f"step_n {p['total']['best_ns']:.0f}{budget}")
     lines.append(f"  load average (1 min) before / after: {result['load_average_1min'][0]:.2f} / "
                  f"{result['load_average_1min'][1]:.2f}")
     return "\n".join(lines)

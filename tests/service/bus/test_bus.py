@@ -260,10 +260,12 @@ def test_bad_ids_and_duplicates_are_refused(bus):
         bus.attach_twin("ok-1", lambda: None, lambda p: {})
 
 
-def test_twin_ids_are_unique_per_prefix_across_buses(endpoint, support):
+def test_twin_ids_are_unique_per_prefix_across_buses(endpoint, support, caplog):
     """One id per key prefix on the whole zenoh network: a second bus (another process in real
-    life) refuses an id the first runs, with a 409 naming the owner (P/{id}/owner); another
-    prefix may use it; after a detach the id is free again."""
+    life) refuses an id the first runs, with a 409 naming the owner by the zenoh id zenoh reports
+    (its owner answer P/{id}/owner goes to the log, not the answer); another prefix may use it;
+    after a detach the id is free again."""
+    import logging
     import os
 
     from service.core.errors import InputError
@@ -281,7 +283,9 @@ def test_twin_ids_are_unique_per_prefix_across_buses(endpoint, support):
             bus2.attach_twin("x", lambda: None, lambda p: {})
         assert err.value.status_code == 409 and err.value.errors[0].field == "id"
         message = err.value.errors[0].message
-        assert f"process {os.getpid()}" in message and bus1.zid in message and "8001" in message
+        assert bus1.zid in message and "8001" not in message and f"process {os.getpid()}" not in message
+        logged = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+        assert any(f"in process '{os.getpid()}'" in m and "'http://127.0.0.1:8001'" in m for m in logged), logged
         assert "x" not in bus2.channels
         assert bus3.attach_twin("x", lambda: None, lambda p: {}).prefix == "plant1/line3/x"
         first.detach()
@@ -293,6 +297,45 @@ def test_twin_ids_are_unique_per_prefix_across_buses(endpoint, support):
         bus3.close()
         bus2.close()
         bus1.close()
+
+
+def _squat(endpoint: str, key: str, answer: dict):
+    """An anonymous peer that declares `key`/alive and answers `key`/owner with `answer`."""
+    evil = zenoh.open(make_config([], [endpoint], "peer"))
+    token = evil.liveliness().declare_token(f"{key}/alive")
+    owner = evil.declare_queryable(f"{key}/owner", lambda q: q.reply(f"{key}/owner", json.dumps(answer)))
+    return evil, token, owner
+
+
+def test_an_unauthenticated_claim_never_blocks_an_untrusting_bus(endpoint, support, caplog):
+    """The squat of the attack (README "Attack"): with an HTTP token but no zenoh access control
+    the service does not trust claims (`trust_claims=False`); a peer holding P/{id}/alive and
+    answering P/{id}/owner with forged text neither blocks the twin nor reaches an answer, and the
+    log quotes nothing of it unescaped. A trusting bus refuses the same claim without repeating
+    the forged text."""
+    from service.core.errors import InputError
+
+    forged = {"pid": 1, "host": "evil\nINFO forged line", "http": "http://evil", "zid": "0"}
+    host = ZenohBus(listen=[endpoint], connect=[], prefix="bearing")
+    evil, token, owner = _squat(endpoint, "bearing/pump-9", forged)
+    untrusting = ZenohBus(listen=[], connect=[endpoint], mode="client", prefix="bearing", trust_claims=False)
+    trusting = ZenohBus(listen=[], connect=[endpoint], mode="client", prefix="bearing")
+    try:
+        assert wait_until(lambda: trusting._alive_elsewhere("bearing/pump-9"), WAIT_S)
+        with pytest.raises(InputError) as err:
+            trusting.attach_twin("pump-9", lambda: None, lambda p: {})
+        message = err.value.errors[0].message
+        assert err.value.status_code == 409 and "evil" not in message and "process 1 " not in message
+        channel = untrusting.attach_twin("pump-9", lambda: None, lambda p: {})
+        assert channel.prefix == "bearing/pump-9" and "pump-9" in untrusting.channels
+        assert all("\n" not in r.getMessage() for r in caplog.records)
+    finally:
+        owner.undeclare()
+        token.undeclare()
+        evil.close()
+        trusting.close()
+        untrusting.close()
+        host.close()
 
 
 def test_prefixes_are_checked():
