@@ -11,8 +11,9 @@ in it (`service.recording.layout` lists the entities; the per-contact series go 
 
 Outputs: the file given to the constructor (in segments) and/or a spawned viewer (each its own
 `RecordingStream`), plus at most one extra file opened with `start_file` and closed with
-`stop_file` (its own stream with the same recording id, complete on its own). Nothing listens on
-the network unless `spawn_viewer=True` (and then only the spawned viewer does).
+`stop_file` (its own stream with the same recording id, complete on its own), plus viewers it
+sends to (`connect_viewer`, e.g. the live web viewer of `service.recording.live`). Nothing here
+listens on the network; a spawned viewer, or rerun's web viewer server, listens in its own process.
 
 Append-only. Every file is created here, exclusively and without following links
 (`service.recording.paths`); a main path that exists already (an earlier run, e.g. one killed
@@ -202,14 +203,13 @@ class RerunRecorder:
         self._rows.start_output(out.stream)
         self._send_blueprint([out])
 
-    def add_live_stream(self, stream: rr.RecordingStream) -> None:
-        """Also send everything from now on to `stream`, which the caller has connected (e.g. a
-        gRPC server the web viewer reads, `service.recording.live`); it gets the static data and
-        the blueprint first. The recorder never disconnects it before `close`."""
+    def connect_viewer(self, url: str) -> None:
+        """Also send everything from now on to the viewer or gRPC proxy at `url` (e.g. the live
+        web viewer's, `service.recording.live`); it gets the static data and the blueprint first."""
         with self._io_lock:
             self._drain_locked()
             self._send_locked(force_slow=True)
-            self._out.add_stream_output(stream)
+            self._out.connect_viewer(url)
 
     def start_file(self, path: str | Path) -> Path:
         """Start recording into a further .rrd file while running (static geometry and blueprint

@@ -136,9 +136,11 @@ class SegmentWriter:
         self.viewers.append(out)
         return out
 
-    def add_stream_output(self, stream: rr.RecordingStream, url: str | None = None) -> Output:
-        """An output whose stream the caller has connected (e.g. to a live gRPC server); it gets
-        the static data and the blueprint now, and every row from now on."""
+    def connect_viewer(self, url: str) -> Output:
+        """An output to a running viewer or gRPC proxy at `url` (e.g. `LiveWebViewer.grpc_url`);
+        it gets the static data and the blueprint now, and every row from now on."""
+        stream = self.new_stream()
+        stream.connect_grpc(url)
         out = Output(stream=stream, viewer=True, viewer_url=url)
         self.on_start(out)
         self.viewers.append(out)
@@ -389,12 +391,10 @@ class SegmentWriter:
         """Move every output that can to a fresh stream of the same recording (files written
         directly continue where they are; a viewer is connected again); the old streams are
         dropped for `RerunStreams.reclaim`. Outputs written by rerun's own file sink (footer on),
-        and live servers (their stream is the server), keep their stream."""
+        keep their stream."""
         renewed = False
         for out in self.outputs():
             if out.stream is None or (out.file is not None and out.file.rebind is None):
-                continue
-            if out.viewer and out.viewer_url is None:
                 continue
             old = out.stream
             if out.file is not None:
