@@ -21,7 +21,9 @@ from typing import Any
 
 import numpy as np
 
+from service.core.alarms import ALARM_IDS
 from service.recording import columns as C
+from service.recording import trends
 from service.recording.layout import TwinLayout, send_static
 
 log = logging.getLogger("service.recorder")
@@ -64,6 +66,7 @@ class TwinRows(TwinLayout):
     alarm_states: dict = field(default_factory=dict)  # alarm id -> latest state seen (ALARM_STATES)
     alarm_carry: dict = field(default_factory=dict)   # a new output: the states to log again
     wave_rows: list = field(default_factory=list)     # accelerometer samples not sent yet (columns.WaveRow)
+    trend_rows: list = field(default_factory=list)    # rows of the trend window still open (sent: not yet)
 
     def keep_state_of(self, old: TwinRows) -> None:
         """The same twin registered again (new geometry): keep its rows and state."""
@@ -71,14 +74,19 @@ class TwinRows(TwinLayout):
         self.last_time_s, self.last_seq, self.time_offset_s = old.last_time_s, old.last_seq, old.time_offset_s
         self.prev_time_s, self.slow_prev_time_s = old.prev_time_s, old.slow_prev_time_s
         self.alarm_rows, self.alarm_states = old.alarm_rows, old.alarm_states
-        self.wave_rows = old.wave_rows
+        self.wave_rows, self.trend_rows = old.wave_rows, old.trend_rows
 
 
 class RowBatcher:
     """Queues of snapshots, alarm events and waveforms; rows per twin; columns per send."""
 
     def __init__(self, *, queue_size: int, slow_interval_s: float, min_interval_s: float,
-                 wake: threading.Event):
+                 wake: threading.Event, trend_window_s: float | None = None, now_interval_s: float = 0.0):
+        """`trend_window_s` [s of simulated time]: a trend row per window (`service.recording.
+        trends`; None: a row per snapshot, no min / max); `now_interval_s` [s of simulated time]: the 3D, load-zone and per-contact
+        entities get the first snapshot of each such interval (0: every snapshot)."""
+        self.trend_window_s = trend_window_s
+        self.now_interval_s = float(now_interval_s)
         self.queue_size = int(queue_size)
         self.slow_interval_s = float(slow_interval_s)
         self.min_interval_s = float(min_interval_s)
@@ -180,7 +188,8 @@ class RowBatcher:
         for tw in self.twins.values():
             send_static(stream, tw)
             tw.last.clear()
-            tw.alarm_carry = {k: v for k, v in tw.alarm_states.items() if v != "inactive"}
+            # every alarm's state from the first row on (the state timeline shows "inactive" too)
+            tw.alarm_carry = {a: tw.alarm_states.get(a, "inactive") for a in ALARM_IDS}
 
     def note_all(self, text: str) -> None:
         for tw in self.twins.values():
@@ -286,7 +295,20 @@ class RowBatcher:
                 log.exception("rerun recorder: %d rows of %s lost", len(rows), tw.bearing_id)
         return sent
 
-    def _columns(self, tw: TwinRows, rows: list, alarm_rows: list, wave_rows: list, now: float,
+    def _sample(self, rows: list, tw: TwinRows, key: str) -> list:
+        """The first row of each `now_interval_s` of simulated time (and every row after a gap)."""
+        if self.now_interval_s <= 0.0:
+            return rows
+        last = tw.last
+        out = []
+        for r in rows:
+            k = math.floor(r.time_s / self.now_interval_s)
+            if last.get(key) != k or r.gap_before is not None:
+                out.append(r)
+                last[key] = k
+        return out
+
+    def _columns(self, tw: TwinRows, rows: list, alarm_rows: list, wave_rows: list, now_s: float,
                  force_slow: bool) -> list:
         triples: list = []
         if tw.alarm_carry and (rows or alarm_rows):
@@ -301,16 +323,28 @@ class RowBatcher:
             triples += C.waveform_columns(tw, wave_rows, tw.time_offset_s)
         if rows:
             batch = C.Batch.of(rows, tw.time_offset_s)
-            C.fast_columns(tw, batch)
+            now = self._sample(rows, tw, "now_interval")
+            if now:
+                now_batch = C.Batch.of(now, tw.time_offset_s)
+                C.now_columns(tw, now_batch)
+                triples += now_batch.out
             C.events(tw, batch)
             C.vibration_columns(tw, batch)
             batch.breaks(C.scalar_paths(tw, slow=False), tw.time_offset_s, tw.prev_time_s)
             triples += batch.out
             tw.prev_time_s = rows[-1].time_s
-            if not tw.slow_rows:
-                tw.slow_since = now
-            tw.slow_rows.extend(rows)
-        if tw.slow_rows and (force_slow or now - tw.slow_since >= self.slow_interval_s):
+            slow_rows = self._sample(rows, tw, "slow_interval")
+            if slow_rows and not tw.slow_rows:
+                tw.slow_since = now_s
+            tw.slow_rows.extend(slow_rows)
+        if rows or (force_slow and tw.trend_rows):
+            if self.trend_window_s is None:
+                triples += trends.trend_columns(tw, [[r] for r in rows], tw.time_offset_s, bands=False)
+            else:
+                windows, tw.trend_rows = trends.split_windows(tw.trend_rows + rows, self.trend_window_s,
+                                                              final=force_slow)
+                triples += trends.trend_columns(tw, windows, tw.time_offset_s)
+        if tw.slow_rows and (force_slow or now_s - tw.slow_since >= self.slow_interval_s):
             slow, tw.slow_rows = tw.slow_rows, []
             batch = C.Batch.of(slow, tw.time_offset_s)
             C.slow_columns(tw, batch)

@@ -78,6 +78,11 @@ class RerunRecorder:
         rec.close()                        # drains, sends, writes, closes
     """
 
+    # what the service's recordings keep (`service.wiring.recorder_options`, the offline scenario
+    # runner): a trend row per 0.2 s of simulated time (mean, min, max of its 10 snapshots at
+    # 50 Hz), the bearing now (3D, load zone, per-contact series) every 0.2 s
+    SERVICE_RATES = {"trend_window_s": 0.2, "now_interval_s": 0.2}
+
     def __init__(self, path: str | Path | CreatedFile | None = None, *, spawn_viewer: bool = False,
                  application_id: str = "bearing-twin", flush_interval_s: float = 1.0,
                  slow_interval_s: float = 5.0, queue_size: int = 512, viewer_port: int = 9876,
@@ -85,7 +90,8 @@ class RerunRecorder:
                  segment_s: float | None = None, segment_bytes: int | None = None,
                  write_footer: bool = False, streams: RerunStreams | None = None,
                  rename_existing: bool = True, retention: Retention | None = None,
-                 retry_s: float = 2.0, write_timeout_s: float = 30.0):
+                 retry_s: float = 2.0, write_timeout_s: float = 30.0, trend_window_s: float | None = None,
+                 now_interval_s: float = 0.0):
         """`path`: the main file (None: none); taken -> `<stem>.runN.rrd` with `rename_existing`,
         else RecordingPathError; or a `CreatedFile` made by the caller (`create_exclusive`), which
         the recorder then owns (removed again if the start fails). `flush_interval_s` [s]: send
@@ -96,7 +102,15 @@ class RerunRecorder:
         (rerun's own file sink writes it; memory grows with the open segment). `streams`: makes
         and frees this recorder's rerun streams (shared by the recorders of a service).
         `retention`: applied after each new segment. `retry_s` [s]: after a write error, try a new
-        segment this often."""
+        segment this often. `trend_window_s` [s of simulated time]: the trends are a row per such
+        window (mean, min, max: `service.recording.trends`; None: a row per snapshot, no bands);
+        `now_interval_s` [s of simulated time]: the 3D, load-zone and per-contact entities get
+        one snapshot per such interval (0: every snapshot). The service records with both
+        (`SERVICE_RATES`); the defaults keep every snapshot."""
+        if trend_window_s is not None and not (trend_window_s > 0.0 and math.isfinite(trend_window_s)):
+            raise ValueError(f"trend_window_s = {trend_window_s!r}: must be finite and > 0")
+        if not (now_interval_s >= 0.0 and math.isfinite(now_interval_s)):
+            raise ValueError(f"now_interval_s = {now_interval_s!r}: must be finite and >= 0")
         if not (flush_interval_s > 0.0 and math.isfinite(flush_interval_s)):
             raise ValueError(f"flush_interval_s = {flush_interval_s!r}: must be finite and > 0")
         if not (slow_interval_s > 0.0 and math.isfinite(slow_interval_s)):
@@ -125,7 +139,8 @@ class RerunRecorder:
         self._blueprints = BlueprintSender(application_id, self._streams)
         self._rows = RowBatcher(queue_size=self.queue_size,
                                 slow_interval_s=max(float(slow_interval_s), self.flush_interval_s),
-                                min_interval_s=float(min_interval_s), wake=self._wake)
+                                min_interval_s=float(min_interval_s), wake=self._wake,
+                                trend_window_s=trend_window_s, now_interval_s=float(now_interval_s))
         self._out = SegmentWriter(
             application_id=application_id, recording_id=self.recording_id, streams=self._streams,
             on_start=self._start_output, on_resume=self._rows.note_all,
@@ -509,13 +524,16 @@ class RerunRecorder:
         return list(self._rows.twins)
 
     # ---- blueprint --------------------------------------------------------------------------
-    def blueprint(self):
-        """The default layout (`service.recording.layout.blueprint`)."""
-        return blueprint(list(self._rows.twins.values()), self.series_window_s)
+    def blueprint(self, live: bool = False):
+        """The default layout (`service.recording.layout.blueprint`); `live`: for a viewer (the
+        time cursor follows the newest data), else for a file."""
+        return blueprint(list(self._rows.twins.values()), self.series_window_s, live=live)
 
     def _send_blueprint(self, outs: list[Output]) -> None:
         if not outs or not self._rows.twins:
             return
-        bp = self.blueprint()
+        layouts: dict[bool, Any] = {}
         for out in outs:
-            self._blueprints.send(bp, out.stream)
+            if out.viewer not in layouts:
+                layouts[out.viewer] = self.blueprint(live=out.viewer)
+            self._blueprints.send(layouts[out.viewer], out.stream)
