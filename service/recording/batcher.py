@@ -24,6 +24,7 @@ import numpy as np
 from service.core.alarms import ALARM_IDS
 from service.recording import columns as C
 from service.recording import trends
+from service.recording.archive import WaveformArchive
 from service.recording.layout import TwinLayout, send_static
 
 log = logging.getLogger("service.recorder")
@@ -67,6 +68,8 @@ class TwinRows(TwinLayout):
     alarm_carry: dict = field(default_factory=dict)   # a new output: the states to log again
     wave_rows: list = field(default_factory=list)     # accelerometer samples not sent yet (columns.WaveRow)
     trend_rows: list = field(default_factory=list)    # rows of the trend window still open (sent: not yet)
+    wave_events_s: list = field(default_factory=list) # simulated times of recent events (WaveformArchive)
+    wave_defects: tuple = ()                          # the defects of the last row seen
 
     def keep_state_of(self, old: TwinRows) -> None:
         """The same twin registered again (new geometry): keep its rows and state."""
@@ -81,10 +84,14 @@ class RowBatcher:
     """Queues of snapshots, alarm events and waveforms; rows per twin; columns per send."""
 
     def __init__(self, *, queue_size: int, slow_interval_s: float, min_interval_s: float,
-                 wake: threading.Event, trend_window_s: float | None = None, now_interval_s: float = 0.0):
+                 wake: threading.Event, trend_window_s: float | None = None, now_interval_s: float = 0.0,
+                 waveform_archive: WaveformArchive | None = None):
         """`trend_window_s` [s of simulated time]: a trend row per window (`service.recording.
-        trends`; None: a row per snapshot, no min / max); `now_interval_s` [s of simulated time]: the 3D, load-zone and per-contact
-        entities get the first snapshot of each such interval (0: every snapshot)."""
+        trends`; None: a row per snapshot, no min / max); `now_interval_s` [s of simulated
+        time]: the 3D, load-zone and per-contact entities get the first snapshot of each such
+        interval (0: every snapshot). `waveform_archive`: which accelerometer samples the files
+        get (None: all; viewers always get all)."""
+        self.waveform_archive = waveform_archive
         self.trend_window_s = trend_window_s
         self.now_interval_s = float(now_interval_s)
         self.queue_size = int(queue_size)
@@ -284,16 +291,44 @@ class RowBatcher:
             if not outputs:
                 continue
             try:
-                triples = self._columns(tw, rows, alarm_rows, wave_rows, now, force_slow)
+                triples = self._columns(tw, rows, alarm_rows, now, force_slow)
                 for path, indexes, columns in triples:
                     for out in outputs:
                         out.stream.send_columns(path, indexes=indexes, columns=columns)
+                self._send_waveform(tw, rows, alarm_rows, wave_rows, outputs)
                 sent += len(rows)
                 self.alarms_logged += len(alarm_rows)
             except Exception:
                 self.errors += len(rows)
                 log.exception("rerun recorder: %d rows of %s lost", len(rows), tw.bearing_id)
         return sent
+
+    def _send_waveform(self, tw: TwinRows, rows: list, alarm_rows: list, wave_rows: list, outputs: list) -> None:
+        """Every sample to the viewers; to the files all of them, or what `waveform_archive` keeps."""
+        archive = self.waveform_archive
+        if archive is not None and tw.vibration:
+            for r in rows:
+                defects = tuple(r.defects or ())
+                if r.defects is not None and defects != tw.wave_defects:
+                    tw.wave_events_s.append(r.time_s)
+                    tw.wave_defects = defects
+            tw.wave_events_s += [a.time_s for a in alarm_rows if a.transition in ("raised", "escalated")]
+        if not wave_rows:
+            return
+        files = [o for o in outputs if not o.viewer]
+        viewers = [o for o in outputs if o.viewer]
+        if archive is None:
+            groups = [(outputs, wave_rows)]
+        else:
+            newest = max(w.t0_s for w in wave_rows)
+            tw.wave_events_s = [t for t in tw.wave_events_s if t + archive.after_event_s >= newest - 60.0]
+            groups = [(viewers, wave_rows), (files, archive.keep(wave_rows, tw.wave_events_s))]
+        for outs, part in groups:
+            if not outs or not part:
+                continue
+            for path, indexes, columns in C.waveform_columns(tw, part, tw.time_offset_s):
+                for out in outs:
+                    out.stream.send_columns(path, indexes=indexes, columns=columns)
 
     def _sample(self, rows: list, tw: TwinRows, key: str) -> list:
         """The first row of each `now_interval_s` of simulated time (and every row after a gap)."""
@@ -308,8 +343,7 @@ class RowBatcher:
                 last[key] = k
         return out
 
-    def _columns(self, tw: TwinRows, rows: list, alarm_rows: list, wave_rows: list, now_s: float,
-                 force_slow: bool) -> list:
+    def _columns(self, tw: TwinRows, rows: list, alarm_rows: list, now_s: float, force_slow: bool) -> list:
         triples: list = []
         if tw.alarm_carry and (rows or alarm_rows):
             first = rows[0] if rows else None
@@ -319,8 +353,6 @@ class RowBatcher:
                 first.seq if first else alarm_rows[0].seq, tw.time_offset_s)
         if alarm_rows:
             triples += C.alarm_columns(tw, alarm_rows, tw.time_offset_s)
-        if wave_rows:
-            triples += C.waveform_columns(tw, wave_rows, tw.time_offset_s)
         if rows:
             batch = C.Batch.of(rows, tw.time_offset_s)
             now = self._sample(rows, tw, "now_interval")

@@ -55,6 +55,7 @@ from typing import Any, Self
 
 import rerun as rr
 
+from service.recording.archive import WaveformArchive
 from service.recording.batcher import RowBatcher, TwinRows
 from service.recording.layout import blueprint
 from service.recording.paths import CreatedFile, RecordingPathError, create_recording
@@ -80,8 +81,9 @@ class RerunRecorder:
 
     # what the service's recordings keep (`service.wiring.recorder_options`, the offline scenario
     # runner): a trend row per 0.2 s of simulated time (mean, min, max of its 10 snapshots at
-    # 50 Hz), the bearing now (3D, load zone, per-contact series) every 0.2 s
-    SERVICE_RATES = {"trend_window_s": 0.2, "now_interval_s": 0.2}
+    # 50 Hz), the bearing now (3D, load zone, per-contact series) every 0.2 s, the accelerometer's
+    # samples in bursts and around events (`service.recording.archive`)
+    SERVICE_RATES = {"trend_window_s": 0.2, "now_interval_s": 0.2, "waveform_archive": WaveformArchive()}
 
     def __init__(self, path: str | Path | CreatedFile | None = None, *, spawn_viewer: bool = False,
                  application_id: str = "bearing-twin", flush_interval_s: float = 1.0,
@@ -91,7 +93,7 @@ class RerunRecorder:
                  write_footer: bool = False, streams: RerunStreams | None = None,
                  rename_existing: bool = True, retention: Retention | None = None,
                  retry_s: float = 2.0, write_timeout_s: float = 30.0, trend_window_s: float | None = None,
-                 now_interval_s: float = 0.0):
+                 now_interval_s: float = 0.0, waveform_archive: WaveformArchive | None = None):
         """`path`: the main file (None: none); taken -> `<stem>.runN.rrd` with `rename_existing`,
         else RecordingPathError; or a `CreatedFile` made by the caller (`create_exclusive`), which
         the recorder then owns (removed again if the start fails). `flush_interval_s` [s]: send
@@ -105,8 +107,10 @@ class RerunRecorder:
         segment this often. `trend_window_s` [s of simulated time]: the trends are a row per such
         window (mean, min, max: `service.recording.trends`; None: a row per snapshot, no bands);
         `now_interval_s` [s of simulated time]: the 3D, load-zone and per-contact entities get
-        one snapshot per such interval (0: every snapshot). The service records with both
-        (`SERVICE_RATES`); the defaults keep every snapshot."""
+        one snapshot per such interval (0: every snapshot). `waveform_archive`: which
+        accelerometer samples the files keep (`service.recording.archive`; None: all, viewers
+        always get all). The service records with all three (`SERVICE_RATES`); the defaults keep
+        every snapshot and sample."""
         if trend_window_s is not None and not (trend_window_s > 0.0 and math.isfinite(trend_window_s)):
             raise ValueError(f"trend_window_s = {trend_window_s!r}: must be finite and > 0")
         if not (now_interval_s >= 0.0 and math.isfinite(now_interval_s)):
@@ -140,7 +144,8 @@ class RerunRecorder:
         self._rows = RowBatcher(queue_size=self.queue_size,
                                 slow_interval_s=max(float(slow_interval_s), self.flush_interval_s),
                                 min_interval_s=float(min_interval_s), wake=self._wake,
-                                trend_window_s=trend_window_s, now_interval_s=float(now_interval_s))
+                                trend_window_s=trend_window_s, now_interval_s=float(now_interval_s),
+                                waveform_archive=waveform_archive)
         self._out = SegmentWriter(
             application_id=application_id, recording_id=self.recording_id, streams=self._streams,
             on_start=self._start_output, on_resume=self._rows.note_all,
