@@ -74,7 +74,7 @@ def _recorder_class():
 def recorder_options(settings: ServiceSettings) -> dict:
     """Trend window, sampling of the bearing now, send interval, segment rotation and footer of
     every recording the service writes."""
-    return dict(**_recorder_class().SERVICE_RATES, flush_interval_s=settings.record_flush_interval_s,
+    return dict(**_recorder_class().SERVICE_OPTIONS, flush_interval_s=settings.record_flush_interval_s,
                 segment_s=settings.record_segment_s or None,
                 segment_bytes=round(settings.record_segment_mb * 1e6) or None,
                 write_footer=settings.record_footer)

@@ -82,8 +82,9 @@ class RerunRecorder:
     # what the service's recordings keep (`service.wiring.recorder_options`, the offline scenario
     # runner): a trend row per 0.2 s of simulated time (mean, min, max of its 10 snapshots at
     # 50 Hz), the bearing now (3D, load zone, per-contact series) every 0.2 s, the accelerometer's
-    # samples in bursts and around events (`service.recording.archive`)
-    SERVICE_RATES = {"trend_window_s": 0.2, "now_interval_s": 0.2, "waveform_archive": WaveformArchive()}
+    # samples in bursts and around events (`service.recording.archive`), each closed file compacted
+    SERVICE_OPTIONS = {"trend_window_s": 0.2, "now_interval_s": 0.2, "waveform_archive": WaveformArchive(),
+                       "compact_segments": True}
 
     def __init__(self, path: str | Path | CreatedFile | None = None, *, spawn_viewer: bool = False,
                  application_id: str = "bearing-twin", flush_interval_s: float = 1.0,
@@ -93,7 +94,8 @@ class RerunRecorder:
                  write_footer: bool = False, streams: RerunStreams | None = None,
                  rename_existing: bool = True, retention: Retention | None = None,
                  retry_s: float = 2.0, write_timeout_s: float = 30.0, trend_window_s: float | None = None,
-                 now_interval_s: float = 0.0, waveform_archive: WaveformArchive | None = None):
+                 now_interval_s: float = 0.0, waveform_archive: WaveformArchive | None = None,
+                 compact_segments: bool = False):
         """`path`: the main file (None: none); taken -> `<stem>.runN.rrd` with `rename_existing`,
         else RecordingPathError; or a `CreatedFile` made by the caller (`create_exclusive`), which
         the recorder then owns (removed again if the start fails). `flush_interval_s` [s]: send
@@ -109,8 +111,9 @@ class RerunRecorder:
         `now_interval_s` [s of simulated time]: the 3D, load-zone and per-contact entities get
         one snapshot per such interval (0: every snapshot). `waveform_archive`: which
         accelerometer samples the files keep (`service.recording.archive`; None: all, viewers
-        always get all). The service records with all three (`SERVICE_RATES`); the defaults keep
-        every snapshot and sample."""
+        always get all). `compact_segments`: rewrite every file once closed with fewer, larger
+        chunks and rerun's footer (`service.recording.compaction`). The service records with all
+        four (`SERVICE_OPTIONS`); the defaults keep every snapshot and sample, as sent."""
         if trend_window_s is not None and not (trend_window_s > 0.0 and math.isfinite(trend_window_s)):
             raise ValueError(f"trend_window_s = {trend_window_s!r}: must be finite and > 0")
         if not (now_interval_s >= 0.0 and math.isfinite(now_interval_s)):
@@ -151,7 +154,7 @@ class RerunRecorder:
             on_start=self._start_output, on_resume=self._rows.note_all,
             segment_s=float(segment_s) if segment_s else None, segment_bytes=int(segment_bytes) if segment_bytes else None,
             write_footer=bool(write_footer), retention=retention, retry_s=float(retry_s),
-            write_timeout_s=float(write_timeout_s))
+            write_timeout_s=float(write_timeout_s), compact_segments=bool(compact_segments))
         try:
             if spawn_viewer:
                 self._out.open_viewer(self.viewer_port)

@@ -26,6 +26,7 @@ import logging
 import os
 import socket
 import sys
+import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -34,6 +35,7 @@ from typing import Any
 
 import rerun as rr
 
+from service.recording.compaction import compact
 from service.recording.paths import CreatedFile, RecordingPathError, create_exclusive
 from service.recording.retention import Retention
 from service.recording.segments import DirectFile, RecordingWriteError, RerunFile, segment_path
@@ -81,7 +83,8 @@ class SegmentWriter:
     def __init__(self, *, application_id: str, recording_id: str, streams: RerunStreams,
                  on_start: Callable[[Output], None], on_resume: Callable[[str], None],
                  segment_s: float | None = None, segment_bytes: int | None = None, write_footer: bool = False,
-                 retention: Retention | None = None, retry_s: float = 2.0, write_timeout_s: float = 30.0):
+                 retention: Retention | None = None, retry_s: float = 2.0, write_timeout_s: float = 30.0,
+                 compact_segments: bool = False):
         self.application_id = application_id
         self.recording_id = recording_id
         self.streams = streams
@@ -93,6 +96,8 @@ class SegmentWriter:
         self.retention = retention
         self.retry_s = retry_s
         self.write_timeout_s = write_timeout_s
+        self.compact_segments = compact_segments  # rewrite each closed file compacted (service.recording.compaction)
+        self._compactions: list[threading.Thread] = []
         self.path: Path | None = None             # the main file's first segment
         self.viewers: list[Output] = []           # spawned viewer, live server
         self.primary: Output | None = None        # the main file's stream (its open segment in .file)
@@ -194,11 +199,36 @@ class SegmentWriter:
             log.warning("rerun: disconnect failed: %s", exc)
         if out.file is not None:
             out.file.close()
-            if self.retention is not None:
-                self.retention.release(out.file.path)
+            self._finished(out.file.path, background=False)
         out.stream = None
 
+    def _finished(self, path: Path, background: bool) -> None:
+        """A file closed complete: compact it (in the background after a rotation, here when
+        the recording or a clip stops), then let retention have it."""
+        if not self.compact_segments:
+            if self.retention is not None:
+                self.retention.release(path)
+            return
+
+        def run() -> None:
+            try:
+                compact(path)
+            finally:
+                if self.retention is not None:
+                    self.retention.release(path)
+
+        if not background:
+            run()
+            return
+        self._compactions = [t for t in self._compactions if t.is_alive()]
+        t = threading.Thread(target=run, name="rerun-compact", daemon=True)
+        t.start()
+        self._compactions.append(t)
+
     def close_all(self) -> None:
+        for t in self._compactions:
+            t.join()
+        self._compactions = []
         for out in self.outputs():
             self.close_output(out)
         self.viewers, self.primary, self.extra = [], None, None
@@ -290,8 +320,7 @@ class SegmentWriter:
             created.discard()
             raise
         old.close()
-        if self.retention is not None:
-            self.retention.release(old.path)
+        self._finished(old.path, background=True)
         log.info("rerun: segment %s closed (%d snapshots), recording into %s", old.path, old_rows, created.path)
         return self._segment_opened(out, created)
 
