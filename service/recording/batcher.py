@@ -24,7 +24,7 @@ import numpy as np
 from service.core.alarms import ALARM_IDS
 from service.recording import columns as C
 from service.recording import trends
-from service.recording.archive import WaveformArchive
+from service.recording.archive import WaveformArchive, is_spectrum
 from service.recording.layout import TwinLayout, send_static
 
 log = logging.getLogger("service.recorder")
@@ -70,6 +70,7 @@ class TwinRows(TwinLayout):
     trend_rows: list = field(default_factory=list)    # rows of the trend window still open (sent: not yet)
     wave_events_s: list = field(default_factory=list) # simulated times of recent events (WaveformArchive)
     wave_defects: tuple = ()                          # the defects of the last row seen
+    spectrum_filed_s: float = -math.inf               # simulated time of the last spectra sent to the files
 
     def keep_state_of(self, old: TwinRows) -> None:
         """The same twin registered again (new geometry): keep its rows and state."""
@@ -85,13 +86,15 @@ class RowBatcher:
 
     def __init__(self, *, queue_size: int, slow_interval_s: float, min_interval_s: float,
                  wake: threading.Event, trend_window_s: float | None = None, now_interval_s: float = 0.0,
-                 waveform_archive: WaveformArchive | None = None):
+                 waveform_archive: WaveformArchive | None = None, contacts_interval_s: float = 0.0):
         """`trend_window_s` [s of simulated time]: a trend row per window (`service.recording.
         trends`; None: a row per snapshot, no min / max); `now_interval_s` [s of simulated
         time]: the 3D, load-zone and per-contact entities get the first snapshot of each such
-        interval (0: every snapshot). `waveform_archive`: which accelerometer samples the files
-        get (None: all; viewers always get all)."""
+        interval (0: every snapshot), the per-contact series of each `contacts_interval_s`.
+        `waveform_archive`: which accelerometer samples and spectra the files get (None: all;
+        viewers always get all)."""
         self.waveform_archive = waveform_archive
+        self.contacts_interval_s = float(contacts_interval_s)
         self.trend_window_s = trend_window_s
         self.now_interval_s = float(now_interval_s)
         self.queue_size = int(queue_size)
@@ -176,6 +179,7 @@ class RowBatcher:
             tw.keep_state_of(old)
         else:
             tw.continue_after_s = self.ended.pop(tw.bearing_id, None)
+            tw.alarm_carry = dict.fromkeys(ALARM_IDS, "inactive")   # the state timelines start with it
         self.twins[tw.bearing_id] = tw
         if context is not None:
             self.context[tw.bearing_id] = context
@@ -293,7 +297,7 @@ class RowBatcher:
             try:
                 triples = self._columns(tw, rows, alarm_rows, now, force_slow)
                 for path, indexes, columns in triples:
-                    for out in outputs:
+                    for out in self._audience(tw, path, rows, outputs):
                         out.stream.send_columns(path, indexes=indexes, columns=columns)
                 self._send_waveform(tw, rows, alarm_rows, wave_rows, outputs)
                 sent += len(rows)
@@ -302,6 +306,19 @@ class RowBatcher:
                 self.errors += len(rows)
                 log.exception("rerun recorder: %d rows of %s lost", len(rows), tw.bearing_id)
         return sent
+
+    def _audience(self, tw: TwinRows, path: str, rows: list, outputs: list) -> list:
+        """Every output, except the files for a spectrum sent less than `spectrum_every_s` after
+        the last one they got (with a `waveform_archive`)."""
+        archive = self.waveform_archive
+        if archive is None or not is_spectrum(path) or not rows:
+            return outputs
+        t = rows[-1].time_s
+        if t >= tw.spectrum_filed_s + archive.spectrum_every_s or t < tw.spectrum_filed_s:
+            if path.endswith("/vibration/spectrum_envelope_band"):    # the last of a window's spectra
+                tw.spectrum_filed_s = t
+            return outputs
+        return [o for o in outputs if o.viewer]
 
     def _send_waveform(self, tw: TwinRows, rows: list, alarm_rows: list, wave_rows: list, outputs: list) -> None:
         """Every sample to the viewers; to the files all of them, or what `waveform_archive` keeps."""
@@ -330,14 +347,15 @@ class RowBatcher:
                 for out in outs:
                     out.stream.send_columns(path, indexes=indexes, columns=columns)
 
-    def _sample(self, rows: list, tw: TwinRows, key: str) -> list:
-        """The first row of each `now_interval_s` of simulated time (and every row after a gap)."""
-        if self.now_interval_s <= 0.0:
+    @staticmethod
+    def _sample(rows: list, tw: TwinRows, key: str, interval_s: float) -> list:
+        """The first row of each `interval_s` of simulated time (and every row after a gap)."""
+        if interval_s <= 0.0:
             return rows
         last = tw.last
         out = []
         for r in rows:
-            k = math.floor(r.time_s / self.now_interval_s)
+            k = math.floor(r.time_s / interval_s)
             if last.get(key) != k or r.gap_before is not None:
                 out.append(r)
                 last[key] = k
@@ -355,7 +373,7 @@ class RowBatcher:
             triples += C.alarm_columns(tw, alarm_rows, tw.time_offset_s)
         if rows:
             batch = C.Batch.of(rows, tw.time_offset_s)
-            now = self._sample(rows, tw, "now_interval")
+            now = self._sample(rows, tw, "now_interval", self.now_interval_s)
             if now:
                 now_batch = C.Batch.of(now, tw.time_offset_s)
                 C.now_columns(tw, now_batch)
@@ -365,7 +383,7 @@ class RowBatcher:
             batch.breaks(C.scalar_paths(tw, slow=False), tw.time_offset_s, tw.prev_time_s)
             triples += batch.out
             tw.prev_time_s = rows[-1].time_s
-            slow_rows = self._sample(rows, tw, "slow_interval")
+            slow_rows = self._sample(rows, tw, "contacts_interval", self.contacts_interval_s)
             if slow_rows and not tw.slow_rows:
                 tw.slow_since = now_s
             tw.slow_rows.extend(slow_rows)

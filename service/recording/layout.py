@@ -145,8 +145,8 @@ SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
     "temperatures_c": (("oil setpoint [degC]", "contact inlet [degC]"), ((150, 150, 150), (255, 120, 40))),
     "electrical/capacitance_pf": (("bearing C [pF]",), ((0, 200, 255),)),
     "electrical/resistance_log10_kohm": (("log10 R [kohm]", "log10 |Z| [kohm]"), ((255, 200, 0), (200, 200, 200))),
-    "electrical/shaft_voltage_v": (("setpoint [V]", "shaft voltage [V]"), ((150, 150, 150), (255, 120, 40))),
-    "electrical/shaft_current_ma": (("setpoint [mA]", "shaft current [mA]"), ((150, 150, 150), (80, 160, 255))),
+    "electrical/shaft_voltage_v": (("shaft voltage [V]", "setpoint [V]"), ((255, 120, 40), (150, 150, 150))),
+    "electrical/shaft_current_ma": (("shaft current [mA]", "setpoint [mA]"), ((80, 160, 255), (150, 150, 150))),
     "electrical/film_field_v_per_um": (("largest film field [V/um]",), ((220, 40, 40),)),
     "electrical/current_density_a_per_mm2": (("largest current density [A/mm2]",), ((255, 150, 0),)),
 }
@@ -156,7 +156,7 @@ SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
 TREND_BANDS: dict[str, tuple[int, ...]] = {
     "friction_torque_n_m": (0,), "loads_n": (0,), "speeds_rad_s": (1, 2), "min_lambda": (0, 1),
     "temperatures_c": (1,), "electrical/capacitance_pf": (0,), "electrical/resistance_log10_kohm": (0, 1),
-    "electrical/shaft_voltage_v": (1,), "electrical/shaft_current_ma": (1,),
+    "electrical/shaft_voltage_v": (0,), "electrical/shaft_current_ma": (0,),
     "electrical/film_field_v_per_um": (0,), "electrical/current_density_a_per_mm2": (0,),
 }
 BAND_ALPHA = 110
@@ -398,7 +398,7 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Contain
             rrb.Grid(ts("RMS, peak [m/s^2]", "vibration/acceleration_rms_peak_m_s2"),
                      ts("velocity RMS [mm/s]", "vibration/velocity_rms_mm_s"),
                      ts("kurtosis, crest [-]", "vibration/kurtosis"),
-                     ts("envelope at defect lines [m/s^2]", "vibration/envelope_lines_m_s2"),
+                     ts("envelope lines [m/s^2]", "vibration/envelope_lines_m_s2"),
                      grid_columns=2),
             column_shares=[1.1, 1.9, 1.0], name="vibration"))
     return rrb.Vertical(*rows, row_shares=[1.5, 1.0, 1.3][:len(rows)], name=tag)

@@ -81,10 +81,11 @@ class RerunRecorder:
 
     # what the service's recordings keep (`service.wiring.recorder_options`, the offline scenario
     # runner): a trend row per 0.2 s of simulated time (mean, min, max of its 10 snapshots at
-    # 50 Hz), the bearing now (3D, load zone, per-contact series) every 0.2 s, the accelerometer's
-    # samples in bursts and around events (`service.recording.archive`), each closed file compacted
-    SERVICE_OPTIONS = {"trend_window_s": 0.2, "now_interval_s": 0.2, "waveform_archive": WaveformArchive(),
-                       "compact_segments": True}
+    # 50 Hz), the bearing now (3D, load zone) every 0.2 s, the per-contact series every 1 s, the
+    # accelerometer's samples in bursts and around events and the spectra every 10 s
+    # (`service.recording.archive`), each closed file compacted
+    SERVICE_OPTIONS = {"trend_window_s": 0.2, "now_interval_s": 0.2, "contacts_interval_s": 1.0,
+                       "waveform_archive": WaveformArchive(), "compact_segments": True}
 
     def __init__(self, path: str | Path | CreatedFile | None = None, *, spawn_viewer: bool = False,
                  application_id: str = "bearing-twin", flush_interval_s: float = 1.0,
@@ -95,7 +96,7 @@ class RerunRecorder:
                  rename_existing: bool = True, retention: Retention | None = None,
                  retry_s: float = 2.0, write_timeout_s: float = 30.0, trend_window_s: float | None = None,
                  now_interval_s: float = 0.0, waveform_archive: WaveformArchive | None = None,
-                 compact_segments: bool = False):
+                 compact_segments: bool = False, contacts_interval_s: float = 0.0):
         """`path`: the main file (None: none); taken -> `<stem>.runN.rrd` with `rename_existing`,
         else RecordingPathError; or a `CreatedFile` made by the caller (`create_exclusive`), which
         the recorder then owns (removed again if the start fails). `flush_interval_s` [s]: send
@@ -109,15 +110,17 @@ class RerunRecorder:
         segment this often. `trend_window_s` [s of simulated time]: the trends are a row per such
         window (mean, min, max: `service.recording.trends`; None: a row per snapshot, no bands);
         `now_interval_s` [s of simulated time]: the 3D, load-zone and per-contact entities get
-        one snapshot per such interval (0: every snapshot). `waveform_archive`: which
+        one snapshot per such interval (0: every snapshot), the per-contact series one per
+        `contacts_interval_s` [s of simulated time]. `waveform_archive`: which
         accelerometer samples the files keep (`service.recording.archive`; None: all, viewers
         always get all). `compact_segments`: rewrite every file once closed with fewer, larger
         chunks and rerun's footer (`service.recording.compaction`). The service records with all
         four (`SERVICE_OPTIONS`); the defaults keep every snapshot and sample, as sent."""
         if trend_window_s is not None and not (trend_window_s > 0.0 and math.isfinite(trend_window_s)):
             raise ValueError(f"trend_window_s = {trend_window_s!r}: must be finite and > 0")
-        if not (now_interval_s >= 0.0 and math.isfinite(now_interval_s)):
-            raise ValueError(f"now_interval_s = {now_interval_s!r}: must be finite and >= 0")
+        for name, value in (("now_interval_s", now_interval_s), ("contacts_interval_s", contacts_interval_s)):
+            if not (value >= 0.0 and math.isfinite(value)):
+                raise ValueError(f"{name} = {value!r}: must be finite and >= 0")
         if not (flush_interval_s > 0.0 and math.isfinite(flush_interval_s)):
             raise ValueError(f"flush_interval_s = {flush_interval_s!r}: must be finite and > 0")
         if not (slow_interval_s > 0.0 and math.isfinite(slow_interval_s)):
@@ -148,7 +151,7 @@ class RerunRecorder:
                                 slow_interval_s=max(float(slow_interval_s), self.flush_interval_s),
                                 min_interval_s=float(min_interval_s), wake=self._wake,
                                 trend_window_s=trend_window_s, now_interval_s=float(now_interval_s),
-                                waveform_archive=waveform_archive)
+                                waveform_archive=waveform_archive, contacts_interval_s=float(contacts_interval_s))
         self._out = SegmentWriter(
             application_id=application_id, recording_id=self.recording_id, streams=self._streams,
             on_start=self._start_output, on_resume=self._rows.note_all,

@@ -77,8 +77,8 @@ def trend_values(tw: TwinLayout, rows: list) -> dict[str, np.ndarray]:
         out[CAPACITANCE_LEAF] = el("capacitance_f", 1e12)[:, None]
         out["electrical/resistance_log10_kohm"] = np.column_stack(
             [log10_kohm(el("resistance_ohm")), log10_kohm(el("impedance_ohm"))])
-        out["electrical/shaft_voltage_v"] = np.column_stack([sp[:, 5], el("shaft_voltage_v")])
-        out["electrical/shaft_current_ma"] = np.column_stack([sp[:, 4] * 1e3, el("shaft_current_a", 1e3)])
+        out["electrical/shaft_voltage_v"] = np.column_stack([el("shaft_voltage_v"), sp[:, 5]])
+        out["electrical/shaft_current_ma"] = np.column_stack([el("shaft_current_a", 1e3), sp[:, 4] * 1e3])
         out["electrical/film_field_v_per_um"] = el("max_film_field_v_m", 1e-6)[:, None]
         out["electrical/current_density_a_per_mm2"] = el("current_density_a_m2", 1e-6)[:, None]
     return out
