@@ -53,8 +53,6 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, Self
 
-import rerun as rr
-
 from service.recording.archive import WaveformArchive
 from service.recording.batcher import RowBatcher, TwinRows
 from service.recording.layout import blueprint
@@ -155,7 +153,8 @@ class RerunRecorder:
         self._out = SegmentWriter(
             application_id=application_id, recording_id=self.recording_id, streams=self._streams,
             on_start=self._start_output, on_resume=self._rows.note_all,
-            segment_s=float(segment_s) if segment_s else None, segment_bytes=int(segment_bytes) if segment_bytes else None,
+            segment_s=float(segment_s) if segment_s else None,
+            segment_bytes=int(segment_bytes) if segment_bytes else None,
             write_footer=bool(write_footer), retention=retention, retry_s=float(retry_s),
             write_timeout_s=float(write_timeout_s), compact_segments=bool(compact_segments))
         try:

@@ -151,7 +151,8 @@ def trend_columns(tw: TwinLayout, windows: list[list], offset_s: float, bands: b
         notes += _capacitance_scale(tw, values[CAPACITANCE_LEAF][:, 0], has_el, t_ns, seq, out)
     root = tw.root
     for leaf, v in values.items():
-        out.append((f"{root}/{leaf}", _index(w_t, w_seq), _scalars(_stats(v, bounds, TREND_BANDS.get(leaf, ()) if bands else ()))))
+        band = TREND_BANDS.get(leaf, ()) if bands else ()
+        out.append((f"{root}/{leaf}", _index(w_t, w_seq), _scalars(_stats(v, bounds, band))))
     changed = _changes(tw, rows)
     if changed:
         sel = np.array(changed)

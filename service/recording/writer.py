@@ -353,7 +353,8 @@ class SegmentWriter:
             self._lost_since_fault = 0
         self._lost_since_fault += rows
         self.fault = f"recording write failed: {exc}"
-        log.error("rerun: %s; %d snapshots lost so far, retrying every %.0f s", self.fault, self.rows_lost, self.retry_s)
+        log.error("rerun: %s; %d snapshots lost so far, retrying every %.0f s", self.fault, self.rows_lost,
+                  self.retry_s)
         f = out.file
         out.file = None
         if f is not None and not discarded:
