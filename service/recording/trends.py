@@ -15,9 +15,10 @@ snapshot where it took effect (`{trend}/changes`); the text of the change is in 
 Robust scale. The bearing capacitance spans decades when a contact's film nearly closes: one
 value 10^7 times the others flattens the line to zero. A value more than `OFF_SCALE_DECADES`
 decades from the running median is left out of the line and drawn as a marker at the edge of the
-line's range (`electrical/capacitance_pf/off_scale`), with its value in `events`; a snapshot
-without a capacitance (the film broke: metal contact, the capacitance is undefined) is marked at
-`electrical/capacitance_pf/film_broken`, and `events` says why the line is empty there.
+line's range (`electrical/capacitance_pf/off_scale`), with its value in `events`; where the
+capacitance goes missing (the film broke: metal contact, the capacitance is undefined) a marker
+at `electrical/capacitance_pf/film_broken` starts each such run, and `events` says why the line
+is empty there (at most once a minute: a film in mixed lubrication breaks and heals often).
 """
 
 from __future__ import annotations
@@ -41,6 +42,7 @@ from service.recording.layout import (
 )
 
 OFF_SCALE_DECADES = 1.0     # a capacitance more than this many decades from the running median is off scale
+NOTE_EVERY_NS = 60_000_000_000   # [ns of simulated time] at most one film-broken / -healed event per minute
 _MEDIAN_MEMORY = 0.9        # running median of the capacitance: weight of the old value per window
 
 
@@ -204,9 +206,16 @@ def _capacitance_scale(tw: TwinLayout, c_pf: np.ndarray, has_el: np.ndarray, t_n
         last["c_median_pf"] = ref
     broken = ~np.isfinite(c_pf) & has_el
     state = last.get("c_state", "ok")
+    starts = np.zeros(c_pf.size, dtype=bool)        # the first snapshot of each run of broken ones
     for j in range(c_pf.size):
         now = "broken" if broken[j] else "off" if off[j] else "ok"
         if now != state:
+            starts[j] = now == "broken"
+            quiet = t_ns[j] < last.get("c_note_ns", -NOTE_EVERY_NS) + NOTE_EVERY_NS
+            if quiet and now != "off":
+                state = now                          # the film breaks and heals often: one note a minute
+                continue
+            last["c_note_ns"] = int(t_ns[j])
             if now == "broken":
                 notes.append((j, "film broken (metal contact): the bearing capacitance is undefined, its plot is "
                                  "empty and marked x until the film carries the load again"))
@@ -222,9 +231,9 @@ def _capacitance_scale(tw: TwinLayout, c_pf: np.ndarray, has_el: np.ndarray, t_n
     if off.any():
         out.append((f"{root}/{OFF_SCALE_LEAF}", _index(t_ns[off], seq[off]),
                     rr.Scalars.columns(scalars=np.full(int(off.sum()), edge))))
-    if broken.any():
+    if starts.any():
         base = float(np.min(c_pf[good])) if good.any() else edge
-        out.append((f"{root}/{FILM_BROKEN_LEAF}", _index(t_ns[broken], seq[broken]),
-                    rr.Scalars.columns(scalars=np.full(int(broken.sum()), base))))
+        out.append((f"{root}/{FILM_BROKEN_LEAF}", _index(t_ns[starts], seq[starts]),
+                    rr.Scalars.columns(scalars=np.full(int(starts.sum()), base))))
     c_pf[off | broken] = math.nan
     return notes

@@ -130,7 +130,7 @@ def test_an_off_scale_capacitance_and_a_broken_film_are_marked_not_plotted():
     c = np.array([200.0, 210.0, 2.5e9, 205.0, math.nan, math.nan, 202.0])
     has_el = np.ones(c.size, dtype=bool)
     out: list = []
-    notes = _capacitance_scale(tw, c, has_el, np.arange(c.size) * 1_000_000, np.arange(c.size), out)
+    notes = _capacitance_scale(tw, c, has_el, np.arange(c.size) * 30_000_000_000, np.arange(c.size), out)   # 30 s apart
     assert np.isnan(c[[2, 4, 5]]).all() and np.isfinite(c[[0, 1, 3, 6]]).all()
     paths = [p for p, _i, _c in out]
     assert paths == ["bearing/a/electrical/capacitance_pf/off_scale", "bearing/a/electrical/capacitance_pf/film_broken"]
@@ -138,6 +138,12 @@ def test_an_off_scale_capacitance_and_a_broken_film_are_marked_not_plotted():
     assert "off scale" in notes[0][1] and f"{OFF_SCALE_DECADES:g} decade" in notes[0][1]
     assert "film broken" in notes[1][1] and "empty" in notes[1][1]
     assert "again" in notes[2][1]
+    # a film that breaks and heals every snapshot: a marker at each break, one note a minute
+    c = np.array([200.0, math.nan] * 10)
+    out = []
+    notes = _capacitance_scale(tw, c, np.ones(c.size, dtype=bool), 300_000_000_000 + np.arange(c.size) * 20_000_000,
+                               np.arange(c.size), out)
+    assert len(notes) == 1 and [len(idx[1].as_arrow_array()) for _p, idx, _cols in out] == [10]
 
 
 def test_the_waveform_archive_keeps_bursts_and_the_second_after_an_event():
