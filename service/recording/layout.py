@@ -215,10 +215,11 @@ class TwinLayout:
 
 def trend_style(leaf: str, names: tuple[str, ...], colors: tuple) -> rr.SeriesLines:
     """Series names, colours and widths of a trend: the window means, then the min and the max
-    of the series in `TREND_BANDS` (named "... min" / "... max", thin and translucent)."""
+    of the series in `TREND_BANDS` (both named "... min-max", thin and translucent)."""
     band = TREND_BANDS.get(leaf, ())
-    lo = [f"{names[i].split(' [')[0]} min" if len(names) > 1 else "min" for i in band]
-    hi = [f"{names[i].split(' [')[0]} max" if len(names) > 1 else "max" for i in band]
+    # min and max share a name: the plot legend shows one entry for both (and toggles both)
+    lo = [f"{names[i].split(' [')[0]} min-max" if len(names) > 1 else "min-max" for i in band]
+    hi = lo
     faded = [(*colors[i], BAND_ALPHA) for i in band]
     return rr.SeriesLines(names=[*names, *lo, *hi], colors=[(*c, 255) for c in colors] + faded + faded,
                           widths=[TREND_WIDTH] * len(names) + [BAND_WIDTH] * (2 * len(band)))
@@ -307,7 +308,7 @@ def _window(seconds: float | None):
                                 end=rrb.TimeRangeBoundary.cursor_relative())
 
 
-def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Container:
+def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = True) -> rrb.Container:
     """The default layout of one twin: top, the bearing in 3D, the load zone now and the
     bearing-level trends with the setpoint beside them; bottom, the events, the alarms (states
     and events) and the electrical panel. The per-contact series (`contacts/...`) are not in it (add them from the streams)."""
@@ -382,8 +383,11 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Contain
     if tw.vibration:
         rows.append(rrb.Horizontal(
             rrb.Vertical(
-                rrb.TimeSeriesView(name="housing acceleration [m/s^2] (last 0.1 s)", origin=root,
-                                   contents=[f"+ {root}/{WAVEFORM_LEAF}"], time_ranges=_window(0.1),
+                # live: the last 0.1 s at full rate; a file keeps bursts (service.recording.archive):
+                # the whole run, each burst drawn min-max
+                rrb.TimeSeriesView(name="housing acceleration [m/s^2] " + ("(last 0.1 s)" if live else "(bursts)"),
+                                   origin=root, contents=[f"+ {root}/{WAVEFORM_LEAF}"],
+                                   time_ranges=_window(0.1 if live else None),
                                    plot_legend=rrb.PlotLegend(visible=False)),
                 rrb.BarChartView(name="acceleration spectrum [m/s^2] vs [Hz]; envelope band orange",
                                  origin=root, contents=[f"+ {root}/vibration/spectrum",
@@ -408,7 +412,7 @@ def blueprint(twins: list[TwinLayout], series_window_s: float | None, live: bool
     """The default layout: one twin, or one tab per twin. `series_window_s` [s]: the span of the
     trend views (None: the whole recording). `live`: the time cursor follows the newest data (a
     viewer watching the twins); else (a file) it stays where the viewer opens the recording."""
-    layouts = [twin_blueprint(tw, series_window_s) for tw in twins]
+    layouts = [twin_blueprint(tw, series_window_s, live) for tw in twins]
     if not layouts:
         body = rrb.Vertical()
     elif len(layouts) == 1:
