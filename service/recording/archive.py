@@ -24,7 +24,7 @@ class WaveformArchive:
     burst_s: float = 0.1           # [s of simulated time] length of each burst
     every_s: float = 60.0          # [s of simulated time] a burst starts at every multiple of this
     after_event_s: float = 1.0     # [s of simulated time] kept whole after an event
-    spectrum_every_s: float = 10.0  # [s of simulated time] the files get a window's spectra this often
+    spectrum_every_s: float = 30.0  # [s of simulated time] the files get a window's spectra this often
 
     def __post_init__(self) -> None:
         if not (0.0 < self.burst_s <= self.every_s):
