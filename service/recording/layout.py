@@ -316,7 +316,10 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = T
     tag = tw.bearing_id
     window = _window(series_window_s)
 
-    def ts(title: str, leaf: str, legend: bool = True) -> rrb.TimeSeriesView:
+    def ts(title: str, leaf: str, legend: bool | None = None) -> rrb.TimeSeriesView:
+        # a key where a view has several quantities; one quantity: its title names it and its unit
+        if legend is None:
+            legend = len(SERIES.get(leaf, VIBRATION_SERIES.get(leaf, ((), ())))[0]) > 1
         # the trend, its change markers (and for the capacitance its off-scale markers)
         return rrb.TimeSeriesView(name=title, origin=root, contents=[f"+ {root}/{leaf}/**"], time_ranges=window,
                                   plot_legend=rrb.PlotLegend(visible=legend, corner="LeftTop"))
