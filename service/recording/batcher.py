@@ -340,10 +340,13 @@ class RowBatcher:
             newest = max(w.t0_s for w in wave_rows)
             tw.wave_events_s = [t for t in tw.wave_events_s if t + archive.after_event_s >= newest - 60.0]
             groups = [(viewers, wave_rows), (files, archive.keep(wave_rows, tw.wave_events_s))]
-        for outs, part in groups:
+        for k, (outs, part) in enumerate(groups):
             if not outs or not part:
                 continue
-            for path, indexes, columns in C.waveform_columns(tw, part, tw.time_offset_s):
+            triples = C.waveform_columns(tw, part, tw.time_offset_s)
+            if k:                                   # the archive: a line break before every burst
+                triples += C.waveform_breaks(tw, part, tw.time_offset_s)
+            for path, indexes, columns in triples:
                 for out in outs:
                     out.stream.send_columns(path, indexes=indexes, columns=columns)
 

@@ -615,3 +615,12 @@ def waveform_columns(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> li
     x = np.concatenate([r.samples for r in rows]).astype(np.float64)
     index = [rr.TimeColumn(SIM_TIME, duration=t.astype("timedelta64[ns]")), rr.TimeColumn(SEQ, sequence=seq)]
     return [(f"{tw.root}/vibration/acceleration_m_s2", index, rr.Scalars.columns(scalars=x))]
+
+
+def waveform_breaks(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> list:
+    """An empty row (a line break) half a sample before each of `rows` (bursts kept apart by
+    `service.recording.archive`: no line drawn across the samples not kept), on sim_time only."""
+    at = np.array([round((r.t0_s + offset_s - 0.5 / r.sample_rate_hz) * 1e9) for r in rows], dtype=np.int64)
+    index = [rr.TimeColumn(SIM_TIME, duration=at.astype("timedelta64[ns]"))]
+    return [(f"{tw.root}/vibration/acceleration_m_s2", index,
+             rr.Scalars.columns(scalars=np.zeros(0)).partition(np.zeros(at.size, np.int32)))]

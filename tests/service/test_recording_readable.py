@@ -231,3 +231,23 @@ def test_closed_files_are_compacted_in_rerun_s_current_format(tmp_path, run):
         RrdReader(str(packed))
     assert not [w for w in caught if "footer" in str(w.message) or "legacy" in str(w.message)]
     assert sorted(p.name for p in tmp_path.iterdir()) == ["packed.rrd", "plain.rrd"]     # no temporary left
+
+
+def test_a_file_keeps_waveform_bursts_with_line_breaks_between(tmp_path):
+    """A recorder with a WaveformArchive writes the kept bursts, each after an empty row."""
+    from types import SimpleNamespace
+
+    path = tmp_path / "v.rrd"
+    rec = RerunRecorder(path, waveform_archive=WaveformArchive(burst_s=0.01, every_s=0.05, after_event_s=0.0))
+    rec.add_twin("v", designation="6208", pitch_radius_m=0.02, ball_radius_m=0.006, inner_raceway_radius_m=0.014,
+        outer_raceway_radius_m=0.026, ball_count=9, vibration=True)
+    fs = 10_000.0
+    block = SimpleNamespace(t0_s=0.0, sample_rate_hz=fs, samples=np.ones(int(0.2 * fs), dtype=np.float32))
+    rec.publish_waveform("v", [block], seq=1)
+    rec.close()
+    rows = read_column(path, "bearing/v/vibration/acceleration_m_s2", "Scalars:scalars")
+    kept = [r for r in rows if r]
+    assert len(kept) == pytest.approx(4 * 0.01 * fs, abs=4)    # bursts at 0, 0.05, 0.1, 0.15 s, 0.01 s each
+    from service.recording import describe_recording as _d
+
+    assert _d(path)["entities"]["bearing/v/vibration/acceleration_m_s2"]["breaks"] == 4
