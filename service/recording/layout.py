@@ -78,6 +78,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
+from rerun.datatypes import TimeRange
 
 from service.core.alarms import ALARM_IDS
 
@@ -315,6 +316,9 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = T
     root = f"/{tw.root}"
     tag = tw.bearing_id
     window = _window(series_window_s)
+    # the x axis shows the whole recording too (else the viewer opens it on a span at the cursor)
+    axis_x = rrb.TimeAxis(view_range=TimeRange(start=rrb.TimeRangeBoundary.infinite(),
+                                               end=rrb.TimeRangeBoundary.infinite())) if not series_window_s else None
 
     def ts(title: str, leaf: str, legend: bool | None = None) -> rrb.TimeSeriesView:
         # a key where a view has several quantities; one quantity: its title names it and its unit
@@ -322,7 +326,7 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = T
             legend = len(SERIES.get(leaf, VIBRATION_SERIES.get(leaf, ((), ())))[0]) > 1
         # the trend, its change markers (and for the capacitance its off-scale markers)
         return rrb.TimeSeriesView(name=title, origin=root, contents=[f"+ {root}/{leaf}/**"], time_ranges=window,
-                                  plot_legend=rrb.PlotLegend(visible=legend, corner="LeftTop"))
+                                  axis_x=axis_x, plot_legend=rrb.PlotLegend(visible=legend, corner="LeftTop"))
 
     def bars(field_: str, title: str) -> rrb.BarChartView:
         return rrb.BarChartView(name=f"{title} vs azimuth [deg]: inner blue, outer violet", origin=root,
