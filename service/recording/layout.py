@@ -78,7 +78,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
-from rerun.datatypes import TimeRange
+from rerun.encodings import TimeRange
 
 from service.core.alarms import ALARM_IDS
 
