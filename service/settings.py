@@ -420,6 +420,18 @@ class ServiceSettings(ZenohAccessSettings):
         "[h of wall time, by modification time]; 0 = no age limit.")
     spawn_viewer: bool = Field(default=False,
                                description="Also stream to a rerun viewer spawned on this machine [bool].")
+    rerun_web_port: int | None = Field(
+        default=None, ge=1, le=65534,
+        description="Serve the live recording to rerun's web viewer: http://HOST:PORT, its gRPC proxy on "
+        "PORT + 1 (rerun's own server, in a process of its own) [TCP port]; unset = off.")
+    rerun_web_bind: str = Field(
+        default="127.0.0.1", min_length=1, max_length=64,
+        description="Address rerun's web viewer and gRPC proxy bind to [IP address]. rerun checks no "
+        "token: with BEARING_TWIN_TOKEN set only a loopback address is accepted (use an SSH tunnel).")
+    rerun_web_memory_mb: float = Field(
+        default=500.0, gt=0.0, le=1e6,
+        description="What rerun's gRPC proxy keeps of the live recording for viewers that connect late "
+        "(oldest rows dropped first) [MB].")
     fast: bool = Field(default=False,
                        description="Run the twins as fast as possible instead of paced to the wall clock [bool].")
     publish_rate_hz: float = Field(

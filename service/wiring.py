@@ -27,7 +27,8 @@ from service.settings import ServiceSettings
 
 log = logging.getLogger(__name__)
 
-__all__ = ["TwinEntry", "TwinService", "WiringError", "open_bus", "open_opcua", "open_recorder",
+__all__ = ["TwinEntry", "TwinService", "WiringError", "open_bus", "open_live_viewer", "open_opcua",
+           "open_recorder",
            "recorder_options"]
 
 
@@ -74,8 +75,9 @@ def _recorder_class():
 
 
 def recorder_options(settings: ServiceSettings) -> dict:
-    """Send interval, segment rotation and footer of every recording the service writes."""
-    return dict(flush_interval_s=settings.record_flush_interval_s,
+    """Trend window, sampling of the bearing now, send interval, segment rotation and footer of
+    every recording the service writes."""
+    return dict(**_recorder_class().SERVICE_OPTIONS, flush_interval_s=settings.record_flush_interval_s,
                 segment_s=settings.record_segment_s or None,
                 segment_bytes=round(settings.record_segment_mb * 1e6) or None,
                 write_footer=settings.record_footer)
@@ -86,7 +88,7 @@ def open_recorder(settings: ServiceSettings, streams: Any = None):
     `streams`: the service's `RerunStreams`, shared with the per-twin recordings (stream creation
     and reclaim must not run concurrently, see `service.recording.RerunStreams`)."""
     path = settings.recording_path
-    if path is None and not settings.spawn_viewer:
+    if path is None and not settings.spawn_viewer and settings.rerun_web_port is None:
         return None
     cls = _recorder_class()
     from service.recording import RecordingPathError, RecordingWriteError, Retention
@@ -101,6 +103,29 @@ def open_recorder(settings: ServiceSettings, streams: Any = None):
     except (RecordingPathError, RecordingWriteError, OSError) as exc:
         raise WiringError(f"cannot record to {str(path)!r}: {' '.join(str(exc).split())[:300]} "
                           "(--record PATH.rrd elsewhere, or --no-record)") from None
+
+
+def open_live_viewer(settings: ServiceSettings, recorder):
+    """rerun's web viewer serving the live recording (`service.recording.live`), connected to
+    `recorder`, or None when `settings.rerun_web_port` is unset. WiringError (one line) when it
+    cannot start or the bind is refused (a non-loopback address while a token is set)."""
+    if settings.rerun_web_port is None or recorder is None:
+        return None
+    from service.recording.live import LiveViewerError, LiveWebViewer, check_bind
+
+    try:
+        check_bind(settings.rerun_web_bind, settings.token is not None)
+        live = LiveWebViewer(settings.rerun_web_port, host=settings.rerun_web_bind,
+                             memory_limit_mb=settings.rerun_web_memory_mb).start()
+    except (LiveViewerError, ValueError, OSError) as exc:
+        raise WiringError(f"rerun web viewer: {exc}") from None
+    try:
+        recorder.connect_viewer(live.grpc_url)
+    except Exception as exc:
+        live.close()
+        raise WiringError(f"rerun web viewer: cannot connect the recording: {exc}") from None
+    log.warning("rerun web viewer: open %s", live.url())
+    return live
 
 
 def open_opcua(settings: ServiceSettings, registry: TwinRegistry):
@@ -125,6 +150,7 @@ class TwinService(TwinRegistry):
         super().__init__(settings, gate)
         self._rerun_streams = None          # service.recording.RerunStreams, made on first use
         self.opcua = None                   # service.opcua.OpcUaFacade when settings.opcua is set
+        self.live_viewer = None             # service.recording.live.LiveWebViewer when rerun_web_port is set
 
     def rerun_streams(self):
         """The `RerunStreams` that makes and frees every rerun stream of this service."""
@@ -138,8 +164,10 @@ class TwinService(TwinRegistry):
 
     def _open_outputs(self) -> None:
         self.bus = open_bus(self.settings)
-        if self.settings.recording_path is not None or self.settings.spawn_viewer:
+        if (self.settings.recording_path is not None or self.settings.spawn_viewer
+                or self.settings.rerun_web_port is not None):
             self.recorder = open_recorder(self.settings, self.rerun_streams())
+        self.live_viewer = open_live_viewer(self.settings, self.recorder)
         if self.recorder is not None:
             self.alarms.subscribe(self.recorder.log_alarm)     # alarm events into the recording
         self.alarms.subscribe(self._alarm_to_twin_recording)
@@ -165,6 +193,9 @@ class TwinService(TwinRegistry):
                 self.recorder.close()
             except Exception:
                 log.exception("closing the recorder")
+        if self.live_viewer is not None:
+            self.live_viewer.close()
+            self.live_viewer = None
         if self.bus is not None:
             try:
                 self.bus.close()

@@ -2,7 +2,7 @@
 
 `extract` turns a snapshot (the pydantic `twin.snapshot.Snapshot`, or any object of the same
 shape: fields a snapshot does not carry are simply not recorded) into a `Row` of plain numbers;
-`fast_columns` / `slow_columns` turn the rows buffered for one twin into
+`now_columns` / `slow_columns` turn the rows buffered for one twin into
 (entity path, index columns, component columns) triples for the entities of
 `service.recording.layout`; `events` derives the log rows (setpoints, scenario, restarts,
 fallbacks, status) from consecutive rows.
@@ -27,7 +27,6 @@ from service.recording.layout import (
     CURSOR_WIDTH_FRACTION,
     LOAD_ZONE,
     REGIME_CODE,
-    REGIME_ORDER,
     RISK_VALUES,
     SEQ,
     SIDES,
@@ -270,14 +269,14 @@ class Batch:
             self.out.append((path, idx, rr.Scalars.columns(scalars=np.zeros(0)).partition(np.zeros(len(at), np.int32))))
 
 
-def _log10_kohm(ohm: np.ndarray) -> np.ndarray:
+def log10_kohm(ohm: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         v = np.log10(ohm / 1e3)
     v[~np.isfinite(v)] = math.nan
     return v
 
 
-def _ball_regime(regimes: np.ndarray) -> np.ndarray:
+def ball_regime(regimes: np.ndarray) -> np.ndarray:
     """(..., Z, 2) contact regimes -> (..., Z) ball regime: the worst loaded contact (boundary <
     mixed < full film), no contact when neither contact is loaded."""
     r = regimes.astype(np.int16)
@@ -286,16 +285,17 @@ def _ball_regime(regimes: np.ndarray) -> np.ndarray:
     return np.where(worst == 99, 0, worst).astype(np.uint16)
 
 
-def fast_columns(tw: TwinLayout, batch: Batch) -> None:
+def now_columns(tw: TwinLayout, batch: Batch) -> None:
+    """The views of the bearing now (at the time cursor): the balls by regime and the contact
+    loads in 3D, the load zone bars. The trends are `service.recording.trends`."""
     rows = batch.rows
     n, z = len(rows), tw.ball_count
     root = tw.root
     c = np.stack([r.contacts for r in rows])                    # (n, z, 2, K)
     reg = np.stack([r.regimes for r in rows])                   # (n, z, 2)
     az = np.stack([r.azimuth_rad for r in rows])                # (n, z)
-    ball_reg = _ball_regime(reg)                                # (n, z)
+    ball_reg = ball_regime(reg)                                # (n, z)
     load = c[..., F_LOAD]
-    lam = c[..., F_LAMBDA]
 
     # 3D: balls by regime, contact loads as arrows
     if tw.has_geometry:
@@ -330,37 +330,6 @@ def fast_columns(tw: TwinLayout, batch: Batch) -> None:
             batch.out.append((f"{root}/load_zone/{leaf}/{name}", batch.index(),
                               _bar_columns(values, deg + (w / 2 if side else -w / 2))))
 
-    # bearing-level trends and the setpoint beside them
-    batch.scalars(f"{root}/friction_torque_n_m", [r.friction_torque_n_m for r in rows])
-    sp = np.array([r.setpoint if r.setpoint is not None else (math.nan,) * 6 for r in rows])
-    qmax = np.nanmax(np.where(np.isfinite(load), load, -math.inf).reshape(n, -1), axis=1)
-    qmax[~np.isfinite(qmax)] = math.nan
-    batch.scalars(f"{root}/loads_n", np.column_stack([qmax, sp[:, 1], sp[:, 2]]))
-    batch.scalars(f"{root}/speeds_rad_s", np.column_stack(
-        [sp[:, 0], [r.shaft_speed_rad_s for r in rows], [r.cage_speed_rad_s for r in rows]]))
-    with np.errstate(invalid="ignore"):
-        loaded = np.isfinite(lam) & (load > 0)
-    min_lam = np.where(loaded, lam, math.inf).min(axis=1)                          # (n, 2)
-    min_lam[~np.isfinite(min_lam)] = math.nan
-    batch.scalars(f"{root}/min_lambda", min_lam)
-    counts = np.stack([(ball_reg == code).sum(axis=1) for code in REGIME_ORDER], axis=1)
-    batch.scalars(f"{root}/regime_counts", counts.astype(np.float64))
-    rise = np.array([r.electrical.get("contact_temperature_rise_k", math.nan) for r in rows])
-    batch.scalars(f"{root}/temperatures_c", np.column_stack([sp[:, 3], sp[:, 3] + np.nan_to_num(rise)]))
-
-    # electrical panel, engineering units
-    if any(r.electrical for r in rows):
-        def el(key: str, scale: float = 1.0) -> np.ndarray:
-            return np.array([r.electrical.get(key, math.nan) for r in rows]) * scale
-
-        batch.scalars(f"{root}/electrical/capacitance_pf", el("capacitance_f", 1e12))
-        batch.scalars(f"{root}/electrical/resistance_log10_kohm",
-                      np.column_stack([_log10_kohm(el("resistance_ohm")), _log10_kohm(el("impedance_ohm"))]))
-        batch.scalars(f"{root}/electrical/shaft_voltage_v", el("shaft_voltage_v"))
-        batch.scalars(f"{root}/electrical/shaft_current_ma", el("shaft_current_a", 1e3))
-        batch.scalars(f"{root}/electrical/film_field_v_per_um", el("max_film_field_v_m", 1e-6))
-        batch.scalars(f"{root}/electrical/current_density_a_per_mm2", el("current_density_a_m2", 1e-6))
-
 
 def slow_columns(tw: TwinLayout, batch: Batch) -> None:
     """The per-contact series (2 Z instances per row)."""
@@ -369,7 +338,7 @@ def slow_columns(tw: TwinLayout, batch: Batch) -> None:
     root = tw.root
     c = np.stack([r.contacts for r in rows]).reshape(n, -1, len(CONTACT_FIELDS))   # (n, 2z, K)
     fields = {"load_n": c[..., F_LOAD], "lambda": c[..., F_LAMBDA], "mu": c[..., F_MU],
-              "resistance_log10_kohm": _log10_kohm(c[..., F_R]), "capacitance_pf": c[..., F_C] * 1e12}
+              "resistance_log10_kohm": log10_kohm(c[..., F_R]), "capacitance_pf": c[..., F_C] * 1e12}
     has_el = bool(np.isfinite(c[..., F_C]).any())
     for leaf, _title in CONTACT_SERIES:
         if leaf in ("resistance_log10_kohm", "capacitance_pf") and not has_el:
@@ -522,9 +491,9 @@ def alarm_columns(tw: TwinLayout, rows: list[AlarmRow], offset_s: float) -> list
 
 def alarm_states_in_force(tw: TwinLayout, states: Mapping[str, str], time_s: float, seq: int | None,
                           offset_s: float) -> list:
-    """StateChange rows of the alarms active when a new output (a segment) started, at `time_s`
-    (its first row), so that its state timeline does not begin empty."""
-    active = [(k, v) for k, v in states.items() if v != "inactive"]
+    """StateChange rows of every alarm's state when a new output (a segment) started, at
+    `time_s` (its first row), so that its state timeline does not begin empty."""
+    active = list(states.items())
     t = np.array([round((time_s + offset_s) * 1e9)], dtype=np.int64)
     return [(f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, [seq]), rr.StateChange.columns(state=[state]))
             for alarm_id, state in active]
@@ -646,3 +615,12 @@ def waveform_columns(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> li
     x = np.concatenate([r.samples for r in rows]).astype(np.float64)
     index = [rr.TimeColumn(SIM_TIME, duration=t.astype("timedelta64[ns]")), rr.TimeColumn(SEQ, sequence=seq)]
     return [(f"{tw.root}/vibration/acceleration_m_s2", index, rr.Scalars.columns(scalars=x))]
+
+
+def waveform_breaks(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> list:
+    """An empty row (a line break) half a sample before each of `rows` (bursts kept apart by
+    `service.recording.archive`: no line drawn across the samples not kept), on sim_time only."""
+    at = np.array([round((r.t0_s + offset_s - 0.5 / r.sample_rate_hz) * 1e9) for r in rows], dtype=np.int64)
+    index = [rr.TimeColumn(SIM_TIME, duration=at.astype("timedelta64[ns]"))]
+    return [(f"{tw.root}/vibration/acceleration_m_s2", index,
+             rr.Scalars.columns(scalars=np.zeros(0)).partition(np.zeros(at.size, np.int32)))]

@@ -78,6 +78,7 @@ from dataclasses import dataclass, field
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
+from rerun.encodings import TimeRange
 
 from service.core.alarms import ALARM_IDS
 
@@ -110,10 +111,11 @@ SPECTRUM_RGB = (40, 70, 150)      # the full spectra's bars
 # (what an analyser's display does: the peak of the bins under each pixel)
 SPECTRUM_PIXELS = 700.0
 ENVELOPE_BAND_RGBA = (255, 170, 0, 40)
+WAVEFORM_LEAF = "vibration/acceleration_m_s2"
 VIBRATION_SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
-    "vibration/acceleration_m_s2": (("acceleration",), ((80, 160, 255),)),
-    "vibration/acceleration_rms_peak_m_s2": (("RMS", "peak"), ((80, 160, 255), (230, 60, 60))),
-    "vibration/velocity_rms_mm_s": (("velocity RMS 10-1000 Hz",), ((255, 200, 0),)),
+    WAVEFORM_LEAF: (("acceleration [m/s^2]",), ((80, 160, 255),)),
+    "vibration/acceleration_rms_peak_m_s2": (("RMS [m/s^2]", "peak [m/s^2]"), ((80, 160, 255), (230, 60, 60))),
+    "vibration/velocity_rms_mm_s": (("velocity RMS 10-1000 Hz [mm/s]",), ((255, 200, 0),)),
     "vibration/kurtosis": (("kurtosis", "band kurtosis", "crest factor"),
                            ((230, 60, 60), (255, 150, 0), (150, 150, 150))),
     "vibration/defect_frequencies_hz": (VIB_LINE_LABELS, VIB_LINE_RGB),
@@ -130,24 +132,43 @@ LOAD_ZONE = (("load_n", "contact load Q [N]"), ("lambda", "film parameter Lambda
 CONTACT_SERIES = (("load_n", "contact load [N]"), ("lambda", "Lambda [-]"), ("mu", "mu [-]"),
                   ("resistance_log10_kohm", "log10 R [kohm]"), ("capacitance_pf", "C [pF]"))
 
-# single quantities: entity leaf -> (series names, colours)
+# bearing-level trends (service.recording.trends: a row per window of snapshots, the mean of each
+# series): entity leaf -> (series names with their unit, colours)
 SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
-    "friction_torque_n_m": (("friction torque",), ((255, 200, 0),)),
-    "loads_n": (("Qmax", "Fr", "Fa"),
+    "friction_torque_n_m": (("friction torque [N m]",), ((255, 200, 0),)),
+    "loads_n": (("Qmax [N]", "Fr setpoint [N]", "Fa setpoint [N]"),
                 ((230, 60, 60), (80, 160, 255), (160, 120, 255))),
-    "speeds_rad_s": (("shaft setpoint", "shaft", "cage"),
+    "speeds_rad_s": (("shaft setpoint [rad/s]", "shaft [rad/s]", "cage [rad/s]"),
                      ((150, 150, 150), (80, 160, 255), (0, 210, 200))),
-    "min_lambda": (("inner", "outer"), (INNER_RGB, OUTER_RGB)),
+    "min_lambda": (("inner [-]", "outer [-]"), (INNER_RGB, OUTER_RGB)),
     "regime_counts": (tuple(REGIME_LABEL[c] for c in REGIME_ORDER),
                       tuple(tuple(int(v) for v in REGIME_RGB[c]) for c in REGIME_ORDER)),
-    "temperatures_c": (("oil", "inlet"), ((150, 150, 150), (255, 120, 40))),
-    "electrical/capacitance_pf": (("bearing C",), ((0, 200, 255),)),
-    "electrical/resistance_log10_kohm": (("R", "|Z|"), ((255, 200, 0), (200, 200, 200))),
-    "electrical/shaft_voltage_v": (("shaft voltage",), ((255, 120, 40),)),
-    "electrical/shaft_current_ma": (("shaft current",), ((80, 160, 255),)),
-    "electrical/film_field_v_per_um": (("largest film field",), ((220, 40, 40),)),
-    "electrical/current_density_a_per_mm2": (("largest current density",), ((255, 150, 0),)),
+    "temperatures_c": (("oil setpoint [degC]", "contact inlet [degC]"), ((150, 150, 150), (255, 120, 40))),
+    "electrical/capacitance_pf": (("bearing C [pF]",), ((0, 200, 255),)),
+    "electrical/resistance_log10_kohm": (("log10 R [kohm]", "log10 |Z| [kohm]"), ((255, 200, 0), (200, 200, 200))),
+    "electrical/shaft_voltage_v": (("shaft voltage [V]", "setpoint [V]"), ((255, 120, 40), (150, 150, 150))),
+    "electrical/shaft_current_ma": (("shaft current [mA]", "setpoint [mA]"), ((80, 160, 255), (150, 150, 150))),
+    "electrical/film_field_v_per_um": (("largest film field [V/um]",), ((220, 40, 40),)),
+    "electrical/current_density_a_per_mm2": (("largest current density [A/mm2]",), ((255, 150, 0),)),
 }
+# the measured series of each trend whose smallest and largest value per window are drawn too
+# (thin, translucent: the band the ball-pass ripple spans); the setpoints and the regime counts
+# have none
+TREND_BANDS: dict[str, tuple[int, ...]] = {
+    "friction_torque_n_m": (0,), "loads_n": (0,), "speeds_rad_s": (1, 2), "min_lambda": (0, 1),
+    "temperatures_c": (1,), "electrical/capacitance_pf": (0,), "electrical/resistance_log10_kohm": (0, 1),
+    "electrical/shaft_voltage_v": (0,), "electrical/shaft_current_ma": (0,),
+    "electrical/film_field_v_per_um": (0,), "electrical/current_density_a_per_mm2": (0,),
+}
+BAND_ALPHA = 110
+TREND_WIDTH = 1.5                 # [ui points] the window means
+BAND_WIDTH = 0.75                 # [ui points] their min / max
+CAPACITANCE_LEAF = "electrical/capacitance_pf"
+OFF_SCALE_LEAF = f"{CAPACITANCE_LEAF}/off_scale"          # marker: a capacitance off the robust scale
+FILM_BROKEN_LEAF = f"{CAPACITANCE_LEAF}/film_broken"      # marker: no capacitance (metal contact)
+# markers beside every trend where a setpoint or the defects changed (`{trend}/changes`)
+CHANGE_MARKER = dict(names=["setpoint / defect change"], colors=[(40, 40, 40)], markers=["Diamond"],
+                     marker_sizes=[5.0])
 FAST_SERIES = tuple(SERIES)
 
 
@@ -193,6 +214,18 @@ class TwinLayout:
         return 360.0 / max(self.ball_count, 1) * 0.3
 
 
+def trend_style(leaf: str, names: tuple[str, ...], colors: tuple) -> rr.SeriesLines:
+    """Series names, colours and widths of a trend: the window means, then the min and the max
+    of the series in `TREND_BANDS` (both named "... min-max", thin and translucent)."""
+    band = TREND_BANDS.get(leaf, ())
+    # min and max share a name: the plot legend shows one entry for both (and toggles both)
+    lo = [f"{names[i].split(' [')[0]} min-max" if len(names) > 1 else "min-max" for i in band]
+    hi = lo
+    faded = [(*colors[i], BAND_ALPHA) for i in band]
+    return rr.SeriesLines(names=[*names, *lo, *hi], colors=[(*c, 255) for c in colors] + faded + faded,
+                          widths=[TREND_WIDTH] * len(names) + [BAND_WIDTH] * (2 * len(band)))
+
+
 def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
     """The static data of one twin: geometry, legends, series names and colours."""
     root = tw.root
@@ -224,7 +257,12 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
                 rr.components.LengthBatch(np.full(tw.ball_count, tw.bar_width_deg, dtype=np.float32)).described(
                     rr.BarChart.descriptor_widths())], static=True)
     for leaf, (names, colors) in SERIES.items():
-        s.log(f"{root}/{leaf}", rr.SeriesLines(names=list(names), colors=list(colors)), static=True)
+        s.log(f"{root}/{leaf}", trend_style(leaf, names, colors), static=True)
+        s.log(f"{root}/{leaf}/changes", rr.SeriesPoints(**CHANGE_MARKER), static=True)
+    s.log(f"{root}/{OFF_SCALE_LEAF}", rr.SeriesPoints(names=["off scale (value in events)"], colors=[(220, 40, 40)],
+                                                     markers=["Up"], marker_sizes=[5.0]), static=True)
+    s.log(f"{root}/{FILM_BROKEN_LEAF}", rr.SeriesPoints(names=["film broken: C undefined"], colors=[(220, 40, 40)],
+                                                       markers=["Cross"], marker_sizes=[5.0]), static=True)
     z = tw.ball_count
     names = [f"ball {i} {side}" for i in range(z) for side in SIDES]
     colors = [ball_rgb(i, z, k) for i in range(z) for k in range(2)]
@@ -236,7 +274,10 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
                                 colors=np.array(RISK_RGBA, dtype=np.uint32)), static=True)
     if tw.vibration:
         for leaf, (names, colors) in VIBRATION_SERIES.items():
-            s.log(f"{root}/{leaf}", rr.SeriesLines(names=list(names), colors=list(colors)), static=True)
+            # a waveform drawn at min-max per pixel keeps its peaks (an average per pixel halves them)
+            policy = "MinMax" if leaf == WAVEFORM_LEAF else None
+            s.log(f"{root}/{leaf}", rr.SeriesLines(names=list(names), colors=list(colors), aggregation_policy=policy),
+                  static=True)
         for leaf, rgb in (("peaks", (80, 160, 255)), ("defect_lines", (230, 60, 60))):
             s.log(f"{root}/vibration/envelope/{leaf}", [
                 rr.components.ColorBatch([rgb]).described(rr.BarChart.descriptor_color()),
@@ -259,26 +300,36 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
 
 # ---- blueprint --------------------------------------------------------------------------------
 def _window(seconds: float | None):
+    """The span a trend view shows: the last `seconds` before the time cursor, or (None) the
+    whole recording whatever the cursor."""
     if not seconds:
-        return None
+        return rrb.VisibleTimeRange(SIM_TIME, start=rrb.TimeRangeBoundary.infinite(),
+                                    end=rrb.TimeRangeBoundary.infinite())
     return rrb.VisibleTimeRange(SIM_TIME, start=rrb.TimeRangeBoundary.cursor_relative(seconds=-float(seconds)),
                                 end=rrb.TimeRangeBoundary.cursor_relative())
 
 
-def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Container:
+def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = True) -> rrb.Container:
     """The default layout of one twin: top, the bearing in 3D, the load zone now and the
     bearing-level trends with the setpoint beside them; bottom, the events, the alarms (states
     and events) and the electrical panel. The per-contact series (`contacts/...`) are not in it (add them from the streams)."""
     root = f"/{tw.root}"
     tag = tw.bearing_id
     window = _window(series_window_s)
+    # the x axis shows the whole recording too (else the viewer opens it on a span at the cursor)
+    axis_x = rrb.TimeAxis(view_range=TimeRange(start=rrb.TimeRangeBoundary.infinite(),
+                                               end=rrb.TimeRangeBoundary.infinite())) if not series_window_s else None
 
-    def ts(title: str, leaf: str, legend: bool = True) -> rrb.TimeSeriesView:
-        return rrb.TimeSeriesView(name=title, origin=root, contents=[f"+ {root}/{leaf}"], time_ranges=window,
-                                  plot_legend=rrb.PlotLegend(visible=legend, corner="LeftTop"))
+    def ts(title: str, leaf: str, legend: bool | None = None) -> rrb.TimeSeriesView:
+        # a key where a view has several quantities; one quantity: its title names it and its unit
+        if legend is None:
+            legend = len(SERIES.get(leaf, VIBRATION_SERIES.get(leaf, ((), ())))[0]) > 1
+        # the trend, its change markers (and for the capacitance its off-scale markers)
+        return rrb.TimeSeriesView(name=title, origin=root, contents=[f"+ {root}/{leaf}/**"], time_ranges=window,
+                                  axis_x=axis_x, plot_legend=rrb.PlotLegend(visible=legend, corner="LeftTop"))
 
     def bars(field_: str, title: str) -> rrb.BarChartView:
-        return rrb.BarChartView(name=f"{title} vs azimuth [deg]", origin=root,
+        return rrb.BarChartView(name=f"{title} vs azimuth [deg]: inner blue, outer violet", origin=root,
                                 contents=[f"+ {root}/load_zone/{field_}/**"],
                                 plot_legend=rrb.PlotLegend(visible=False))
 
@@ -297,22 +348,22 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Contain
     top.append(rrb.Vertical(*(bars(f, t) for f, t in LOAD_ZONE), name="load zone now (inner blue, outer violet)"))
     shares.append(1.0)
     top.append(rrb.Grid(
-        ts("loads [N]: Qmax, radial Fr, axial Fa", "loads_n"),
+        ts("loads [N]", "loads_n"),
         ts("speeds [rad/s]", "speeds_rad_s"),
-        ts("friction torque [N m]", "friction_torque_n_m", legend=False),
-        ts("smallest Lambda, loaded contacts [-]", "min_lambda"),
-        ts("balls per regime (Lambda < 1 boundary, 1-3 mixed, > 3 full film)", "regime_counts"),
+        ts("friction torque [N m]", "friction_torque_n_m"),
+        ts("min Lambda [-]", "min_lambda"),
+        ts("balls per regime (mean)", "regime_counts"),
         ts("temperatures [degC]", "temperatures_c"),
         grid_columns=3, name="trends"))
     shares.append(2.4)
     electrical = rrb.Vertical(
         rrb.Grid(
-            ts("bearing capacitance [pF]", "electrical/capacitance_pf", legend=False),
-            ts("log10 R, log10 |Z| [kohm]", "electrical/resistance_log10_kohm"),
-            ts("largest film field [V/um]", "electrical/film_field_v_per_um", legend=False),
-            ts("shaft voltage [V]", "electrical/shaft_voltage_v", legend=False),
-            ts("shaft current [mA]", "electrical/shaft_current_ma", legend=False),
-            ts("largest current density [A/mm2]", "electrical/current_density_a_per_mm2", legend=False),
+            ts("capacitance [pF]", "electrical/capacitance_pf"),
+            ts("log10 R, |Z| [kohm]", "electrical/resistance_log10_kohm"),
+            ts("film field [V/um]", "electrical/film_field_v_per_um"),
+            ts("shaft voltage [V]", "electrical/shaft_voltage_v"),
+            ts("shaft current [mA]", "electrical/shaft_current_ma"),
+            ts("current density [A/mm2]", "electrical/current_density_a_per_mm2"),
             grid_columns=3),
         rrb.StateTimelineView(name="discharge risk", origin=root, contents=[f"+ {root}/electrical/discharge_risk"],
                               time_ranges=window),
@@ -339,8 +390,11 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Contain
     if tw.vibration:
         rows.append(rrb.Horizontal(
             rrb.Vertical(
-                rrb.TimeSeriesView(name="housing acceleration [m/s^2] (last 0.1 s)", origin=root,
-                                   contents=[f"+ {root}/vibration/acceleration_m_s2"], time_ranges=_window(0.1),
+                # live: the last 0.1 s at full rate; a file keeps bursts (service.recording.archive):
+                # the whole run, each burst drawn min-max
+                rrb.TimeSeriesView(name="housing acceleration [m/s^2] " + ("(last 0.1 s)" if live else "(bursts)"),
+                                   origin=root, contents=[f"+ {root}/{WAVEFORM_LEAF}"],
+                                   time_ranges=_window(0.1 if live else None),
                                    plot_legend=rrb.PlotLegend(visible=False)),
                 rrb.BarChartView(name="acceleration spectrum [m/s^2] vs [Hz]; envelope band orange",
                                  origin=root, contents=[f"+ {root}/vibration/spectrum",
@@ -352,18 +406,20 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None) -> rrb.Contain
                              origin=root, contents=[f"+ {root}/vibration/envelope/spectrum",
                                                     f"+ {root}/vibration/envelope/cursor/**"],
                              plot_legend=rrb.PlotLegend(visible=False)),
-            rrb.Grid(ts("acceleration RMS, peak [m/s^2]", "vibration/acceleration_rms_peak_m_s2"),
-                     ts("velocity RMS 10-1000 Hz [mm/s] (ISO 20816)", "vibration/velocity_rms_mm_s", legend=False),
-                     ts("kurtosis, band kurtosis, crest factor [-]", "vibration/kurtosis"),
-                     ts("envelope at the defect frequencies [m/s^2]", "vibration/envelope_lines_m_s2"),
+            rrb.Grid(ts("RMS, peak [m/s^2]", "vibration/acceleration_rms_peak_m_s2"),
+                     ts("velocity RMS [mm/s]", "vibration/velocity_rms_mm_s"),
+                     ts("kurtosis, crest [-]", "vibration/kurtosis"),
+                     ts("envelope lines [m/s^2]", "vibration/envelope_lines_m_s2"),
                      grid_columns=2),
             column_shares=[1.1, 1.9, 1.0], name="vibration"))
     return rrb.Vertical(*rows, row_shares=[1.5, 1.0, 1.3][:len(rows)], name=tag)
 
 
-def blueprint(twins: list[TwinLayout], series_window_s: float | None) -> rrb.Blueprint:
-    """The default layout: one twin, or one tab per twin."""
-    layouts = [twin_blueprint(tw, series_window_s) for tw in twins]
+def blueprint(twins: list[TwinLayout], series_window_s: float | None, live: bool = False) -> rrb.Blueprint:
+    """The default layout: one twin, or one tab per twin. `series_window_s` [s]: the span of the
+    trend views (None: the whole recording). `live`: the time cursor follows the newest data (a
+    viewer watching the twins); else (a file) it stays where the viewer opens the recording."""
+    layouts = [twin_blueprint(tw, series_window_s, live) for tw in twins]
     if not layouts:
         body = rrb.Vertical()
     elif len(layouts) == 1:
@@ -371,5 +427,6 @@ def blueprint(twins: list[TwinLayout], series_window_s: float | None) -> rrb.Blu
     else:
         body = rrb.Tabs(*layouts)
     return rrb.Blueprint(body, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
-                         rrb.TimePanel(timeline=SIM_TIME, play_state="following", state="collapsed"),
+                         rrb.TimePanel(timeline=SIM_TIME, play_state="following" if live else "paused",
+                                       state="collapsed"),
                          collapse_panels=True)

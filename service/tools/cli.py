@@ -243,6 +243,12 @@ def build_parser() -> argparse.ArgumentParser:
                        "[BEARING_TWIN_RECORD]")
     serve.add_argument("--spawn-viewer", action="store_true", default=None,
                        help="also stream to a rerun viewer spawned here [BEARING_TWIN_SPAWN_VIEWER]")
+    serve.add_argument("--rerun-web", type=int, metavar="PORT",
+                       help="serve the live recording to rerun's web viewer at http://127.0.0.1:PORT "
+                       "(gRPC proxy on PORT+1) [BEARING_TWIN_RERUN_WEB_PORT]")
+    serve.add_argument("--rerun-web-bind", metavar="ADDRESS",
+                       help="address of the web viewer (default 127.0.0.1; non-loopback refused with a token) "
+                       "[BEARING_TWIN_RERUN_WEB_BIND]")
     serve.add_argument("--fast", action="store_true", default=None,
                        help="run the twins as fast as possible, not paced to the wall clock [BEARING_TWIN_FAST]")
     serve.add_argument("--publish-rate", type=_positive_float, metavar="HZ",
@@ -406,6 +412,7 @@ def _serve_settings(args: argparse.Namespace):
                        ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
                        ("zenoh_mode", "zenoh_mode"), ("zenoh_prefix", "zenoh_prefix"), ("record", "record"),
                        ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),
+                       ("rerun_web", "rerun_web_port"), ("rerun_web_bind", "rerun_web_bind"),
                        ("publish_rate", "publish_rate_hz"), ("opcua", "opcua"),
                        ("opcua_security", "opcua_security"), ("opcua_certificate", "opcua_certificate"),
                        ("opcua_private_key", "opcua_private_key"), ("opcua_pki_dir", "opcua_pki_dir"),

@@ -145,7 +145,7 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
     if record is not None:
         from service.recording import RerunRecorder
 
-        recorder = RerunRecorder(record, queue_size=1_000_000)
+        recorder = RerunRecorder(record, queue_size=1_000_000, **RerunRecorder.SERVICE_OPTIONS)
         if on_recording is not None and recorder.path is not None:
             on_recording(recorder.path)
     settings = alarms or AlarmSettings()

@@ -201,9 +201,11 @@ def test_serve_http_zenoh_rerun_sigterm(service, support):
     for chunk in RrdReader(str(service.rrd)).stream():
         if not chunk.is_static:
             rows[chunk.entity_path] = rows.get(chunk.entity_path, 0) + chunk.num_rows
+    # the service records a trend row per 0.2 s window of its 50 Hz snapshots and the bearing now
+    # every 0.5 s (RerunRecorder.SERVICE_OPTIONS): every snapshot counted is in a window
     torque = rows.get("/bearing/default/friction_torque_n_m", 0)
-    assert torque >= max(rows_before, 1)
-    assert rows.get("/bearing/default/balls", 0) == torque
+    assert torque >= max(rows_before // 10, 1)
+    assert rows.get("/bearing/default/balls", 0) >= max(rows_before // 25, 1)
     assert rows.get("/bearing/second/friction_torque_n_m", 0) > 0
 
 

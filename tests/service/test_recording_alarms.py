@@ -67,15 +67,17 @@ def test_every_alarm_event_is_a_log_row_and_a_state_at_its_snapshot(tmp_path, ru
     assert escalated.startswith("electrical_discharge escalated to critical") and "raise at 2, clear at 1.5" in escalated
     assert cleared.startswith("electrical_discharge cleared") and "[value 0," in cleared
     states = read_column(path, "bearing/a/alarm_states/electrical_discharge", "StateChange:state")
-    assert [s[0] for s in states] == ["warning", "critical", "inactive"]
-    assert read_column(path, "bearing/a/alarm_states/electrical_discharge", "seq") == [snaps[k].seq for k in (10, 20, 31)]
+    # the state from the first row on ("inactive"), then one row per event
+    assert [s[0] for s in states] == ["inactive", "warning", "critical", "inactive"]
+    assert read_column(path, "bearing/a/alarm_states/electrical_discharge", "seq") == [
+        snaps[k].seq for k in (0, 10, 20, 31)]
 
     info = describe_recording(path)["entities"]
-    # every alarm has its state configuration (values and colours) from the start; no rows without events
+    # every alarm has its state configuration (values and colours) and its state from the start
     for alarm_id in ALARM_IDS:
         e = info[f"bearing/a/alarm_states/{alarm_id}"]
         assert "StateConfiguration:values" in e["components"]
-        assert e["rows"] == (3 if alarm_id == "electrical_discharge" else 0)
+        assert e["rows"] == 1 + (3 if alarm_id == "electrical_discharge" else 0)    # the first row's state too
     assert not any(k.startswith("bearing/a/alarms/") and k != "bearing/a/alarms/electrical_discharge"
                    for k in info)
 
@@ -118,7 +120,7 @@ def test_a_new_segment_starts_with_the_alarms_in_force(tmp_path, run):
     assert read_column(second, "bearing/a/alarms/electrical_discharge", "seq") == []   # the event is in the first
     both = recording_segments(path)
     assert [s[0] for s in read_column(both, "bearing/a/alarm_states/electrical_discharge", "StateChange:state")] == [
-        "warning", "warning"]
+        "inactive", "warning", "warning"]                                     # from the first row on
 
 
 def test_the_blueprint_has_the_alarm_views():

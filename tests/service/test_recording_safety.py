@@ -26,6 +26,7 @@ pytest.importorskip("rerun")
 
 from service.recording import (  # noqa: E402
     RecordingPathError,
+    RerunRecorder,
     check_relative_path,
     create_exclusive,
     read_index,
@@ -193,7 +194,9 @@ def full_tmpfs(tmp_path):
 
 
 @needs_proc
-def test_full_disk_degrades_health_keeps_the_twin_and_recovers(full_tmpfs, support):
+def test_full_disk_degrades_health_keeps_the_twin_and_recovers(full_tmpfs, support, monkeypatch):
+    # a row per snapshot in every entity, so that the seqs below account for every snapshot
+    monkeypatch.setattr(RerunRecorder, "SERVICE_OPTIONS", {"trend_window_s": None, "now_interval_s": 0.0})
     mnt, fill, free = full_tmpfs
     rec_dir = mnt / "rec"
     settings = ServiceSettings(enable_zenoh=False, enable_recording=True, record=rec_dir / "service.rrd",
