@@ -71,13 +71,18 @@ def complex_envelope_kurtosis(nodes: np.ndarray) -> np.ndarray:
 def _filter_bank(nodes: np.ndarray, taps: np.ndarray, factor: int) -> np.ndarray:
     """Every row of `nodes` filtered causally by each column of `taps` (lfilter(taps[:, m], 1,
     row)) and kept at the samples factor - 1, 2 factor - 1, ... (the reference implementation's
-    a(factor:factor:N)): (rows, n // factor, filters), numpy's own einsum loop over
-    sliding windows (a multi-threaded BLAS product stalls on a shared machine)."""
+    a(factor:factor:N)): (rows, n // factor, filters), a polyphase sum over the taps, in place
+    (no BLAS product: its threads stall on a shared machine)."""
     rows, n = nodes.shape
     length, count = taps.shape[0], n // factor
     padded = np.concatenate((np.zeros((rows, length - 1), dtype=nodes.dtype), nodes), axis=1)
-    windows = np.lib.stride_tricks.sliding_window_view(padded, length, axis=1)[:, factor - 1::factor][:, :count]
-    return np.einsum("rcl,lf->rcf", windows, taps[::-1].astype(complex), optimize=False)
+    out = np.zeros((rows, count, taps.shape[1]), dtype=complex)
+    for m in range(taps.shape[1]):
+        acc = out[:, :, m]
+        for k in range(length):
+            start = factor - 1 + length - 1 - k
+            acc += padded[:, start:start + factor * count:factor] * taps[k, m]
+    return out
 
 
 _BINARY_TAPS = np.stack((_H, np.concatenate((_G, np.zeros(_H.size - _G.size)))), axis=1)
