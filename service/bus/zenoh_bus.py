@@ -236,7 +236,8 @@ class TwinChannel:
 
     def __init__(self, bus: ZenohBus, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
                  on_setpoint: Callable[[bytes], dict], *, queue_size: int = DEFAULT_QUEUE_SIZE,
-                 flush_timeout_s: float = 2.0, on_defects: Callable[[bytes], dict] | None = None):
+                 flush_timeout_s: float = 2.0, on_defects: Callable[[bytes], dict] | None = None,
+                 on_measured: Callable[[bytes], dict] | None = None):
         if queue_size < 1:
             raise ValueError("queue_size must be >= 1")
         self.bus = bus
@@ -293,6 +294,14 @@ class TwinChannel:
             self._defects_result_pub = session.declare_publisher(
                 f"{self.prefix}/defects/result", encoding=_JSON, congestion_control=zenoh.CongestionControl.BLOCK)
             self._defects_sub = session.declare_subscriber(f"{self.prefix}/defects", self._on_defects_sample)
+        # measured accelerometer windows (service.core.measured: binary frame in, comparison out)
+        self._on_measured = on_measured
+        self._measured_sub = self._comparison_pub = None
+        if on_measured is not None:
+            self._comparison_pub = session.declare_publisher(
+                f"{self.prefix}/vibration/comparison", encoding=_JSON, congestion_control=zenoh.CongestionControl.BLOCK)
+            self._measured_sub = session.declare_subscriber(
+                f"{self.prefix}/vibration/measured", lambda sample: self._enqueue_control(("measured", _payload(sample))))
         self._queryable = session.declare_queryable(f"{self.prefix}/snapshot", self._on_query)
         self._owner_queryable = session.declare_queryable(f"{self.prefix}/owner", self._on_owner_query)
         self._token = session.liveliness().declare_token(f"{self.prefix}/alive")
@@ -370,7 +379,8 @@ class TwinChannel:
             if self._closed:
                 return
             self._closed = True
-        for entity in (self._token, self._setpoint_sub, self._defects_sub, self._queryable, self._owner_queryable):
+        for entity in (self._token, self._setpoint_sub, self._defects_sub, self._measured_sub, self._queryable,
+                       self._owner_queryable):
             if entity is not None:
                 self._undeclare(entity)
         with self._control_cond:
@@ -386,7 +396,7 @@ class TwinChannel:
             self._publishers_gone = True
             publishers = [self._state_pub, self._result_pub, *self._ball_publishers.values()]
             publishers += [p for p in (self._alarm_pub, self._defects_result_pub, self._vibration_pub,
-                                       self._waveform_pub) if p is not None]
+                                       self._waveform_pub, self._comparison_pub) if p is not None]
             self._ball_publishers.clear()
         for pub in publishers:
             self._undeclare(pub)
@@ -571,6 +581,8 @@ class TwinChannel:
                     self._handle_setpoint(value)
                 elif kind == "defects":
                     self._handle_write(value, self._on_defects, self._defects_result_pub)
+                elif kind == "measured":
+                    self._handle_write(value, self._on_measured, self._comparison_pub)
                 elif kind == "owner":
                     self._handle_owner_query(value)
                 else:
@@ -717,7 +729,8 @@ class ZenohBus:
     def attach_twin(self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
                     on_setpoint: Callable[[bytes], dict], *,
                     queue_size: int = DEFAULT_QUEUE_SIZE,
-                    on_defects: Callable[[bytes], dict] | None = None) -> TwinChannel:
+                    on_defects: Callable[[bytes], dict] | None = None,
+                    on_measured: Callable[[bytes], dict] | None = None) -> TwinChannel:
         """Declare the twin's publishers, setpoint subscriber, snapshot and owner queryables and
         liveliness token; return its channel (a SnapshotSink: hand it to the runner).
 
@@ -737,7 +750,7 @@ class ZenohBus:
             if self._alive_elsewhere(key):
                 raise self._taken(bearing_id, self._owners(key))
             channel = TwinChannel(self, bearing_id, get_snapshot, on_setpoint, queue_size=queue_size,
-                                  on_defects=on_defects)
+                                  on_defects=on_defects, on_measured=on_measured)
             others = [o for o in self._owners(key) if o.get("zid") != self.zid]
             if others:                      # claimed at the same moment elsewhere: withdraw
                 channel.detach()
