@@ -41,7 +41,8 @@ HEALTHY_WINDOW = np.load(DATA / "97_DE_12k_5s.npy")[:12000]  # [g]
 @pytest.fixture(scope="module")
 def service(support):
     endpoint = support.free_endpoint()
-    settings = ServiceSettings(enable_recording=False, zenoh_listen=[endpoint], fast=True, publish_rate_hz=50.0)
+    settings = ServiceSettings(enable_recording=False, zenoh_listen=[endpoint], fast=True, publish_rate_hz=50.0,
+                               opcua=f"opc.tcp://127.0.0.1:{support.free_port()}", opcua_security="none")
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=60.0) as srv, \
             httpx.Client(base_url=srv.url, timeout=60.0) as http:
         for name in ("healthy", "inner"):
@@ -146,3 +147,35 @@ def test_zenoh_frame_gives_the_comparison(service, support):
         assert result["accepted"] is False and result["status"] == 422 and result["detail"][0]["field"] == "n"
     finally:
         peer.close()
+
+
+def test_opcua_shows_the_comparison(service, support):
+    """OPC UA `<twin>/MeasuredVibration/...`: after an inner-race window on the healthy twin, its
+    `alarm` is true, `alarm_codes` names the BPFI line, `bpfi_height_db` and `kurtosis` are the
+    HTTP comparison's (read within a bounded wait: the facade refreshes with the snapshots)."""
+    import asyncio
+
+    from asyncua import Client
+
+    from service.opcua.layout import NAMESPACE_URI, ROOT_FOLDER
+
+    srv, http, _ep = service
+    posted = _post(http, "healthy", INNER_WINDOW).json()
+    bpfi = next(d["height_db"] for d in posted["measured"]["defect_lines"] if d["name"] == "BPFI")
+
+    async def read_all():
+        c = Client(srv.service.opcua.url, timeout=20, watchdog_intervall=10.0)
+        async with c:
+            idx = await c.get_namespace_index(NAMESPACE_URI)
+            folder = await c.nodes.objects.get_child([f"{idx}:{ROOT_FOLDER}", f"{idx}:healthy",
+                                                      f"{idx}:MeasuredVibration"])
+            out = {}
+            for name in ("window", "alarm", "alarm_codes", "bpfi_height_db", "kurtosis"):
+                out[name] = await (await folder.get_child(f"{idx}:{name}")).read_value()
+            return out
+
+    values = support.wait_for(lambda: asyncio.run(asyncio.wait_for(read_all(), 60.0)),
+                              lambda v: v["window"] == posted["window"], 60.0)
+    assert values["alarm"] is True and "unexplained_line:BPFI" in values["alarm_codes"]
+    assert values["bpfi_height_db"] == pytest.approx(bpfi, rel=1e-12)
+    assert values["kurtosis"] == pytest.approx(posted["measured"]["kurtosis"], rel=1e-12)
