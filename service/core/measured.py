@@ -191,6 +191,8 @@ class MeasuredComparator:
         self._lock = threading.Lock()
         self._latest: dict | None = None
         self.windows = 0
+        self.listeners: list = []      # callables taking each comparison (the rerun recorder); must not block
+        self.listener_errors = 0
 
     @property
     def latest(self) -> dict | None:
@@ -228,10 +230,16 @@ class MeasuredComparator:
             self.windows += 1
             out = {"bearing_id": self.bearing_id, "window": self.windows, "received_wall_s": time.time(),
                    "twin_time_s": float(snapshot.time_s) if snapshot is not None else None,
+                   "twin_seq": int(snapshot.seq) if snapshot is not None else None,
                    "shaft_hz": shaft_hz, "units_received": window.units,
                    "measured": measured, "predicted": predicted, "residual": residual,
                    "alarm": bool(alarms), "alarms": alarms}
             self._latest = out
+        for listener in list(self.listeners):
+            try:
+                listener(out)
+            except Exception:  # noqa: BLE001 - a listener never fails the comparison
+                self.listener_errors += 1
         return out
 
     def _predicted(self, snapshot, defects: tuple) -> dict:

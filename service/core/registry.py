@@ -334,6 +334,8 @@ class TwinRegistry:
             if self.recorder is not None:
                 self.recorder.add_twin_from(twin)
                 runner.add_sink(self.recorder)
+                if hasattr(self.recorder, "log_measured"):
+                    entry.measured.listeners.append(self.recorder.log_measured)
             self.alarms.add_twin(bearing_id)
             runner.add_sink(self.alarms)
             runner.start()

@@ -123,6 +123,7 @@ class _Twin(TwinLayout):
     alarm_states: dict = field(default_factory=dict)  # alarm id -> latest state seen (ALARM_STATES)
     alarm_carry: dict = field(default_factory=dict)   # a new output: the active states to log again
     wave_rows: list = field(default_factory=list)     # accelerometer samples not sent yet (columns.WaveRow)
+    measured_rows: list = field(default_factory=list)  # measured-window comparisons not sent yet (dicts)
 
 
 @dataclass
@@ -196,6 +197,7 @@ class RerunRecorder:
 
         self._queue: deque = deque()
         self._alarm_queue: deque = deque()
+        self._measured_queue: deque = deque()
         self._wave_queue: deque = deque()
         self._waveform_dropped = 0
         self._alarms_dropped = 0
@@ -753,6 +755,17 @@ class RerunRecorder:
                 self._alarms_dropped += 1
             self._alarm_queue.append(row)
 
+    def log_measured(self, comparison: dict) -> None:
+        """Queue a measured-window comparison (service.core.measured) for the twin's
+        `vibration/measured/...` entities (`columns.measured_columns`); never blocks or raises.
+        When `queue_size` wait, the oldest is dropped."""
+        if self._closed or not isinstance(comparison, dict):
+            return
+        with self._qlock:
+            if len(self._measured_queue) >= self.queue_size:
+                self._measured_queue.popleft()
+            self._measured_queue.append(comparison)
+
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
         """Queue accelerometer blocks (twin.vibration.sensor.WaveformBlock) of a twin for
         `vibration/acceleration_m_s2`, at the `seq` of the snapshot they came with (by default
@@ -886,6 +899,12 @@ class RerunRecorder:
             self._alarm_queue.clear()
             waves = list(self._wave_queue)
             self._wave_queue.clear()
+            measured = list(self._measured_queue)
+            self._measured_queue.clear()
+        for comparison in measured:
+            tw = self._twins.get(str(comparison.get("bearing_id")))
+            if tw is not None:
+                tw.measured_rows.append(comparison)
         for bearing_id, wave_rows in waves:
             tw = self._twins.get(bearing_id)
             if tw is not None:
@@ -961,6 +980,7 @@ class RerunRecorder:
             rows, tw.rows = tw.rows, []
             alarm_rows, tw.alarm_rows = tw.alarm_rows, []
             wave_rows, tw.wave_rows = tw.wave_rows, []
+            measured_rows, tw.measured_rows = tw.measured_rows, []
             if not outs:
                 continue
             triples: list = []
@@ -975,6 +995,8 @@ class RerunRecorder:
                     triples += C.alarm_columns(tw, alarm_rows, tw.time_offset_s)
                 if wave_rows:
                     triples += C.waveform_columns(tw, wave_rows, tw.time_offset_s)
+                if measured_rows:
+                    triples += C.measured_columns(tw, measured_rows, tw.time_offset_s)
                 if rows:
                     batch = C.Batch.of(rows, tw.time_offset_s)
                     C.fast_columns(tw, batch)

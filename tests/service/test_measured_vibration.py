@@ -179,3 +179,34 @@ def test_opcua_shows_the_comparison(service, support):
     assert values["alarm"] is True and "unexplained_line:BPFI" in values["alarm_codes"]
     assert values["bpfi_height_db"] == pytest.approx(bpfi, rel=1e-12)
     assert values["kurtosis"] == pytest.approx(posted["measured"]["kurtosis"], rel=1e-12)
+
+
+def test_rerun_recording_holds_measured_beside_predicted(tmp_path):
+    """The rerun recorder (service.recording) logs each comparison at the twin's simulated time:
+    `vibration/measured/kurtosis/{measured,predicted}` side by side, the BPFI line height and the
+    alarm text, read back from the .rrd file."""
+    from service.core.measured import MeasuredComparator, window_from_float32
+    from service.recording import RerunRecorder, read_column
+    from twin.engine import Twin
+    from twin.setpoint import Setpoint
+
+    twin = Twin(catalog.bearing("6205"), bearing_id="m",
+                setpoint=Setpoint(shaft_speed_rad_s=SPEED_RAD_S, radial_load_n=1000.0))
+    twin.advance(0.01)
+    path = tmp_path / "m.rrd"
+    rec = RerunRecorder(path)
+    rec.add_twin_from(twin)
+    comparator = MeasuredComparator("m", twin.model.spec.geometry)
+    comparator.listeners.append(rec.log_measured)
+    snap = twin.snapshot()
+    rec.publish(snap)
+    out = comparator.compare(window_from_float32(INNER_WINDOW.astype("<f4").tobytes(), FS, "g"), snap, ())
+    rec.close()
+    assert rec.errors == 0 and comparator.listener_errors == 0
+    base = "bearing/m/vibration/measured"
+    assert [v[0] for v in read_column(path, f"{base}/kurtosis/measured", "Scalars:scalars")] == \
+        pytest.approx([out["measured"]["kurtosis"]])
+    assert [v[0] for v in read_column(path, f"{base}/kurtosis/predicted", "Scalars:scalars")] == [3.0]
+    bpfi = next(d["height_db"] for d in out["measured"]["defect_lines"] if d["name"] == "BPFI")
+    assert [v[0] for v in read_column(path, f"{base}/line_height_db/BPFI", "Scalars:scalars")] == pytest.approx([bpfi])
+    assert "BPFI" in read_column(path, f"{base}/alarms", "TextLog:text")[0][0]
