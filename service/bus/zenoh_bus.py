@@ -33,6 +33,11 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
     P/{id}/vibration/waveform  accelerometer samples, binary (twin.vibration.waveform: header
                              "BTWF" v1, float32 little-endian m/s^2; one chunk per block the twin
                              produced, its own chunk seq), not JSON numbers
+    P/{id}/vibration/measured  a measured accelerometer window in (subscriber): binary, header
+                             "BTVM" v1 + float32 little-endian (service.core.measured); same
+                             admission as a setpoint
+    P/{id}/vibration/comparison  its analysis beside the twin's prediction, residual and alarms
+                             (JSON), or the refusal (accepted false, status, field)
     P/{id}/alive             liveliness token while the twin is attached
 
 One id per prefix in the whole zenoh network: `attach_twin` first asks for the liveliness token
@@ -301,7 +306,8 @@ class TwinChannel:
             self._comparison_pub = session.declare_publisher(
                 f"{self.prefix}/vibration/comparison", encoding=_JSON, congestion_control=zenoh.CongestionControl.BLOCK)
             self._measured_sub = session.declare_subscriber(
-                f"{self.prefix}/vibration/measured", lambda sample: self._enqueue_control(("measured", _payload(sample))))
+                f"{self.prefix}/vibration/measured",
+                lambda sample: self._enqueue_control(("measured", _payload(sample))))
         self._queryable = session.declare_queryable(f"{self.prefix}/snapshot", self._on_query)
         self._owner_queryable = session.declare_queryable(f"{self.prefix}/owner", self._on_owner_query)
         self._token = session.liveliness().declare_token(f"{self.prefix}/alive")

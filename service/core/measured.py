@@ -53,7 +53,11 @@ import numpy as np
 
 from service.core.admission import AdmissionGate, Refusal
 from service.core.errors import InputError
-from twin.vibration.analysis import AnalysisInputError, analyse_signal, defect_multiples_of
+from twin.vibration.analysis import (
+    AnalysisInputError,
+    analyse_signal,
+    defect_multiples_of,
+)
 
 STANDARD_GRAVITY_M_S2 = 9.80665
 UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY_M_S2}

@@ -21,8 +21,12 @@ from pathlib import Path
 
 import numpy as np
 
-from twin.vibration.analysis import (MAX_SAMPLE_RATE_HZ, AnalysisInputError, analyse_signal,
-                                     defect_multiples_of)
+from twin.vibration.analysis import (
+    MAX_SAMPLE_RATE_HZ,
+    AnalysisInputError,
+    analyse_signal,
+    defect_multiples_of,
+)
 
 STANDARD_GRAVITY_M_S2 = 9.80665
 UNITS = {"g": STANDARD_GRAVITY_M_S2, "m/s2": 1.0}
@@ -45,7 +49,8 @@ def _pick_column(data: np.ndarray, column: int, what: str) -> np.ndarray:
     if data.ndim != 2:
         raise RecordError("FILE", f"the {what} has {data.ndim} dimensions; need 1 (or 2 with --column)")
     if not 0 <= column < data.shape[1]:
-        raise RecordError("--column", f"{column}: the {what} has {data.shape[1]} columns; allowed 0-{data.shape[1] - 1}")
+        raise RecordError("--column",
+                          f"{column}: the {what} has {data.shape[1]} columns; allowed 0-{data.shape[1] - 1}")
     return data[:, column]
 
 
@@ -106,7 +111,8 @@ def analyse_file(args: argparse.Namespace) -> dict:
         raise RecordError("--sample-rate", f"{args.sample_rate:g} Hz disagrees with the file's {file_rate:g} Hz")
     rate = file_rate if file_rate is not None else args.sample_rate
     if rate is None:
-        raise RecordError("--sample-rate", f"required for {path.suffix} records; allowed (0, {MAX_SAMPLE_RATE_HZ:g}] Hz")
+        raise RecordError("--sample-rate",
+                          f"required for {path.suffix} records; allowed (0, {MAX_SAMPLE_RATE_HZ:g}] Hz")
     if not (math.isfinite(rate) and 0.0 < rate <= MAX_SAMPLE_RATE_HZ):
         raise RecordError("--sample-rate", f"{rate:g} is out of range; allowed (0, {MAX_SAMPLE_RATE_HZ:g}] Hz")
     if not (math.isfinite(args.rpm) and 0.0 < args.rpm <= 3.0 * rate):

@@ -123,7 +123,7 @@ class Kurtogram:
 def max_level(n_samples: int) -> int:
     """Deepest level Antoni recommends for n samples: log2(n) - 7 (rounded down), so that the
     finest band keeps ~128 samples per node."""
-    return int(math.floor(math.log2(max(n_samples, 1)))) - 7
+    return math.floor(math.log2(max(n_samples, 1))) - 7
 
 
 def fast_kurtogram(signal: np.ndarray, sample_rate_hz: float, nlevel: int | None = None,
@@ -132,7 +132,8 @@ def fast_kurtogram(signal: np.ndarray, sample_rate_hz: float, nlevel: int | None
     """The fast kurtogram of a real signal (module docstring) up to level `nlevel` (default and
     upper bound `max_level`), and its best band among those at least min_bandwidth_hz [Hz] wide
     whose lower edge lies in low_edge_range_hz = [min, max) [Hz] and upper edge at most
-    max_high_edge_hz [Hz] (default: every band, as in the reference implementation). Raises ValueError naming the argument when the signal is too short
+    max_high_edge_hz [Hz] (default: every band, as in the reference implementation). Raises
+    ValueError naming the argument when the signal is too short
     (fewer than 256 samples) or no band is eligible."""
     x = np.asarray(signal, dtype=float).ravel()
     fs = float(sample_rate_hz)
