@@ -9,6 +9,9 @@ sample; --column picks the column, lines starting with '#' and a non-numeric hea
 skipped), `.wav` (scipy.io.wavfile: float samples as they are, integer PCM scaled to +-1 at full
 scale and multiplied by --full-scale; the file's rate is the sample rate, --sample-rate must
 agree when given). Units: --units g (x 9.80665) or m/s2.
+
+The analysis (scipy.signal) is imported by the command, not with the parser: every other
+`bearing-twin` command starts without it.
 """
 
 from __future__ import annotations
@@ -20,13 +23,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-
-from twin.vibration.analysis import (
-    MAX_SAMPLE_RATE_HZ,
-    AnalysisInputError,
-    analyse_signal,
-    defect_multiples_of,
-)
 
 STANDARD_GRAVITY_M_S2 = 9.80665
 UNITS = {"g": STANDARD_GRAVITY_M_S2, "m/s2": 1.0}
@@ -103,8 +99,11 @@ def _parse_line(text: str) -> tuple[str, float]:
 
 
 def analyse_file(args: argparse.Namespace) -> dict:
-    """The JSON of `vibration analyse` (module docstring). Raises RecordError / AnalysisInputError
-    / ValueError naming the option."""
+    """The JSON of `vibration analyse` (module docstring). Raises RecordError / ValueError naming
+    the option."""
+    from twin.vibration.analysis import (MAX_SAMPLE_RATE_HZ, AnalysisInputError, analyse_signal,
+                                         defect_multiples_of)
+
     path = Path(args.file)
     x, file_rate = read_record(path, args.column, args.full_scale)
     if file_rate is not None and args.sample_rate is not None and abs(file_rate - args.sample_rate) > 1e-9 * file_rate:

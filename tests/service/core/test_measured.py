@@ -10,8 +10,14 @@ import numpy as np
 import pytest
 
 from service.core.errors import InputError
-from service.core.measured import (HEADER, MeasuredComparator, encode_frame, window_from_float32,
-                                   window_from_frame, window_from_json)
+from service.core.measured import (
+    HEADER,
+    MeasuredComparator,
+    encode_frame,
+    window_from_float32,
+    window_from_frame,
+    window_from_json,
+)
 from twin import catalog
 
 DATA = Path(__file__).resolve().parents[2] / "data" / "cwru"
