@@ -33,6 +33,11 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
     P/{id}/vibration/waveform  accelerometer samples, binary (twin.vibration.waveform: header
                              "BTWF" v1, float32 little-endian m/s^2; one chunk per block the twin
                              produced, its own chunk seq), not JSON numbers
+    P/{id}/vibration/measured  a measured accelerometer window in (subscriber): binary, header
+                             "BTVM" v1 + float32 little-endian (service.core.measured); same
+                             admission as a setpoint
+    P/{id}/vibration/comparison  its analysis beside the twin's prediction, residual and alarms
+                             (JSON), or the refusal (accepted false, status, field)
     P/{id}/alive             liveliness token while the twin is attached
 
 One id per prefix in the whole zenoh network: `attach_twin` first asks for the liveliness token
@@ -250,7 +255,8 @@ class TwinChannel:
 
     def __init__(self, bus: ZenohBus, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
                  on_setpoint: Callable[[bytes], dict], *, queue_size: int = DEFAULT_QUEUE_SIZE,
-                 flush_timeout_s: float = 2.0, on_defects: Callable[[bytes], dict] | None = None):
+                 flush_timeout_s: float = 2.0, on_defects: Callable[[bytes], dict] | None = None,
+                 on_measured: Callable[[bytes], dict] | None = None):
         if queue_size < 1:
             raise ValueError("queue_size must be >= 1")
         self.bus = bus
@@ -307,6 +313,15 @@ class TwinChannel:
             self._defects_result_pub = session.declare_publisher(
                 f"{self.prefix}/defects/result", encoding=_JSON, congestion_control=zenoh.CongestionControl.BLOCK)
             self._defects_sub = session.declare_subscriber(f"{self.prefix}/defects", self._on_defects_sample)
+        # measured accelerometer windows (service.core.measured: binary frame in, comparison out)
+        self._on_measured = on_measured
+        self._measured_sub = self._comparison_pub = None
+        if on_measured is not None:
+            self._comparison_pub = session.declare_publisher(
+                f"{self.prefix}/vibration/comparison", encoding=_JSON, congestion_control=zenoh.CongestionControl.BLOCK)
+            self._measured_sub = session.declare_subscriber(
+                f"{self.prefix}/vibration/measured",
+                lambda sample: self._enqueue_control(("measured", _payload(sample))))
         self._queryable = session.declare_queryable(f"{self.prefix}/snapshot", self._on_query)
         self._owner_queryable = session.declare_queryable(f"{self.prefix}/owner", self._on_owner_query)
         self._token = session.liveliness().declare_token(f"{self.prefix}/alive")
@@ -384,7 +399,8 @@ class TwinChannel:
             if self._closed:
                 return
             self._closed = True
-        for entity in (self._token, self._setpoint_sub, self._defects_sub, self._queryable, self._owner_queryable):
+        for entity in (self._token, self._setpoint_sub, self._defects_sub, self._measured_sub, self._queryable,
+                       self._owner_queryable):
             if entity is not None:
                 self._undeclare(entity)
         with self._control_cond:
@@ -400,7 +416,7 @@ class TwinChannel:
             self._publishers_gone = True
             publishers = [self._state_pub, self._result_pub, *self._ball_publishers.values()]
             publishers += [p for p in (self._alarm_pub, self._defects_result_pub, self._vibration_pub,
-                                       self._waveform_pub) if p is not None]
+                                       self._waveform_pub, self._comparison_pub) if p is not None]
             self._ball_publishers.clear()
         for pub in publishers:
             self._undeclare(pub)
@@ -585,6 +601,8 @@ class TwinChannel:
                     self._handle_setpoint(value)
                 elif kind == "defects":
                     self._handle_write(value, self._on_defects, self._defects_result_pub)
+                elif kind == "measured":
+                    self._handle_write(value, self._on_measured, self._comparison_pub)
                 elif kind == "owner":
                     self._handle_owner_query(value)
                 else:
@@ -734,7 +752,8 @@ class ZenohBus:
     def attach_twin(self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
                     on_setpoint: Callable[[bytes], dict], *,
                     queue_size: int = DEFAULT_QUEUE_SIZE,
-                    on_defects: Callable[[bytes], dict] | None = None) -> TwinChannel:
+                    on_defects: Callable[[bytes], dict] | None = None,
+                    on_measured: Callable[[bytes], dict] | None = None) -> TwinChannel:
         """Declare the twin's publishers, setpoint subscriber, snapshot and owner queryables and
         liveliness token; return its channel (a SnapshotSink: hand it to the runner).
 
@@ -758,7 +777,7 @@ class ZenohBus:
                             "authenticate it (zenoh access control is off while the HTTP API needs a token): "
                             "the claim is not trusted and the twin starts here", bearing_id, key)
             channel = TwinChannel(self, bearing_id, get_snapshot, on_setpoint, queue_size=queue_size,
-                                  on_defects=on_defects)
+                                  on_defects=on_defects, on_measured=on_measured)
             others = self._claimants(key) if self.trust_claims else []
             if others:                      # claimed at the same moment elsewhere: withdraw
                 channel.detach()

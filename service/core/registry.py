@@ -44,6 +44,7 @@ from service.core.alarms import AlarmEvent
 from service.core.capacity import Capacity, TwinCost, calibrate, usable_cores
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import DefectIntake, SetpointIntake
+from service.core.measured import MeasuredComparator, MeasuredIntake
 from service.core.pool import SteppingPool
 from service.core.heap import freeze_heap
 from service.core.priority import EGRESS_THREAD_NAMES, ThreadPriority
@@ -119,6 +120,7 @@ class TwinEntry:
     recording: Any = None               # this twin's own recording (POST .../recording)
     recording_path: Path | None = None
     created_wall_s: float = field(default_factory=time.time)
+    measured: MeasuredComparator | None = None   # measured vibration beside the twin (service.core.measured)
 
     @property
     def designation(self) -> str:
@@ -322,14 +324,18 @@ class TwinRegistry:
                                 pool=self.pool, cost=cost)
             entry = TwinEntry(id=bearing_id, twin=twin, runner=runner,
                               intake=SetpointIntake(bearing_id, self.gate, runner),
-                              lubricant=twin.model.spec.lubricant.name)
+                              lubricant=twin.model.spec.lubricant.name,
+                              measured=MeasuredComparator(bearing_id, twin.model.spec.geometry, runner))
             if self.bus is not None:
                 entry.channel = self.bus.attach_twin(bearing_id, runner.latest_snapshot, entry.intake,
-                                                     on_defects=DefectIntake(bearing_id, self.gate, runner))
+                                                     on_defects=DefectIntake(bearing_id, self.gate, runner),
+                                                     on_measured=MeasuredIntake(bearing_id, self.gate, entry.measured))
                 runner.add_sink(entry.channel)
             if self.recorder is not None:
                 self.recorder.add_twin_from(twin)
                 runner.add_sink(self.recorder)
+                if hasattr(self.recorder, "log_measured"):
+                    entry.measured.listeners.append(self.recorder.log_measured)
             self.alarms.add_twin(bearing_id)
             runner.add_sink(self.alarms)
             runner.start()

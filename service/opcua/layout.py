@@ -41,6 +41,7 @@ class View:
     alarms: Mapping[str, Alarm]
     target: Setpoint | None
     settings: AlarmSettings
+    measured: Mapping[str, Any] | None = None   # the last measured-window comparison (service.core.measured)
 
 
 @dataclass(frozen=True)
@@ -123,6 +124,25 @@ def _regime_count(regime: str) -> Callable[[View], Any]:
     return lambda v: sum(1 for c in _contacts(v) if c.regime == regime) if v.snapshot is not None else None
 
 
+def _measured(*path: str) -> Callable[[View], Any]:
+    """A value of the last measured-window comparison (service.core.measured) by its JSON path."""
+    def read(v: View) -> Any:
+        value: Any = v.measured
+        for key in path:
+            if not isinstance(value, Mapping):
+                return None
+            value = value.get(key)
+        return value
+    return read
+
+
+def _measured_line(name: str) -> Callable[[View], Any]:
+    def read(v: View) -> Any:
+        lines = _measured("measured", "defect_lines")(v) or ()
+        return next((d["height_db"] for d in lines if d.get("name") == name), None)
+    return read
+
+
 def _alarm_level(alarm_id: str) -> Callable[[View], Any]:
     def read(v: View) -> str | None:
         a = v.alarms.get(alarm_id)
@@ -203,6 +223,23 @@ FOLDERS: dict[str, tuple[Var, ...]] = {
             lambda v: _vib(v).noise_floor_m_s2 if _vib(v) is not None else None),
         Var("defect_count", "UInt32", "Local defects active (twin.vibration.defects) [-].",
             lambda v: len(getattr(v.snapshot, "defects", ()) or ()) if v.snapshot is not None else None),
+    ),
+    "MeasuredVibration": (
+        Var("window", "UInt32", "Measured windows compared so far (POST .../vibration/measured, zenoh "
+            ".../vibration/measured) [-]; no value before the first.", _measured("window")),
+        Var("alarm", "Boolean", "The measurement shows what the twin's state does not explain [-].", _measured("alarm")),
+        Var("alarm_codes", "String", "The comparison's alarms: unexplained_line:<line> | kurtosis_above_twin, "
+            "comma separated [text].", lambda v: (",".join(f"{a['code']}:{a['line']}" if a.get("line") else a["code"]
+                                                      for a in _measured("alarms")(v)) if v.measured else None)),
+        Var("shaft_hz", "Double", "Shaft frequency of the analysis [Hz].", _measured("shaft_hz")),
+        Var("rms_m_s2", "Double", "Measured acceleration RMS [m/s^2].", _measured("measured", "rms_m_s2")),
+        Var("kurtosis", "Double", "Measured kurtosis [-].", _measured("measured", "kurtosis")),
+        Var("crest_factor", "Double", "Measured crest factor [-].", _measured("measured", "crest_factor")),
+        Var("predicted_kurtosis", "Double", "The twin's kurtosis at the same moment [-].",
+            _measured("predicted", "kurtosis")),
+        Var("kurtosis_residual", "Double", "Measured - predicted kurtosis [-].", _measured("residual", "kurtosis")),
+        *(Var(f"{key}_height_db", "Double", f"Measured {name} line over the median of +-20 Hz around it [dB].",
+              _measured_line(name)) for key, name in (("bpfo", "BPFO"), ("bpfi", "BPFI"), ("two_bsf", "2xBSF"))),
     ),
     "Life": tuple(Var(name, "Double", desc + "; no value without the snapshot's life block.", _life(name)) for name, desc in (
         ("kappa", "Viscosity ratio nu / nu1 (ISO 281:2007 clause 9.3) [-]"),

@@ -473,7 +473,8 @@ class OpcUaFacade:
         hub = self.registry.alarms
         settings = hub.settings
         view = View(snapshot=snap, inputs=inputs_from_snapshot(snap, settings) if snap is not None else None,
-                    alarms={a.alarm_id: a for a in hub.states(entry.id)}, target=target, settings=settings)
+                    alarms={a.alarm_id: a for a in hub.states(entry.id)}, target=target, settings=settings,
+                    measured=getattr(entry, "measured", None) and entry.measured.latest)
         now = datetime.now(UTC)
         for key, (nid, vt, read) in nodes.vars.items():
             try:

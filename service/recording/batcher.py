@@ -67,6 +67,7 @@ class TwinRows(TwinLayout):
     alarm_states: dict = field(default_factory=dict)  # alarm id -> latest state seen (ALARM_STATES)
     alarm_carry: dict = field(default_factory=dict)   # a new output: the states to log again
     wave_rows: list = field(default_factory=list)     # accelerometer samples not sent yet (columns.WaveRow)
+    measured_rows: list = field(default_factory=list)  # measured-window comparisons not sent yet (dicts)
     trend_rows: list = field(default_factory=list)    # rows of the trend window still open (sent: not yet)
     wave_events_s: list = field(default_factory=list) # simulated times of recent events (WaveformArchive)
     wave_defects: tuple = ()                          # the defects of the last row seen
@@ -108,6 +109,7 @@ class RowBatcher:
         self.ended: dict[str, float] = {}
         self._queue: deque = deque()
         self._alarm_queue: deque = deque()
+        self._measured_queue: deque = deque()
         self._wave_queue: deque = deque()
         self.dropped = 0
         self.waveform_dropped = 0
@@ -156,6 +158,14 @@ class RowBatcher:
                 self._alarm_queue.popleft()
                 self.alarms_dropped += 1
             self._alarm_queue.append(row)
+
+    def log_measured(self, comparison: dict) -> None:
+        """Queue a measured-window comparison (service.core.measured); drops the oldest when
+        `queue_size` wait."""
+        with self.qlock:
+            if len(self._measured_queue) >= self.queue_size:
+                self._measured_queue.popleft()
+            self._measured_queue.append(comparison)
 
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
         try:
@@ -214,6 +224,8 @@ class RowBatcher:
             self._queue.clear()
             alarms = list(self._alarm_queue)
             self._alarm_queue.clear()
+            measured = list(self._measured_queue)
+            self._measured_queue.clear()
             waves = list(self._wave_queue)
             self._wave_queue.clear()
         for bearing_id, wave_rows in waves:
@@ -223,6 +235,10 @@ class RowBatcher:
                     if w.seq < 0:          # no seq given: the snapshot it came with is the last one seen
                         w.seq = tw.last_seq if tw.last_seq is not None else 0
                 tw.wave_rows.extend(wave_rows)
+        for comparison in measured:
+            tw = self.twins.get(str(comparison.get("bearing_id")))
+            if tw is not None:
+                tw.measured_rows.append(comparison)
         for row in alarms:
             tw = self.twins.get(row.bearing_id)
             if tw is not None:
@@ -292,10 +308,13 @@ class RowBatcher:
             rows, tw.rows = tw.rows, []
             alarm_rows, tw.alarm_rows = tw.alarm_rows, []
             wave_rows, tw.wave_rows = tw.wave_rows, []
+            measured_rows, tw.measured_rows = tw.measured_rows, []
             if not outputs:
                 continue
             try:
                 triples = self._columns(tw, rows, alarm_rows, now, force_slow)
+                if measured_rows:
+                    triples += C.measured_columns(tw, measured_rows, tw.time_offset_s)
                 for path, indexes, columns in triples:
                     for out in self._audience(tw, path, rows, outputs):
                         out.stream.send_columns(path, indexes=indexes, columns=columns)

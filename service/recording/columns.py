@@ -489,6 +489,44 @@ def alarm_columns(tw: TwinLayout, rows: list[AlarmRow], offset_s: float) -> list
     return out
 
 
+MEASURED_LINES = ("BPFO", "BPFI", "2xBSF")
+
+
+def measured_columns(tw: TwinLayout, comparisons: list[Mapping], offset_s: float) -> list:
+    """(entity path, index columns, component columns) triples of the measured-window comparisons
+    of a twin (service.core.measured), at the twin's simulated time when each window arrived
+    (shifted by the twin's offset) and its snapshot seq: Scalars `vibration/measured/{kurtosis,rms_m_s2,crest_factor}/
+    {measured,predicted}` (no row where the twin predicts none), `vibration/measured/line_height_db/
+    {BPFO,BPFI,2xBSF}` [dB over the median of +-20 Hz], and a TextLog `vibration/measured/alarms`
+    (level WARN per alarm, INFO when the window raises none)."""
+    rows = [c for c in comparisons if c.get("twin_time_s") is not None]
+    if not rows:
+        return []
+    t = np.round((np.array([c["twin_time_s"] for c in rows]) + offset_s) * 1e9).astype(np.int64)
+    seqs = [c.get("twin_seq") for c in rows]
+    base = f"{tw.root}/vibration/measured"
+    out: list = []
+
+    def scalars(path: str, values: list) -> None:
+        keep = [k for k, v in enumerate(values) if v is not None]
+        if keep:
+            idx = _alarm_index(t[keep], [seqs[k] for k in keep])
+            out.append((path, idx, rr.Scalars.columns(scalars=np.array([values[k] for k in keep], dtype=float))))
+
+    for key in ("kurtosis", "rms_m_s2", "crest_factor"):
+        scalars(f"{base}/{key}/measured", [c["measured"][key] for c in rows])
+        scalars(f"{base}/{key}/predicted", [c["predicted"].get(key) for c in rows])
+    for name in MEASURED_LINES:
+        scalars(f"{base}/line_height_db/{name}",
+                [next((d["height_db"] for d in c["measured"]["defect_lines"] if d["name"] == name), None)
+                 for c in rows])
+    texts = [("; ".join(a["message"] for a in c["alarms"]) or f"window {c['window']}: explained by the twin",
+              "WARN" if c["alarms"] else "INFO") for c in rows]
+    out.append((f"{base}/alarms", _alarm_index(t, seqs),
+                rr.TextLog.columns(text=[x for x, _ in texts], level=[lv for _, lv in texts])))
+    return out
+
+
 def alarm_states_in_force(tw: TwinLayout, states: Mapping[str, str], time_s: float, seq: int | None,
                           offset_s: float) -> list:
     """StateChange rows of every alarm's state when a new output (a segment) started, at

@@ -55,6 +55,11 @@ vibration/envelope/cursor/{FTF,BPFO,BPFI,BSF,2xBSF}
 vibration/spectrum            BarChart: the window's acceleration amplitude spectrum [m/s^2]
                               (VibrationState.amplitude_spectrum: 0 - fs/2, power-summed bins)
 vibration/spectrum_envelope_band   BarChart: one translucent bar over the envelope band [Hz]
+vibration/measured/{kurtosis,rms_m_s2,crest_factor}/{measured,predicted}
+                              Scalars: a measured accelerometer window (service.core.measured)
+                              beside the twin's prediction, a row per window at the twin's time
+vibration/measured/line_height_db/{BPFO,BPFI,2xBSF}   Scalars: measured line heights [dB]
+vibration/measured/alarms     TextLog: what the measurement shows that the twin does not explain
 contacts/{load_n,lambda,mu,resistance_log10_kohm,capacitance_pf}
                               Scalars, 2 Z instances (ball 0 inner, ball 0 outer, ball 1 inner,
                               ...): the per-contact series, not in the default layout

@@ -326,6 +326,13 @@ class RerunRecorder:
         if not self._closed:
             self._rows.log_alarm(event)
 
+    def log_measured(self, comparison: dict) -> None:
+        """Queue a measured-window comparison (service.core.measured) for the twin's
+        `vibration/measured/...` entities (`columns.measured_columns`); never blocks or raises.
+        When `queue_size` wait, the oldest is dropped."""
+        if not self._closed and isinstance(comparison, dict):
+            self._rows.log_measured(comparison)
+
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
         """Queue accelerometer blocks (twin.vibration.sensor.WaveformBlock) of a twin for
         `vibration/acceleration_m_s2`, at the `seq` of the snapshot they came with (by default

@@ -15,6 +15,7 @@ from pathlib import Path
 
 from service.tools.bench_results import save as save_result
 
+from service.tools.vibration_cli import add_analyse_command
 
 class ArgumentParser(argparse.ArgumentParser):
     """argparse with whole option names only (no abbreviations: `--clear` is not `--clearance`)
@@ -140,6 +141,10 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
     from twin.setpoint import SetpointError
     from twin.vibration.run import simulate_vibration
 
+    missing = [name for name, value in (("--speed", args.speed), ("--radial-load", args.radial_load)) if value is None]
+    if missing:
+        print(f"error: vibration: {', '.join(missing)} required (or `vibration analyse FILE`)", file=sys.stderr)
+        return 2
     try:
         result, samples = simulate_vibration(
             args.bearing, args.speed, args.radial_load, args.axial_load, defect=args.defect,
@@ -309,8 +314,8 @@ def build_parser() -> argparse.ArgumentParser:
         "sampled in the kernel) and an optional local defect, discard 0.05 s, analyse `--duration` of the signal "
         "(twin.vibration.run.simulate_vibration).")
     vib.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
-    vib.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
-    vib.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
+    vib.add_argument("--speed", type=float, default=None, help="shaft speed [rad/s] (required)")
+    vib.add_argument("--radial-load", type=float, default=None, help="radial load [N] (required)")
     vib.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     vib.add_argument("--defect", choices=["outer", "inner", "ball"], help="local defect (default: none, healthy)")
     vib.add_argument("--defect-size", type=float, default=0.5e-3,
@@ -326,6 +331,7 @@ def build_parser() -> argparse.ArgumentParser:
     vib.add_argument("--plot", metavar="FILE.png", help="waveform, spectrum and envelope spectrum with the defect "
                      "frequencies marked")
     vib.set_defaults(func=_cmd_vibration)
+    add_analyse_command(vib)
 
     _add_monitor(sub)
     from service.tools.router import add_router_command

@@ -14,11 +14,9 @@ Envelope analysis (Randall & Antoni 2011, sec. 3.2-3.3): band-pass around a stru
 excited by the impacts (4th-order Butterworth, zero phase: scipy.signal.butter + sosfiltfilt),
 envelope |analytic signal| (scipy.signal.hilbert), mean removed, amplitude spectrum with a Hann
 window (amplitude-corrected, [m/s^2]). The band is either given, centred on the housing's sensed
-resonance, or chosen by spectral kurtosis: the STFT-based kurtogram of Antoni & Randall 2006
-("The spectral kurtosis: application to the vibratory surveillance and diagnostics of rotating
-machines", MSSP 20(2) 308-331, eq. 5 estimator SK(f) = <|X(t,f)|^4> / <|X(t,f)|^2>^2 - 2 over a
-set of window lengths; sec. 4 kurtogram), the band of highest SK wins (a simpler stand-in for the
-fast kurtogram of Antoni 2007, MSSP 21, 108-124).
+resonance, or chosen by spectral kurtosis: the fast kurtogram of Antoni 2007 (MSSP 21, 108-124;
+twin.vibration.kurtogram), the band of highest kurtosis wins. The analysis of a whole measured
+or simulated record (twin.vibration.analysis) is built on these functions.
 
 Full spectra of a window (`amplitude_spectrum`, `envelope_spectrum_view`), for the snapshot's
 `vibration` block and the sinks, never its JSON: the acceleration amplitude spectrum from 0 to
@@ -45,6 +43,7 @@ import math
 import numpy as np
 
 from twin.vibration.defect_frequencies import DefectFrequencies
+from twin.vibration.kurtogram import fast_kurtogram
 
 ISO_20816_BAND_HZ = (10.0, 1000.0)
 
@@ -114,40 +113,17 @@ def velocity_rms_mm_s(a_m_s2: np.ndarray, sample_rate_hz: float,
     return 1e3 * math.sqrt(ms)
 
 
-def kurtogram_band(a_m_s2: np.ndarray, sample_rate_hz: float,
-                   window_lengths: tuple[int, ...] = (16, 32, 64, 128, 256),
-                   min_bandwidth_hz: float = 0.0,
+def kurtogram_band(a_m_s2: np.ndarray, sample_rate_hz: float, min_bandwidth_hz: float = 0.0,
                    max_frequency_hz: float | None = None) -> tuple[float, float, float]:
-    """(low [Hz], high [Hz], SK [-]) of the band of highest spectral kurtosis (STFT kurtogram,
-    Antoni & Randall 2006 eq. 5 and sec. 4). For each window length Nw (Hann, 75 % overlap) the
-    band is f +- fs / Nw, at least min_bandwidth_hz wide; bands reaching 0 Hz or beyond
-    max_frequency_hz (default: 0.45 fs, inside the anti-aliasing passband) are not candidates."""
-    import scipy.signal
-
-    x = np.asarray(a_m_s2, dtype=float)
+    """(low [Hz], high [Hz], SK [-]) of the band of highest spectral kurtosis: Antoni's fast
+    kurtogram (twin.vibration.kurtogram, MSSP 21, 2007) among its bands at least min_bandwidth_hz
+    wide that neither reach 0 Hz nor pass max_frequency_hz (default: 0.45 fs, inside the
+    anti-aliasing passband)."""
     fs = float(sample_rate_hz)
     fmax = 0.45 * fs if max_frequency_hz is None else min(max_frequency_hz, 0.5 * fs)
-    best = None
-    for nw in window_lengths:
-        if nw * 8 > x.size:
-            continue
-        f, _, z = scipy.signal.stft(x - x.mean(), fs=fs, window="hann", nperseg=nw,
-                                    noverlap=3 * nw // 4, boundary=None, padded=False)
-        p2 = np.mean(np.abs(z) ** 2, axis=1)
-        p4 = np.mean(np.abs(z) ** 4, axis=1)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            sk = np.where(p2 > 0.0, p4 / np.maximum(p2, 1e-300) ** 2 - 2.0, -np.inf)
-        half = max(fs / nw, 0.5 * min_bandwidth_hz)
-        ok = (f - half > 0.0) & (f + half <= fmax)
-        if not np.any(ok):
-            continue
-        i = int(np.argmax(np.where(ok, sk, -np.inf)))
-        if best is None or sk[i] > best[2]:
-            best = (float(f[i] - half), float(f[i] + half), float(sk[i]))
-    if best is None:
-        raise ValueError("the window is too short for a spectral-kurtosis band search "
-                         f"({x.size} samples; needs at least {8 * min(window_lengths)})")
-    return best
+    kg = fast_kurtogram(a_m_s2, fs, min_bandwidth_hz=min_bandwidth_hz,
+                        low_edge_range_hz=(np.nextafter(0.0, 1.0), fmax), max_high_edge_hz=fmax)
+    return kg.band_hz[0], kg.band_hz[1], kg.band_kurtosis
 
 
 def resonance_band(resonance_hz: float, damping_ratio: float, sample_rate_hz: float,
