@@ -157,6 +157,20 @@ class Twin:
             raise ValueError("thermal: a measured temperature needs ModelOptions.thermal = 'network'")
         self.thermal.measure(node, float(temperature_c), self.time_s)
 
+    def hold_thermal_state(self, temperature_c) -> None:
+        """Set the network's node temperatures [degC] (twin.thermal.network.NODE_NAMES order) and
+        apply them at once: inlet viscosity and expansion (a steady-state solver, or a restart from
+        a known thermal state). Raises ValueError with the fixed oil temperature or a bad array."""
+        th = self.thermal
+        if th is None:
+            raise ValueError("thermal: node temperatures need ModelOptions.thermal = 'network'")
+        t = np.asarray(temperature_c, dtype=float)
+        if t.shape != th.temperature_c.shape or not np.all(np.isfinite(t)) or t.min() < -60.0 or t.max() > 400.0:
+            raise ValueError(f"temperature_c: {th.temperature_c.size} finite node temperatures in [-60, 400] degC")
+        th.filter.x[:t.size] = t
+        write_groove_lanes(self.state.contacts, self._groove_lanes, th.expansion, self.model.ball_count)
+        self._refresh_oil_viscosity()
+
     def _thermal_step(self) -> None:
         """One network period: heat from the engine's state, node temperatures, then the inlet
         viscosity and the expansion of the rings and balls (written into the contacts' groove lanes)."""

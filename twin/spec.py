@@ -315,7 +315,7 @@ class ModelOptions(BaseModel):
         "twin.kernels.step.centred_inputs): the held values' error becomes second order in tribology_period_s "
         "instead of first. False: at the refresh's own step (the engine before it; tests/engine/test_step_reference.py).")
     thermal: Literal["network", "fixed"] = Field(
-        default="fixed",
+        default="network",
         description="'network': the bearing's thermal network (twin.thermal) runs in the loop, fed by the friction "
         "power; its temperatures set the inlet viscosity and the rings' and balls' expansion the clearance, and the "
         "setpoint's oil temperature is the ambient (sump) or oil-inlet (circulating) temperature. 'fixed': the oil "

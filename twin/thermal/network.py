@@ -133,6 +133,17 @@ class Network:
         return np.sort(1.0 / lam)[::-1]
 
 
+def coupled_time_constants_s(net: Network, heat_slope_w_k: float, heat_share: np.ndarray,
+                             inlet_weights: np.ndarray, dissipation_factor: float = 1.0) -> np.ndarray:
+    """Time constants of the network with the friction's feedback, slowest first [s]: the heat
+    q = P(T_in) p, P the friction power, p its share per node, T_in = w . T the inlet
+    temperature; linearised, C dT/dt = -(K - dP/dT_in p w^T) T + ... A heat falling with the
+    temperature (thinner oil, dP/dT_in < 0) shortens them."""
+    a = net.stiffness(dissipation_factor) - heat_slope_w_k * np.outer(heat_share, inlet_weights)
+    lam = np.linalg.eigvals(a / net.capacity_j_k[:, None]).real
+    return np.sort(1.0 / lam)[::-1]
+
+
 def _link(k: np.ndarray, i: int, j: int, g: float) -> None:
     k[i, j] += g
     k[j, i] += g
