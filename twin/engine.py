@@ -91,7 +91,8 @@ class Twin:
         self._frozen_thermal: ThermalState | None = None
         if self.model.options.thermal == "network":
             opts = self.model.options
-            frames = max(1, int(round(opts.thermal_period_s / FRAME_S)))
+            period = opts.thermal_period_s * opts.thermal_network.heat_capacity_scale  # thermal -> simulated time
+            frames = max(1, int(round(period / FRAME_S)))
             self.thermal = ThermalCoupling(self.model, opts.thermal_network, frames * FRAME_S,
                                            (setpoint or self.default_setpoint()).oil_temperature_c)
         c = self.state.contacts

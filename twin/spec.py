@@ -321,10 +321,12 @@ class ModelOptions(BaseModel):
         "setpoint's oil temperature is the ambient (sump) or oil-inlet (circulating) temperature. 'fixed': the oil "
         "and the contacts' inlet stay at the setpoint's oil temperature.")
     thermal_period_s: float = Field(
-        default=0.05, ge=1e-3, le=10.0,
-        description="The thermal network's step [s] of simulated time, a whole number of frames (the nearest, at "
-        "least 1); the exponential step is exact for any period, the coupling holds the heat over it "
-        "(twin.thermal.period_study: 50 ms moves the accelerated 6208 start-up by under 0.05 K from 5 ms).")
+        default=1.0, ge=0.01, le=60.0,
+        description="The thermal network's step [s of thermal time]: every thermal_period_s x heat_capacity_scale of "
+        "simulated time, a whole number of frames (the nearest, at least 1). The exponential step is exact for any "
+        "step; the heat is held over it while the friction falls with the temperature (an explicit coupling), so it "
+        "stays short against the balls' time constants (2-10 s): twin.thermal.studies.period_study, README "
+        "'Thermal network'.")
     thermal_network: ThermalNetworkSettings = Field(
         default_factory=ThermalNetworkSettings,
         description="The bearing's surroundings and oil supply for thermal = 'network' (twin.thermal.settings).")

@@ -384,6 +384,12 @@ class TwinRunner:
         """A scenario step's defects (checked when the run started): in force from this frame."""
         self.defect_box.offer(parse_defects(defects, self.twin.model.spec.geometry))
 
+    def _offer_scenario_temperature(self, node: str, temperature_c: float) -> None:
+        """A scenario step's measured temperature: to the twin's network at this frame (ignored with
+        the fixed oil temperature, where there is no network to follow it)."""
+        if self.twin.thermal is not None:
+            self.twin.measure_temperature(node, temperature_c)
+
     def _restart_at(self, initial: SetpointUpdate) -> None:
         """A scenario asked to start from the warm start at its initial setpoint."""
         self._offer(initial, timed=False)
@@ -420,7 +426,7 @@ class TwinRunner:
                 self._reanchor = False
             event = self.scenarios.tick(self.sim_elapsed_s, self.mailbox.target,
                                         lambda u: self._offer(u, timed=False), self._restart_at,
-                                        self._offer_scenario_defects)
+                                        self._offer_scenario_defects, self._offer_scenario_temperature)
             changed, outside = self._apply_mailbox()
             if self.idle_without_scenario and not self.scenarios.active:
                 if (event and pacing.last_publish_sim != self.sim_elapsed_s) or changed:

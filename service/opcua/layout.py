@@ -242,7 +242,8 @@ FOLDERS: dict[str, tuple[Var, ...]] = {
             _thermal("inlet_temperature_c")),
         *(Var(f"heat_{source}_w", "Double", f"Friction heat from {source} [W].", _thermal_heat(source))
           for source in ("rolling", "sliding", "spin", "drag", "seal")),
-        Var("dissipated_w", "Double", "Heat carried to the surroundings and the oil supply [W].", _thermal("dissipated_w")),
+        Var("dissipated_w", "Double", "Heat carried to the surroundings and the oil supply [W].",
+            _thermal("dissipated_w")),
         Var("dissipation_factor", "Double", "Estimated factor on the dissipation to the surroundings [-].",
             _thermal("dissipation_factor")),
         Var("dissipation_factor_sigma", "Double", "Its standard deviation [-].", _thermal("dissipation_factor_sigma")),

@@ -32,8 +32,8 @@ def test_rises_with_the_stated_time_constants(transient):
     fitted = decay_time_constant_s(tr, OUTER)
     assert tau[0] < tr.time_constants_s[0]
     assert fitted == pytest.approx(tau[0], rel=0.15), (fitted, tau[:3])
-    # monotone warming of the outer ring (beyond the noise of the friction, 0.2 K)
-    assert np.all(np.diff(tr.temperatures_c[:, OUTER]) > -0.2)
+    # monotone warming of the outer ring after the first minute (beyond the noise of the friction, 0.2 K)
+    assert np.all(np.diff(tr.temperatures_c[1:, OUTER]) > -0.2)
 
 
 def test_viscosity_lambda_and_friction_follow_the_temperature(transient):

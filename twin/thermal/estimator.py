@@ -13,6 +13,10 @@ joint state and parameter estimation, ch. 13.4):
 * update with a measured node temperature z (variance r): y = z - T_m, S = P_mm + r,
   K = P H^T / S, Joseph form for P.
 
+The start temperatures (every node at the ambient) carry one offset common to all nodes
+(`initial_temperature_sigma_k`, fully correlated): a twin started beside a bearing that is already
+warm takes the first measurement's offset into every node at once.
+
 A measurement whose innovation lies beyond `gate_sigma` standard deviations (sqrt(S)) is not
 one the dissipation can explain (a network cannot jump; a heat burst from lubricant loss, an
 overload, a failing bearing can): it is not assimilated and `unexplained` is raised while it
@@ -47,6 +51,7 @@ class EstimatorSettings:
     """Noise model of the filter."""
 
     measurement_sigma_k: float = 0.3         # sensor noise of a thermocouple / RTD reading [K]
+    initial_temperature_sigma_k: float = 10.0  # the start temperatures, one offset common to every node [K]
     initial_theta_sigma: float = 0.7         # prior on ln s: the correlations within a factor 2 [-]
     theta_process_sigma_per_sqrt_s: float = 1e-3   # random walk of ln s [1/sqrt(s)]
     temperature_process_sigma_k_per_sqrt_s: float = 0.01  # model error of the node temperatures [K/sqrt(s)]
@@ -66,6 +71,7 @@ class DissipationEstimator:
         self.settings = settings or EstimatorSettings()
         self.x = np.concatenate([np.asarray(temperature_c, dtype=float), [0.0]])
         self.p = np.zeros((N_NODES + 1, N_NODES + 1))
+        self.p[:N_NODES, :N_NODES] = self.settings.initial_temperature_sigma_k ** 2
         self.p[N_NODES, N_NODES] = self.settings.initial_theta_sigma ** 2
         self.residual_k: float | None = None
         self.innovation_sigma_k: float | None = None

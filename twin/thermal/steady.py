@@ -27,6 +27,9 @@ from twin.thermal.settings import ThermalNetworkSettings
 from twin.thermal.sources import HeatSources
 
 
+STEADY_PERIOD_S = 0.05   # network step of the steady iteration [s] (real heat capacities: 50 ms of simulated time)
+
+
 @dataclass(frozen=True)
 class SteadyState:
     """The converged state."""
@@ -45,8 +48,8 @@ class SteadyState:
 
 def steady_state(twin: Twin, *, settle_s: float = 0.1, tolerance_k: float = 0.1, relaxation: float = 0.6,
                  max_iterations: int = 20, start_rise_k: float = 20.0) -> SteadyState:
-    """Iterate `twin` (ModelOptions.thermal = 'network', real heat capacities) to its thermal steady
-    state at its setpoint (module docstring)."""
+    """Iterate `twin` (ModelOptions.thermal = 'network', real heat capacities, a network step
+    shorter than `settle_s`) to its thermal steady state at its setpoint (module docstring)."""
     th = twin.thermal
     if th is None:
         raise ValueError("thermal: the steady state needs ModelOptions.thermal = 'network'")
@@ -79,7 +82,7 @@ def steady_operating_point(designation: str, shaft_speed_rad_s: float, radial_lo
     temperatures in degC): node temperatures, friction torque, heat by source and by ring."""
     settings = (settings or ThermalNetworkSettings()).model_copy(update={"heat_capacity_scale": 1.0})
     spec = catalog.bearing(designation, lubricant=lubricant)
-    twin = Twin(spec, options=ModelOptions(thermal="network", thermal_network=settings),
+    twin = Twin(spec, options=ModelOptions(thermal="network", thermal_period_s=STEADY_PERIOD_S, thermal_network=settings),
                 setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n,
                                   axial_load_n=axial_load_n, oil_temperature_c=ambient_c))
     ss = steady_state(twin)
