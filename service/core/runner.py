@@ -120,7 +120,7 @@ class TwinRunner:
         self._clock = clock
 
         self.mailbox = Mailbox(twin.setpoint, self.limits, clock=clock)
-        self.defect_box = DefectBox()        # local defects waiting for the next frame (issue 14)
+        self.defect_box = DefectBox()        # local defects waiting for the next frame
         self._measurement_lock = threading.Lock()
         self._measurement: tuple[str, float] | None = None   # a measured temperature for the next frame
         self.faults = FaultPolicy(twin.setpoint, self.limits, safe_after_frames=safe_after_frames,
