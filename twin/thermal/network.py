@@ -84,7 +84,8 @@ def network_geometry(spec, settings: ThermalNetworkSettings) -> NetworkGeometry:
     shaft_len = settings.shaft_length_m or 4.0 * width
     v_shaft = math.pi * (0.5 * bore) ** 2 * (width + 2.0 * shaft_len)
     h_d, h_w = 2.0 * od, 2.0 * width
-    m_housing = settings.housing_mass_kg or CAST_IRON_DENSITY_KG_M3 * math.pi * h_w * ((0.5 * h_d) ** 2 - (0.5 * od) ** 2)
+    m_housing = (settings.housing_mass_kg
+                 or CAST_IRON_DENSITY_KG_M3 * math.pi * h_w * ((0.5 * h_d) ** 2 - (0.5 * od) ** 2))
     free = math.pi * width * (r_os ** 2 - r_is ** 2) - v_balls
     oil_volume = settings.oil_volume_m3 or 3.0 * max(free, 0.0)
     oil_rho = spec.lubricant.density_15c_kg_m3

@@ -82,7 +82,8 @@ def steady_operating_point(designation: str, shaft_speed_rad_s: float, radial_lo
     temperatures in degC): node temperatures, friction torque, heat by source and by ring."""
     settings = (settings or ThermalNetworkSettings()).model_copy(update={"heat_capacity_scale": 1.0})
     spec = catalog.bearing(designation, lubricant=lubricant)
-    twin = Twin(spec, options=ModelOptions(thermal="network", thermal_period_s=STEADY_PERIOD_S, thermal_network=settings),
+    options = ModelOptions(thermal="network", thermal_period_s=STEADY_PERIOD_S, thermal_network=settings)
+    twin = Twin(spec, options=options,
                 setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n,
                                   axial_load_n=axial_load_n, oil_temperature_c=ambient_c))
     ss = steady_state(twin)

@@ -43,7 +43,8 @@ def startup_transient(designation: str = "6208", shaft_speed_rad_s: float = 1000
                       sample_every_network_s: float = 30.0, settings: ThermalNetworkSettings | None = None,
                       lubricant=None) -> Transient:
     """The start-up from cold: every node at `ambient_c`, the shaft at speed from the warm start."""
-    net_settings = (settings or ThermalNetworkSettings()).model_copy(update={"heat_capacity_scale": heat_capacity_scale})
+    net_settings = (settings or ThermalNetworkSettings()).model_copy(
+        update={"heat_capacity_scale": heat_capacity_scale})
     spec = catalog.bearing(designation, lubricant=lubricant) if lubricant is not None else designation
     options = ModelOptions(thermal="network", thermal_period_s=thermal_step_s, thermal_network=net_settings)
     twin = Twin(spec, options=options,
