@@ -4,10 +4,11 @@ import math
 
 import numpy as np
 import pytest
+from scipy.linalg import expm
 
 from twin import catalog
 from twin.thermal import correlations as cr
-from twin.thermal.integrator import step_c, steady_state_c
+from twin.thermal.integrator import step_c, steady_state_c, transition
 from twin.thermal.materials import AIR_CONDUCTIVITY_W_M_K, AIR_KINEMATIC_VISCOSITY_M2_S, AIR_PRANDTL
 from twin.thermal.network import NODE_NAMES, Network, Operating, assemble, network_geometry
 from twin.thermal.settings import ThermalNetworkSettings
@@ -120,3 +121,12 @@ def test_iso_dissipation_settles_the_outer_ring_at_70_for_the_reference_heat():
     inf = steady_state_c(net, 1.0, 20.0, 20.0, HeatSources(per).node_heat_w())
     assert inf[NODE_NAMES.index("outer_ring")] == pytest.approx(70.0, abs=3.0)
     assert inf[NODE_NAMES.index("inner_ring")] == pytest.approx(70.0, abs=3.0)
+
+
+def test_transition_equals_the_pade_exponential():
+    # the eigen form of exp(-C^-1 K h) against scipy's Pade expm, real and accelerated capacities
+    for scale in (1.0, 1e-3):
+        _, net = _network(ThermalNetworkSettings(heat_capacity_scale=scale))
+        for h in (1e-3, 1.0, 100.0):
+            ref = expm(-net.stiffness(1.0) / net.capacity_j_k[:, None] * h)
+            assert np.allclose(transition(net, 1.0, h), ref, atol=1e-10, rtol=1e-9)

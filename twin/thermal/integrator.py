@@ -10,7 +10,6 @@ the heat and the conductances over the period, which twin.thermal.studies.period
 from __future__ import annotations
 
 import numpy as np
-from scipy.linalg import expm
 
 from twin.thermal.network import Network
 
@@ -29,8 +28,13 @@ def steady_state_c(net: Network, dissipation_factor: float, ambient_c: float, su
 
 
 def transition(net: Network, dissipation_factor: float, period_s: float) -> np.ndarray:
-    """Phi = exp(-C^-1 K h) [-]."""
-    return expm(-net.stiffness(dissipation_factor) / net.capacity_j_k[:, None] * period_s)
+    """Phi = exp(-C^-1 K h) [-], through the symmetric S = C^-1/2 K C^-1/2 (K symmetric, C > 0):
+    S = V diag(lambda) V^T, Phi = C^-1/2 V diag(exp(-lambda h)) V^T C^1/2 (exact; an eigh of the
+    6 x 6 costs a tenth of a Pade expm, whose scaling and squaring grows with the accelerated
+    mode's small capacities)."""
+    r = 1.0 / np.sqrt(net.capacity_j_k)
+    lam, v = np.linalg.eigh(net.stiffness(dissipation_factor) * r[:, None] * r[None, :])
+    return (r[:, None] * v) @ (np.exp(-lam * period_s)[:, None] * (v.T / r[None, :]))
 
 
 def step_c(net: Network, temperature_c: np.ndarray, dissipation_factor: float, ambient_c: float,
