@@ -338,6 +338,23 @@ class AlarmSettings(BaseModel):
     life_used_critical: float = Field(
         default=0.9, gt=0.0, le=10.0,
         description="Damage fraction above which the life alarm is critical [-].")
+    temperature_warning_c: float = Field(
+        default=82.0, gt=-30.0, le=300.0,
+        description="Outer-ring temperature above which the temperature alarm is a warning [degC] (82 degC: the oil "
+        "sump limit of ISO 13709 / API 610 for ring-oil and splash lubricated bearings).")
+    temperature_critical_c: float = Field(
+        default=95.0, gt=-30.0, le=300.0,
+        description="Outer-ring temperature above which the temperature alarm is critical [degC].")
+    temperature_rate_warning_k_per_min: float = Field(
+        default=5.0, gt=0.0, le=1000.0,
+        description="Rate of rise of the outer ring (over a minute of thermal time) above which the rate alarm is a "
+        "warning [K/min].")
+    temperature_rate_critical_k_per_min: float = Field(
+        default=10.0, gt=0.0, le=1000.0,
+        description="Rate of rise above which the rate alarm is critical [K/min].")
+    temperature_delay_s: float = Field(
+        default=0.0, ge=0.0, le=3600.0,
+        description="A temperature alarm rises after its value stays beyond the threshold this long [s of simulated time].")
     history: int = Field(default=200, ge=1, le=100000,
                          description="Alarm events kept per twin for GET .../alarms [count].")
 

@@ -31,9 +31,11 @@ from twin.electrical_network import bearing_network
 from twin.life.monitor import LifeMonitor
 from twin.life.settings import LifeSettings
 from twin.snapshot import BallState, ContactState, LifeState, Snapshot
-from twin.snapshot import ElectricalState
+from twin.snapshot import ElectricalState, ThermalState
 from twin.spec import BearingSpec, ModelOptions
 from twin.state import MAX_DEFECTS, TwinState, make_state
+from twin.thermal.coupling import ThermalCoupling
+from twin.thermal.expansion import write_groove_lanes
 from twin.vibration.defects import BallDefect, defect_row, validate_defects
 from twin.vibration.housing import housing_equilibrium
 from twin.vibration.sensor import SensorReader, WaveformBlock
@@ -86,6 +88,17 @@ class Twin:
         self._defects: tuple = ()  # the active local defects (twin.vibration.defects)
         self._sensor = SensorReader(self.model) if self.model.housing_on else None
         self._frozen_vibration = None  # a frozen copy's last window (`frozen`); the live twin reads its sensor
+        self.thermal: ThermalCoupling | None = None
+        """The thermal network in the loop (ModelOptions.thermal = 'network', twin.thermal.coupling)."""
+        self._frozen_thermal: ThermalState | None = None
+        if self.model.options.thermal == "network":
+            opts = self.model.options
+            period = opts.thermal_period_s * opts.thermal_network.heat_capacity_scale  # thermal -> simulated time
+            frames = max(1, int(round(period / FRAME_S)))
+            self.thermal = ThermalCoupling(self.model, opts.thermal_network, frames * FRAME_S,
+                                           (setpoint or self.default_setpoint()).oil_temperature_c)
+        c = self.state.contacts
+        self._groove_lanes = (c[L.M_GROOVE_CENTRE_RADIUS].copy(), c[L.M_GROOVE_CLEARANCE].copy())
         self._apply(self.limits.admit(setpoint or self.default_setpoint()))
         self.reset(warm=warm)
 
@@ -118,11 +131,60 @@ class Twin:
         v[L.S_SHAFT_SPEED] = new.shaft_speed_rad_s
         v[L.S_RADIAL_LOAD] = new.radial_load_n
         v[L.S_AXIAL_LOAD] = new.axial_load_n
-        lub = self.model.spec.lubricant
-        self._oil_viscosity_pa_s = dynamic_viscosity_pa_s(lub, new.oil_temperature_c)
-        self._oil_beta_k_inv = temperature_viscosity_coefficient_k_inv(lub, new.oil_temperature_c)
-        self._update_inlet_viscosity(force=True)
+        if self.thermal is not None:
+            self.thermal.set_ambient(new.oil_temperature_c)
+        self._refresh_oil_viscosity()
         return new
+
+    # ---- thermal network (twin.thermal) -------------------------------------------------------
+    def film_temperature_c(self) -> float:
+        """The temperature the film's viscosity is taken at [degC]: the setpoint's oil temperature
+        (ModelOptions.thermal = 'fixed') or the network's contact inlet temperature ('network')."""
+        if self.thermal is None:
+            return self._setpoint.oil_temperature_c
+        return self.thermal.inlet_temperature_c
+
+    def _refresh_oil_viscosity(self) -> None:
+        """Viscosity and its temperature coefficient at the film temperature, and the inlet's."""
+        lub = self.model.spec.lubricant
+        t = self.film_temperature_c()
+        self._oil_viscosity_pa_s = dynamic_viscosity_pa_s(lub, t)
+        self._oil_beta_k_inv = temperature_viscosity_coefficient_k_inv(lub, t)
+        self._update_inlet_viscosity(force=True)
+
+    def measure_temperature(self, node: str, temperature_c: float) -> None:
+        """A measured temperature of a node ('outer_ring', 'housing' or 'oil') [degC], assimilated by
+        the dissipation estimator at the next network step (twin.thermal.estimator). Raises
+        ValueError naming the field and its range, or with ModelOptions.thermal = 'fixed'."""
+        if self.thermal is None:
+            raise ValueError("thermal: a measured temperature needs ModelOptions.thermal = 'network'")
+        self.thermal.measure(node, float(temperature_c), self.time_s)
+
+    def hold_thermal_state(self, temperature_c) -> None:
+        """Set the network's node temperatures [degC] (twin.thermal.network.NODE_NAMES order) and
+        apply them at once: inlet viscosity and expansion (a steady-state solver, or a restart from
+        a known thermal state). Raises ValueError with the fixed oil temperature or a bad array."""
+        th = self.thermal
+        if th is None:
+            raise ValueError("thermal: node temperatures need ModelOptions.thermal = 'network'")
+        t = np.asarray(temperature_c, dtype=float)
+        if t.shape != th.temperature_c.shape or not np.all(np.isfinite(t)) or t.min() < -60.0 or t.max() > 400.0:
+            raise ValueError(f"temperature_c: {th.temperature_c.size} finite node temperatures in [-60, 400] degC")
+        th.filter.x[:t.size] = t
+        write_groove_lanes(self.state.contacts, self._groove_lanes, th.expansion, self.model.ball_count)
+        self._refresh_oil_viscosity()
+
+    def _thermal_step(self) -> None:
+        """One network period: heat from the engine's state, node temperatures, then the inlet
+        viscosity and the expansion of the rings and balls (written into the contacts' groove lanes)."""
+        s, th = self.state, self.thermal
+        spin = float(np.mean(np.linalg.norm(s.ball_angular_velocity_rad_s, axis=1)))
+        th.step(s.contacts, s.scalars, th.take_mean_power_w(), spin, self._effective_mu, self.time_s)
+        write_groove_lanes(s.contacts, self._groove_lanes, th.expansion, self.model.ball_count)
+        self._refresh_oil_viscosity()
+
+    def _thermal_state(self) -> ThermalState | None:
+        return self._frozen_thermal if self.thermal is None else self.thermal.block()
 
     # ---- electro-thermal coupling (seed 003) ------------------------------------------------
     def _update_inlet_viscosity(self, force: bool = False, elapsed_s: float = 0.0) -> None:
@@ -147,7 +209,7 @@ class Twin:
         current_rise = 0.0
         if sp.shaft_current_a > 0.0 and th.current_heating and have_state:
             current_rise = self.current_heating_k()
-        theta0 = sp.oil_temperature_c + 273.15
+        theta0 = self.film_temperature_c() + 273.15
         eta0, beta = self._oil_viscosity_pa_s, self._oil_beta_k_inv
         current_factor = 1.0
         if current_rise > 0.0:
@@ -293,7 +355,7 @@ class Twin:
             return
         sp = self._setpoint
         rise = getattr(self, "_current_heating_k", 0.0) + getattr(self, "_shear_heating_k", 0.0)
-        rho = density_kg_m3(self.model.spec.lubricant.density_15c_kg_m3, sp.oil_temperature_c + rise)
+        rho = density_kg_m3(self.model.spec.lubricant.density_15c_kg_m3, self.film_temperature_c() + rise)
         self.life_monitor.update(self.time_s, float(self.state.scalars[L.X_SHAFT_SPEED]), sp.radial_load_n,
                                  sp.axial_load_n, self._inlet_viscosity_pa_s / rho, self.state.contacts,
                                  force=force)
@@ -316,6 +378,11 @@ class Twin:
             self._recover(status)
         else:
             self._last_good_time_s = self.time_s
+            if self.thermal is not None:
+                frame_s = done * self.model.dt_s
+                self.thermal.add_work(self._last_torque_n_m * float(s.scalars[L.X_SHAFT_SPEED]), frame_s)
+                if self.thermal.due(frame_s, self.model.dt_s):
+                    self._thermal_step()
             self._update_life()
         return done
 
@@ -438,6 +505,8 @@ class Twin:
         frozen.state = self.state.copy()
         frozen._sensor = None
         frozen._frozen_vibration = latest
+        frozen._frozen_thermal = self._thermal_state()
+        frozen.thermal = None
         return frozen
 
     def drain_waveform(self) -> list[WaveformBlock]:
@@ -547,7 +616,7 @@ class Twin:
             balls=balls,
             life=self._life_state(),
             outer_ring_displacement_m=tuple(float(h) for h in s.housing_displacement_m[:3]),
-            defects=self._defects, vibration=self.vibration)
+            defects=self._defects, vibration=self.vibration, thermal=self._thermal_state())
 
     def _life_state(self) -> LifeState | None:
         block = self.life_monitor.block(self.time_s)

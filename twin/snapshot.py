@@ -190,6 +190,35 @@ class VibrationState(BaseModel):
         "twin.vibration.indicators.amplitude_spectrum). Not serialised.")
 
 
+class ThermalState(BaseModel):
+    """The thermal network in the loop (twin.thermal): node temperatures, heat by source, the
+    dissipation estimate that follows a measured temperature, and its residual."""
+
+    model_config = _FROZEN
+    accelerated: bool = Field(description="True: the heat capacities are scaled down (heat_capacity_scale < 1), the "
+                              "transient runs 1 / scale times faster than a real bearing's; steady states are the same.")
+    heat_capacity_scale: float = Field(description="Factor on every heat capacity [-] (1: real).")
+    network_time_s: float = Field(description="Thermal time: simulated time / heat_capacity_scale [s].")
+    ambient_c: float = Field(description="Ambient (sump) or oil-inlet (circulating) temperature: the setpoint's oil temperature [degC].")
+    temperatures_c: dict[str, float] = Field(description="Node temperatures: shaft, inner_ring, balls, outer_ring, housing, oil [degC].")
+    inlet_temperature_c: float = Field(description="The contacts' inlet temperature, which sets the film viscosity [degC].")
+    heat_w: dict[str, float] = Field(description="Friction heat by source: rolling, sliding, spin, drag, seal [W].")
+    heat_inner_contacts_w: float = Field(description="Friction heat of the inner-ring contacts [W].")
+    heat_outer_contacts_w: float = Field(description="Friction heat of the outer-ring contacts [W].")
+    dissipated_w: float = Field(description="Heat carried to the surroundings and the oil supply [W].")
+    slowest_time_constant_s: float | None = Field(description="Slowest time constant of the network with real heat capacities [s].")
+    clearance_change_m: float = Field(description="Change of the diametral clearance by thermal expansion (< 0: closes) [m].")
+    outer_ring_rate_k_per_min: float = Field(description="Rate of rise of the outer ring over the last minute of thermal time [K/min].")
+    dissipation_factor: float = Field(description="Estimated factor on the dissipation to the surroundings [-] (1: the correlations).")
+    dissipation_factor_sigma: float = Field(description="Its standard deviation [-].")
+    measured_node: str | None = Field(default=None, description="Node of the last measured temperature; null: none.")
+    measured_c: float | None = Field(default=None, description="Last measured temperature [degC]; null: none.")
+    residual_k: float | None = Field(default=None, description="Measured - predicted temperature before the update [K]; null: no measurement.")
+    residual_sigma_k: float | None = Field(default=None, description="Standard deviation of that residual (prediction and sensor) [K].")
+    unexplained_heating: bool = Field(default=False, description="The last measurement lay beyond the filter's gate: heat "
+                                      "the friction and the dissipation cannot explain (lubricant loss, overload, a failing bearing).")
+
+
 class Snapshot(BaseModel):
     """Everything the world may see of one twin at one instant."""
 
@@ -216,6 +245,8 @@ class Snapshot(BaseModel):
     outer_ring_displacement_m: tuple[float, float, float] = Field(
         default=(0.0, 0.0, 0.0), description="Outer ring (housing) centre (x, y, z) [m]; zero with the rigid outer ring.")
     defects: tuple[Defect, ...] = Field(default=(), description="Active local defects (twin.vibration.defects).")
+    thermal: ThermalState | None = Field(
+        default=None, description="The thermal network (ModelOptions.thermal = 'network'); null with the fixed oil temperature.")
     vibration: VibrationState | None = Field(
         default=None, description="Indicators of the last complete accelerometer window; null before the first "
         "window or with the rigid outer ring.")

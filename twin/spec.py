@@ -12,6 +12,7 @@ from typing import Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from twin.thermal.settings import ThermalNetworkSettings
 from twin.vibration.housing import Housing
 
 # the range of an explicit ModelOptions.time_step_s [s] (twin.timestep.TIME_STEP_RANGE_S)
@@ -313,6 +314,24 @@ class ModelOptions(BaseModel):
         "the period it is held for (extrapolated from the previous refresh and the step's rates, "
         "twin.kernels.step.centred_inputs): the held values' error becomes second order in tribology_period_s "
         "instead of first. False: at the refresh's own step (the engine before it; tests/engine/test_step_reference.py).")
+    thermal: Literal["network", "fixed"] = Field(
+        default="network",
+        description="'network': the bearing's thermal network (twin.thermal) runs in the loop, fed by the friction "
+        "power; its temperatures set the inlet viscosity and the rings' and balls' expansion the clearance, and the "
+        "setpoint's oil temperature is the ambient (sump) or oil-inlet (circulating) temperature. 'fixed': the oil "
+        "and the contacts' inlet stay at the setpoint's oil temperature.")
+    thermal_period_s: float = Field(
+        default=1.0, ge=0.01, le=60.0,
+        description="The thermal network's step [s of thermal time]: every thermal_period_s x heat_capacity_scale of "
+        "simulated time, a whole number of frames (the nearest, at least 1). The exponential step is exact for any "
+        "step; the heat is held over it while the friction falls with the temperature (an explicit coupling), so it "
+        "stays short against the balls' time constants (2-10 s). twin.thermal.studies.period_study (6208 start-up "
+        "from cold, 1000 rad/s, 3000 N, accelerated x1000, 900 s): 5 s moves the node temperatures by 0.43 K from "
+        "1 s, 20 s by 1.4 K, 50 s by 18 K (the first step's held heat overshoots the balls); first order, so 1 s "
+        "lies within about 0.1 K of the limit.")
+    thermal_network: ThermalNetworkSettings = Field(
+        default_factory=ThermalNetworkSettings,
+        description="The bearing's surroundings and oil supply for thermal = 'network' (twin.thermal.settings).")
 
     @field_validator("time_step_s", mode="before")
     @classmethod

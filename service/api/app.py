@@ -36,7 +36,7 @@ from service.api.deps import require_token
 from service.api.errors import install_error_handlers
 from service.api.middleware import BodySizeLimit, ReadRateLimit, Tarpit, TarpitStats, TokenGate
 from service.api.routers import (alarms, bearings, defects, docs, health, measured, recording, scenarios, setpoint,
-                                 state)
+                                 state, temperature)
 from service.api.schemas import ErrorResponse
 from service.core.registry import TwinRegistry, admission_gate
 from service.settings import ServiceSettings, is_loopback_host
@@ -109,7 +109,8 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
     app.include_router(health.router)
     for router in (bearings.read, state.read, alarms.read, defects.read, measured.read, scenarios.read, docs.read):
         app.include_router(router, **reads)
-    for router in (bearings.write, setpoint.write, defects.write, measured.write, scenarios.write, recording.write):
+    for router in (bearings.write, setpoint.write, defects.write, measured.write, scenarios.write, recording.write,
+                   temperature.write):
         app.include_router(router, **writes)
     docs.mount_assets(app)
     return app

@@ -31,6 +31,15 @@ The alarms (ids are stable; docs/service.md "Alarms"):
   & Antoni 2011 sec. 3.3; twin.vibration.indicators.SIGNIFICANCE).
 * `life_used` - Palmgren-Miner damage fraction (snapshot `life.damage_fraction`) above
   `life_used_warning` (warning) and `life_used_critical` (critical).
+* `temperature_zone` - outer-ring temperature (snapshot `thermal.temperatures_c.outer_ring`, the
+  measured one when a measurement is assimilated) above `temperature_warning_c` (82 degC: the oil
+  sump limit of ISO 13709 / API 610) and `temperature_critical_c`.
+* `temperature_rate` - rate of rise of the outer ring over a minute of thermal time (snapshot
+  `thermal.outer_ring_rate_k_per_min`) above `temperature_rate_warning_k_per_min` and
+  `temperature_rate_critical_k_per_min`.
+* `temperature_unexplained` - the dissipation estimator gated the last measured temperature
+  (snapshot `thermal.unexplained_heating`): heat the friction and the dissipation cannot
+  explain (lubricant loss, overload, a failing bearing; twin.thermal.estimator); critical.
 
 State (`AlarmTracker`): every alarm has ordered levels (warning, critical), each with a raise
 threshold and a clear threshold on the safe side of it (a deadband; `clear_ratio`). A level is
@@ -83,7 +92,8 @@ _TIME_EPS_S = 1e-9   # a delay of 0.2 s is over at t = 0.3 after 0.1 (0.3 - 0.1 
 DISCHARGE_LEVELS = {"none": 0.0, "possible": 1.0, "likely": 2.0}
 
 ALARM_IDS: tuple[str, ...] = ("vibration_zone", "lubrication_kappa", "lubrication_boundary",
-                              "electrical_discharge", *(f"defect_{n}" for n in DEFECT_LINES), "life_used")
+                              "electrical_discharge", *(f"defect_{n}" for n in DEFECT_LINES), "life_used",
+                              "temperature_zone", "temperature_rate", "temperature_unexplained")
 
 
 def _line_name(name: str) -> str:
@@ -131,6 +141,10 @@ class AlarmInputs:
     discharge_reason: str = ""
     damage_fraction: float | None = None              # Palmgren-Miner damage [-]
     vibration: VibrationInputs | None = None
+    outer_ring_c: float | None = None                 # outer-ring temperature [degC]
+    outer_ring_rate_k_per_min: float | None = None    # its rate of rise [K/min]
+    unexplained_heating: bool | None = None           # the estimator gated the last measurement
+    residual_k: float | None = None                   # measured - predicted temperature [K]
 
 
 def _get(obj: Any, *names: str) -> Any:
@@ -209,6 +223,9 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
                 boundary += 1
     electrical = _get(snapshot, "electrical")
     life = _get(snapshot, "life")
+    thermal = _get(snapshot, "thermal")
+    temps = _get(thermal, "temperatures_c") or {}
+    unexplained = _get(thermal, "unexplained_heating")
     return AlarmInputs(
         time_s=float(_get(snapshot, "time_s") or 0.0),
         seq=_seq(_get(snapshot, "seq")),
@@ -218,6 +235,10 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
         discharge_reason=str(_get(electrical, "reason") or ""),
         damage_fraction=finite_number(_get(life, "damage_fraction")),
         vibration=vibration_inputs(_get(snapshot, "vibration")),
+        outer_ring_c=finite_number(temps.get("outer_ring")) if thermal is not None else None,
+        outer_ring_rate_k_per_min=finite_number(_get(thermal, "outer_ring_rate_k_per_min")),
+        unexplained_heating=bool(unexplained) if unexplained is not None else None,
+        residual_k=finite_number(_get(thermal, "residual_k")),
     )
 
 
@@ -419,6 +440,15 @@ class AlarmEvaluator:
             Rule("life_used", "life", "-", "above", 0.0, hold,
                  f"Palmgren-Miner damage fraction above {s.life_used_warning:g} (warning), "
                  f"{s.life_used_critical:g} (critical)"),
+            Rule("temperature_zone", "thermal", "degC", "above", s.temperature_delay_s, hold,
+                 f"outer ring above {s.temperature_warning_c:g} degC (warning; ISO 13709 / API 610 oil sump "
+                 f"limit 82 degC) or {s.temperature_critical_c:g} degC (critical)"),
+            Rule("temperature_rate", "thermal", "K/min", "above", s.temperature_delay_s, hold,
+                 f"outer ring rising faster than {s.temperature_rate_warning_k_per_min:g} K/min (warning) or "
+                 f"{s.temperature_rate_critical_k_per_min:g} K/min (critical) over a minute of thermal time"),
+            Rule("temperature_unexplained", "thermal", "-", "above", 0.0, hold,
+                 "measured temperature beyond what the friction and the dissipation explain (the estimator's "
+                 "innovation gate); value 1 = unexplained"),
         ]
         self.trackers: dict[str, AlarmTracker] = {r.id: AlarmTracker(r) for r in rules}
         r = s.clear_ratio
@@ -429,6 +459,11 @@ class AlarmEvaluator:
             # ordinal value: warning at 1 (possible), critical at 2 (likely); clear = one step down
             "electrical_discharge": (Level("warning", 1.0, 0.5), Level("critical", 2.0, 1.5)),
             "life_used": (_above("warning", s.life_used_warning, r), _above("critical", s.life_used_critical, r)),
+            "temperature_zone": (_above("warning", s.temperature_warning_c, r),
+                                 _above("critical", s.temperature_critical_c, r)),
+            "temperature_rate": (_above("warning", s.temperature_rate_warning_k_per_min, r),
+                                 _above("critical", s.temperature_rate_critical_k_per_min, r)),
+            "temperature_unexplained": (Level("critical", 1.0, 0.5),),
         }
         for tracker in self.trackers.values():
             tracker.levels = self._levels(tracker.rule.id, None)
@@ -463,6 +498,14 @@ class AlarmEvaluator:
             out[f"defect_{n}"] = (a, "" if a is None else f"envelope amplitude at {_line_name(n)} {a:.3g} m/s^2")
         d = x.damage_fraction
         out["life_used"] = (d, "" if d is None else f"damage fraction {d:.3g}")
+        t = x.outer_ring_c
+        out["temperature_zone"] = (t, "" if t is None else f"outer ring {t:.1f} degC")
+        rate = x.outer_ring_rate_k_per_min
+        out["temperature_rate"] = (rate, "" if rate is None else f"outer ring rising {rate:.2f} K/min")
+        u = x.unexplained_heating
+        res = "" if x.residual_k is None else f" (measured - predicted {x.residual_k:+.1f} K)"
+        out["temperature_unexplained"] = (None if u is None else float(u),
+                                          "" if u is None else ("unexplained heating" if u else "explained") + res)
         return out
 
     def update(self, inputs: AlarmInputs) -> list[AlarmEvent]:

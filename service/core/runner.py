@@ -62,6 +62,7 @@ from service.core.stats import LoopCounters, health_record
 from twin.engine import Twin
 from twin.setpoint import Setpoint, SetpointError, SetpointLimits, SetpointUpdate
 from twin.snapshot import Snapshot
+from twin.thermal.coupling import MEASURABLE_NODES
 
 log = logging.getLogger(__name__)
 
@@ -120,6 +121,8 @@ class TwinRunner:
 
         self.mailbox = Mailbox(twin.setpoint, self.limits, clock=clock)
         self.defect_box = DefectBox()        # local defects waiting for the next frame
+        self._measurement_lock = threading.Lock()
+        self._measurement: tuple[str, float] | None = None   # a measured temperature for the next frame
         self.faults = FaultPolicy(twin.setpoint, self.limits, safe_after_frames=safe_after_frames,
                                   max_restarts_per_frame=max_restarts_per_frame)
         self.pacing = PacingClock(fast=self.fast, publish_period_s=1.0 / self.publish_rate_hz, clock=clock,
@@ -252,6 +255,28 @@ class TwinRunner:
         self._wake()
         return items
 
+    def submit_temperature(self, node: str, temperature_c: float) -> None:
+        """A measured temperature of a node ('outer_ring', 'housing', 'oil') [degC] for the twin's
+        dissipation estimator (twin.thermal.estimator): checked here (InputError 422 naming the
+        field and its range; 409 with the fixed oil temperature), handed to the twin at the next
+        frame boundary (the latest wins)."""
+        if self.twin.thermal is None:
+            raise InputError.one("node", "the twin runs with the fixed oil temperature (ModelOptions.thermal = "
+                                 "'fixed'): no thermal network to follow a measurement", status_code=409)
+        if node not in MEASURABLE_NODES:
+            raise InputError.one("node", f"{node!r} cannot be measured", allowed=list(MEASURABLE_NODES))
+        if not (math.isfinite(temperature_c) and -60.0 <= temperature_c <= 400.0):
+            raise InputError.one("temperature_c", f"{temperature_c!r}: must be finite, in [-60, 400] degC")
+        with self._measurement_lock:
+            self._measurement = (node, float(temperature_c))
+        self._wake()
+
+    def _take_measurement(self) -> None:
+        with self._measurement_lock:
+            pending, self._measurement = self._measurement, None
+        if pending is not None and self.twin.thermal is not None:
+            self.twin.measure_temperature(*pending)
+
     def start_scenario(self, run: ResolvedRun, *, restart: bool = False) -> tuple[ScenarioHandle, ScenarioHandle | None]:
         """Hand a scenario run to the runner (a running one is cancelled). Values are checked
         against the bearing's limits first (ScenarioError). Returns (handle, replaced)."""
@@ -350,6 +375,7 @@ class TwinRunner:
         defects = self.defect_box.take()
         if defects is not None:
             self.twin.set_defects(defects)
+        self._take_measurement()
         outside = bool(timings) or defects is not None
         return pending is not None or outside, outside
 
@@ -357,6 +383,12 @@ class TwinRunner:
     def _offer_scenario_defects(self, defects: list) -> None:
         """A scenario step's defects (checked when the run started): in force from this frame."""
         self.defect_box.offer(parse_defects(defects, self.twin.model.spec.geometry))
+
+    def _offer_scenario_temperature(self, node: str, temperature_c: float) -> None:
+        """A scenario step's measured temperature: to the twin's network at this frame (ignored with
+        the fixed oil temperature, where there is no network to follow it)."""
+        if self.twin.thermal is not None:
+            self.twin.measure_temperature(node, temperature_c)
 
     def _restart_at(self, initial: SetpointUpdate) -> None:
         """A scenario asked to start from the warm start at its initial setpoint."""
@@ -394,7 +426,7 @@ class TwinRunner:
                 self._reanchor = False
             event = self.scenarios.tick(self.sim_elapsed_s, self.mailbox.target,
                                         lambda u: self._offer(u, timed=False), self._restart_at,
-                                        self._offer_scenario_defects)
+                                        self._offer_scenario_defects, self._offer_scenario_temperature)
             changed, outside = self._apply_mailbox()
             if self.idle_without_scenario and not self.scenarios.active:
                 if (event and pacing.last_publish_sim != self.sim_elapsed_s) or changed:

@@ -40,6 +40,7 @@ class ScenarioExecutor:
     _initial_done: bool = False
     phase: str | None = None
     defects: list | None = None        # the defects of the steps just passed (taken by the driver)
+    temperature: object | None = None  # the measured temperature of the steps just passed (MeasuredTemperature)
 
     def updates(self, t: float, current: Setpoint) -> SetpointUpdate:
         eps = 1e-9
@@ -55,6 +56,8 @@ class ScenarioExecutor:
                 self.phase = step.phase
             if step.defects is not None:
                 self.defects = list(step.defects)     # the latest step wins
+            if step.temperature is not None:
+                self.temperature = step.temperature   # the latest step wins
             if step.set is None and step.ramp is None:
                 continue
             if step.set is not None:
@@ -198,7 +201,8 @@ class ScenarioDriver:
     # ---- runner thread -------------------------------------------------------------------------
     def tick(self, elapsed_s: float, target: Setpoint, offer: Callable[[SetpointUpdate], object],
              restart_at: Callable[[SetpointUpdate], None],
-             offer_defects: Callable[[list], object] | None = None) -> bool:
+             offer_defects: Callable[[list], object] | None = None,
+             offer_temperature: Callable[[str, float], object] | None = None) -> bool:
         """Before a frame at `elapsed_s` of the runner's simulated time: take over a new scenario
         (`restart_at(initial)` when it asks for a warm restart), `offer` its updates and
         `offer_defects` its steps' defects, finish it when its time is up. Returns whether a
@@ -232,6 +236,9 @@ class ScenarioDriver:
             defects, self._executor.defects = self._executor.defects, None
             if defects is not None and offer_defects is not None:
                 offer_defects(defects)
+            measured, self._executor.temperature = self._executor.temperature, None
+            if measured is not None and offer_temperature is not None:
+                offer_temperature(measured.node, measured.temperature_c)
             handle.phase = self._executor.phase
         except Exception as exc:  # noqa: BLE001 - a bad scenario must not stop the twin
             handle.finish("failed", f"{type(exc).__name__}: {exc}", notify=False)

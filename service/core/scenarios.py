@@ -51,7 +51,7 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Literal
 
 import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
@@ -76,6 +76,14 @@ class ScenarioError(ValueError):
         super().__init__(message if message.startswith(f"{field}: ") else f"{field}: {message}")
 
 
+class MeasuredTemperature(BaseModel):
+    """A measured node temperature handed to the twin's thermal network (twin.thermal.estimator)."""
+
+    model_config = _FROZEN
+    node: Literal["outer_ring", "housing", "oil"] = Field(default="outer_ring", description="Measured node [text].")
+    temperature_c: float = Field(ge=-60.0, le=400.0, description="Measured temperature [degC].")
+
+
 class ScenarioStep(BaseModel):
     """One timed change of the setpoint."""
 
@@ -90,13 +98,16 @@ class ScenarioStep(BaseModel):
         description="Local defects in force from at_s (twin.vibration.defects vocabulary: kind outer | "
         "inner | ball, width_m, length_m, depth_m [m], ...; [] clears them), checked against the bearing's "
         "geometry before the run starts.")
+    temperature: MeasuredTemperature | None = Field(
+        default=None, description="A measured temperature at at_s for the thermal network to follow (the twin's "
+        "setpoint oil_temperature_c is the ambient; needs ModelOptions.thermal = 'network').")
 
     @model_validator(mode="after")
     def _one_action(self) -> ScenarioStep:
         if self.set is not None and self.ramp is not None:
             raise ValueError("a step has one of 'set' or 'ramp', not both")
-        if self.set is None and self.ramp is None and self.defects is None:
-            raise ValueError("a step needs one of 'set' or 'ramp', or 'defects'")
+        if self.set is None and self.ramp is None and self.defects is None and self.temperature is None:
+            raise ValueError("a step needs one of 'set' or 'ramp', or 'defects', or 'temperature'")
         if self.ramp is not None and self.over_s is None:
             raise ValueError("a ramp needs over_s > 0 [s]")
         if self.set is not None and self.over_s is not None:
@@ -130,7 +141,8 @@ class ScenarioRun(BaseModel):
 
 
 def _drop_empty_steps(steps: list[ScenarioStep]) -> list[ScenarioStep]:
-    return [s for s in steps if s.defects is not None or (s.set or s.ramp).model_dump(exclude_none=True)]
+    return [s for s in steps if s.defects is not None or s.temperature is not None
+            or (s.set or s.ramp).model_dump(exclude_none=True)]
 
 
 def _check_steps(steps: list[ScenarioStep], duration_s: float, where: str) -> None:

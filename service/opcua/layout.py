@@ -90,6 +90,28 @@ def _life(name: str) -> Callable[[View], Any]:
     return read
 
 
+def _thermal(name: str) -> Callable[[View], Any]:
+    """A field of the snapshot's thermal block (twin.snapshot.ThermalState)."""
+    def read(v: View) -> Any:
+        block = getattr(v.snapshot, "thermal", None) if v.snapshot is not None else None
+        return getattr(block, name, None) if block is not None else None
+    return read
+
+
+def _thermal_temperature(node: str) -> Callable[[View], Any]:
+    def read(v: View) -> Any:
+        block = getattr(v.snapshot, "thermal", None) if v.snapshot is not None else None
+        return block.temperatures_c.get(node) if block is not None else None
+    return read
+
+
+def _thermal_heat(source: str) -> Callable[[View], Any]:
+    def read(v: View) -> Any:
+        block = getattr(v.snapshot, "thermal", None) if v.snapshot is not None else None
+        return block.heat_w.get(source) if block is not None else None
+    return read
+
+
 def _vib(v: View):
     return v.inputs.vibration if v.inputs is not None else None
 
@@ -250,6 +272,28 @@ FOLDERS: dict[str, tuple[Var, ...]] = {
         ("damage_fraction", "Palmgren-Miner damage accumulated [-]"),
         ("remaining_life_h", "Remaining life at the current conditions [h]"),
     )),
+    "Thermal": (
+        *(Var(f"{node}_c", "Double", f"Thermal network node {node.replace('_', ' ')} [degC]; no value with the fixed "
+              "oil temperature (ModelOptions.thermal = 'fixed').", _thermal_temperature(node))
+          for node in ("shaft", "inner_ring", "balls", "outer_ring", "housing", "oil")),
+        Var("inlet_temperature_c", "Double", "Contacts' inlet temperature, which sets the film viscosity [degC].",
+            _thermal("inlet_temperature_c")),
+        *(Var(f"heat_{source}_w", "Double", f"Friction heat from {source} [W].", _thermal_heat(source))
+          for source in ("rolling", "sliding", "spin", "drag", "seal")),
+        Var("dissipated_w", "Double", "Heat carried to the surroundings and the oil supply [W].",
+            _thermal("dissipated_w")),
+        Var("dissipation_factor", "Double", "Estimated factor on the dissipation to the surroundings [-].",
+            _thermal("dissipation_factor")),
+        Var("dissipation_factor_sigma", "Double", "Its standard deviation [-].", _thermal("dissipation_factor_sigma")),
+        Var("residual_k", "Double", "Measured - predicted temperature [K]; no value without a measurement.",
+            _thermal("residual_k")),
+        Var("outer_ring_rate_k_per_min", "Double", "Rate of rise of the outer ring [K/min].",
+            _thermal("outer_ring_rate_k_per_min")),
+        Var("clearance_change_m", "Double", "Diametral clearance change by thermal expansion [m].",
+            _thermal("clearance_change_m")),
+        Var("accelerated", "Boolean", "Heat capacities scaled down (accelerated thermal mode) [-].",
+            _thermal("accelerated")),
+    ),
     "Alarms": (
         Var("active_count", "UInt32", "Number of active alarms [-].",
             lambda v: sum(1 for a in v.alarms.values() if a.active)),

@@ -41,6 +41,8 @@ CONTACT_FIELDS = ("load_n", "lambda_", "mu", "contact_angle_rad", "resistance_oh
 F_LOAD, F_LAMBDA, F_MU, F_ANGLE, F_R, F_C = range(len(CONTACT_FIELDS))
 SETPOINT_FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c",
                    "shaft_current_a", "shaft_voltage_v")
+THERMAL_NODES = ("shaft", "inner_ring", "balls", "outer_ring", "housing", "oil")
+THERMAL_SOURCES = ("rolling", "sliding", "spin", "drag", "seal")
 _ELECTRICAL_FIELDS = ("resistance_ohm", "capacitance_f", "impedance_ohm", "shaft_voltage_v", "shaft_current_a",
                       "max_film_field_v_m", "current_density_a_m2", "contact_temperature_rise_k")
 
@@ -68,6 +70,7 @@ class Row:
     gap_before: str | None = None     # why the line breaks before this row (lost rows, new run)
     defects: tuple | None = None      # the active local defects as text (None: not in the snapshot)
     vibration: object | None = None   # the snapshot's vibration block (twin.snapshot.VibrationState)
+    thermal: tuple | None = None      # THERMAL_NODES temperatures [degC] then THERMAL_SOURCES heat [W]
 
 
 _FIELD_CACHE: dict = {}
@@ -130,6 +133,11 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
     has_defects, has_vibration = _present(snapshot, ("defects", "vibration"))
     defects = tuple(_defect_text(d) for d in snapshot.defects or ()) if has_defects else None
     vibration = snapshot.vibration if has_vibration else None
+    block = getattr(snapshot, "thermal", None) if _present(snapshot, ("thermal",))[0] else None
+    thermal = None
+    if block is not None:
+        thermal = (*(_num(block.temperatures_c.get(n)) for n in THERMAL_NODES),
+                   *(_num(block.heat_w.get(n)) for n in THERMAL_SOURCES))
     sp = getattr(snapshot, "setpoint", None) if _present(snapshot, ("setpoint",))[0] else None
     setpoint = tuple(_num(getattr(sp, f, None)) for f in SETPOINT_FIELDS) if sp is not None else None
     return Row(time_s=float(snapshot.time_s), seq=int(snapshot.seq), status=str(snapshot.status),
@@ -139,7 +147,7 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
                friction_torque_n_m=_num(snapshot.friction_torque_n_m),
                contacts=contacts, regimes=regimes, azimuth_rad=azimuth,
                electrical=electrical, risk=risk, risk_reason=reason, context=context,
-               positions_m=positions_m, defects=defects, vibration=vibration)
+               positions_m=positions_m, defects=defects, vibration=vibration, thermal=thermal)
 
 
 def _defect_text(d) -> str:

@@ -19,6 +19,9 @@ speeds_rad_s                  Scalars: shaft speed setpoint, shaft speed, cage s
 min_lambda                    Scalars: smallest Lambda of the loaded inner / outer contacts [-]
 regime_counts                 Scalars: balls in full film, mixed, boundary, without contact
 temperatures_c                Scalars: oil temperature setpoint, contact inlet [degC]
+thermal/nodes_c, thermal/heat_w   Scalars: the thermal network's node temperatures (shaft, inner ring,
+                              balls, outer ring, housing, oil) [degC] and the friction heat by source
+                              (rolling, sliding, spin, drag, seal) [W] (ModelOptions.thermal = 'network')
 electrical/capacitance_pf     Scalars: bearing capacitance [pF]
 electrical/resistance_log10_kohm   Scalars: log10 of R and |Z| [kohm] (decades; no log axes in
                               the viewer); a row without R (no conduction) breaks the line
@@ -149,6 +152,11 @@ SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
     "regime_counts": (tuple(REGIME_LABEL[c] for c in REGIME_ORDER),
                       tuple(tuple(int(v) for v in REGIME_RGB[c]) for c in REGIME_ORDER)),
     "temperatures_c": (("oil setpoint [degC]", "contact inlet [degC]"), ((150, 150, 150), (255, 120, 40))),
+    "thermal/nodes_c": (("shaft [degC]", "inner ring [degC]", "balls [degC]", "outer ring [degC]", "housing [degC]",
+                         "oil [degC]"),
+                        ((150, 150, 150), INNER_RGB, (255, 120, 40), OUTER_RGB, (120, 90, 60), (230, 200, 40))),
+    "thermal/heat_w": (("rolling [W]", "sliding [W]", "spin [W]", "drag [W]", "seal [W]"),
+                       ((80, 160, 255), (230, 60, 60), (160, 120, 255), (0, 210, 200), (150, 150, 150))),
     "electrical/capacitance_pf": (("bearing C [pF]",), ((0, 200, 255),)),
     "electrical/resistance_log10_kohm": (("log10 R [kohm]", "log10 |Z| [kohm]"), ((255, 200, 0), (200, 200, 200))),
     "electrical/shaft_voltage_v": (("shaft voltage [V]", "setpoint [V]"), ((255, 120, 40), (150, 150, 150))),
@@ -359,6 +367,8 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = T
         ts("min Lambda [-]", "min_lambda"),
         ts("balls per regime (mean)", "regime_counts"),
         ts("temperatures [degC]", "temperatures_c"),
+        ts("thermal network [degC]", "thermal/nodes_c"),
+        ts("friction heat by source [W]", "thermal/heat_w"),
         grid_columns=3, name="trends"))
     shares.append(2.4)
     electrical = rrb.Vertical(

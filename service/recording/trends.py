@@ -29,7 +29,7 @@ import warnings
 import numpy as np
 import rerun as rr
 
-from service.recording.columns import F_LAMBDA, F_LOAD, ball_regime, log10_kohm
+from service.recording.columns import F_LAMBDA, F_LOAD, THERMAL_NODES, THERMAL_SOURCES, ball_regime, log10_kohm
 from service.recording.layout import (
     CAPACITANCE_LEAF,
     FILM_BROKEN_LEAF,
@@ -72,6 +72,12 @@ def trend_values(tw: TwinLayout, rows: list) -> dict[str, np.ndarray]:
         "regime_counts": counts,
         "temperatures_c": np.column_stack([sp[:, 3], sp[:, 3] + np.nan_to_num(rise)]),
     }
+    if any(r.thermal is not None for r in rows):
+        nt = len(THERMAL_NODES)
+        th = np.array([r.thermal if r.thermal is not None else (math.nan,) * (nt + len(THERMAL_SOURCES))
+                       for r in rows], dtype=np.float64)
+        out["thermal/nodes_c"] = th[:, :nt]
+        out["thermal/heat_w"] = th[:, nt:]
     if any(r.electrical for r in rows):
         def el(key: str, scale: float = 1.0) -> np.ndarray:
             return np.array([r.electrical.get(key, math.nan) for r in rows], dtype=np.float64) * scale

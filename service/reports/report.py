@@ -176,9 +176,10 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
     from service.reports.angular_contact import angular_contact_section
     from service.reports.friction import friction_section
     from service.reports.ehl import write_ehl_section
+    from service.reports.thermal import thermal_section
     from service.reports.vibration import vibration_section
 
-    total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 9 + report_ev.study_count(quick)
+    total = len(SPEEDS) + len(LOADS) + len(CLEARANCES_UM) + 10 + report_ev.study_count(quick)
     with tqdm(total=total, desc="bearing-twin report", unit="study") as progress:
         az_png, az = _fig_azimuth(out, quick)
         progress.update(1)
@@ -209,6 +210,8 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
         step_study = timestep_study.run_all(quick=quick)
         progress.update(1)
         vib_md = vibration_section(out, quick)
+        progress.update(1)
+        thermal_md = thermal_section(out, quick)
         progress.update(1)
 
     md = [f"# bearing-twin validation report\n\nGenerated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}"
@@ -256,7 +259,8 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
            f"{'Quick subset; `bearing-twin timestep-study` runs the whole envelope. ' if quick else ''}"
            "Outputs averaged over whole cage revolutions (twin.validation.timestep_study).\n",
            timestep_study.markdown(step_study) + "\n",
-           *vib_md]
+           *vib_md,
+           *thermal_md]
     path = out / "report.md"
     path.write_text("\n".join(md))
     return path

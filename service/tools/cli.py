@@ -349,6 +349,9 @@ def build_parser() -> argparse.ArgumentParser:
     from service.tools.life_cli import add_life_command
 
     add_life_command(sub)
+    from service.tools.thermal_cli import add_thermal_command
+
+    add_thermal_command(sub)
     return parser
 
 

@@ -1,0 +1,88 @@
+"""The thermal network in the loop of a Twin (twin.thermal.coupling): heat from the engine's own
+friction, temperatures back into the viscosity and the clearance, measurements, options."""
+
+import math
+
+import pytest
+
+from twin import catalog
+from twin.engine import Twin
+from twin.physics.viscosity import dynamic_viscosity_pa_s
+from twin.setpoint import Setpoint
+from twin.spec import ModelOptions
+from twin.thermal.settings import ThermalNetworkSettings
+
+ACCELERATED = ModelOptions(thermal="network", thermal_network=ThermalNetworkSettings(heat_capacity_scale=1e-3))
+
+
+@pytest.fixture(scope="module")
+def warmed():
+    twin = Twin("6208", options=ACCELERATED,
+                setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0))
+    start = twin.snapshot()
+    twin.advance(0.3)     # 300 s of thermal time
+    return twin, start, twin.snapshot()
+
+
+def test_starts_at_the_set_temperature_with_its_viscosity(warmed):
+    _, start, _ = warmed
+    th = start.thermal
+    assert th.accelerated and th.heat_capacity_scale == 1e-3
+    assert all(t == pytest.approx(20.0, abs=1e-9) for t in th.temperatures_c.values())
+    lub = catalog.bearing("6208").lubricant
+    # the film starts at the set temperature's viscosity (ASTM D341), as with the fixed oil temperature
+    fixed = Twin("6208", options=ModelOptions(thermal="fixed"),
+                 setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0))
+    assert start.viscosity_pa_s == pytest.approx(fixed.snapshot().viscosity_pa_s, rel=1e-12)
+    assert dynamic_viscosity_pa_s(lub, 20.0) == pytest.approx(fixed.snapshot().viscosity_pa_s, rel=1e-12)
+    assert fixed.snapshot().thermal is None
+
+
+def test_friction_heats_the_bearing_and_thins_the_oil(warmed):
+    twin, start, end = warmed
+    th = end.thermal
+    t = th.temperatures_c
+    # heat flows from the contacts outwards: balls > rings > housing > ambient
+    assert t["balls"] > t["inner_ring"] > 20.5 and t["balls"] > t["outer_ring"] > t["housing"] > 20.0
+    # energy: the heat is the drive power (friction torque x shaft speed over the period), split by source
+    assert sum(th.heat_w.values()) == pytest.approx(th.heat_inner_contacts_w + th.heat_outer_contacts_w, rel=1e-9)
+    assert 20.0 < sum(th.heat_w.values()) < 1000.0
+    # the warmer inlet thins the film: viscosity at the network's inlet temperature (ASTM D341)
+    lub = twin.model.spec.lubricant
+    assert th.inlet_temperature_c > 25.0
+    assert end.viscosity_pa_s == pytest.approx(dynamic_viscosity_pa_s(lub, th.inlet_temperature_c), rel=1e-9)
+    assert end.viscosity_pa_s < 0.7 * start.viscosity_pa_s
+    # expansion: the hotter balls and inner ring close the clearance
+    assert th.clearance_change_m < 0.0
+    assert th.network_time_s == pytest.approx(300.0, rel=0.01)
+
+
+def test_ambient_change_shifts_every_node_and_bad_measurements_are_refused(warmed):
+    twin, _, end = warmed
+    before = dict(end.thermal.temperatures_c)
+    twin.set_setpoint(oil_temperature_c=25.0)
+    after = twin.snapshot().thermal
+    assert after.ambient_c == 25.0
+    for k, v in before.items():
+        assert after.temperatures_c[k] == pytest.approx(v + 5.0, abs=1e-9)
+    with pytest.raises(ValueError, match="node"):
+        twin.measure_temperature("cage", 50.0)
+    with pytest.raises(ValueError, match="temperature_c"):
+        twin.measure_temperature("outer_ring", math.nan)
+    fixed = Twin("6208", options=ModelOptions(thermal="fixed"), warm=False)
+    with pytest.raises(ValueError, match="thermal"):
+        fixed.measure_temperature("outer_ring", 50.0)
+
+
+def test_measurement_is_assimilated_and_published(warmed):
+    twin, _, _ = warmed
+    pred = twin.snapshot().thermal.temperatures_c["outer_ring"]
+    twin.measure_temperature("outer_ring", pred + 0.5)
+    twin.advance(0.06)
+    th = twin.snapshot().thermal
+    assert th.measured_node == "outer_ring" and th.measured_c == pytest.approx(pred + 0.5)
+    assert th.residual_k is not None and th.residual_sigma_k is not None and th.residual_sigma_k > 0.0
+    assert not th.unexplained_heating
+    assert math.isfinite(th.dissipation_factor) and th.dissipation_factor_sigma > 0.0
+    # the snapshot stays valid JSON with the block (no NaN)
+    assert '"thermal"' in twin.snapshot().to_json()

@@ -1,0 +1,25 @@
+"""`bearing-twin thermal`: the steady state of one operating point (twin.thermal.steady)."""
+
+import json
+
+import pytest
+
+from service.cli import main
+
+
+def test_bad_ambient_names_the_field(capsys):
+    assert main(["thermal", "--speed", "1000", "--radial-load", "3000", "--ambient", "500"]) == 2
+    assert "ambient" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_json_steady_state_balances_its_heat(capsys):
+    assert main(["thermal", "--bearing", "6208", "--speed", "1000", "--radial-load", "3000", "--ambient", "20",
+                 "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)
+    assert r["converged"]
+    t = r["temperatures_c"]
+    assert t["balls"] > t["outer_ring"] > t["housing"] > 20.0
+    # the heat by source adds up to the total, friction torque x speed
+    assert sum(r["heat_w"].values()) == pytest.approx(r["heat_total_w"], rel=1e-9)
+    assert r["heat_total_w"] == pytest.approx(r["friction_torque_n_m"] * 1000.0, rel=1e-9)
