@@ -289,6 +289,10 @@ class BearingSpec(BaseModel):
     mounting: Mounting = Mounting()
     electrical: Electrical = Electrical()
     thermal: Thermal = Thermal()
+    limiting_speed_rad_s: float | None = Field(
+        default=None, gt=0.0, le=1e5,
+        description="Highest shaft speed the twin admits for this bearing [rad/s]; null: the n d_m rule of thumb of "
+        "oil-lubricated ball bearings, n d_m = 1.2e6 mm/min (twin.model).")
     lubrication: Lubrication = Field(
         default_factory=Lubrication,
         description="Lubrication method and seals (starvation, ball drag, seal friction); the default 'flooded' "

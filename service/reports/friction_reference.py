@@ -78,7 +78,8 @@ def iso15312_rows() -> list[dict]:
         load = ISO_LOAD_SHARE_OF_C0 * catalog.load_ratings(d).static_load_rating_n
         total, twin = studies.mean_friction_torque_n_m(
             speed, load, designation=d, shear_heating=True, lubrication=Lubrication(method="oil_bath"),
-            lubricant=catalog.lubricant("ISO VG 32"), oil_temperature_c=ISO_OUTER_RING_C)
+            lubricant=catalog.lubricant("ISO VG 32"), oil_temperature_c=ISO_OUTER_RING_C,
+            limiting_speed_rad_s=1.1 * speed)
         reference = ISO_HEAT_FLOW_DENSITY_W_MM2 * math.pi * width * (od + bore)
         rows.append({"bearing": d, "speed": speed, "load": load, "power": total * speed, "reference": reference,
                      "drag_w": twin.drag_power_w})
