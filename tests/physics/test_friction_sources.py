@@ -24,7 +24,7 @@ def test_sphere_drag_tends_to_stokes_law():
     # Stokes: C_D = 24 / Re as Re -> 0 (F = 3 pi eta D v)
     re = 1e-4
     assert drag.sphere_drag_coefficient(re) == pytest.approx(24.0 / re, rel=1e-3)
-    d, v, rho, eta = 1e-3, 1e-4, 870.0, 0.04
+    d, v, rho, eta = 1e-3, 1e-6, 870.0, 0.04
     assert drag.ball_drag_force_n(d, v, rho, eta) == pytest.approx(3.0 * math.pi * eta * d * v, rel=1e-3)
 
 
