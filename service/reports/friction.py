@@ -56,7 +56,7 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
         results[d] = {"speed": [_row(d, w, 3000.0, nu) for w in speeds],
                       "load": [_row(d, 500.0, f, nu) for f in loads]}
     centre = None
-    if not quick:  # the former centre-point friction on the 6208's load sweep, for the slope
+    if not quick:  # the centre-point friction (stribeck_line) on the 6208's load sweep, for the slope
         centre = [studies.mean_friction_torque_n_m(500.0, f, options=ModelOptions(friction_model="stribeck_line"))[0]
                   for f in loads]
     plt = pyplot()
@@ -78,7 +78,7 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
     png = "friction_torque_skf.png"
     save(fig, out_dir / png)
 
-    md = ["## Friction torque against the SKF model (issue 11)\n",
+    md = ["## Friction torque against the SKF model\n",
           "The twin's shaft torque with the traction integrated over strips of every contact ellipse (Heathcote and "
           "spin slip; seed 000 mu(Lambda) x seed 001 eq. A2 asperity share + Eyring / limiting-shear film) and seed "
           "001's rolling resistance, averaged over whole ball passages, against the SKF model for the frictional "
@@ -103,7 +103,7 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
         line = (f"{d}: d ln M / d ln F_r at 500 rad/s over {loads[0]:g}-{loads[-1]:g} N: twin {slope_twin:.2f}, "
                 f"SKF {slope_skf:.2f}")
         if d == "6208" and centre is not None:
-            line += f", the former centre-point friction {studies.log_slope(loads, centre):.2f}"
+            line += f", the centre-point friction {studies.log_slope(loads, centre):.2f}"
         md.append(line + ".\n")
     if not quick:
         md += ["### Oil bath with inlet heating and kinematic starvation against the SKF model\n",
