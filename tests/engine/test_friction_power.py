@@ -48,11 +48,12 @@ def test_friction_torque_is_not_negative_from_start_to_rest():
     for t_end, speed in ((0.15, 500.0), (0.25, 500.0), (0.4, 0.0)):
         twin.set_setpoint(shaft_speed_rad_s=speed)
         while twin.time_s < t_end - 1e-9:
-            twin.advance(1e-3)
             s = twin.state.scalars
-            rows.append((float(s[L.X_SHAFT_SPEED]), twin.snapshot().friction_torque_n_m,
+            before = float(s[L.X_SHAFT_SPEED])
+            twin.advance(1e-3)
+            rows.append((0.5 * (before + float(s[L.X_SHAFT_SPEED])), twin.snapshot().friction_torque_n_m,
                          s[L.X_TORQUE_SUM] / s[L.X_TORQUE_COUNT]))
-    speed, friction, drive = np.array(rows).T
+    speed, friction, drive = np.array(rows).T   # speed: the frame's mean shaft speed
     turning = speed > 0.0
     assert drive.min() < -0.02                      # the inertia the drive torque carries
     assert friction[turning].min() > 0.0
