@@ -55,9 +55,10 @@ def skf_markdown(rows: list[dict]) -> list[str]:
     md = ["| bearing | speed [rad/s] | Fr [N] | twin contacts [mN m] | SKF M_rr + M_sl [mN m] | twin / SKF | "
           "SKF phi_ish phi_rs | twin drag [mN m] |", "|---|---|---|---|---|---|---|---|"]
     for r in rows:
-        md.append(f"| {r['bearing']} | {r['speed']:g} | {r['load']:.0f} | {1e3 * r['twin']:.1f} | {1e3 * r['skf']:.1f} | "
-                  f"{r['twin'] / r['skf']:.2f} | {r['phi']:.2f} | {1e3 * r['drag']:.2f} |")
-    md += ["", "| bearing | speed [rad/s] | load slope twin | load slope SKF | twin / SKF range |", "|---|---|---|---|---|"]
+        md.append(f"| {r['bearing']} | {r['speed']:g} | {r['load']:.0f} | {1e3 * r['twin']:.1f} | "
+                  f"{1e3 * r['skf']:.1f} | {r['twin'] / r['skf']:.2f} | {r['phi']:.2f} | {1e3 * r['drag']:.2f} |")
+    md += ["", "| bearing | speed [rad/s] | load slope twin | load slope SKF | twin / SKF range |",
+           "|---|---|---|---|---|"]
     for d in sorted({r["bearing"] for r in rows}):
         for speed in SPEEDS_RAD_S:
             sel = [r for r in rows if r["bearing"] == d and r["speed"] == speed]
