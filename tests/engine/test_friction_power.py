@@ -57,9 +57,9 @@ def test_friction_torque_is_not_negative_from_start_to_rest():
     turning = speed > 0.0
     assert drive.min() < -0.02                      # the inertia the drive torque carries
     assert friction[turning].min() > 0.0
-    # at rest: the torque the tangential springs still hold, under 2 % of the running torque
+    # at rest: the torque the tangential springs still hold (elastic, not dissipative), within
+    # +-3 mN m, 2 % of the running torque
     assert np.abs(friction[~turning]).max() < 3e-3
-    assert friction[~turning].min() > -1e-3
     steady = (np.arange(len(speed)) >= 110) & (np.arange(len(speed)) < 250)
     assert friction[steady].mean() == pytest.approx(drive[steady].mean(), rel=0.01)
 
@@ -81,6 +81,9 @@ def test_oil_bath_starves_the_film_and_adds_drag_and_seal():
     assert h_bath / h_flooded == pytest.approx(phi, rel=0.02)
     fp = bath.friction_power_w()
     assert fp.seal_w == pytest.approx(bath._seal_moment_n_m * 1000.0, rel=1e-9)
-    assert fp.drag_w > 0.0 and np.count_nonzero(fp.drag_ball_w) < bath.model.ball_count  # only balls in the bath
+    # the balls in the bath churn oil, the others air (three orders of magnitude less)
+    in_oil = fp.drag_ball_w > 100.0 * fp.drag_ball_w.min()
+    assert 0 < np.count_nonzero(in_oil) < bath.model.ball_count
+    assert fp.drag_ball_w[in_oil].sum() > 0.9 * fp.drag_w
     added = bath.snapshot().friction_torque_n_m - bath.contact_friction_torque_n_m
     assert added == pytest.approx(bath.drag_power_w / 1000.0 + bath._seal_moment_n_m, rel=1e-9)
