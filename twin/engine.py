@@ -211,8 +211,9 @@ class Twin:
     def kinetic_energy_j(self) -> float:
         """Kinetic energy of the balls (translation and rotation) and the cage [J]."""
         s, p = self.state, self.model.params
-        v, w = s.ball_velocity_in_bearing_m_s, s.ball_angular_velocity_rad_s
-        return 0.5 * (p[L.P_BALL_MASS] * float(np.sum(v * v)) + p[L.P_BALL_INERTIA] * float(np.sum(w * w))
+        v = (s.ball_velocity_in_bearing_m_s if self.model.housing_on else s.ball_velocity_m_s).ravel()
+        w = s.ball_angular_velocity_rad_s.ravel()
+        return 0.5 * (p[L.P_BALL_MASS] * float(v @ v) + p[L.P_BALL_INERTIA] * float(w @ w)
                       + p[L.P_CAGE_INERTIA] * float(s.scalars[L.X_CAGE_SPEED]) ** 2)
 
     def mean_entrainment_speed_m_s(self) -> float:
@@ -344,9 +345,12 @@ class Twin:
         s = self.state
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
-        momentum_before = self.axial_angular_momentum_n_m_s()
         energy_before = self.kinetic_energy_j()
         speed_before = float(s.scalars[L.X_SHAFT_SPEED])
+        # the frame can end at rest (mean speed under REST_SPEED_RAD_S) only from near rest: only
+        # then does the friction torque need the angular momentum
+        near_rest = abs(speed_before) < REST_SPEED_RAD_S + self.model.options.speed_ramp_rad_s2 * n * self.model.dt_s
+        momentum_before = self.axial_angular_momentum_n_m_s() if near_rest else 0.0
         status, done = step_n(*self._kernel_args(), n)
         if done < n and status == L.STATUS_OK:    # interrupted (interrupt_frame): n - done not run
             self._since_coupling_s -= (n - done) * self.model.dt_s
@@ -358,7 +362,8 @@ class Twin:
             self._contact_torque_n_m = self._dissipative_torque_n_m(
                 s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT], done * self.model.dt_s,
                 0.5 * (speed_before + float(s.scalars[L.X_SHAFT_SPEED])),
-                self.kinetic_energy_j() - energy_before, self.axial_angular_momentum_n_m_s() - momentum_before)
+                self.kinetic_energy_j() - energy_before,
+                (self.axial_angular_momentum_n_m_s() - momentum_before) if near_rest else 0.0)
             self._last_torque_n_m = self._contact_torque_n_m + self._churning_and_seal_torque_n_m()
         if status != L.STATUS_OK:
             self._recover(status)
