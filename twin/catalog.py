@@ -50,12 +50,29 @@ _ISO_VG_NU100_MM2_S = {10: 2.6, 15: 3.3, 22: 4.2, 32: 5.4, 46: 6.8, 68: 8.7, 100
                        150: 14.5, 220: 18.8, 320: 24.0, 460: 30.5}
 
 
+# ISO 15312 thermal reference speed [r/min] of the SKF executions (SKF Rolling bearings catalogue,
+# PUB BU/P1 10000/2 EN, 2016, deep-groove ball bearing product tables, column 'Reference speed'):
+# the speed at which, under the standard's reference conditions (P = 0.05 C0, ISO VG 32 at an outer
+# ring of 70 degC over an ambient of 20 degC, oil bath to the centre of the lowest ball), the
+# bearing's friction power equals the reference heat flow 0.016 W/mm^2 over A_r = pi B (D + d).
+_THERMAL_REFERENCE_SPEED_RPM = {"6205": 28000.0, "6208": 22000.0, "6210": 20000.0}
+
+
+def thermal_reference_speed_rad_s(designation: str) -> float:
+    """ISO 15312 thermal reference speed of a catalog bearing [rad/s] (SKF product tables)."""
+    key = designation.strip().upper()
+    if key not in _THERMAL_REFERENCE_SPEED_RPM:
+        raise ValueError(f"designation = {designation!r}: a thermal reference speed is known for "
+                         f"{', '.join(sorted(_THERMAL_REFERENCE_SPEED_RPM))}")
+    return _THERMAL_REFERENCE_SPEED_RPM[key] * math.pi / 30.0
+
+
 def _seed_6208() -> Geometry:
     return Geometry(
         ball_radius_m=6.3e-3, ball_count=9, inner_raceway_radius_m=24.0e-3,
         outer_raceway_radius_m=36.6e-3, inner_groove_radius_m=6.552e-3,
         outer_groove_radius_m=6.552e-3, cage_element_radius_m=4.19e-3,
-        nominal_contact_angle_deg=0.0, cage_mass_kg=0.02)
+        nominal_contact_angle_deg=0.0, cage_mass_kg=0.02, bore_diameter_m=40e-3, outside_diameter_m=80e-3)
 
 
 # angular-contact executions of the 7208 with seed 004's geometry: designation -> contact angle
@@ -68,7 +85,8 @@ def _seed_7208(contact_angle_deg: float) -> Geometry:
     return Geometry(
         ball_radius_m=rb, ball_count=13, inner_raceway_radius_m=24.0e-3,
         outer_raceway_radius_m=36.6e-3, inner_groove_radius_m=groove, outer_groove_radius_m=groove,
-        cage_element_radius_m=1.01e-3, nominal_contact_angle_deg=contact_angle_deg, cage_mass_kg=0.025)
+        cage_element_radius_m=1.01e-3, nominal_contact_angle_deg=contact_angle_deg, cage_mass_kg=0.025,
+        bore_diameter_m=40e-3, outside_diameter_m=80e-3)
 
 
 def _deep_groove(bore_mm: float, od_mm: float, z: int, dw_mm: float) -> Geometry:
@@ -80,7 +98,7 @@ def _deep_groove(bore_mm: float, od_mm: float, z: int, dw_mm: float) -> Geometry
         outer_raceway_radius_m=pitch + rb, inner_groove_radius_m=0.52 * 2 * rb,
         outer_groove_radius_m=0.52 * 2 * rb,
         cage_element_radius_m=half_chord - rb - _POCKET_CLEARANCE_M,
-        cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3)
+        cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3, bore_diameter_m=bore_mm * 1e-3, outside_diameter_m=od_mm * 1e-3)
 
 
 def designations() -> list[str]:

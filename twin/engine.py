@@ -26,12 +26,15 @@ from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_tempera
                                   thermal_loading_parameter)
 from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.faults import Fault, FaultKind
+from twin.friction_power import (FrictionPower, ball_drag_power_w, contact_powers_w, mean_immersed_fraction,
+                                 oil_level_m, seal_moment_n_m, starvation_film_factor)
+from twin.physics import drag as drag_law
 from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
 from twin.electrical_network import bearing_network
 from twin.life.monitor import LifeMonitor
 from twin.life.settings import LifeSettings
 from twin.snapshot import BallState, ContactState, LifeState, Snapshot
-from twin.snapshot import ElectricalState, ThermalState
+from twin.snapshot import ElectricalState, FrictionPowerState, ThermalState
 from twin.spec import BearingSpec, ModelOptions
 from twin.state import MAX_DEFECTS, TwinState, make_state
 from twin.thermal.coupling import ThermalCoupling
@@ -44,6 +47,7 @@ from twin.warmstart import warm_start
 FRAME_S = 1e-3  # simulated time per compiled call [s] (1000 steps at dt = 1 us)
 RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
 MIN_FILM_THERMAL_FACTOR = 1e-4  # floor of the thermal film factor [-]
+REST_SPEED_RAD_S = 1.0  # below this mean shaft speed over a frame the shaft counts as at rest [rad/s]
 COUPLING_PERIOD_S = 0.01  # electro-thermal coupling refreshed every 10 ms of simulated time [s]
 
 
@@ -85,6 +89,11 @@ class Twin:
         self._last_restart_time_s = -math.inf
         self._last_good_time_s = 0.0
         self._last_torque_n_m = 0.0
+        self._contact_torque_n_m = 0.0   # friction torque of the contacts over the last frame [N m]
+        self._drag_power_w = 0.0          # orbit-mean drag power of the balls at the last coupling [W]
+        self._starvation_factor = 1.0     # film factor of the kinematic starvation [-]
+        self._seal_moment_n_m = seal_moment_n_m(spec)
+        self._immersed_fraction = mean_immersed_fraction(spec)
         self._defects: tuple = ()  # the active local defects (twin.vibration.defects)
         self._sensor = SensorReader(self.model) if self.model.housing_on else None
         self._frozen_vibration = None  # a frozen copy's last window (`frozen`); the live twin reads its sensor
@@ -225,8 +234,14 @@ class Twin:
             shear_factor = murch_wilson_thermal_factor(loading)
             shear_rise = equivalent_inlet_temperature_rise_k(shear_factor, eta_c, theta_c, beta_c)
         rise = current_rise + shear_rise
+        speed = float(self.state.scalars[L.X_SHAFT_SPEED]) if have_state else sp.shaft_speed_rad_s
+        lub = self.model.spec.lubricant
+        rho = density_kg_m3(lub.density_15c_kg_m3, sp.oil_temperature_c)
+        starved = starvation_film_factor(self.model.spec, speed, eta0 / rho)
+        self._starvation_factor = starved
+        self._drag_power_w = self._mean_drag_power_w(rho)
         # floored: below 1e-4 of the isothermal film there is no film to speak of
-        factor = max(MIN_FILM_THERMAL_FACTOR, current_factor * shear_factor)
+        factor = max(MIN_FILM_THERMAL_FACTOR, current_factor * shear_factor * starved)
         self._current_heating_k = current_rise
         self._shear_heating_k = shear_rise
         self._shear_film_factor = shear_factor
@@ -235,6 +250,33 @@ class Twin:
                                       if rise > 0.0 else eta0)
         speed_exponent = float(self.model.race_tribology[0, T_HMIN_EXP_EU])  # d ln h / d ln(eta u)
         self._setpoint_vector[L.S_VISCOSITY] = eta0 * factor ** (1.0 / speed_exponent)
+
+    def _mean_drag_power_w(self, oil_density_kg_m3: float) -> float:
+        """Drag power of the balls [W] at the cage speed, each ball with the orbit-mean share of its
+        frontal disc in the oil (twin.friction_power.mean_immersed_fraction); 0 'flooded'."""
+        if self._immersed_fraction <= 0.0 or not hasattr(self, "state"):
+            return 0.0
+        m = self.model
+        v = abs(float(self.state.scalars[L.X_CAGE_SPEED])) * m.pitch_radius_m
+        return m.ball_count * ball_drag_power_w(2.0 * m.ball_radius_m, v, self._immersed_fraction,
+                                                oil_density_kg_m3, self._oil_viscosity_pa_s)
+
+    def axial_angular_momentum_n_m_s(self) -> float:
+        """Angular momentum of the balls and the cage about the bearing axis [N m s]: the balls'
+        orbital m (x v_y - y v_x) and spin I omega_z, the cage's I_c omega_c."""
+        s, p = self.state, self.model.params
+        x, v = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s
+        orbital = p[L.P_BALL_MASS] * float(np.sum(x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]))
+        spin = p[L.P_BALL_INERTIA] * float(np.sum(s.ball_angular_velocity_rad_s[:, 2]))
+        return orbital + spin + p[L.P_CAGE_INERTIA] * float(s.scalars[L.X_CAGE_SPEED])
+
+    def kinetic_energy_j(self) -> float:
+        """Kinetic energy of the balls (translation and rotation) and the cage [J]."""
+        s, p = self.state, self.model.params
+        v = (s.ball_velocity_in_bearing_m_s if self.model.housing_on else s.ball_velocity_m_s).ravel()
+        w = s.ball_angular_velocity_rad_s.ravel()
+        return 0.5 * (p[L.P_BALL_MASS] * float(v @ v) + p[L.P_BALL_INERTIA] * float(w @ w)
+                      + p[L.P_CAGE_INERTIA] * float(s.scalars[L.X_CAGE_SPEED]) ** 2)
 
     def mean_entrainment_speed_m_s(self) -> float:
         """Mean entrainment speed of the loaded inner-race contacts (all inner contacts if none
@@ -365,6 +407,12 @@ class Twin:
         s = self.state
         s.scalars[L.X_TORQUE_SUM] = 0.0
         s.scalars[L.X_TORQUE_COUNT] = 0.0
+        energy_before = self.kinetic_energy_j()
+        speed_before = float(s.scalars[L.X_SHAFT_SPEED])
+        # the frame can end at rest (mean speed under REST_SPEED_RAD_S) only from near rest: only
+        # then does the friction torque need the angular momentum
+        near_rest = abs(speed_before) < REST_SPEED_RAD_S + self.model.options.speed_ramp_rad_s2 * n * self.model.dt_s
+        momentum_before = self.axial_angular_momentum_n_m_s() if near_rest else 0.0
         status, done = step_n(*self._kernel_args(), n)
         if done < n and status == L.STATUS_OK:    # interrupted (interrupt_frame): n - done not run
             self._since_coupling_s -= (n - done) * self.model.dt_s
@@ -372,8 +420,13 @@ class Twin:
             self._sensor.after_frame(s, done, float(s.scalars[L.X_SHAFT_SPEED]))
             if status != L.STATUS_OK:
                 self._sensor.flush(s)
-        if s.scalars[L.X_TORQUE_COUNT] > 0:
-            self._last_torque_n_m = s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT]
+        if s.scalars[L.X_TORQUE_COUNT] > 0 and status == L.STATUS_OK:
+            self._contact_torque_n_m = self._dissipative_torque_n_m(
+                s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT], done * self.model.dt_s,
+                0.5 * (speed_before + float(s.scalars[L.X_SHAFT_SPEED])),
+                self.kinetic_energy_j() - energy_before,
+                (self.axial_angular_momentum_n_m_s() - momentum_before) if near_rest else 0.0)
+            self._last_torque_n_m = self._contact_torque_n_m + self._churning_and_seal_torque_n_m()
         if status != L.STATUS_OK:
             self._recover(status)
         else:
@@ -385,6 +438,68 @@ class Twin:
                     self._thermal_step()
             self._update_life()
         return done
+
+    @property
+    def contact_friction_torque_n_m(self) -> float:
+        """Friction torque of the ball-raceway contacts over the last frame [N m]: the
+        snapshot's friction_torque_n_m without the balls' drag and the seals."""
+        return float(self._contact_torque_n_m)
+
+    @property
+    def drag_power_w(self) -> float:
+        """Drag power of the balls at the last coupling refresh, each ball with the orbit-mean
+        share of its frontal disc in the oil [W] (the snapshot's torque carries it as power / omega)."""
+        return float(self._drag_power_w)
+
+    @staticmethod
+    def _dissipative_torque_n_m(drive_n_m: float, duration_s: float, mean_speed_rad_s: float,
+                                kinetic_energy_change_j: float, momentum_change_n_m_s: float) -> float:
+        """The friction torque of a frame [N m]: the shaft's mean drive torque less the torque that
+        speeds the balls and the cage up (or that they give back as they slow down), which is
+        inertia, not friction. Turning, the shaft's power drive * omega splits into the friction's
+        dissipation and the rate of change of the balls' and cage's kinetic energy E, so
+        M_f = drive - dE/dt / omega. With the shaft at rest (|omega| < REST_SPEED_RAD_S) the shaft
+        does no work and the torque is the one the outer ring holds: drive less the rate of change
+        of the balls' and cage's angular momentum about the axis."""
+        if abs(mean_speed_rad_s) >= REST_SPEED_RAD_S:
+            return drive_n_m - kinetic_energy_change_j / (duration_s * mean_speed_rad_s)
+        return drive_n_m - momentum_change_n_m_s / duration_s
+
+    def _churning_and_seal_torque_n_m(self) -> float:
+        """Shaft torque of the ball drag and the seals [N m]: the drag power over the shaft speed
+        (the shaft supplies it through the balls) and the seals' moment while the shaft turns."""
+        speed = abs(float(self.state.scalars[L.X_SHAFT_SPEED]))
+        if speed <= 0.0:
+            return 0.0
+        return self._drag_power_w / speed + self._seal_moment_n_m
+
+    def friction_power_w(self) -> FrictionPower:
+        """Friction power of the current instant by source and by contact [W]
+        (twin.friction_power): the contacts' rolling, sliding and spin power from the last step's
+        lanes, each ball's drag at its own depth in the oil bath (or in the cavity's oil-air
+        mixture) and the seals' moment times the shaft speed."""
+        s, m = self.state, self.model
+        rolling, sliding, spin = contact_powers_w(s.contacts, s.ball_angular_velocity_rad_s, m.ball_radius_m)
+        lub = m.spec.lubricant
+        rho = density_kg_m3(lub.density_15c_kg_m3, self._setpoint.oil_temperature_c)
+        x, v = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s
+        orbit_speed = np.hypot(v[:, 0], v[:, 1])
+        drag_w = np.zeros(m.ball_count)
+        if m.spec.lubrication.method != "flooded":
+            from_bottom = np.arctan2(x[:, 1], x[:, 0])  # the bath's bottom lies on the load line (+x)
+            for j in range(m.ball_count):
+                if m.spec.lubrication.method == "oil_bath":
+                    depth = drag_law.ball_depth_in_bath_m(oil_level_m(m.spec), float(from_bottom[j]),
+                                                          m.pitch_radius_m)
+                    share = drag_law.immersed_area_fraction(depth, 2.0 * m.ball_radius_m)
+                else:
+                    share = self._immersed_fraction
+                drag_w[j] = ball_drag_power_w(2.0 * m.ball_radius_m, float(orbit_speed[j]), share, rho,
+                                              self._oil_viscosity_pa_s)
+        seal_w = self._seal_moment_n_m * abs(float(s.scalars[L.X_SHAFT_SPEED]))
+        return FrictionPower(rolling_w=float(rolling.sum()), sliding_w=float(sliding.sum()), spin_w=float(spin.sum()),
+                             drag_w=float(drag_w.sum()), seal_w=seal_w, rolling_contact_w=rolling,
+                             sliding_contact_w=sliding, spin_contact_w=spin, drag_ball_w=drag_w)
 
     def _recover(self, status: int) -> None:
         """A kernel reported a diverged or overloaded state: restart from the warm start at the
@@ -600,6 +715,7 @@ class Twin:
             cage_speed_rad_s=float(s.scalars[L.X_CAGE_SPEED]),
             inner_ring_displacement_m=tuple(float(a) for a in s.inner_ring_offset_m),
             friction_torque_n_m=float(self._last_torque_n_m),
+            friction_power_w=FrictionPowerState(**self.friction_power_w().by_source_w()),
             viscosity_pa_s=float(self._inlet_viscosity_pa_s),
             electrical=ElectricalState(
                 resistance_ohm=_finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,

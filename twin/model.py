@@ -324,6 +324,8 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     max_axial = q_limit * z * max(math.sin(alpha), 0.2)
     # limiting speed by the n dm rule of thumb (1.2e6 mm/min for oil-lubricated ball bearings)
     max_speed = 1.2e6 / (2.0 * pitch * 1e3) * 2.0 * math.pi / 60.0
+    if spec.limiting_speed_rad_s is not None:  # the bearing's own limiting speed, where the spec gives it
+        max_speed = spec.limiting_speed_rad_s
     tribology = np.stack([
         tribology_coefficients(race[r, L.R_RX], race[r, L.R_RY], race[r, L.R_K_ELLIPTICITY], e_prime,
                                p[L.P_G_PARAM], rb, race[r, L.R_SEMI_MAJOR_COEF],

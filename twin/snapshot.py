@@ -219,6 +219,18 @@ class ThermalState(BaseModel):
                                       "the friction and the dissipation cannot explain (lubricant loss, overload, a failing bearing).")
 
 
+class FrictionPowerState(BaseModel):
+    """Friction power of the bearing by source at the snapshot's instant [W]
+    (twin.friction_power; Twin.friction_power_w() gives it contact by contact)."""
+
+    model_config = _FROZEN
+    rolling: float = Field(description="Rolling resistance of the ball-raceway contacts, F_R u (seed 001) [W].")
+    sliding: float = Field(description="Traction against the slip of the contacts (centre and differential slip) [W].")
+    spin: float = Field(description="Traction moment about the contact normals against the spin rate [W].")
+    drag: float = Field(description="Drag of the balls in the oil (Harris and Kotzalas; twin.physics.drag) [W].")
+    seal: float = Field(description="Rubbing seals, M_seal omega (SKF model; twin.physics.seals) [W].")
+
+
 class Snapshot(BaseModel):
     """Everything the world may see of one twin at one instant."""
 
@@ -237,7 +249,12 @@ class Snapshot(BaseModel):
     shaft_speed_rad_s: float = Field(description="Current (ramped) shaft speed [rad/s].")
     cage_speed_rad_s: float = Field(description="Cage angular speed [rad/s].")
     inner_ring_displacement_m: tuple[float, float, float] = Field(description="Inner ring centre relative to the outer ring's (x along the radial load, y, z axial) [m].")
-    friction_torque_n_m: float = Field(description="Torque the shaft supplies to the bearing, averaged over the last frame [N m].")
+    friction_torque_n_m: float = Field(
+        description="Friction torque of the bearing averaged over the last frame [N m]: the torque its outer ring holds "
+        "(the shaft's drive torque less the rate of change of the balls' and cage's angular momentum) plus the balls' "
+        "drag and the seals.")
+    friction_power_w: FrictionPowerState | None = Field(
+        default=None, description="Friction power by source at time_s [W] (rolling, sliding, spin, drag, seal).")
     viscosity_pa_s: float = Field(description="Inlet viscosity: the oil at the oil temperature plus the inlet's current and shear heating (Roelands, seed 003 eq. 3) [Pa s].")
     electrical: ElectricalState
     balls: tuple[BallState, ...]

@@ -53,6 +53,18 @@ class Geometry(BaseModel):
         description="Depth of the groove below the ring's land (shoulder height) [m], for the capacitance of the gap "
         "around the contacts; null: 0.18 ball diameters, a typical deep-groove proportion (an assumption: between "
         "0.15 and 0.22 the contact capacitance moves by under 3 %, tests/physics/test_electrical.py).")
+    bore_diameter_m: float | None = Field(
+        default=None, gt=0.0, le=2.0,
+        description="Bore d [m] (ISO 15 boundary dimension), for the kinematic starvation and the seals; null: "
+        "the pitch diameter minus 1.6 ball diameters (twin.friction_power.boundary_dimensions_m).")
+    outside_diameter_m: float | None = Field(
+        default=None, gt=0.0, le=2.5,
+        description="Outside diameter D [m] (ISO 15 boundary dimension); null: the pitch diameter plus 1.6 ball "
+        "diameters.")
+    seal_counterface_diameter_m: float | None = Field(
+        default=None, gt=0.0, le=2.0,
+        description="Diameter d_s of the seals' counterface on the inner ring [m] (d1 of the product tables), for "
+        "the seal friction; null: d + 0.32 (D - d), the inner-ring shoulder of the 62 series.")
 
     @model_validator(mode="after")
     def _fits(self) -> "Geometry":
@@ -222,6 +234,35 @@ class Thermal(BaseModel):
         "28 cells of seed 003 Appendix 2, rms 13 % in ln h, max error 6.4 points of reduction).")
 
 
+class Lubrication(BaseModel):
+    """How the oil reaches the bearing, and its seals: sets the kinematic starvation of the
+    contacts (twin.physics.starvation), the drag of the balls in the oil (twin.physics.drag) and
+    the seal friction (twin.physics.seals). 'flooded' (the default) is seed 000's idealisation:
+    fully flooded contacts and no churning."""
+
+    model_config = _FROZEN
+
+    method: Literal["flooded", "oil_bath", "jet", "oil_air"] = Field(
+        default="flooded",
+        description="'flooded': fully flooded contacts, no drag (seed 000); 'oil_bath': a sump at oil_level_m; "
+        "'jet': an oil jet of jet_flow_m3_s at jet_inlet_temperature_c; 'oil_air': oil-air (minimal oil).")
+    oil_level_m: float | None = Field(
+        default=None, ge=0.0, le=1.0,
+        description="oil_bath: height of the oil surface above the bottom of the outer raceway [m]; null: one ball "
+        "radius, to the centre of the lowest ball (the usual recommendation for an oil bath).")
+    jet_flow_m3_s: float = Field(
+        default=1e-6, gt=0.0, le=1e-2, description="jet: oil flow through the bearing [m^3/s] (1e-6 = 60 ml/min).")
+    jet_inlet_temperature_c: float = Field(
+        default=40.0, ge=-40.0, le=200.0, description="jet: oil temperature at the jet [degC].")
+    cavity_oil_volume_fraction: float = Field(
+        default=0.05, gt=0.0, le=1.0,
+        description="jet and oil_air: volume share of oil in the oil-air mixture the balls churn in the cavity [-] "
+        "(Harris and Kotzalas, vol. 2 ch. 3: a few percent under jet lubrication); the mixture's density sets the "
+        "ball drag. An input: it depends on the flow and the scavenging of the housing.")
+    seal: Literal["open", "2Z", "2RS"] = Field(
+        default="open", description="Seal execution: 'open', '2Z' (shields, no contact), '2RS' (rubbing seals).")
+
+
 class Mounting(BaseModel):
     """How the bearing is mounted."""
 
@@ -249,6 +290,14 @@ class BearingSpec(BaseModel):
     mounting: Mounting = Mounting()
     electrical: Electrical = Electrical()
     thermal: Thermal = Thermal()
+    limiting_speed_rad_s: float | None = Field(
+        default=None, gt=0.0, le=1e5,
+        description="Highest shaft speed the twin admits for this bearing [rad/s]; null: the n d_m rule of thumb of "
+        "oil-lubricated ball bearings, n d_m = 1.2e6 mm/min (twin.model).")
+    lubrication: Lubrication = Field(
+        default_factory=Lubrication,
+        description="Lubrication method and seals (starvation, ball drag, seal friction); the default 'flooded' "
+        "keeps seed 000's fully flooded contacts without churning.")
     housing: Housing = Field(
         default_factory=Housing,
         description="Outer ring + housing support and the accelerometer (twin.vibration.housing; Sawalhi & "

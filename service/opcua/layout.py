@@ -204,7 +204,7 @@ FOLDERS: dict[str, tuple[Var, ...]] = {
             "without the snapshot's life block.", _life("kappa")),
     ),
     "Friction": (
-        Var("friction_torque_n_m", "Double", "Torque the shaft supplies to the bearing [N m].", _snap("friction_torque_n_m")),
+        Var("friction_torque_n_m", "Double", "Friction torque of the bearing [N m].", _snap("friction_torque_n_m")),
         Var("max_friction_coefficient", "Double", "Largest sliding friction coefficient over the contacts [-].",
             lambda v: _max(c.mu for c in _contacts(v))),
         Var("max_slide_roll_ratio", "Double", "Largest |sliding / entrainment speed| over the contacts [-].",

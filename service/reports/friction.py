@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from service.reports.figures import pyplot, save
+from service.reports.friction_reference import iso15312_markdown, iso15312_rows, skf_markdown, skf_rows
 from twin import catalog
 from twin.validation import skf_friction
 from twin.validation import studies
@@ -104,7 +105,15 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
         if d == "6208" and centre is not None:
             line += f", the centre-point friction {studies.log_slope(loads, centre):.2f}"
         md.append(line + ".\n")
-    md.append("At high speed the twin's torque exceeds the SKF model's: its rolling resistance (seed 001) is fully "
-              "flooded (no kinematic starvation, SKF's phi_rs) and grows with (eta u)^(2/3..3/4); with inlet heating "
-              "the Murch-Wilson factor brings it down through the film viscosity.\n")
+    if not quick:
+        md += ["### Oil bath with inlet heating and kinematic starvation against the SKF model\n",
+               "The twin's contact friction (`Twin.contact_friction_torque_n_m`, oil bath to the centre of the lowest "
+               "ball, Murch-Wilson inlet heating, kinematic starvation) against M_rr + M_sl with phi_ish phi_rs, "
+               "0.02-0.2 C0 (`python -m service.reports.friction_reference`); the twin's ball drag beside it.\n",
+               *skf_markdown(skf_rows()), "", "### ISO 15312 thermal reference speed\n", *iso15312_markdown(iso15312_rows()),
+               ""]
+    md.append("Flooded and isothermal (the upper tables), the twin's torque exceeds the SKF model's at high speed: "
+              "its rolling resistance (seed 001) grows with (eta u)^(2/3..3/4). Lubrication.method = 'oil_bath' "
+              "starves the film (twin.physics.starvation) and Thermal.shear_heating heats the inlet (Murch-Wilson), "
+              "which bring it down (the oil-bath table).\n")
     return md

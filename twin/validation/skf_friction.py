@@ -22,8 +22,10 @@ S1 = 3.23e-3, S2 = 36.5; series 60: R1 = 4.1e-7, R2 = 1.7, S1 = 3.73e-3, S2 = 14
 R1 = 3.7e-7, R2 = 1.7, S1 = 2.84e-3, S2 = 92.8. K_z = 3.1 for deep-groove ball bearings;
 K_rs = 3e-8 for oil jet / low-level oil bath, 6e-8 for grease and oil-air.
 
-The twin models an open bearing without oil bath: M_seal = 0 and M_drag = 0 here. This module
-knows nothing of the twin's engine; it takes the designation's boundary dimensions.
+M_seal = 0 and M_drag = 0 here: the comparison takes the twin's contact friction
+(Twin.contact_friction_torque_n_m) against M_rr + M_sl; the twin's drag and seal laws are its own
+(twin.physics.drag, twin.physics.seals). This module knows nothing of the twin's engine; it takes
+the designation's boundary dimensions.
 """
 
 from __future__ import annotations

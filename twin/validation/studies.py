@@ -15,7 +15,7 @@ from twin import catalog
 from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.setpoint import Setpoint
-from twin.spec import BearingSpec, ModelOptions, Thermal
+from twin.spec import BearingSpec, Lubricant, Lubrication, ModelOptions, Thermal
 
 SETTLE_S = 0.005
 
@@ -165,13 +165,18 @@ TORQUE_BALL_PASSAGES = 3
 def mean_friction_torque_n_m(shaft_speed_rad_s: float, radial_load_n: float, *, designation: str = "6208",
                              axial_load_n: float = 0.0, shear_heating: bool = False, oil_temperature_c: float = 40.0,
                              options: ModelOptions | None = None, settle_s: float = TORQUE_SETTLE_S,
-                             passages: int = TORQUE_BALL_PASSAGES) -> tuple[float, Twin]:
+                             passages: int = TORQUE_BALL_PASSAGES, lubrication: Lubrication | None = None,
+                             lubricant: Lubricant | None = None,
+                             limiting_speed_rad_s: float | None = None) -> tuple[float, Twin]:
     """Shaft torque [N m] averaged over whole ball passages (`passages` ball pitches of the cage,
     at least 10 ms) after `settle_s` from the warm start, and the twin. `shear_heating` turns the
-    Murch-Wilson inlet heating on (Thermal.shear_heating)."""
-    base = catalog.bearing(designation)
+    Murch-Wilson inlet heating on (Thermal.shear_heating); `lubrication` (default: flooded) and
+    `lubricant` (default: the seed oil) and `limiting_speed_rad_s` as in BearingSpec."""
+    base = catalog.bearing(designation, lubricant=lubricant)
     spec = BearingSpec.model_validate({**base.model_dump(),
-                                       "thermal": Thermal(shear_heating=shear_heating).model_dump()})
+                                       "thermal": Thermal(shear_heating=shear_heating).model_dump(),
+                                       "lubrication": (lubrication or Lubrication()).model_dump(),
+                                       "limiting_speed_rad_s": limiting_speed_rad_s})
     twin = Twin(spec, options=options, setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s,
                                                          radial_load_n=radial_load_n, axial_load_n=axial_load_n,
                                                          oil_temperature_c=oil_temperature_c))

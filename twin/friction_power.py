@@ -1,0 +1,162 @@
+"""The bearing's friction power by source and by contact [W]: the heat the friction puts into
+the bearing, where it arises (the heat sources of a thermal network).
+
+Sources:
+- rolling: the rolling resistance of every ball-raceway contact (seed 001 eqs. 1-5, 9: the
+  inlet's hydrodynamic force and the hysteresis) against the ball centre's velocity over the
+  raceway, P = -F_R . (v_ball - v_ring(q)) (about F_R u);
+- sliding: the tangential traction against the slip of the contact centre, P = -F_t . s (F_t the
+  friction force on the ball, s the ball's slip velocity over the raceway), plus the moment of
+  the traction across the ellipse (differential slip) against the ball's rotation relative to the
+  ring;
+- spin: the traction's moment about the contact normal against the relative spin rate,
+  P = |M_n omega_spin| (twin.kernels.traction);
+- drag: the balls churning the oil of the cavity (twin.physics.drag), P = F_D v per ball;
+- seal: the rubbing seals (twin.physics.seals), P = M_seal |omega_shaft|.
+
+The contact powers are read from the contact lanes of the last step (instantaneous); in steady
+running their sum equals the contacts' friction torque times the shaft speed (the energy balance,
+tests/engine/test_friction_power.py). The spin power is the ellipse traction's
+(ModelOptions.friction_model = 'ellipse_traction'); the centre-point laws put none here.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from twin.kernels import layout as L
+from twin.physics import drag, seals, starvation
+from twin.spec import BearingSpec, Geometry
+
+ORBIT_SAMPLES = 720  # azimuths of the orbit-mean immersed fraction of an oil bath
+
+
+@dataclass(frozen=True)
+class FrictionPower:
+    """Friction power of one instant by source [W]; per-contact arrays have shape (Z, 2), column 0
+    the inner, 1 the outer raceway contact of each ball; drag per ball (Z,)."""
+
+    rolling_w: float
+    sliding_w: float
+    spin_w: float
+    drag_w: float
+    seal_w: float
+    rolling_contact_w: np.ndarray
+    sliding_contact_w: np.ndarray
+    spin_contact_w: np.ndarray
+    drag_ball_w: np.ndarray
+
+    @property
+    def total_w(self) -> float:
+        """Sum of every source [W]."""
+        return self.rolling_w + self.sliding_w + self.spin_w + self.drag_w + self.seal_w
+
+    def by_source_w(self) -> dict[str, float]:
+        """{'rolling', 'sliding', 'spin', 'drag', 'seal'} -> power [W]."""
+        return {"rolling": self.rolling_w, "sliding": self.sliding_w, "spin": self.spin_w,
+                "drag": self.drag_w, "seal": self.seal_w}
+
+
+def boundary_dimensions_m(geometry: Geometry) -> tuple[float, float]:
+    """(bore d, outside diameter D) [m] from the spec, or, where it gives none, the pitch diameter
+    -+ 1.6 ball diameters (the 62 series' proportion: 6208 40.4 / 80.8 mm against 40 / 80)."""
+    pitch_d = geometry.inner_raceway_radius_m + geometry.outer_raceway_radius_m
+    ball_d = 2.0 * geometry.ball_radius_m
+    d = geometry.bore_diameter_m if geometry.bore_diameter_m is not None else pitch_d - 1.6 * ball_d
+    big_d = geometry.outside_diameter_m if geometry.outside_diameter_m is not None else pitch_d + 1.6 * ball_d
+    return d, big_d
+
+
+def starvation_film_factor(spec: BearingSpec, shaft_speed_rad_s: float, kinematic_viscosity_m2_s: float) -> float:
+    """Film reduction of kinematic starvation (twin.physics.starvation) for the spec's
+    lubrication method [-]; 1 for 'flooded'."""
+    method = spec.lubrication.method
+    if method == "flooded":
+        return 1.0
+    d, big_d = boundary_dimensions_m(spec.geometry)
+    return starvation.kinematic_replenishment_factor(shaft_speed_rad_s, kinematic_viscosity_m2_s, d, big_d,
+                                                     starvation.K_RS[method], starvation.K_Z[spec.kind])
+
+
+def seal_moment_n_m(spec: BearingSpec) -> float:
+    """Frictional moment of the spec's seals [N m] (twin.physics.seals)."""
+    g = spec.geometry
+    d, big_d = boundary_dimensions_m(g)
+    d_s = g.seal_counterface_diameter_m if g.seal_counterface_diameter_m is not None else d + 0.32 * (big_d - d)
+    return seals.seal_moment_n_m(spec.lubrication.seal, d_s, big_d)
+
+
+def oil_level_m(spec: BearingSpec) -> float:
+    """Oil bath level above the bottom of the outer raceway [m] (default: one ball radius)."""
+    lub = spec.lubrication
+    return lub.oil_level_m if lub.oil_level_m is not None else spec.geometry.ball_radius_m
+
+
+def mean_immersed_fraction(spec: BearingSpec) -> float:
+    """Orbit mean of the share of a ball's frontal disc in the oil [-]: the oil bath's immersed
+    fraction (twin.physics.drag) averaged over ORBIT_SAMPLES azimuths; the oil-air mixture's oil
+    volume share for 'jet' and 'oil_air'; 0 for 'flooded' (no churning modelled)."""
+    lub = spec.lubrication
+    if lub.method == "flooded":
+        return 0.0
+    if lub.method != "oil_bath":
+        return lub.cavity_oil_volume_fraction
+    g = spec.geometry
+    pitch = 0.5 * (g.inner_raceway_radius_m + g.outer_raceway_radius_m)
+    level = oil_level_m(spec)
+    az = (np.arange(ORBIT_SAMPLES) + 0.5) * (2.0 * math.pi / ORBIT_SAMPLES)
+    return float(np.mean([drag.immersed_area_fraction(drag.ball_depth_in_bath_m(level, a, pitch), 2.0 * g.ball_radius_m)
+                          for a in az]))
+
+
+def ball_drag_power_w(ball_diameter_m: float, orbital_speed_m_s: float, oil_fraction: float,
+                      oil_density_kg_m3: float, oil_viscosity_pa_s: float) -> float:
+    """Drag power of one ball [W]: the share `oil_fraction` of its frontal disc in oil, the rest in
+    air (twin.physics.drag), times its orbital speed."""
+    v = abs(orbital_speed_m_s)
+    f_oil = drag.ball_drag_force_n(ball_diameter_m, v, oil_density_kg_m3, oil_viscosity_pa_s)
+    f_air = drag.ball_drag_force_n(ball_diameter_m, v, drag.AIR_DENSITY_KG_M3, drag.AIR_VISCOSITY_PA_S)
+    return (oil_fraction * f_oil + (1.0 - oil_fraction) * f_air) * v
+
+
+def contact_powers_w(contacts: np.ndarray, ball_angular_velocity_rad_s: np.ndarray,
+                     ball_radius_m: float) -> tuple[np.ndarray, ...]:
+    """(rolling, sliding, spin) power of every ball-raceway contact [W], each (Z, 2), from the
+    contact lanes (N_ROWS, 2Z) of the last step, the balls' angular velocities (Z, 3) and radius.
+
+    The work the DEM's forces do: the rolling force (applied at the ball's centre along the
+    entrainment, twin.kernels.contacts) against the ball centre's velocity over the raceway's
+    contact point; the tangential friction force against the slip of the contact point; the
+    traction's moment across the ellipse (differential slip, E_M2*) against the ball's rotation
+    relative to the ring; the moment about the normal against the relative spin rate. Their sum
+    over the contacts is the shaft's power in steady running. Each is floored at 0 per contact
+    (the tangential springs store and give back a little energy from step to step)."""
+    c = contacts
+    loaded = c[L.G_DELTA] > 0.0
+    n = c[[L.G_NX, L.G_NY, L.G_NZ]]
+    e = c[[L.O_EX, L.O_EY, L.O_EZ]]
+    roll_force = c[L.C_ROLLING_PER_SPEED] * e            # on the ball [N]
+    spin = c[L.K_SPIN]
+    q = c[[L.K_PX, L.K_PY, L.K_PZ]] + ball_radius_m * n   # contact point relative to the ring centre
+    ring_velocity = c[[L.K_OVX, L.K_OVY, L.K_OVZ]].copy()
+    ring_velocity[0] -= spin * q[1]
+    ring_velocity[1] += spin * q[0]
+    centre_over_ring = c[[L.K_VX, L.K_VY, L.K_VZ]] - ring_velocity
+    rolling = -np.sum(roll_force * centre_over_ring, axis=0)
+    f = c[[L.O_FX, L.O_FY, L.O_FZ]]
+    f_t = f - np.sum(f * n, axis=0) * n - roll_force     # the friction force on the ball, tangential
+    slip = c[[L.O_SX, L.O_SY, L.O_SZ]]
+    w_rel = np.repeat(ball_angular_velocity_rad_s.T, 2, axis=1)   # (3, 2Z)
+    w_rel[2] -= spin
+    m2 = c[[L.E_M2X, L.E_M2Y, L.E_M2Z]]
+    sliding = -np.sum(f_t * slip, axis=0) - np.sum(m2 * w_rel, axis=0)
+    spin_w = np.abs(c[L.E_SPIN_MOMENT] * c[L.E_SPIN_RATE])
+    z = contacts.shape[1] // 2
+
+    def per_contact(p):
+        return np.where(loaded, np.maximum(p, 0.0), 0.0).reshape(z, 2)
+
+    return per_contact(rolling), per_contact(sliding), per_contact(spin_w)
