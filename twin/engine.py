@@ -39,6 +39,7 @@ from twin.spec import BearingSpec, ModelOptions
 from twin.state import MAX_DEFECTS, TwinState, make_state
 from twin.thermal.coupling import ThermalCoupling
 from twin.thermal.expansion import write_groove_lanes
+from twin.thermal.sources import HeatSources, friction_heat
 from twin.vibration.defects import BallDefect, defect_row, validate_defects
 from twin.vibration.housing import housing_equilibrium
 from twin.vibration.sensor import SensorReader, WaveformBlock
@@ -188,7 +189,15 @@ class Twin:
         viscosity and the expansion of the rings and balls (written into the contacts' groove lanes)."""
         s, th = self.state, self.thermal
         spin = float(np.mean(np.linalg.norm(s.ball_angular_velocity_rad_s, axis=1)))
-        th.step(s.contacts, s.scalars, th.take_mean_power_w(), spin, self._effective_mu, self.time_s)
+        # the drive power is the contacts' friction plus the balls' drag and the seals' rubbing:
+        # the contacts' share is split over the contacts by their lanes, drag heats the oil and
+        # the seals the outer ring (twin.thermal.sources.HeatSources.node_heat_w)
+        drag_w = max(float(self._drag_power_w), 0.0)
+        seal_w = max(self._seal_moment_n_m * abs(float(s.scalars[L.X_SHAFT_SPEED])), 0.0)
+        contacts_w = max(th.take_mean_power_w() - drag_w - seal_w, 0.0)
+        heat = friction_heat(s.contacts, self.model.ball_count, contacts_w, self._effective_mu)
+        heat = HeatSources(per_contact_w=heat.per_contact_w, drag_w=drag_w, seal_w=seal_w)
+        th.step(s.contacts, s.scalars, contacts_w, spin, self._effective_mu, self.time_s, heat=heat)
         write_groove_lanes(s.contacts, self._groove_lanes, th.expansion, self.model.ball_count)
         self._refresh_oil_viscosity()
 
