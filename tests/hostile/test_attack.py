@@ -7,7 +7,7 @@ from __future__ import annotations
 
 import pytest
 
-from service.tools.attack import AttackConfig, check_loopback, format_report, run_attack
+from loadtest.attack import AttackConfig, check_loopback, format_report, run_attack
 
 
 def test_attack_short_run_with_its_own_service():

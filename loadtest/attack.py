@@ -368,7 +368,7 @@ def run_attack(cfg: AttackConfig) -> dict:
     try:
         zuser = zpass = None
         if cfg.start:
-            from service.tools.soak import _Started
+            from loadtest.soak import _Started
 
             started = _Started(token, None, lambda line: log(line.replace("soak: ", "attack: ", 1)),
                                record=cfg.record)
@@ -381,7 +381,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         if info.status_code != 200:
             raise RuntimeError(f"GET /v1/bearings/{cfg.bearing_id}: {info.status_code} {info.text[:300]}")
         limits = info.json()["limits"]
-        from service.tools.soak import _SAFE
+        from loadtest.soak import _SAFE
 
         ranges = {n: (max(lo, limits[n][0]), min(hi, limits[n][1])) for n, (lo, hi) in _SAFE.items() if n in limits}
         t_ref = time.monotonic()
