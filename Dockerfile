@@ -1,7 +1,7 @@
 # bearing-twin service image: `docker build -t bearing-twin .` then
 #   docker run --rm -p 8000:8000 -p 7447:7447 -v "$PWD/recordings:/home/twin/recordings" bearing-twin
 # The package is installed with README's command (`pip install -c constraints.txt .`, into a venv):
-# the tested versions, no load tools; the numba kernels
+# the tested versions, without the load tools' httpx; the numba kernels
 # are compiled at build time into a cache the runtime user owns, so the first twin starts at once.
 FROM python:3.11-slim
 

@@ -317,7 +317,7 @@ def _probe(client, url: str, bid: str, seconds: float, every_s: float, t_ref: fl
             tw = next((x for x in r.json().get("twins", []) if x.get("id") == bid), None)
             if tw is not None:
                 rec["rtf"], rec["late"] = tw.get("real_time_factor"), tw.get("late_fraction")
-        except Exception:   # noqa: BLE001, S110 - a failed probe is counted (ok False)
+        except Exception:   # noqa: BLE001 - a failed probe is counted (ok False)
             pass
         out.append(rec)
         time.sleep(max(0.0, every_s - (time.monotonic() - t)))
@@ -415,7 +415,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         while len(parts) < len(specs) and time.monotonic() < deadline:
             try:
                 part = out.get(timeout=1.0)
-            except Exception:   # noqa: BLE001, S112 - queue.Empty
+            except Exception:   # noqa: BLE001 - queue.Empty
                 continue
             parts[part.get("mode", "?")] = part
         settled = [p for p in during if p["t"] >= flood_start - t_ref + 1.0] or during

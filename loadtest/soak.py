@@ -103,7 +103,7 @@ def _rss_bytes(pid: int) -> tuple[int | None, str]:
         return int(psutil.Process(pid).memory_info().rss), "psutil"
     except ImportError:
         pass
-    except Exception:
+    except Exception:  # noqa: BLE001
         return None, "psutil"
     try:
         with open(f"/proc/{pid}/status", encoding="ascii") as f:
@@ -158,7 +158,7 @@ class _Started:
             try:
                 if client.get(f"{self.url}/health", timeout=2.0).status_code == 200:
                     return
-            except Exception:
+            except Exception:  # noqa: BLE001
                 pass
             time.sleep(0.2)
         raise RuntimeError("the service did not answer /health in time")
@@ -219,7 +219,7 @@ class _Stream:
             with self.lock:
                 self.non_finite += 1
             return
-        except Exception:
+        except Exception:  # noqa: BLE001
             return
         with self.lock:
             self.messages += 1
@@ -238,7 +238,7 @@ class _Stream:
     def _on_result(self, sample) -> None:
         try:
             msg = strict_json(sample.payload.to_bytes())
-        except Exception:
+        except Exception:  # noqa: BLE001
             msg = {"accepted": None}
         with self.lock:
             self.results.append(msg)
@@ -256,11 +256,11 @@ class _Stream:
         for sub in self._subs:
             try:
                 sub.undeclare()
-            except Exception:
+            except Exception:  # noqa: BLE001
                 pass
         try:
             self.session.close()
-        except Exception:
+        except Exception:  # noqa: BLE001
             pass
 
 
@@ -440,7 +440,7 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
                 tw = next((t for t in h["twins"] if t["id"] == cfg.bearing_id), None)
                 samples.append({"t": now, "twin": tw, "recording_rows": h.get("recording_rows", 0),
                                 "rss_bytes": h.get("rss_bytes")})
-            except Exception as exc:
+            except Exception as exc:  # noqa: BLE001
                 counts["health_errors"] += 1
                 unexpected.append(f"/health: {type(exc).__name__}: {exc}")
                 h = {}
@@ -658,7 +658,7 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
         out["complete"] = bool(segments_ok and len(recording_ids) == 1 and out["rows_read"] >= max(rows_reported, 1)
                                and gaps == 0 and out["duplicates"] == 0
                                and (last_stream_seq is None or (len(s) and int(s[-1]) >= last_stream_seq)))
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001
         out["error"] = f"{type(exc).__name__}: {exc}"
     return out
 
@@ -713,7 +713,7 @@ def _shutdown_text(sd: dict) -> str:
 
 def format_report(r: dict) -> str:
     """Human-readable summary."""
-    f = lambda v, spec="{:.3f}": "-" if v is None else spec.format(v)
+    f = lambda v, spec="{:.3f}": "-" if v is None else spec.format(v)  # noqa: E731
     lines = [f"soak: {r['duration_s']:.0f} s against {r.get('url')} (zenoh {r.get('zenoh') or 'off'}), "
              f"{'own service' if r['started_service'] else 'external service'}, token {r.get('token') or 'none'}"]
     sp = r["setpoints"]

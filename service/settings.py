@@ -342,7 +342,7 @@ class AlarmSettings(BaseModel):
                          description="Alarm events kept per twin for GET .../alarms [count].")
 
     @model_validator(mode="after")
-    def _ordered(self) -> "AlarmSettings":
+    def _ordered(self) -> AlarmSettings:
         if self.life_used_critical < self.life_used_warning:
             raise ValueError(f"life_used_critical = {self.life_used_critical:g} must be >= "
                              f"life_used_warning = {self.life_used_warning:g}")

@@ -13,7 +13,8 @@ import queue
 import socket
 import threading
 import time
-from typing import Any, Callable, NamedTuple
+from typing import Any, NamedTuple
+from collections.abc import Callable
 
 PEER_WAIT_S = 30.0
 

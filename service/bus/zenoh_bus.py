@@ -202,7 +202,7 @@ def _one_line(exc: BaseException) -> str:
                 parts.append(f"{loc}: {e.get('msg', '')}")
             if parts:
                 return "; ".join(parts)
-        except Exception:  # noqa: BLE001, S110 - fall back to str()
+        except Exception:  # noqa: BLE001 - fall back to str()
             pass
     text = " ".join(str(exc).split())
     return text or type(exc).__name__
@@ -350,7 +350,7 @@ class TwinChannel:
                     self._dropped += 1
                 self._queue.append(item)
                 self._cond.notify()
-        except Exception:  # noqa: BLE001, S110 - a sink never raises into the physics
+        except Exception:  # noqa: BLE001 - a sink never raises into the physics
             pass
 
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:

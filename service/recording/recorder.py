@@ -484,7 +484,7 @@ class RerunRecorder:
     def _apply_retention(self) -> None:
         try:
             self.retention.apply()
-        except Exception:  # noqa: BLE001 - retention must never stop the recording
+        except Exception:
             log.exception("retention failed")
 
     # ---- faults -----------------------------------------------------------------------------

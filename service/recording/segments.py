@@ -28,11 +28,9 @@ from __future__ import annotations
 
 import logging
 import os
-import re
 import struct
 import sys
 import warnings
-from pathlib import Path
 
 from service.recording.names import is_segment_of, numbered_segments, recording_segments, segment_path
 from service.recording.paths import CreatedFile

@@ -211,7 +211,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
         vib_md = vibration_section(out, quick)
         progress.update(1)
 
-    md = [f"# bearing-twin validation report\n\nGenerated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}"
+    md = [f"# bearing-twin validation report\n\nGenerated {_dt.datetime.now(_dt.UTC):%Y-%m-%d %H:%M UTC}"
           f"{' (quick mode)' if quick else ''}. 6208 of seed 000 Table 1, Hamrock-Dowson film (seed 000 eq. 6), "
           "Stribeck-line friction, eta = 0.04 Pa s, races 0.3 um.\n",
           "## Lambda against azimuth at 500 rad/s (seed 000 Fig. 8)\n",

@@ -399,7 +399,6 @@ def _cmd_serve(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 2
 
-    import uvicorn
 
     from service.api.app import create_app
     from service.settings import is_loopback_host
@@ -502,7 +501,7 @@ def _interruptible_server_class():
     return InterruptibleServer
 
 
-def _InterruptibleServer(config):  # noqa: N802 - a class made on demand (uvicorn imported lazily)
+def _InterruptibleServer(config):
     return _interruptible_server_class()(config)
 
 

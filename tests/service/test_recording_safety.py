@@ -24,14 +24,14 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.recording import (  # noqa: E402
+from service.recording import (
     RecordingPathError,
     check_relative_path,
     create_exclusive,
     read_index,
     recording_segments,
 )
-from service.settings import ServiceSettings  # noqa: E402
+from service.settings import ServiceSettings
 
 needs_proc = pytest.mark.skipif(not os.path.isdir("/proc/self/task"), reason="counts threads and fds in /proc")
 TORQUE = "bearing/default/friction_torque_n_m"

@@ -15,10 +15,10 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
-from service.bus.zenoh_bus import ZenohBus, make_config, wait_until
-from service.tools.monitor import add_monitor_command, run_monitor
-from twin.engine import Twin
-from twin.setpoint import SetpointLimits, SetpointUpdate
+from service.bus.zenoh_bus import ZenohBus, make_config, wait_until  # noqa: E402
+from service.tools.monitor import add_monitor_command, run_monitor  # noqa: E402
+from twin.engine import Twin  # noqa: E402
+from twin.setpoint import SetpointLimits, SetpointUpdate  # noqa: E402
 
 WAIT_S = 10.0
 
