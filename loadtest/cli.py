@@ -4,7 +4,7 @@ service over HTTP and zenoh (the `loadtest` extra brings their HTTP client, http
 from __future__ import annotations
 
 import argparse
-import importlib.util
+import importlib
 import json
 import sys
 
@@ -72,7 +72,9 @@ def f(value: float | None, spec: str = "{:.2f}") -> str:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
-    if importlib.util.find_spec("httpx") is None:
+    try:
+        importlib.import_module("httpx")
+    except ImportError:
         print(f"error: {EXTRA_HINT}", file=sys.stderr)
         return 2
     status: int = args.func(args)
