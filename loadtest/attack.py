@@ -49,6 +49,7 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
+from service.keys import DEFAULT_PREFIX
 from service.tools.client import (TargetConfig, add_target_arguments, check_loopback, strict_json,
                                   target_arguments)
 
@@ -397,8 +398,8 @@ def run_attack(cfg: AttackConfig) -> dict:
                                         "seed": rng.randrange(2**32)}))
         if zenoh_endpoint:
             specs.append((_zenoh_flood, {"endpoint": zenoh_endpoint, "bearing_id": cfg.bearing_id,
-                                         "prefix": "bearing" if started is not None else
-                                         os.environ.get("BEARING_TWIN_ZENOH_PREFIX", "bearing"),
+                                         "prefix": DEFAULT_PREFIX if started is not None else
+                                         os.environ.get("BEARING_TWIN_ZENOH_PREFIX", DEFAULT_PREFIX),
                                          "user": zuser, "password": zpass, "seconds": cfg.seconds,
                                          "rate_hz": cfg.zenoh_rate_hz, "seed": rng.randrange(2**32)}))
         for target, spec in specs:

@@ -65,6 +65,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from service.keys import DEFAULT_PREFIX, SETPOINT, SETPOINT_RESULT, STATE, all_twins, twin_key
 from service.tools.client import TargetConfig, add_target_arguments, strict_json, target_arguments, url_is_loopback
 
 _FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c")
@@ -191,7 +192,7 @@ class _Started:
 class _Stream:
     """zenoh client: seq gaps of {prefix}/*/state and the setpoint results of one twin."""
 
-    def __init__(self, endpoint: str, bearing_id: str, prefix: str = "bearing", access: Any = None):
+    def __init__(self, endpoint: str, bearing_id: str, prefix: str = DEFAULT_PREFIX, access: Any = None):
         import zenoh
 
         from service.bus.zenoh_bus import client_config
@@ -207,9 +208,10 @@ class _Stream:
         self.non_finite = 0
         self.first_at: float | None = None
         self.results: collections.deque = collections.deque()
-        self._subs = [self.session.declare_subscriber(f"{prefix}/*/state", self._on_state),
-                      self.session.declare_subscriber(f"{prefix}/{bearing_id}/setpoint/result", self._on_result)]
-        self.publisher_key = f"{prefix}/{bearing_id}/setpoint"
+        self._subs = [self.session.declare_subscriber(all_twins(prefix, STATE), self._on_state),
+                      self.session.declare_subscriber(twin_key(prefix, bearing_id, SETPOINT_RESULT),
+                                                      self._on_result)]
+        self.publisher_key = twin_key(prefix, bearing_id, SETPOINT)
 
     def _on_state(self, sample) -> None:
         try:
@@ -371,7 +373,7 @@ def run_soak(cfg: SoakConfig) -> dict:
             env = ZenohAccessSettings()
             access = (ZenohAccess(user=started.zenoh_user, password=started.zenoh_password)
                       if started is not None else ZenohAccess.from_settings(env))
-            prefix = "bearing" if started is not None else env.zenoh_prefix   # the started one: default
+            prefix = DEFAULT_PREFIX if started is not None else env.zenoh_prefix   # the started one: default
             stream = _Stream(zenoh_endpoint, cfg.bearing_id, prefix, access)
             report["zenoh_access"] = access.describe(listening=False) if access.enabled else "none"
         health0 = client.get(f"{url}/health", headers=headers).json()

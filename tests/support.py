@@ -51,6 +51,17 @@ def wait_for(fetch: Callable[[], Any], predicate: Callable[[Any], bool], timeout
         time.sleep(interval)
 
 
+def wait_until(predicate: Callable[[], bool], timeout_s: float, interval_s: float = 0.02) -> bool:
+    """Poll `predicate` until true or the timeout passes; whether it became true."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        if predicate():
+            return True
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(interval_s)
+
+
 class Sample(NamedTuple):
     """One received zenoh sample: key expression, kind (PUT / DELETE) and payload bytes."""
 

@@ -33,7 +33,8 @@ def test_the_contracts_are_declared():
     runtime -= {"validation", "ehl_solver"}
     assert {m.removeprefix("twin.") for m in contracts["runtime"]["source_modules"]} == runtime
     assert {"fastapi", "zenoh", "rerun"} <= set(contracts["core"]["forbidden_modules"])
-    assert contracts["layers"]["layers"][0] == "service.tools" and contracts["layers"]["layers"][-2] == "service.core"
+    layers = contracts["layers"]["layers"]
+    assert layers[0] == "service.tools" and layers[-3:] == ["service.core", "service.settings", "service.keys"]
 
 
 def test_the_code_keeps_the_contracts(monkeypatch):

@@ -12,6 +12,9 @@ import os
 import re
 import sys
 
+from service import __version__
+from twin.catalog import DEFAULT_DESIGNATION
+
 
 class ArgumentParser(argparse.ArgumentParser):
     """argparse with whole option names only (no abbreviations: `--clear` is not `--clearance`)
@@ -168,10 +171,11 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog="bearing-twin", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     sim = sub.add_parser("simulate", help="run one twin for a duration, print the final snapshot")
-    sim.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    sim.add_argument("--bearing", default=DEFAULT_DESIGNATION, help=f"catalog designation (default {DEFAULT_DESIGNATION})")
     sim.add_argument("--radial-load", type=float, default=3000.0, help="radial load [N]")
     sim.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     sim.add_argument("--speed", type=float, default=500.0, help="shaft speed [rad/s]")
@@ -279,7 +283,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run the twin with its outer ring on the housing (Sawalhi & Randall 2008 support, accelerometer "
         "sampled in the kernel) and an optional local defect, discard 0.05 s, analyse `--duration` of the signal "
         "(twin.vibration.run.simulate_vibration).")
-    vib.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    vib.add_argument("--bearing", default=DEFAULT_DESIGNATION, help=f"catalog designation (default {DEFAULT_DESIGNATION})")
     vib.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
     vib.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
     vib.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")

@@ -27,7 +27,6 @@ from typing import Any
 from service.core.alarm_hub import AlarmHub
 from service.core.alarms import AlarmEvent
 from service.core.runner import TwinRunner
-from service.core.scenario_driver import ScenarioHandle
 from service.core.scenarios import ResolvedRun, Scenario
 from service.settings import AlarmSettings
 from twin.engine import Twin
@@ -88,18 +87,18 @@ class TableSink:
         self.rows: list[dict[str, Any]] = []
         self.dropped = 0
         self._context: dict[str, Any] = {}
-        self._scenario: Callable[[], ScenarioHandle | None] = lambda: None
+        self._runner: TwinRunner | None = None
         self._t0: float | None = None
 
-    def begin(self, run: ResolvedRun, scenario: Callable[[], ScenarioHandle | None], lubricant: str) -> None:
-        """A new run: `scenario()` gives the runner's scenario handle (its phase) at publish time."""
+    def begin(self, run: ResolvedRun, runner: TwinRunner, lubricant: str) -> None:
+        """A new run on `runner`, whose scenario handle gives each row its phase at publish time."""
         self._context = {"run": run.id, "run_label": run.label, "bearing": run.bearing,
                          "diametral_clearance_m": run.diametral_clearance_m, "lubricant": lubricant}
-        self._scenario, self._t0 = scenario, None
+        self._runner, self._t0 = runner, None
 
     def publish(self, snapshot: Snapshot) -> None:
         row = dict(self._context)
-        handle = self._scenario()
+        handle = self._runner.scenario if self._runner is not None else None
         row["phase"] = handle.phase if handle is not None else None
         flat = flatten_snapshot(snapshot)
         row["seq"] = flat.pop("seq", None)
@@ -180,7 +179,7 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
                 recorder.add_twin_from(twin, context=lambda runner=runner: runner.scenario)
                 runner.add_sink(recorder)
             t_wall = time.perf_counter()
-            table.begin(run, lambda runner=runner: runner.scenario, spec.lubricant.name)
+            table.begin(run, runner, spec.lubricant.name)
             rows_before = len(table.rows)
             runner.start(publish_initial=False)
             handle, _ = runner.start_scenario(run)
