@@ -465,7 +465,8 @@ class TwinChannel:
         with self._pub_lock:
             pub = getattr(self, attr)
             if pub is None and not self._publishers_gone:
-                pub = self.bus.session.declare_publisher(twin_key(self.bus.prefix, self.bearing_id, suffix), encoding=encoding,
+                pub = self.bus.session.declare_publisher(twin_key(self.bus.prefix, self.bearing_id, suffix),
+                                                         encoding=encoding,
                                                          congestion_control=zenoh.CongestionControl.DROP)
                 setattr(self, attr, pub)
             return pub
@@ -487,7 +488,8 @@ class TwinChannel:
             if self._publishers_gone:
                 return
             if self._alarm_pub is None:
-                self._alarm_pub = self.bus.session.declare_publisher(twin_key(self.bus.prefix, self.bearing_id, ALARM), encoding=_JSON)
+                self._alarm_pub = self.bus.session.declare_publisher(
+                    twin_key(self.bus.prefix, self.bearing_id, ALARM), encoding=_JSON)
             pub = self._alarm_pub
         pub.put(_dumps({**event, "bearing_id": self.bearing_id}))
 
@@ -628,7 +630,8 @@ class TwinChannel:
 
     def _handle_owner_query(self, query: zenoh.Query) -> None:
         try:
-            query.reply(twin_key(self.bus.prefix, self.bearing_id, OWNER), _dumps(self.bus.owner(self.bearing_id)), encoding=_JSON)
+            query.reply(twin_key(self.bus.prefix, self.bearing_id, OWNER), _dumps(self.bus.owner(self.bearing_id)),
+                        encoding=_JSON)
         finally:
             with contextlib.suppress(Exception):
                 query.drop()

@@ -259,7 +259,8 @@ class TwinRegistry:
             n += 1
         return f"{designation}-{n}"
 
-    def build_twin(self, bearing_id: str, designation: str = catalog.DEFAULT_DESIGNATION, diametral_clearance_m: float = 0.0,
+    def build_twin(self, bearing_id: str, designation: str = catalog.DEFAULT_DESIGNATION,
+                   diametral_clearance_m: float = 0.0,
                    lubricant: str = "seed-000", setpoint: SetpointUpdate | None = None,
                    thermal: Thermal | None = None, housing: Any = None) -> Twin:
         """A warm-started Twin (InputError naming the field if a value is not valid). `housing`:

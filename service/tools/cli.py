@@ -175,7 +175,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     sim = sub.add_parser("simulate", help="run one twin for a duration, print the final snapshot")
-    sim.add_argument("--bearing", default=DEFAULT_DESIGNATION, help=f"catalog designation (default {DEFAULT_DESIGNATION})")
+    sim.add_argument("--bearing", default=DEFAULT_DESIGNATION,
+                     help=f"catalog designation (default {DEFAULT_DESIGNATION})")
     sim.add_argument("--radial-load", type=float, default=3000.0, help="radial load [N]")
     sim.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     sim.add_argument("--speed", type=float, default=500.0, help="shaft speed [rad/s]")
@@ -212,7 +213,7 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--host", help="HTTP bind address (default 127.0.0.1: loopback only; "
                        "0.0.0.0 exposes the API on every interface) [BEARING_TWIN_HOST]")
     serve.add_argument("--port", type=int, help="HTTP port (default 8000) [BEARING_TWIN_PORT]")
-    serve.add_argument("--bearing", help="designation of the `default` twin (default 6208) [BEARING_TWIN_BEARING]")
+    serve.add_argument("--bearing", help=f"designation of the `default` twin (default {DEFAULT_DESIGNATION}) [BEARING_TWIN_BEARING]")
     serve.add_argument("--housing", action="store_true", default=None,
                        help="the `default` twin runs on the housing support with the accelerometer "
                        "(vibration; default off) [BEARING_TWIN_HOUSING]")
@@ -283,7 +284,8 @@ def build_parser() -> argparse.ArgumentParser:
         description="Run the twin with its outer ring on the housing (Sawalhi & Randall 2008 support, accelerometer "
         "sampled in the kernel) and an optional local defect, discard 0.05 s, analyse `--duration` of the signal "
         "(twin.vibration.run.simulate_vibration).")
-    vib.add_argument("--bearing", default=DEFAULT_DESIGNATION, help=f"catalog designation (default {DEFAULT_DESIGNATION})")
+    vib.add_argument("--bearing", default=DEFAULT_DESIGNATION,
+                     help=f"catalog designation (default {DEFAULT_DESIGNATION})")
     vib.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
     vib.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
     vib.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
