@@ -166,7 +166,7 @@ class _Started:
 
     def stop(self, timeout_s: float = 30.0) -> dict:
         t0 = time.monotonic()
-        out = {"signal": "SIGTERM", "exit_code": None, "seconds": None, "killed": False}
+        out: dict[str, Any] = {"signal": "SIGTERM", "exit_code": None, "seconds": None, "killed": False}
         if self.proc.poll() is None:
             self.proc.send_signal(signal.SIGTERM)
             try:
@@ -356,6 +356,7 @@ def run_soak(cfg: SoakConfig) -> dict:
     stream = None
     try:
         if cfg.start:
+            assert token is not None            # generated above when not given
             started = _Started(token, cfg.publish_rate_hz, log, record=cfg.record,
                                record_segment_s=cfg.record_segment_s)
             url, zenoh_endpoint = started.url, started.zenoh_endpoint
@@ -422,7 +423,7 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
     duration = cfg.minutes * 60.0
     warmup = warmup_s(duration)
     put_url = f"{url}/v1/bearings/{cfg.bearing_id}/setpoint"
-    counts = collections.Counter()
+    counts: collections.Counter = collections.Counter()
     status_counts: collections.Counter = collections.Counter()
     unexpected: list[str] = []
     expectations: collections.deque = collections.deque()
