@@ -1,6 +1,7 @@
 # bearing-twin service image: `docker build -t bearing-twin .` then
 #   docker run --rm -p 8000:8000 -p 7447:7447 -v "$PWD/recordings:/home/twin/recordings" bearing-twin
-# The package is installed with README's command (`pip install .`, into a venv); the numba kernels
+# The package is installed with README's command (`pip install -c constraints.txt .`, into a venv):
+# the tested versions, without the load tools' httpx; the numba kernels
 # are compiled at build time into a cache the runtime user owns, so the first twin starts at once.
 FROM python:3.11-slim
 
@@ -19,10 +20,10 @@ ENV BEARING_TWIN_ZENOH_LISTEN=tcp/0.0.0.0:7447
 RUN useradd --create-home --uid 10001 --shell /usr/sbin/nologin twin
 
 WORKDIR /opt/bearing-twin
-COPY pyproject.toml README.md ./
+COPY pyproject.toml README.md constraints.txt ./
 COPY twin ./twin
 COPY service ./service
-RUN python3 -m venv /opt/venv && /opt/venv/bin/pip install .
+RUN python3 -m venv /opt/venv && /opt/venv/bin/pip install -c constraints.txt .
 
 USER twin
 WORKDIR /home/twin

@@ -17,6 +17,9 @@ from typing import Annotated, Literal
 from pydantic import BaseModel, ConfigDict, Field, SecretStr, field_validator, model_validator
 from pydantic_settings import BaseSettings, NoDecode, SettingsConfigDict
 
+from service.keys import DEFAULT_PREFIX, PREFIX_WILDCARD_RE, TWIN_ID_PATTERN
+from twin.catalog import DEFAULT_DESIGNATION
+
 
 def is_loopback_host(host: str | None) -> bool:
     """Whether `host` (an IP address, bracketed or not, or a host name) is this machine's
@@ -60,9 +63,6 @@ def _split_endpoints(value):
 
 
 DEFAULT_ZENOH_LISTEN = ["tcp/127.0.0.1:7447"]
-_CHUNK = r"[A-Za-z0-9_.-]+"
-_PREFIX_RE = re.compile(rf"^{_CHUNK}(?:/{_CHUNK}){{0,7}}$")
-_PATTERN_RE = re.compile(rf"^(?:{_CHUNK}|\*|\*\*)(?:/(?:{_CHUNK}|\*|\*\*)){{0,7}}$")
 _NAME_RE = re.compile(r"^[A-Za-z0-9_.@+-]{1,128}$")
 
 
@@ -122,7 +122,7 @@ class ZenohAccessSettings(BaseSettings):
                                       validate_default=True, hide_input_in_errors=True)
 
     zenoh_prefix: str = Field(
-        default="bearing",
+        default=DEFAULT_PREFIX,
         description="Key prefix of the twins on zenoh [key expression chunks, e.g. plant1/line2/motor7]: "
         "a twin publishes under {prefix}/{id}/...; site / line / asset, up to 8 chunks of letters, "
         "digits, '_', '.', '-'. The router and the monitor also take patterns with '*' and '**' "
@@ -203,7 +203,7 @@ class ZenohAccessSettings(BaseSettings):
     @classmethod
     def _prefix(cls, value: str) -> str:
         value = value.strip().strip("/")
-        if len(value) > 200 or not _PATTERN_RE.match(value):
+        if len(value) > 200 or not PREFIX_WILDCARD_RE.match(value):
             raise ValueError("a key prefix is 1-8 chunks of letters, digits, '_', '.', '-' separated "
                              "by '/' (patterns may use '*' and '**'), e.g. plant1/line2/motor7")
         return value
@@ -359,7 +359,7 @@ class AlarmSettings(BaseModel):
                          description="Alarm events kept per twin for GET .../alarms [count].")
 
     @model_validator(mode="after")
-    def _ordered(self) -> "AlarmSettings":
+    def _ordered(self) -> AlarmSettings:
         if self.life_used_critical < self.life_used_warning:
             raise ValueError(f"life_used_critical = {self.life_used_critical:g} must be >= "
                              f"life_used_warning = {self.life_used_warning:g}")
@@ -377,13 +377,13 @@ class ServiceSettings(ZenohAccessSettings):
                       "(0.0.0.0 exposes the API on every interface).")
     port: int = Field(default=8000, ge=0, le=65535,
                       description="HTTP port [TCP port number, 0 = any free port].")
-    bearing: str = Field(default="6208",
+    bearing: str = Field(default=DEFAULT_DESIGNATION,
                          description="Catalog designation of the twin started with the service [designation, e.g. 6208].")
     housing: bool = Field(default=False,
                           description="The twin started with the service has its outer ring on the housing "
                           "support with the accelerometer (vibration indicators, waveform, defects "
                           "show in the signal) [bool]; other twins choose with POST /v1/bearings `housing`.")
-    twin_id: str = Field(default="default", pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$",
+    twin_id: str = Field(default="default", pattern=TWIN_ID_PATTERN,
                          description="Name of the twin started with the service [text]; give each "
                          "service on one zenoh network its own (keys are bearing/{id}/...).")
     start_twin: bool = Field(default=True, description="Start that twin with the service [bool].")
@@ -481,11 +481,10 @@ class ServiceSettings(ZenohAccessSettings):
     io_thread_nice: int = Field(
         default=-5, ge=-20, le=19,
         description="Nice value given to every thread of the service but the stepping threads and the publish "
-        "worker, the HTTP event loop included (Linux, per thread; service.core.priority) [-]. Between the stepping "
-        "threads' (-10) and the host's other processes' (0): these threads hold the GIL the stepping threads wait "
-        "for, and below the load they are preempted while holding it (priority inversion; `attack` measures the "
-        "real-time factor under a flood). Below the process's nice needs root or "
-        "CAP_SYS_NICE (refused: counted in /health thread_priority errors). 0: the process's nice.")
+        "worker, the HTTP event loop included (Linux, per thread; service.core.priority) [-]: between the stepping "
+        "threads' and the host's other processes', since these threads hold the GIL the stepping threads wait for. "
+        "Below the process's nice needs root or CAP_SYS_NICE (refused: counted in /health thread_priority errors). "
+        "0: the process's nice.")
     gc_freeze: bool = Field(
         default=True,
         description="Freeze the start-up heap out of Python's cyclic garbage collector once the service is open "

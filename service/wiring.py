@@ -121,7 +121,7 @@ def open_live_viewer(settings: ServiceSettings, recorder):
         raise WiringError(f"rerun web viewer: {exc}") from None
     try:
         recorder.connect_viewer(live.grpc_url)
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001 - any failure of rerun's connection is reported as a wiring error
         live.close()
         raise WiringError(f"rerun web viewer: cannot connect the recording: {exc}") from None
     log.warning("rerun web viewer: open %s", live.url())

@@ -13,7 +13,8 @@ import queue
 import socket
 import threading
 import time
-from typing import Any, Callable, NamedTuple
+from typing import Any, NamedTuple
+from collections.abc import Callable
 
 PEER_WAIT_S = 30.0
 
@@ -48,6 +49,17 @@ def wait_for(fetch: Callable[[], Any], predicate: Callable[[Any], bool], timeout
         if time.monotonic() > deadline:
             raise AssertionError(f"condition not met within {timeout} s; last value {value!r}")
         time.sleep(interval)
+
+
+def wait_until(predicate: Callable[[], bool], timeout_s: float, interval_s: float = 0.02) -> bool:
+    """Poll `predicate` until true or the timeout passes; whether it became true."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        if predicate():
+            return True
+        if time.monotonic() >= deadline:
+            return False
+        time.sleep(interval_s)
 
 
 class Sample(NamedTuple):

@@ -1,7 +1,8 @@
 """The import rules of the README's "Architecture" section, as import-linter contracts in
 pyproject.toml ([tool.importlinter]): `twin` never imports `service` (nor fastapi, zenoh, rerun,
 matplotlib); the runtime engine never imports `twin.validation` (the offline science); `service.core` imports no fastapi, zenoh or rerun, nor the wings built on them;
-the service's layers go tools > reports > api > wiring > bus | recording > core > settings.
+the service's layers go tools > reports > api > wiring > bus | recording > core > settings; no
+import cycle among the modules of `service` and `loadtest`; the runtime never imports the load tools.
 import-linter reads every import statement, those inside functions included."""
 
 from __future__ import annotations
@@ -20,7 +21,10 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_the_contracts_are_declared():
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
     contracts = {c["id"]: c for c in config["contracts"]}
-    assert set(contracts) == {"engine", "runtime", "core", "layers"}
+    assert set(contracts) == {"engine", "runtime", "core", "layers", "service-acyclic", "loadtest"}
+    assert contracts["service-acyclic"]["type"] == "acyclic_siblings"
+    assert set(contracts["service-acyclic"]["ancestors"]) == {"service", "loadtest"}
+    assert {"loadtest", "httpx"} <= set(contracts["loadtest"]["forbidden_modules"])
     assert {"service", "fastapi", "zenoh", "rerun"} <= set(contracts["engine"]["forbidden_modules"])
     assert contracts["runtime"]["forbidden_modules"] == ["twin.validation"]
     # every runtime module of twin/ (all but the offline packages) is a source of the "runtime" contract
@@ -29,7 +33,8 @@ def test_the_contracts_are_declared():
     runtime -= {"validation", "ehl_solver"}
     assert {m.removeprefix("twin.") for m in contracts["runtime"]["source_modules"]} == runtime
     assert {"fastapi", "zenoh", "rerun"} <= set(contracts["core"]["forbidden_modules"])
-    assert contracts["layers"]["layers"][0] == "service.tools" and contracts["layers"]["layers"][-2] == "service.core"
+    layers = contracts["layers"]["layers"]
+    assert layers[0] == "service.tools" and layers[-3:] == ["service.core", "service.settings", "service.keys"]
 
 
 def test_the_code_keeps_the_contracts(monkeypatch):
@@ -50,4 +55,20 @@ def test_a_broken_rule_is_caught(tmp_path, monkeypatch):
                       'source_modules = ["demo.core"]\nforbidden_modules = ["fastapi"]\n')
     monkeypatch.syspath_prepend(str(tmp_path))
     sys.modules.pop("demo", None)
+    assert lint.lint_imports(config_filename=str(config), no_cache=True, no_logo=True) == 1
+
+
+def test_a_hidden_cycle_is_caught(tmp_path, monkeypatch):
+    """A cycle between two sibling modules, one side hidden in a function, breaks `acyclic_siblings`."""
+    pkg = tmp_path / "demo_cycle"
+    pkg.mkdir()
+    (pkg / "__init__.py").write_text("")
+    (pkg / "paths.py").write_text("def taken():\n    from demo_cycle.segments import numbered\n    return numbered\n")
+    (pkg / "segments.py").write_text("from demo_cycle.paths import taken\n\nnumbered = taken\n")
+    config = tmp_path / "contracts.toml"
+    config.write_text('[tool.importlinter]\nroot_packages = ["demo_cycle"]\n\n'
+                      '[[tool.importlinter.contracts]]\nname = "acyclic"\ntype = "acyclic_siblings"\n'
+                      'ancestors = ["demo_cycle"]\n')
+    monkeypatch.syspath_prepend(str(tmp_path))
+    sys.modules.pop("demo_cycle", None)
     assert lint.lint_imports(config_filename=str(config), no_cache=True, no_logo=True) == 1

@@ -16,7 +16,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import shlex
 import shutil
 import signal
 import socket
@@ -61,15 +60,16 @@ SKIPPED = {
     r"host[AB]\$|anywhere\$|router\$": "several hosts: tests/service/test_end_to_end.py, test_fleet.py and "
                                          "tests/hostile/test_zenoh_access.py run them on loopback",
     r"bearing-twin router": "runs until stopped: tests/service/test_fleet.py runs it",
-    r"bearing-twin soak --minutes 60 --url": "needs a service of its own: the --start variant is run",
-    r"bearing-twin attack --seconds 60 --url": "needs a service of its own: the --start variant is run",
+    r"bearing-twin-loadtest soak --minutes 60 --url": "needs a service of its own: the --start variant is run",
+    r"bearing-twin-loadtest attack --seconds 60 --url": "needs a service of its own: the --start variant is run",
     r"export BEARING_TWIN_TOKEN": "run by test_token_and_opcua_commands",
 }
 SERVED = (r"bearing-twin serve", r"curl ", r"bearing-twin monitor")   # run by test_serve_and_its_clients
 
 
-def _cli(*args: str, cwd: Path, env: dict | None = None, timeout: float = TIMEOUT_S) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "service.cli", *args], cwd=cwd, capture_output=True, text=True,
+def _cli(*args: str, cwd: Path, env: dict | None = None, timeout: float = TIMEOUT_S,
+         module: str = "service.cli") -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", module, *args], cwd=cwd, capture_output=True, text=True,
                           timeout=timeout, env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})})
 
 
@@ -98,16 +98,16 @@ ONE_SHOT = {
     "bearing-twin simulate --bearing 7208": lambda out: [
         "simulate", "--bearing", "7208", "--radial-load", "3000", "--axial-load", "3000", "--clearance", "-1e-5",
         "--dt", "1e-6"],
-    "bearing-twin bench-service": lambda out: ["bench-service", "--seconds", "3", "--json"],
     "bearing-twin bench": lambda out: ["bench", "--json", "--seconds", "0.01", "--repeats", "5",  # >= 5 repeats
                                        "--save", str(out / "results")],
     "bearing-twin timestep-study": lambda out: ["timestep-study", "--quick", "--json"],
     "bearing-twin life": lambda out: ["life", "--bearing", "6208", "--radial-load", "3000", "--speed", "500",
                                       "--json"],
-    "bearing-twin soak --minutes 10 --start": lambda out: ["soak", "--minutes", "0.3", "--start", "--json"],
-    "bearing-twin attack --seconds 60 --start": lambda out: ["attack", "--seconds", "3", "--start", "--baseline",
-                                                             "1", "--json"],
     "bearing-twin ehl solve": lambda out: ["ehl", "solve", "--current", "20", "--grid", "65", "--json"],
+    "bearing-twin-loadtest bench-service": lambda out: ["bench-service", "--seconds", "3", "--json"],
+    "bearing-twin-loadtest soak --minutes 10 --start": lambda out: ["soak", "--minutes", "0.3", "--start", "--json"],
+    "bearing-twin-loadtest attack --seconds 60 --start": lambda out: ["attack", "--seconds", "3", "--start",
+                                                                      "--baseline", "1", "--json"],
     "bearing-twin vibration": lambda out: ["vibration", "--bearing", "6208", "--speed", "523", "--radial-load", "3000",
                                            "--defect", "outer", "--duration", "0.1", "--json",
                                            "--plot", str(out / "vib.png")],
@@ -142,7 +142,8 @@ def test_every_shell_line_is_covered():
 
 @pytest.mark.parametrize("prefix", sorted(ONE_SHOT))
 def test_one_shot_command(prefix, tmp_path):
-    res = _cli(*ONE_SHOT[prefix](tmp_path), cwd=ROOT)
+    module = "loadtest" if prefix.startswith("bearing-twin-loadtest ") else "service.cli"
+    res = _cli(*ONE_SHOT[prefix](tmp_path), cwd=ROOT, module=module)
     assert res.returncode == 0, f"{prefix}: exit {res.returncode}\n{res.stdout[-2000:]}\n{res.stderr[-3000:]}"
     assert "Traceback" not in res.stderr
     if "--json" in ONE_SHOT[prefix](tmp_path):

@@ -39,6 +39,9 @@ _DEEP_GROOVE_MM = {
     "6210": (50.0, 90.0, 10, 12.7),
 }
 
+DEFAULT_DESIGNATION = "6208"
+"""The bearing of seed 000, the default of every entry point (API, CLI, scenarios, settings)."""
+
 _POCKET_CLEARANCE_M = 30e-6
 
 # ISO 15 ring width B [mm] of the dimension series 02 (62xx, 72xx): the rings' lands' capacitance
@@ -106,7 +109,7 @@ def designations() -> list[str]:
     return sorted(["6208", "7208", "7208AC", "7208C", *_DEEP_GROOVE_MM])
 
 
-def bearing(designation: str = "6208", *, diametral_clearance_m: float = 0.0,
+def bearing(designation: str = DEFAULT_DESIGNATION, *, diametral_clearance_m: float = 0.0,
             lubricant: Lubricant | None = None, **spec_fields) -> BearingSpec:
     """The spec of a catalog bearing with the given mounting clearance [m] and lubricant."""
     key = designation.strip().upper()

@@ -8,7 +8,7 @@ allowed range (pydantic reports the field path; the messages below give the rang
 from __future__ import annotations
 
 import math
-from typing import Literal
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
@@ -19,6 +19,15 @@ from twin.vibration.housing import Housing
 TIME_STEP_RANGE_S = (1e-8, 2e-5)
 
 _FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+
+TWIN_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
+TwinId = Annotated[str, Field(pattern=TWIN_ID_PATTERN, description="Twin name used in URLs and zenoh keys [text: 1-64 "
+                                                                    "letters, digits, _ . -, first a letter or digit].")]
+"""A twin's name: one zenoh key chunk, a URL path segment and a file name."""
+Clearance = Annotated[float, Field(ge=-50e-6, le=200e-6,
+                                   description="Diametral clearance Pd [m]; negative = preload (seed 000 Appendix A: "
+                                   "+-12.6e-6 m).")]
+"""Diametral clearance Pd [m], from a 50 um preload to 200 um of play."""
 
 
 class Geometry(BaseModel):
@@ -198,9 +207,10 @@ class Electrical(BaseModel):
 
 
 class Thermal(BaseModel):
-    """Electro-thermal inputs of seed 003 (Appendix 2 values as defaults)."""
+    """Electro-thermal inputs of seed 003 (Appendix 2 values as defaults); an input of the HTTP API,
+    so strict like the setpoint (no "1" for 1.0, no "yes" for True)."""
 
-    model_config = _FROZEN
+    model_config = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
     oil_thermal_conductivity_w_m_k: float = Field(
         default=0.145, gt=0.0, le=10.0, description="Oil thermal conductivity k' [W/(m K)] (seed 003: 0.145).")
@@ -268,9 +278,7 @@ class Mounting(BaseModel):
 
     model_config = _FROZEN
 
-    diametral_clearance_m: float = Field(
-        default=0.0, ge=-50e-6, le=200e-6,
-        description="Diametral clearance Pd [m]; negative = preload (seed 000 Appendix A: +-12.6 um).")
+    diametral_clearance_m: Clearance = 0.0
     rotor_mass_kg: float = Field(
         default=0.5, gt=0.01, le=1000.0,
         description="Mass carried by the inner ring [kg]: the ring plus the share of the shaft.")

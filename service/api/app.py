@@ -32,6 +32,7 @@ from contextlib import asynccontextmanager
 from fastapi import Depends, FastAPI
 from starlette.concurrency import run_in_threadpool
 
+from service import __version__
 from service.api.deps import require_token
 from service.api.errors import install_error_handlers
 from service.api.middleware import BodySizeLimit, ReadRateLimit, Tarpit, TarpitStats, TokenGate
@@ -82,7 +83,7 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
 
     app = FastAPI(
         title="bearing-twin",
-        version="0.1.0",
+        version=__version__,
         summary="Real-time DEM digital twin of lubricated ball bearings",
         description="Setpoints in, live contact state out. Units are in every field name and "
         "description (SI, oil temperature in degC). State schema 'bearing-twin/state/1'; the same "

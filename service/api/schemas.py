@@ -12,15 +12,16 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from service.core.errors import FieldError, InputError
-from service.core.registry import ID_PATTERN
 from twin.setpoint import Setpoint, SetpointUpdate
-from twin.spec import Thermal
+from twin import catalog
+from twin.spec import Clearance, Thermal, TwinId
+from twin.vibration.housing import Housing
 
 __all__ = ["BearingCreate", "BearingInfo", "ErrorResponse", "FieldError", "Health", "InputError",
            "RecordingRequest", "RecordingStatus", "ScenarioAccepted", "ScenarioList", "ScenarioRequest",
            "ScenarioStatus", "SetpointResponse", "TwinHealth", "request_bounds"]
 
-_STRICT = ConfigDict(extra="forbid", allow_inf_nan=False)
+_STRICT = ConfigDict(extra="forbid", strict=True, allow_inf_nan=False)
 
 
 class ErrorResponse(BaseModel):
@@ -34,13 +35,13 @@ class BearingCreate(BaseModel):
     """A new twin: catalog bearing, mounting, lubricant, optional name and initial setpoint."""
 
     model_config = _STRICT
-    id: str | None = Field(default=None, pattern=ID_PATTERN, description="Twin name used in URLs and zenoh keys [text: letters, digits, _ . -]; default '<designation>-<n>'.")
-    designation: str = Field(default="6208", max_length=32, description="Catalog designation, e.g. '6208', '7208', '6200'..'6210' [text].")
-    diametral_clearance_m: float = Field(default=0.0, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload (seed 000: +-12.6e-6 m).")
+    id: TwinId | None = Field(default=None, description="Twin name used in URLs and zenoh keys [text: letters, digits, _ . -]; default '<designation>-<n>'.")
+    designation: str = Field(default=catalog.DEFAULT_DESIGNATION, max_length=32, description="Catalog designation, e.g. '6208', '7208', '6200'..'6210' [text].")
+    diametral_clearance_m: Clearance = 0.0
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' (0.04 Pa s at 40 degC) or an ISO grade such as 'ISO VG 68' [text].")
     setpoint: SetpointUpdate | None = Field(default=None, description="Initial setpoint (partial, defaults for the rest); the twin is warm-started at it [fields with units].")
     thermal: Thermal | None = Field(default=None, description="Electro-thermal options (seed 003): shear_heating, current_heating, equivalent_resistance_ohm [ohm], crater_depth_m [m], ...; default: the spec's (shear heating off).")
-    housing: dict[str, Any] | None = Field(default=None, description="Housing and accelerometer (twin.vibration.housing.Housing): {\"enabled\": true} puts the outer ring on the housing support (Sawalhi & Randall 2008 defaults) and samples the accelerometer (vibration indicators, waveform); other fields: pedestal_mass_kg [kg], radial_stiffness_n_m [N/m], ..., accelerometer {sample_rate_hz [Hz], ...}; default: rigid outer ring, no vibration.")
+    housing: Housing | None = Field(default=None, description="Housing and accelerometer (twin.vibration.housing.Housing): {\"enabled\": true} puts the outer ring on the housing support (Sawalhi & Randall 2008 defaults) and samples the accelerometer (vibration indicators, waveform); other fields: pedestal_mass_kg [kg], radial_stiffness_n_m [N/m], ..., accelerometer {sample_rate_hz [Hz], ...}; default: rigid outer ring, no vibration.")
 
 
 class ScenarioStatus(BaseModel):

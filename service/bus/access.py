@@ -54,6 +54,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from service.keys import all_twins
 from service.settings import zenoh_access_enabled
 
 # what each role may do: (messages, flow, key suffixes under P/*)
@@ -106,7 +107,7 @@ def twin_key(prefix: str, suffix: str) -> str:
     """`{prefix}/*/{suffix}` in zenoh's canonical form (`**/*` is written `*/**`)."""
     import zenoh
 
-    return str(zenoh.KeyExpr.autocanonize(f"{prefix}/*/{suffix}"))
+    return str(zenoh.KeyExpr.autocanonize(all_twins(prefix, suffix)))
 
 
 def acl_config(prefixes: str | Sequence[str], roles: Roles, *, tls: bool = False) -> dict:

@@ -102,7 +102,6 @@ import os
 import re
 import socket
 import threading
-import time
 import weakref
 from collections.abc import Callable, Iterable
 from typing import Any, Self
@@ -110,13 +109,15 @@ from typing import Any, Self
 import zenoh
 
 from service.bus.access import ZenohAccess
+from service.keys import (ALARM, ALIVE, DEFAULT_PREFIX, DEFECTS, DEFECTS_RESULT, OWNER, SETPOINT, SETPOINT_RESULT,
+                          SNAPSHOT, STATE, TWIN_ID_RE, VIBRATION_COMPARISON, VIBRATION_MEASURED, ball_key,
+                          check_prefix, twin_key)
 from service.core.errors import InputError
 from twin.snapshot import Snapshot
 
 log = logging.getLogger(__name__)
 
 DEFAULT_LISTEN = ["tcp/127.0.0.1:7447"]
-DEFAULT_PREFIX = "bearing"
 DEFAULT_QUEUE_SIZE = 64
 _CONTROL_QUEUE_SIZE = 256
 _JSON = "application/json"
@@ -130,7 +131,6 @@ class _Waveform:
 
     def __init__(self, blocks: list):
         self.blocks = blocks
-_ID_RE = re.compile(r"^[A-Za-z0-9_.:+=,;~@%-]+$")  # one key-expression chunk, no wildcards/slashes
 _ZID_RE = re.compile(r"^[0-9a-f]{1,32}$")            # a zenoh id as zenoh writes it (hex)
 
 
@@ -173,17 +173,6 @@ def client_config(connect: Iterable[str], *, access: ZenohAccess | None = None,
     return make_config(listen, list(connect), "peer" if listen else "client", access=access, prefix=prefix)
 
 
-_PREFIX_RE = re.compile(r"^[A-Za-z0-9_.:+=,;~@%-]+(?:/[A-Za-z0-9_.:+=,;~@%-]+){0,7}$")
-
-
-def check_prefix(prefix: str) -> str:
-    """A concrete key prefix (1-8 chunks, no wildcards), else ValueError."""
-    if not isinstance(prefix, str) or not _PREFIX_RE.match(prefix):
-        raise ValueError(f"key prefix {prefix!r}: 1-8 key-expression chunks separated by '/', "
-                         "no wildcards (e.g. plant1/line2/motor7)")
-    return prefix
-
-
 _ENDPOINT_RE = re.compile(r"^([a-z0-9-]+)/([^?#]+)([?#].*)?$")
 _IP_PROTOCOLS = {"tcp", "udp", "tls", "quic", "ws"}
 
@@ -221,7 +210,7 @@ def _one_line(exc: BaseException) -> str:
                 parts.append(f"{loc}: {e.get('msg', '')}")
             if parts:
                 return "; ".join(parts)
-        except Exception:  # noqa: BLE001, S110 - fall back to str()
+        except Exception:  # noqa: BLE001 - fall back to str()
             pass
     text = " ".join(str(exc).split())
     return text or type(exc).__name__
@@ -261,7 +250,7 @@ class TwinChannel:
             raise ValueError("queue_size must be >= 1")
         self.bus = bus
         self.bearing_id = bearing_id
-        self.prefix = f"{bus.prefix}/{bearing_id}"   # the twin's key: P/{id}
+        self.prefix = twin_key(bus.prefix, bearing_id)   # the twin's key: P/{id}
         self._get_snapshot = get_snapshot
         self._on_setpoint = on_setpoint
         self._on_defects = on_defects
@@ -299,32 +288,37 @@ class TwinChannel:
         self._pub_lock = threading.Lock()
         # express: the state message is sent at once, not held for a batch with other messages
         self._state_pub = session.declare_publisher(
-            f"{self.prefix}/state", encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP,
+            twin_key(bus.prefix, bearing_id, STATE), encoding=_JSON, congestion_control=zenoh.CongestionControl.DROP,
             express=True)
         # BLOCK, not DROP: a result is never lost in zenoh's transmission queue (with DROP, 13-18 of
         # 30 000 results of an `attack --record` zenoh flood never arrived); the back-pressure is the
         # control thread's bounded queue, which refuses further setpoints with 429
         self._result_pub = session.declare_publisher(
-            f"{self.prefix}/setpoint/result", encoding=_JSON,
+            twin_key(bus.prefix, bearing_id, SETPOINT_RESULT), encoding=_JSON,
             congestion_control=zenoh.CongestionControl.BLOCK)
-        self._setpoint_sub = session.declare_subscriber(f"{self.prefix}/setpoint", self._on_setpoint_sample)
+        self._setpoint_sub = session.declare_subscriber(twin_key(bus.prefix, bearing_id, SETPOINT),
+                                                        self._on_setpoint_sample)
         self._defects_sub = self._defects_result_pub = None
         if on_defects is not None:
             self._defects_result_pub = session.declare_publisher(
-                f"{self.prefix}/defects/result", encoding=_JSON, congestion_control=zenoh.CongestionControl.BLOCK)
-            self._defects_sub = session.declare_subscriber(f"{self.prefix}/defects", self._on_defects_sample)
+                twin_key(bus.prefix, bearing_id, DEFECTS_RESULT), encoding=_JSON,
+                congestion_control=zenoh.CongestionControl.BLOCK)
+            self._defects_sub = session.declare_subscriber(twin_key(bus.prefix, bearing_id, DEFECTS),
+                                                           self._on_defects_sample)
         # measured accelerometer windows (service.core.measured: binary frame in, comparison out)
         self._on_measured = on_measured
         self._measured_sub = self._comparison_pub = None
         if on_measured is not None:
             self._comparison_pub = session.declare_publisher(
-                f"{self.prefix}/vibration/comparison", encoding=_JSON, congestion_control=zenoh.CongestionControl.BLOCK)
+                twin_key(bus.prefix, bearing_id, VIBRATION_COMPARISON), encoding=_JSON,
+                congestion_control=zenoh.CongestionControl.BLOCK)
             self._measured_sub = session.declare_subscriber(
-                f"{self.prefix}/vibration/measured",
+                twin_key(bus.prefix, bearing_id, VIBRATION_MEASURED),
                 lambda sample: self._enqueue_control(("measured", _payload(sample))))
-        self._queryable = session.declare_queryable(f"{self.prefix}/snapshot", self._on_query)
-        self._owner_queryable = session.declare_queryable(f"{self.prefix}/owner", self._on_owner_query)
-        self._token = session.liveliness().declare_token(f"{self.prefix}/alive")
+        self._queryable = session.declare_queryable(twin_key(bus.prefix, bearing_id, SNAPSHOT), self._on_query)
+        self._owner_queryable = session.declare_queryable(twin_key(bus.prefix, bearing_id, OWNER),
+                                                          self._on_owner_query)
+        self._token = session.liveliness().declare_token(twin_key(bus.prefix, bearing_id, ALIVE))
 
         self._publisher_thread = threading.Thread(
             target=self._publish_loop, name=f"zenoh-pub-{bearing_id}", daemon=True)
@@ -379,7 +373,7 @@ class TwinChannel:
                     self._dropped += 1
                 self._queue.append(item)
                 self._cond.notify()
-        except Exception:  # noqa: BLE001, S110 - a sink never raises into the physics
+        except Exception:  # noqa: BLE001 - a sink never raises into the physics
             pass
 
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
@@ -503,7 +497,8 @@ class TwinChannel:
         with self._pub_lock:
             pub = getattr(self, attr)
             if pub is None and not self._publishers_gone:
-                pub = self.bus.session.declare_publisher(f"{self.prefix}/{suffix}", encoding=encoding,
+                pub = self.bus.session.declare_publisher(twin_key(self.bus.prefix, self.bearing_id, suffix),
+                                                         encoding=encoding,
                                                          congestion_control=zenoh.CongestionControl.DROP)
                 setattr(self, attr, pub)
             return pub
@@ -513,7 +508,7 @@ class TwinChannel:
             pub = self._ball_publishers.get(index)
             if pub is None and not self._closed:
                 pub = self.bus.session.declare_publisher(
-                    f"{self.prefix}/ball/{index}", encoding=_JSON,
+                    ball_key(self.bus.prefix, self.bearing_id, index), encoding=_JSON,
                     congestion_control=zenoh.CongestionControl.DROP)
                 self._ball_publishers[index] = pub
             return pub
@@ -525,7 +520,8 @@ class TwinChannel:
             if self._publishers_gone:
                 return
             if self._alarm_pub is None:
-                self._alarm_pub = self.bus.session.declare_publisher(f"{self.prefix}/alarm", encoding=_JSON)
+                self._alarm_pub = self.bus.session.declare_publisher(
+                    twin_key(self.bus.prefix, self.bearing_id, ALARM), encoding=_JSON)
             pub = self._alarm_pub
         pub.put(_dumps({**event, "bearing_id": self.bearing_id}))
 
@@ -656,7 +652,7 @@ class TwinChannel:
             with self._last_lock:
                 last = self._last
             text = last[1] if last is not None and last[0] is snapshot else snapshot.to_json()
-            query.reply(f"{self.prefix}/snapshot", text, encoding=_JSON)  # concrete key
+            query.reply(twin_key(self.bus.prefix, self.bearing_id, SNAPSHOT), text, encoding=_JSON)  # concrete key
             self.queries_answered += 1
         except Exception as exc:  # noqa: BLE001
             with contextlib.suppress(Exception):
@@ -668,7 +664,8 @@ class TwinChannel:
 
     def _handle_owner_query(self, query: zenoh.Query) -> None:
         try:
-            query.reply(f"{self.prefix}/owner", _dumps(self.bus.owner(self.bearing_id)), encoding=_JSON)
+            query.reply(twin_key(self.bus.prefix, self.bearing_id, OWNER), _dumps(self.bus.owner(self.bearing_id)),
+                        encoding=_JSON)
         finally:
             with contextlib.suppress(Exception):
                 query.drop()
@@ -759,7 +756,7 @@ class ZenohBus:
 
         InputError 409 (field `id`) naming the other process when the id is taken under this
         prefix anywhere on the zenoh network (see the module docstring)."""
-        if not isinstance(bearing_id, str) or not _ID_RE.match(bearing_id):
+        if not isinstance(bearing_id, str) or not TWIN_ID_RE.match(bearing_id):
             raise ValueError(f"bearing id {bearing_id!r} is not a single key-expression chunk "
                              "(letters, digits, _ . - ... ; no '/', '*', '$', '?', '#')")
         with self._lock:
@@ -769,7 +766,7 @@ class ZenohBus:
                 raise ValueError(f"twin {bearing_id!r} is already attached to this bus")
             self._claiming.add(bearing_id)
         try:
-            key = f"{self.prefix}/{bearing_id}"
+            key = twin_key(self.prefix, bearing_id)
             if self._alive_elsewhere(key):
                 if self.trust_claims:
                     raise self._taken(bearing_id, self._claimants(key))
@@ -795,7 +792,7 @@ class ZenohBus:
     # ---- one id per prefix across processes ---------------------------------------------
     def owner(self, bearing_id: str) -> dict:
         """What P/{id}/owner answers: the twin's key, this process and its zenoh id."""
-        return {"key": f"{self.prefix}/{bearing_id}", "bearing_id": bearing_id, **self._owner,
+        return {"key": twin_key(self.prefix, bearing_id), "bearing_id": bearing_id, **self._owner,
                 "zid": self.zid}
 
     def _alive_elsewhere(self, key: str) -> bool:
@@ -877,14 +874,3 @@ class ZenohBus:
             log.warning("zenoh session close failed: %s", exc)
         with contextlib.suppress(Exception):
             atexit.unregister(self._atexit)
-
-
-def wait_until(predicate: Callable[[], bool], timeout_s: float, interval_s: float = 0.02) -> bool:
-    """Poll `predicate` until true or the timeout passes (helper for tests and start-up)."""
-    deadline = time.monotonic() + timeout_s
-    while True:
-        if predicate():
-            return True
-        if time.monotonic() >= deadline:
-            return False
-        time.sleep(interval_s)

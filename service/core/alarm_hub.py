@@ -134,7 +134,7 @@ class AlarmHub:
                 self._busy = True
             try:
                 self._evaluate(snapshot)
-            except Exception:  # noqa: BLE001 - nothing kills the hub
+            except Exception:
                 log.exception("alarms: evaluating a snapshot of %s failed", snapshot.bearing_id)
             finally:
                 with self._cond:

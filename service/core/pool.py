@@ -200,7 +200,7 @@ class PublishWorker:
                 return
             try:
                 fn()
-            except Exception:  # noqa: BLE001 - nothing stops the publishing of the other twins
+            except Exception:
                 log.exception("publish worker: a task failed")
 
 
@@ -298,7 +298,7 @@ class SteppingPool:
             schedule: Schedule | None = None
             try:
                 schedule = job.task.step(self.clock())
-            except Exception:  # noqa: BLE001 - a broken job leaves the pool, the others go on
+            except Exception:
                 log.exception("stepping pool: job %s failed and leaves the pool", job.name)
             job.frames += 1
             with cond:
@@ -313,6 +313,6 @@ class SteppingPool:
             if schedule is None:
                 try:
                     job.task.left_pool()
-                except Exception:  # noqa: BLE001
+                except Exception:
                     log.exception("stepping pool: %s left the pool with an error", job.name)
                 job.done.set()

@@ -46,6 +46,7 @@ from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import DefectIntake, SetpointIntake
 from service.core.measured import MeasuredComparator, MeasuredIntake
 from service.core.pool import SteppingPool
+from service.keys import TWIN_ID_PATTERN, TWIN_ID_RE
 from service.core.heap import freeze_heap
 from service.core.priority import EGRESS_THREAD_NAMES, ThreadPriority
 from service.core.runner import TwinRunner
@@ -59,8 +60,7 @@ from twin.spec import Thermal
 
 log = logging.getLogger(__name__)
 
-ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
-_ID_RE = re.compile(ID_PATTERN)
+ID_PATTERN = TWIN_ID_PATTERN
 # per-twin recording paths: relative, plain names (no control characters, spaces, '..', hidden
 # folders), so a request cannot reach outside the recordings directory or trip the file system
 _REC_PATH_RE = re.compile(r"^(?=.{1,256}$)(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/)*[A-Za-z0-9_][A-Za-z0-9_.-]*\.rrd$")
@@ -261,7 +261,8 @@ class TwinRegistry:
             n += 1
         return f"{designation}-{n}"
 
-    def build_twin(self, bearing_id: str, designation: str = "6208", diametral_clearance_m: float = 0.0,
+    def build_twin(self, bearing_id: str, designation: str = catalog.DEFAULT_DESIGNATION,
+                   diametral_clearance_m: float = 0.0,
                    lubricant: str = "seed-000", setpoint: SetpointUpdate | None = None,
                    thermal: Thermal | None = None, housing: Any = None) -> Twin:
         """A warm-started Twin (InputError naming the field if a value is not valid). `housing`:
@@ -292,7 +293,7 @@ class TwinRegistry:
             twin.reset()  # warm start at the requested setpoint
         return twin
 
-    def create_twin(self, id: str | None = None, designation: str = "6208", *,
+    def create_twin(self, id: str | None = None, designation: str = catalog.DEFAULT_DESIGNATION, *,
                     over_capacity_ok: bool = False, **options: Any) -> TwinEntry:
         """Create, wire and start a twin (`options`: diametral_clearance_m, lubricant, setpoint,
         thermal, housing). InputError 409 on a duplicate id or at max_twins, 503 when this host cannot
@@ -303,7 +304,7 @@ class TwinRegistry:
             if self._closed:
                 raise InputError.one(None, "the service is shutting down", status_code=503)
             bearing_id = id or self._new_id(designation.strip().upper())
-            if not _ID_RE.match(bearing_id):
+            if not TWIN_ID_RE.match(bearing_id):
                 raise InputError.one("id", f"{bearing_id!r}: letters, digits, '_', '.', '-' only "
                                      "(it is used in URLs and zenoh key expressions)")
             if bearing_id in self._twins or bearing_id in self._reserved:

@@ -57,14 +57,15 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
 
 from service.core.errors import loc_text
+from service.keys import TWIN_ID_PATTERN
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointLimits, SetpointUpdate
-from twin.spec import BearingSpec, Thermal
+from twin.spec import BearingSpec, Clearance, Thermal
 
 SCENARIO_SCHEMA = "bearing-twin/scenario/1"
 
-_NAME_RE = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
-_FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+_NAME_RE = TWIN_ID_PATTERN   # a scenario or run name names the twin of an offline run
+_FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
 
 class ScenarioError(ValueError):
@@ -127,7 +128,7 @@ class ScenarioRun(BaseModel):
     id: str | None = Field(default=None, pattern=_NAME_RE, description="Run name [text]; default run<i>.")
     label: str | None = Field(default=None, max_length=128, description="Human label of the run [text].")
     bearing: str | None = Field(default=None, max_length=32, description="Catalog designation [text].")
-    diametral_clearance_m: float | None = Field(default=None, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload.")
+    diametral_clearance_m: Clearance | None = None
     lubricant: str | None = Field(default=None, max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
     thermal: Thermal | None = Field(default=None, description="Electro-thermal options replacing the scenario's (twin.spec.Thermal, units in each field).")
     initial: SetpointUpdate | None = Field(default=None, description="Initial setpoint, merged over the scenario's (fields with units).")
@@ -163,12 +164,12 @@ def _check_steps(steps: list[ScenarioStep], duration_s: float, where: str) -> No
 class Scenario(BaseModel):
     """A timeline of setpoints and ramps (see the module docstring for the YAML format)."""
 
-    model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+    model_config = _FROZEN
 
     name: str = Field(pattern=_NAME_RE, description="Scenario name [text: letters, digits, _ . -].")
     description: str = Field(default="", max_length=4000, description="What the scenario shows [text].")
-    bearing: str = Field(default="6208", max_length=32, description="Catalog designation [text].")
-    diametral_clearance_m: float = Field(default=0.0, ge=-50e-6, le=200e-6, description="Diametral clearance Pd [m]; negative = preload.")
+    bearing: str = Field(default=catalog.DEFAULT_DESIGNATION, max_length=32, description="Catalog designation [text].")
+    diametral_clearance_m: Clearance = 0.0
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
     thermal: Thermal | None = Field(default=None, description="Electro-thermal options of the bearing (twin.spec.Thermal: shear / current heating, R_b, H_c; units in each field); default: the spec's.")
     initial: SetpointUpdate = Field(default_factory=SetpointUpdate, description="Setpoint applied at t = 0 (fields with units).")
@@ -403,6 +404,21 @@ def _locate(error: dict) -> tuple[str, str]:
     return where, msg
 
 
+class ScenarioLoader(yaml.SafeLoader):
+    """YAML 1.2's numbers: `5e-4` is a float (YAML 1.1, PyYAML's default, reads it as a string,
+    which the strict scenario models refuse)."""
+
+
+ScenarioLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+                |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
+                |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
+                |[-+]?\.(?:inf|Inf|INF)
+                |\.(?:nan|NaN|NAN))$""", re.X),
+    list("-+0123456789."))
+
+
 def load_scenario(path: str | Path) -> Scenario:
     """Read and validate a scenario YAML file."""
     path = Path(path)
@@ -411,7 +427,7 @@ def load_scenario(path: str | Path) -> Scenario:
     except OSError as exc:
         raise ScenarioError(str(path), f"cannot read: {exc.strerror or exc}") from exc
     try:
-        data = yaml.safe_load(text)
+        data = yaml.load(text, Loader=ScenarioLoader)
     except yaml.YAMLError as exc:
         raise ScenarioError(str(path), f"not valid YAML: {' '.join(str(exc).split())}") from exc
     return scenario_from_dict(data, source=str(path))

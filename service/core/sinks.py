@@ -23,10 +23,3 @@ class SnapshotSink(Protocol):
         """Flush what is queued and release resources (idempotent)."""
 
 
-class WaveformSink(Protocol):
-    """A sink that also takes the accelerometer samples: `twin.vibration.sensor.WaveformBlock`s
-    (float32 [m/s^2], t0_s [s], sample_rate_hz [Hz]), handed over after the snapshot they came
-    with; the same rules (never block, drop-oldest, count)."""
-
-    def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
-        """Hand the blocks over without blocking (`seq`: the snapshot they came with)."""

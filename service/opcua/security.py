@@ -58,7 +58,7 @@ class PkiError(ValueError):
 
 def thumbprint(cert: x509.Certificate) -> str:
     """SHA-1 thumbprint of the DER certificate, upper-case hex (as OPC UA tools show it)."""
-    return cert.fingerprint(hashes.SHA1()).hex().upper()  # noqa: S303 - OPC UA's thumbprint is SHA-1
+    return cert.fingerprint(hashes.SHA1()).hex().upper()
 
 
 @dataclass(frozen=True)

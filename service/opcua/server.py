@@ -296,7 +296,7 @@ class OpcUaFacade:
     def _thread_main(self) -> None:
         try:
             asyncio.run(self._main())
-        except BaseException as exc:  # noqa: BLE001 - reported by start()
+        except BaseException as exc:
             if not self._ready.is_set():
                 self._error = exc
                 self._ready.set()
@@ -351,7 +351,7 @@ class OpcUaFacade:
                     await self._sync()
                     await self._send_alarms()
                     self.guard.logins.sweep()
-                except Exception:  # noqa: BLE001 - the server keeps serving
+                except Exception:
                     log.exception("OPC UA update failed")
                 try:
                     await asyncio.wait_for(self._stop.wait(), timeout=0.5 * self.period_s)

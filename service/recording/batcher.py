@@ -131,7 +131,7 @@ class RowBatcher:
             except (TypeError, ValueError) as exc:   # never raise into the runner: draw from azimuth
                 log.warning("rerun recorder: positions_m ignored: %s", exc)
         context = None
-        ctx = self.context.get(getattr(snapshot, "bearing_id", None))
+        ctx = self.context.get(str(getattr(snapshot, "bearing_id", "")))
         if ctx is not None:
             try:
                 context = scenario_text(ctx())

@@ -29,6 +29,8 @@ import stat
 from dataclasses import dataclass, field
 from pathlib import Path, PurePosixPath
 
+from service.recording.names import numbered_segments
+
 MAX_DEPTH = 8                 # components of a per-twin path (7 folders and the file)
 MAX_PATH_CHARS = 255          # characters of a per-twin path
 MAX_NAME_CHARS = 100          # characters of one component
@@ -206,8 +208,6 @@ def run_name(path: Path, run: int) -> Path:
 
 
 def _taken(path: Path) -> bool:
-    from service.recording.segments import numbered_segments
-
     return os.path.lexists(path) or bool(numbered_segments(path))
 
 

@@ -338,7 +338,7 @@ class SegmentWriter:
             self.retention.protect(created.path)
             try:
                 self.retention.apply()
-            except Exception:  # noqa: BLE001 - retention must never stop the recording
+            except Exception:
                 log.exception("retention failed")
         return created.path
 

@@ -13,6 +13,7 @@ from tqdm import tqdm
 from service.reports.figures import pyplot, save
 from twin.validation import studies, timestep_study
 from twin.validation.bench import run_engine_benchmark
+from twin import catalog
 from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.validation import thrust_bearing_seed001 as s001
@@ -115,7 +116,7 @@ def _fig_clearance(out: Path, quick: bool, progress) -> tuple[str, list]:
 def _fig_startup(out: Path, quick: bool) -> tuple[str, dict]:
     """Seed 000 Fig. 7: start-up, steady and slow-down of one ball at 500 rad/s, 3000 N."""
     ramp = 5000.0
-    twin = Twin("6208", options=ModelOptions(speed_ramp_rad_s2=ramp),
+    twin = Twin(catalog.DEFAULT_DESIGNATION, options=ModelOptions(speed_ramp_rad_s2=ramp),
                 setpoint=Setpoint(shaft_speed_rad_s=500.0, radial_load_n=3000.0))
     twin.reset(shaft_speed_rad_s=0.0)
     dt_s = 1e-3 if quick else 2.5e-4
@@ -214,7 +215,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
         thermal_md = thermal_section(out, quick)
         progress.update(1)
 
-    md = [f"# bearing-twin validation report\n\nGenerated {_dt.datetime.now(_dt.timezone.utc):%Y-%m-%d %H:%M UTC}"
+    md = [f"# bearing-twin validation report\n\nGenerated {_dt.datetime.now(_dt.UTC):%Y-%m-%d %H:%M UTC}"
           f"{' (quick mode)' if quick else ''}. 6208 of seed 000 Table 1, Hamrock-Dowson film (seed 000 eq. 6), "
           "Stribeck-line friction, eta = 0.04 Pa s, races 0.3 um.\n",
           "## Lambda against azimuth at 500 rad/s (seed 000 Fig. 8)\n",

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from pathlib import Path
 
-import numpy as np
 
 from service.reports.figures import pyplot, save
 from twin.thermal.network import NODE_NAMES

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from service.reports.figures import pyplot, save
+from twin.catalog import DEFAULT_DESIGNATION
 
 _LINES = (("ftf", "FTF", "tab:gray"), ("bpfo", "BPFO", "tab:red"), ("bpfi", "BPFI", "tab:green"),
           ("two_bsf", "2xBSF", "tab:purple"))
@@ -83,7 +84,7 @@ def vibration_section(out_dir, quick: bool = False) -> list[str]:
              "|---|---|---|---|---|---|"]
     for defect in (None, "outer", "inner", "ball"):
         name = defect or "healthy"
-        result, x = simulate_vibration("6208", defect=defect, **run)
+        result, x = simulate_vibration(DEFAULT_DESIGNATION, defect=defect, **run)
         png = f"vibration_{name}.png"
         plot_vibration(x, result, str(out / png))
         peaks = ", ".join(f"{p['frequency_hz']:.1f}" for p in result["envelope_peaks_hz"][:3])
@@ -94,7 +95,7 @@ def vibration_section(out_dir, quick: bool = False) -> list[str]:
               "Outer spall against its width (same conditions):\n",
               "| width [mm] | kurtosis | band kurtosis | RMS [m/s2] | BPFO envelope line [m/s2] |", "|---|---|---|---|---|"]
     for size in REPORT_SIZES_M[:2] if quick else REPORT_SIZES_M:
-        result, _ = simulate_vibration("6208", defect="outer", defect_size_m=size, **run)
+        result, _ = simulate_vibration(DEFAULT_DESIGNATION, defect="outer", defect_size_m=size, **run)
         lines.append(f"| {size * 1e3:g} | {result['kurtosis']:.2f} | {result['band_kurtosis']:.2f} | "
                      f"{result['rms_m_s2']:.3g} | {result['defect_lines']['bpfo']['harmonics'][0]:.3g} |")
     lines += ["", "A large spall can drive seed 000's 0.5 kg rotor into its radial mode (~3.1 kHz, ~0.5 % damping), "

@@ -1,5 +1,5 @@
-"""`bearing-twin` command line: simulate, bench, timestep-study, report, serve, router, scenario, bench-service,
-monitor, soak, attack, ehl, life, vibration.
+"""`bearing-twin` command line: simulate, bench, timestep-study, report, serve, router, scenario, monitor,
+ehl, life, vibration (the load tools soak, attack and bench-service are `bearing-twin-loadtest`).
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -13,9 +13,11 @@ import re
 import sys
 from pathlib import Path
 
+from service import __version__
 from service.tools.bench_results import save as save_result
-
 from service.tools.vibration_cli import add_analyse_command
+from twin.catalog import DEFAULT_DESIGNATION
+
 
 class ArgumentParser(argparse.ArgumentParser):
     """argparse with whole option names only (no abbreviations: `--clear` is not `--clearance`)
@@ -179,10 +181,12 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
 
 def build_parser() -> argparse.ArgumentParser:
     parser = ArgumentParser(prog="bearing-twin", description=__doc__)
+    parser.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = parser.add_subparsers(dest="command", required=True)
 
     sim = sub.add_parser("simulate", help="run one twin for a duration, print the final snapshot")
-    sim.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    sim.add_argument("--bearing", default=DEFAULT_DESIGNATION,
+                     help=f"catalog designation (default {DEFAULT_DESIGNATION})")
     sim.add_argument("--radial-load", type=float, default=3000.0, help="radial load [N]")
     sim.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     sim.add_argument("--speed", type=float, default=500.0, help="shaft speed [rad/s]")
@@ -222,7 +226,7 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--host", help="HTTP bind address (default 127.0.0.1: loopback only; "
                        "0.0.0.0 exposes the API on every interface) [BEARING_TWIN_HOST]")
     serve.add_argument("--port", type=int, help="HTTP port (default 8000) [BEARING_TWIN_PORT]")
-    serve.add_argument("--bearing", help="designation of the `default` twin (default 6208) [BEARING_TWIN_BEARING]")
+    serve.add_argument("--bearing", help=f"designation of the `default` twin (default {DEFAULT_DESIGNATION}) [BEARING_TWIN_BEARING]")
     serve.add_argument("--housing", action="store_true", default=None,
                        help="the `default` twin runs on the housing support with the accelerometer "
                        "(vibration; default off) [BEARING_TWIN_HOUSING]")
@@ -294,26 +298,13 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("files", nargs="+")
     check.set_defaults(func=_cmd_scenario_check)
 
-    bsv = sub.add_parser("bench-service", help="service benchmark: N twins in real time with zenoh and "
-                         "recording on: real-time factor and late fraction per twin, HTTP setpoint -> "
-                         "zenoh state delay (p50/p99)")
-    bsv.add_argument("--twins", type=_positive_int, default=1,
-                     help="twins to run: 6208, 6205, 7208, 6208 with 5 A, in turn (default 1)")
-    bsv.add_argument("--seconds", type=_positive_float, default=10.0, help="measurement time [s of wall time]")
-    bsv.add_argument("--rate", type=_positive_float, default=20.0, help="setpoints per second, all twins [Hz]")
-    bsv.add_argument("--force", action="store_true",
-                     help="admission off: run every twin even beyond the measured capacity")
-    bsv.add_argument("--no-zenoh", action="store_true", help="without zenoh (then no setpoint delay)")
-    bsv.add_argument("--no-record", action="store_true", help="without the rerun recording")
-    bsv.add_argument("--json", action="store_true")
-    bsv.set_defaults(func=_cmd_bench_service)
-
     vib = sub.add_parser(
         "vibration", help="housing acceleration with a local defect: indicators, defect frequencies, envelope peaks",
         description="Run the twin with its outer ring on the housing (Sawalhi & Randall 2008 support, accelerometer "
         "sampled in the kernel) and an optional local defect, discard 0.05 s, analyse `--duration` of the signal "
         "(twin.vibration.run.simulate_vibration).")
-    vib.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    vib.add_argument("--bearing", default=DEFAULT_DESIGNATION,
+                     help=f"catalog designation (default {DEFAULT_DESIGNATION})")
     vib.add_argument("--speed", type=float, default=None, help="shaft speed [rad/s] (required)")
     vib.add_argument("--radial-load", type=float, default=None, help="radial load [N] (required)")
     vib.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
@@ -337,12 +328,7 @@ def build_parser() -> argparse.ArgumentParser:
     from service.tools.router import add_router_command
 
     add_router_command(sub)
-    from service.tools.soak import add_soak_command
-
-    add_soak_command(sub)
-    from service.tools.attack import add_attack_command
-
-    add_attack_command(sub)
+    _add_moved_load_tools(sub)
     from service.tools.ehl_cli import add_ehl_command
 
     add_ehl_command(sub)
@@ -355,35 +341,20 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _cmd_bench_service(args: argparse.Namespace) -> int:
-    from service.tools.benchmark import run_service_benchmark
+LOAD_TOOLS = ("bench-service", "soak", "attack")
 
-    try:
-        r = run_service_benchmark(twins=args.twins, seconds=args.seconds, rate_hz=args.rate,
-                                  record=not args.no_record, zenoh_on=not args.no_zenoh, force=args.force)
-    except RuntimeError as exc:
-        print(f"error: {' '.join(str(exc).split())[:2000]}", file=sys.stderr)
-        return 1
-    if args.json:
-        print(json.dumps(r))
-        return 0
-    f = lambda v, spec="{:.2f}": "-" if v is None else spec.format(v)  # noqa: E731
-    print(f"{len(r['twins'])} twin(s) in real time, frames of {f(r['frame_s'], '{:g}')} s, zenoh "
-          f"{'on' if r['zenoh'] else 'off'}, recording {'on' if r['recording'] else 'off'}, admission "
-          f"{r['admission']}; {r['setpoints']} setpoints in {r['seconds']:g} s")
-    for t in r["twins"]:
-        print(f"  {t['id']:<14} {t['designation']:<5} real-time factor median {f(t['real_time_factor_median'], '{:.3f}')} "
-              f"(min {f(t['real_time_factor_min'], '{:.3f}')}), late {f(t['late_fraction'], '{:.2%}')} of "
-              f"{t['frames']} frames, dropped {t['dropped']}, PUT -> zenoh p99 {f(t['client_latency_ms_p99'])} ms")
-    for t in r["refused"]:
-        print(f"  {t['id']:<14} {t['designation']:<5} refused ({t['status']}): {t['message']}")
-    print(f"  HTTP PUT -> zenoh state [ms]: p50 {f(r['client_latency_ms_p50'])}, "
-          f"p99 {f(r['client_latency_ms_p99'])}, max {f(r['client_latency_ms_max'])}, lost {r['client_lost']}")
-    cap = r.get("capacity") or {}
-    if cap:
-        print(f"  capacity: {f(cap.get('used_cpu_s_per_s'), '{:.3f}')} of {f(cap.get('budget_cpu_s_per_s'), '{:.3f}')} "
-              f"CPU s per s in use; max twins like the last calibrated one: {cap.get('max_twins')}")
-    return 0
+
+def _add_moved_load_tools(sub) -> None:
+    """The load tools live in the `loadtest` package (`bearing-twin-loadtest`, extra `loadtest`):
+    their old subcommand names answer with where to find them."""
+    for name in LOAD_TOOLS:
+        sub.add_parser(name, help=f"moved: `bearing-twin-loadtest {name}` (pip install '.[loadtest]')")
+
+
+def _moved_load_tool(name: str) -> int:
+    print(f"error: `{name}` is a load tool: run `bearing-twin-loadtest {name} ...` "
+          "(install it with pip install '.[loadtest]')", file=sys.stderr)
+    return 2
 
 
 def _add_monitor(sub) -> None:
@@ -458,7 +429,6 @@ def _cmd_serve(args: argparse.Namespace) -> int:
               file=sys.stderr)
         return 2
 
-    import uvicorn
 
     from service.api.app import create_app
     from service.settings import is_loopback_host
@@ -561,7 +531,7 @@ def _interruptible_server_class():
     return InterruptibleServer
 
 
-def _InterruptibleServer(config):  # noqa: N802 - a class made on demand (uvicorn imported lazily)
+def _InterruptibleServer(config):
     return _interruptible_server_class()(config)
 
 
@@ -673,6 +643,9 @@ def _cmd_report(args: argparse.Namespace) -> int:
 
 
 def main(argv: list[str] | None = None) -> int:
+    argv = sys.argv[1:] if argv is None else argv
+    if argv and argv[0] in LOAD_TOOLS:
+        return _moved_load_tool(argv[0])
     args = build_parser().parse_args(argv)
     try:
         status = args.func(args)

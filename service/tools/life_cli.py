@@ -7,6 +7,8 @@ import argparse
 import json
 import sys
 
+from twin.catalog import DEFAULT_DESIGNATION
+
 _CONTAMINATION = ("extreme_cleanliness", "high_cleanliness", "normal_cleanliness",
                   "slight_to_typical_contamination", "severe_contamination", "very_severe_contamination")
 
@@ -19,7 +21,8 @@ def add_life_command(sub) -> None:
         description="ISO 281:2007 basic and modified rating life of a catalogue bearing at one steady operating "
         "point, and the life from the contact loads (Lundberg-Palmgren per raceway, ISO/TS 16281 spirit) of the "
         "twin's quasi-static equilibrium (a short DEM run where the equilibrium does not converge).")
-    p.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    p.add_argument("--bearing", default=DEFAULT_DESIGNATION,
+                     help=f"catalog designation (default {DEFAULT_DESIGNATION})")
     p.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
     p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     p.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")

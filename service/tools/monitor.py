@@ -26,20 +26,18 @@ import time
 from typing import Any
 
 from service.core.alarms import finite_number
+from service.keys import ALIVE, DEFAULT_PREFIX, STATE, all_twins
 from service.tools.client import strict_json
 
-DEFAULT_PREFIX = "bearing"
-DEFAULT_KEYEXPR = "bearing/*/state"
 DEFAULT_CONNECT = ["tcp/127.0.0.1:7447"]
-ALIVE_KEYEXPR = "bearing/*/alive"
 
 
 def twin_keys(prefix: str) -> tuple[str, str]:
     """(state, liveliness) key expressions of the twins under `prefix` (canonical form)."""
     import zenoh
 
-    return (str(zenoh.KeyExpr.autocanonize(f"{prefix}/*/state")),
-            str(zenoh.KeyExpr.autocanonize(f"{prefix}/*/alive")))
+    return (str(zenoh.KeyExpr.autocanonize(all_twins(prefix, STATE))),
+            str(zenoh.KeyExpr.autocanonize(all_twins(prefix, ALIVE))))
 _REFRESH_S = 0.25
 _ONCE_SETTLE_S = 0.5
 

@@ -27,7 +27,6 @@ from typing import Any
 from service.core.alarm_hub import AlarmHub
 from service.core.alarms import AlarmEvent
 from service.core.runner import TwinRunner
-from service.core.scenario_driver import ScenarioHandle
 from service.core.scenarios import ResolvedRun, Scenario
 from service.settings import AlarmSettings
 from twin.engine import Twin
@@ -76,28 +75,38 @@ class RunResult:
 
 
 class TableSink:
-    """Collects flattened rows (a plain list append: lossless, never blocks)."""
+    """Collects flattened rows (a plain list append: lossless, never blocks).
+
+    `begin` is called before the runner starts, so every row of a run carries its context. The
+    run's scenario time is the snapshot's time minus that of the run's first row: the runner
+    publishes its first sample of a scenario run at the frame the scenario takes over
+    (`TwinRunner.start(publish_initial=False)`, then a sample at the scenario's start), in its own
+    thread; the twin's time read from the caller's thread would race with that thread."""
 
     def __init__(self) -> None:
         self.rows: list[dict[str, Any]] = []
         self.dropped = 0
         self._context: dict[str, Any] = {}
-        self._handle: ScenarioHandle | None = None
-        self._t0 = 0.0
+        self._runner: TwinRunner | None = None
+        self._t0: float | None = None
 
-    def begin(self, run: ResolvedRun, handle: ScenarioHandle, lubricant: str, t0: float) -> None:
+    def begin(self, run: ResolvedRun, runner: TwinRunner, lubricant: str) -> None:
+        """A new run on `runner`, whose scenario handle gives each row its phase at publish time."""
         self._context = {"run": run.id, "run_label": run.label, "bearing": run.bearing,
                          "diametral_clearance_m": run.diametral_clearance_m, "lubricant": lubricant}
-        self._handle, self._t0 = handle, t0
+        self._runner, self._t0 = runner, None
 
     def publish(self, snapshot: Snapshot) -> None:
         row = dict(self._context)
-        row["phase"] = self._handle.phase if self._handle is not None else None
+        handle = self._runner.scenario if self._runner is not None else None
+        row["phase"] = handle.phase if handle is not None else None
         flat = flatten_snapshot(snapshot)
         row["seq"] = flat.pop("seq", None)
         row["time_s"] = flat.pop("time_s", None)
+        if self._t0 is None and row["time_s"] is not None:
+            self._t0 = row["time_s"]
         row["scenario_time_s"] = (round(row["time_s"] - self._t0, 9)
-                                  if row["time_s"] is not None else None)
+                                  if row["time_s"] is not None and self._t0 is not None else None)
         row.update(flat)
         self.rows.append(row)
 
@@ -170,10 +179,10 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
                 recorder.add_twin_from(twin, context=lambda runner=runner: runner.scenario)
                 runner.add_sink(recorder)
             t_wall = time.perf_counter()
+            table.begin(run, runner, spec.lubricant.name)
+            rows_before = len(table.rows)
             runner.start(publish_initial=False)
             handle, _ = runner.start_scenario(run)
-            table.begin(run, handle, spec.lubricant.name, twin.time_s)
-            rows_before = len(table.rows)
             deadline = time.monotonic() + max(min_timeout_s, timeout_factor * run.duration_s)
             try:
                 while not handle.wait(0.1):

@@ -1,7 +1,6 @@
 """The friction power by source (twin.friction_power, Twin.friction_power_w) and the friction
 torque's definition (Twin._dissipative_torque_n_m)."""
 
-import math
 
 import numpy as np
 import pytest

@@ -10,7 +10,7 @@ import hmac
 import httpx
 import pytest
 
-from service.core.admission import AdmissionGate, bearer_token, token_matches
+from service.core.admission import bearer_token, token_matches
 from service.settings import ServiceSettings
 
 TOKEN = "s3cret-Token_for.tests"

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import pytest
 
-from service.tools.attack import AttackConfig, check_loopback, format_report, run_attack
+from loadtest.attack import AttackConfig, check_loopback, format_report, run_attack
 
 
 def test_attack_short_run_with_its_own_service():
@@ -37,7 +37,7 @@ def test_attack_short_run_with_its_own_service():
     assert set(r["targets"]) == {"real_time_factor_median_min", "health_p99_ms_max", "real_time_factor_median",
                                  "health_p99_ms", "met"}
     assert r["shutdown"]["clean"]
-    # the floods on what watchers use (service.tools.attack_watchers): the squatter (refused a link by
+    # the floods on what watchers use (loadtest.attack_watchers): the squatter (refused a link by
     # zenoh access control) blocks no create and no answer repeats it; no guessed password opens a
     # session; sessions, subscriptions and items stay within the default limits (service.opcua.guard)
     sq, logins, sessions, subs = (r[k] for k in ("squat", "opcua_logins", "opcua_sessions", "opcua_subscriptions"))

@@ -192,7 +192,7 @@ def test_after_the_fuzzing_the_service_is_alive_and_finite(fuzz_server):
                                                           "shaft_current_a": 0.0, "shaft_voltage_v": 0.0})
     assert r.status_code in (200, 422), r.text   # 422 only if a value was learned as not held
     seq = client.get("/v1/bearings/default/state").json()["seq"]
-    client_state = lambda: client.get("/v1/bearings/default/state").json()
+    client_state = lambda: client.get("/v1/bearings/default/state").json()  # noqa: E731
     deadline = time.monotonic() + 30
     while client_state()["seq"] <= seq:
         assert time.monotonic() < deadline, "the twin stopped publishing"

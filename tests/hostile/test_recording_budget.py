@@ -20,7 +20,7 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.recording import read_index, recording_segments  # noqa: E402
+from service.recording import read_index, recording_segments
 
 RUN_S = 30.0
 TORQUE = "bearing/default/friction_torque_n_m"

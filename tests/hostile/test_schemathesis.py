@@ -8,11 +8,11 @@ from __future__ import annotations
 import pytest
 
 schemathesis = pytest.importorskip("schemathesis")
-from hypothesis import HealthCheck, settings
-from schemathesis.checks import not_a_server_error
+from hypothesis import HealthCheck, settings  # noqa: E402
+from schemathesis.checks import not_a_server_error  # noqa: E402
 
-from service.api.app import create_app
-from service.settings import ServiceSettings
+from service.api.app import create_app  # noqa: E402
+from service.settings import ServiceSettings  # noqa: E402
 
 EXAMPLES = 60
 

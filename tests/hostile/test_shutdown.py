@@ -9,7 +9,6 @@ from __future__ import annotations
 import hashlib
 import json
 import signal
-import time
 
 import httpx
 import pytest
@@ -17,13 +16,13 @@ import pytest
 zenoh = pytest.importorskip("zenoh")
 pytest.importorskip("rerun")
 
-from service.recording import (
+from service.recording import (  # noqa: E402
     describe_recording,
     read_index,
     read_recording,
     recording_segments,
 )
-from service.recording.reader import open_reader as _reader
+from service.recording.reader import open_reader as _reader  # noqa: E402
 
 TOKEN = "shutdown-test-token"
 AUTH = {"Authorization": f"Bearer {TOKEN}"}

@@ -1,4 +1,4 @@
-"""`bearing-twin soak` (issue 6), the short CI version: 18 s against its own `serve` subprocess
+"""`bearing-twin-loadtest soak`, the short CI version: 18 s against its own `serve` subprocess
 (free loopback ports, token, recording in a temp dir), then SIGTERM and the recording read back.
 The figures are reported, not judged against wall-clock thresholds (a shared, noisy machine):
 what must hold is no 5xx, no unexpected answer, no lost zenoh result, a finite state stream and
@@ -7,22 +7,27 @@ a complete recording."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
 from service.settings import ServiceSettings
-from service.tools.soak import SoakConfig, _memory, format_report, run_soak
+from loadtest.soak import SoakConfig, _memory, format_report, run_soak
+
+# `python -m loadtest` from any folder finds this tree's package
+LOADTEST_ENV = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}
 
 
 def test_soak_short_run_with_its_own_service(hostile, tmp_path):
     pytest.importorskip("zenoh")
     pytest.importorskip("rerun")
     # the service's recording rotates every 4 s: the check reads every segment back
-    cmd = [sys.executable, "-m", "service.cli", "soak", "--minutes", "0.3", "--start", "--json",
+    cmd = [sys.executable, "-m", "loadtest", "soak", "--minutes", "0.3", "--start", "--json",
            "--seed", "7", "--rate", "12", "--record-segment-s", "4"]
-    proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=300)
+    proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=300, env=LOADTEST_ENV)
     assert proc.stdout.strip(), proc.stderr
     r = json.loads(proc.stdout)
     detail = json.dumps(r, indent=1) + "\n" + proc.stderr[-3000:]
@@ -77,8 +82,8 @@ def test_memory_growth_uses_the_first_sample_after_the_warm_up():
 def test_soak_refuses_unbounded_runs():
     with pytest.raises(ValueError):
         run_soak(SoakConfig(minutes=float("inf")))
-    proc = subprocess.run([sys.executable, "-m", "service.cli", "soak", "--minutes", "0"],
-                          capture_output=True, text=True, timeout=60)
+    proc = subprocess.run([sys.executable, "-m", "loadtest", "soak", "--minutes", "0"],
+                          capture_output=True, text=True, timeout=60, env=LOADTEST_ENV)
     assert proc.returncode == 2 and "--minutes" in proc.stderr
 
 
@@ -102,7 +107,7 @@ def _segmented_recording(tmp_path, groups):
 
 def test_recording_check_reads_every_segment(tmp_path):
     pytest.importorskip("rerun")
-    from service.tools.soak import _check_recording
+    from loadtest.soak import _check_recording
 
     rec = _segmented_recording(tmp_path, (4, 6, 5))
     r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None)
@@ -119,7 +124,7 @@ def test_short_runs_report_memory_growth_without_judging_it():
     """A 30 s soak: the warm-up is 10 s and the 20 s after it are too short to tell a leak from
     a one-off settling step (a +28 MB step 28 s into a run, flat afterwards, was seen), so the
     growth is reported, not judged; a run with 60 s or more after its warm-up is judged."""
-    from service.tools.soak import MIN_JUDGED_WINDOW_S, warmup_s
+    from loadtest.soak import MIN_JUDGED_WINDOW_S, warmup_s
 
     mib = 2**20
     assert warmup_s(30.0) == 10.0 and warmup_s(120.0) == 30.0 and warmup_s(600.0) == 60.0
@@ -131,7 +136,7 @@ def test_short_runs_report_memory_growth_without_judging_it():
 
 
 def test_a_clean_sigterm_shutdown_reads_as_such():
-    from service.tools.soak import _shutdown_text
+    from loadtest.soak import _shutdown_text
 
     assert _shutdown_text({"killed": False, "exit_code": -15, "seconds": 0.2}) == "clean shutdown in 0.2 s"
     assert _shutdown_text({"killed": False, "exit_code": 0, "seconds": 0.2}) == "clean shutdown in 0.2 s"

@@ -92,7 +92,7 @@ class Spy:
         for entity in self._keep:
             try:
                 entity.undeclare()
-            except Exception:
+            except Exception:  # noqa: BLE001
                 pass
         self.session.close()
 
@@ -379,7 +379,7 @@ def test_a_client_with_wrong_credentials_cannot_join(hostile, users):
     router, _ = open_router(RouterSettings(zenoh_listen=[endpoint], zenoh_usersfile=path, zenoh_readers=["viewer"]))
     try:
         for user, password in ((None, None), ("viewer", "wrong"), ("nobody", pw["viewer"])):
-            with pytest.raises(Exception):
+            with pytest.raises(Exception):  # noqa: B017
                 zenoh.open(make_config([], [endpoint], "client", access=ZenohAccess(user=user, password=password)))
         ok = zenoh.open(make_config([], [endpoint], "client", access=ZenohAccess(user="viewer", password=pw["viewer"])))
         ok.close()
@@ -477,7 +477,7 @@ def test_mutual_tls_roles_by_certificate_common_name(hostile, tmp_path):
             for name in seen:
                 sessions[name] = client(name)
                 subs.append(sessions[name].declare_subscriber("bearing/*/state", lambda smp, n=name: seen[n].append(1)))
-            with pytest.raises(Exception):
+            with pytest.raises(Exception):  # noqa: B017
                 zenoh.open(make_config([], [endpoint], "client"))            # no certificate
             _wait(lambda: len(seen["viewer"]) >= CONTROL_N and len(seen["op"]) >= CONTROL_N, what="states")
             before = channel.setpoints_received

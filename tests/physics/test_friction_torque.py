@@ -58,7 +58,6 @@ def _spin_moments(twin):
     spin = c[L.K_WX] * c[L.G_NX] + c[L.K_WY] * c[L.G_NY] + (c[L.K_WZ] - c[L.K_SPIN]) * c[L.G_NZ]
     applied = np.clip(c[L.E_SPIN_MOMENT] + c[L.E_SPIN_SLOPE] * (spin - c[L.E_SPIN_RATE]),
                       -c[L.E_SPIN_CAP], c[L.E_SPIN_CAP])[loaded]
-    m = twin.model
     evaluate(*twin._kernel_args())
     return applied, twin.state.contacts[L.E_SPIN_MOMENT][loaded].copy()
 

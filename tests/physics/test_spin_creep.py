@@ -6,7 +6,6 @@ Hertz pressure (for a circle M = 3 pi / 8; Johnson, Contact Mechanics, ch. 8, fu
 
 import math
 
-import numpy as np
 import pytest
 from scipy import integrate
 

@@ -86,14 +86,14 @@ class HeadlessChromium:
     def close(self) -> None:
         try:
             self.ws.close()
-        except Exception:
+        except Exception:  # noqa: BLE001 - best-effort teardown
             pass
         try:
             os.killpg(self.proc.pid, signal.SIGTERM)
             self.proc.wait(timeout=10)
-        except Exception:
+        except Exception:  # noqa: BLE001 - best-effort teardown
             try:
                 os.killpg(self.proc.pid, signal.SIGKILL)
-            except Exception:
+            except Exception:  # noqa: BLE001 - best-effort teardown
                 pass
         shutil.rmtree(self.profile, ignore_errors=True)

@@ -15,10 +15,10 @@ import pytest
 
 pytest.importorskip("asyncua")
 pytest.importorskip("zenoh")
-from asyncua import Client  # noqa: E402
+from asyncua import Client
 
-from service.opcua.layout import EVENT_TYPE, NAMESPACE_URI, ROOT_FOLDER  # noqa: E402
-from service.settings import AlarmSettings, ServiceSettings  # noqa: E402
+from service.opcua.layout import EVENT_TYPE, NAMESPACE_URI, ROOT_FOLDER
+from service.settings import AlarmSettings, ServiceSettings
 
 WAIT_S = 120.0
 DELAY_S = 0.05       # lubrication on-delay [s of simulated time]

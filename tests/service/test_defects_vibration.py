@@ -24,10 +24,10 @@ import pytest
 
 pytest.importorskip("zenoh")
 
-from service.settings import AlarmSettings, ServiceSettings  # noqa: E402
-from twin import catalog  # noqa: E402
-from twin.vibration.defects import race_limits  # noqa: E402
-from twin.vibration.waveform import decode_chunk  # noqa: E402
+from service.settings import AlarmSettings, ServiceSettings
+from twin import catalog
+from twin.vibration.defects import race_limits
+from twin.vibration.waveform import decode_chunk
 
 WAIT_S = 180.0
 WINDOW_S = 0.25

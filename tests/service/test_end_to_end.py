@@ -24,7 +24,7 @@ zenoh = pytest.importorskip("zenoh")
 pytest.importorskip("rerun")
 httpx = pytest.importorskip("httpx")
 
-from twin.snapshot import Snapshot
+from twin.snapshot import Snapshot  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 WAIT_S = 30.0
@@ -89,7 +89,7 @@ class Service:
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait(10)
-            raise AssertionError("service did not stop on SIGTERM:\n" + "".join(self.log))
+            raise AssertionError("service did not stop on SIGTERM:\n" + "".join(self.log)) from None
         return time.monotonic() - t0
 
     def kill(self):

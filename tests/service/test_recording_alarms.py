@@ -10,10 +10,10 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.core.alarms import ALARM_IDS, AlarmEvaluator, AlarmInputs  # noqa: E402
-from service.recording import RerunRecorder, describe_recording, read_column, recording_segments  # noqa: E402
-from service.settings import AlarmSettings  # noqa: E402
-from twin.engine import Twin  # noqa: E402
+from service.core.alarms import ALARM_IDS, AlarmEvaluator, AlarmInputs
+from service.recording import RerunRecorder, describe_recording, read_column, recording_segments
+from service.settings import AlarmSettings
+from twin.engine import Twin
 
 FRAME_S = 0.02
 

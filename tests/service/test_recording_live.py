@@ -27,8 +27,8 @@ pytest.importorskip("rerun")
 pytest.importorskip("zenoh")
 pytest.importorskip("httpx")
 
-from service.recording.layout import REGIME_RGB  # noqa: E402
-from service.recording.live import LiveViewerError, check_bind, is_loopback  # noqa: E402
+from service.recording.layout import REGIME_RGB
+from service.recording.live import LiveViewerError, check_bind, is_loopback
 
 
 def _sibling(name: str):
@@ -78,7 +78,7 @@ def _regime_pixels(png: bytes) -> int:
 
 def _listeners(port: int) -> list[str]:
     out = subprocess.run(["ss", "-ltnH", f"sport = :{port}"], capture_output=True, text=True).stdout
-    return re.findall(r"\s(\S+):%d\s" % port, out)
+    return re.findall(rf"\s(\S+):{port}\s", out)
 
 
 @pytest.mark.skipif(chromium_path() is None, reason="needs Chromium (apt-get install chromium; .ci/run installs it)")

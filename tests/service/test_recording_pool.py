@@ -14,15 +14,15 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.recording import (  # noqa: E402
+from service.recording import (
     RerunRecorder,
     RerunStreams,
     describe_recording,
     read_index,
     read_recording,
 )
-from service.recording.reader import open_reader as _reader  # noqa: E402
-from twin.engine import Twin  # noqa: E402
+from service.recording.reader import open_reader as _reader
+from twin.engine import Twin
 
 FRAME_S = 0.002
 GEOMETRY = ("inner_raceway", "outer_raceway", "pitch_circle", "load_line")

@@ -13,13 +13,13 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.core.alarms import ALARM_IDS  # noqa: E402
-from service.recording import RerunRecorder, describe_recording, read_column, read_index  # noqa: E402
-from service.recording.archive import WaveformArchive  # noqa: E402
-from service.recording.columns import WaveRow  # noqa: E402
-from service.recording.layout import SERIES, TREND_BANDS, TwinLayout, blueprint  # noqa: E402
-from service.recording.trends import OFF_SCALE_DECADES, _capacitance_scale, split_windows  # noqa: E402
-from twin.engine import Twin  # noqa: E402
+from service.core.alarms import ALARM_IDS
+from service.recording import RerunRecorder, describe_recording, read_column, read_index
+from service.recording.archive import WaveformArchive
+from service.recording.columns import WaveRow
+from service.recording.layout import SERIES, TREND_BANDS, TwinLayout, blueprint
+from service.recording.trends import OFF_SCALE_DECADES, _capacitance_scale, split_windows
+from twin.engine import Twin
 
 FRAME_S = 0.02      # 50 Hz snapshots
 WINDOW_S = 0.2      # 10 snapshots per trend window

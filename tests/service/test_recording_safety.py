@@ -24,7 +24,7 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.recording import (  # noqa: E402
+from service.recording import (
     RecordingPathError,
     RerunRecorder,
     check_relative_path,
@@ -32,7 +32,7 @@ from service.recording import (  # noqa: E402
     read_index,
     recording_segments,
 )
-from service.settings import ServiceSettings  # noqa: E402
+from service.settings import ServiceSettings
 
 needs_proc = pytest.mark.skipif(not os.path.isdir("/proc/self/task"), reason="counts threads and fds in /proc")
 TORQUE = "bearing/default/friction_torque_n_m"

@@ -12,11 +12,11 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.recording import RerunRecorder, describe_recording, read_column  # noqa: E402
-from twin import catalog  # noqa: E402
-from twin.engine import Twin  # noqa: E402
-from twin.setpoint import Setpoint  # noqa: E402
-from twin.spec import BearingSpec  # noqa: E402
+from service.recording import RerunRecorder, describe_recording, read_column
+from twin import catalog
+from twin.engine import Twin
+from twin.setpoint import Setpoint
+from twin.spec import BearingSpec
 
 FRAME_S = 0.01
 WINDOW_S = 0.05

@@ -11,8 +11,8 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.recording import RerunRecorder, describe_recording, read_column, read_index  # noqa: E402
-from twin.engine import Twin  # noqa: E402
+from service.recording import RerunRecorder, describe_recording, read_column, read_index
+from twin.engine import Twin
 
 FRAME_S = 0.02      # one snapshot per 20 ms of simulated time (50 Hz)
 

@@ -14,11 +14,11 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.core.alarms import inputs_from_snapshot  # noqa: E402
-from service.core.scenarios import load_scenario  # noqa: E402
-from service.recording import read_column  # noqa: E402
-from service.settings import AlarmSettings, ServiceSettings  # noqa: E402
-from service.tools.offline import TableSink, run_scenario  # noqa: E402
+from service.core.alarms import inputs_from_snapshot
+from service.core.scenarios import load_scenario
+from service.recording import read_column
+from service.settings import AlarmSettings, ServiceSettings
+from service.tools.offline import TableSink, run_scenario
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "lubrication_alarm.yaml"
 WAIT_S = 240.0

@@ -12,7 +12,7 @@ from twin.kernels import layout as L
 from twin.model import make_model
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.defects import (
-    BallDefect, OuterRaceSpall, contact_defect_drop_m, defect_row, edge_drop_m, pit_drop_m,
+    OuterRaceSpall, contact_defect_drop_m, defect_row, edge_drop_m, pit_drop_m,
     quat_integrate, quat_rotate, race_limits, validate_defect, validate_defects,
 )
 

@@ -9,14 +9,17 @@ REGIME_BOUNDARY = 1
 REGIME_MIXED = 2
 REGIME_FULL_FILM = 3
 REGIME_NAMES = ("no_contact", "boundary", "mixed", "full_film")
+# seed 000 Table 2: the film parameter Lambda [-] up to which a contact is boundary, then mixed
+BOUNDARY_LAMBDA_MAX = 1.0
+MIXED_LAMBDA_MAX = 3.0
 
 
 @njit(**JIT)
 def regime_code(film_parameter):
     """Seed 000 Table 2: boundary for Lambda <= 1, mixed for 1 < Lambda <= 3, full film above."""
-    if film_parameter <= 1.0:
+    if film_parameter <= BOUNDARY_LAMBDA_MAX:
         return REGIME_BOUNDARY
-    if film_parameter <= 3.0:
+    if film_parameter <= MIXED_LAMBDA_MAX:
         return REGIME_MIXED
     return REGIME_FULL_FILM
 

@@ -88,15 +88,6 @@ def eyring_saturation_slip_m_s(film_m, viscosity_pa_s, pressure_pa, eyring_stres
 
 
 @njit(**JIT)
-def asperity_slip_fraction(slip_m_s, regularisation_slip_m_s):
-    """sgn_reg(s) = s / sqrt(s^2 + s_a^2): Coulomb's sign of the asperity friction, smoothed over
-    the slip s_a so that the traction is a continuous, monotone function of the slip (needed to
-    locate the no-slip lines; results are insensitive to s_a well below the differential slip,
-    tests/kernels/test_traction.py)."""
-    return slip_m_s / math.sqrt(slip_m_s * slip_m_s + regularisation_slip_m_s * regularisation_slip_m_s)
-
-
-@njit(**JIT)
 def traction_capacity(asperity_share, asperity_mu, limiting_shear_coefficient):
     """Largest net traction coefficient of a contact, every element sliding one way [-]:
     Qa/Q mu(Lambda) + (1 - Qa/Q) gamma (the traction law above at large slip)."""

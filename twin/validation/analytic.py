@@ -85,25 +85,6 @@ def radial_equilibrium(model: BearingModel, radial_load_n: float, azimuths_rad,
     }
 
 
-def qmax_continuous_n(model: BearingModel, radial_load_n: float, clearance_m: float) -> tuple[float, float]:
-    """(Qmax [N], eps) from the continuous Stribeck-Sjovall integral: solves
-    Fr = Z K_eff delta_r^1.5 (1 - 1/(2 eps))^... in its integral form (Harris eq. 7.40 style)."""
-    k = series_stiffness_n_m15(model.race_params[0, L.R_STIFFNESS], model.race_params[1, L.R_STIFFNESS])
-    z = model.ball_count
-
-    def fr_of(delta_r):
-        eps = load_parameter_epsilon(delta_r, clearance_m)
-        qmax = k * max(delta_r - 0.5 * clearance_m, 0.0) ** 1.5
-        return qmax * z * radial_integral(eps) - radial_load_n
-
-    lo = max(0.5 * clearance_m, 0.0) + 1e-12
-    delta_r = optimize.brentq(fr_of, lo, 1e-3, xtol=1e-15)
-    eps = load_parameter_epsilon(delta_r, clearance_m)
-    return k * (delta_r - 0.5 * clearance_m) ** 1.5, eps
-
-
-# ---- Jones quasi-static solution of angular-contact and deep-groove ball bearings ---------------
-
 @dataclass(frozen=True)
 class JonesSolution:
     """Quasi-static equilibrium of the inner ring and every ball (Jones 1960; Harris & Kotzalas,

@@ -46,7 +46,7 @@ from twin.jit import JIT
 # costs reference counting of each array (measured ~100 ns per step for these on the test machine).
 JIT_INLINE = dict(JIT, inline="always")
 
-_FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+_FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
 # Whether a bearing's outer ring rides on the housing unless its spec says otherwise. Off: with the
 # housing on, two seed checks leave their tolerances at the auto step (the 7208 B's inner-ring

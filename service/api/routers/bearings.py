@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from fastapi import APIRouter
 
 from service.api.deps import RegistryDep, TwinDep
 from service.api.schemas import BearingCreate, BearingInfo, ErrorResponse, ScenarioStatus
 from service.core.registry import TwinEntry
+from service.keys import DEFAULT_PREFIX, STATE, twin_key
 
-UNKNOWN_TWIN = {404: {"model": ErrorResponse, "description": "Unknown twin"}}
-INVALID = {422: {"model": ErrorResponse, "description": "Invalid input: field, message, allowed range"}}
+UNKNOWN_TWIN: dict[int | str, dict[str, Any]] = {404: {"model": ErrorResponse, "description": "Unknown twin"}}
+INVALID: dict[int | str, dict[str, Any]] = {422: {"model": ErrorResponse, "description": "Invalid input: field, message, allowed range"}}
 
 read = APIRouter(prefix="/v1/bearings", tags=["bearings"])
 write = APIRouter(prefix="/v1/bearings", tags=["bearings"])
@@ -27,7 +30,8 @@ def bearing_info(entry: TwinEntry) -> BearingInfo:
         setpoint=r.target_setpoint, limits=r.limits.as_dict(),
         scenario=ScenarioStatus(**handle.status()) if handle is not None else None,
         state_url=f"/v1/bearings/{entry.id}/state",
-        zenoh_state_key=f"{getattr(entry.channel, 'prefix', None) or 'bearing/' + entry.id}/state")
+        zenoh_state_key=twin_key(entry.channel.bus.prefix if entry.channel is not None else DEFAULT_PREFIX,
+                                 entry.id, STATE))
 
 
 @read.get("", response_model=list[BearingInfo])

@@ -29,7 +29,7 @@ _VOCABULARY = (
 class DefectsRequest(BaseModel):
     """The complete set of local defects (replaces the active ones; [] clears them)."""
 
-    model_config = ConfigDict(extra="forbid")
+    model_config = ConfigDict(extra="forbid", strict=True)
     defects: list[dict[str, Any]] = Field(max_length=64, description=_VOCABULARY)
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Any
 
 from fastapi import APIRouter, Body, Depends
 
@@ -13,7 +13,7 @@ from twin.setpoint import SetpointUpdate
 
 write = APIRouter(prefix="/v1/bearings", tags=["bearings"])
 
-TOO_MANY = {429: {"model": ErrorResponse, "description": "Too many setpoints for this twin; see Retry-After",
+TOO_MANY: dict[int | str, dict[str, Any]] = {429: {"model": ErrorResponse, "description": "Too many setpoints for this twin; see Retry-After",
                   "headers": {"Retry-After": {"schema": {"type": "integer"}, "description": "seconds"}}}}
 
 

@@ -15,10 +15,10 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
-from service.bus.zenoh_bus import ZenohBus, make_config, wait_until
-from service.tools.monitor import add_monitor_command, run_monitor
-from twin.engine import Twin
-from twin.setpoint import SetpointLimits, SetpointUpdate
+from service.bus.zenoh_bus import ZenohBus, make_config  # noqa: E402
+from service.tools.monitor import add_monitor_command, run_monitor  # noqa: E402
+from twin.engine import Twin  # noqa: E402
+from twin.setpoint import SetpointLimits, SetpointUpdate  # noqa: E402
 
 WAIT_S = 10.0
 
@@ -68,7 +68,7 @@ def validating_on_setpoint(applied: list):
 
 
 # ---- (a) state and ball messages ------------------------------------------------------------
-def test_state_and_ball_messages_reach_a_remote_session(bus, client, twin):
+def test_state_and_ball_messages_reach_a_remote_session(bus, client, twin, support):
     snap = twin.snapshot()
     channel = bus.attach_twin("t1", lambda: snap, lambda p: {"accepted": False, "error": "n/a"})
     client.subscribe("bearing/t1/state")
@@ -91,7 +91,7 @@ def test_state_and_ball_messages_reach_a_remote_session(bus, client, twin):
     assert ball["inner"] == state["balls"][0]["inner"]
     # the ball message is the head's three fields and the ball's, nothing else (pydantic-serialised, spliced)
     assert ball == {"schema": state["schema"], "bearing_id": "t1", "time_s": snap.time_s, **state["balls"][0]}
-    assert wait_until(lambda: channel.published >= 1, 5.0) and channel.errors == 0
+    assert support.wait_until(lambda: channel.published >= 1, 5.0) and channel.errors == 0
 
 
 def test_every_ball_is_published(bus, client, twin):
@@ -289,7 +289,7 @@ def test_twin_ids_are_unique_per_prefix_across_buses(endpoint, support, caplog):
         assert "x" not in bus2.channels
         assert bus3.attach_twin("x", lambda: None, lambda p: {}).prefix == "plant1/line3/x"
         first.detach()
-        assert wait_until(lambda: not bus2._alive_elsewhere("plant1/line2/x"), WAIT_S)
+        assert support.wait_until(lambda: not bus2._alive_elsewhere("plant1/line2/x"), WAIT_S)
         assert bus2.attach_twin("x", lambda: None, lambda p: {}).prefix == "plant1/line2/x"
         with pytest.raises(InputError):          # and now the first one is refused
             bus1.attach_twin("x", lambda: None, lambda p: {})
@@ -321,7 +321,7 @@ def test_an_unauthenticated_claim_never_blocks_an_untrusting_bus(endpoint, suppo
     untrusting = ZenohBus(listen=[], connect=[endpoint], mode="client", prefix="bearing", trust_claims=False)
     trusting = ZenohBus(listen=[], connect=[endpoint], mode="client", prefix="bearing")
     try:
-        assert wait_until(lambda: trusting._alive_elsewhere("bearing/pump-9"), WAIT_S)
+        assert support.wait_until(lambda: trusting._alive_elsewhere("bearing/pump-9"), WAIT_S)
         with pytest.raises(InputError) as err:
             trusting.attach_twin("pump-9", lambda: None, lambda p: {})
         message = err.value.errors[0].message
@@ -436,7 +436,7 @@ def test_monitor_sees_twins_of_two_services(endpoint, twin, support):
     assert "m1" in text and "m3" in text
 
 
-def test_monitor_counts_gaps_marks_gone_and_reads_electrical(endpoint, twin):
+def test_monitor_counts_gaps_marks_gone_and_reads_electrical(endpoint, twin, support):
     bus = ZenohBus(listen=[endpoint], connect=[])
     result: dict = {}
     try:
@@ -452,7 +452,7 @@ def test_monitor_counts_gaps_marks_gone_and_reads_electrical(endpoint, twin):
         # wait until the monitor's subscriber is routed to this publisher (NB: matching_status
         # is a MatchingStatus object, always truthy: read .matching), then send seq 1..10
         # without 4, 7, 8
-        assert wait_until(lambda: pub.matching_status.matching, 8.0)
+        assert support.wait_until(lambda: pub.matching_status.matching, 8.0)
         for seq in (1, 2, 3, 5, 6, 9, 10):
             pub.put(json.dumps({**base, "seq": seq}))
         pub.put(b"garbage")
@@ -525,7 +525,7 @@ class _Blocker:
         raise RuntimeError("not a real snapshot")  # must not kill the publisher thread
 
 
-def test_publish_never_blocks_and_counts_drops(bus, client, twin):
+def test_publish_never_blocks_and_counts_drops(bus, client, twin, support):
     snap = twin.snapshot()
     channel = bus.attach_twin("t1", lambda: snap, lambda p: {}, queue_size=8)
     blocker = _Blocker()
@@ -542,7 +542,7 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin):
     assert channel.dropped == 200 - 8 and channel.errors == 1
     blocker.release.set()
     # the thread survives the failure and drains the queue
-    assert wait_until(lambda: channel.published == 8 and channel.errors == 2, 5.0), \
+    assert support.wait_until(lambda: channel.published == 8 and channel.errors == 2, 5.0), \
         (channel.published, channel.errors)
     client.subscribe("bearing/t1/state")
     client.wait_for(lambda item: True, poke=lambda: channel.publish(snap))

@@ -190,7 +190,6 @@ def test_real_time_pacing(twin, make_runner):
     tests/service/core/test_pool.py's, with a fake clock), so only progress is asserted here."""
     sink = ListSink()
     runner = make_runner(twin, publish_rate_hz=50.0, sinks=[sink])
-    time0 = twin.time_s
     t0 = time.perf_counter()
     runner.start()
     assert wait_until(lambda: runner.frames >= 50 and runner.published >= 3)   # progress (bounded wait)

@@ -206,6 +206,34 @@ def test_scenario_run_command_writes_the_table(tmp_path, capsys):
     assert "done" in capsys.readouterr().out
 
 
+def test_scenario_table_starts_at_zero_however_late_the_caller(tmp_path, monkeypatch):
+    """The runner thread takes the scenario over and samples it at once; a caller thread that
+    looks at the twin only later (a busy machine) must not shift the table's scenario time."""
+    import time as _time
+
+    import service.tools.offline as offline
+
+    pq = pytest.importorskip("pyarrow.parquet")
+    original = offline.TwinRunner.start_scenario
+
+    def slow_caller(self, *args, **kwargs):
+        out = original(self, *args, **kwargs)
+        _time.sleep(0.3)
+        return out
+
+    monkeypatch.setattr(offline.TwinRunner, "start_scenario", slow_caller)
+    path = _write(tmp_path, {
+        "name": "late", "duration_s": 0.02, "sample_every_s": 0.002,
+        "initial": {"shaft_speed_rad_s": 400.0, "radial_load_n": 2000.0},
+        "steps": [{"at_s": 0.0, "phase": "up", "ramp": {"radial_load_n": 3000.0}, "over_s": 0.01},
+                  {"at_s": 0.01, "phase": "hold", "set": {"radial_load_n": 3000.0}}]})
+    out = tmp_path / "late.parquet"
+    assert main(["scenario", "run", str(path), "--table", str(out), "--no-progress"]) == 0
+    table = pq.read_table(out).to_pylist()
+    assert [r["scenario_time_s"] for r in table] == pytest.approx([0.002 * i for i in range(11)])
+    assert table[0]["phase"] == "up" and table[-1]["phase"] == "hold"
+
+
 def test_scenario_run_with_runs(tmp_path):
     pq = pytest.importorskip("pyarrow.parquet")
     data = yaml.safe_load((SCENARIOS / "seed000_clearance_sweep.yaml").read_text())

@@ -104,7 +104,7 @@ def test_basic256sha256_sign_and_encrypt_writes_a_setpoint_that_lands(facade, pk
             await node.write_value(4200.0)
             return server_der, json.loads(await last.read_value()), await node.read_value()
     server_der, last, value = run(main())
-    assert hashlib.sha1(server_der).hexdigest().upper() == facade.pki.thumbprint_sha1     # noqa: S324
+    assert hashlib.sha1(server_der).hexdigest().upper() == facade.pki.thumbprint_sha1
     assert last["accepted"] is True and last["setpoint"]["radial_load_n"] == 4200.0 and value == 4200.0
     support.wait_for(lambda: http.get("/v1/bearings/default/state").json()["setpoint"]["radial_load_n"],
                      lambda v: v == 4200.0, timeout=WAIT_S)
@@ -137,7 +137,7 @@ def test_the_endpoints_offer_six_secure_policies_and_encrypt_the_password(facade
     assert offered == {(p, m) for p in ("Basic256Sha256", "Aes128_Sha256_RsaOaep", "Aes256_Sha256_RsaPss")
                        for m in (S, SE)}
     for e in endpoints:
-        assert hashlib.sha1(e.ServerCertificate).hexdigest().upper() == facade.pki.thumbprint_sha1  # noqa: S324
+        assert hashlib.sha1(e.ServerCertificate).hexdigest().upper() == facade.pki.thumbprint_sha1
         names = [t for t in e.UserIdentityTokens if t.TokenType == ua.UserTokenType.UserName]
         assert [t.SecurityPolicyUri for t in names] == [e.SecurityPolicyUri]   # password RSA-encrypted
 
@@ -264,7 +264,7 @@ def test_the_generated_certificate_is_kept_across_a_restart(support, tmp_path):
     finally:
         second.close()
     assert not pki2.generated_key and not pki2.generated_certificate
-    assert pki2.thumbprint_sha1 == pki1.thumbprint_sha1 == hashlib.sha1(cert_bytes).hexdigest().upper()  # noqa: S324
+    assert pki2.thumbprint_sha1 == pki1.thumbprint_sha1 == hashlib.sha1(cert_bytes).hexdigest().upper()
     assert (folder / KEY_FILE).read_bytes() == key_bytes and (folder / CERT_FILE).read_bytes() == cert_bytes
     assert stat.S_IMODE((folder / KEY_FILE).stat().st_mode) == 0o600
     assert stat.S_IMODE(folder.stat().st_mode) == 0o700
@@ -295,7 +295,7 @@ def test_a_given_certificate_is_used_and_checked(support, tmp_path):
     svc = _open(_light(support, tmp_path, opcua_certificate=good_cert, opcua_private_key=good_key,
                        opcua_pki_dir=tmp_path / "unused"))
     try:
-        assert svc.opcua.pki.thumbprint_sha1 == cert.fingerprint(hashes.SHA1()).hex().upper()  # noqa: S303
+        assert svc.opcua.pki.thumbprint_sha1 == cert.fingerprint(hashes.SHA1()).hex().upper()
         assert not (tmp_path / "unused").exists()                                 # nothing generated
     finally:
         svc.close()

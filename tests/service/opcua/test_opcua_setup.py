@@ -11,9 +11,9 @@ from pydantic import ValidationError
 
 pytest.importorskip("asyncua")
 
-from service.core.admission import AdmissionGate  # noqa: E402
-from service.opcua.server import TokenUserManager  # noqa: E402
-from service.settings import ServiceSettings  # noqa: E402
+from service.core.admission import AdmissionGate
+from service.opcua.server import TokenUserManager
+from service.settings import ServiceSettings
 
 
 def test_the_token_is_the_password():

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 
-from service.tools.benchmark import run_service_benchmark, twin_plan
+from loadtest.benchmark import run_service_benchmark, twin_plan
 
 
 def test_twin_plan_cycles_the_designations():

@@ -11,9 +11,9 @@ import pytest
 
 pytest.importorskip("zenoh")
 
-from service.bus.zenoh_bus import ZenohBus  # noqa: E402
-from service.core.alarms import AlarmEvaluator, AlarmInputs  # noqa: E402
-from service.tools.monitor import TwinTable, run_monitor  # noqa: E402
+from service.bus.zenoh_bus import ZenohBus
+from service.core.alarms import AlarmEvaluator, AlarmInputs
+from service.tools.monitor import TwinTable, run_monitor
 
 
 def _events() -> list[dict]:

@@ -39,6 +39,8 @@ import threading
 import time
 from pathlib import Path
 
+from service.keys import STATE, all_twins, twin_key
+
 #: (designation, initial setpoint) of the twins, in order
 TWIN_MIX: tuple[tuple[str, dict], ...] = (
     ("6208", {}),
@@ -164,7 +166,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
                     def on_state(sample):  # zenoh thread: hand off only
                         inbox.put((time.perf_counter(), str(sample.key_expr), sample.payload.to_bytes()))
 
-                    sub = session.declare_subscriber(f"{prefix}/*/state", on_state)
+                    sub = session.declare_subscriber(all_twins(prefix, STATE), on_state)
                 # settle: every twin stepping, then settle_s more
                 settle_end = time.monotonic() + 120.0
                 while time.monotonic() < settle_end:
@@ -183,7 +185,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
                     k += 1
                     load = base_load[tid] - 0.5 * (k % 400)        # a new value every time, in range
                     pattern = re.compile(rb'"radial_load_n":' + re.escape(repr(float(load)).encode()) + rb"[,}]")
-                    key = f"{prefix}/{tid}/state"
+                    key = twin_key(prefix, tid, STATE)
                     t0 = time.perf_counter()
                     http.put(f"/v1/bearings/{tid}/setpoint", json={"radial_load_n": load}).raise_for_status()
                     if zenoh_on:

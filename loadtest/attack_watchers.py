@@ -1,4 +1,4 @@
-"""The attack's floods on what watchers use (service.tools.attack runs each in its own process):
+"""The attack's floods on what watchers use (loadtest.attack runs each in its own process):
 
 * `squat`: an anonymous zenoh peer (no credentials) declares P/{id}/alive and answers P/{id}/owner
   with forged text for fresh ids; the attacker then creates each id over HTTP with the token and
@@ -187,7 +187,7 @@ async def _sessions(spec: dict, cert) -> dict:
     for c in opened:
         try:
             await c.disconnect()
-        except Exception:  # noqa: BLE001, S110 - the server may have dropped it
+        except Exception:  # noqa: BLE001 - the server may have dropped it
             pass
     return {"mode": spec["mode"], "seconds": round(time.monotonic() - t0, 2), "opened": len(opened),
             "refused": dict(refused)}

@@ -66,6 +66,7 @@ from pathlib import Path
 from typing import Any
 
 import service
+from service.keys import DEFAULT_PREFIX, SETPOINT, SETPOINT_RESULT, STATE, all_twins, twin_key
 from service.tools.client import TargetConfig, add_target_arguments, strict_json, target_arguments, url_is_loopback
 
 _FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c")
@@ -104,7 +105,7 @@ def _rss_bytes(pid: int) -> tuple[int | None, str]:
         return int(psutil.Process(pid).memory_info().rss), "psutil"
     except ImportError:
         pass
-    except Exception:
+    except Exception:  # noqa: BLE001
         return None, "psutil"
     try:
         with open(f"/proc/{pid}/status", encoding="ascii") as f:
@@ -166,14 +167,14 @@ class _Started:
             try:
                 if client.get(f"{self.url}/health", timeout=2.0).status_code == 200:
                     return
-            except Exception:
+            except Exception:  # noqa: BLE001
                 pass
             time.sleep(0.2)
         raise RuntimeError("the service did not answer /health in time")
 
     def stop(self, timeout_s: float = 30.0) -> dict:
         t0 = time.monotonic()
-        out = {"signal": "SIGTERM", "exit_code": None, "seconds": None, "killed": False}
+        out: dict[str, Any] = {"signal": "SIGTERM", "exit_code": None, "seconds": None, "killed": False}
         if self.proc.poll() is None:
             self.proc.send_signal(signal.SIGTERM)
             try:
@@ -199,7 +200,7 @@ class _Started:
 class _Stream:
     """zenoh client: seq gaps of {prefix}/*/state and the setpoint results of one twin."""
 
-    def __init__(self, endpoint: str, bearing_id: str, prefix: str = "bearing", access: Any = None):
+    def __init__(self, endpoint: str, bearing_id: str, prefix: str = DEFAULT_PREFIX, access: Any = None):
         import zenoh
 
         from service.bus.zenoh_bus import client_config
@@ -215,9 +216,10 @@ class _Stream:
         self.non_finite = 0
         self.first_at: float | None = None
         self.results: collections.deque = collections.deque()
-        self._subs = [self.session.declare_subscriber(f"{prefix}/*/state", self._on_state),
-                      self.session.declare_subscriber(f"{prefix}/{bearing_id}/setpoint/result", self._on_result)]
-        self.publisher_key = f"{prefix}/{bearing_id}/setpoint"
+        self._subs = [self.session.declare_subscriber(all_twins(prefix, STATE), self._on_state),
+                      self.session.declare_subscriber(twin_key(prefix, bearing_id, SETPOINT_RESULT),
+                                                      self._on_result)]
+        self.publisher_key = twin_key(prefix, bearing_id, SETPOINT)
 
     def _on_state(self, sample) -> None:
         try:
@@ -227,7 +229,7 @@ class _Stream:
             with self.lock:
                 self.non_finite += 1
             return
-        except Exception:
+        except Exception:  # noqa: BLE001
             return
         with self.lock:
             self.messages += 1
@@ -246,7 +248,7 @@ class _Stream:
     def _on_result(self, sample) -> None:
         try:
             msg = strict_json(sample.payload.to_bytes())
-        except Exception:
+        except Exception:  # noqa: BLE001
             msg = {"accepted": None}
         with self.lock:
             self.results.append(msg)
@@ -264,11 +266,11 @@ class _Stream:
         for sub in self._subs:
             try:
                 sub.undeclare()
-            except Exception:
+            except Exception:  # noqa: BLE001
                 pass
         try:
             self.session.close()
-        except Exception:
+        except Exception:  # noqa: BLE001
             pass
 
 
@@ -362,6 +364,7 @@ def run_soak(cfg: SoakConfig) -> dict:
     stream = None
     try:
         if cfg.start:
+            assert token is not None            # generated above when not given
             started = _Started(token, cfg.publish_rate_hz, log, record=cfg.record,
                                record_segment_s=cfg.record_segment_s)
             url, zenoh_endpoint = started.url, started.zenoh_endpoint
@@ -379,7 +382,7 @@ def run_soak(cfg: SoakConfig) -> dict:
             env = ZenohAccessSettings()
             access = (ZenohAccess(user=started.zenoh_user, password=started.zenoh_password)
                       if started is not None else ZenohAccess.from_settings(env))
-            prefix = "bearing" if started is not None else env.zenoh_prefix   # the started one: default
+            prefix = DEFAULT_PREFIX if started is not None else env.zenoh_prefix   # the started one: default
             stream = _Stream(zenoh_endpoint, cfg.bearing_id, prefix, access)
             report["zenoh_access"] = access.describe(listening=False) if access.enabled else "none"
         health0 = client.get(f"{url}/health", headers=headers).json()
@@ -428,7 +431,7 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
     duration = cfg.minutes * 60.0
     warmup = warmup_s(duration)
     put_url = f"{url}/v1/bearings/{cfg.bearing_id}/setpoint"
-    counts = collections.Counter()
+    counts: collections.Counter = collections.Counter()
     status_counts: collections.Counter = collections.Counter()
     unexpected: list[str] = []
     expectations: collections.deque = collections.deque()
@@ -448,7 +451,7 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
                 tw = next((t for t in h["twins"] if t["id"] == cfg.bearing_id), None)
                 samples.append({"t": now, "twin": tw, "recording_rows": h.get("recording_rows", 0),
                                 "rss_bytes": h.get("rss_bytes")})
-            except Exception as exc:
+            except Exception as exc:  # noqa: BLE001
                 counts["health_errors"] += 1
                 unexpected.append(f"/health: {type(exc).__name__}: {exc}")
                 h = {}
@@ -666,7 +669,7 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
         out["complete"] = bool(segments_ok and len(recording_ids) == 1 and out["rows_read"] >= max(rows_reported, 1)
                                and gaps == 0 and out["duplicates"] == 0
                                and (last_stream_seq is None or (len(s) and int(s[-1]) >= last_stream_seq)))
-    except Exception as exc:
+    except Exception as exc:  # noqa: BLE001
         out["error"] = f"{type(exc).__name__}: {exc}"
     return out
 
@@ -721,7 +724,7 @@ def _shutdown_text(sd: dict) -> str:
 
 def format_report(r: dict) -> str:
     """Human-readable summary."""
-    f = lambda v, spec="{:.3f}": "-" if v is None else spec.format(v)
+    f = lambda v, spec="{:.3f}": "-" if v is None else spec.format(v)  # noqa: E731
     lines = [f"soak: {r['duration_s']:.0f} s against {r.get('url')} (zenoh {r.get('zenoh') or 'off'}), "
              f"{'own service' if r['started_service'] else 'external service'}, token {r.get('token') or 'none'}"]
     sp = r["setpoints"]

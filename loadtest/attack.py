@@ -19,7 +19,7 @@ flood's client work does not show up as the service's latency in another's figur
   and checking every state message for non-finite numbers;
 * each flood process measures its own CPU time (`attacker_cpu_cores`: on a shared host the
   attackers' CPU is taken from the twin too);
-* on what watchers use (service.tools.attack_watchers): zenoh twin-id squatting by an anonymous
+* on what watchers use (loadtest.attack_watchers): zenoh twin-id squatting by an anonymous
   peer (`squat`, on by default with zenoh) and, with an OPC UA endpoint (`--opcua`, or `--start`),
   password guessing, a session flood and a subscription flood (`opcua_*`);
 * in this process, a /health probe every 50 ms: its latency (p50, p99, max) and the default
@@ -53,7 +53,8 @@ import time
 from dataclasses import dataclass, field
 from typing import Any
 
-from service.tools import attack_watchers
+from loadtest import attack_watchers
+from service.keys import DEFAULT_PREFIX
 from service.tools.client import (TargetConfig, add_target_arguments, check_loopback, strict_json,
                                   target_arguments, url_is_loopback)
 
@@ -324,7 +325,7 @@ def _probe(client, url: str, bid: str, seconds: float, every_s: float, t_ref: fl
             tw = next((x for x in r.json().get("twins", []) if x.get("id") == bid), None)
             if tw is not None:
                 rec["rtf"], rec["late"] = tw.get("real_time_factor"), tw.get("late_fraction")
-        except Exception:   # noqa: BLE001, S110 - a failed probe is counted (ok False)
+        except Exception:   # noqa: BLE001 - a failed probe is counted (ok False)
             pass
         out.append(rec)
         time.sleep(max(0.0, every_s - (time.monotonic() - t)))
@@ -377,7 +378,7 @@ def run_attack(cfg: AttackConfig) -> dict:
     try:
         zuser = zpass = None
         if cfg.start:
-            from service.tools.soak import _Started
+            from loadtest.soak import _Started
 
             started = _Started(token, None, lambda line: log(line.replace("soak: ", "attack: ", 1)),
                                record=cfg.record, opcua=True)
@@ -390,7 +391,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         if info.status_code != 200:
             raise RuntimeError(f"GET /v1/bearings/{cfg.bearing_id}: {info.status_code} {info.text[:300]}")
         limits = info.json()["limits"]
-        from service.tools.soak import _SAFE
+        from loadtest.soak import _SAFE
 
         ranges = {n: (max(lo, limits[n][0]), min(hi, limits[n][1])) for n, (lo, hi) in _SAFE.items() if n in limits}
         t_ref = time.monotonic()
@@ -406,8 +407,8 @@ def run_attack(cfg: AttackConfig) -> dict:
                                         "seed": rng.randrange(2**32)}))
         if zenoh_endpoint:
             specs.append((_zenoh_flood, {"endpoint": zenoh_endpoint, "bearing_id": cfg.bearing_id,
-                                         "prefix": "bearing" if started is not None else
-                                         os.environ.get("BEARING_TWIN_ZENOH_PREFIX", "bearing"),
+                                         "prefix": DEFAULT_PREFIX if started is not None else
+                                         os.environ.get("BEARING_TWIN_ZENOH_PREFIX", DEFAULT_PREFIX),
                                          "user": zuser, "password": zpass, "seconds": cfg.seconds,
                                          "rate_hz": cfg.zenoh_rate_hz, "seed": rng.randrange(2**32)}))
         specs += attack_watchers.specs(cfg, started, url, zenoh_endpoint, token)
@@ -425,7 +426,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         while len(parts) < len(specs) and time.monotonic() < deadline:
             try:
                 part = out.get(timeout=1.0)
-            except Exception:   # noqa: BLE001, S112 - queue.Empty
+            except Exception:   # noqa: BLE001 - queue.Empty
                 continue
             parts[part.get("mode", "?")] = part
         settled = [p for p in during if p["t"] >= flood_start - t_ref + 1.0] or during
