@@ -12,7 +12,7 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
-from service.bus.zenoh_bus import make_config, wait_until  # noqa: E402
+from service.bus.zenoh_bus import make_config  # noqa: E402
 from service.settings import ServiceSettings  # noqa: E402
 
 TOKEN = "squat-test-token-321"
@@ -32,7 +32,7 @@ def test_an_anonymous_squatter_blocks_no_create(support):
             owner = evil.declare_queryable("bearing/pump-9/owner",
                                            lambda q: q.reply("bearing/pump-9/owner", json.dumps(FORGED)))
             bus = srv.service.bus
-            assert wait_until(lambda: bus._alive_elsewhere("bearing/pump-9"), 10.0)
+            assert support.wait_until(lambda: bus._alive_elsewhere("bearing/pump-9"), 10.0)
             with httpx.Client(base_url=srv.url, timeout=60.0,
                               headers={"Authorization": f"Bearer {TOKEN}"}) as http:
                 r = http.post("/v1/bearings", json={"id": "pump-9", "designation": "6208"})
