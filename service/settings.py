@@ -107,7 +107,7 @@ def zenoh_access_enabled(usersfile: Path | None, user: str | None, tls_certifica
 
 
 class ZenohAccessSettings(BaseSettings):
-    """Who may do what on zenoh (README "zenoh access control"), read by the service, the router
+    """Who may do what on zenoh (docs/operations.md "zenoh access control"), read by the service, the router
     and the bundled clients (`monitor`, `soak`, benchmarks) from `BEARING_TWIN_ZENOH_*`.
 
     Access control is on when a users file, credentials or TLS client certificates are
@@ -278,7 +278,7 @@ def _check_tls_endpoints(s) -> None:
 
 
 class AlarmSettings(BaseModel):
-    """Alarm thresholds and timing (service.core.alarms; README "Alarms"). Times are simulated
+    """Alarm thresholds and timing (service.core.alarms; docs/service.md "Alarms"). Times are simulated
     seconds (the twin's clock). Give them in the environment as JSON:
     `BEARING_TWIN_ALARMS='{"machine_group": 1, "support": "flexible"}'`."""
 
@@ -364,7 +364,7 @@ class ServiceSettings(ZenohAccessSettings):
                          description="Catalog designation of the twin started with the service [designation, e.g. 6208].")
     housing: bool = Field(default=False,
                           description="The twin started with the service has its outer ring on the housing "
-                          "support with the accelerometer (issue 14: vibration indicators, waveform, defects "
+                          "support with the accelerometer (vibration indicators, waveform, defects "
                           "show in the signal) [bool]; other twins choose with POST /v1/bearings `housing`.")
     twin_id: str = Field(default="default", pattern=r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$",
                          description="Name of the twin started with the service [text]; give each "
@@ -430,7 +430,7 @@ class ServiceSettings(ZenohAccessSettings):
         default=0.005, ge=1e-5, le=0.1,
         description="Simulated time per frame: setpoints and scenario steps apply between frames [s]. "
         "A stepping thread runs one frame of one twin at a time; 5 ms keeps the Python between frames "
-        "a small share of the work (README \"Runner pool\").")
+        "a small share of the work (docs/service.md \"Runner pool\").")
     setpoint_frame_s: float = Field(
         default=0.001, ge=1e-5, le=0.1,
         description="Real-time mode: the frame that applies an outside setpoint (HTTP, zenoh) lasts this "
@@ -454,9 +454,8 @@ class ServiceSettings(ZenohAccessSettings):
         description="Nice value given to every thread of the service but the stepping threads and the publish "
         "worker, the HTTP event loop included (Linux, per thread; service.core.priority) [-]. Between the stepping "
         "threads' (-10) and the host's other processes' (0): these threads hold the GIL the stepping threads wait "
-        "for, and below the load (nice 10 before 2026-11-23) they were preempted while holding it (attack: real-time "
-        "factor 0.78-0.86 at 10, 0.998-1.000 at 0 on a quiet host; at 0 against -5 with other processes busy: "
-        "0.68-0.81 against 0.80-0.91, /health p99 214-317 against 52-89 ms). Below the process's nice needs root or "
+        "for, and below the load they are preempted while holding it (priority inversion; `attack` measures the "
+        "real-time factor under a flood). Below the process's nice needs root or "
         "CAP_SYS_NICE (refused: counted in /health thread_priority errors). 0: the process's nice.")
     gc_freeze: bool = Field(
         default=True,
@@ -499,7 +498,7 @@ class ServiceSettings(ZenohAccessSettings):
         default=None, ge=1, le=256,
         description="Most twins one service runs at a time [count]; unset = as many as the measured "
         "capacity admits (admission 'measured'), at most 256.")
-    # ---- hardening (README "Hardening") -------------------------------------------------------
+    # ---- hardening (docs/operations.md) -------------------------------------------------------
     token: SecretStr | None = Field(
         default=None,
         description="Bearer token [text]: when set, every mutating HTTP request (POST, PUT, DELETE) "
@@ -569,7 +568,7 @@ class ServiceSettings(ZenohAccessSettings):
         description="Directory of named scenarios [path]; default ./scenarios if it exists, else "
         "the scenarios/ folder of the source tree.")
 
-    # ---- alarms and the OPC UA facade (README "Alarms", "OPC UA") -------------------------------
+    # ---- alarms and the OPC UA facade (docs/service.md "Alarms", "OPC UA") -------------------------------
     alarms: AlarmSettings = Field(default_factory=AlarmSettings,
                                   description="Alarm thresholds and timing [see AlarmSettings].")
     opcua: str | None = Field(
@@ -613,7 +612,7 @@ class ServiceSettings(ZenohAccessSettings):
     @model_validator(mode="after")
     def _zenoh(self):
         """Resolve the listen default and the mode; refuse what zenoh's access control cannot
-        guard (README "zenoh access control")."""
+        guard (docs/operations.md "zenoh access control")."""
         if self.zenoh_listen is None:
             self.zenoh_listen = [] if self.zenoh_connect else list(DEFAULT_ZENOH_LISTEN)
         if self.zenoh_mode is None:
@@ -684,7 +683,7 @@ class ServiceSettings(ZenohAccessSettings):
 
     @model_validator(mode="after")
     def _opcua_security(self):
-        """The OPC UA certificate and trust settings (README "OPC UA", "Secure connections")."""
+        """The OPC UA certificate and trust settings (docs/service.md "OPC UA")."""
         if (self.opcua_certificate is None) != (self.opcua_private_key is None):
             missing = "opcua_private_key" if self.opcua_private_key is None else "opcua_certificate"
             raise ValueError(f"{missing}: the OPC UA server certificate and its private key go together "

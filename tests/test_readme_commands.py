@@ -1,11 +1,15 @@
-"""Every command of README.md that a user would type works: each is run in a subprocess (the
-CLI as `python -m service.cli`, like the other CLI tests; short variants where the README's
-would run for minutes) and must exit 0. The commands are read from the README itself, so a
-command added there without a way to run it here fails `test_every_readme_command_is_covered`.
+"""Every shell and Python block of README.md and docs/*.md works: each command a user would type
+is run in a subprocess (the CLI as `python -m service.cli`, like the other CLI tests; short
+variants where the documented one would run for minutes) and must exit 0, and each ```python
+block runs as printed. The blocks are read from the files themselves, so a block added there
+without a way to run it here fails `test_every_shell_line_is_covered` or
+`test_every_python_block_is_covered`. A command that appears on several pages runs once.
 
 Not run, with the reason in SKIPPED: the venv/pip install lines (this test runs inside an
 installed environment), docker, and the multi-host lines (tests/service/test_end_to_end.py runs
-that setup on loopback)."""
+that setup on loopback). Blocks that need a running service get one started here on free
+loopback ports: `bearing-twin serve`, then the curl lines, the zenoh client, `monitor`, the
+OPC UA client snippets; `serve` stops with SIGINT (Ctrl-C)."""
 
 from __future__ import annotations
 
@@ -24,23 +28,27 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-README = (ROOT / "README.md").read_text()
+DOC_FILES = (ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")))
 TIMEOUT_S = 600
 
 
 def _blocks(lang: str) -> list[str]:
-    return re.findall(rf"```{lang}\n(.*?)```", README, flags=re.DOTALL)
+    """The fenced ```lang blocks of README.md and docs/*.md, in file order."""
+    return [block for path in DOC_FILES
+            for block in re.findall(rf"```{lang}\n(.*?)```", path.read_text(), flags=re.DOTALL)]
 
 
 def readme_shell_lines() -> list[str]:
-    """Logical lines of the ```sh blocks (continuations joined, comments cut, blanks dropped)."""
-    out = []
+    """Logical lines of the ```sh blocks of README.md and docs/*.md (continuations joined, comments
+    cut, blanks dropped), each once."""
+    out: list[str] = []
     for block in _blocks("sh"):
         text = block.replace("\\\n", " ")
         for line in text.splitlines():
             line = re.sub(r"\s+#\s.*$", "", line).strip()     # trailing comment
-            if line and not line.startswith("#"):
-                out.append(" ".join(line.split()))
+            line = " ".join(line.split())
+            if line and not line.startswith("#") and line not in out:
+                out.append(line)
     return out
 
 
@@ -55,7 +63,7 @@ SKIPPED = {
     r"bearing-twin router": "runs until stopped: tests/service/test_fleet.py runs it",
     r"bearing-twin soak --minutes 60 --url": "needs a service of its own: the --start variant is run",
     r"bearing-twin attack --seconds 60 --url": "needs a service of its own: the --start variant is run",
-    r"export BEARING_TWIN_TOKEN": "run by test_token_commands",
+    r"export BEARING_TWIN_TOKEN": "run by test_token_and_opcua_commands",
 }
 SERVED = (r"bearing-twin serve", r"curl ", r"bearing-twin monitor")   # run by test_serve_and_its_clients
 
@@ -91,14 +99,15 @@ ONE_SHOT = {
         "simulate", "--bearing", "7208", "--radial-load", "3000", "--axial-load", "3000", "--clearance", "-1e-5",
         "--dt", "1e-6"],
     "bearing-twin bench-service": lambda out: ["bench-service", "--seconds", "3", "--json"],
-    "bearing-twin bench": lambda out: ["bench", "--json", "--seconds", "0.01", "--repeats", "5"],   # >= 5 repeats
+    "bearing-twin bench": lambda out: ["bench", "--json", "--seconds", "0.01", "--repeats", "5",  # >= 5 repeats
+                                       "--save", str(out / "results")],
     "bearing-twin timestep-study": lambda out: ["timestep-study", "--quick", "--json"],
     "bearing-twin life": lambda out: ["life", "--bearing", "6208", "--radial-load", "3000", "--speed", "500",
                                       "--json"],
-    "bearing-twin soak --minutes 10 --start": lambda out: ["soak", "--minutes", "0.5", "--start", "--json"],
+    "bearing-twin soak --minutes 10 --start": lambda out: ["soak", "--minutes", "0.3", "--start", "--json"],
     "bearing-twin attack --seconds 60 --start": lambda out: ["attack", "--seconds", "3", "--start", "--baseline",
                                                              "1", "--json"],
-    "bearing-twin ehl solve": lambda out: ["ehl", "solve", "--current", "20", "--json"],
+    "bearing-twin ehl solve": lambda out: ["ehl", "solve", "--current", "20", "--grid", "65", "--json"],
     "bearing-twin vibration": lambda out: ["vibration", "--bearing", "6208", "--speed", "523", "--radial-load", "3000",
                                            "--defect", "outer", "--duration", "0.1", "--json",
                                            "--plot", str(out / "vib.png")],
@@ -121,12 +130,12 @@ def _handler(line: str) -> str:
     return "NOT COVERED"
 
 
-def test_every_readme_command_is_covered():
+def test_every_shell_line_is_covered():
     lines = readme_shell_lines()
     assert len(lines) > 20
     uncovered = [line for line in lines if _handler(line) == "NOT COVERED"]
-    assert not uncovered, f"README commands this test does not run: {uncovered}"
-    # and every variant here still matches a README line (none left over after a README edit)
+    assert not uncovered, f"README / docs commands this test does not run: {uncovered}"
+    # and every variant here still matches a documented line (none left over after an edit)
     used = {_handler(line) for line in lines}
     assert set(ONE_SHOT) | set(PYTHON_MODULES) <= used, (set(ONE_SHOT) | set(PYTHON_MODULES)) - used
 
@@ -138,6 +147,11 @@ def test_one_shot_command(prefix, tmp_path):
     assert "Traceback" not in res.stderr
     if "--json" in ONE_SHOT[prefix](tmp_path):
         json.loads(res.stdout.splitlines()[-1] if prefix.startswith("bearing-twin bench ") else res.stdout)
+    if "--save" in ONE_SHOT[prefix](tmp_path):   # the dated result file: machine and versions beside the figures
+        (saved,) = (tmp_path / "results").glob("*-bench.json")
+        data = json.loads(saved.read_text())
+        assert data["environment"]["cpu_model"] and data["environment"]["versions"]["numba"]
+        assert data["result"]["real_time_factor"] > 0
 
 
 @pytest.mark.parametrize("prefix", sorted(PYTHON_MODULES))
@@ -147,12 +161,35 @@ def test_python_module_command(prefix, tmp_path):
     assert res.returncode == 0, res.stderr
 
 
-def test_python_api_block(tmp_path):
-    (block,) = [b for b in _blocks("python") if b.startswith("from twin import Twin")]
+# ```python blocks that need a running service (first line -> the test that runs them); every other
+# block runs on its own, as printed
+SERVED_PYTHON = {"import zenoh": "test_serve_and_its_clients", "import asyncio": "test_token_and_opcua_commands"}
+# what a standalone block must print (first line -> text in its output), beside exiting 0
+PYTHON_PRINTS = {"from twin import Twin                     # the public face": "2073.6"}   # the 6208's limit
+
+
+def standalone_python_blocks() -> list[str]:
+    return [b for b in _blocks("python") if not any(b.startswith(p) for p in SERVED_PYTHON)]
+
+
+def test_every_python_block_is_covered():
+    blocks = _blocks("python")
+    assert len(blocks) >= 5
+    assert len(standalone_python_blocks()) >= 4
+    for prefix in SERVED_PYTHON:
+        assert any(b.startswith(prefix) for b in blocks), f"no ```python block starts with {prefix!r} any more"
+    for prefix in PYTHON_PRINTS:
+        assert any(b.startswith(prefix) for b in standalone_python_blocks()), prefix
+
+
+@pytest.mark.parametrize("block", standalone_python_blocks(), ids=lambda b: b.splitlines()[0][:40].strip())
+def test_python_block(block, tmp_path):
     res = subprocess.run([sys.executable, "-c", block], cwd=tmp_path, capture_output=True, text=True,
                          timeout=TIMEOUT_S, env={**os.environ, "PYTHONPATH": str(ROOT)})
     assert res.returncode == 0, res.stderr
-    assert "2073.6" in res.stdout          # the 6208's speed limit the README quotes
+    for prefix, text in PYTHON_PRINTS.items():
+        if block.startswith(prefix):
+            assert text in res.stdout, res.stdout
 
 
 class _Serve:
@@ -221,38 +258,28 @@ def test_serve_and_its_clients(tmp_path):
     assert list((tmp_path / "recordings").glob("bearing-twin-*.rrd"))
 
 
-@pytest.mark.skipif(shutil.which("curl") is None, reason="curl not installed")
-def test_token_commands(tmp_path):
-    """Hardening, Access: the token from the README's command, serve, and the curl with it."""
+def _documented_token() -> str:
+    """The token made by the documented `export BEARING_TWIN_TOKEN=...` line."""
     (block,) = [b for b in _blocks("sh") if b.startswith("export BEARING_TWIN_TOKEN")]
     export = block.splitlines()[0]
     token = subprocess.run(["bash", "-c", f"{export} && printf %s \"$BEARING_TWIN_TOKEN\""], capture_output=True,
                            text=True, timeout=60).stdout
     assert len(token) >= 32
-    env = {"BEARING_TWIN_TOKEN": token}
-    serve = _Serve(tmp_path, env)
-    try:
-        serve.wait_healthy()
-        (line,) = [line for line in readme_shell_lines() if line.startswith("curl ") and "Authorization" in line]
-        res = _shell(line, serve.port, tmp_path, env)
-        assert res.returncode == 0 and '"radial_load_n":5000.0' in res.stdout, res.stdout + res.stderr
-        res = _shell(line.replace("$BEARING_TWIN_TOKEN", "wrong"), serve.port, tmp_path, env)
-        assert '"status"' not in res.stdout and "invalid token" in res.stdout
-    finally:
-        if serve.proc.poll() is None:
-            serve.stop()
+    return token
 
 
-def test_opcua_client_snippets(tmp_path):
-    """OPC UA: the README's two asyncua snippets as printed (the client's certificate, then a
-    SignAndEncrypt session pinning the server's certificate that writes radial_load_n = 5000 with
-    the token), against `serve --opcua` with a token (security `both`) on a free loopback port."""
+@pytest.mark.skipif(shutil.which("curl") is None, reason="curl not installed")
+def test_token_and_opcua_commands(tmp_path):
+    """Operations, Access, and Service, OPC UA, against one `serve --opcua` with the token from the
+    documented command (security `both`) on free loopback ports: the two asyncua snippets as
+    printed (the client's certificate, then a SignAndEncrypt session pinning the server's
+    certificate that writes radial_load_n = 5000 with the token), then the curl with the token
+    and with a wrong one."""
     pytest.importorskip("asyncua")
     blocks = [b for b in _blocks("python") if b.startswith("import asyncio")]
     assert len(blocks) == 2 and "setup_self_signed_certificate" in blocks[0] and "Client(" in blocks[1]
-    token = "readme-opcua-token-0123456789abcdef"
+    env = {"BEARING_TWIN_TOKEN": _documented_token()}
     opcua = f"opc.tcp://127.0.0.1:{_free_port()}"
-    env = {"BEARING_TWIN_TOKEN": token}
     serve = _Serve(tmp_path, env, extra=("--opcua", opcua, "--no-record"))
     try:
         serve.wait_healthy()
@@ -267,7 +294,12 @@ def test_opcua_client_snippets(tmp_path):
         import httpx
 
         state = httpx.get(f"http://127.0.0.1:{serve.port}/v1/bearings/default", timeout=10.0).json()
-        assert state["setpoint"]["radial_load_n"] == 5000.0            # the write landed
+        assert state["setpoint"]["radial_load_n"] == 5000.0            # the OPC UA write landed
+        (line,) = [line for line in readme_shell_lines() if line.startswith("curl ") and "Authorization" in line]
+        res = _shell(line, serve.port, tmp_path, env)
+        assert res.returncode == 0 and '"radial_load_n":5000.0' in res.stdout, res.stdout + res.stderr
+        res = _shell(line.replace("$BEARING_TWIN_TOKEN", "wrong"), serve.port, tmp_path, env)
+        assert '"status"' not in res.stdout and "invalid token" in res.stdout
     finally:
         if serve.proc.poll() is None:
             serve.stop()

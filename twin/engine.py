@@ -14,6 +14,7 @@ import numpy as np
 from twin import catalog
 from twin.kernels import layout as L
 from twin.kernels.step import evaluate, step_n
+from twin.kernels.structures import ModelArrays, StateArrays
 from twin.model import BearingModel, make_model
 from twin.physics.friction import REGIME_NAMES
 from twin.physics.hertz import max_pressure_pa
@@ -27,7 +28,8 @@ from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temper
 from twin.faults import Fault, FaultKind
 from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
 from twin.electrical_network import bearing_network
-from twin.life import LifeMonitor, LifeSettings
+from twin.life.monitor import LifeMonitor
+from twin.life.settings import LifeSettings
 from twin.snapshot import BallState, ContactState, LifeState, Snapshot
 from twin.snapshot import ElectricalState
 from twin.spec import BearingSpec, ModelOptions
@@ -81,7 +83,7 @@ class Twin:
         self._last_restart_time_s = -math.inf
         self._last_good_time_s = 0.0
         self._last_torque_n_m = 0.0
-        self._defects: tuple = ()  # issue 14: the active local defects (twin.vibration.defects)
+        self._defects: tuple = ()  # the active local defects (twin.vibration.defects)
         self._sensor = SensorReader(self.model) if self.model.housing_on else None
         self._frozen_vibration = None  # a frozen copy's last window (`frozen`); the live twin reads its sensor
         self._apply(self.limits.admit(setpoint or self.default_setpoint()))
@@ -263,14 +265,12 @@ class Twin:
             evaluate(*self._kernel_args())
         self._update_life(force=True)
 
-    def _kernel_args(self) -> tuple:
-        """Model arrays, setpoint and state in `step_n` / `evaluate` order (without n)."""
-        m, s = self.model, self.state
-        return (m.params, m.angle_table, self._setpoint_vector, *s.kernel_args(), m.housing_params,
-                m.decimator_taps)
+    def _kernel_args(self) -> tuple[ModelArrays, StateArrays, np.ndarray]:
+        """(model, state, setpoint) as `step_n` / `evaluate` take them (without n)."""
+        return self.model.arrays(), self.state.arrays(), self._setpoint_vector
 
     def _place_on_housing(self, radial_load_n: float, axial_load_n: float) -> None:
-        """Warm start on the housing (issue 14): the outer ring at the static equilibrium of its
+        """Warm start on the housing: the outer ring at the static equilibrium of its
         support under the whole load (at the quasi-static equilibrium the balls pass the applied
         loads to the outer ring; their centrifugal forces cancel over the ring), the balls and the
         inner ring moved with it; the decimator and the sample ring restart
@@ -382,7 +382,7 @@ class Twin:
         """Simulated time [s]."""
         return float(self.state.scalars[L.X_TIME])
 
-    # ---- local defects and the accelerometer (issue 14, twin.vibration) ------------------------
+    # ---- local defects and the accelerometer (twin.vibration) ----------------------------------
     @property
     def defects(self) -> tuple:
         """The active local defects (twin.vibration.defects models)."""

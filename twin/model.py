@@ -20,6 +20,7 @@ import numpy as np
 
 from twin import timestep
 from twin.kernels import layout as L
+from twin.kernels.structures import ModelArrays
 from twin.kernels.tribology import N_TRIBOLOGY, T_PIVOT, tribology_coefficients
 from twin.physics import hertz
 from twin.physics.electrical import (ball_raceway_gap_integral_m, coaxial_capacitance_f,
@@ -61,14 +62,18 @@ class BearingModel:
 
     gap_limit_m: tuple[float, float] = (50e-6, 50e-6)   # inner, outer: geometric gap limit of the contact capacitance
     rest_capacitance_f: float = 0.0                     # the rings' lands across the oil-filled annulus [F]
-    # issue 14 (twin.vibration): housing H_* vector, V_* vector, accelerometer decimator
+    # twin.vibration: housing H_* vector, V_* vector, accelerometer decimator
     housing_params: np.ndarray | None = None
     decimator: DecimatorDesign | None = None  # None with the rigid outer ring
     decimator_taps: np.ndarray | None = None  # reversed FIR taps (K R,); without the housing a (1,) zero array, as the kernel's signature takes an array
 
+    def arrays(self) -> ModelArrays:
+        """The model's arrays as the kernels take them (`twin.kernels.structures.ModelArrays`)."""
+        return ModelArrays(self.params, self.angle_table, self.housing_params, self.decimator_taps)
+
     @property
     def vibration_params(self) -> np.ndarray:
-        """The V_* vector of issue 14 (twin.kernels.layout), a view of params[P_VIB:]."""
+        """The V_* vector (twin.kernels.layout), a view of params[P_VIB:]."""
         return self.params[L.P_VIB:L.P_VIB + L.N_VIB_PARAMS]
 
     @property

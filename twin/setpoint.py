@@ -155,7 +155,7 @@ class Admitted:
 @dataclass(frozen=True)
 class SetpointLimits(Mapping):
     """Allowed [low, high] of every setpoint field for one bearing (in the field's unit); reads
-    like the dict `{field: (low, high)}` it was before."""
+    like a dict `{field: (low, high)}`."""
 
     ranges: Mapping[str, tuple[float, float]]
     bearing: str = ""   # designation, quoted in the errors

@@ -1,4 +1,4 @@
-"""The public state message, schema "bearing-twin/state/1" (README, Architecture): immutable, units in
+"""The public state message, schema "bearing-twin/state/1" (docs/architecture.md): immutable, units in
 every field name, JSON without NaN or Infinity (undefined values are null)."""
 
 from __future__ import annotations

@@ -276,7 +276,7 @@ class ModelOptions(BaseModel):
         description="Tangential friction of the ball-raceway contacts: 'ellipse_traction' integrates the traction over "
         "strips of the contact ellipse (differential and spin slip; seed 000 mu(Lambda) x seed 001 eq. A2 asperity "
         "share + Eyring / limiting-shear film; twin.kernels.traction); 'stribeck_line' (seed 000 section 2.3) and "
-        "'asperity_share' (seed 001 eq. A1-A2) are the former centre-point Coulomb laws.")
+        "'asperity_share' (seed 001 eq. A1-A2) are centre-point Coulomb laws.")
     traction_strips: int = Field(
         default=12, ge=2, le=32,
         description="Strips across the major axis of each contact ellipse (ellipse_traction) [-]; 12: moments within 0.5 % "
@@ -285,9 +285,9 @@ class ModelOptions(BaseModel):
         default=4e-4, ge=1e-6, le=1e-3,
         description="Strip integration (ellipse_traction) every this period [s], a whole number of tribology "
         "refreshes (the nearest, at least 1); 400 us (10 refreshes of 40 us): over the envelope at the auto step "
-        "(twin.validation.subrate_study) every output stays within issue 13's tolerances of the former 10 us / "
-        "200 us and of the 1 us step (torque 1.14 % of 2 % on the 7208 at 1700 rad/s, 7500 N + 3000 N); 800 us "
-        "did not (loads 1.3 %, torque 3.1 % there). The torque moves by under 0.5 % from a solve at every "
+        "(twin.validation.subrate_study) every output stays within the study's tolerances of "
+        "the 10 us / 200 us sub-rates and of the 1 us step (torque 1.14 % of 2 % on the 7208 at 1700 rad/s, "
+        "7500 N + 3000 N); 800 us does not (loads 1.3 %, torque 3.1 % there). The torque moves by under 0.5 % from a solve at every "
         "refresh, the 7208 B's spin moments (Fr = Fa = 3000 N) by under 5 % (tests/physics/test_friction_torque.py), "
         "first order in the period.")
     asperity_regularisation_slip_m_s: float = Field(
@@ -299,9 +299,9 @@ class ModelOptions(BaseModel):
         "whole number of steps (the nearest, at least 1; 12 steps at the 6208's auto step of 3.3 us), each refresh "
         "centred on its period (centred_refresh); the contacts' RC every 5 refreshes (200 us). 40 us: over the "
         "envelope at the auto step (twin.validation.subrate_study, `bearing-twin timestep-study --subrates`) every "
-        "output stays within issue 13's tolerances of the former 10 us / 200 us and of the 1 us step (closest: "
+        "output stays within the study's tolerances of the 10 us / 200 us sub-rates and of the 1 us step (closest: "
         "loads 0.32 % of 0.5 %, Lambda 0.24 %, on the 7208 at 1700 rad/s, 7500 N + 3000 N). Without the centring "
-        "20 us was the limit (Lambda 0.30 % there, 30 us 0.64 %).")
+        "20 us is the limit (Lambda 0.30 % there, 30 us 0.64 %).")
     tangential_stiffness_ratio: float = Field(
         default=0.8, ge=2.0 / 3.0, le=1.0, description="Kt/Kn [-] (seed 000 section 2.1: [2/3, 1]).")
     tangential_damping_ratio: float = Field(

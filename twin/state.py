@@ -10,6 +10,7 @@ import numpy as np
 from twin.kernels import layout as L
 from twin.model import BearingModel
 from twin.kernels.layout import MAX_DEFECTS
+from twin.kernels.structures import StateArrays
 from twin.vibration.defects import N_DEFECT_PARAMS
 from twin.vibration.housing import N_HOUSING_DOF
 from twin.vibration.signal import N_DD_HEADER, N_RS_HEADER
@@ -34,7 +35,7 @@ class TwinState:
     workspace: np.ndarray        # the kernel's `w` (layout.N_WORKSPACE): the lanes, then the defects
     lanes: np.ndarray            # flat per-contact lanes, row k of contact c at [k * CW + c] (a view)
     cage_load_n: np.ndarray      # (Z, 2) ball j against cage element ahead (0) and behind (1)
-    # issue 14 (twin.vibration); all zero and unused with the rigid outer ring
+    # vibration (twin.vibration); all zero and unused with the rigid outer ring
     housing_displacement_m: np.ndarray  # (N_HOUSING_DOF,) outer ring x, y, z, sprung mass [m]
     housing_velocity_m_s: np.ndarray     # [m/s]
     housing_acceleration_m_s2: np.ndarray  # [m/s^2]
@@ -105,15 +106,16 @@ class TwinState:
         return dataclasses.replace(self, **{f.name: (v.copy() if isinstance(v := getattr(self, f.name), np.ndarray) else v)
                                             for f in dataclasses.fields(self)})
 
-    def kernel_args(self) -> tuple:
-        """The state arrays in `step_n` order."""
-        return (self.scalars, self.ball_position_m, self.ball_velocity_m_s,
-                self.ball_angular_velocity_rad_s, self.ball_acceleration,
-                self.ball_angular_acceleration, self.ring_position_m, self.ring_velocity_m_s,
-                self.ring_acceleration, self.workspace, self.cage_load_n,
-                self.housing_displacement_m, self.housing_velocity_m_s,
-                self.housing_acceleration_m_s2, self.decimator_state,
-                self.sample_ring_m_s2, self.sample_ring_state)
+    def arrays(self) -> StateArrays:
+        """The state's arrays as the kernels take them (`twin.kernels.structures.StateArrays`:
+        the same array objects, written in place by `step_n`)."""
+        return StateArrays(self.scalars, self.ball_position_m, self.ball_velocity_m_s,
+                           self.ball_angular_velocity_rad_s, self.ball_acceleration,
+                           self.ball_angular_acceleration, self.ring_position_m, self.ring_velocity_m_s,
+                           self.ring_acceleration, self.workspace, self.cage_load_n,
+                           self.housing_displacement_m, self.housing_velocity_m_s,
+                           self.housing_acceleration_m_s2, self.decimator_state,
+                           self.sample_ring_m_s2, self.sample_ring_state)
 
 
 def make_state(model: BearingModel) -> TwinState:

@@ -56,7 +56,7 @@ AUTO = "auto"
 # (the estimate treats each alone, and coupling raises the highest frequency slightly), and the
 # bound of the fluid damping holds at the reference oil temperature only. 0.8 leaves 25 % on the
 # step for these. Accuracy is not what sets it: `twin.validation.timestep_study` shows that the outputs at
-# the auto step agree with 1 us within the tolerances of issue 13 over the operating envelope.
+# the auto step agree with 1 us within the study's tolerances over the operating envelope.
 SAFETY_FACTOR = 0.8
 FRAME_S = 1e-3                    # the auto step divides the 1 ms frame
 REFERENCE_OIL_TEMPERATURE_C = 40.0  # ISO 3448 reference temperature, the seeds' oil temperature

@@ -40,7 +40,7 @@ class BearingCreate(BaseModel):
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' (0.04 Pa s at 40 degC) or an ISO grade such as 'ISO VG 68' [text].")
     setpoint: SetpointUpdate | None = Field(default=None, description="Initial setpoint (partial, defaults for the rest); the twin is warm-started at it [fields with units].")
     thermal: Thermal | None = Field(default=None, description="Electro-thermal options (seed 003): shear_heating, current_heating, equivalent_resistance_ohm [ohm], crater_depth_m [m], ...; default: the spec's (shear heating off).")
-    housing: dict[str, Any] | None = Field(default=None, description="Housing and accelerometer (issue 14, twin.vibration.housing.Housing): {\"enabled\": true} puts the outer ring on the housing support (Sawalhi & Randall 2008 defaults) and samples the accelerometer (vibration indicators, waveform); other fields: pedestal_mass_kg [kg], radial_stiffness_n_m [N/m], ..., accelerometer {sample_rate_hz [Hz], ...}; default: rigid outer ring, no vibration.")
+    housing: dict[str, Any] | None = Field(default=None, description="Housing and accelerometer (twin.vibration.housing.Housing): {\"enabled\": true} puts the outer ring on the housing support (Sawalhi & Randall 2008 defaults) and samples the accelerometer (vibration indicators, waveform); other fields: pedestal_mass_kg [kg], radial_stiffness_n_m [N/m], ..., accelerometer {sample_rate_hz [Hz], ...}; default: rigid outer ring, no vibration.")
 
 
 class ScenarioStatus(BaseModel):
@@ -142,7 +142,7 @@ class TwinCost(BaseModel):
 
 
 class Capacity(BaseModel):
-    """The host's capacity for twins in real time, as measured (admission rule: README "Runner pool")."""
+    """The host's capacity for twins in real time, as measured (admission rule: docs/service.md "Runner pool")."""
 
     admission: Literal["measured", "off"] = Field(description="Whether new twins are checked against the capacity [text].")
     cores: int = Field(description="Cores this process may use [-].")

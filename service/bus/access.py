@@ -1,6 +1,6 @@
 """zenoh's own security for the bus: authentication of every link and access-control rules.
 
-Nothing of the HTTP token travels on zenoh. When access control is on (README "zenoh access
+Nothing of the HTTP token travels on zenoh. When access control is on (docs/operations.md "zenoh access
 control"):
 
 * every link is authenticated by zenoh itself when it opens: the user-password handshake
@@ -57,7 +57,7 @@ from typing import Any
 from service.settings import zenoh_access_enabled
 
 # what each role may do: (messages, flow, key suffixes under P/*)
-# what a twin publishes (besides its state): results, alarm events, vibration (issue 14, 15)
+# what a twin publishes (besides its state): results, alarm events, vibration
 _OUT = ["state", "ball/*", "setpoint/result", "defects/result", "alarm", "vibration", "vibration/waveform"]
 _READ_IN = [
     (["declare_subscriber"], "ingress", _OUT),

@@ -1,6 +1,6 @@
 """The zenoh bus: ONE zenoh session for the whole service, one `TwinChannel` per twin.
 
-Key expressions (README "Architecture", schema "bearing-twin/state/1"), under the service's key
+Key expressions (docs/architecture.md, schema "bearing-twin/state/1"), under the service's key
 prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/line2/motor7`):
 
     P/{id}/state             snapshot JSON (publisher)
@@ -16,7 +16,7 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
     P/{id}/owner             queryable: which process runs the twin (pid, host, zenoh id, HTTP)
     P/{id}/alarm             alarm events JSON, schema "bearing-twin/alarm/1" (publisher;
                              service.core.alarms, handed over by the alarm hub)
-    P/{id}/defects           local defects JSON in (subscriber; issue 14): {"defects": [...]}
+    P/{id}/defects           local defects JSON in (subscriber): {"defects": [...]}
                              or the list, [] clears (service.core.defects); same rules as a setpoint
     P/{id}/defects/result    what became of each defects message, like setpoint/result
     P/{id}/vibration         the vibration indicators of each new accelerometer window, JSON,
@@ -666,7 +666,7 @@ class ZenohBus:
                  mode: str = "peer", *, gossip: bool = True, prefix: str = DEFAULT_PREFIX,
                  access: ZenohAccess | None = None, owner: dict | None = None,
                  claim_timeout_s: float = 2.0):
-        """`prefix`: the key prefix P of every twin (README "Fleet"); `access`: zenoh's
+        """`prefix`: the key prefix P of every twin (docs/service.md "A fleet"); `access`: zenoh's
         authentication and access-control rules (service.bus.access); `owner`: what P/{id}/owner
         tells about this process besides pid, host and zenoh id (e.g. {"http": url});
         `claim_timeout_s`: how long the id clash check waits for answers [s]."""

@@ -5,7 +5,7 @@ inputs are typed (`AlarmInputs`), made from a snapshot by `inputs_from_snapshot`
 snapshot may not carry yet (`life`, `vibration`) are optional, and their alarms stay quiet while
 they are absent.
 
-The alarms (ids are stable; README "Alarms"):
+The alarms (ids are stable; docs/service.md "Alarms"):
 
 * `vibration_zone` - ISO 20816-3:2022 evaluation zones from the broadband velocity RMS
   [mm/s] (10-1000 Hz, snapshot `vibration.velocity_rms_mm_s`, twin.vibration.indicators). Zone boundaries of Annex A,
@@ -250,7 +250,7 @@ class Rule:
 
 class AlarmEvent(BaseModel):
     """A transition of one alarm: JSON on zenoh `bearing/{id}/alarm`, rows in the recording,
-    OPC UA events (README "Alarms")."""
+    OPC UA events (docs/service.md "Alarms")."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
     schema_: str = Field(default=EVENT_SCHEMA, alias="schema", serialization_alias="schema",

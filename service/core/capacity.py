@@ -1,7 +1,7 @@
 """Admission by measured capacity: a twin this host cannot run in real time is refused when it is
 created, instead of slowing every twin.
 
-The rule (README "Runner pool"):
+The rule (docs/service.md "Runner pool"):
 
 * A twin's COST is the CPU time it needs per wall-clock second in real time [CPU s / s]: the
   engine's CPU time per simulated second (`engine_cpu_s_per_sim_s`, 1 / the real-time factor

@@ -1,4 +1,4 @@
-"""Local defects from the outside (issue 14): HTTP `PUT /v1/bearings/{id}/defects`, zenoh
+"""Local defects from the outside: HTTP `PUT /v1/bearings/{id}/defects`, zenoh
 `{prefix}/{id}/defects`, scenario steps `defects:`. Validated here, in the calling thread, against
 the bearing's own geometry (`twin.vibration.defects.validate_defects`: a spall wider than the
 ball spacing or longer than the groove arc, a depth beyond Rb / 2, a ball index the bearing does

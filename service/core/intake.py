@@ -72,7 +72,7 @@ class SetpointIntake:
 
 
 class DefectIntake(SetpointIntake):
-    """Local defects as raw payloads (zenoh `{prefix}/{id}/defects`, issue 14): the same gate
+    """Local defects as raw payloads (zenoh `{prefix}/{id}/defects`): the same gate
     (bus writer, size, the twin's setpoint budget), then `TwinRunner.submit_defects` (the
     bearing's own geometry, 422 naming the field). A payload is {"defects": [...]} or the list
     itself; [] clears them. The answer carries "defects": [...] when accepted."""

@@ -25,8 +25,8 @@ zenoh subscriber sees stays steady even if the twin falls behind), plus right af
 applied a new setpoint (at most one such extra publication every `setpoint_publish_min_interval_s`:
 a closer one waits for the next frame after that interval). The regular ticks do not hold a
 setpoint's publication back: the state carrying a fresh setpoint goes out at the end of the
-frame that applied it even right after a tick (it used to wait one more frame when a tick had
-been published less than the interval before, one setpoint in ten at 50 Hz). In fast mode every 1/publish_rate_hz of SIMULATED time (a
+frame that applied it even right after a tick (holding it to the interval would delay one setpoint in
+ten by a frame at 50 Hz). In fast mode every 1/publish_rate_hz of SIMULATED time (a
 scenario's samples sit on a regular grid of simulated time however fast the machine is).
 """
 

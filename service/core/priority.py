@@ -5,9 +5,9 @@ Why. Real time is the stepping threads' job (service.core.pool). On a small host
 threads of the process (uvicorn's event loop answering a flood of requests, zenoh's runtime, the
 rerun recorder, the OPC UA server, the HTTP worker threads) and other processes compete with
 them for the same cores, and under the kernel's fair scheduler every runnable thread of equal
-nice gets an equal share: a hostile HTTP flood at concurrency 32 took the default twin from
-1.00 to 0.46 of real time on the 2-core VM. A real-time system puts its control loop above its
-I/O. Here that is the nice value, which Linux keeps per thread:
+nice gets an equal share, so a hostile HTTP flood takes real time from the twins (the `attack`
+tool measures it; docs/operations.md). A real-time system puts its control loop above its I/O.
+Here that is the nice value, which Linux keeps per thread:
 
 - the stepping threads and the publish worker (their output is the product: snapshots, waveform,
   alarms) get nice `stepping_thread_nice` (-10: CFS weight 9548 against 1024 at nice 0, about
@@ -21,10 +21,9 @@ I/O. Here that is the nice value, which Linux keeps per thread:
   `kept_nice`, the lower (higher-priority) of io_thread_nice and the process's nice: the HTTP
   event loop (`keep_thread`: /health answers in time) and zenoh's transmit threads
   (`EGRESS_THREAD_NAMES`: "tx-0", "tx-1", ... by their kernel name), which write the state
-  messages to the links. With io_thread_nice set above the process's nice (it was 10 before
-  2026-11-23), that keeps them from waiting behind every other process: bench-service with
-  other work on the 2-core VM gave zenoh put -> client p90 10-12 ms, p99 29-52 ms with the tx
-  threads at nice 10 against p90 2.3-4.1 ms, p99 3.3-7.3 ms at the process's nice. A tx thread is
+  messages to the links. With io_thread_nice set above the process's nice, that keeps them from
+  waiting behind every other process (a tx thread behind the host's load delays every state
+  message on its link: `bench-service` measures the put -> client latency). A tx thread is
   made when a link opens, by a zenoh thread already at io_thread_nice, so bringing it back to a
   lower nice needs the same privilege as raising the stepping threads (counted in
   `egress_priority_refused`). New threads appear all the time (a twin's zenoh publisher, a
@@ -33,20 +32,18 @@ I/O. Here that is the nice value, which Linux keeps per thread:
   started before the first sweep
   (TwinRegistry.open).
 
-Why the I/O threads are above the load and not below it (io_thread_nice was 10 until
-2026-11-23). The stepping threads need the GIL for the Python between frames, and whoever holds
-the GIL when they ask is an I/O thread (the event loop, a zenoh callback, the zenoh publisher).
-A thread at nice 10 beside processes at nice 0 (an attacker on the same host, like the `attack`
-tool's own processes, or any busy process) gets a tenth of their CPU share: preempted while
+Why the I/O threads are above the load and not below it. The stepping threads need the GIL for
+the Python between frames, and whoever holds the GIL when they ask is an I/O thread (the event
+loop, a zenoh callback, the zenoh publisher). A thread at a nice above the host's other
+processes' (an attacker on the same host, like the `attack` tool's own processes, or any busy
+process) gets a fraction of their CPU share (a tenth at nice 10 against 0): preempted while
 holding the GIL, it keeps every stepping thread waiting for as long as the kernel leaves it off
-the CPU (priority inversion; the GIL has no priority inheritance). Measured with `attack
---seconds 30` on the 2-core VM: median real-time factor under the flood 0.78-0.86 at nice 10,
-0.998-1.000 at 0 (quiet host); with other processes busy as well, 0.68-0.81 at 0 and 0.80-0.91
-at -5, /health p99 214-317 ms against 52-89 ms. The I/O work they can do is bounded by the
-per-client budgets and the tarpit (service.api.middleware), so their priority does not let a
-flood take more than the budgets allow; the stepping threads (-10, weight 9548) still come first.
-Raising a priority needs root or CAP_SYS_NICE; without it these threads keep the process's nice
-(counted in `errors`).
+the CPU (priority inversion; the GIL has no priority inheritance). `attack` measures the
+real-time factor under a flood with each setting (docs/operations.md). The I/O work they can do
+is bounded by the per-client budgets and the tarpit (service.api.middleware), so their priority
+does not let a flood take more than the budgets allow; the stepping threads (-10, weight 9548)
+still come first. Raising a priority needs root or CAP_SYS_NICE; without it these threads keep
+the process's nice (counted in `errors`).
 
 Not done: real-time scheduling classes (SCHED_FIFO / SCHED_RR) for the stepping threads. A FIFO
 thread that never sleeps (a twin behind the wall clock steps without pause) would lock every

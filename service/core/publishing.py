@@ -17,7 +17,7 @@ Sinks (zenoh channel, recorder, table) only enqueue (bounded, drop-oldest, count
 service.core.sinks), so the worker never blocks on I/O; a sink that raises is counted and
 skipped. The runner's own status note (a fallback, a caught error) is written into the
 snapshot's `status` beside the engine's. The accelerometer samples the twin produced since the
-last capture (`Twin.drain_waveform`, issue 14) are drained with each capture and handed, after
+last capture (`Twin.drain_waveform`) are drained with each capture and handed, after
 the snapshot, to the sinks that have `publish_waveform(bearing_id, blocks, seq=...)` (zenoh
 `.../vibration/waveform`, the recorder); a capture dropped under back-pressure passes its
 samples on to the next one. The first snapshot that reflects an accepted setpoint
@@ -52,7 +52,7 @@ class Capture:
     late_fraction: float | None
     note: str | None
     timings: list[SetpointTiming] = field(default_factory=list)
-    waveform: list = field(default_factory=list)   # accelerometer blocks drained with it (issue 14)
+    waveform: list = field(default_factory=list)   # accelerometer blocks drained with it
 
 
 class Publisher:

@@ -264,7 +264,7 @@ class TwinRegistry:
                    thermal: Thermal | None = None, housing: Any = None) -> Twin:
         """A warm-started Twin (InputError naming the field if a value is not valid). `housing`:
         twin.vibration.housing.Housing (or its dict); `{"enabled": true}` puts the outer ring on
-        the housing support with the accelerometer (issue 14)."""
+        the housing support with the accelerometer."""
         wanted = designation
         designation = designation.strip().upper()
         if designation not in catalog.designations():

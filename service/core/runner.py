@@ -119,7 +119,7 @@ class TwinRunner:
         self._clock = clock
 
         self.mailbox = Mailbox(twin.setpoint, self.limits, clock=clock)
-        self.defect_box = DefectBox()        # local defects waiting for the next frame (issue 14)
+        self.defect_box = DefectBox()        # local defects waiting for the next frame
         self.faults = FaultPolicy(twin.setpoint, self.limits, safe_after_frames=safe_after_frames,
                                   max_restarts_per_frame=max_restarts_per_frame)
         self.pacing = PacingClock(fast=self.fast, publish_period_s=1.0 / self.publish_rate_hz, clock=clock,

@@ -28,7 +28,7 @@ Format (schema "bearing-twin/scenario/1"; all times are SIMULATED seconds from t
 Rules:
 
 * every step has one of `set` or `ramp`, or `defects` (the local defects in force from `at_s`,
-  issue 14: a list in the vocabulary of twin.vibration.defects, `[]` clears them; with `set` or
+  a list in the vocabulary of twin.vibration.defects, `[]` clears them; with `set` or
   `ramp` beside it, or alone; checked against the bearing's geometry like the setpoint values
   against its limits); a ramp needs `over_s` > 0 and must end by `duration_s`; `at_s` is
   non-decreasing and below `duration_s`;
@@ -87,7 +87,7 @@ class ScenarioStep(BaseModel):
     phase: str | None = Field(default=None, max_length=64, description="Optional label of the phase this step starts [text].")
     defects: list[dict[str, Any]] | None = Field(
         default=None, max_length=64,
-        description="Local defects in force from at_s (issue 14; twin.vibration.defects vocabulary: kind outer | "
+        description="Local defects in force from at_s (twin.vibration.defects vocabulary: kind outer | "
         "inner | ball, width_m, length_m, depth_m [m], ...; [] clears them), checked against the bearing's "
         "geometry before the run starts.")
 

@@ -24,7 +24,7 @@ class SnapshotSink(Protocol):
 
 
 class WaveformSink(Protocol):
-    """A sink that also takes the accelerometer samples (issue 14): `twin.vibration.sensor.WaveformBlock`s
+    """A sink that also takes the accelerometer samples: `twin.vibration.sensor.WaveformBlock`s
     (float32 [m/s^2], t0_s [s], sample_rate_hz [Hz]), handed over after the snapshot they came
     with; the same rules (never block, drop-oldest, count)."""
 

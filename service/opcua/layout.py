@@ -1,5 +1,5 @@
 """The address space of the OPC UA facade: namespace URI, folders and browse names, and how each
-variable is read from a twin's latest snapshot (README "OPC UA").
+variable is read from a twin's latest snapshot (docs/service.md "OPC UA").
 
 Browse names are the service's own field names (units in the name, as in the JSON contract and
 the setpoint vocabulary twin.setpoint), so one vocabulary serves HTTP, zenoh and OPC UA. Node ids
@@ -18,6 +18,7 @@ from typing import Any, Literal
 
 from service.core.alarms import ALARM_IDS, Alarm, AlarmInputs, vibration_zone
 from service.settings import AlarmSettings
+from twin.life.iso281 import ratings_for
 from twin.setpoint import FIELDS as SETPOINT_FIELDS
 from twin.setpoint import Setpoint
 from twin.snapshot import Snapshot
@@ -233,19 +234,12 @@ def identification(entry: Any) -> list[tuple[str, UaType, str, Any]]:
     """Static (name, type, description, value) of a twin: designation, kind, geometry, C, C0.
 
     C and C0 come from `twin.life.ratings_for` (catalogue, else ISO 281 / ISO 76 from the
-    geometry) when the engine has it; without it C has no value and C0 is the radial load at
-    which the model's Hertz pressure reaches ISO 76's 4.2 GPa (the model's load limit)."""
+    geometry)."""
     model = entry.twin.model
     spec = model.spec
     g = spec.geometry
-    c = c0 = None
-    try:
-        from twin.life import ratings_for  # on the engine once rating life is merged
-    except ImportError:
-        c0 = float(model.max_radial_load_n)
-    else:
-        r = ratings_for(spec)
-        c, c0 = float(r.dynamic_load_rating_n), float(r.static_load_rating_n)
+    r = ratings_for(spec)
+    c, c0 = float(r.dynamic_load_rating_n), float(r.static_load_rating_n)
     return [
         ("bearing_id", "String", "Twin name [text].", entry.id),
         ("designation", "String", "Catalog designation [text].", spec.designation),

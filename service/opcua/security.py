@@ -1,7 +1,7 @@
 """OPC UA message security of the facade: which policies a mode offers, the server certificate
 (given, or self-signed once and reused), and the trusted client certificates.
 
-Modes (setting `opcua_security`, README "OPC UA"):
+Modes (setting `opcua_security`, docs/service.md "OPC UA"):
 
     none              SecurityPolicy#None only (no certificate)
     sign              Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss in Sign

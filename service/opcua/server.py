@@ -7,7 +7,7 @@
 The server runs its own asyncio loop in a daemon thread. Every half publish period it reads each
 twin's latest published snapshot (`runner.latest`, no work on the stepping threads) and, when
 the snapshot is new, writes the variables that changed; twins created or deleted in the
-registry appear or disappear at the same pace. Address space: service.opcua.layout (README
+registry appear or disappear at the same pace. Address space: service.opcua.layout (docs/service.md
 "OPC UA").
 
 Writes. The Setpoint variables are answered by `_GatedAttributeService` (it replaces asyncua's
@@ -218,7 +218,7 @@ class OpcUaFacade:
         if parsed.scheme != "opc.tcp" or not parsed.hostname or parsed.port is None:
             raise ValueError(f"opcua = {endpoint!r}: expected opc.tcp://HOST:PORT[/path]")
         settings = registry.settings
-        # security: the mode (README "OPC UA"); the certificate, key and folders from the settings
+        # security: the mode (docs/service.md "OPC UA"); the certificate, key and folders from the settings
         self.security = security if security is not None else settings.opcua_security_mode
         if self.security not in POLICIES:
             raise ValueError(f"opcua_security = {self.security!r}: expected one of {', '.join(POLICIES)}")

@@ -530,7 +530,7 @@ def alarm_states_in_force(tw: TwinLayout, states: Mapping[str, str], time_s: flo
             for alarm_id, state in active]
 
 
-# ---- vibration (issue 14) ---------------------------------------------------------------------------
+# ---- vibration ------------------------------------------------------------------------------------
 def vibration_columns(tw: TwinLayout, batch: Batch) -> None:
     """The indicators of every new accelerometer window (a row at the snapshot that first
     carries it): `vibration/...` Scalars and the envelope bar charts (layout.VIBRATION_SERIES)."""

@@ -34,7 +34,7 @@ alarms/{alarm_id}             TextLog, one row per alarm event (raised, escalate
 alarm_states/{alarm_id}       StateChange inactive / warning / critical, one row per event (and
                               the active ones again at the start of a new segment)
 vibration/acceleration_m_s2   Scalars: the housing accelerometer, one row per sample at its own
-                              simulated time (twin with the housing on, issue 14; about 1.2 MB per
+                              simulated time (twin with the housing on; about 1.2 MB per
                               simulated second at 51.2 kHz)
 vibration/acceleration_rms_peak_m_s2, vibration/velocity_rms_mm_s, vibration/kurtosis
                               Scalars: the indicators of each window (RMS, peak; ISO 20816 velocity
@@ -173,7 +173,7 @@ class TwinLayout:
     inner_raceway_radius_m: float | None = None
     outer_raceway_radius_m: float | None = None
     load_scale_m_per_n: float | None = None
-    vibration: bool = False           # the twin has the housing and accelerometer (issue 14)
+    vibration: bool = False           # the twin has the housing and accelerometer
     # state of the event rows, per output segment (reset when a segment starts)
     last: dict = field(default_factory=dict)
 

@@ -1,4 +1,4 @@
-"""The friction-torque section of `bearing-twin report` (issue 11): the twin's friction torque
+"""The friction-torque section of `bearing-twin report`: the twin's friction torque
 (traction integrated over the contact ellipses, seed 001 rolling resistance) against the SKF
 model for the frictional moment (twin.validation.skf_friction, the public catalogue formula), for the 6208
 of seed 000 and the 6210, over 100-1700 rad/s and 750-7500 N, isothermal and with the inlet
@@ -55,7 +55,7 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
         results[d] = {"speed": [_row(d, w, 3000.0, nu) for w in speeds],
                       "load": [_row(d, 500.0, f, nu) for f in loads]}
     centre = None
-    if not quick:  # the former centre-point friction on the 6208's load sweep, for the slope
+    if not quick:  # the centre-point friction (stribeck_line) on the 6208's load sweep, for the slope
         centre = [studies.mean_friction_torque_n_m(500.0, f, options=ModelOptions(friction_model="stribeck_line"))[0]
                   for f in loads]
     plt = pyplot()
@@ -77,7 +77,7 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
     png = "friction_torque_skf.png"
     save(fig, out_dir / png)
 
-    md = ["## Friction torque against the SKF model (issue 11)\n",
+    md = ["## Friction torque against the SKF model\n",
           "The twin's shaft torque with the traction integrated over strips of every contact ellipse (Heathcote and "
           "spin slip; seed 000 mu(Lambda) x seed 001 eq. A2 asperity share + Eyring / limiting-shear film) and seed "
           "001's rolling resistance, averaged over whole ball passages, against the SKF model for the frictional "
@@ -102,7 +102,7 @@ def friction_section(out_dir: Path, quick: bool) -> list[str]:
         line = (f"{d}: d ln M / d ln F_r at 500 rad/s over {loads[0]:g}-{loads[-1]:g} N: twin {slope_twin:.2f}, "
                 f"SKF {slope_skf:.2f}")
         if d == "6208" and centre is not None:
-            line += f", the former centre-point friction {studies.log_slope(loads, centre):.2f}"
+            line += f", the centre-point friction {studies.log_slope(loads, centre):.2f}"
         md.append(line + ".\n")
     md.append("At high speed the twin's torque exceeds the SKF model's: its rolling resistance (seed 001) is fully "
               "flooded (no kinematic starvation, SKF's phi_rs) and grows with (eta u)^(2/3..3/4); with inlet heating "

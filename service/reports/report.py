@@ -233,7 +233,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
            "| Pd [um] | eps (twin) | Qmax outer [N] | Lambda_out at psi = 0 |", "|---|---|---|---|"]
     md += [f"| {pd:+.1f} | {eps:.3f} | {q:.0f} | {lam:.3f} |" for pd, eps, q, lam in cl_rows]
     md += ["\nThe seed prints eps = 0.685 / 0.5 / 0.4 for Pd = -12.6 / 0 / +12.6 um; the exact Hertz constants "
-           "(README, readings) give 0.684 / 0.500 / 0.402 for the rigid-ring equilibrium, which the twin reproduces.\n",
+           "(docs/physics.md, readings) give 0.684 / 0.500 / 0.402 for the rigid-ring equilibrium, which the twin reproduces.\n",
            "## Start-up, steady, slow-down (seed 000 Figs. 7-8)\n", f"![startup]({st_png})\n",
            f"Steady ball spin {st['steady_ball_spin']:.2f} rad/s (seed 000: 952.38 rad/s).\n",
            "## Seed 001: measured friction torque of the 3-ball 51205 thrust bearing\n", f"![seed001]({s1_png})\n",
@@ -252,7 +252,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
            f"`bearing-twin bench` (6208, 3000 N, 500 rad/s): real-time factor {bench['real_time_factor']:.2f} "
            f"(best of {bench['repeats']}, {bench['ns_per_step']:.0f} ns per step) at the auto step "
            f"dt = {bench['time_step_s'] * 1e6:.3f} us, {bench['real_time_factor_1us']:.2f} at dt = 1 us.\n",
-           "## Time step: the auto step against 1 us (issue 13)\n",
+           "## Time step: the auto step against 1 us\n",
            f"{'Quick subset; `bearing-twin timestep-study` runs the whole envelope. ' if quick else ''}"
            "Outputs averaged over whole cage revolutions (twin.validation.timestep_study).\n",
            timestep_study.markdown(step_study) + "\n",

@@ -73,7 +73,7 @@ def vibration_section(out_dir, quick: bool = False) -> list[str]:
     duration = 0.5 if quick else 1.0
     run = dict(shaft_speed_rad_s=REPORT_SPEED_RAD_S, radial_load_n=3000.0, duration_s=duration,
                noise_density_m_s2_rthz=REPORT_NOISE, window_s=duration)
-    lines = ["## Vibration: housing acceleration with local defects (issue 14)\n",
+    lines = ["## Vibration: housing acceleration with local defects\n",
              f"6208, 3000 N, {REPORT_SPEED_RAD_S:g} rad/s, outer ring on the Sawalhi & Randall housing, accelerometer "
              f"at 51.2 kHz with a background of {REPORT_NOISE:g} m/s2/sqrt(Hz), {duration:g} s after 0.05 s; pits "
              "0.5 mm wide along the rolling direction, 0.6 Rb long across, 50 um deep (`bearing-twin vibration`). "
@@ -99,5 +99,5 @@ def vibration_section(out_dir, quick: bool = False) -> list[str]:
                      f"{result['rms_m_s2']:.3g} | {result['defect_lines']['bpfo']['harmonics'][0]:.3g} |")
     lines += ["", "A large spall can drive seed 000's 0.5 kg rotor into its radial mode (~3.1 kHz, ~0.5 % damping), "
               "which then carries the broadband signal: compare the broadband and the band kurtosis columns "
-              "(README, Vibration limits).\n"]
+              "(docs/physics.md, Vibration).\n"]
     return lines

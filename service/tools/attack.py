@@ -1,5 +1,5 @@
 """`bearing-twin attack`: a bounded, loopback-only abuse run against a service, measuring whether
-load steals real time (issue 16, "Load cannot steal real time").
+load steals real time ("Load cannot steal real time").
 
     bearing-twin attack --seconds 60 --start --json                # own service on free loopback ports
     bearing-twin attack --seconds 60 --url http://127.0.0.1:8000 --zenoh-connect tcp/127.0.0.1:7447

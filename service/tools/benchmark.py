@@ -22,7 +22,7 @@ Measured over `seconds` after the twins have settled:
   the first `bearing/{id}/state` message carrying it (HTTP + mailbox + frame + snapshot +
   zenoh); `client_lost`: none arrived within 1 s.
 
-Wall-clock figures belong here and in the README, never in tests.
+Wall-clock figures belong here and in the docs, never in tests.
 """
 
 from __future__ import annotations

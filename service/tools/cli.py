@@ -11,6 +11,9 @@ import json
 import os
 import re
 import sys
+from pathlib import Path
+
+from service.tools.bench_results import save as save_result
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -114,6 +117,9 @@ def _cmd_bench(args: argparse.Namespace) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     print(json.dumps(result) if args.json else summary_text(result))
+    if args.save is not None:
+        command = "bearing-twin " + " ".join(sys.argv[1:])
+        print(f"saved: {save_result(result, 'bench', command, Path(args.save))}", file=sys.stderr)
     return 0
 
 
@@ -196,6 +202,9 @@ def build_parser() -> argparse.ArgumentParser:
     bench.add_argument("--seconds", type=_positive_float, default=0.2, help="simulated seconds per repeat")
     bench.add_argument("--repeats", type=int, default=5, help="repeats, at least 5 (best and median reported)")
     bench.add_argument("--json", action="store_true")
+    bench.add_argument("--save", nargs="?", const="benchmarks/results", default=None, metavar="DIR",
+                       help="also write the result with the CPU model, versions and git commit as "
+                       "DIR/<UTC date>-<cpu>-bench.json (default DIR: benchmarks/results)")
     bench.set_defaults(func=_cmd_bench)
     study = sub.add_parser("timestep-study", help="the auto time step against 1 us over the operating envelope")
     study.add_argument("--quick", action="store_true", help="a subset of the cases (the test suite's)")
@@ -234,7 +243,7 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--zenoh-prefix", metavar="PREFIX",
                        help="key prefix of the twins on zenoh: site / line / asset, e.g. "
                        "plant1/line2/motor7 (default bearing) [BEARING_TWIN_ZENOH_PREFIX]; zenoh "
-                       "credentials and access rules come from the environment (README \"zenoh "
+                       "credentials and access rules come from the environment (docs/operations.md \"zenoh "
                        "access control\")")
     serve.add_argument("--record", metavar="PATH.rrd",
                        help="rerun recording (default recordings/bearing-twin-<UTC timestamp>.rrd) "

@@ -150,7 +150,7 @@ def solve_to_dict(args: argparse.Namespace) -> dict:
 
 
 def _finite(obj):
-    """JSON never carries NaN or Infinity (README "Architecture"): non-finite floats become null."""
+    """JSON never carries NaN or Infinity (docs/architecture.md): non-finite floats become null."""
     if isinstance(obj, float):
         return obj if math.isfinite(obj) else None
     if isinstance(obj, dict):

@@ -38,7 +38,8 @@ def _fmt(value, spec: str = "{:.4g}") -> str:
 def _cmd_life(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
-    from twin.life import LifeSettings, rate_operating_point
+    from twin.life.settings import LifeSettings
+    from twin.validation.life_rating import rate_operating_point
     from twin.setpoint import SetpointError
 
     try:

@@ -41,7 +41,7 @@ with --start a clean exit and a complete recording. `--no-record` (with --start)
 without its rerun recording, to tell the service's own memory from the rerun SDK's. (rerun-sdk
 0.41's file sink holds the RRD footer's chunk manifest in memory until the file closes, about
 1 MB/s at 50 snapshots/s here: the service writes its recording without a footer by default,
-`BEARING_TWIN_RECORD_FOOTER`; README "Hardening".)
+`BEARING_TWIN_RECORD_FOOTER`; docs/operations.md.)
 """
 
 from __future__ import annotations
@@ -728,7 +728,7 @@ def format_report(r: dict) -> str:
                      f"unexpected {z['unexpected']}, missing {z['missing']}; access {r.get('zenoh_access')}")
         if z["refused"].get("403"):
             lines.append("  note: zenoh setpoints refused with 403: the service needs an HTTP token and has "
-                         "no zenoh access control (README \"zenoh access control\")")
+                         "no zenoh access control (docs/operations.md \"zenoh access control\")")
     s = r.get("stream")
     if s:
         lines.append(f"  state stream: {s['messages']} messages ({s['rate_hz']:.1f}/s), seq gaps {s['seq_gaps']} "

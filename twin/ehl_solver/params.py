@@ -81,8 +81,7 @@ DEFAULT_ENTRAINMENT_SPEED_M_S = 2.496  # 30,000 rpm, the middle of Fig. 1's rang
 # Anchored by `calibration.anchor_bearing_resistance` (see the module docstring): 84.8 %
 # minimum-film reduction at 30 A and the default speed (2.496 m/s), grid 257, default inputs
 # (secant iteration: 2.5e-4 -> 0.1856, 3.0e-4 -> 0.1468, 2.9197e-4 -> 0.1520; target 0.152).
-# Re-anchored after the solver's domain became X in [-3, 1.5], Y in [-2, 2] (was 2.81e-4 ohm on
-# [-4.5, 1.5] x [-3, 3]: the finer lateral spacing resolves the side lobes better).
+# On the solver's domain X in [-3, 1.5], Y in [-2, 2] (the lateral spacing resolves the side lobes).
 DEFAULT_BEARING_RESISTANCE_OHM = 2.92e-4
 
 

@@ -31,7 +31,7 @@ The wedge term is a hybrid upwind scheme (kernels.wedge_weight): second-order up
 eps/hx^2 is large (the inlet, where the film is formed), first-order upwind where it vanishes
 (Hertzian zone, exit spike).
 
-Accuracy (isothermal, seed 003 Appendix 2, issue 7). h_c changes by < 0.5 % from 129 to 257 nodes
+Accuracy (isothermal, seed 003 Appendix 2). h_c changes by < 0.5 % from 129 to 257 nodes
 and by < 0.2 % from 257 to 513 at every speed of Fig. 1 and agrees with Hamrock-Dowson (HD) within
 4 %. h_min (the global film minimum, in the side lobes: what HD's h_min fits) changes from 129 to
 257 nodes by about 1 % at 2.5-4.2 m/s but by 4.6 % at 0.832 and 2.3 % at 1.664 m/s (M = 435 /
@@ -52,8 +52,8 @@ model's accuracy "diminishes when the entrainment speed falls below 2.5 m/s". HD
 k = a/b = 1 for the circle (k = 1.03 (Ry/Rx)^0.64 is HD's approximate fit; it would raise HD's
 h_min by 2 %).
 
-513 nodes. The multigrid used to stagnate there (pressure change ~7e-4 per cycle at 0.832 m/s,
-~1e-2 at 3.3-4.2 m/s). Two smoother defects, both invisible on 129/257 because the Poiseuille
+513 nodes. A multigrid without the two smoother corrections below stagnates there (pressure change ~7e-4 per
+cycle at 0.832 m/s, ~1e-2 at 3.3-4.2 m/s). Two smoother defects, both invisible on 129/257 because the Poiseuille
 coefficient eps/hx^2 of a given point grows 4x per refinement:
 (1) the Jacobi distributive line model truncated the distributed influence kernel Kt at two
 nodes, so its row sum was (Kt(2) - Kt(3))/hx < 0 instead of 0. For a change smooth along X and

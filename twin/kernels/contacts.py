@@ -76,7 +76,7 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     """Seed 000 eq. 8 for every contact lane at once (vectorised, branch-free):
 
     - kinematics: slip (ball minus ring surface velocity, tangential) and entrainment (mean
-      surface velocity relative to the contact point, which orbits with the ball; README
+      surface velocity relative to the contact point, which orbits with the ball; docs/physics.md
       reading of eq. 6, ~7.25 m/s for the 6208 at 500 rad/s);
     - Fn = K delta^1.5 + C_n(Lambda) d(delta)/dt, never adhesive, C_n per Table 2: C_hyst =
       3 alpha_e K delta^1.5 / 2 (eq. 4) for Lambda <= 1, C_hyst C_fluid / (C_hyst + C_fluid) for
@@ -100,7 +100,7 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     Reads the G_*, K_*, M_STIFFNESS rows and the cached C_* rows; writes the O_* rows (with
     O_NORMAL_RATE between its two loops) and the spring T_XI* (reset where the contact is
     open)."""
-    # two loops, not one (issue 13): the kinematics (slip, entrainment, normal rate, kept in
+    # two loops, not one: the kinematics (slip, entrainment, normal rate, kept in
     # their rows), then the forces; one loop held more values than the 16 vector registers and
     # went to the stack 77 times per 4 lanes, two go 40 times (with the moment pass 504 -> 461 ns
     # in one process, same operations, bitwise the same results; a third loop was slower)

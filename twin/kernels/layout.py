@@ -31,7 +31,7 @@ P_OIL_PERMITTIVITY = 23    # relative permittivity of the oil at ambient pressur
 P_GAP_LIMIT = 24           # gap limit of the outer-zone capacitance, inner race [m] (outer: P_GAP_LIMIT_OUTER)
 P_ASPERITY_RESISTANCE = 25 # resistance of a fully metallic contact [ohm]
 P_OIL_RESISTIVITY = 26     # [ohm m]
-# friction over the contact ellipse (twin.kernels.traction; issue 11 item 3)
+# friction over the contact ellipse (twin.kernels.traction)
 P_TRACTION_STRIPS = 27     # strips across the major axis [-]
 P_TRACTION_EVERY = 28      # tribology refreshes between two strip integrations [-]
 P_EYRING_STRESS = 29       # tau0 [Pa]
@@ -42,10 +42,10 @@ P_DEFORMED_RADIUS = 33     # contact-surface radius across the groove, inner (33
 P_GAP_LIMIT_OUTER = 35     # gap limit of the outer-zone capacitance, outer race [m]
 P_STRIP_TABLE = 36         # MAX_STRIPS rows of 4: mean t, mean t^2, load share, mean pressure / p_h
 MAX_STRIPS = 32
-# issue 14 (twin.vibration): the model's V_* vector (end of this file) at p[P_VIB + V_*]
+# vibration (twin.vibration): the model's V_* vector (end of this file) at p[P_VIB + V_*]
 P_VIB = P_STRIP_TABLE + 4 * MAX_STRIPS
 N_VIB_PARAMS = 10
-P_LN_ROUGHNESS = P_VIB + N_VIB_PARAMS  # ln(P_ROUGHNESS / 1 m): ln Lambda = ln h_min - this (issue 13)
+P_LN_ROUGHNESS = P_VIB + N_VIB_PARAMS  # ln(P_ROUGHNESS / 1 m): ln Lambda = ln h_min - this
 P_CAGE_STEP_COS = P_LN_ROUGHNESS + 1   # cos(2 pi / Z): turns one cage element's unit vector to the next
 P_CAGE_STEP_SIN = P_LN_ROUGHNESS + 2   # sin(2 pi / Z)
 P_CENTRED_REFRESH = P_LN_ROUGHNESS + 3 # 1: the tribology refresh's inputs centred on its period (twin.kernels.step.centred_inputs)
@@ -89,7 +89,7 @@ X_DRIVE_TORQUE = 7    # instantaneous torque the contacts apply to the inner rin
 X_TORQUE_SUM = 8      # sum of X_DRIVE_TORQUE over steps since the last reset
 X_TORQUE_COUNT = 9
 X_MAX_PENETRATION = 10  # largest ball-raceway penetration since the last reset [m]
-X_DEFECT_COUNT = 11   # issue 14: active local defects (rows at W_DEFECTS of the workspace)
+X_DEFECT_COUNT = 11   # vibration: active local defects (rows at W_DEFECTS of the workspace)
 N_SCALARS = 12
 
 # ---- per-contact lanes ---------------------------------------------------------------------------
@@ -207,7 +207,7 @@ H_SPEED = 79       # its entrainment speed u [m/s]
 H_SIN_ANGLE = 80   # its |sin(contact angle)| = |n_z|, within the angle table [-]
 N_ROWS = 81
 
-# ---- the kernel workspace `w`: the N_ROWS x CW contact lanes, then (issue 14) the local defects ---
+# ---- the kernel workspace `w`: the N_ROWS x CW contact lanes, then the local defects -----------
 # The defect table and the balls' orientations ride in the workspace after the lanes, so that the
 # force pass takes no further array argument (an array argument of a compiled call costs its
 # reference counting, measured ~50 ns per array per step): `TwinState.lanes` is the first
@@ -235,7 +235,7 @@ ANGLE_INV_STEP = 1.0 / ANGLE_STEP
 A_STIFFNESS = 0    # Hertz K [N/m^1.5]
 A_TRIBOLOGY = 1    # first of the N_TRIBOLOGY coefficients of twin.kernels.tribology (T_* + 1)
 
-# ---- vibration (issue 14): housing, local defects, accelerometer (twin.vibration) --------------
+# ---- vibration: housing, local defects, accelerometer (twin.vibration) --------------
 # Model vector p[P_VIB + V_*] (twin.model; `BearingModel.vibration_params` is a view of it); the
 # housing's own vector is twin.vibration.housing.H_*, a defect row twin.vibration.defects.D_*.
 V_HOUSING_ON = 0            # 1: the outer ring rides on the housing model and the sensor is sampled

@@ -30,7 +30,6 @@ from twin.kernels.layout import (
 from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient_share
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 from twin.physics.rolling import asperity_load_share_ln
-# ---- issue 14 (vibration): housing, local defects, accelerometer; hooks marked "issue 14" below --
 from twin.kernels.layout import P_PROFILE_ON, P_VIB, V_DECIMATION_RATIO, V_HOUSING_ON, X_DEFECT_COUNT
 from twin.kernels.vibration import (apply_clearances, defect_table, has_ball_defect, integrate_orientations,
                                     orientations, outer_ring_force, shift_frame)
@@ -92,7 +91,7 @@ def _minmod(a, b):
 
 @njit(inline="always", **JIT)
 def centred_inputs(p, w, c, q_el, u_now, s_now, stamp):
-    """The tribology refresh's inputs CENTRED on the period they are held for (issue 13).
+    """The tribology refresh's inputs CENTRED on the period they are held for.
 
     A refresh at step k holds its values for the P_SUBSTEPS = N steps k .. k + N - 1 while the ball
     rolls on, so values computed from the inputs at step k lag by (N - 1) / 2 steps on average:
@@ -161,13 +160,13 @@ def refresh_contact(p, tr, w, c, q_now, eta, electrical_now, stamp):
     `electrical_now` (or the contact has just closed), its parallel RC (`contact_electrical`).
     Writes the contact's C_* lanes.
 
-    Centred (issue 13): the load, the entrainment speed and the contact angle are those of the
+    Centred: the load, the entrainment speed and the contact angle are those of the
     middle of the period the values are held for (`centred_inputs`, second order in the period),
     not those of this step.
 
     With the ellipse friction the asperity share (seed 001 eq. A2) takes ln Lambda = ln h_min -
     ln sigma from the film's own logarithm (`contact_tribology`'s last output), not another
-    logarithm (issue 13)."""
+    logarithm."""
     friction_model = int(p[P_FRICTION_MODEL])
     r = c & 1
     ex = w[O_EX * CW + c]
@@ -243,8 +242,8 @@ def gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st):
     frame, the ball's velocity and angular velocity turned by (ct, st) (`compute_accelerations`),
     the ring's velocity and spin, the ball's orbital speed; then the pad lanes. Returns the
     padded lane count. The outer and pad lanes' ring velocity and spin (K_OVX..K_SPIN) are not written:
-    the outer ring is fixed (or the frame is its own, issue 14), they hold the 0 that
-    `twin.state.make_state` and `TwinState.clear_contacts` put there (issue 13: 4 Z stores per
+    the outer ring is fixed (or the frame is its own), they hold the 0 that
+    `twin.state.make_state` and `TwinState.clear_contacts` put there (4 Z stores per
     step fewer)."""
     z = bx.shape[0]
     nc = 2 * z
@@ -400,7 +399,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     angle whose cosine and sine are (ct, st) (`step_n`: the half step of the cage's rotation;
     (1, 0) for none), as they are read: bv and bw themselves are left as they are.
 
-    Issue 14: positions and velocities are those relative to the outer ring (`step_n` shifts
+    Positions and velocities are those relative to the outer ring (`step_n` shifts
     them with the housing on); the active defect rows (scal[X_DEFECT_COUNT] of them in the
     workspace after the lanes, twin.kernels.layout W_DEFECTS) open their clearance between the
     geometry and the force pass, with the surface profiles when on (`twin.kernels.vibration.apply_clearances`).
@@ -458,25 +457,37 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
 
 
 @njit(**JIT_STEP)
-def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx, hv, ha,
-           dec_state, ring, ring_state, hp, taps, n):
+def step_n(model, state, setpoint, n):
     """Advance n steps of dt (seed 000 eq. 10, velocity-Verlet; velocity-dependent forces use the
-    half-step velocity turned on by the cage's half-step rotation). The shaft speed moves towards its setpoint at the ramp rate; the torque
-    the shaft supplies is accumulated for averaging. Returns (status, steps done).
+    half-step velocity turned on by the cage's half-step rotation). The shaft speed moves towards
+    its setpoint at the ramp rate; the torque the shaft supplies is accumulated for averaging.
+    Returns (status, steps done).
 
-    Issue 14 (twin.vibration), skipped with the rigid outer ring and no defect: with
-    p[P_VIB + V_HOUSING_ON] the outer ring rides on the housing (hx, hv, ha: twin.vibration.housing DOFs,
-    hp its H_* vector), leapfrogged with the balls, the forces evaluated in the outer ring's frame
-    (`shift_frame`) and the outer contacts' reaction driving it; the sensed acceleration goes
-    through the anti-aliasing decimator (`taps`, `dec_state`) into the sample ring (`ring`,
-    `ring_state`) every step (twin.vibration.signal.sensor_push_direct; the engine adds the sensor
-    noise between frames). The orientation of a ball carrying one of the active defects (in the
-    workspace `w`, twin.kernels.layout W_DEFECTS, W_ORIENTATION) is integrated.
+    `model` is a `twin.kernels.structures.ModelArrays`, `state` a `StateArrays` (written in place),
+    `setpoint` the layout.S_* vector. The body reads them through the short local names of the
+    equations (bx, bv, bw: ball positions, velocities, angular velocities; rx, rv: inner ring;
+    hx, hv, ha: housing; p: the P_* constants; sp: the setpoint).
+
+    With the housing on (p[P_VIB + V_HOUSING_ON]; skipped with the rigid outer ring and no defect)
+    the outer ring rides on the housing (twin.vibration.housing DOFs), leapfrogged with the balls,
+    the forces evaluated in the outer ring's frame (`shift_frame`) and the outer contacts' reaction
+    driving it; the sensed acceleration goes through the anti-aliasing decimator into the sample
+    ring every step (twin.vibration.signal.sensor_push_direct; the engine adds the sensor noise
+    between frames). The orientation of a ball carrying one of the active defects (in the
+    workspace, twin.kernels.layout W_DEFECTS, W_ORIENTATION) is integrated.
 
     A nonzero sp[S_STOP] (written by another thread while this one runs without the GIL:
     Twin.interrupt_frame) ends the frame at the next step boundary, after at least one step, with
     status OK and done < n; the closing half kick is the same, so frames of k and n - k steps
     give the state of one frame of n (the sub-rates count the steps in scal[X_STEP])."""
+    p, tr, hp, taps = model.params, model.angle_table, model.housing_params, model.decimator_taps
+    sp = setpoint
+    scal, w, cage_load = state.scalars, state.workspace, state.cage_load_n
+    bx, bv, bw = state.ball_position_m, state.ball_velocity_m_s, state.ball_angular_velocity_rad_s
+    ba, balpha = state.ball_acceleration, state.ball_angular_acceleration
+    rx, rv, ra = state.ring_position_m, state.ring_velocity_m_s, state.ring_acceleration
+    hx, hv, ha = state.housing_displacement_m, state.housing_velocity_m_s, state.housing_acceleration_m_s2
+    dec_state, ring, ring_state = state.decimator_state, state.sample_ring_m_s2, state.sample_ring_state
     z = bx.shape[0]
     dt = p[P_DT]
     half = 0.5 * dt
@@ -488,7 +499,7 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
     # kick of the next are one full kick; the state holds full-step velocities between frames
     status = STATUS_OK
     done = 0
-    housing_on = p[P_VIB + V_HOUSING_ON] != 0.0  # issue 14
+    housing_on = p[P_VIB + V_HOUSING_ON] != 0.0
     ratio = int(p[P_VIB + V_DECIMATION_RATIO])
     defects = defect_table(w, int(scal[X_DEFECT_COUNT]))
     bq = orientations(w, z)
@@ -505,7 +516,7 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
         for k in range(3):
             rv[k] += kick * ra[k]
             rx[k] += dt * rv[k]
-        if housing_on:  # issue 14
+        if housing_on:
             housing_kick_drift(hx, hv, ha, kick, dt)
         if turning:
             integrate_orientations(bq, bw, defects, dt)
@@ -527,14 +538,14 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
         # friction torque at 1 us, 10 % at 4 us); compute_accelerations turns them as it reads
         # them (the state's velocities stay unturned)
         ct, st = _cos_sin(half * scal[X_CAGE_SPEED])
-        if housing_on:  # issue 14: forces in the outer ring's frame
+        if housing_on:  # forces in the outer ring's frame
             shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
         status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w,
                                        cage_load, step % substeps == 0,
                                        step % (substeps * ELECTRICAL_EVERY) == 0,
                                        step % (substeps * traction_every) == 0, ct, st,
                                        step + 1.0)  # a tribology step
-        if housing_on:  # issue 14: back to the world frame; the housing and the accelerometer
+        if housing_on:  # back to the world frame; the housing and the accelerometer
             shift_frame(bx, bv, rx, rv, hx, hv, 1.0)
             fx, fy, fz = outer_ring_force(w, z)
             sensed = housing_accelerations(hp, hx, hv, fx, fy, fz, dt, ha)
@@ -552,20 +563,27 @@ def step_n(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx
             bw[j, k] += half * balpha[j, k]
     for k in range(3):
         rv[k] += half * ra[k]
-    if housing_on:  # issue 14
+    if housing_on:
         housing_close(hv, ha, half)
     scal[X_CAGE_SPEED] += half * scal[X_CAGE_TORQUE] / cage_inertia
     return status, done
 
 
 @njit(**JIT_STEP)
-def evaluate(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, hx, hv, ha,
-             dec_state, ring, ring_state, hp, taps):
-    """Contact forces, tribology and accelerations (balls, rings and, issue 14, the housing) at
-    the current state without advancing time (used after a warm start). Returns the status. Same
-    arguments as `step_n` but n; the accelerometer is not sampled. The tribology is refreshed at
-    the state as it is, not centred (stamp 0: a warm-started state has no history to extrapolate
-    from, and the next regular refresh takes none from this one)."""
+def evaluate(model, state, setpoint):
+    """Contact forces, tribology and accelerations (balls, rings and the housing) at the current
+    state without advancing time (used after a warm start). Returns the status. Same structures as
+    `step_n`; the accelerometer is not sampled. The tribology is refreshed at the state as it is,
+    not centred (stamp 0: a warm-started state has no history to extrapolate from, and the next
+    regular refresh takes none from this one)."""
+    p, tr, hp, taps = model.params, model.angle_table, model.housing_params, model.decimator_taps
+    sp = setpoint
+    scal, w, cage_load = state.scalars, state.workspace, state.cage_load_n
+    bx, bv, bw = state.ball_position_m, state.ball_velocity_m_s, state.ball_angular_velocity_rad_s
+    ba, balpha = state.ball_acceleration, state.ball_angular_acceleration
+    rx, rv, ra = state.ring_position_m, state.ring_velocity_m_s, state.ring_acceleration
+    hx, hv, ha = state.housing_displacement_m, state.housing_velocity_m_s, state.housing_acceleration_m_s2
+    dec_state, ring, ring_state = state.decimator_state, state.sample_ring_m_s2, state.sample_ring_state
     housing_on = p[P_VIB + V_HOUSING_ON] != 0.0
     if housing_on:
         shift_frame(bx, bv, rx, rv, hx, hv, -1.0)

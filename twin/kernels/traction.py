@@ -1,4 +1,4 @@
-"""Friction over the contact ellipse (issue 11, item 3): the traction of every loaded
+"""Friction over the contact ellipse: the traction of every loaded
 ball-raceway contact integrated in strips across the major axis of its Hertz ellipse.
 
 Kinematics (rigid-body velocity fields of ball and ring evaluated on the contact surface, which
@@ -29,7 +29,7 @@ spin moment is applied every step from its value and slope at the solution, clip
 all-sliding value, so that it follows the spin rate without a sign chatter.
 
 Cost: the strip solve (a few exponentials per strip pair, one to three Newton passes from the
-last solution) runs every `P_TRACTION_EVERY` tribology refreshes (400 us by default; it was 200 us): the torque moves by
+last solution) runs every `P_TRACTION_EVERY` tribology refreshes (400 us by default): the torque moves by
 under 0.04 % between a solve every 10 us and every 500 us (tests/physics/test_friction_torque.py),
 and 12 strips hold the moments within 0.5 % of 32 (tests/kernels/test_traction.py). No allocation: the per-strip values of the contact being solved
 live in scratch rows of the lane array.
@@ -319,7 +319,7 @@ def apply_traction_moments(w, nc):
     """Every lane (vectorised, branch-free): add the strips' moment about the contact centre
     (`traction_moment_lane`) to the ball torque (O_T*) and its reaction to the ring's torque
     about its axis (O_RING_TZ). A pass of its own: carried in the force pass's loop (with the
-    force pass's runtime flag) it cost more than it saved (issue 13)."""
+    force pass's runtime flag) it costs more than it saves."""
     for c in range(nc):
         loaded = 1.0 if w[G_DELTA * CW + c] > 0.0 else 0.0
         nx = w[G_NX * CW + c]

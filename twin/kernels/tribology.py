@@ -87,7 +87,7 @@ def contact_tribology(load_n, entrainment_m_s, viscosity_pa_s, roughness_m, t0, 
 
     Returns (h_min [m], h_c [m], Lambda, regime code, mu, a [m], b [m], C_fluid [N s/m],
     rolling force [N], pivoting moment [N m], ln(h_min / 1 m)); the last lets the caller take
-    ln Lambda = ln h_min - ln sigma without another logarithm (issue 13). Without entrainment
+    ln Lambda = ln h_min - ln sigma without another logarithm. Without entrainment
     (u <= 0) the film is zero: boundary lubrication, hysteretic damping only (ln h_min = -inf)."""
     ln_q = math.log(load_n)
     cube = math.exp(ln_q / 3.0)

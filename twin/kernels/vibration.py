@@ -1,4 +1,4 @@
-"""Kernel passes of issue 14 (condition monitoring): local defects in the contact geometry, the
+"""Kernel passes of condition monitoring: local defects in the contact geometry, the
 outer ring's reaction that drives the housing, the ball orientations. Called by
 `twin.kernels.step` (one function per pass; the housing and sensor steps themselves are
 `twin.vibration.housing` and `twin.vibration.signal`).

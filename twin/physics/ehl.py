@@ -1,7 +1,7 @@
 """Elastohydrodynamic film thickness and the film parameter.
 
 Dimensionless groups of seed 000 eq. 6: U = eta u / (E' Rx), G = xi E', W = Q / (E' Rx^2), with u
-the entrainment speed (mean of the two surface speeds relative to the contact, README).
+the entrainment speed (mean of the two surface speeds relative to the contact, docs/physics.md).
 """
 
 import math
@@ -46,7 +46,7 @@ def hamrock_dowson_h_c_m(rx_m, u_param, g_param, w_param, k_ellipticity):
 def masjedi_khonsari_h_min_m(rx_m, u_param, g_param, w_param, k_ellipticity):
     """h_min = 1.637 Rx U^(0.711 k^-0.023) G^(0.65 k^-0.045) W^(-0.09 k^-0.15)
     (1 - 0.974 exp(-0.676 k)) [m] (seed 004 eq. 6, smooth surfaces, exponents as products per
-    README)."""
+    docs/physics.md)."""
     if u_param <= 0.0 or w_param <= 0.0:
         return 0.0
     return (1.637 * rx_m * u_param ** (0.711 * k_ellipticity ** -0.023)

@@ -80,7 +80,7 @@ def parallel_resistance_ohm(r1, r2):
     return r1 * r2 / (r1 + r2)
 
 
-# ---- capacitance of the bearing's geometry (model build, numpy; issue 11 item 5) ------------
+# ---- capacitance of the bearing's geometry (model build, numpy) ---------------------------
 
 def ball_raceway_gap_integral_m(ball_radius_m: float, groove_radius_m: float, groove_centre_radius_m: float,
                                 contact_angle_rad: float, inner: bool, land_radius_m: float,

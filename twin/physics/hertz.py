@@ -1,6 +1,6 @@
 """Hertz elliptic point contact: curvature, ellipticity, stiffness, contact ellipse.
 
-Seed 000 eq. 2 with the README's reading (the printed 2 pi k G lost the 1/(1 - nu) factor):
+Seed 000 eq. 2 with the reading of docs/physics.md (the printed 2 pi k G lost the 1/(1 - nu) factor):
 Q = K delta^1.5, K = pi k E' sqrt(2 Ebar R / (9 Fbar^3)), R = Rx Ry / (Rx + Ry); k = a/b is the
 ellipticity and Fbar = K(m), Ebar = E(m) the complete elliptic integrals of the first and second
 kind of parameter m = 1 - 1/k^2. They are solved EXACTLY from the curvature ratio Ry/Rx
@@ -127,7 +127,7 @@ def brewe_hamrock_ellipticity(rx_m, ry_m):
 
 @njit(**JIT)
 def brewe_hamrock_first_kind(rx_m, ry_m):
-    """Fbar ~ pi/2 + (pi/2 - 1) ln(Ry/Rx) [-] (Brewe & Hamrock 1977; README's corrected reading)."""
+    """Fbar ~ pi/2 + (pi/2 - 1) ln(Ry/Rx) [-] (Brewe & Hamrock 1977; the reading of docs/physics.md)."""
     return 0.5 * math.pi + _Q * math.log(ry_m / rx_m)
 
 
@@ -141,7 +141,7 @@ def brewe_hamrock_second_kind(rx_m, ry_m):
 
 @njit(**JIT)
 def stiffness_from_constants(k, fbar, ebar, r_m, effective_modulus):
-    """K = pi k E' sqrt(2 Ebar R / (9 Fbar^3)) [N/m^1.5] (seed 000 eq. 2, README)."""
+    """K = pi k E' sqrt(2 Ebar R / (9 Fbar^3)) [N/m^1.5] (seed 000 eq. 2, docs/physics.md)."""
     return math.pi * k * effective_modulus * math.sqrt(2.0 * ebar * r_m / (9.0 * fbar ** 3))
 
 

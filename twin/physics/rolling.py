@@ -4,7 +4,7 @@ lubricated ball-race contact (seed 001, Biboulet-Houpert laws as used by Balan/H
 All functions are scalar, SI in and SI out, and return 0.0 (never NaN) for a zero, negative or
 NaN speed or load. Speeds are magnitudes: the caller applies the sign of the rolling direction.
 
-Notation of seed 001 (read with README, "Readings of garbled seed formulas", seed 001 bullet):
+Notation of seed 001 (read with docs/physics.md, "Readings of garbled seed formulas", seed 001 bullet):
   E*  equivalent modulus of the pair, 2.3e11 Pa for steel on steel (seed 001 below eq. 7; it is
       E' = E / (1 - nu^2), the same modulus as seed 000's E');
   Rx  equivalent radius in the rolling direction, Ry transverse;
@@ -32,7 +32,7 @@ LAMBDA_ASPERITY_FIT_MIN = (0.64 / (0.37 * (1.26 - 0.64))) ** (1.0 / 1.26)  # = 2
 
 @njit(**JIT)
 def speed_parameter_u(eta_pa_s, entrainment_speed_m_s, e_star_pa, rx_m):
-    """Dimensionless speed U = eta0 u / (E* Rx) [-] (seed 001 eq. 6, README seed 001 reading).
+    """Dimensionless speed U = eta0 u / (E* Rx) [-] (seed 001 eq. 6, docs/physics.md seed 001 reading).
 
     eta_pa_s: dynamic viscosity at the contact inlet [Pa s]; entrainment_speed_m_s: u = (v1+v2)/2
     [m/s]; e_star_pa: E* [Pa]; rx_m: Rx [m]. Returns 0.0 if any input is <= 0 or NaN.
@@ -44,7 +44,7 @@ def speed_parameter_u(eta_pa_s, entrainment_speed_m_s, e_star_pa, rx_m):
 
 @njit(**JIT)
 def load_parameter_w(load_n, e_star_pa, rx_m):
-    """Dimensionless load W = Q / (E* Rx^2) [-] (seed 001 eq. 7, README seed 001 reading).
+    """Dimensionless load W = Q / (E* Rx^2) [-] (seed 001 eq. 7, docs/physics.md seed 001 reading).
 
     load_n: normal load Q of the contact [N]. Returns 0.0 if any input is <= 0 or NaN.
     """
@@ -57,7 +57,7 @@ def load_parameter_w(load_n, e_star_pa, rx_m):
 def rolling_force_ivr_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainment_speed_m_s):
     """Isoviscous-rigid (IVR) hydrodynamic rolling force of one contact [N], fully flooded
     (meniscus at -d/2):  FR_IVR = 2.9766 E* Rx^2 k^0.3316 W^(1/3) U^(2/3)
-    (seed 001 eq. 1, Biboulet-Houpert; README seed 001 reading). k = Ry/Rx.
+    (seed 001 eq. 1, Biboulet-Houpert; docs/physics.md seed 001 reading). k = Ry/Rx.
 
     FR acts on BOTH surfaces of the contact, against their motion; the power it dissipates is
     2 FR u. Returns 0.0 for non-positive / NaN speed, load or properties.
@@ -74,7 +74,7 @@ def rolling_force_ivr_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrai
 def rolling_force_ehl_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainment_speed_m_s):
     """Elastohydrodynamic (EHL) hydrodynamic rolling force of one contact [N], fully flooded
     (meniscus at about 10 b):  FR_EHL = 7.5826 E* Rx^2 k^0.4055 W^(1/3) U^(3/4)
-    (seed 001 eq. 2, Biboulet-Houpert; README seed 001 reading). k = Ry/Rx.
+    (seed 001 eq. 2, Biboulet-Houpert; docs/physics.md seed 001 reading). k = Ry/Rx.
 
     Returns 0.0 for non-positive / NaN speed, load or properties.
     """
@@ -89,7 +89,7 @@ def rolling_force_ehl_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrai
 @njit(**JIT)
 def ehl_parameter_m(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainment_speed_m_s):
     """IVR-to-EHL transition parameter  M = 0.5549 k^-0.6029 W U^-0.75  [-]
-    (seed 001 eq. 4 with the NEGATIVE U exponent of the README reading: it reproduces the
+    (seed 001 eq. 4 with the NEGATIVE U exponent of the docs/physics.md reading: it reproduces the
     seed's EHL partitions, e.g. 20-40 % for d = 6.35 mm, Q = 0.125 N). k = Ry/Rx.
 
     M grows with load and falls with speed (large M = EHL dominated). As u -> 0, M -> infinity,
@@ -106,7 +106,7 @@ def ehl_parameter_m(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainmen
 
 @njit(**JIT)
 def ehl_share(m_parameter):
-    """EHL partition (M/6.6) / (1 + M/6.6) in [0, 1] (seed 001 eq. 5 and Section 4.4; README).
+    """EHL partition (M/6.6) / (1 + M/6.6) in [0, 1] (seed 001 eq. 5 and Section 4.4; docs/physics.md).
 
     The IVR partition is 1 - share. Written as 1 / (1 + 6.6/M) so that M = inf gives 1.0.
     Returns 0.0 for M <= 0 or NaN.
@@ -121,7 +121,7 @@ def rolling_force_transition_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s,
                                entrainment_speed_m_s):
     """Biboulet-Houpert transition rolling force of one contact [N]:
     FR = [FR_IVR + (M/6.6) FR_EHL] / (1 + M/6.6) = (1 - s) FR_IVR + s FR_EHL, s = EHL share
-    (seed 001 eqs. 3 and 5 with eqs. 1, 2, 4; README seed 001 reading). k = Ry/Rx.
+    (seed 001 eqs. 3 and 5 with eqs. 1, 2, 4; docs/physics.md seed 001 reading). k = Ry/Rx.
 
     The seed recommends it when the EHL share exceeds 50 %; below that (very light load) the pure
     IVR force (eq. 1) matched its measurements better (Sections 4.4-4.5, conclusion).
@@ -140,7 +140,7 @@ def rolling_force_transition_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s,
 def hysteresis_moment_n_m(ball_diameter_m, load_n, k_radii_ratio):
     """Elastic-hysteresis rolling-resistance moment of one ball-race contact [N m]:
     MER = 7.48e-7 (d/2)^0.33 Q^1.33 [1 - 3.519e-3 (k - 1)^0.8063]
-    (seed 001 eq. 9, Houpert ref. [1]; README seed 001 reading). k = Ry/Rx >= 1.
+    (seed 001 eq. 9, Houpert ref. [1]; docs/physics.md seed 001 reading). k = Ry/Rx >= 1.
 
     Units: the constant 7.48e-7 is SI -- d in m, Q in N, MER in N m -- so no conversion is
     applied. Evidence: (i) MER has the form of Johnson's hysteresis moment
@@ -191,12 +191,12 @@ def pivoting_moment_n_m(mu_s, load_n, semi_major_axis_m, k_radii_ratio):
 @njit(**JIT)
 def asperity_load_share(film_parameter_lambda):
     """Share of the normal load carried by asperities, Qa/Q = 1 - 1.21 L^0.64 / (1 + 0.37 L^1.26),
-    clipped to [0, 1] (seed 001 eq. A2, from its ref. [6]; README seed 001 reading).
+    clipped to [0, 1] (seed 001 eq. A2, from its ref. [6]; docs/physics.md seed 001 reading).
 
     Validity: the fit is used for L (Lambda, film parameter) up to about 3 and must not be used
     past its minimum, where it rises again (0.013 at L = 3, 0.059 at L = 4, -> 1 as L -> inf,
     which is unphysical: thicker films carry more, not less, of the load). The minimum is at
-    L* = (0.64 / (0.37 * 0.62))^(1/1.26) = 2.258 (the README's "near 3"), where the fit is
+    L* = (0.64 / (0.37 * 0.62))^(1/1.26) = 2.258 (the "near 3" of docs/physics.md), where the fit is
     -0.003, i.e. 0 after clipping; the fit already crosses 0 at L = 2.013. Choice: for L >= L*
     return 0.0. This is at once "hold the value at its minimum" (the clipped minimum IS 0) and
     "return 0", so the two options of the brief coincide; it keeps Qa/Q continuous and
@@ -214,7 +214,7 @@ def asperity_load_share(film_parameter_lambda):
 @njit(**JIT)
 def asperity_load_share_ln(film_parameter_lambda, ln_lambda):
     """`asperity_load_share` (seed 001 eq. A2) given ln Lambda as well: the tribology refresh has
-    it from the film's logarithm (twin.kernels.tribology), and saves the logarithm (issue 13).
+    it from the film's logarithm (twin.kernels.tribology), and saves the logarithm.
     Two exps: cheaper than two general powers."""
     lam = film_parameter_lambda
     if not (lam > 0.0):
@@ -232,7 +232,7 @@ def asperity_load_share_ln(film_parameter_lambda, ln_lambda):
 @njit(**JIT)
 def sliding_friction_coefficient_asperity_share(asperity_share, mu_ehl=0.03, mu_asperity=0.11):
     """Mixed-film sliding friction coefficient mu_s = mu_EHL (1 - Qa/Q) + mu_a Qa/Q [-]
-    (seed 001 eq. A1; mu_EHL = 0.03 and mu_a = 0.11 from its ref. [6]; README seed 001 reading).
+    (seed 001 eq. A1; mu_EHL = 0.03 and mu_a = 0.11 from its ref. [6]; docs/physics.md seed 001 reading).
 
     asperity_share: Qa/Q from asperity_load_share, clipped to [0, 1]; NaN is treated as 0
     (full film), so the result is never NaN for finite coefficients.

@@ -1,5 +1,5 @@
 """Traction across the contact ellipse: rheology of the film, asperity friction and the geometry
-of a ball rolling in a conforming groove (issue 11, item 3).
+of a ball rolling in a conforming groove.
 
 A ball in a groove touches the raceway over an ellipse whose long (major) axis runs across the
 groove. The contact surface is curved across the groove, so the surface speeds of ball and ring

@@ -1,4 +1,4 @@
-"""Engine benchmark (issue 13): the twin `serve` runs by default, at its default step and at 1 us,
+"""Engine benchmark: the twin `serve` runs by default, at its default step and at 1 us,
 further cases, and the per-pass timing of the step.
 
 - `real_time_factor`, `time_step_s`: the twin `bearing-twin serve` starts (6208, 3000 N,
@@ -6,7 +6,7 @@ further cases, and the per-pass timing of the step.
   `real_time_factor_1us`: the same twin at the seed's 1 us;
 - `cases`: the electro-thermal coupling on (5 A shaft current, current and inlet shear heating fed
   back into the film every 10 ms), the 7208 under Fr = Fa = 3000 N, the 6208 at 1700 rad/s and
-  7500 N, the 6208 with its outer ring on the housing (issue 14: housing DOFs, in-kernel
+  7500 N, the 6208 with its outer ring on the housing (housing DOFs, in-kernel
   accelerometer decimation, the sample drain every frame) healthy and with a 0.5 mm outer-race
   spall (defect drops), and healthy with the race profiles and ball sizes on (twin.vibration.surface);
   each at its default step and at 1 us (snapped to 1 / (20 x 51.2 kHz) with
@@ -21,7 +21,8 @@ further cases, and the per-pass timing of the step.
   traction, cage and integration (`twin.validation.step_timing`, a harness that times each pass
   alone), at the default step.
 
-Wall-clock figures belong here and in README, never in tests (machines are shared and noisy).
+Wall-clock figures belong here and in benchmarks/results/ (`bench --save`), never in tests (machines are
+shared and noisy).
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """The SKF model for the frictional moment of a deep-groove ball bearing: an independent
-reference for the twin's friction torque (issue 11, item 3).
+reference for the twin's friction torque.
 
 SKF, Rolling bearings catalogue (PUB BU/P1 10000/2 EN, 2016; the same model since the 2003
 General Catalogue 6000 EN), section 'The SKF model for calculating the frictional moment':

@@ -1,4 +1,4 @@
-"""Build-to-build comparison of the step's outputs (issue 13): a speed change must not change them.
+"""Build-to-build comparison of the step's outputs: a speed change must not change them.
 
 `dump` runs a few short cases (the twin `serve` runs at its auto step and at 1 us, the 7208 under
 Fr = Fa = 3000 N, the centre-point friction laws, the 6208 at 1700 rad/s and 7500 N, the outer ring
@@ -15,7 +15,7 @@ on each build, then `compare` the two files: per array, max |a - b| over max |a|
 A change that only reorders floating-point operations shows up as last-bit differences that
 the trajectory amplifies (1e-11 after 0.05 s has been seen); a model change moves these figures
 by 1e-4 or more. tests/engine/test_step_reference.py holds the same guarantee as a test against
-the engine before issue 13 (window means, tolerance 1e-6).
+the engine before its speed optimisation (window means, tolerance 1e-6).
 """
 
 from __future__ import annotations

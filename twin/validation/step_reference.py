@@ -1,10 +1,10 @@
-"""Reference outputs of the step (issue 13): what an optimised `step_n` must reproduce.
+"""Reference outputs of the step: what an optimised `step_n` must reproduce.
 
 `reference_outputs(case)` runs one twin from its warm start for `settle_s`, then samples every
 1 ms frame for `window_s` and returns the window means of: the load and Lambda of every contact
 (lane order c = 2 ball + race; Lambda -1 where a contact is open at a sample), the friction
 torque the shaft supplies, the cage speed, and the inner ring's displacement. The figures of the
-engine before the issue 13 optimisation are stored in tests/engine/data/step_reference.json
+engine before the step's speed optimisation are stored in tests/engine/data/step_reference.json
 (`python -m twin.validation.step_reference > tests/engine/data/step_reference.json`, run on that
 engine); tests/engine/test_step_reference.py compares the current engine with them.
 """

@@ -1,4 +1,4 @@
-"""Per-pass timing of one step (issue 13): gather, geometry, forces, tribology, traction, cage,
+"""Per-pass timing of one step: gather, geometry, forces, tribology, traction, cage,
 integration.
 
 `twin.kernels.step.compute_accelerations` runs its passes inline in one compiled function, so a
@@ -44,6 +44,7 @@ from twin.kernels.layout import (
     S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED, X_CAGE_TORQUE, padded_lane_count,
 )
 from twin.kernels.step import ELECTRICAL_EVERY, _cos_sin, ball_loads_and_cage, gather_lanes, refresh_contact, step_n
+from twin.kernels.structures import StateArrays
 from twin.kernels.traction import apply_traction_moments, ellipse_traction
 
 PASSES = ("gather", "geometry", "forces", "tribology", "traction", "cage", "integration")
@@ -162,8 +163,7 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     traction_steps = substeps * max(int(p[P_TRACTION_EVERY]), 1)
 
     def copies():
-        args = [a.copy() for a in s.kernel_args()]
-        return args  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, then the housing/sensor arrays
+        return StateArrays(*(a.copy() for a in s.arrays()))  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, ...
 
     scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load = copies()[:11]
     ct, st = math.cos(0.5 * p[P_DT] * scal[X_CAGE_SPEED]), math.sin(0.5 * p[P_DT] * scal[X_CAGE_SPEED])
@@ -201,10 +201,10 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
                        for key in ("best_ns", "median_ns")}
     # the real step on a copy of the state
     full = copies()
-    vib = (m.housing_params, m.decimator_taps)
+    model_arrays = m.arrays()
     n_total = max(1000, reps // 10)
-    step_n(p, tr, sp, *full, *vib, 10)
-    best, median = _best_median_ns(lambda n: step_n(p, tr, sp, *full, *vib, n), n_total, repeats)
+    step_n(model_arrays, full, sp, 10)
+    best, median = _best_median_ns(lambda n: step_n(model_arrays, full, sp, n), n_total, repeats)
     out["total"] = {"best_ns": best, "median_ns": median}
     out["sum_of_passes"] = {key: sum(out[k][key] for k in PASSES) for key in ("best_ns", "median_ns")}
     out["tribology_steps_per_refresh"] = substeps

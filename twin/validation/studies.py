@@ -157,7 +157,7 @@ def ev_operating_point(shaft_current_a: float, shaft_speed_rpm: float, *, oil_te
     return sample, snap
 
 
-# ---- friction torque (issue 11 item 3; the SKF comparison of `bearing-twin report`) ----------
+# ---- friction torque (the SKF comparison of `bearing-twin report`) ---------------------------
 TORQUE_SETTLE_S = 0.015
 TORQUE_BALL_PASSAGES = 3
 

@@ -1,12 +1,12 @@
-"""Convergence study of the tribology sub-rates (issue 13): how rarely may the contacts' tribology
+"""Convergence study of the tribology sub-rates: how rarely may the contacts' tribology
 and the strip traction solve be refreshed at the auto step?
 
 The DEM step refreshes each closed contact's film, Lambda, mu, damping, rolling resistance and
 Hertz constants every `ModelOptions.tribology_period_s`, the strip traction solve every
 `traction_period_s` (a whole number of refreshes) and the contacts' RC every 5 refreshes
-(twin.kernels.step ELECTRICAL_EVERY: 200 us at the chosen 40 us; it was 10 refreshes of 10 us).
+(twin.kernels.step ELECTRICAL_EVERY: 200 us at the chosen 40 us).
 Those quantities change on the time scale of a ball's passage through the load zone (ms), not of
-the step (us). Every case of `timestep_study`'s envelope runs at the auto step with the former
+the step (us). Every case of `timestep_study`'s envelope runs at the auto step with the reference
 sub-rates (REFERENCE: 10 us, 200 us; the RC then every 50 us) and with each candidate (PERIODS);
 the outputs are averaged over whole cage revolutions and compared with `timestep_study.compare`
 against its TOLERANCES (0.5 % loads, films, Lambda, mu, speeds; 2 % torque and electrical values).
@@ -42,7 +42,7 @@ REFERENCE = (1e-5, 2e-4)  # (tribology_period_s, traction_period_s) before the s
 PERIODS = ((2e-5, 2e-4), (3e-5, 2e-4), (4e-5, 2e-4), (6e-5, 2e-4), (2e-5, 4e-4), (3e-5, 3e-4), (4e-5, 4e-4),
            (6e-5, 4e-4))
 # the choice (ModelOptions defaults), with the centred refresh: 40 us / 400 us passes every case
-# against the former sub-rates and against 1 us with a margin of 1.58 on the closest quantity (the
+# against the reference sub-rates and against 1 us with a margin of 1.58 on the closest quantity (the
 # 7208 at 1700 rad/s, 7500 N + 3000 N: loads 0.32 % of 0.5 %; torque 1.14 % of 2 %, impedance 1.2 %
 # of 2 % on the 6208 at 750 N); 60 us / 200 us already comes within 1.1 of the tolerance (Lambda
 # 0.45 % against 1 us); 60 / 400 us passed with 1.51 (this case's Lambda and loads move by
@@ -156,7 +156,7 @@ def run_all(*, quick: bool = False, against_1us: bool = False, progress=None) ->
 
 
 def summary_table(result: dict) -> str:
-    """Largest deviation [%] over the cases per candidate, against the former sub-rates and (if run)
+    """Largest deviation [%] over the cases per candidate, against the reference sub-rates and (if run)
     against 1 us, as a Markdown table."""
     head = ts._HEAD
     lines = ["| tribology / traction period | against | " + " | ".join(ts._TITLE) + " | every case within |",
@@ -174,7 +174,7 @@ def markdown(result: dict) -> str:
     """The tables of `run_all` as Markdown: the summary, then per case."""
     text = (f"Largest deviation [%] over {len({r['id'] for r in result['cases']})} cases, whole cage revolutions "
             "at the auto step\n\n" + summary_table(result)
-            + "\n\nPer case, against the former sub-rates (tribology 10 us / traction 200 us)\n\n"
+            + "\n\nPer case, against the reference sub-rates (tribology 10 us / traction 200 us)\n\n"
             + markdown_table(result["cases"]))
     if "summary_against_1us" in result:
         text += ("\n\nPer case, against the 1 us step (10 us / 200 us)\n\n"

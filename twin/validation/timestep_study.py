@@ -1,4 +1,4 @@
-"""Convergence study of the time step (issue 13): the auto step against 1 us over the envelope.
+"""Convergence study of the time step: the auto step against 1 us over the envelope.
 
 Every case runs three times from the same warm start, at the seed's 1 us, at `time_step_s =
 "auto"` (`twin.timestep`) and at twice auto, settles for SETTLE_S, then averages its outputs over
@@ -9,7 +9,7 @@ step), the bearing's impedance magnitude |Z| (always defined), its capacitance w
 publishes one (the network is capacitive: the mean over the samples that publish it, compared when
 both runs publish it in every sample, else null) and, with a shaft current, the current-heating
 temperature rise.
-The deviations from 1 us are checked against TOLERANCES (issue 13: 0.5 % for loads, films,
+The deviations from 1 us are checked against TOLERANCES (0.5 % for loads, films,
 Lambda and speeds, 2 % for torque and electrical values; mu, a film value, is held to 0.5 %).
 
 How a deviation is measured: loads as the largest change of a bin's mean load relative to the
@@ -55,7 +55,7 @@ ELECTRICAL_EVERY_SAMPLES = 10  # the bearing network is evaluated every this man
 AZIMUTH_BINS = 36
 MIN_BIN_SAMPLES = 3
 LOADED_FRACTION = 0.05         # bins with a mean load above this fraction of the peak: loaded zone
-TOLERANCES = {  # relative, issue 13
+TOLERANCES = {  # relative
     "ball_load": 0.005, "lambda": 0.005, "h_min": 0.005, "mu": 0.005,
     "cage_speed": 0.005, "ball_spin": 0.005, "ball_orbital_speed": 0.005,
     "friction_torque": 0.02, "impedance": 0.02, "capacitance": 0.02, "current_heating": 0.02,

@@ -1,4 +1,4 @@
-"""Condition monitoring I (issue 14): the pieces the engine plugs in to produce the vibration a
+"""Condition monitoring: the pieces the engine plugs in to produce the vibration a
 sensor on the housing would measure, and the indicators computed from it.
 
 Modules, one idea each (SI inside, every public quantity carries its unit):
@@ -17,7 +17,7 @@ Modules, one idea each (SI inside, every public quantity carries its unit):
 - `sensor`: between frames, the kernel's sample ring -> waveform blocks (`Twin.drain_waveform`)
   and, every window, the snapshot's `vibration` block.
 
-In the engine (issue 14): the model holds `housing_params` (H_*), `vibration_params`
+In the engine: the model holds `housing_params` (H_*), `vibration_params`
 (twin.kernels.layout V_*) and the decimator's reversed taps (the step snapped to dt = 1 / (R f_s));
 the state the housing DOFs, ball quaternions, decimator state, sample ring and up to MAX_DEFECTS
 defect rows; `twin.kernels.step.step_n` leapfrogs the housing with the balls, evaluates the forces

@@ -1,4 +1,4 @@
-"""PUT / DELETE / GET /v1/bearings/{id}/defects: local defects of a twin (issue 14; the
+"""PUT / DELETE / GET /v1/bearings/{id}/defects: local defects of a twin (the
 vocabulary of twin.vibration.defects, validated by service.core.defects against the bearing's
 own geometry and applied by the twin's runner at its next frame, like a setpoint)."""
 
