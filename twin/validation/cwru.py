@@ -1,5 +1,5 @@
-"""The `CWRU-DE` twin against the measured CWRU drive-end records (issue: vibration a vibration
-analyst believes). `python -m twin.validation.cwru [--json] [--duration S]` regenerates the table.
+"""The `CWRU-DE` twin against the measured CWRU drive-end records: `python -m twin.validation.cwru
+[--json] [--duration S]` regenerates the table of docs/validation.md.
 
 Measured: the 5 s float32 excerpts committed in tests/data/cwru (Case Western Reserve University
 Bearing Data Center, engineering.case.edu/bearingdatacenter, 0 hp, 0.007 in EDM faults; manifest
