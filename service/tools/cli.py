@@ -327,7 +327,8 @@ def build_parser() -> argparse.ArgumentParser:
     vib.add_argument("--duration", type=_positive_float, default=1.0, help="analysed simulated time [s] (default 1)")
     vib.add_argument("--noise-density", type=float, default=None,
                      help="sensor noise density [m/s2/sqrt(Hz)] (default: the spec's, 0)")
-    vib.add_argument("--sample-rate", type=float, default=None, help="accelerometer rate [Hz] (default: the spec's, 51200 for catalog bearings, 12000 for CWRU-DE)")
+    vib.add_argument("--sample-rate", type=float, default=None,
+                     help="accelerometer rate [Hz] (default: the spec's; 51200, 12000 for CWRU-DE)")
     vib.add_argument("--json", action="store_true", help="print the result as JSON")
     vib.add_argument("--waveform", metavar="FILE.npy",
                      help="write the analysed accelerometer signal [m/s2] at the sample rate (float64 .npy)")
