@@ -40,6 +40,18 @@ def test_profile_interpolation_is_periodic_and_exact_on_the_grid():
     assert mid == pytest.approx(0.5 * (h[-1] + h[0]), abs=1e-18)
 
 
+def test_profile_at_a_tiny_negative_angle_is_the_height_at_zero():
+    """A ball at azimuth 0 with the ring 1e-12 m off the axis reads the profile at angle -5e-17 rad,
+    which wraps to exactly PROFILE_POINTS: point 0, not 4096 x the slope to point 1 (the
+    CWRU-DE warm start at 1796 rpm read -110 um there and restarted at every step)."""
+    p = np.zeros(L.N_PARAMS)
+    h = race_profile_m(5e-8, 0.0156, 0.3e-3, np.random.default_rng(0))
+    p[L.P_PROFILE_INNER:L.P_PROFILE_INNER + L.PROFILE_POINTS] = h
+    for angle in (-1e-17, -5e-17, -1e-300, -0.0, 0.0):
+        assert profile_height_m(p, L.P_PROFILE_INNER, angle) == pytest.approx(h[0], abs=1e-18)
+    assert profile_height_m(p, L.P_PROFILE_INNER, math.atan2(-1.05e-12, 19.5e-3)) == pytest.approx(h[0], abs=1e-14)
+
+
 def test_ball_offsets_have_zero_mean_and_the_spread():
     """ISO 3290-1 G10 lot variation 0.5 um taken as 4 sigma: radius offsets are half the diameter
     deviations, zero mean; over many balls their std is half the diameter spread (5 %)."""

@@ -119,8 +119,9 @@ def profile_height_m(p, base, angle_rad):
     u = angle_rad * _INV_TWO_PI * PROFILE_POINTS
     u -= math.floor(u / PROFILE_POINTS) * PROFILE_POINTS
     i = int(u)
-    if i >= PROFILE_POINTS:  # rounding of u just below PROFILE_POINTS
+    if i >= PROFILE_POINTS:  # a tiny negative angle wraps to u = PROFILE_POINTS exactly: that is point 0
         i = 0
+        u = 0.0
     f = u - i
     i1 = i + 1 if i + 1 < PROFILE_POINTS else 0
     return p[base + i] + f * (p[base + i1] - p[base + i])
