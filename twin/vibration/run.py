@@ -169,7 +169,8 @@ def simulate_vibration(bearing="6208", shaft_speed_rad_s: float = 500.0, radial_
     and window override the spec's accelerometer when given); radial_load_n None: the rig's load of
     the designation (`twin.catalog.default_radial_load_n`, e.g. `CWRU-DE`). Returns (the `run_vibration` dict
     plus bearing, loads, speed, defect, time_step_s, status; the samples [m/s^2], float64).
-    Raises pydantic.ValidationError / SetpointError / ValueError naming the field and its range."""
+    Raises pydantic.ValidationError / SetpointError / ValueError naming the field and its range, and
+    RuntimeError (with the twin's status) when the twin cannot hold the setpoint (it halted)."""
     from twin import catalog
     from twin.engine import Twin
     from twin.kernels import layout as L
@@ -199,9 +200,14 @@ def simulate_vibration(bearing="6208", shaft_speed_rad_s: float = 500.0, radial_
     if defect is not None:
         twin.set_defects([defect_for(defect, spec.geometry, defect_size_m, defect_length_m, defect_depth_m,
                                      defect_angle_deg)])
-    twin.advance(settle_s)
-    twin.drain_waveform()
-    twin.advance(duration_s)
+    for k, span in enumerate((settle_s, duration_s)):
+        if k == 1:
+            twin.drain_waveform()   # the settling part is discarded
+        left = twin.advance(span)
+        if left or twin.halted:
+            raise RuntimeError(f"bearing {spec.designation!r} at {shaft_speed_rad_s:g} rad/s, {radial_load_n:g} N: "
+                               f"the twin stopped at t = {twin.time_s:.6f} s after {twin.restarts} restarts "
+                               f"({twin.status})")
     blocks = twin.drain_waveform()
     x = np.concatenate([b.samples for b in blocks]).astype(float) if blocks else np.zeros(0)
     angle = contact_angle_of_lanes_rad(twin.model, twin.state)
