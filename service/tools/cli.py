@@ -151,6 +151,9 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
     except (ValidationError, SetpointError, ValueError) as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except RuntimeError as exc:   # the twin halted: the setpoint cannot be held (its status says why)
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        return 1
     if args.waveform:
         import numpy as np
 
