@@ -117,19 +117,3 @@ def test_defect_angle_places_the_outer_spall_from_the_load_zone():
     with pytest.raises(ValueError, match="defect_angle_deg"):
         defect_for("outer", g, angle_deg=float("nan"))
 
-
-def test_pit_load_fraction_against_the_closed_forms():
-    """Hertz ellipsoidal pressure (Johnson 1985 eq. 7.48) integrated over a pit: a pit covering
-    the ellipse carries the whole load (1), one covering the half x > 0 half of it (1/2), a pit
-    beside the ellipse none; the equivalent drop of losing a share f at deflection delta is
-    delta (1 - (1 - f)^(2/3)) (Q ~ delta^1.5). Tolerance 1 % (8 x 8 Gauss points on the square root)."""
-    from twin.vibration.defects import load_loss_drop_m, pit_load_fraction
-
-    b, a = 0.1e-3, 0.5e-3
-    assert pit_load_fraction(0.0, 0.0, 1e-3, 1e-3, b, a) == pytest.approx(1.0, rel=1e-2)
-    assert pit_load_fraction(-0.5e-3, 0.0, 0.5e-3, 1e-3, b, a) == pytest.approx(0.5, rel=1e-2)
-    assert pit_load_fraction(0.3e-3, 0.0, 0.089e-3, 0.089e-3, b, a) == 0.0
-    small = pit_load_fraction(0.0, 0.0, 0.089e-3, 0.089e-3, b, a)
-    assert 0.05 < small < 0.5
-    assert load_loss_drop_m(small, 2e-6) == pytest.approx(2e-6 * (1 - (1 - small) ** (2 / 3)), rel=1e-12)
-    assert load_loss_drop_m(0.3, -1e-6) == 0.0

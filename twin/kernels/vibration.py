@@ -30,7 +30,7 @@ from twin.jit import JIT, JIT_VECTOR
 # counting, ~100 ns per step on the test machine for these passes); the rare ones stay calls.
 JIT_INLINE = dict(JIT, inline="always")
 from twin.kernels.layout import (
-    C_SEMI_MAJOR, C_SEMI_MINOR, CW, G_DEFECT_DROP, G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_PX, K_PY, K_WX, K_WY,
+    CW, G_DEFECT_DROP, G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_PX, K_PY, K_WX, K_WY,
     K_WZ, M_STIFFNESS, N_VIB_PARAMS, O_FX, O_FY, O_FZ, P_PROFILE_ON, P_VIB, W_DEFECTS, W_ORIENTATION, V_INNER_GROOVE_RADIUS, V_INNER_RACEWAY_RADIUS, V_INNER_RX,
     V_INNER_RY, V_OUTER_GROOVE_RADIUS, V_OUTER_RACEWAY_RADIUS, V_OUTER_RX, V_OUTER_RY,
 )
@@ -53,8 +53,7 @@ def _lane_drop(defects, k, c, w, bq, shaft_angle, vp, rb):
         bq[j, 0], bq[j, 1], bq[j, 2], bq[j, 3], rb,
         vp[V_OUTER_RACEWAY_RADIUS] if outer else vp[V_INNER_RACEWAY_RADIUS],
         vp[V_OUTER_GROOVE_RADIUS] if outer else vp[V_INNER_GROOVE_RADIUS],
-        vp[V_OUTER_RX] if outer else vp[V_INNER_RX], vp[V_OUTER_RY] if outer else vp[V_INNER_RY],
-        w[G_DELTA * CW + c], w[C_SEMI_MINOR * CW + c], w[C_SEMI_MAJOR * CW + c])
+        vp[V_OUTER_RX] if outer else vp[V_INNER_RX], vp[V_OUTER_RY] if outer else vp[V_INNER_RY])
 
 
 @njit(**JIT_INLINE)

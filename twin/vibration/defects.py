@@ -277,72 +277,6 @@ def pit_drop_m(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx
     return max(0.0, min(depth_m, along, across))
 
 
-# Gauss-Legendre nodes and weights on [-1, 1] for the pressure over a pit (`pit_load_fraction`)
-_GAUSS_POINTS = 8
-_GAUSS_X, _GAUSS_W = np.polynomial.legendre.leggauss(_GAUSS_POINTS)
-
-
-@njit(**JIT)
-def pit_load_fraction(u_m, v_m, half_width_m, half_length_m, semi_minor_m, semi_major_m):
-    """Share [-] of a Hertz contact's load that the pressure over a pit carries: the contact centre
-    at (u, v) [m] from the pit centre (u along the rolling direction, v across), its ellipse of
-    semi-axes b = semi_minor (along the rolling direction) and a = semi_major (across), the
-    ellipsoidal pressure p = 3 Q / (2 pi a b) sqrt(1 - x^2/b^2 - y^2/a^2) (Johnson 1985, Contact
-    Mechanics, eq. 7.48) integrated over the pit's rectangle clipped to the ellipse's bounding box
-    (8 x 8 Gauss-Legendre points; tests/vibration/test_surface.py checks it against the closed
-    forms 1 (pit covering the ellipse) and 1/2 (half plane) within 1 %). 0 when the contact has no
-    ellipse (a or b = 0) or misses the pit."""
-    if semi_minor_m <= 0.0 or semi_major_m <= 0.0:
-        return 0.0
-    x0 = max(-u_m - half_width_m, -semi_minor_m)
-    x1 = min(-u_m + half_width_m, semi_minor_m)
-    y0 = max(-v_m - half_length_m, -semi_major_m)
-    y1 = min(-v_m + half_length_m, semi_major_m)
-    if x1 <= x0 or y1 <= y0:
-        return 0.0
-    hx = 0.5 * (x1 - x0)
-    cx = 0.5 * (x1 + x0)
-    hy = 0.5 * (y1 - y0)
-    cy = 0.5 * (y1 + y0)
-    inv_b2 = 1.0 / (semi_minor_m * semi_minor_m)
-    inv_a2 = 1.0 / (semi_major_m * semi_major_m)
-    total = 0.0
-    for i in range(_GAUSS_POINTS):
-        x = cx + hx * _GAUSS_X[i]
-        rest = 1.0 - x * x * inv_b2
-        for k in range(_GAUSS_POINTS):
-            y = cy + hy * _GAUSS_X[k]
-            q = rest - y * y * inv_a2
-            if q > 0.0:
-                total += _GAUSS_W[i] * _GAUSS_W[k] * math.sqrt(q)
-    return min(1.0, total * hx * hy * 1.5 / (math.pi * semi_minor_m * semi_major_m))
-
-
-@njit(**JIT)
-def load_loss_drop_m(fraction, delta_m):
-    """Extra clearance [m] equivalent to losing `fraction` of a Hertz contact's load at deflection
-    delta (Q ~ delta^1.5, seed 000 eq. 2): delta (1 - (1 - f)^(2/3)); 0 for an open contact."""
-    if delta_m <= 0.0 or fraction <= 0.0:
-        return 0.0
-    return delta_m * (1.0 - (1.0 - min(fraction, 1.0)) ** (2.0 / 3.0))
-
-
-@njit(**JIT)
-def small_pit_drop_m(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, ry_m,
-                     delta_m, semi_minor_m, semi_major_m):
-    """Extra clearance [m] of a pit under a contact of deflection delta [m] and semi-axes b, a [m]:
-    the larger of the geometric drop (`pit_drop_m`: the ball falls in until an edge stops it) and
-    the load the pit's area takes out of the contact (`pit_load_fraction`, `load_loss_drop_m`): a
-    pit smaller than the contact ellipse (CWRU's 0.178 mm EDM holes under a ~0.5 x 0.1 mm ellipse)
-    is bridged, so the ball hardly drops, but the pressure over the hole is lost; entering, the
-    contact unloads as the hole takes more of the ellipse, leaving it reloads over the semi-axis b
-    (tens of microseconds): the impulse that excites the housing."""
-    geometric = pit_drop_m(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, ry_m)
-    area = load_loss_drop_m(pit_load_fraction(u_m, v_m, half_width_m, half_length_m, semi_minor_m, semi_major_m),
-                            delta_m)
-    return max(geometric, area)
-
-
 @njit(**JIT)
 def wrap_angle(a):
     """Angle wrapped into (-pi, pi] [rad]."""
@@ -351,8 +285,7 @@ def wrap_angle(a):
 
 @njit(**JIT)
 def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_angle,
-                          qw, qx, qy, qz, rb, race_radius, groove_radius, rx, ry,
-                          delta=0.0, semi_minor=0.0, semi_major=0.0):
+                          qw, qx, qy, qz, rb, race_radius, groove_radius, rx, ry):
     """Extra radial clearance [m] that the defect row `d` (D_* layout) opens at the contact of
     ball `ball` with race `race` (0 inner, 1 outer): the kernel subtracts it from the contact's
     deflection.
@@ -361,9 +294,7 @@ def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_a
     groove-curvature centre -> ball centre (the contact point is at ball centre + Rb n);
     (wx, wy, wz): ball angular velocity, world frame [rad/s]; shaft_angle [rad]; q the ball's
     orientation quaternion; rb ball radius, race_radius raceway radius at the contact, groove_radius,
-    and rx, ry the contact's relative radii of curvature along / across the rolling direction [m];
-    delta the contact's deflection [m], semi_minor / semi_major its ellipse's semi-axes along /
-    across the rolling direction [m] (`small_pit_drop_m`; 0: the geometric drop alone).
+    and rx, ry the contact's relative radii of curvature along / across the rolling direction [m].
 
     Race spall: u = race_radius wrap(ball azimuth - spall azimuth) (inner: spall azimuth = shaft
     angle + ring angle), v = groove_radius (asin nz - asin nz_centre). Ball defect: the defect
@@ -376,8 +307,7 @@ def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_a
         centre = d[D_ANGLE] + (shaft_angle if kind == KIND_INNER else 0.0)
         u = race_radius * wrap_angle(math.atan2(py, px) - centre)
         v = groove_radius * (math.asin(min(1.0, max(-1.0, nz))) - math.asin(d[D_CENTRE_NZ]))
-        return small_pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, ry,
-                                delta, semi_minor, semi_major)
+        return pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, ry)
     if kind == KIND_BALL and ball == int(d[D_BALL]):
         ex, ey, ez = quat_rotate(qw, qx, qy, qz, d[D_BODY_X], d[D_BODY_Y], d[D_BODY_Z])
         cos_n = ex * nx + ey * ny + ez * nz
@@ -400,8 +330,7 @@ def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_a
             dist = rb * math.sqrt(max(0.0, 1.0 - cos_n * cos_n))
             u = dist
             v = dist
-        return small_pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, ry,
-                                delta, semi_minor, semi_major)
+        return pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, ry)
     return 0.0
 
 
