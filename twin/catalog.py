@@ -104,15 +104,98 @@ def _deep_groove(bore_mm: float, od_mm: float, z: int, dw_mm: float) -> Geometry
         cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3, bore_diameter_m=bore_mm * 1e-3, outside_diameter_m=od_mm * 1e-3)
 
 
+# ---- the CWRU drive-end test bearing ---------------------------------------------------------
+# Case Western Reserve University Bearing Data Center rig (engineering.case.edu/bearingdatacenter):
+# a 2 hp Reliance induction motor whose drive-end shaft runs in an SKF 6205-2RS JEM, the
+# accelerometer on a magnetic base at 12 o'clock on the motor housing.
+_INCH_M = 0.0254
+CWRU_BALL_DIAMETER_M = 0.3126 * _INCH_M   # 7.940 mm (data center: bearing specification)
+CWRU_PITCH_DIAMETER_M = 1.537 * _INCH_M   # 39.04 mm
+# Not published; estimated. The rotor of a 2 hp 4-pole induction motor (NEMA 145T frame: core about
+# 90 mm across and 100 mm long, 5 kg of steel and copper, 1.5 kg of shaft) is ~6.5 kg; the drive-end
+# bearing carries half of it plus half of the coupling to the torque transducer (~1 kg): 3.75 kg on
+# the inner ring, and its weight, 3.75 x 9.80665 = 36.8 N, is the radial load at 0 hp (the
+# coupling's misalignment forces are unknown and left out).
+CWRU_ROTOR_MASS_KG = 3.75
+CWRU_RADIAL_LOAD_N = 36.8
+# ISO 5753-1 normal (CN) radial internal clearance of a 25 mm bore deep-groove ball bearing:
+# 5-20 um; the middle of the range as the mounted diametral clearance.
+CWRU_DIAMETRAL_CLEARANCE_M = 12.5e-6
+# Calibrated once on the healthy record 97 only (twin.validation.cwru.calibrate_housing): the
+# healthy acceleration's power spectrum (Welch, 512 points at 12 kHz) has its broadband housing
+# resonance at 3234 Hz with a half-power bandwidth of 108 Hz (damping ratio 0.0167); the sprung
+# mass (1 kg on the Sawalhi & Randall pedestal) is tuned to sense that mode.
+CWRU_SPRUNG_STIFFNESS_N_M = 3.587e8
+CWRU_SPRUNG_DAMPING_N_S_M = 549.9
+# Calibrated once on the healthy record 97 only: the white noise density whose RMS over 0-6 kHz is
+# the record's RMS (0.0711 g = 0.697 m/s2 over the committed 5 s excerpt: rho = 0.697 sqrt(2 / 12000)),
+# i.e. the rig's background (motor, dynamometer, the narrow lines at 4.1-4.3 kHz) is taken to carry
+# the whole healthy RMS, the bearing's own broadband part being small beside it.
+CWRU_NOISE_DENSITY_M_S2_RTHZ = 9.0e-3
+
+# designations with a rig: their default radial load [N] (`default_radial_load_n`)
+_RIG_RADIAL_LOAD_N = {"CWRU-DE": CWRU_RADIAL_LOAD_N}
+
+
+def _cwru_drive_end() -> BearingSpec:
+    """`CWRU-DE`: the SKF 6205-2RS JEM of the CWRU rig's drive end as the data center publishes it
+    (ball diameter 0.3126 in, pitch diameter 1.537 in, 9 balls, contact angle 0: BPFI 5.4152,
+    BPFO 3.5848, FTF 0.39828, 2 x BSF 4.7135 x shaft), groove radii 0.52 Dw (not published; the
+    usual deep-groove conformity, as the 62xx entries), the motor's rotor on the inner ring
+    (CWRU_ROTOR_MASS_KG, estimated), the housing path to the accelerometer at 12 o'clock (azimuth
+    180 deg from the load direction +x, i.e. 6 o'clock is +x) with its resonance and damping and
+    the sensor noise calibrated on the healthy record only (values above), sampled at 12 kHz as
+    the fault records, the race profiles and ball sizes of `twin.vibration.surface` on (defaults:
+    not calibrated)."""
+    from twin.spec import Mounting as _Mounting
+    from twin.vibration.housing import Accelerometer, Housing
+    from twin.vibration.surface import SurfaceProfile
+
+    rb = 0.5 * CWRU_BALL_DIAMETER_M
+    pitch = 0.5 * CWRU_PITCH_DIAMETER_M
+    z = 9
+    half_chord = 2.0 * pitch * math.sin(math.pi / (2 * z))
+    geometry = Geometry(
+        ball_radius_m=rb, ball_count=z, inner_raceway_radius_m=pitch - rb, outer_raceway_radius_m=pitch + rb,
+        inner_groove_radius_m=0.52 * 2 * rb, outer_groove_radius_m=0.52 * 2 * rb,
+        cage_element_radius_m=half_chord - rb - _POCKET_CLEARANCE_M,
+        cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3, ring_width_m=15.0e-3)
+    housing = Housing(
+        enabled=True, sprung_stiffness_n_m=CWRU_SPRUNG_STIFFNESS_N_M, sprung_damping_n_s_m=CWRU_SPRUNG_DAMPING_N_S_M,
+        accelerometer=Accelerometer(azimuth_deg=180.0, sample_rate_hz=12000.0, window_s=1.0,
+                                    noise_density_m_s2_rthz=CWRU_NOISE_DENSITY_M_S2_RTHZ))
+    return BearingSpec(
+        designation="CWRU-DE", kind="deep_groove", geometry=geometry,
+        mounting=_Mounting(diametral_clearance_m=CWRU_DIAMETRAL_CLEARANCE_M, rotor_mass_kg=CWRU_ROTOR_MASS_KG),
+        lubricant=Lubricant(), housing=housing, surface_profile=SurfaceProfile(enabled=True))
+
+
+def default_radial_load_n(designation: str) -> float | None:
+    """The radial load [N] of the rig a designation stands for (`CWRU-DE`: the estimate above), or
+    None for a plain catalog bearing."""
+    return _RIG_RADIAL_LOAD_N.get(designation.strip().upper())
+
+
 def designations() -> list[str]:
     """Every designation the catalog knows, sorted."""
-    return sorted(["6208", "7208", "7208AC", "7208C", *_DEEP_GROOVE_MM])
+    return sorted(["6208", "7208", "7208AC", "7208C", "CWRU-DE", *_DEEP_GROOVE_MM])
 
 
 def bearing(designation: str = DEFAULT_DESIGNATION, *, diametral_clearance_m: float = 0.0,
             lubricant: Lubricant | None = None, **spec_fields) -> BearingSpec:
     """The spec of a catalog bearing with the given mounting clearance [m] and lubricant."""
     key = designation.strip().upper()
+    if key == "CWRU-DE":
+        spec = _cwru_drive_end()
+        if lubricant is not None or diametral_clearance_m != 0.0 or spec_fields:
+            data = spec.model_dump()
+            if lubricant is not None:
+                data["lubricant"] = lubricant.model_dump()
+            if diametral_clearance_m != 0.0:
+                data["mounting"]["diametral_clearance_m"] = diametral_clearance_m
+            data.update({k: (v.model_dump() if hasattr(v, "model_dump") else v) for k, v in spec_fields.items()})
+            spec = BearingSpec.model_validate(data)
+        return spec
     if key == "6208":
         geometry, kind = _seed_6208(), "deep_groove"
     elif key in _ANGULAR_7208_DEG:
@@ -202,3 +285,42 @@ def load_ratings(designation: str) -> LoadRatings:
 def rated_designations() -> list[str]:
     """Every designation with catalogue load ratings, sorted."""
     return sorted(_LOAD_RATINGS_KN)
+
+
+# ---- bearing spec files ------------------------------------------------------------------------
+SPEC_FILE_SUFFIXES = (".yaml", ".yml", ".json")
+
+
+def load_spec_file(path: str) -> BearingSpec:
+    """A `BearingSpec` from a YAML or JSON file (the fields of `twin.spec.BearingSpec`: geometry,
+    materials, lubricant, mounting, housing, surface profile ...), validated as any spec. Raises
+    ValueError naming the file when it cannot be read or parsed, pydantic.ValidationError naming
+    the field otherwise."""
+    import json
+    from pathlib import Path
+
+    import yaml
+
+    file = Path(path)
+    if file.suffix.lower() not in SPEC_FILE_SUFFIXES:
+        raise ValueError(f"bearing: spec file {path!r} must end in {', '.join(SPEC_FILE_SUFFIXES)}")
+    try:
+        text = file.read_text()
+    except OSError as exc:
+        raise ValueError(f"bearing: cannot read spec file {path!r}: {exc.strerror}") from None
+    try:
+        data = json.loads(text) if file.suffix.lower() == ".json" else yaml.safe_load(text)
+    except (json.JSONDecodeError, yaml.YAMLError) as exc:
+        raise ValueError(f"bearing: spec file {path!r} is not valid {file.suffix[1:].upper()}: "
+                         f"{str(exc).splitlines()[0]}") from None
+    if not isinstance(data, dict):
+        raise ValueError(f"bearing: spec file {path!r} must hold a mapping of BearingSpec fields")
+    return BearingSpec.model_validate(data)
+
+
+def bearing_or_file(name: str) -> BearingSpec:
+    """A catalog designation (`bearing`) or, when `name` ends in .yaml, .yml or .json, a spec file
+    (`load_spec_file`)."""
+    if name.strip().lower().endswith(SPEC_FILE_SUFFIXES):
+        return load_spec_file(name.strip())
+    return bearing(name)

@@ -536,8 +536,11 @@ class Twin:
 
         A state the kernel cannot hold at the setpoint in force fails again right after its warm
         restart, i.e. at nearly every step (each restart costs a warm start): `max_restarts`
-        stops the call after that many restarts within it (None: no bound). Returns the steps
-        left undone (0 unless stopped by `max_restarts`)."""
+        stops the call after that many restarts within it (None: no other bound than the next
+        one). Whatever `max_restarts`, the call stops as soon as the twin halts (a second failure
+        within RESTART_WINDOW_S of a restart, `status` says why): without a new setpoint every
+        later step would fail and restart again, one warm start per step. Returns the steps left
+        undone (0 unless stopped by `max_restarts`, a halt or `interrupt_frame`)."""
         if not (math.isfinite(seconds) and seconds >= 0.0):
             raise ValueError(f"seconds = {seconds!r}: must be finite and >= 0")
         remaining = int(round(seconds / self.model.dt_s))
@@ -549,6 +552,8 @@ class Twin:
             n = min(frame_steps, remaining)
             remaining -= max(self._frame(n), 1)  # a failing frame still consumes a step: no hang
             if max_restarts is not None and self.restarts - first >= max_restarts:
+                return max(remaining, 0)
+            if self.halted:   # the setpoint cannot be held: stop instead of a warm start per step
                 return max(remaining, 0)
             if remaining > 0 and self._setpoint_vector[L.S_STOP] != 0.0:
                 self.frame_interrupted = True    # interrupt_frame: the caller has input waiting

@@ -29,6 +29,7 @@ from twin.physics.traction import deformed_surface_radius_m, hertz_strip_table
 from twin.physics.viscosity import dynamic_viscosity_pa_s
 from twin.spec import BearingSpec, ModelOptions
 from twin.vibration.housing import housing_params
+from twin.vibration.surface import write_profile_params
 from twin.vibration.signal import DecimatorDesign, design_decimator, integer_ratio_time_step
 
 # ISO 76 static limit for ball bearings: 4.2 GPa; the model refuses loads whose analytic maximum
@@ -360,6 +361,8 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     v[L.V_INNER_RY], v[L.V_OUTER_RY] = race[0, L.R_RY], race[1, L.R_RY]
     p[L.P_SUBSTEPS] = timestep.steps_per_period(options.tribology_period_s, p[L.P_DT])
     p[L.P_CENTRED_REFRESH] = 1.0 if options.centred_refresh else 0.0
+    p[L.P_PROFILE_ON] = 1.0 if spec.surface_profile.enabled else 0.0
+    write_profile_params(p, spec.surface_profile, g)
     # the strip solve's period as a whole number of tribology refreshes (nearest, at least 1)
     p[L.P_TRACTION_EVERY] = timestep.steps_per_period(options.traction_period_s, p[L.P_SUBSTEPS] * p[L.P_DT])
     if options.friction_model == "ellipse_traction":

@@ -14,6 +14,7 @@ from pydantic import BaseModel, ConfigDict, Field, field_validator, model_valida
 
 from twin.thermal.settings import ThermalNetworkSettings
 from twin.vibration.housing import Housing
+from twin.vibration.surface import SurfaceProfile
 
 # the range of an explicit ModelOptions.time_step_s [s] (twin.timestep.TIME_STEP_RANGE_S)
 TIME_STEP_RANGE_S = (1e-8, 2e-5)
@@ -310,6 +311,10 @@ class BearingSpec(BaseModel):
         default_factory=Housing,
         description="Outer ring + housing support and the accelerometer (twin.vibration.housing; Sawalhi & "
         "Randall 2008 defaults); `enabled: false` (the default) keeps the rigid, fixed outer ring.")
+    surface_profile: SurfaceProfile = Field(
+        default_factory=SurfaceProfile,
+        description="Race profiles (waviness, roughness) and ball-size spread exciting the contacts "
+        "(twin.vibration.surface); `enabled: false` (the default) keeps perfect geometry.")
 
 
 class ModelOptions(BaseModel):

@@ -143,18 +143,27 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
     from twin.setpoint import SetpointError
     from twin.vibration.run import simulate_vibration
 
-    missing = [name for name, value in (("--speed", args.speed), ("--radial-load", args.radial_load)) if value is None]
-    if missing:
-        print(f"error: vibration: {', '.join(missing)} required (or `vibration analyse FILE`)", file=sys.stderr)
+    from twin import catalog
+
+    if args.speed is None:
+        print("error: vibration: --speed required (or `vibration analyse FILE`)", file=sys.stderr)
         return 2
     try:
         result, samples = simulate_vibration(
-            args.bearing, args.speed, args.radial_load, args.axial_load, defect=args.defect,
-            defect_size_m=args.defect_size, defect_length_m=args.defect_length, defect_depth_m=args.defect_depth,
+            catalog.bearing_or_file(args.bearing), args.speed, args.radial_load, args.axial_load,
+            defect=args.defect, defect_size_m=args.defect_size, defect_length_m=args.defect_length,
+            defect_depth_m=args.defect_depth, defect_angle_deg=args.defect_angle,
             duration_s=args.duration, noise_density_m_s2_rthz=args.noise_density, sample_rate_hz=args.sample_rate)
     except (ValidationError, SetpointError, ValueError) as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return 2
+    except RuntimeError as exc:   # the twin halted: the setpoint cannot be held (its status says why)
+        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        return 1
+    if args.waveform:
+        import numpy as np
+
+        np.save(args.waveform, np.asarray(samples, dtype=np.float64))
     if args.plot:
         from service.reports.vibration import plot_vibration
 
@@ -304,9 +313,11 @@ def build_parser() -> argparse.ArgumentParser:
         "sampled in the kernel) and an optional local defect, discard 0.05 s, analyse `--duration` of the signal "
         "(twin.vibration.run.simulate_vibration).")
     vib.add_argument("--bearing", default=DEFAULT_DESIGNATION,
-                     help=f"catalog designation (default {DEFAULT_DESIGNATION})")
+                     help=f"catalog designation (default {DEFAULT_DESIGNATION}; CWRU-DE: the CWRU rig's drive end) "
+                     "or a BearingSpec file (.yaml, .yml, .json)")
     vib.add_argument("--speed", type=float, default=None, help="shaft speed [rad/s] (required)")
-    vib.add_argument("--radial-load", type=float, default=None, help="radial load [N] (required)")
+    vib.add_argument("--radial-load", type=float, default=None,
+                     help="radial load [N] (default: the rig's, for CWRU-DE; required otherwise)")
     vib.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     vib.add_argument("--defect", choices=["outer", "inner", "ball"], help="local defect (default: none, healthy)")
     vib.add_argument("--defect-size", type=float, default=0.5e-3,
@@ -314,11 +325,17 @@ def build_parser() -> argparse.ArgumentParser:
     vib.add_argument("--defect-length", type=float, default=None,
                      help="defect length across the rolling direction, length_m [m] (default 0.6 x ball radius)")
     vib.add_argument("--defect-depth", type=float, default=50e-6, help="defect depth, depth_m [m] (default 50e-6)")
+    vib.add_argument("--defect-angle", type=float, default=0.0,
+                     help="defect position [deg]: outer race from the centre of the load zone (CWRU 6:00, 3:00, "
+                     "12:00 = 0, 90, 180), inner race from the ring's mark (default 0)")
     vib.add_argument("--duration", type=_positive_float, default=1.0, help="analysed simulated time [s] (default 1)")
     vib.add_argument("--noise-density", type=float, default=None,
                      help="sensor noise density [m/s2/sqrt(Hz)] (default: the spec's, 0)")
-    vib.add_argument("--sample-rate", type=float, default=None, help="accelerometer rate [Hz] (default 51200)")
+    vib.add_argument("--sample-rate", type=float, default=None,
+                     help="accelerometer rate [Hz] (default: the spec's; 51200, 12000 for CWRU-DE)")
     vib.add_argument("--json", action="store_true", help="print the result as JSON")
+    vib.add_argument("--waveform", metavar="FILE.npy",
+                     help="write the analysed accelerometer signal [m/s2] at the sample rate (float64 .npy)")
     vib.add_argument("--plot", metavar="FILE.png", help="waveform, spectrum and envelope spectrum with the defect "
                      "frequencies marked")
     vib.set_defaults(func=_cmd_vibration)

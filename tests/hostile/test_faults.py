@@ -101,6 +101,18 @@ def test_restart_storm_is_bounded_by_max_restarts(twin):
     finite_json(twin.snapshot().to_json())
 
 
+def test_advance_stops_when_the_twin_halts_without_max_restarts(twin):
+    """Without max_restarts a long advance at a setpoint the kernel cannot hold stops at the halt
+    (restart, then a second failure within RESTART_WINDOW_S) instead of a warm start per step."""
+    twin._setpoint_vector[L.S_RADIAL_LOAD] = 1e7          # bypasses validation
+    before = twin.restarts
+    left = twin.advance(0.3)
+    assert twin.halted and twin.restarts - before == 2 and left > 0
+    assert twin.status.startswith("halted: overloaded")
+    twin.set_setpoint(radial_load_n=3000.0)                # a new setpoint: runs again
+    assert not twin.halted and twin.advance(0.002) == 0
+
+
 def test_nan_in_the_state_is_detected_and_restarted(twin):
     sink = ListSink()
     runner = TwinRunner(twin, sinks=[sink]).start()

@@ -49,7 +49,13 @@ P_LN_ROUGHNESS = P_VIB + N_VIB_PARAMS  # ln(P_ROUGHNESS / 1 m): ln Lambda = ln h
 P_CAGE_STEP_COS = P_LN_ROUGHNESS + 1   # cos(2 pi / Z): turns one cage element's unit vector to the next
 P_CAGE_STEP_SIN = P_LN_ROUGHNESS + 2   # sin(2 pi / Z)
 P_CENTRED_REFRESH = P_LN_ROUGHNESS + 3 # 1: the tribology refresh's inputs centred on its period (twin.kernels.step.centred_inputs)
-N_PARAMS = P_CENTRED_REFRESH + 1
+# the healthy bearing's excitation (twin.vibration.surface): race profiles and ball sizes
+P_PROFILE_ON = P_CENTRED_REFRESH + 1   # 1: the profiles and ball sizes open / close the contacts
+P_BALL_SIZE = P_PROFILE_ON + 1         # 16 ball radius offsets [m] (Geometry.ball_count <= 16)
+PROFILE_POINTS = 4096                  # points of a race profile over its circumference
+P_PROFILE_INNER = P_BALL_SIZE + 16     # inner race profile heights [m], angle on the ring from its mark
+P_PROFILE_OUTER = P_PROFILE_INNER + PROFILE_POINTS  # outer race profile heights [m], azimuth from +x
+N_PARAMS = P_PROFILE_OUTER + PROFILE_POINTS
 
 # ---- per-race parameter rows: race_params[r, :], r = 0 inner, 1 outer -------------------------
 R_GROOVE_CENTRE_RADIUS = 0  # radius of the groove-curvature-centre circle [m]
@@ -189,7 +195,7 @@ E_SCRATCH_SSAT = 68  # slip at which strip k reaches the limiting shear stress [
 E_SCRATCH_EY = 69    # Eyring force coefficient (1 - Qa/Q) A_k tau0 [N]
 E_SCRATCH_SPREAD = 70  # half the spread of the slip across strip k [m/s]
 E_SCRATCH_SIGNED_HALF = 71  # half-width of strip k in t, signed like ds/dt across it [-]
-# local defects (twin.kernels.vibration.apply_defects, only while a defect is active)
+# local defects and surface profiles (twin.kernels.vibration.apply_clearances, only while one is active)
 G_DEFECT_DROP = 75  # extra radial clearance a defect opens at the contact, taken off G_DELTA [m]
 O_NORMAL_RATE = 76  # d(delta)/dt of the force pass: ball minus ring centre velocity along n [m/s]
 # the inputs of the contact's last tribology refresh as they were (not extrapolated), for the

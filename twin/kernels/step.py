@@ -30,8 +30,8 @@ from twin.kernels.layout import (
 from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient_share
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 from twin.physics.rolling import asperity_load_share_ln
-from twin.kernels.layout import P_VIB, V_DECIMATION_RATIO, V_HOUSING_ON, X_DEFECT_COUNT
-from twin.kernels.vibration import (apply_defects, defect_table, has_ball_defect, integrate_orientations,
+from twin.kernels.layout import P_PROFILE_ON, P_VIB, V_DECIMATION_RATIO, V_HOUSING_ON, X_DEFECT_COUNT
+from twin.kernels.vibration import (apply_clearances, defect_table, has_ball_defect, integrate_orientations,
                                     orientations, outer_ring_force, shift_frame)
 from twin.vibration.housing import housing_accelerations, housing_close, housing_kick_drift
 from twin.vibration.signal import sensor_push_direct
@@ -402,7 +402,7 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     Positions and velocities are those relative to the outer ring (`step_n` shifts
     them with the housing on); the active defect rows (scal[X_DEFECT_COUNT] of them in the
     workspace after the lanes, twin.kernels.layout W_DEFECTS) open their clearance between the
-    geometry and the force pass (`twin.kernels.vibration.apply_defects`).
+    geometry and the force pass, with the surface profiles when on (`twin.kernels.vibration.apply_clearances`).
     Returns a status code."""
     z = bx.shape[0]
     nc = 2 * z
@@ -413,8 +413,8 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
     eta = sp[S_VISCOSITY]
     nl = gather_lanes(scal, bx, bv, bw, rx, rv, w, ct, st)
     raceway_geometry(w, nl)
-    if scal[X_DEFECT_COUNT] > 0.0:  # local defects
-        apply_defects(w, nc, int(scal[X_DEFECT_COUNT]), scal[X_SHAFT_ANGLE], p, rb)
+    if scal[X_DEFECT_COUNT] > 0.0 or p[P_PROFILE_ON] != 0.0:  # local defects, surface profiles
+        apply_clearances(w, nc, int(scal[X_DEFECT_COUNT]), scal[X_SHAFT_ANGLE], p, rb)
     raceway_forces(w, nl, rb, p[P_DT], kt_ratio, p[P_ALPHA_E])
     # per contact: outputs, tribology refresh, opened contacts
     max_pen = scal[X_MAX_PENETRATION]

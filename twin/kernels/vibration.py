@@ -3,12 +3,13 @@ outer ring's reaction that drives the housing, the ball orientations. Called by
 `twin.kernels.step` (one function per pass; the housing and sensor steps themselves are
 `twin.vibration.housing` and `twin.vibration.signal`).
 
-- `apply_defects`: between the geometry pass and the force pass, every active defect row
+- `apply_clearances`: between the geometry pass and the force pass, every active defect row
   (`twin.vibration.defects`, D_* layout) opens an extra radial clearance at the contacts it lies
   under (`contact_defect_drop_m`: Sawalhi & Randall 2008 Part I sec. 4.1, generalised to curved
   bodies); the deepest drop of all defects is taken off the lane's deflection before the Hertz
   load (seed 000 eq. 2), so a ball entering a spall loses load and strikes its exit edge: the
-  impulses come from the dynamics.
+  impulses come from the dynamics. With the surface profile on, the race profiles and ball sizes
+  (`twin.vibration.surface`) add their signed clearance to the same row.
 - `outer_ring_force`: the force of the balls on the outer ring (minus the sum of the outer
   contacts' forces on the balls), the excitation of the housing.
 - `shift_frame`: the balls and the inner ring moved into (and back out of) the frame of the outer
@@ -30,13 +31,14 @@ from twin.jit import JIT, JIT_VECTOR
 JIT_INLINE = dict(JIT, inline="always")
 from twin.kernels.layout import (
     CW, G_DEFECT_DROP, G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_PX, K_PY, K_WX, K_WY,
-    K_WZ, M_STIFFNESS, N_VIB_PARAMS, O_FX, O_FY, O_FZ, P_VIB, W_DEFECTS, W_ORIENTATION, V_INNER_GROOVE_RADIUS, V_INNER_RACEWAY_RADIUS, V_INNER_RX,
+    K_WZ, M_STIFFNESS, N_VIB_PARAMS, O_FX, O_FY, O_FZ, P_PROFILE_ON, P_VIB, W_DEFECTS, W_ORIENTATION, V_INNER_GROOVE_RADIUS, V_INNER_RACEWAY_RADIUS, V_INNER_RX,
     V_INNER_RY, V_OUTER_GROOVE_RADIUS, V_OUTER_RACEWAY_RADIUS, V_OUTER_RX, V_OUTER_RY,
 )
 from twin.vibration.defects import (
     N_DEFECT_PARAMS, D_BALL, D_CENTRE_COS, D_CENTRE_SIN, D_KIND, D_REACH_COS, KIND_BALL, KIND_INNER, KIND_OUTER,
     contact_defect_drop_m, quat_integrate,
 )
+from twin.vibration.surface import profile_drops
 
 
 @njit(**JIT)
@@ -124,14 +126,19 @@ orientations = njit(**JIT_INLINE)(orientations)
 
 
 @njit(**JIT_INLINE)
-def apply_defects(w, nc, count, shaft_angle, p, rb):
-    """`defect_drops` of the `count` active defect rows of the workspace then, where a defect
-    opens a clearance, `subtract_drops` (module docstring). Called only while a defect is active
-    (X_DEFECT_COUNT > 0)."""
+def apply_clearances(w, nc, count, shaft_angle, p, rb):
+    """`defect_drops` of the `count` active defect rows of the workspace, plus, with the surface
+    profile on (p[P_PROFILE_ON]), the race profiles and ball sizes (`twin.vibration.surface.
+    profile_drops`); then, where anything opens or closes a clearance, `subtract_drops` (module
+    docstring). Called only while a defect is active (X_DEFECT_COUNT > 0) or the profile is on."""
     defects = defect_table(w, count)
     bq = orientations(w, nc // 2)
     vp = p[P_VIB:P_VIB + N_VIB_PARAMS]
-    if defect_drops(w, nc, defects, bq, shaft_angle, vp, rb):
+    found = defect_drops(w, nc, defects, bq, shaft_angle, vp, rb)
+    if p[P_PROFILE_ON] != 0.0:
+        profile_drops(w, nc, p, shaft_angle)
+        found = True
+    if found:
         subtract_drops(w, nc)
 
 

@@ -8,7 +8,8 @@ further cases, and the per-pass timing of the step.
   back into the film every 10 ms), the 7208 under Fr = Fa = 3000 N, the 6208 at 1700 rad/s and
   7500 N, the 6208 with its outer ring on the housing (housing DOFs, in-kernel
   accelerometer decimation, the sample drain every frame) healthy and with a 0.5 mm outer-race
-  spall (defect drops); each at its default step and at 1 us (snapped to 1 / (20 x 51.2 kHz) with
+  spall (defect drops), and healthy with the race profiles and ball sizes on (twin.vibration.surface);
+  each at its default step and at 1 us (snapped to 1 / (20 x 51.2 kHz) with
   the housing on). With the housing on, the indicators of a window (Python, once per
   `Accelerometer.window_s`) are timed apart (`indicator_window_s`, best of `repeats`) and
   `real_time_factor` includes their share, `real_time_factor_kernel` does not; and seed 003's EV
@@ -60,6 +61,7 @@ class BenchCase:
     shear_heating: bool = False
     housing: bool | None = None       # outer ring on the housing (None: the spec's default, off)
     defect: str | None = None         # local defect of twin.vibration.run.defect_for (outer, inner, ball)
+    surface_profile: bool = False     # race profiles and ball sizes exciting the contacts (twin.vibration.surface)
 
 
 SERVE_DEFAULT = BenchCase("serve-default")  # Twin("6208")'s default setpoint, what `serve` runs
@@ -69,6 +71,7 @@ CASES = (
     BenchCase("6208-1700rad-7.5kN", shaft_speed_rad_s=1700.0, radial_load_n=7500.0),
     BenchCase("vibration-healthy", housing=True),
     BenchCase("vibration-outer-spall", housing=True, defect="outer"),
+    BenchCase("vibration-healthy-profile", housing=True, surface_profile=True),
 )
 EV_20K = BenchCase("ev-6200-20krpm", designation=EV_BEARING, shaft_speed_rad_s=20000.0 * math.pi / 30.0,
                    radial_load_n=EV_RADIAL_LOAD_N, shaft_current_a=10.0, shear_heating=True)
@@ -83,6 +86,9 @@ def _twin(case: BenchCase, time_step_s: float | str) -> Twin:
     if case.housing is not None and case.housing != spec.housing.enabled:
         spec = BearingSpec.model_validate({**spec.model_dump(), "housing": {
             **spec.housing.model_dump(), "enabled": case.housing}})
+    if case.surface_profile != spec.surface_profile.enabled:
+        spec = BearingSpec.model_validate({**spec.model_dump(), "surface_profile": {
+            **spec.surface_profile.model_dump(), "enabled": case.surface_profile}})
     twin = Twin(spec, options=ModelOptions(time_step_s=time_step_s),
                 setpoint=Setpoint(shaft_speed_rad_s=case.shaft_speed_rad_s, radial_load_n=case.radial_load_n,
                                   axial_load_n=case.axial_load_n, shaft_current_a=case.shaft_current_a))
