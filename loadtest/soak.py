@@ -67,6 +67,9 @@ from typing import Any
 
 import service
 from service.keys import DEFAULT_PREFIX, SETPOINT, SETPOINT_RESULT, STATE, all_twins, twin_key
+from service.recording.reader import snapshots_per_trend_window, window_seq_gaps
+from service.recording.recorder import RerunRecorder
+from service.settings import ServiceSettings
 from service.tools.client import TargetConfig, add_target_arguments, strict_json, target_arguments, url_is_loopback
 
 _FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c")
@@ -661,12 +664,18 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
         s = np.sort(np.array(seqs, dtype=np.int64))
         out["rows_read"] = len(s)
         d = s[1:] - s[:-1] if len(s) > 1 else np.zeros(0, dtype=np.int64)
-        gaps = int((d > 1).sum())
+        # the trends are window means: a row per window of `per_window` snapshots, carrying the
+        # seq of the window's last snapshot (RerunRecorder.SERVICE_OPTIONS)
+        per_window = snapshots_per_trend_window(ServiceSettings().publish_rate_hz,
+                                                RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
+        gaps = window_seq_gaps(s, per_window)
+        out["snapshots_per_row"] = per_window
         out["seq_gaps"] = gaps
         out["duplicates"] = int((d == 0).sum())
         out["first_seq"] = int(s[0]) if len(s) else None
         out["last_seq"] = int(s[-1]) if len(s) else None
-        out["complete"] = bool(segments_ok and len(recording_ids) == 1 and out["rows_read"] >= max(rows_reported, 1)
+        out["complete"] = bool(segments_ok and len(recording_ids) == 1
+                               and len(s) * per_window >= max(rows_reported - per_window, 1)
                                and gaps == 0 and out["duplicates"] == 0
                                and (last_stream_seq is None or (len(s) and int(s[-1]) >= last_stream_seq)))
     except Exception as exc:  # noqa: BLE001

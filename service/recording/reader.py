@@ -137,3 +137,19 @@ def read_index(path: PathOrPaths, entity: str, timeline: str = SEQ) -> np.ndarra
     """Sorted values of one timeline ("seq", or "sim_time" in integer nanoseconds) over the
     snapshot rows of one entity, e.g. the `seq` numbers that made it into the file(s)."""
     return np.sort(np.array(read_column(path, entity, timeline), dtype=np.int64))
+
+
+def snapshots_per_trend_window(publish_rate_hz: float, trend_window_s: float) -> int:
+    """Snapshots a trend row of the service's recordings averages (`RerunRecorder.SERVICE_OPTIONS`
+    trend_window_s at the service's publish rate), at least 1."""
+    return max(1, int(round(publish_rate_hz * trend_window_s)))
+
+
+def window_seq_gaps(seqs: np.ndarray, per_window: int) -> int:
+    """Lost trend windows in a windowed entity's sorted `seq` index: each row carries the seq of
+    the last snapshot of its window, so consecutive rows lie at most one window apart; a step of
+    more than 1.5 windows is a window missing from the file."""
+    s = np.asarray(seqs, dtype=np.int64)
+    if s.size < 2:
+        return 0
+    return int(((s[1:] - s[:-1]) > 1.5 * per_window).sum())

@@ -43,7 +43,12 @@ def test_load_up_and_hot_oil_raise_then_clear_the_lubrication_alarm(support):
         alarms=AlarmSettings(lubrication_delay_s=DELAY_S, clear_hold_s=HOLD_S,
                              # this test follows the boundary-regime alarm; the ISO 281 kappa alarm
                              # (kappa ~ 0.3 at 110 degC, also raised) has its own tests in test_alarms.py
-                             kappa_threshold=0.01))
+                             kappa_threshold=0.01,
+                             # and the thermal alarms (the 110 degC oil puts the outer ring above
+                             # the 82 degC zone; the step raises its rate): test_thermal_alarms.py
+                             temperature_warning_c=250.0, temperature_critical_c=290.0,
+                             temperature_rate_warning_k_per_min=999.0,
+                             temperature_rate_critical_k_per_min=1000.0))
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=30.0) as srv, \
             httpx.Client(base_url=srv.url, timeout=30.0) as http:
         peer = support.Peer(endpoint)
