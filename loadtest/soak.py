@@ -624,8 +624,10 @@ def _memory(rss: list[tuple[float, int]], warmup: float, source: str | None) -> 
             "growth_pct": round((final - base) / base * 100.0, 3) if base else None}
 
 
-def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_stream_seq: int | None) -> dict:
-    """Read every segment of the recording `path` once (see the module doc)."""
+def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_stream_seq: int | None,
+                     snapshots_per_row: int | None = None) -> dict:
+    """Read every segment of the recording `path` once (see the module doc). `snapshots_per_row`:
+    snapshots a trend row stands for (None: the service's, `RerunRecorder.SERVICE_OPTIONS`)."""
     out: dict[str, Any] = {"path": str(path), "rows_reported": rows_reported, "rows_read": None,
                            "seq_gaps": None, "duplicates": None, "segments": 0, "segment_files": [],
                            "complete": False, "error": None}
@@ -666,8 +668,8 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
         d = s[1:] - s[:-1] if len(s) > 1 else np.zeros(0, dtype=np.int64)
         # the trends are window means: a row per window of `per_window` snapshots, carrying the
         # seq of the window's last snapshot (RerunRecorder.SERVICE_OPTIONS)
-        per_window = snapshots_per_trend_window(ServiceSettings().publish_rate_hz,
-                                                RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
+        per_window = snapshots_per_row or snapshots_per_trend_window(
+            ServiceSettings().publish_rate_hz, RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
         gaps = window_seq_gaps(s, per_window)
         out["snapshots_per_row"] = per_window
         out["seq_gaps"] = gaps
