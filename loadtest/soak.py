@@ -669,7 +669,7 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
         # the trends are window means: a row per window of `per_window` snapshots, carrying the
         # seq of the window's last snapshot (RerunRecorder.SERVICE_OPTIONS)
         per_window = snapshots_per_row or snapshots_per_trend_window(
-            ServiceSettings().publish_rate_hz, RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
+            ServiceSettings().publish_rate_hz, float(RerunRecorder.SERVICE_OPTIONS["trend_window_s"]))
         gaps = window_seq_gaps(s, per_window)
         out["snapshots_per_row"] = per_window
         out["seq_gaps"] = gaps

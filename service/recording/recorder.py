@@ -82,7 +82,7 @@ class RerunRecorder:
     # 50 Hz), the bearing now (3D, load zone) every 0.5 s, the per-contact series every 1 s, the
     # accelerometer's samples in bursts and around events and the spectra every 30 s
     # (`service.recording.archive`), each closed file compacted
-    SERVICE_OPTIONS = {"trend_window_s": 0.2, "now_interval_s": 0.5, "contacts_interval_s": 1.0,
+    SERVICE_OPTIONS: dict[str, Any] = {"trend_window_s": 0.2, "now_interval_s": 0.5, "contacts_interval_s": 1.0,
                        "waveform_archive": WaveformArchive(), "compact_segments": True}
 
     def __init__(self, path: str | Path | CreatedFile | None = None, *, spawn_viewer: bool = False,
