@@ -15,6 +15,7 @@ from pathlib import Path
 
 from service import __version__
 from service.tools.bench_results import save as save_result
+from service.tools.messages import error_text
 from service.tools.vibration_cli import add_analyse_command
 from twin.catalog import DEFAULT_DESIGNATION
 
@@ -83,13 +84,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _one_line(exc: Exception) -> str:
-    from pydantic import ValidationError
-
-    if isinstance(exc, ValidationError):
-        # a model-level check names its field at the start of its message ("zenoh_user: ...")
-        return "; ".join(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" if e["loc"]
-                         else str(e["msg"]).removeprefix("Value error, ") for e in exc.errors())
-    return str(exc)
+    return error_text(exc)
 
 
 def _print_table(snap) -> None:

@@ -7,6 +7,7 @@ import argparse
 import json
 import sys
 
+from service.tools.messages import error_text
 from twin.catalog import DEFAULT_DESIGNATION
 
 _CONTAMINATION = ("extreme_cleanliness", "high_cleanliness", "normal_cleanliness",
@@ -50,8 +51,7 @@ def _cmd_life(args: argparse.Namespace) -> int:
                                       oil_temperature_c=args.oil_temperature, diametral_clearance_m=args.clearance,
                                       settings=LifeSettings(contamination=args.contamination))
     except ValidationError as exc:
-        msg = "; ".join(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" for e in exc.errors())
-        print(f"error: {msg}", file=sys.stderr)
+        print(f"error: {error_text(exc)}", file=sys.stderr)
         return 2
     except (SetpointError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)

@@ -7,6 +7,8 @@ import argparse
 import json
 import sys
 
+from service.tools.messages import error_text
+
 
 def add_thermal_command(sub) -> None:
     """Register `thermal` on the `bearing-twin` subparsers."""
@@ -43,8 +45,7 @@ def _cmd_thermal(args: argparse.Namespace) -> int:
                                    ThermalNetworkSettings(dissipation=args.dissipation),
                                    catalog.lubricant(args.lubricant))
     except ValidationError as exc:
-        msg = "; ".join(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" for e in exc.errors())
-        print(f"error: {msg}", file=sys.stderr)
+        print(f"error: {error_text(exc)}", file=sys.stderr)
         return 2
     except (SetpointError, ValueError) as exc:
         print(f"error: {exc}", file=sys.stderr)
