@@ -576,14 +576,13 @@ def evaluate(model, state, setpoint):
     `step_n`; the accelerometer is not sampled. The tribology is refreshed at the state as it is,
     not centred (stamp 0: a warm-started state has no history to extrapolate from, and the next
     regular refresh takes none from this one)."""
-    p, tr, hp, taps = model.params, model.angle_table, model.housing_params, model.decimator_taps
+    p, tr, hp = model.params, model.angle_table, model.housing_params
     sp = setpoint
     scal, w, cage_load = state.scalars, state.workspace, state.cage_load_n
     bx, bv, bw = state.ball_position_m, state.ball_velocity_m_s, state.ball_angular_velocity_rad_s
     ba, balpha = state.ball_acceleration, state.ball_angular_acceleration
     rx, rv, ra = state.ring_position_m, state.ring_velocity_m_s, state.ring_acceleration
     hx, hv, ha = state.housing_displacement_m, state.housing_velocity_m_s, state.housing_acceleration_m_s2
-    dec_state, ring, ring_state = state.decimator_state, state.sample_ring_m_s2, state.sample_ring_state
     housing_on = p[P_VIB + V_HOUSING_ON] != 0.0
     if housing_on:
         shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
