@@ -358,7 +358,9 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     v[L.V_INNER_GROOVE_RADIUS] = g.inner_groove_radius_m
     v[L.V_OUTER_GROOVE_RADIUS] = g.outer_groove_radius_m
     v[L.V_INNER_RX], v[L.V_OUTER_RX] = race[0, L.R_RX], race[1, L.R_RX]
-    v[L.V_INNER_RY], v[L.V_OUTER_RY] = race[0, L.R_RY], race[1, L.R_RY]
+    # a = coef Q^(1/3) and Q = K delta^1.5 (seed 000 eq. 2), so a / sqrt(delta) = coef K^(1/3)
+    v[L.V_INNER_FOOTPRINT], v[L.V_OUTER_FOOTPRINT] = (
+        race[r, L.R_SEMI_MAJOR_COEF] * race[r, L.R_STIFFNESS] ** (1.0 / 3.0) for r in (0, 1))
     p[L.P_SUBSTEPS] = timestep.steps_per_period(options.tribology_period_s, p[L.P_DT])
     p[L.P_CENTRED_REFRESH] = 1.0 if options.centred_refresh else 0.0
     p[L.P_PROFILE_ON] = 1.0 if spec.surface_profile.enabled else 0.0

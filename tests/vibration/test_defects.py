@@ -12,7 +12,7 @@ from twin.kernels import layout as L
 from twin.model import make_model
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.defects import (
-    OuterRaceSpall, contact_defect_drop_m, defect_row, edge_drop_m, pit_drop_m,
+    OuterRaceSpall, contact_defect_drop_m, defect_row, edge_drop_m, pit_drop_m, pit_load_loss,
     quat_integrate, quat_rotate, race_limits, validate_defect, validate_defects,
 )
 
@@ -21,8 +21,9 @@ G = SPEC.geometry
 MODEL = make_model(SPEC)
 RB = G.ball_radius_m
 RX_IN, RX_OUT = MODEL.race_params[0, L.R_RX], MODEL.race_params[1, L.R_RX]
-RY_IN, RY_OUT = MODEL.race_params[0, L.R_RY], MODEL.race_params[1, L.R_RY]
-FREE = 1e-6  # relative radius far below the pit's size: that direction never limits the drop
+# A contact far stiffer than any pit is deep (1 m of deflection) with a tiny ellipse (1 um across):
+# the pit covers the ellipse across and the drop is the rolling-direction law alone.
+DEEP, TINY = 1.0, 1e-6
 
 
 # ---- depth profile ---------------------------------------------------------------------------
@@ -31,7 +32,7 @@ def test_flat_race_centre_drop_is_sawalhi_randall(width, depth):
     """Flat raceway (relative radius = ball radius), long across: at the spall centre
     h_eff = min(depth, Rb - sqrt(Rb^2 - (w/2)^2)) (Sawalhi & Randall 2008 Part I sec. 4.1), exactly."""
     expected = min(depth, RB - math.sqrt(RB ** 2 - (width / 2) ** 2))
-    assert pit_drop_m(0.0, 0.0, width / 2, 0.5, depth, 0.0, RB, FREE) == pytest.approx(expected, rel=1e-12)
+    assert pit_drop_m(0.0, 0.0, width / 2, 0.5, depth, 0.0, RB, DEEP, TINY) == pytest.approx(expected, rel=1e-10)
 
 
 def _exact_outer(w, ro):
@@ -54,22 +55,68 @@ def test_curved_races_follow_the_relative_radius(width, tol):
     inner race curves away (deeper)."""
     ro = G.outer_raceway_radius_m
     ri = G.inner_raceway_radius_m
-    out = pit_drop_m(0.0, 0.0, width / 2, 0.5, 1.0, 0.0, RX_OUT, FREE)
-    inn = pit_drop_m(0.0, 0.0, width / 2, 0.5, 1.0, 0.0, RX_IN, FREE)
+    out = pit_drop_m(0.0, 0.0, width / 2, 0.5, 1.0, 0.0, RX_OUT, DEEP, TINY)
+    inn = pit_drop_m(0.0, 0.0, width / 2, 0.5, 1.0, 0.0, RX_IN, DEEP, TINY)
     assert out == pytest.approx(_exact_outer(width, ro), rel=tol)
     assert inn == pytest.approx(_exact_inner(width, ri), rel=tol)
     flat = RB - math.sqrt(RB ** 2 - (width / 2) ** 2)
     assert out < flat < inn
 
 
-def test_narrow_spall_across_the_conforming_groove_barely_lets_the_ball_in():
-    """Across the track the relative radius is Ry = 1/(1/Rb - 1/Rg) = 164 mm (6208, Rg = 0.52 D):
-    a spall 2 mm long across drops the ball by (1 mm)^2 / (2 Ry) = 3.05 um even when 5 mm wide
-    along the rolling direction (which alone would allow 0.43 mm)."""
-    drop = pit_drop_m(0.0, 0.0, 2.5e-3, 1e-3, 1e-3, 0.0, RX_OUT, RY_OUT)
-    assert drop == pytest.approx(RY_OUT - math.sqrt(RY_OUT ** 2 - 1e-6), rel=1e-12)
-    assert drop == pytest.approx(1e-6 / (2 * RY_OUT), rel=1e-4)
-    assert RY_OUT == pytest.approx(1 / (1 / RB - 1 / G.outer_groove_radius_m), rel=1e-12)
+def _hertz_strip_fraction(lo, hi, a, b, n=4001):
+    """Fraction of the load of a Hertz ellipse (semi-axes a across, b along) carried in the strip
+    lo <= y <= hi: the elliptic pressure p0 sqrt(1 - x^2/b^2 - y^2/a^2) integrated on a grid."""
+    y = np.linspace(-a, a, n)
+    x = np.linspace(-b, b, n)
+    yy, xx = np.meshgrid(y, x, indexing="ij")
+    p = np.sqrt(np.clip(1.0 - (xx / b) ** 2 - (yy / a) ** 2, 0.0, None))
+    inside = (yy >= lo) & (yy <= hi)
+    return float((p * inside).sum() / p.sum())
+
+
+@pytest.mark.parametrize("half_length, offset", [(0.089e-3, 0.0), (0.089e-3, 0.2e-3), (0.2e-3, -0.1e-3)])
+def test_deep_pit_narrower_than_the_ellipse_removes_the_hertz_load_of_its_strip(half_length, offset):
+    """A pit deeper than the contact's interference and narrower across than its ellipse (CWRU's
+    0.178 mm pit under a 0.36 mm semi-major axis): the contact keeps the Hertz pressure outside the
+    pit's strip. lambda = 3/2 (l/a) - 1/2 (l/a)^3 for a centred strip (the integral of
+    1 - y^2/a^2), and in general the share of the elliptic Hertz pressure (Hertz 1882; Johnson,
+    Contact Mechanics, eq. 3.63) over the strip, integrated here independently on a 4001^2 grid
+    (agreement within 2e-3, the grid's error at the ellipse's edge)."""
+    a, b = 0.36e-3, 0.038e-3
+    lost = pit_load_loss(0.0, offset, 1e-3, half_length, 1e-3, 0.0, RX_IN, 1e-6, a)
+    expected = _hertz_strip_fraction(-offset - half_length, -offset + half_length, a, b)
+    assert lost == pytest.approx(expected, abs=2e-3)
+    if offset == 0.0:
+        r = half_length / a
+        assert lost == pytest.approx(1.5 * r - 0.5 * r ** 3, rel=1e-12)
+
+
+@pytest.mark.parametrize("ratio", [0.1, 0.5, 0.9, 1.5])
+def test_pit_across_the_whole_ellipse_is_sawalhi_randall_drop(ratio):
+    """A pit longer across than the ellipse: every slice loses h, the load is K (delta - h)^1.5
+    (Sawalhi & Randall 2008 Part I sec. 4.1: the drop taken off the deflection), so
+    1 - lambda = (1 - h/delta)^1.5 and the equivalent drop is min(delta, h), to 1e-12."""
+    a, half_width = 0.3e-3, 1e-3
+    h = edge_drop_m(half_width, 0.0, RX_OUT)
+    delta = h / ratio
+    lost = pit_load_loss(0.0, 0.0, half_width, 5e-3, 1.0, 0.0, RX_OUT, delta, a)
+    assert 1.0 - lost == pytest.approx(max(0.0, 1.0 - ratio) ** 1.5, abs=1e-12)
+    assert pit_drop_m(0.0, 0.0, half_width, 5e-3, 1.0, 0.0, RX_OUT, delta, a) == pytest.approx(
+        min(delta, h), rel=1e-12)
+
+
+def test_load_loss_grows_with_the_pit_and_vanishes_beside_it():
+    """Monotonic in the pit's length across and in its depth below the interference; zero once the
+    pit's strip lies beyond the ellipse (|v| >= a + l) or the contact is open (delta <= 0)."""
+    a, delta = 0.36e-3, 0.84e-6
+    lengths = [pit_load_loss(0.0, 0.0, 1e-3, hl, 1e-3, 0.0, RX_IN, delta, a)
+               for hl in (0.05e-3, 0.1e-3, 0.2e-3, 0.4e-3)]
+    assert np.all(np.diff(lengths) > 0.0) and lengths[-1] == pytest.approx(1.0)
+    depths = [pit_load_loss(0.0, 0.0, 1e-3, 0.089e-3, d, 0.0, RX_IN, delta, a) for d in (0.1e-6, 0.4e-6, 0.8e-6, 2e-6)]
+    r = 0.089e-3 / a
+    assert np.all(np.diff(depths) > 0.0) and depths[3] == pytest.approx(1.5 * r - 0.5 * r ** 3, rel=1e-12)
+    assert pit_load_loss(0.0, a + 0.089e-3, 1e-3, 0.089e-3, 1e-3, 0.0, RX_IN, delta, a) == 0.0
+    assert pit_load_loss(0.0, 0.0, 1e-3, 0.089e-3, 1e-3, 0.0, RX_IN, 0.0, a) == 0.0
 
 
 def test_profile_shape_unloads_entering_and_closes_at_the_exit_edge():
@@ -81,15 +128,15 @@ def test_profile_shape_unloads_entering_and_closes_at_the_exit_edge():
     0.5 mm before the edge and lowers that slope by sqrt(R / (R + r_e)) (2 %)."""
     hw, depth = 1e-3, 20e-6
     u = np.linspace(-2e-3, 2e-3, 4001)
-    sharp = np.array([pit_drop_m(x, 0.0, hw, 0.5, depth, 0.0, RX_OUT, FREE) for x in u])
+    sharp = np.array([pit_drop_m(x, 0.0, hw, 0.5, depth, 0.0, RX_OUT, DEEP, TINY) for x in u])
     assert np.all(sharp[np.abs(u) >= hw] == 0.0)
     assert sharp == pytest.approx(sharp[::-1], abs=1e-18)
     a = 0.1e-3
-    assert pit_drop_m(hw - a, 0.0, hw, 0.5, depth, 0.0, RX_OUT, FREE) == pytest.approx(
+    assert pit_drop_m(hw - a, 0.0, hw, 0.5, depth, 0.0, RX_OUT, DEEP, TINY) == pytest.approx(
         RX_OUT - math.sqrt(RX_OUT ** 2 - a * a), rel=1e-12)
-    assert sharp[2000] == depth
+    assert sharp[2000] == pytest.approx(depth, rel=1e-9)
     r_e = 0.5e-3
-    rounded = np.array([pit_drop_m(x, 0.0, hw, 0.5, depth, r_e, RX_OUT, FREE) for x in u])
+    rounded = np.array([pit_drop_m(x, 0.0, hw, 0.5, depth, r_e, RX_OUT, DEEP, TINY) for x in u])
     assert rounded[np.searchsorted(u, -hw - 0.49e-3)] > 0.0
     assert rounded[np.searchsorted(u, -hw - 0.51e-3)] == 0.0
     slope = lambda h: np.max(np.abs(np.diff(h))) / (u[1] - u[0])  # noqa: E731
@@ -150,9 +197,8 @@ def _drop(row, race, ball, azimuth, shaft_angle=0.0, nz=0.0, q=(1.0, 0.0, 0.0, 0
     sign = 1.0 if race == 1 else -1.0
     nx, ny = sign * math.cos(azimuth), sign * math.sin(azimuth)
     rx = RX_OUT if race == 1 else RX_IN
-    ry = RY_OUT if race == 1 else RY_IN
     return contact_defect_drop_m(row, race, ball, px, py, nx, ny, nz, w[0], w[1], w[2], shaft_angle,
-                                 q[0], q[1], q[2], q[3], RB, r, G.outer_groove_radius_m, rx, ry)
+                                 q[0], q[1], q[2], q[3], RB, r, G.outer_groove_radius_m, rx, DEEP, TINY)
 
 
 def test_race_spall_is_seen_only_by_its_race_at_its_azimuth():
@@ -160,7 +206,7 @@ def test_race_spall_is_seen_only_by_its_race_at_its_azimuth():
     race or 2 widths away; inner spall at 10 deg on the ring with the shaft at 20 deg sits at 30 deg."""
     spall = dict(width_m=2e-3, length_m=6e-3, depth_m=20e-6)
     outer = defect_row(validate_defect({"kind": "outer", "azimuth_deg": 30.0, **spall}, G), G)
-    centre = pit_drop_m(0.0, 0.0, 1e-3, 3e-3, 20e-6, 0.0, RX_OUT, RY_OUT)
+    centre = pit_drop_m(0.0, 0.0, 1e-3, 3e-3, 20e-6, 0.0, RX_OUT, DEEP, TINY)
     assert centre > 0.0
     assert _drop(outer, 1, 3, math.radians(30.0)) == pytest.approx(centre, rel=1e-12)
     assert _drop(outer, 0, 3, math.radians(30.0)) == 0.0
@@ -168,7 +214,7 @@ def test_race_spall_is_seen_only_by_its_race_at_its_azimuth():
     assert _drop(outer, 1, 3, math.radians(30.0) - 2 * math.pi) == pytest.approx(centre, rel=1e-9)
     inner = defect_row(validate_defect({"kind": "inner", "ring_angle_deg": 10.0, **spall}, G), G)
     assert _drop(inner, 0, 0, math.radians(30.0), shaft_angle=math.radians(20.0)) == pytest.approx(
-        pit_drop_m(0.0, 0.0, 1e-3, 3e-3, 20e-6, 0.0, RX_IN, RY_IN), rel=1e-9)
+        pit_drop_m(0.0, 0.0, 1e-3, 3e-3, 20e-6, 0.0, RX_IN, DEEP, TINY), rel=1e-9)
     assert _drop(inner, 0, 0, math.radians(30.0)) == 0.0  # shaft at 0: the spall is at 10 deg
 
 
@@ -179,7 +225,7 @@ def test_ball_defect_is_seen_where_it_faces_the_contact():
     row = defect_row(validate_defect({"kind": "ball", "ball_index": 2, "colatitude_deg": 90.0,
                                       "longitude_deg": 0.0, "width_m": 1.5e-3, "length_m": 3e-3,
                                       "depth_m": 30e-6}, G), G)
-    centre = pit_drop_m(0.0, 0.0, 0.75e-3, 1.5e-3, 30e-6, 0.0, RX_OUT, RY_OUT)
+    centre = pit_drop_m(0.0, 0.0, 0.75e-3, 1.5e-3, 30e-6, 0.0, RX_OUT, DEEP, TINY)
     assert centre > 0.0
     assert _drop(row, 1, 2, 0.0) == pytest.approx(centre, rel=1e-12)
     assert _drop(row, 0, 2, 0.0) == 0.0
@@ -222,7 +268,7 @@ def test_quat_integrate_is_exact_for_constant_omega_and_stays_unit():
 
 
 @njit
-def _roll_ball(row, n, dt, w_cage, w_ball, pitch, rb, ro, ri, rg, rx_o, ry_o, rx_i, ry_i, hits):
+def _roll_ball(row, n, dt, w_cage, w_ball, pitch, rb, ro, ri, rg, rx_o, rx_i, hits):
     """Pure rolling of ball 0 (outer race fixed): orbit at w_cage, world spin w_ball about +z;
     record for each step whether the defect opens a drop at the outer (hits[k, 1]) / inner
     (hits[k, 0]) contact."""
@@ -232,9 +278,9 @@ def _roll_ball(row, n, dt, w_cage, w_ball, pitch, rb, ro, ri, rg, rx_o, ry_o, rx
         c, s = math.cos(phi), math.sin(phi)
         px, py = pitch * c, pitch * s
         hits[k, 1] = contact_defect_drop_m(row, 1, 0, px, py, c, s, 0.0, 0.0, 0.0, w_ball, 0.0,
-                                           q[0], q[1], q[2], q[3], rb, ro, rg, rx_o, ry_o)
+                                           q[0], q[1], q[2], q[3], rb, ro, rg, rx_o, 1.0, 1e-6)
         hits[k, 0] = contact_defect_drop_m(row, 0, 0, px, py, -c, -s, 0.0, 0.0, 0.0, w_ball, 0.0,
-                                           q[0], q[1], q[2], q[3], rb, ri, rg, rx_i, ry_i)
+                                           q[0], q[1], q[2], q[3], rb, ri, rg, rx_i, 1.0, 1e-6)
         quat_integrate(q, 0.0, 0.0, w_ball, dt)
 
 
@@ -252,7 +298,7 @@ def test_ball_defect_meets_the_races_twice_per_ball_revolution():
     dt, n = 1e-6, 50_000
     hits = np.zeros((n, 2))
     _roll_ball(row, n, dt, w_cage, w_ball, G.pitch_radius_m, RB, G.outer_raceway_radius_m,
-               G.inner_raceway_radius_m, G.outer_groove_radius_m, RX_OUT, RY_OUT, RX_IN, RY_IN, hits)
+               G.inner_raceway_radius_m, G.outer_groove_radius_m, RX_OUT, RX_IN, hits)
     events = []
     for race in (0, 1):
         on = hits[:, race] > 0.0

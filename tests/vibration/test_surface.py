@@ -117,3 +117,18 @@ def test_defect_angle_places_the_outer_spall_from_the_load_zone():
     with pytest.raises(ValueError, match="defect_angle_deg"):
         defect_for("outer", g, angle_deg=float("nan"))
 
+
+
+def test_cwru_de_noise_floor_is_the_healthy_records_floor():
+    """`CWRU-DE`'s sensor noise density is record 97's 2.0-2.9 kHz floor (twin.validation.cwru.
+    calibrate_background, within 1 %), and that floor alone fills the record's 2.9-3.6 kHz
+    resonance band to within 5 %: the healthy bearing's own excitation is below the floor, which
+    bounds the race profile RMS (twin.catalog.CWRU_RACE_PROFILE_RMS_M)."""
+    from twin.validation import cwru
+
+    x = np.load(cwru.DATA_DIR / "97_DE_12k_5s.npy").astype(float) * cwru.G_M_S2
+    cal = cwru.calibrate_background(x)
+    acc = catalog.bearing("CWRU-DE").housing.accelerometer
+    assert acc.noise_density_m_s2_rthz == pytest.approx(cal["noise_density_m_s2_rthz"], rel=0.01)
+    assert cal["floor_in_resonance_band_m_s2"] == pytest.approx(cal["resonance_band_rms_m_s2"], rel=0.05)
+    assert catalog.bearing("CWRU-DE").surface_profile.race_profile_rms_m == catalog.CWRU_RACE_PROFILE_RMS_M

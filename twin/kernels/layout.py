@@ -246,5 +246,5 @@ V_INNER_GROOVE_RADIUS = 4   # [m]
 V_OUTER_GROOVE_RADIUS = 5
 V_INNER_RX = 6              # relative radius of curvature along the rolling direction [m]
 V_OUTER_RX = 7
-V_INNER_RY = 8              # across it [m]
-V_OUTER_RY = 9
+V_INNER_FOOTPRINT = 8       # semi-major axis of the contact ellipse per root deflection, a / sqrt(delta) [m^0.5]
+V_OUTER_FOOTPRINT = 9

@@ -5,8 +5,9 @@ outer ring's reaction that drives the housing, the ball orientations. Called by
 
 - `apply_clearances`: between the geometry pass and the force pass, every active defect row
   (`twin.vibration.defects`, D_* layout) opens an extra radial clearance at the contacts it lies
-  under (`contact_defect_drop_m`: Sawalhi & Randall 2008 Part I sec. 4.1, generalised to curved
-  bodies); the deepest drop of all defects is taken off the lane's deflection before the Hertz
+  under (`contact_defect_drop_m`: Sawalhi & Randall 2008 Part I sec. 4.1 along the rolling
+  direction, generalised to curved bodies, and the load of the ellipse's slices over the pit
+  across it); the deepest drop of all defects is taken off the lane's deflection before the Hertz
   load (seed 000 eq. 2), so a ball entering a spall loses load and strikes its exit edge: the
   impulses come from the dynamics. With the surface profile on, the race profiles and ball sizes
   (`twin.vibration.surface`) add their signed clearance to the same row.
@@ -32,7 +33,7 @@ JIT_INLINE = dict(JIT, inline="always")
 from twin.kernels.layout import (
     CW, G_DEFECT_DROP, G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_PX, K_PY, K_WX, K_WY,
     K_WZ, M_STIFFNESS, N_VIB_PARAMS, O_FX, O_FY, O_FZ, P_PROFILE_ON, P_VIB, W_DEFECTS, W_ORIENTATION, V_INNER_GROOVE_RADIUS, V_INNER_RACEWAY_RADIUS, V_INNER_RX,
-    V_INNER_RY, V_OUTER_GROOVE_RADIUS, V_OUTER_RACEWAY_RADIUS, V_OUTER_RX, V_OUTER_RY,
+    V_INNER_FOOTPRINT, V_OUTER_GROOVE_RADIUS, V_OUTER_RACEWAY_RADIUS, V_OUTER_RX, V_OUTER_FOOTPRINT,
 )
 from twin.vibration.defects import (
     N_DEFECT_PARAMS, D_BALL, D_CENTRE_COS, D_CENTRE_SIN, D_KIND, D_REACH_COS, KIND_BALL, KIND_INNER, KIND_OUTER,
@@ -43,17 +44,22 @@ from twin.vibration.surface import profile_drops
 
 @njit(**JIT)
 def _lane_drop(defects, k, c, w, bq, shaft_angle, vp, rb):
-    """Drop [m] of defect row k at lane c (contact_defect_drop_m with the lane's kinematics)."""
+    """Drop [m] of defect row k at lane c (contact_defect_drop_m with the lane's kinematics, its
+    deflection and its ellipse's semi-major axis a = V_*_FOOTPRINT sqrt(delta))."""
     r = c & 1
     j = c >> 1
     outer = r == 1
+    delta = w[G_DELTA * CW + c]
+    if delta <= 0.0:
+        return 0.0
+    semi_major = (vp[V_OUTER_FOOTPRINT] if outer else vp[V_INNER_FOOTPRINT]) * math.sqrt(delta)
     return contact_defect_drop_m(
         defects[k], r, j, w[K_PX * CW + c], w[K_PY * CW + c], w[G_NX * CW + c], w[G_NY * CW + c],
         w[G_NZ * CW + c], w[K_WX * CW + c], w[K_WY * CW + c], w[K_WZ * CW + c], shaft_angle,
         bq[j, 0], bq[j, 1], bq[j, 2], bq[j, 3], rb,
         vp[V_OUTER_RACEWAY_RADIUS] if outer else vp[V_INNER_RACEWAY_RADIUS],
         vp[V_OUTER_GROOVE_RADIUS] if outer else vp[V_INNER_GROOVE_RADIUS],
-        vp[V_OUTER_RX] if outer else vp[V_INNER_RX], vp[V_OUTER_RY] if outer else vp[V_INNER_RY])
+        vp[V_OUTER_RX] if outer else vp[V_INNER_RX], delta, semi_major)
 
 
 @njit(**JIT_INLINE)

@@ -191,6 +191,33 @@ def calibrate_housing(x_m_s2: np.ndarray, sample_rate_hz: float = SAMPLE_RATE_HZ
     return float(f[i]), float((f_hi - f_lo) / (2.0 * f[i]))
 
 
+FLOOR_BAND_HZ = (2000.0, 2900.0)      # healthy record: between the motor's content and the resonance
+RESONANCE_BAND_HZ = (2900.0, 3600.0)  # healthy record: the housing resonance the impacts ring
+
+
+def band_rms(x_m_s2: np.ndarray, band_hz: tuple[float, float], sample_rate_hz: float = SAMPLE_RATE_HZ) -> float:
+    """RMS [m/s^2] of the signal in a frequency band: Welch power spectrum (1024 points, Hann),
+    summed over the bins in [lo, hi)."""
+    from scipy.signal import welch
+
+    f, p = welch(np.asarray(x_m_s2, dtype=float), sample_rate_hz, nperseg=1024)
+    sel = (f >= band_hz[0]) & (f < band_hz[1])
+    return float(math.sqrt(p[sel].sum() * (f[1] - f[0])))
+
+
+def calibrate_background(x_m_s2: np.ndarray, sample_rate_hz: float = SAMPLE_RATE_HZ) -> dict[str, float]:
+    """The sensor and rig floor of a healthy record: the white noise density [m/s^2/sqrt(Hz)] whose
+    RMS over FLOOR_BAND_HZ is the record's there, and the record's RMS in RESONANCE_BAND_HZ beside
+    that floor's share of it (the room left for the bearing's own healthy excitation). Run once on
+    record 97 to set `twin.catalog.CWRU_NOISE_DENSITY_M_S2_RTHZ` and bound
+    `CWRU_RACE_PROFILE_RMS_M`."""
+    floor = band_rms(x_m_s2, FLOOR_BAND_HZ, sample_rate_hz)
+    density = floor / math.sqrt(FLOOR_BAND_HZ[1] - FLOOR_BAND_HZ[0])
+    return {"noise_density_m_s2_rthz": density,
+            "resonance_band_rms_m_s2": band_rms(x_m_s2, RESONANCE_BAND_HZ, sample_rate_hz),
+            "floor_in_resonance_band_m_s2": density * math.sqrt(RESONANCE_BAND_HZ[1] - RESONANCE_BAND_HZ[0])}
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m twin.validation.cwru", description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=1.0, help="analysed simulated time per record [s]")

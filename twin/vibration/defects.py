@@ -6,28 +6,40 @@ direction, `length_m` across it, `depth_m`, and an edge radius (0 = sharp). Oute
 azimuth; inner spall at an angle fixed on the rotating inner ring; ball defect at a point fixed on
 the ball, given in ball body coordinates.
 
-Depth profile (`pit_drop_m`). A ball over a pit cannot follow its bottom: it drops until it
-touches an edge, so the extra radial clearance is (Sawalhi & Randall 2008, "Simulating gear and
-bearing interactions in the presence of faults, Part I", MSSP 22(8), sec. 4.1 (localised faults,
-their eq. for the additional displacement of a ball over a spall); Harsha 2005, "Nonlinear
-dynamic analysis of an unbalanced rotor supported by roller bearing", Chaos Solitons Fractals 26,
-defect as an extra deflection term)
+Depth profile (`pit_drop_m`): a slice model of the Hertz contact over the pit.
 
-    h_eff(s) = min(depth, R - sqrt(R^2 - a^2)),  a = distance from the contact to the nearer edge,
+Along the rolling direction (x) a ball cannot follow the pit's bottom: it bridges the pit and
+drops until it touches an edge (Sawalhi & Randall 2008, "Simulating gear and bearing
+interactions in the presence of faults, Part I", MSSP 22(8), sec. 4.1, their eq. for the
+additional displacement of a ball over a spall; Harsha 2005, Chaos Solitons Fractals 26):
 
-with R the ball radius for a flat raceway (at the spall centre a = w/2: the brief's h_eff =
-min(depth, Rb - sqrt(Rb^2 - (w/2)^2))). Generalised here, second order in a/R, to curved bodies
-by the relative radius of curvature of the contact in that direction (Harris' curvature sum;
-the engine's R_RX along the rolling direction, R_RY across): a pit on a concave outer race lets
-the ball drop by ~a^2/2 (1/Rb - 1/Ro), on the convex inner race by ~a^2/2 (1/Rb + 1/Ri); across
-the conforming groove (1/Rb - 1/Rg) the drop is small, so a spall must be long across the track
-for the ball to fall in. The relative curvature is symmetric in the two bodies, so the same law
-holds for a pit on the ball. A rounded edge of radius r_e is a quarter circle tangent to the
-surface and the wall: the contact distance R + r_e from the edge's centre gives
-h = R + r_e - sqrt((R + r_e)^2 - (a + r_e)^2) for a > -r_e (0 before the rounding starts).
-The engine subtracts h_eff from the contact deflection (an extra radial clearance): entering the
-pit the ball unloads, at the exit edge the clearance closes over a short distance and the ball
-strikes it; the contact normal is not tilted by the edge (as in Sawalhi & Randall).
+    h(u) = min(depth, R - sqrt(R^2 - s^2)),  s = distance of the contact centre inside the nearer edge,
+
+with R the relative radius of curvature of the contact along the rolling direction (Harris'
+curvature sum, the engine's R_RX: R = Rb on a flat race; ~1/(1/Rb - 1/Ro) on the concave outer
+race, ~1/(1/Rb + 1/Ri) on the convex inner race). A rounded edge of radius r_e is a quarter circle
+tangent to the surface and the wall: h = R + r_e - sqrt((R + r_e)^2 - (s + r_e)^2) for s > -r_e.
+
+Across the track (y) the pit is often narrower than the contact ellipse: CWRU's 0.178 mm pits
+against a semi-major axis of 0.3-0.6 mm. The ball then does not drop: the race under the rest of
+the ellipse holds it, and the contact loses the load of the part of its area over the pit. The
+contact is cut into slices across the track; a slice at y carries a line load proportional to its
+interference delta (1 - y^2/a^2) (the Hertz pressure of the ellipse integrated along x is
+proportional to 1 - y^2/a^2; the slices' sum is K delta^1.5 because a^2 is proportional to delta,
+seed 000 eq. 2). The slices over the pit (|y - y_pit| < half length) lose h(u) of their
+interference, so the contact keeps the load fraction
+
+    F / (K delta^1.5) = 1 - lambda,   lambda = 3/4 integral over the pit's slices (s = y/a) of min(1 - s^2, h / delta) ds.
+
+Two limits hold exactly: a pit longer across than the ellipse gives 1 - lambda = (1 - h/delta)^1.5,
+the load K (delta - h)^1.5 of Sawalhi & Randall's drop; a pit deeper than the interference
+(h >= delta) removes the Hertz load of its strip, 3/2 (l/a) - 1/2 (l/a)^3 for a centred strip of half
+length l. The engine takes the equivalent clearance delta (1 - (1 - lambda)^(2/3)) off the lane's
+deflection, so the Hertz load, the damping and the film see the reduced load. Entering the pit
+the ball unloads; at the exit edge the clearance closes over sqrt(2 R h) of travel and the lost
+load returns as a strike that excites the housing. Not modelled: the rounding of the edges
+across the track, the tilt of the contact normal by the edge (as in Sawalhi & Randall), and the
+elastic redistribution of pressure around the pit (the slices are independent).
 
 Ball orientation: a unit quaternion q = (w, x, y, z) per ball maps body to world coordinates;
 with the world-frame angular velocity omega (the engine's) q' = 1/2 omega (x) q (Hamilton
@@ -268,13 +280,49 @@ def edge_drop_m(inside_m, edge_radius_m, relative_radius_m):
 
 
 @njit(**JIT)
-def pit_drop_m(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, ry_m):
-    """Extra radial clearance [m] a pit opens at a contact whose centre is at (u, v) [m] from the
-    pit centre (u along the rolling direction, v across): min(depth, drop allowed by the nearer
-    edge along (relative radius rx) and across (ry)), >= 0 (module docstring)."""
-    along = edge_drop_m(half_width_m - abs(u_m), edge_radius_m, rx_m)
-    across = edge_drop_m(half_length_m - abs(v_m), edge_radius_m, ry_m)
-    return max(0.0, min(depth_m, along, across))
+def _slice_load_integral(s, eta, s_star):
+    """Integral of min(1 - t^2, eta) dt from -1 to s (|s| <= 1), with s_star = sqrt(1 - eta) the
+    slice where 1 - t^2 = eta (0 when eta >= 1)."""
+    g_low = -s_star + s_star ** 3 / 3.0 + 2.0 / 3.0   # integral of 1 - t^2 from -1 to -s_star
+    if s <= -s_star:
+        return s - s ** 3 / 3.0 + 2.0 / 3.0
+    if s <= s_star:
+        return g_low + eta * (s + s_star)
+    return g_low + 2.0 * eta * s_star + (s - s ** 3 / 3.0) - (s_star - s_star ** 3 / 3.0)
+
+
+@njit(**JIT)
+def pit_load_loss(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, delta_m, semi_major_m):
+    """Fraction lambda [-] of the Hertz load that a pit removes from a contact of deflection delta
+    and semi-major axis a whose centre is at (u, v) [m] from the pit centre (u along the rolling
+    direction, v across): the slice model of the module docstring, 0 <= lambda <= 1."""
+    if delta_m <= 0.0 or semi_major_m <= 0.0:
+        return 0.0
+    h = min(depth_m, edge_drop_m(half_width_m - abs(u_m), edge_radius_m, rx_m))
+    if h <= 0.0:
+        return 0.0
+    s1 = max(-1.0, (-v_m - half_length_m) / semi_major_m)
+    s2 = min(1.0, (-v_m + half_length_m) / semi_major_m)
+    if s2 <= s1:
+        return 0.0
+    eta = h / delta_m
+    s_star = math.sqrt(1.0 - eta) if eta < 1.0 else 0.0
+    lost = 0.75 * (_slice_load_integral(s2, eta, s_star) - _slice_load_integral(s1, eta, s_star))
+    return min(1.0, max(0.0, lost))
+
+
+@njit(**JIT)
+def pit_drop_m(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, delta_m, semi_major_m):
+    """Extra radial clearance [m] equivalent to the pit's load loss: delta (1 - (1 - lambda)^(2/3)),
+    so that K (delta - drop)^1.5 is the load the contact keeps (`pit_load_loss`); 0 for an open
+    contact. For a pit that covers the ellipse across it is min(delta, h(u)), Sawalhi & Randall's drop."""
+    lost = pit_load_loss(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, delta_m,
+                         semi_major_m)
+    if lost <= 0.0:
+        return 0.0
+    if lost >= 1.0:
+        return delta_m
+    return -delta_m * math.expm1(2.0 / 3.0 * math.log1p(-lost))  # no cancellation for small lambda
 
 
 @njit(**JIT)
@@ -285,7 +333,7 @@ def wrap_angle(a):
 
 @njit(**JIT)
 def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_angle,
-                          qw, qx, qy, qz, rb, race_radius, groove_radius, rx, ry):
+                          qw, qx, qy, qz, rb, race_radius, groove_radius, rx, delta, semi_major):
     """Extra radial clearance [m] that the defect row `d` (D_* layout) opens at the contact of
     ball `ball` with race `race` (0 inner, 1 outer): the kernel subtracts it from the contact's
     deflection.
@@ -294,7 +342,8 @@ def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_a
     groove-curvature centre -> ball centre (the contact point is at ball centre + Rb n);
     (wx, wy, wz): ball angular velocity, world frame [rad/s]; shaft_angle [rad]; q the ball's
     orientation quaternion; rb ball radius, race_radius raceway radius at the contact, groove_radius,
-    and rx, ry the contact's relative radii of curvature along / across the rolling direction [m].
+    rx the contact's relative radius of curvature along the rolling direction, delta its deflection
+    and semi_major its ellipse's semi-major axis (across the rolling direction) [m].
 
     Race spall: u = race_radius wrap(ball azimuth - spall azimuth) (inner: spall azimuth = shaft
     angle + ring angle), v = groove_radius (asin nz - asin nz_centre). Ball defect: the defect
@@ -307,7 +356,7 @@ def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_a
         centre = d[D_ANGLE] + (shaft_angle if kind == KIND_INNER else 0.0)
         u = race_radius * wrap_angle(math.atan2(py, px) - centre)
         v = groove_radius * (math.asin(min(1.0, max(-1.0, nz))) - math.asin(d[D_CENTRE_NZ]))
-        return pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, ry)
+        return pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, delta, semi_major)
     if kind == KIND_BALL and ball == int(d[D_BALL]):
         ex, ey, ez = quat_rotate(qw, qx, qy, qz, d[D_BODY_X], d[D_BODY_Y], d[D_BODY_Z])
         cos_n = ex * nx + ey * ny + ez * nz
@@ -330,7 +379,7 @@ def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_a
             dist = rb * math.sqrt(max(0.0, 1.0 - cos_n * cos_n))
             u = dist
             v = dist
-        return pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, ry)
+        return pit_drop_m(u, v, d[D_HALF_WIDTH], d[D_HALF_LENGTH], d[D_DEPTH], d[D_EDGE_RADIUS], rx, delta, semi_major)
     return 0.0
 
 

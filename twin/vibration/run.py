@@ -136,8 +136,8 @@ def defect_for(kind: str, geometry, size_m: float = DEFAULT_DEFECT_SIZE_M, lengt
                depth_m: float = DEFAULT_DEFECT_DEPTH_M, angle_deg: float = 0.0) -> dict:
     """The defect of `bearing-twin vibration --defect KIND --defect-size SIZE`: a pit `size_m`
     wide along the rolling direction, `length_m` across it (default 0.6 x the ball radius, 3.8 mm
-    on the 6208: across the conforming groove the ball only drops into a pit about as long as its
-    contact ellipse; a shorter one is bridged), `depth_m` deep, sharp edges; outer spall at azimuth
+    on the 6208: a pit shorter across than the contact ellipse takes only the load of its strip,
+    `twin.vibration.defects`), `depth_m` deep, sharp edges; outer spall at azimuth
     `angle_deg` from the load direction (0 = the centre of the load zone; the CWRU positions 6:00,
     3:00 and 12:00 are 0, 90 and 180 deg), inner spall at `angle_deg` from the ring's reference mark,
     ball defect on ball 0's equator (body +x; `angle_deg` its longitude). Plain data for
