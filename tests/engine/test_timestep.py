@@ -171,7 +171,7 @@ def test_bench_json_keys_positive_and_finite():
     assert r["repeats"] >= 5 and r["time_step_s"] > 1e-6
     assert {c["id"] for c in r["cases"]} == {"ev-5A-heating", "7208-combined", "6208-1700rad-7.5kN",
                                              "vibration-healthy", "vibration-outer-spall", "vibration-healthy-profile",
-                                             "ev-6200-20krpm"}
+                                             "vibration-cwru-de", "ev-6200-20krpm"}
     # seed 003's EV case: the 6200 at 20 000 rpm; the auto step (twin.timestep) is about 1.3 us there
     ev = next(c for c in r["cases"] if c["id"] == "ev-6200-20krpm")
     assert ev["designation"] == "6200" and ev["shaft_speed_rad_s"] == pytest.approx(20000.0 * math.pi / 30.0)

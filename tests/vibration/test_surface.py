@@ -132,3 +132,15 @@ def test_cwru_de_noise_floor_is_the_healthy_records_floor():
     assert acc.noise_density_m_s2_rthz == pytest.approx(cal["noise_density_m_s2_rthz"], rel=0.01)
     assert cal["floor_in_resonance_band_m_s2"] == pytest.approx(cal["resonance_band_rms_m_s2"], rel=0.05)
     assert catalog.bearing("CWRU-DE").surface_profile.race_profile_rms_m == catalog.CWRU_RACE_PROFILE_RMS_M
+
+
+def test_profile_azimuth_is_atan2_to_two_hundredths_of_a_microradian():
+    """`azimuth_rad` (Abramowitz & Stegun 4.4.49, |error| <= 2e-8 rad on the octant) against
+    math.atan2 over random points of every quadrant, the axes and the diagonals: within 3e-8 rad."""
+    from twin.vibration.surface import azimuth_rad
+
+    rng = np.random.default_rng(5)
+    pts = list(rng.normal(size=(20000, 2)) * 0.02) + [(0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0),
+                                                       (1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)]
+    err = max(abs(azimuth_rad(y, x) - math.atan2(y, x)) for y, x in pts)
+    assert err <= 3e-8

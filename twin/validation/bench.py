@@ -9,6 +9,7 @@ further cases, and the per-pass timing of the step.
   7500 N, the 6208 with its outer ring on the housing (housing DOFs, in-kernel
   accelerometer decimation, the sample drain every frame) healthy and with a 0.5 mm outer-race
   spall (defect drops), and healthy with the race profiles and ball sizes on (twin.vibration.surface);
+  the CWRU rig's drive end (`CWRU-DE`: housing, rotor and race profiles) at 1797 rpm;
   each at its default step and at 1 us (snapped to 1 / (20 x 51.2 kHz) with
   the housing on). With the housing on, the indicators of a window (Python, once per
   `Accelerometer.window_s`) are timed apart (`indicator_window_s`, best of `repeats`) and
@@ -72,6 +73,9 @@ CASES = (
     BenchCase("vibration-healthy", housing=True),
     BenchCase("vibration-outer-spall", housing=True, defect="outer"),
     BenchCase("vibration-healthy-profile", housing=True, surface_profile=True),
+    # the CWRU rig as `python -m twin.validation.cwru` runs it: housing, rotor, race profiles
+    BenchCase("vibration-cwru-de", designation="CWRU-DE", shaft_speed_rad_s=1797.0 * math.pi / 30.0,
+              radial_load_n=catalog.CWRU_RADIAL_LOAD_N, surface_profile=True),
 )
 EV_20K = BenchCase("ev-6200-20krpm", designation=EV_BEARING, shaft_speed_rad_s=20000.0 * math.pi / 30.0,
                    radial_load_n=EV_RADIAL_LOAD_N, shaft_current_a=10.0, shear_heating=True)
