@@ -175,6 +175,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
     out.mkdir(parents=True, exist_ok=True)
     from service.reports import ev as report_ev
     from service.reports.angular_contact import angular_contact_section
+    from service.reports.cwru import cwru_section
     from service.reports.friction import friction_section
     from service.reports.ehl import write_ehl_section
     from service.reports.thermal import thermal_section
@@ -211,6 +212,7 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
         step_study = timestep_study.run_all(quick=quick)
         progress.update(1)
         vib_md = vibration_section(out, quick)
+        vib_md += cwru_section(out, duration_s=0.5 if quick else 1.0)
         progress.update(1)
         thermal_md = thermal_section(out, quick)
         progress.update(1)

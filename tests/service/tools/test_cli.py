@@ -43,7 +43,8 @@ def test_report_quick(tmp_path):
     for png in ("lambda_azimuth_500.png", "lambda_speed.png", "lambda_load.png", "lambda_clearance.png",
                 "startup.png", "seed001_torque.png", "seed003_reduction.png", "seed003_fig7_speed.png",
                 "seed003_temperature_resistance.png", "ehl_centre_line_isothermal.png",
-                "ehl_centre_line_current.png", "ehl_film_vs_speed.png", "angular_contact_jones.png"):
+                "ehl_centre_line_current.png", "ehl_film_vs_speed.png", "angular_contact_jones.png",
+                "cwru_comparison.png"):
         assert (tmp_path / png).stat().st_size > 10_000
         assert png in text
     assert "0.6797" in text and "-0.0727" in text
@@ -53,6 +54,9 @@ def test_report_quick(tmp_path):
     # the 7208 family against Jones' quasi-static solution (service/reports/angular_contact.py)
     assert "## Angular-contact 7208 family against Jones' quasi-static solution" in text
     assert "| 7208AC | 3000 / 3000 |" in text
+    # the CWRU records beside the twin (service/reports/cwru.py): every record's row
+    assert "## Vibration against the CWRU records" in text
+    assert all(f"| {n} | " in text for n in (97, 105, 118, 130, 144, 156))
     # issue 13: the time-step study's table
     assert "## Time step: the auto step against 1 us" in text and "| 6208-serve | auto |" in text
 
