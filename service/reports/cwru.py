@@ -14,6 +14,7 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -23,13 +24,13 @@ FIGURE = "cwru_comparison.png"
 WAVEFORM_S = 0.05
 
 
-def comparison(duration_s: float = 1.0) -> list[dict]:
+def comparison(duration_s: float = 1.0) -> list[dict[str, Any]]:
     """Measured and simulated signal [m/s^2] and analysis of every record (twin.validation.cwru)."""
     from dataclasses import asdict
 
     from twin.validation import cwru
 
-    rows = []
+    rows: list[dict[str, Any]] = []
     for rec in cwru.RECORDS:
         m, xm = cwru.measured(rec, duration_s)
         s, xs = cwru.simulated(rec, duration_s)
@@ -43,7 +44,7 @@ def comparison(duration_s: float = 1.0) -> list[dict]:
     return rows
 
 
-def plot_comparison(rows: list[dict], path: str | Path) -> None:
+def plot_comparison(rows: list[dict[str, Any]], path: str | Path) -> None:
     """One row of three panels per record: measured waveform, twin waveform (same y scale, g),
     and the two envelope spectra [g] up to 12 x shaft with the expected line marked."""
     from twin.validation import cwru
