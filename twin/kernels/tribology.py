@@ -58,12 +58,12 @@ def tribology_coefficients(rx_m: float, ry_m: float, k_ellipticity: float, e_pri
     k = k_ellipticity
     if film_formula == "hamrock_dowson":
         t[T_LN_HMIN] = math.log(ehl.hamrock_dowson_h_min_m(rx_m, u1, g_param, w1, k))
-        t[T_HMIN_EXP_EU], t[T_HMIN_EXP_Q] = 0.68, -0.073
+        t[T_HMIN_EXP_EU], t[T_HMIN_EXP_Q] = ehl.HD_HMIN_U_EXP, ehl.HD_HMIN_W_EXP
     else:
         t[T_LN_HMIN] = math.log(ehl.masjedi_khonsari_h_min_m(rx_m, u1, g_param, w1, k))
-        t[T_HMIN_EXP_EU], t[T_HMIN_EXP_Q] = 0.711 * k ** -0.023, -0.09 * k ** -0.15
+        t[T_HMIN_EXP_EU], t[T_HMIN_EXP_Q] = ehl.masjedi_khonsari_exponents(k)
     t[T_LN_HC] = math.log(ehl.hamrock_dowson_h_c_m(rx_m, u1, g_param, w1, k))
-    t[T_HC_EXP_EU], t[T_HC_EXP_Q] = 0.67, -0.067
+    t[T_HC_EXP_EU], t[T_HC_EXP_Q] = ehl.HD_HC_U_EXP, ehl.HD_HC_W_EXP
     t[T_SEMI_MAJOR] = semi_major_coef
     t[T_SEMI_MINOR] = semi_minor_coef
     t[T_FLUID_DAMPING] = 3.0 * math.pi / math.sqrt(2.0) * ball_radius_m ** 1.5
@@ -72,7 +72,7 @@ def tribology_coefficients(rx_m: float, ry_m: float, k_ellipticity: float, e_pri
     t[T_LN_EHL] = math.log(rolling.rolling_force_ehl_n(e_prime_pa, rx_m, ratio, 1.0, 1.0, 1.0))
     t[T_LN_M] = math.log(rolling.ehl_parameter_m(e_prime_pa, rx_m, ratio, 1.0, 1.0, 1.0))
     t[T_LN_HYST] = math.log(rolling.hysteresis_moment_n_m(2.0 * ball_radius_m, 1.0, ratio) / ball_radius_m)
-    t[T_HYST_EXP_Q] = 1.33
+    t[T_HYST_EXP_Q] = rolling.HYSTERESIS_LOAD_EXP
     t[T_PIVOT] = rolling.pivoting_moment_n_m(1.0, 1.0, 1.0, ratio)
     t[T_RX], t[T_RY] = rx_m, ry_m
     return t

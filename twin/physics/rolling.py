@@ -136,6 +136,9 @@ def rolling_force_transition_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s,
     return (1.0 - s) * f_ivr + s * f_ehl
 
 
+HYSTERESIS_LOAD_EXP = 1.33  # exponent of Q in seed 001 eq. 9 (twin.kernels.tribology compiles it)
+
+
 @njit(**JIT)
 def hysteresis_moment_n_m(ball_diameter_m, load_n, k_radii_ratio):
     """Elastic-hysteresis rolling-resistance moment of one ball-race contact [N m]:
@@ -157,7 +160,7 @@ def hysteresis_moment_n_m(ball_diameter_m, load_n, k_radii_ratio):
     km1 = k_radii_ratio - 1.0
     if not (km1 > 0.0):
         km1 = 0.0
-    return (7.48e-7 * (0.5 * ball_diameter_m) ** 0.33 * load_n ** 1.33
+    return (7.48e-7 * (0.5 * ball_diameter_m) ** 0.33 * load_n ** HYSTERESIS_LOAD_EXP
             * (1.0 - 3.519e-3 * km1 ** 0.8063))
 
 
