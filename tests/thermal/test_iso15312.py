@@ -64,9 +64,12 @@ def test_network_carries_the_standards_rise_for_the_heat_it_gets(designation):
 
 @pytest.mark.parametrize("designation", sorted(REFERENCE_SPEED_RPM))
 def test_outer_ring_settles_at_70_with_the_standard_dissipation(designation):
-    # the acceptance band (ISO 15312 clause 4: the outer ring at 70 degC at the reference speed), 70 +- 10 degC
-    r, _ = _reference_point(designation)
+    # the acceptance band (ISO 15312 clause 4: the outer ring at 70 degC at the reference speed), 70 +- 10 degC, and
+    # the friction power at the reference point against the reference heat flow q_r A_r within 30 % (measured 1.01 /
+    # 1.11 / 1.04 x for the 6205 / 6208 / 6210)
+    r, phi_r = _reference_point(designation)
     assert r["converged"]
+    assert r["heat_total_w"] == pytest.approx(phi_r, rel=0.3), (r["heat_total_w"], phi_r)
     assert r["temperatures_c"]["outer_ring"] == pytest.approx(70.0, abs=10.0), r
 
 
