@@ -462,8 +462,9 @@ class Twin:
 
     @property
     def drag_power_w(self) -> float:
-        """Drag power of the balls at the last coupling refresh, each ball with the orbit-mean
-        share of its frontal disc in the oil [W] (the snapshot's torque carries it as power / omega)."""
+        """Drag power of the balls at the last coupling refresh [W] (`_mean_drag_power_w`: the SKF
+        drag term in an oil bath, sphere drag in an oil-air mixture); the snapshot's torque carries it
+        as power / omega."""
         return float(self._drag_power_w)
 
     @staticmethod
