@@ -27,7 +27,8 @@ from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_tempera
 from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.faults import Fault, FaultKind
 from twin.friction_power import (FrictionPower, ball_drag_power_w, contact_powers_w, mean_immersed_fraction,
-                                 oil_level_m, seal_moment_n_m, starvation_film_factor)
+                                 oil_bath_drag_power_w, oil_level_m, seal_moment_n_m, seal_power_w,
+                                 starvation_film_factor)
 from twin.physics import drag as drag_law
 from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
 from twin.electrical_network import bearing_network
@@ -193,7 +194,7 @@ class Twin:
         # the contacts' share is split over the contacts by their lanes, drag heats the oil and
         # the seals the outer ring (twin.thermal.sources.HeatSources.node_heat_w)
         drag_w = max(float(self._drag_power_w), 0.0)
-        seal_w = max(self._seal_moment_n_m * abs(float(s.scalars[L.X_SHAFT_SPEED])), 0.0)
+        seal_w = self._seal_power_w()
         contacts_w = max(th.take_mean_power_w() - drag_w - seal_w, 0.0)
         heat = friction_heat(s.contacts, self.model.ball_count, contacts_w, self._effective_mu)
         heat = HeatSources(per_contact_w=heat.per_contact_w, drag_w=drag_w, seal_w=seal_w)
@@ -261,11 +262,16 @@ class Twin:
         self._setpoint_vector[L.S_VISCOSITY] = eta0 * factor ** (1.0 / speed_exponent)
 
     def _mean_drag_power_w(self, oil_density_kg_m3: float) -> float:
-        """Drag power of the balls [W] at the cage speed, each ball with the orbit-mean share of its
-        frontal disc in the oil (twin.friction_power.mean_immersed_fraction); 0 'flooded'."""
+        """Drag power of the balls [W]: in an oil bath the SKF model's drag moment at the shaft
+        speed (twin.friction_power.oil_bath_drag_power_w); in an oil-air mixture each ball's sphere
+        drag at the cage speed with the mixture's oil share (twin.friction_power.ball_drag_power_w);
+        0 'flooded'."""
         if self._immersed_fraction <= 0.0 or not hasattr(self, "state"):
             return 0.0
         m = self.model
+        if m.spec.lubrication.method == "oil_bath":
+            return oil_bath_drag_power_w(m.spec, float(self.state.scalars[L.X_SHAFT_SPEED]),
+                                         self._oil_viscosity_pa_s / oil_density_kg_m3)
         v = abs(float(self.state.scalars[L.X_CAGE_SPEED])) * m.pitch_radius_m
         return m.ball_count * ball_drag_power_w(2.0 * m.ball_radius_m, v, self._immersed_fraction,
                                                 oil_density_kg_m3, self._oil_viscosity_pa_s)
@@ -456,8 +462,9 @@ class Twin:
 
     @property
     def drag_power_w(self) -> float:
-        """Drag power of the balls at the last coupling refresh, each ball with the orbit-mean
-        share of its frontal disc in the oil [W] (the snapshot's torque carries it as power / omega)."""
+        """Drag power of the balls at the last coupling refresh [W] (`_mean_drag_power_w`: the SKF
+        drag term in an oil bath, sphere drag in an oil-air mixture); the snapshot's torque carries it
+        as power / omega."""
         return float(self._drag_power_w)
 
     @staticmethod
@@ -482,6 +489,11 @@ class Twin:
             return 0.0
         return self._drag_power_w / speed + self._seal_moment_n_m
 
+    def _seal_power_w(self) -> float:
+        """Power of the rubbing seals at the current shaft speed [W] (twin.friction_power.seal_power_w):
+        the one evaluation the thermal network's heat and `friction_power_w` share."""
+        return seal_power_w(self._seal_moment_n_m, float(self.state.scalars[L.X_SHAFT_SPEED]))
+
     def friction_power_w(self) -> FrictionPower:
         """Friction power of the current instant by source and by contact [W]
         (twin.friction_power): the contacts' rolling, sliding and spin power from the last step's
@@ -494,18 +506,20 @@ class Twin:
         x, v = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s
         orbit_speed = np.hypot(v[:, 0], v[:, 1])
         drag_w = np.zeros(m.ball_count)
-        if m.spec.lubrication.method != "flooded":
+        method = m.spec.lubrication.method
+        if method == "oil_bath":   # the bath's drag shared by the part of each ball in the oil
             from_bottom = np.arctan2(x[:, 1], x[:, 0])  # the bath's bottom lies on the load line (+x)
+            share = np.array([drag_law.immersed_area_fraction(
+                drag_law.ball_depth_in_bath_m(oil_level_m(m.spec), float(a), m.pitch_radius_m), 2.0 * m.ball_radius_m)
+                for a in from_bottom])
+            if share.sum() > 0.0:
+                drag_w = share / share.sum() * oil_bath_drag_power_w(
+                    m.spec, float(s.scalars[L.X_SHAFT_SPEED]), self._oil_viscosity_pa_s / rho)
+        elif method != "flooded":
             for j in range(m.ball_count):
-                if m.spec.lubrication.method == "oil_bath":
-                    depth = drag_law.ball_depth_in_bath_m(oil_level_m(m.spec), float(from_bottom[j]),
-                                                          m.pitch_radius_m)
-                    share = drag_law.immersed_area_fraction(depth, 2.0 * m.ball_radius_m)
-                else:
-                    share = self._immersed_fraction
-                drag_w[j] = ball_drag_power_w(2.0 * m.ball_radius_m, float(orbit_speed[j]), share, rho,
-                                              self._oil_viscosity_pa_s)
-        seal_w = self._seal_moment_n_m * abs(float(s.scalars[L.X_SHAFT_SPEED]))
+                drag_w[j] = ball_drag_power_w(2.0 * m.ball_radius_m, float(orbit_speed[j]), self._immersed_fraction,
+                                              rho, self._oil_viscosity_pa_s)
+        seal_w = self._seal_power_w()
         return FrictionPower(rolling_w=float(rolling.sum()), sliding_w=float(sliding.sum()), spin_w=float(spin.sum()),
                              drag_w=float(drag_w.sum()), seal_w=seal_w, rolling_contact_w=rolling,
                              sliding_contact_w=sliding, spin_contact_w=spin, drag_ball_w=drag_w)

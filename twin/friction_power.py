@@ -11,8 +11,10 @@ Sources:
   ring;
 - spin: the traction's moment about the contact normal against the relative spin rate,
   P = |M_n omega_spin| (twin.kernels.traction);
-- drag: the balls churning the oil of the cavity (twin.physics.drag), P = F_D v per ball;
-- seal: the rubbing seals (twin.physics.seals), P = M_seal |omega_shaft|.
+- drag: the balls churning the oil of the cavity (twin.physics.drag): in an oil bath the SKF
+  model's drag moment times the shaft speed, shared among the balls by the part of each in the
+  oil; in an oil-air mixture (jet, oil-air) F_D v per ball;
+- seal: the rubbing seals (twin.physics.seals), P = M_seal |omega_shaft| (`seal_power_w`).
 
 The contact powers are read from the contact lanes of the last step (instantaneous); in steady
 running their sum equals the contacts' friction torque times the shaft speed (the energy balance,
@@ -110,6 +112,20 @@ def mean_immersed_fraction(spec: BearingSpec) -> float:
     az = (np.arange(ORBIT_SAMPLES) + 0.5) * (2.0 * math.pi / ORBIT_SAMPLES)
     return float(np.mean([drag.immersed_area_fraction(drag.ball_depth_in_bath_m(level, a, pitch), 2.0 * g.ball_radius_m)
                           for a in az]))
+
+
+def oil_bath_drag_power_w(spec: BearingSpec, shaft_speed_rad_s: float, kinematic_viscosity_m2_s: float) -> float:
+    """Drag power of all the balls in the spec's oil bath [W]: the SKF model's M_drag
+    (twin.physics.drag.oil_bath_drag_moment_n_m) at the spec's oil level, times |omega|."""
+    d, big_d = boundary_dimensions_m(spec.geometry)
+    moment = drag.oil_bath_drag_moment_n_m(d, big_d, oil_level_m(spec), shaft_speed_rad_s, kinematic_viscosity_m2_s,
+                                           starvation.K_Z[spec.kind])
+    return moment * abs(shaft_speed_rad_s)
+
+
+def seal_power_w(seal_moment_n_m: float, shaft_speed_rad_s: float) -> float:
+    """Power of the rubbing seals [W]: their moment times the shaft speed, M_seal |omega|."""
+    return max(seal_moment_n_m * abs(shaft_speed_rad_s), 0.0)
 
 
 def ball_drag_power_w(ball_diameter_m: float, orbital_speed_m_s: float, oil_fraction: float,

@@ -8,7 +8,9 @@ import pytest
 from twin import catalog
 from twin.engine import Twin
 from twin.kernels import layout as L
-from twin.physics import starvation
+from twin.friction_power import boundary_dimensions_m, oil_level_m
+from twin.physics import drag, starvation
+from twin.physics.viscosity import density_kg_m3
 from twin.setpoint import Setpoint
 from twin.spec import Lubrication
 
@@ -80,9 +82,14 @@ def test_oil_bath_starves_the_film_and_adds_drag_and_seal():
     assert h_bath / h_flooded == pytest.approx(phi, rel=0.02)
     fp = bath.friction_power_w()
     assert fp.seal_w == pytest.approx(bath._seal_moment_n_m * 1000.0, rel=1e-9)
-    # the balls in the bath churn oil, the others air (three orders of magnitude less)
-    in_oil = fp.drag_ball_w > 100.0 * fp.drag_ball_w.min()
+    # the bath's drag (the SKF model's drag term, twin.physics.drag) goes to the balls in the oil, shared by the part
+    # of each in it; it is the bath's drag at the shaft speed (the same law as the torque's, the same instant)
+    in_oil = fp.drag_ball_w > 0.0
     assert 0 < np.count_nonzero(in_oil) < bath.model.ball_count
-    assert fp.drag_ball_w[in_oil].sum() > 0.9 * fp.drag_w
+    d, big_d = boundary_dimensions_m(bath.model.spec.geometry)
+    nu = bath._oil_viscosity_pa_s / density_kg_m3(lub.density_15c_kg_m3, 40.0)
+    skf = drag.oil_bath_drag_moment_n_m(d, big_d, oil_level_m(bath.model.spec), 1000.0, nu, 3.1) * 1000.0
+    assert fp.drag_w == pytest.approx(skf, rel=1e-6)
+    assert bath.drag_power_w == pytest.approx(skf, rel=1e-6)
     added = bath.snapshot().friction_torque_n_m - bath.contact_friction_torque_n_m
     assert added == pytest.approx(bath.drag_power_w / 1000.0 + bath._seal_moment_n_m, rel=1e-9)

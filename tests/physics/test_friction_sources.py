@@ -37,6 +37,38 @@ def test_ball_drag_force_is_harris_kotzalas_form():
     assert drag.ball_drag_force_n(d, v, rho, eta) == pytest.approx(hk, rel=1e-12)
 
 
+def test_drag_loss_factor_reads_the_skf_diagram():
+    # SKF catalogue 2018, diagram 'Drag loss factor V_M', ball bearings, as digitised in
+    # JRaposo-m/SKF-Bearing-Selection-Tool (ball_bearing_ampliado.csv, ball_bearing.csv): points of the digitisation
+    # between the table's rounded abscissae, within 4 %
+    for h_over_dm, v_m in ((0.1007, 7.41e-5), (0.1815, 2.14e-4), (0.5, 5.66e-4), (1.0022, 9.49e-4)):
+        assert drag.drag_loss_factor(h_over_dm) == pytest.approx(v_m, rel=0.04)
+    assert drag.drag_loss_factor(0.0) == 0.0
+    assert drag.drag_loss_factor(5.0) == drag.drag_loss_factor(1.2)   # the catalogue caps H at 1.2 d_m
+
+
+def test_oil_bath_drag_is_the_skf_drag_term_by_hand():
+    # SKF catalogue 2018, 'Drag losses in oil bath lubrication', ball bearings: 6208 (d 40, D 80 mm, K_z 3.1), oil to
+    # the centre of the lowest ball (H = 6.3 mm), 1500 rad/s, 46.7 mm^2/s; each factor by hand [N mm]
+    n, d, big_d, h, nu = 1500.0 * 30.0 / math.pi, 40.0, 80.0, 6.3, 46.7
+    dm = 60.0
+    v_m = drag.drag_loss_factor(h / dm)
+    assert v_m == pytest.approx(8.06e-5, rel=0.03)  # the digitised diagram at H/d_m = 0.105 (between 0.1007 and 0.1085)
+    k_ball = 3.1 * (d + big_d) / (big_d - d) * 1e-12
+    t = 2.0 * math.acos((0.6 * dm - h) / (0.6 * dm))
+    r_s = 0.36 * dm ** 2 * (t - math.sin(t)) * 0.05 * 3.1 * (big_d + d) / (big_d - d)
+    hand = 0.4 * v_m * k_ball * dm ** 5 * n ** 2 + 1.093e-7 * n ** 2 * dm ** 3 * (n * dm ** 2 * math.sin(t / 2) / nu) ** -1.379 * r_s
+    twin = drag.oil_bath_drag_moment_n_m(40e-3, 80e-3, 6.3e-3, 1500.0, 46.7e-6, 3.1)
+    assert twin == pytest.approx(hand * 1e-3, rel=1e-12)
+    assert twin == pytest.approx(0.0564, rel=0.03)   # N m, the hand evaluation above with the diagram read at 0.105
+    # the churning term grows with n^2 and the oil level; nothing without oil or speed
+    assert drag.oil_bath_drag_moment_n_m(40e-3, 80e-3, 12.6e-3, 1500.0, 46.7e-6, 3.1) > 2.0 * twin
+    assert drag.oil_bath_drag_moment_n_m(40e-3, 80e-3, 0.0, 1500.0, 46.7e-6, 3.1) == 0.0
+    assert drag.oil_bath_drag_moment_n_m(40e-3, 80e-3, 6.3e-3, 0.0, 46.7e-6, 3.1) == 0.0
+    with pytest.raises(ValueError, match="kinematic_viscosity_m2_s"):
+        drag.oil_bath_drag_moment_n_m(40e-3, 80e-3, 6.3e-3, 1500.0, 0.0, 3.1)
+
+
 def test_immersed_fraction_of_a_ball_is_a_circular_segment():
     d = 10e-3
     assert drag.immersed_area_fraction(-1e-3, d) == 0.0
@@ -69,10 +101,14 @@ def test_starvation_factor_is_the_skf_replenishment_factor():
 
 
 def test_seal_moment_follows_the_catalogue_table():
-    # SKF model, M_seal = K_S1 d_s^beta + K_S2 [N mm], RS1 seals: D <= 62 mm: 0.023, 2.25, 2;
-    # 62 < D <= 80 mm: 0.018, 2.25, 20
+    # SKF model, M_seal = K_S1 d_s^beta + K_S2 [N mm], RS1 seals of deep-groove ball bearings (SKF catalogue table
+    # 'Seal frictional moment: exponent and constants'; the transcription of JRaposo-m/SKF-Bearing-Selection-Tool,
+    # seal_frictional_moment.csv): D <= 62 mm: 0.023, 2.25, 2; 62 < D <= 80 mm: 0.018, 2.25, 20; 80 < D <= 100 mm:
+    # 0.018, 2.25, 15; D > 100 mm: 0.018, 2.25, 0
     assert seals.seal_moment_n_m("2RS", 31e-3, 52e-3) == pytest.approx((0.023 * 31 ** 2.25 + 2) * 1e-3, rel=1e-12)
     assert seals.seal_moment_n_m("2RS", 52.6e-3, 80e-3) == pytest.approx((0.018 * 52.6 ** 2.25 + 20) * 1e-3, rel=1e-12)
+    assert seals.seal_moment_n_m("2RS", 60e-3, 90e-3) == pytest.approx((0.018 * 60 ** 2.25 + 15) * 1e-3, rel=1e-12)
+    assert seals.seal_moment_n_m("2RS", 80e-3, 120e-3) == pytest.approx(0.018 * 80 ** 2.25 * 1e-3, rel=1e-12)
     assert seals.seal_moment_n_m("2Z", 52.6e-3, 80e-3) == 0.0   # shields do not touch the inner ring
     assert seals.seal_moment_n_m("open", 52.6e-3, 80e-3) == 0.0
     with pytest.raises(ValueError, match="seal = 'felt'"):

@@ -20,7 +20,7 @@ import numpy as np
 from twin import catalog
 from twin.engine import Twin
 from twin.setpoint import Setpoint
-from twin.spec import ModelOptions
+from twin.spec import BearingSpec, ModelOptions
 from twin.thermal.integrator import steady_state_c
 from twin.thermal.network import NODE_NAMES
 from twin.thermal.settings import ThermalNetworkSettings
@@ -77,11 +77,13 @@ def steady_state(twin: Twin, *, settle_s: float = 0.1, tolerance_k: float = 0.1,
 
 def steady_operating_point(designation: str, shaft_speed_rad_s: float, radial_load_n: float,
                            axial_load_n: float = 0.0, ambient_c: float = 20.0,
-                           settings: ThermalNetworkSettings | None = None, lubricant=None) -> dict:
-    """The steady state of a catalogue bearing at one operating point, as a plain dict (SI,
-    temperatures in degC): node temperatures, friction torque, heat by source and by ring."""
+                           settings: ThermalNetworkSettings | None = None, lubricant=None,
+                           spec: BearingSpec | None = None) -> dict:
+    """The steady state of a catalogue bearing (or of `spec`, which then replaces the designation's
+    catalogue entry and `lubricant`) at one operating point, as a plain dict (SI, temperatures in
+    degC): node temperatures, friction torque, heat by source and by ring."""
     settings = (settings or ThermalNetworkSettings()).model_copy(update={"heat_capacity_scale": 1.0})
-    spec = catalog.bearing(designation, lubricant=lubricant)
+    spec = spec if spec is not None else catalog.bearing(designation, lubricant=lubricant)
     options = ModelOptions(thermal="network", thermal_period_s=STEADY_PERIOD_S, thermal_network=settings)
     twin = Twin(spec, options=options,
                 setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n,

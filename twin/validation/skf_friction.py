@@ -23,9 +23,15 @@ R1 = 3.7e-7, R2 = 1.7, S1 = 2.84e-3, S2 = 92.8. K_z = 3.1 for deep-groove ball b
 K_rs = 3e-8 for oil jet / low-level oil bath, 6e-8 for grease and oil-air.
 
 M_seal = 0 and M_drag = 0 here: the comparison takes the twin's contact friction
-(Twin.contact_friction_torque_n_m) against M_rr + M_sl; the twin's drag and seal laws are its own
-(twin.physics.drag, twin.physics.seals). This module knows nothing of the twin's engine; it takes
-the designation's boundary dimensions.
+(Twin.contact_friction_torque_n_m) against M_rr + M_sl. The twin's seal and oil-bath drag laws are
+the same model's M_seal and M_drag, written once in twin.physics.seals and twin.physics.drag. This
+module knows nothing of the twin's engine; it takes the designation's boundary dimensions.
+
+Readings that differ between editions: mu_bl = 0.15 (General Catalogue 6000 EN, 2003, taken here);
+the 2018 catalogue's transcription (github.com/JRaposo-m/SKF-Bearing-Selection-Tool) has 0.12 while
+turning and 0.15 at start. Over 100-1500 rad/s with the seed oil at 40 degC phi_bl <= 0.04
+(6205 at 100 rad/s), so M_sl moves by 2 % at most. The deep-groove G_rr and G_sl carry no centrifugal load; the same table's
+angular-contact and self-aligning rows add F_g = R3 d_m^4 n^2 (tests/physics/test_skf_high_speed.py).
 """
 
 from __future__ import annotations
