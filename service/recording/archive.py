@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from service.recording.columns import WaveRow
+from service.recording.vibration_columns import WaveRow
 
 
 @dataclass(frozen=True)

@@ -22,7 +22,9 @@ from typing import Any
 import numpy as np
 
 from service.core.alarms import ALARM_IDS
+from service.recording import alarm_columns as A
 from service.recording import columns as C
+from service.recording import vibration_columns as V
 from service.recording import trends
 from service.recording.archive import WaveformArchive, is_spectrum
 from service.recording.layout import TwinLayout, send_static
@@ -63,10 +65,10 @@ class TwinRows(TwinLayout):
     time_offset_s: float = 0.0                        # added to sim_time (a re-created twin)
     continue_after_s: float | None = None             # where the previous run of this id ended
     note: str | None = None                           # logged (with a line break) before the next row
-    alarm_rows: list = field(default_factory=list)    # alarm events not sent yet (columns.AlarmRow)
+    alarm_rows: list = field(default_factory=list)    # alarm events not sent yet (alarm_columns.AlarmRow)
     alarm_states: dict = field(default_factory=dict)  # alarm id -> latest state seen (ALARM_STATES)
     alarm_carry: dict = field(default_factory=dict)   # a new output: the states to log again
-    wave_rows: list = field(default_factory=list)     # accelerometer samples not sent yet (columns.WaveRow)
+    wave_rows: list = field(default_factory=list)     # accelerometer samples not sent yet (vibration_columns.WaveRow)
     measured_rows: list = field(default_factory=list)  # measured-window comparisons not sent yet (dicts)
     trend_rows: list = field(default_factory=list)    # rows of the trend window still open (sent: not yet)
     wave_events_s: list = field(default_factory=list) # simulated times of recent events (WaveformArchive)
@@ -148,7 +150,7 @@ class RowBatcher:
 
     def log_alarm(self, event) -> None:
         try:
-            row = C.AlarmRow.of(event)
+            row = A.AlarmRow.of(event)
         except Exception as exc:  # noqa: BLE001 - never raise into the alarm hub
             self.errors += 1
             log.warning("rerun recorder: alarm event skipped: %s", exc)
@@ -169,7 +171,7 @@ class RowBatcher:
 
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
         try:
-            rows = [C.WaveRow(seq=-1 if seq is None else int(seq), t0_s=float(b.t0_s),
+            rows = [V.WaveRow(seq=-1 if seq is None else int(seq), t0_s=float(b.t0_s),
                               sample_rate_hz=float(b.sample_rate_hz), samples=np.asarray(b.samples, dtype=np.float32))
                     for b in blocks]
         except Exception as exc:  # noqa: BLE001 - never raise into the publisher
@@ -314,7 +316,7 @@ class RowBatcher:
             try:
                 triples = self._columns(tw, rows, alarm_rows, now, force_slow)
                 if measured_rows:
-                    triples += C.measured_columns(tw, measured_rows, tw.time_offset_s)
+                    triples += A.measured_columns(tw, measured_rows, tw.time_offset_s)
                 for path, indexes, columns in triples:
                     for out in self._audience(tw, path, rows, outputs):
                         out.stream.send_columns(path, indexes=indexes, columns=columns)
@@ -362,9 +364,9 @@ class RowBatcher:
         for k, (outs, part) in enumerate(groups):
             if not outs or not part:
                 continue
-            triples = C.waveform_columns(tw, part, tw.time_offset_s)
+            triples = V.waveform_columns(tw, part, tw.time_offset_s)
             if k:                                   # the archive: a line break before every burst
-                triples += C.waveform_breaks(tw, part, tw.time_offset_s)
+                triples += V.waveform_breaks(tw, part, tw.time_offset_s)
             for path, indexes, columns in triples:
                 for out in outs:
                     out.stream.send_columns(path, indexes=indexes, columns=columns)
@@ -388,11 +390,11 @@ class RowBatcher:
         if tw.alarm_carry and (rows or alarm_rows):
             first = rows[0] if rows else None
             carry, tw.alarm_carry = tw.alarm_carry, {}
-            triples += C.alarm_states_in_force(
+            triples += A.alarm_states_in_force(
                 tw, carry, first.time_s if first else alarm_rows[0].time_s,
                 first.seq if first else alarm_rows[0].seq, tw.time_offset_s)
         if alarm_rows:
-            triples += C.alarm_columns(tw, alarm_rows, tw.time_offset_s)
+            triples += A.alarm_columns(tw, alarm_rows, tw.time_offset_s)
         if rows:
             batch = C.Batch.of(rows, tw.time_offset_s)
             now = self._sample(rows, tw, "now_interval", self.now_interval_s)
@@ -401,7 +403,7 @@ class RowBatcher:
                 C.now_columns(tw, now_batch)
                 triples += now_batch.out
             C.events(tw, batch)
-            C.vibration_columns(tw, batch)
+            V.vibration_columns(tw, batch)
             batch.breaks(C.scalar_paths(tw, slow=False), tw.time_offset_s, tw.prev_time_s)
             triples += batch.out
             tw.prev_time_s = rows[-1].time_s

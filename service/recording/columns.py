@@ -13,26 +13,20 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
-import pyarrow as pa
 import rerun as rr
 
+from service.recording.arrow import bar_columns
 from service.recording.layout import (
-    ALARM_LOG_LEVEL,
-    ALARM_STATES,
     CONTACT_SERIES,
-    CURSOR_HARMONICS,
-    CURSOR_NAMES,
-    CURSOR_WIDTH_FRACTION,
     LOAD_ZONE,
     REGIME_CODE,
     RISK_VALUES,
     SEQ,
     SIDES,
     SIM_TIME,
-    SPECTRUM_PIXELS,
-    VIB_LINES,
     TwinLayout,
 )
 
@@ -69,7 +63,7 @@ class Row:
     positions_m: np.ndarray | None
     gap_before: str | None = None     # why the line breaks before this row (lost rows, new run)
     defects: tuple | None = None      # the active local defects as text (None: not in the snapshot)
-    vibration: object | None = None   # the snapshot's vibration block (twin.snapshot.VibrationState)
+    vibration: Any = None   # the snapshot's vibration block (twin.snapshot.VibrationState) or None
     thermal: tuple | None = None      # THERMAL_NODES temperatures [degC] then THERMAL_SOURCES heat [W]
 
 
@@ -115,17 +109,17 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
                 for k, name in enumerate(cf):
                     if name is not None:
                         row[k] = _num(getattr(c, name))
-                regimes[i, side] = REGIME_CODE.get(getattr(c, "regime", None), 0)
+                regimes[i, side] = REGIME_CODE.get(str(getattr(c, "regime", "")), 0)
     electrical: dict = {}
     risk = reason = None
     el = getattr(snapshot, "electrical", None) if _present(snapshot, ("electrical",))[0] else None
     if el is not None:
         items = el if isinstance(el, Mapping) else {k: getattr(el, k, None) for k in
                                                     (*_ELECTRICAL_FIELDS, "discharge_risk", "reason")}
-        for k in _ELECTRICAL_FIELDS:
-            v = _num(items.get(k))
+        for key in _ELECTRICAL_FIELDS:
+            v = _num(items.get(key))
             if math.isfinite(v):
-                electrical[k] = v
+                electrical[key] = v
         r = items.get("discharge_risk")
         if isinstance(r, str):
             risk = r
@@ -154,75 +148,11 @@ def _defect_text(d) -> str:
     """'outer spall 0.5 x 0.6 mm, 50 um deep at 0 deg' of a twin.vibration.defects model."""
     get = d.get if isinstance(d, Mapping) else (lambda k, default=None: getattr(d, k, default))
     kind = get("kind")
-    size = f"{_fmt(get('width_m', 0.0) * 1e3)} x {_fmt(get('length_m', 0.0) * 1e3)} mm, {_fmt(get('depth_m', 0.0) * 1e6)} um deep"
-    where = {"outer": f"outer spall {size} at azimuth {_fmt(get('azimuth_deg', 0.0))} deg",
-             "inner": f"inner spall {size} at ring angle {_fmt(get('ring_angle_deg', 0.0))} deg",
+    size = f"{format_number(get('width_m', 0.0) * 1e3)} x {format_number(get('length_m', 0.0) * 1e3)} mm, {format_number(get('depth_m', 0.0) * 1e6)} um deep"
+    where = {"outer": f"outer spall {size} at azimuth {format_number(get('azimuth_deg', 0.0))} deg",
+             "inner": f"inner spall {size} at ring angle {format_number(get('ring_angle_deg', 0.0))} deg",
              "ball": f"ball {get('ball_index', 0)} defect {size}"}
-    return where.get(kind, f"{kind} defect {size}")
-
-
-# ---- arrow helpers ------------------------------------------------------------------------------
-class _Arrow:
-    """A ready arrow array as a `ComponentBatchLike`."""
-
-    def __init__(self, array: pa.Array) -> None:
-        self.array = array
-
-    def as_arrow_array(self) -> pa.Array:
-        return self.array
-
-
-_TENSOR_TYPE = None
-
-
-def _tensor_rows(values) -> pa.Array:
-    """One rerun TensorData (1-D, float32) per row of `values` (n, k), or per array of a list of
-    1-D arrays (rows of different lengths), built as one arrow array (rerun's own
-    `BarChart.columns` takes one tensor for all rows)."""
-    global _TENSOR_TYPE
-    if _TENSOR_TYPE is None:
-        _TENSOR_TYPE = rr.components.TensorDataBatch(
-            rr.encodings.TensorData(array=np.zeros(1, np.float32))).as_arrow_array().type
-    if isinstance(values, np.ndarray):
-        values = np.ascontiguousarray(values, dtype=np.float32)
-        n, k = values.shape
-        sizes = np.full(n, k, dtype=np.int64)
-    else:
-        sizes = np.array([len(v) for v in values], dtype=np.int64)
-        n = sizes.size
-        values = np.concatenate([np.asarray(v, dtype=np.float32) for v in values]) if n else np.zeros(0, np.float32)
-    offsets = np.zeros(n + 1, dtype=np.int32)
-    np.cumsum(sizes, out=offsets[1:])
-    f_shape, f_names, f_buffer = _TENSOR_TYPE[0], _TENSOR_TYPE[1], _TENSOR_TYPE[2]
-    shape = pa.ListArray.from_arrays(pa.array(np.arange(n + 1, dtype=np.int32)),
-                                     pa.array(sizes.astype(np.uint64)), type=f_shape.type)
-    utype = f_buffer.type
-    children = []
-    code = None
-    for i in range(utype.num_fields):
-        ft = utype.field(i)
-        if ft.name == "F32":
-            code = utype.type_codes[i]
-            children.append(pa.ListArray.from_arrays(pa.array(offsets), pa.array(values.reshape(-1)), type=ft.type))
-        else:
-            children.append(pa.array([], type=ft.type))
-    buffer = pa.Array.from_buffers(utype, n, [None, pa.py_buffer(np.full(n, code, dtype=np.int8).tobytes()),
-                                              pa.py_buffer(np.arange(n, dtype=np.int32).tobytes())],
-                                   children=children)
-    return pa.StructArray.from_arrays([shape, pa.nulls(n, type=f_names.type), buffer],
-                                      fields=[f_shape, f_names, f_buffer])
-
-
-def _bar_columns(values, abscissa, widths=None) -> list:
-    """BarChart columns, a row per row of values / abscissa (arrays (n, k) or lists of 1-D
-    arrays); widths: the bar widths of each row (a list of 1-D arrays), else the static ones."""
-    out = [rr.ComponentColumn(rr.BarChart.descriptor_values(), _Arrow(_tensor_rows(values))),
-           rr.ComponentColumn(rr.BarChart.descriptor_abscissa(), _Arrow(_tensor_rows(abscissa)))]
-    if widths is not None:
-        out.append(rr.ComponentColumn(rr.BarChart.descriptor_widths(),
-                                      rr.components.LengthBatch(np.concatenate(widths).astype(np.float32)),
-                                      lengths=np.array([len(w) for w in widths])))
-    return out
+    return where.get(str(kind), f"{kind} defect {size}")
 
 
 # ---- columns ------------------------------------------------------------------------------------
@@ -318,7 +248,7 @@ def now_columns(tw: TwinLayout, batch: Batch) -> None:
         if tw.load_scale_m_per_n is None:
             peak = float(np.nanmax(load)) if load.size and np.isfinite(load).any() else 0.0
             if peak > 0.0:
-                tw.load_scale_m_per_n = 2.0 * tw.ball_radius_m / peak
+                tw.load_scale_m_per_n = 2.0 * (tw.ball_radius_m or 0.0) / peak
         scale = tw.load_scale_m_per_n or 0.0
         a = np.nan_to_num(c[:, :, 0, F_ANGLE])          # inner contacts: from the ball centre inwards
         length = np.nan_to_num(load[:, :, 0]) * scale
@@ -336,7 +266,7 @@ def now_columns(tw: TwinLayout, batch: Batch) -> None:
             if f == F_LAMBDA:
                 values = np.where(np.isfinite(values), values, 0.0)   # no contact: no bar
             batch.out.append((f"{root}/load_zone/{leaf}/{name}", batch.index(),
-                              _bar_columns(values, deg + (w / 2 if side else -w / 2))))
+                              bar_columns(values, deg + (w / 2 if side else -w / 2))))
 
 
 def slow_columns(tw: TwinLayout, batch: Batch) -> None:
@@ -363,7 +293,7 @@ def scalar_paths(tw: TwinLayout, slow: bool) -> list[str]:
 
 
 # ---- events ---------------------------------------------------------------------------------------
-def _fmt(v: float) -> str:
+def format_number(v: float) -> str:
     return f"{v:.6g}"
 
 
@@ -387,10 +317,10 @@ def events(tw: TwinLayout, batch: Batch) -> None:
         if r.setpoint is not None and r.setpoint != last.get("setpoint") and not in_phase:
             old = last.get("setpoint")
             if old is None:
-                what = ", ".join(f"{n} = {_fmt(v)}" for n, v in zip(SETPOINT_FIELDS, r.setpoint, strict=True))
+                what = ", ".join(f"{n} = {format_number(v)}" for n, v in zip(SETPOINT_FIELDS, r.setpoint, strict=True))
                 texts.append((j, f"setpoint in force: {what}", "INFO"))
             else:
-                what = ", ".join(f"{n} {_fmt(a)} -> {_fmt(b)}"
+                what = ", ".join(f"{n} {format_number(a)} -> {format_number(b)}"
                                  for n, a, b in zip(SETPOINT_FIELDS, old, r.setpoint, strict=True) if a != b)
                 texts.append((j, f"setpoint: {what}", "INFO"))
             last["setpoint"] = r.setpoint
@@ -424,249 +354,3 @@ def events(tw: TwinLayout, batch: Batch) -> None:
         sel = np.array([j for j, _ in risks])
         batch.out.append((f"{tw.root}/electrical/discharge_risk", batch.index(sel),
                           rr.StateChange.columns(state=[s for _, s in risks])))
-
-
-# ---- alarms ---------------------------------------------------------------------------------------
-@dataclass(slots=True)
-class AlarmRow:
-    """One alarm event (service.core.alarms.AlarmEvent) as the recorder keeps it."""
-
-    bearing_id: str
-    alarm_id: str
-    transition: str                   # raised | escalated | deescalated | cleared
-    severity: str | None              # warning | critical | None (cleared)
-    time_s: float                     # simulated time of the event [s]
-    seq: int | None                   # seq of the snapshot that caused it
-    value: float
-    threshold: float
-    clear_threshold: float
-    unit: str
-    message: str
-
-    @classmethod
-    def of(cls, event) -> AlarmRow:
-        """From an `AlarmEvent` (or its dict)."""
-        get = event.get if isinstance(event, Mapping) else (lambda k, d=None: getattr(event, k, d))
-        seq = get("snapshot_seq")
-        return cls(bearing_id=str(get("bearing_id")), alarm_id=str(get("alarm_id")),
-                   transition=str(get("transition")), severity=get("severity"),
-                   time_s=float(get("time_s")), seq=int(seq) if isinstance(seq, int) else None,
-                   value=float(get("value")), threshold=float(get("threshold")),
-                   clear_threshold=float(get("clear_threshold")), unit=str(get("unit") or "-"),
-                   message=str(get("message") or ""))
-
-    @property
-    def state(self) -> str:
-        return self.severity if self.severity in ALARM_STATES else "inactive"
-
-    @property
-    def text(self) -> str:
-        unit = "" if self.unit == "-" else f" {self.unit}"
-        return (f"{self.message} [value {_fmt(self.value)}{unit}, raise at {_fmt(self.threshold)}{unit}, "
-                f"clear at {_fmt(self.clear_threshold)}{unit}]")
-
-
-def _alarm_index(times_ns: np.ndarray, seqs: list[int | None]) -> list:
-    """sim_time, and seq when every row has one."""
-    index = [rr.TimeColumn(SIM_TIME, duration=times_ns.astype("timedelta64[ns]"))]
-    if all(s is not None for s in seqs):
-        index.append(rr.TimeColumn(SEQ, sequence=np.array(seqs, dtype=np.int64)))
-    return index
-
-
-def alarm_columns(tw: TwinLayout, rows: list[AlarmRow], offset_s: float) -> list:
-    """(entity path, index columns, component columns) triples of a twin's alarm events: a
-    TextLog row at `alarms/{alarm_id}` and a StateChange row at `alarm_states/{alarm_id}` per
-    event, at the event's simulated time (shifted by the twin's offset) and snapshot seq."""
-    out: list = []
-    by_alarm: dict[str, list[AlarmRow]] = {}
-    for r in rows:
-        by_alarm.setdefault(r.alarm_id, []).append(r)
-    for alarm_id, group in by_alarm.items():
-        # rows with and without a snapshot seq go in separate calls (index columns of one length)
-        for part in ([r for r in group if r.seq is not None], [r for r in group if r.seq is None]):
-            if not part:
-                continue
-            t = np.round((np.array([r.time_s for r in part]) + offset_s) * 1e9).astype(np.int64)
-            seqs = [r.seq for r in part]
-            out.append((f"{tw.root}/alarms/{alarm_id}", _alarm_index(t, seqs),
-                        rr.TextLog.columns(text=[r.text for r in part],
-                                           level=[ALARM_LOG_LEVEL.get(r.severity, "INFO") for r in part])))
-            out.append((f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, seqs),
-                        rr.StateChange.columns(state=[r.state for r in part])))
-    return out
-
-
-MEASURED_LINES = ("BPFO", "BPFI", "2xBSF")
-
-
-def measured_columns(tw: TwinLayout, comparisons: list[Mapping], offset_s: float) -> list:
-    """(entity path, index columns, component columns) triples of the measured-window comparisons
-    of a twin (service.core.measured), at the twin's simulated time when each window arrived
-    (shifted by the twin's offset) and its snapshot seq: Scalars `vibration/measured/{kurtosis,rms_m_s2,crest_factor}/
-    {measured,predicted}` (no row where the twin predicts none), `vibration/measured/line_height_db/
-    {BPFO,BPFI,2xBSF}` [dB over the median of +-20 Hz], and a TextLog `vibration/measured/alarms`
-    (level WARN per alarm, INFO when the window raises none)."""
-    rows = [c for c in comparisons if c.get("twin_time_s") is not None]
-    if not rows:
-        return []
-    t = np.round((np.array([c["twin_time_s"] for c in rows]) + offset_s) * 1e9).astype(np.int64)
-    seqs = [c.get("twin_seq") for c in rows]
-    base = f"{tw.root}/vibration/measured"
-    out: list = []
-
-    def scalars(path: str, values: list) -> None:
-        keep = [k for k, v in enumerate(values) if v is not None]
-        if keep:
-            idx = _alarm_index(t[keep], [seqs[k] for k in keep])
-            out.append((path, idx, rr.Scalars.columns(scalars=np.array([values[k] for k in keep], dtype=float))))
-
-    for key in ("kurtosis", "rms_m_s2", "crest_factor"):
-        scalars(f"{base}/{key}/measured", [c["measured"][key] for c in rows])
-        scalars(f"{base}/{key}/predicted", [c["predicted"].get(key) for c in rows])
-    for name in MEASURED_LINES:
-        scalars(f"{base}/line_height_db/{name}",
-                [next((d["height_db"] for d in c["measured"]["defect_lines"] if d["name"] == name), None)
-                 for c in rows])
-    texts = [("; ".join(a["message"] for a in c["alarms"]) or f"window {c['window']}: explained by the twin",
-              "WARN" if c["alarms"] else "INFO") for c in rows]
-    out.append((f"{base}/alarms", _alarm_index(t, seqs),
-                rr.TextLog.columns(text=[x for x, _ in texts], level=[lv for _, lv in texts])))
-    return out
-
-
-def alarm_states_in_force(tw: TwinLayout, states: Mapping[str, str], time_s: float, seq: int | None,
-                          offset_s: float) -> list:
-    """StateChange rows of every alarm's state when a new output (a segment) started, at
-    `time_s` (its first row), so that its state timeline does not begin empty."""
-    active = list(states.items())
-    t = np.array([round((time_s + offset_s) * 1e9)], dtype=np.int64)
-    return [(f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, [seq]), rr.StateChange.columns(state=[state]))
-            for alarm_id, state in active]
-
-
-# ---- vibration ------------------------------------------------------------------------------------
-def vibration_columns(tw: TwinLayout, batch: Batch) -> None:
-    """The indicators of every new accelerometer window (a row at the snapshot that first
-    carries it): `vibration/...` Scalars and the envelope bar charts (layout.VIBRATION_SERIES)."""
-    last = tw.last
-    sel, blocks = [], []
-    for j, r in enumerate(batch.rows):
-        v = r.vibration
-        if v is None or v.window_end_s == last.get("window_end_s"):
-            continue
-        last["window_end_s"] = v.window_end_s
-        sel.append(j)
-        blocks.append(v)
-    if not sel:
-        return
-    idx = np.array(sel)
-    root = tw.root
-    n = len(blocks)
-
-    def scalars(leaf: str, values) -> None:
-        v = np.asarray(values, dtype=np.float64).reshape(n, -1)
-        batch.out.append((f"{root}/vibration/{leaf}", batch.index(idx),
-                          rr.Scalars.columns(scalars=v.reshape(-1)).partition(np.full(n, v.shape[1]))))
-
-    scalars("acceleration_rms_peak_m_s2", [[b.rms_m_s2, b.peak_m_s2] for b in blocks])
-    scalars("velocity_rms_mm_s", [[b.velocity_rms_mm_s] for b in blocks])
-    scalars("kurtosis", [[b.kurtosis, b.band_kurtosis, b.crest_factor] for b in blocks])
-    freqs = np.array([[getattr(b.defect_frequencies_hz, k) for k in VIB_LINES] for b in blocks])
-    amps = np.array([[_line_fundamental(b, k) for k in VIB_LINES] for b in blocks])
-    floor = np.array([[b.envelope_noise_floor_m_s2] for b in blocks])
-    scalars("defect_frequencies_hz", freqs)
-    scalars("envelope_lines_m_s2", np.hstack([amps, floor]))
-    # the envelope spectrum as the snapshot has it: its largest peaks, and the defect lines (markers)
-    k = max(1, max(len(b.envelope_peaks_hz) for b in blocks))
-    peak_f = np.zeros((n, k))
-    peak_a = np.zeros((n, k))
-    for i, b in enumerate(blocks):
-        for m, p in enumerate(b.envelope_peaks_hz):
-            peak_f[i, m], peak_a[i, m] = p.frequency_hz, p.amplitude
-    batch.out.append((f"{root}/vibration/envelope/peaks", batch.index(idx), _bar_columns(peak_a, peak_f)))
-    batch.out.append((f"{root}/vibration/envelope/defect_lines", batch.index(idx),
-                      _bar_columns(np.nan_to_num(amps), freqs)))
-    _spectrum_columns(tw, batch, idx, blocks)
-
-
-def _spectrum_columns(tw: TwinLayout, batch: Batch, idx: np.ndarray, blocks: list) -> None:
-    """The windows' full spectra (VibrationState.envelope_spectrum / amplitude_spectrum; windows
-    without them are skipped) as bar charts against frequency [Hz], bars a bin wide or (range /
-    SPECTRUM_PIXELS), whichever is wider:
-    `vibration/envelope/spectrum` with the defect-frequency cursors
-    `vibration/envelope/cursor/{FTF,BPFO,BPFI,BSF,2xBSF}` (1x, 2x, 3x each, as tall as the spectrum), and
-    `vibration/spectrum` with the envelope band `vibration/spectrum_envelope_band`."""
-    root = tw.root
-    env = [(j, b.envelope_spectrum) for j, b in enumerate(blocks) if getattr(b, "envelope_spectrum", None) is not None]
-    if env:
-        sel = idx[[j for j, _ in env]]
-        amps = [np.asarray(e.amplitude_m_s2) for _, e in env]
-        tops = [float(a.max()) if a.size else 0.0 for a in amps]
-        batch.out.append((f"{root}/vibration/envelope/spectrum", batch.index(sel),
-                          _bar_columns(amps, [e.frequencies_hz for _, e in env],
-                                       [np.full(a.size, _bar_width(e)) for a, (_, e) in zip(amps, env, strict=True)])))
-        for name, label in zip(VIB_LINES, CURSOR_NAMES, strict=True):
-            fs, hs, ws = [], [], []
-            for (j, e), top in zip(env, tops, strict=True):
-                f0 = getattr(blocks[j].defect_frequencies_hz, name)
-                f = np.array([k * f0 for k in range(1, CURSOR_HARMONICS + 1) if k * f0 <= e.max_hz])
-                fs.append(f)
-                hs.append(np.full(f.size, top))
-                ws.append(np.full(f.size, max(2.0 * e.step_hz, e.max_hz / CURSOR_WIDTH_FRACTION)))
-            batch.out.append((f"{root}/vibration/envelope/cursor/{label}", batch.index(sel), _bar_columns(hs, fs, ws)))
-    acc = [(j, b.amplitude_spectrum) for j, b in enumerate(blocks) if getattr(b, "amplitude_spectrum", None) is not None]
-    if acc:
-        sel = idx[[j for j, _ in acc]]
-        amps = [np.asarray(a.amplitude_m_s2) for _, a in acc]
-        batch.out.append((f"{root}/vibration/spectrum", batch.index(sel),
-                          _bar_columns(amps, [a.frequencies_hz for _, a in acc],
-                                       [np.full(x.size, _bar_width(a)) for x, (_, a) in zip(amps, acc, strict=True)])))
-        band = [blocks[j].envelope_band_hz for j, _ in acc]
-        batch.out.append((f"{root}/vibration/spectrum_envelope_band", batch.index(sel),
-                          _bar_columns([np.array([float(a.max()) if a.size else 0.0]) for a in amps],
-                                       [np.array([0.5 * (lo + hi)]) for lo, hi in band],
-                                       [np.array([hi - lo]) for lo, hi in band])))
-
-
-def _bar_width(spectrum) -> float:
-    """Bar width [Hz] of a spectrum's bins: a bin, or (its range / SPECTRUM_PIXELS) when wider."""
-    return max(spectrum.step_hz, (spectrum.max_hz + 0.5 * spectrum.step_hz) / SPECTRUM_PIXELS)
-
-
-def _line_fundamental(block, name: str) -> float:
-    line = (block.envelope_lines or {}).get(name)
-    return float(line.harmonics[0]) if line is not None and line.harmonics else math.nan
-
-
-@dataclass(slots=True)
-class WaveRow:
-    """Accelerometer samples that came with one snapshot (twin.vibration.sensor.WaveformBlock)."""
-
-    seq: int
-    t0_s: float
-    sample_rate_hz: float
-    samples: np.ndarray              # float32 [m/s^2]
-
-
-def waveform_columns(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> list:
-    """`vibration/acceleration_m_s2`: one Scalars row per sample at its own simulated time (the
-    `seq` of the snapshot it came with), all of a send in one call."""
-    rows = [r for r in rows if r.samples.size]
-    if not rows:
-        return []
-    t = np.concatenate([np.round((r.t0_s + offset_s + np.arange(r.samples.size) / r.sample_rate_hz) * 1e9)
-                        for r in rows]).astype(np.int64)
-    seq = np.concatenate([np.full(r.samples.size, r.seq, dtype=np.int64) for r in rows])
-    x = np.concatenate([r.samples for r in rows]).astype(np.float64)
-    index = [rr.TimeColumn(SIM_TIME, duration=t.astype("timedelta64[ns]")), rr.TimeColumn(SEQ, sequence=seq)]
-    return [(f"{tw.root}/vibration/acceleration_m_s2", index, rr.Scalars.columns(scalars=x))]
-
-
-def waveform_breaks(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> list:
-    """An empty row (a line break) half a sample before each of `rows` (bursts kept apart by
-    `service.recording.archive`: no line drawn across the samples not kept), on sim_time only."""
-    at = np.array([round((r.t0_s + offset_s - 0.5 / r.sample_rate_hz) * 1e9) for r in rows], dtype=np.int64)
-    index = [rr.TimeColumn(SIM_TIME, duration=at.astype("timedelta64[ns]"))]
-    return [(f"{tw.root}/vibration/acceleration_m_s2", index,
-             rr.Scalars.columns(scalars=np.zeros(0)).partition(np.zeros(at.size, np.int32)))]

@@ -328,7 +328,7 @@ class RerunRecorder:
 
     def log_measured(self, comparison: dict) -> None:
         """Queue a measured-window comparison (service.core.measured) for the twin's
-        `vibration/measured/...` entities (`columns.measured_columns`); never blocks or raises.
+        `vibration/measured/...` entities (`alarm_columns.measured_columns`); never blocks or raises.
         When `queue_size` wait, the oldest is dropped."""
         if not self._closed and isinstance(comparison, dict):
             self._rows.log_measured(comparison)
