@@ -47,6 +47,16 @@ def _fds() -> int:
 
 
 def _rss_bytes() -> int:
+    """Resident set size [B] after a garbage collection and glibc's malloc_trim, so that freed but
+    cached heap pages (allocator noise of several MB) do not count as growth."""
+    import ctypes
+    import gc
+
+    gc.collect()
+    try:
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except OSError:
+        pass
     with open("/proc/self/status") as f:
         for line in f:
             if line.startswith("VmRSS:"):
