@@ -7,6 +7,10 @@ drains the queue, runs each twin's `AlarmEvaluator` (service.core.alarms) and ha
 the rerun recorder, the OPC UA facade (service.wiring and the registry subscribe them). A
 subscriber must not block (enqueue and return); one that raises is counted and skipped.
 
+`observe_measured(comparison)` queues a measured-window comparison (service.core.measured; the
+registry makes it a listener of every twin's comparator) in the same order as the snapshots: the
+`measured_*` alarms follow the windows.
+
 Twins are added and forgotten by the registry; snapshots of a twin the hub does not know (a late
 one after a delete) are ignored.
 """
@@ -17,7 +21,9 @@ import collections
 import logging
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
 
 from service.core.alarms import Alarm, AlarmEvaluator, AlarmEvent, inputs_from_snapshot
 from service.settings import AlarmSettings
@@ -28,6 +34,14 @@ log = logging.getLogger(__name__)
 AlarmSubscriber = Callable[[AlarmEvent], None]
 
 
+@dataclass(frozen=True)
+class MeasuredItem:
+    """A measured-window comparison queued beside the snapshots."""
+
+    bearing_id: str
+    comparison: Mapping[str, Any]
+
+
 class AlarmHub:
     """Alarm evaluators of every twin of one service (see the module docstring)."""
 
@@ -35,7 +49,7 @@ class AlarmHub:
                  wall_clock: Callable[[], float] = time.time):
         self.settings = settings or AlarmSettings()
         self._wall_clock = wall_clock
-        self._queue: collections.deque[Snapshot] = collections.deque(maxlen=queue_size)
+        self._queue: collections.deque[Snapshot | MeasuredItem] = collections.deque(maxlen=queue_size)
         self._cond = threading.Condition()
         self._evaluators: dict[str, AlarmEvaluator] = {}
         self._history: dict[str, collections.deque[AlarmEvent]] = {}
@@ -89,12 +103,19 @@ class AlarmHub:
 
     # ---- SnapshotSink ------------------------------------------------------------------------
     def publish(self, snapshot: Snapshot) -> None:
+        self._put(snapshot)
+
+    def observe_measured(self, comparison: Mapping[str, Any]) -> None:
+        """Queue a measured-window comparison of a twin (a MeasuredComparator listener: never blocks)."""
+        self._put(MeasuredItem(str(comparison.get("bearing_id")), comparison))
+
+    def _put(self, item: Snapshot | MeasuredItem) -> None:
         with self._cond:
             if self._closed:
                 return
             if len(self._queue) == self._queue.maxlen:
                 self._dropped += 1
-            self._queue.append(snapshot)
+            self._queue.append(item)
             self._cond.notify()
 
     @property
@@ -141,16 +162,19 @@ class AlarmHub:
                     self._busy = False
                     self._cond.notify_all()
 
-    def _evaluate(self, snapshot: Snapshot) -> None:
+    def _evaluate(self, item: Snapshot | MeasuredItem) -> None:
         with self._lock:
-            ev = self._evaluators.get(snapshot.bearing_id)
+            ev = self._evaluators.get(item.bearing_id)
             if ev is None:
                 return
-            events = ev.update(inputs_from_snapshot(snapshot, self.settings))
+            if isinstance(item, MeasuredItem):
+                events = ev.update_measured(item.comparison)
+            else:
+                events = ev.update(inputs_from_snapshot(item, self.settings))
             self.evaluated += 1
             if not events:
                 return
-            self._history[snapshot.bearing_id].extend(events)
+            self._history[item.bearing_id].extend(events)
             subscribers = list(self._subscribers)
         for event in events:
             log.info("alarm %s/%s %s: %s", event.bearing_id, event.alarm_id, event.transition, event.message)

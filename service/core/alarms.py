@@ -40,6 +40,13 @@ The alarms (ids are stable; docs/service.md "Alarms"):
 * `temperature_unexplained` - the dissipation estimator gated the last measured temperature
   (snapshot `thermal.unexplained_heating`): heat the friction and the dissipation cannot
   explain (lubricant loss, overload, a failing bearing; twin.thermal.estimator); critical.
+* `measured_line` - a measured accelerometer window (service.core.measured, posted over HTTP or
+  zenoh) shows a defect line (BPFO, BPFI, 2 x BSF) at least `LINE_ALARM_DB` over its background
+  for a defect the twin does not hold; value: the highest such line [dB]; warning.
+* `measured_kurtosis` - the measured window's kurtosis above the twin's own by more than
+  `KURTOSIS_MARGIN`; value: measured - predicted [-]; warning.
+  Both follow the windows (`update_measured`), not the snapshots: a later window without the
+  finding clears them after `clear_hold_s` of twin time.
 
 State (`AlarmTracker`): every alarm has ordered levels (warning, critical), each with a raise
 threshold and a clear threshold on the safe side of it (a deadband; `clear_ratio`). A level is
@@ -63,6 +70,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
+from service.core.measured import KURTOSIS_MARGIN, LINE_ALARM_DB
 from service.settings import AlarmSettings
 
 __all__ = ["ALARM_IDS", "ISO_20816_3_ZONES", "Alarm", "AlarmEvaluator", "AlarmEvent", "AlarmInputs",
@@ -91,9 +99,11 @@ DEFECT_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")   # keys of VibrationSt
 _TIME_EPS_S = 1e-9   # a delay of 0.2 s is over at t = 0.3 after 0.1 (0.3 - 0.1 = 0.19999999999999998)
 DISCHARGE_LEVELS = {"none": 0.0, "possible": 1.0, "likely": 2.0}
 
+# the alarms on measured accelerometer windows (service.core.measured): fed by `update_measured`
+MEASURED_ALARMS = ("measured_line", "measured_kurtosis")
 ALARM_IDS: tuple[str, ...] = ("vibration_zone", "lubrication_kappa", "lubrication_boundary",
                               "electrical_discharge", *(f"defect_{n}" for n in DEFECT_LINES), "life_used",
-                              "temperature_zone", "temperature_rate", "temperature_unexplained")
+                              "temperature_zone", "temperature_rate", "temperature_unexplained", *MEASURED_ALARMS)
 
 
 def _line_name(name: str) -> str:
@@ -449,6 +459,11 @@ class AlarmEvaluator:
             Rule("temperature_unexplained", "thermal", "-", "above", 0.0, hold,
                  "measured temperature beyond what the friction and the dissipation explain (the estimator's "
                  "innovation gate); value 1 = unexplained"),
+            Rule("measured_line", "vibration", "dB", "above", 0.0, hold,
+                 f"a measured window shows a defect line at least {LINE_ALARM_DB:g} dB over its background for "
+                 "a defect the twin does not hold; value: the highest such line"),
+            Rule("measured_kurtosis", "vibration", "-", "above", 0.0, hold,
+                 f"measured kurtosis above the twin's by more than {KURTOSIS_MARGIN:g}; value: measured - predicted"),
         ]
         self.trackers: dict[str, AlarmTracker] = {r.id: AlarmTracker(r) for r in rules}
         r = s.clear_ratio
@@ -464,6 +479,8 @@ class AlarmEvaluator:
             "temperature_rate": (_above("warning", s.temperature_rate_warning_k_per_min, r),
                                  _above("critical", s.temperature_rate_critical_k_per_min, r)),
             "temperature_unexplained": (Level("critical", 1.0, 0.5),),
+            "measured_line": (_above("warning", LINE_ALARM_DB, r),),
+            "measured_kurtosis": (_above("warning", KURTOSIS_MARGIN, r),),
         }
         for tracker in self.trackers.values():
             tracker.levels = self._levels(tracker.rule.id, None)
@@ -518,6 +535,33 @@ class AlarmEvaluator:
             transition = tracker.update(inputs.time_s, value, levels, message, wall)
             if transition is not None:
                 events.append(self._event(tracker, transition, inputs.time_s, wall, inputs.seq))
+        return events
+
+    def update_measured(self, comparison: Mapping[str, Any]) -> list[AlarmEvent]:
+        """Feed one measured-window comparison (service.core.measured.MeasuredComparator.compare);
+        the events of the `measured_*` alarms, at the twin time the comparison was made."""
+        t = finite_number(comparison.get("twin_time_s"))
+        if t is None:
+            return []
+        alarms = comparison.get("alarms") or []
+        lines = [a for a in alarms if a.get("code") == "unexplained_line"]
+        line_db = max((finite_number(a.get("height_db")) or 0.0 for a in lines), default=0.0)
+        line_text = "; ".join(str(a.get("message", "")) for a in lines) or "no unexplained defect line"
+        measured = finite_number((comparison.get("measured") or {}).get("kurtosis"))
+        predicted = finite_number((comparison.get("predicted") or {}).get("kurtosis"))
+        excess = None if measured is None or predicted is None else measured - predicted
+        values = {"measured_line": (line_db, f"window {comparison.get('window')}: {line_text}"),
+                  "measured_kurtosis": (excess, "" if excess is None else
+                                        f"window {comparison.get('window')}: kurtosis {measured:.2f} measured, "
+                                        f"{predicted:.2f} predicted")}
+        events = []
+        wall = self._wall_clock()
+        seq = comparison.get("twin_seq")
+        for alarm_id, (value, message) in values.items():
+            tracker = self.trackers[alarm_id]
+            transition = tracker.update(t, value, self._levels(alarm_id, None), message, wall)
+            if transition is not None:
+                events.append(self._event(tracker, transition, t, wall, seq if isinstance(seq, int) else None))
         return events
 
     def _event(self, tracker: AlarmTracker, transition: Transition, t: float, wall: float,

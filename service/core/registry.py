@@ -339,6 +339,7 @@ class TwinRegistry:
                     entry.measured.listeners.append(self.recorder.log_measured)
             self.alarms.add_twin(bearing_id)
             runner.add_sink(self.alarms)
+            entry.measured.listeners.append(self.alarms.observe_measured)
             runner.start()
         except BaseException:
             with self._lock:

@@ -86,6 +86,33 @@ def test_inner_race_window_alarms_on_the_healthy_twin_only(service, support):
     assert inner["alarm"] is False and inner["alarms"] == []
 
 
+def _active_alarm_ids(http, name, timeout_s=10.0):
+    """The ids of the twin's active alarms once the alarm thread has seen the latest window."""
+    deadline = time.monotonic() + timeout_s
+    while True:
+        body = http.get(f"/v1/bearings/{name}/alarms").json()
+        ids = {a["alarm_id"] for a in body["active"]}
+        if "measured_line" in ids or time.monotonic() > deadline:
+            return ids, body
+
+
+def test_measured_window_raises_the_stateful_alarm_on_the_healthy_twin_only(service):
+    """The comparison's findings enter the twin's alarms (service.core.alarms `measured_line`,
+    `measured_kurtosis`; ISA-18.2 states, the same events as every alarm: HTTP, zenoh, OPC UA,
+    the recording): after one inner-race window the healthy twin has `measured_line` active with the
+    BPFI height as its value, the twin with the inner-race defect has neither."""
+    _srv, http, _ep = service
+    assert _post(http, "healthy", INNER_WINDOW).status_code == 200
+    ids, body = _active_alarm_ids(http, "healthy")
+    assert {"measured_line", "measured_kurtosis"} <= ids, body["active"]
+    line = next(a for a in body["active"] if a["alarm_id"] == "measured_line")
+    assert line["severity"] == "warning" and line["value"] > 16.0 and "BPFI" in line["message"]
+    assert any(e["alarm_id"] == "measured_line" and e["transition"] == "raised" for e in body["events"])
+    assert _post(http, "inner", INNER_WINDOW).status_code == 200
+    ids, _ = _active_alarm_ids(http, "inner", timeout_s=2.0)
+    assert not ids & {"measured_line", "measured_kurtosis"}
+
+
 def test_healthy_window_on_the_healthy_twin_is_quiet(service):
     """0.4 s of the healthy record as JSON (5 significant digits: the body stays under the
     service's 64 KiB limit): no alarm on the healthy twin."""
