@@ -2,7 +2,8 @@
 pyproject.toml ([tool.importlinter]): `twin` never imports `service` (nor fastapi, zenoh, rerun,
 matplotlib); the runtime engine never imports `twin.validation` (the offline science); `service.core` imports no fastapi, zenoh or rerun, nor the wings built on them;
 the service's layers go tools > reports > api > wiring > bus | recording > core > settings; no
-import cycle among the modules of `service` and `loadtest`; the runtime never imports the load tools.
+import cycle among the modules of `service` and `loadtest`, nor among those of `twin`; the runtime
+never imports the load tools.
 import-linter reads every import statement, those inside functions included."""
 
 from __future__ import annotations
@@ -21,8 +22,9 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_the_contracts_are_declared():
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
     contracts = {c["id"]: c for c in config["contracts"]}
-    assert set(contracts) == {"engine", "runtime", "core", "layers", "service-acyclic", "loadtest"}
+    assert set(contracts) == {"engine", "runtime", "core", "layers", "service-acyclic", "twin-acyclic", "loadtest"}
     assert contracts["service-acyclic"]["type"] == "acyclic_siblings"
+    assert contracts["twin-acyclic"]["type"] == "acyclic_siblings" and contracts["twin-acyclic"]["ancestors"] == ["twin"]
     assert set(contracts["service-acyclic"]["ancestors"]) == {"service", "loadtest"}
     assert {"loadtest", "httpx"} <= set(contracts["loadtest"]["forbidden_modules"])
     assert {"service", "fastapi", "zenoh", "rerun"} <= set(contracts["engine"]["forbidden_modules"])

@@ -43,7 +43,7 @@ from twin.thermal.expansion import write_groove_lanes
 from twin.thermal.sources import HeatSources, friction_heat
 from twin.vibration.defects import BallDefect, defect_row, validate_defects
 from twin.vibration.housing import housing_equilibrium
-from twin.vibration.sensor import SensorReader, WaveformBlock
+from twin.accelerometer import SensorReader, WaveformBlock
 from twin.warmstart import warm_start
 
 FRAME_S = 1e-3  # simulated time per compiled call [s] (1000 steps at dt = 1 us)
@@ -654,7 +654,7 @@ class Twin:
 
     def drain_waveform(self) -> list[WaveformBlock]:
         """The accelerometer samples [m/s^2] produced since the last call, as contiguous float32
-        blocks with their start time t0_s [s] and rate (twin.vibration.sensor.WaveformBlock;
+        blocks with their start time t0_s [s] and rate (twin.accelerometer.WaveformBlock;
         twin.vibration.waveform encodes them for a bus). At most WAVEFORM_QUEUE_S of signal is
         kept between calls. [] with the rigid outer ring."""
         if self._sensor is None:

@@ -377,7 +377,7 @@ class TwinChannel:
             pass
 
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
-        """Queue accelerometer blocks (twin.vibration.sensor.WaveformBlock) for
+        """Queue accelerometer blocks (twin.accelerometer.WaveformBlock) for
         `P/{id}/vibration/waveform`; returns at once, never raises (same queue as the snapshots)."""
         self._enqueue(_Waveform(list(blocks)))
 

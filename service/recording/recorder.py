@@ -334,7 +334,7 @@ class RerunRecorder:
             self._rows.log_measured(comparison)
 
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
-        """Queue accelerometer blocks (twin.vibration.sensor.WaveformBlock) of a twin for
+        """Queue accelerometer blocks (twin.accelerometer.WaveformBlock) of a twin for
         `vibration/acceleration_m_s2`, at the `seq` of the snapshot they came with (by default
         the last one queued); never blocks or raises. When `queue_size` batches wait, the oldest
         is dropped and counted (`waveform_dropped`)."""

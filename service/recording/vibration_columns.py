@@ -119,7 +119,7 @@ def _line_fundamental(block, name: str) -> float:
 
 @dataclass(slots=True)
 class WaveRow:
-    """Accelerometer samples that came with one snapshot (twin.vibration.sensor.WaveformBlock)."""
+    """Accelerometer samples that came with one snapshot (twin.accelerometer.WaveformBlock)."""
 
     seq: int
     t0_s: float

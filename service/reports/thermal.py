@@ -2,7 +2,7 @@
 (ambient 20 degC, 1000 rad/s, 3000 N) with the network in the loop in the accelerated mode, its
 curves (node temperatures, inlet viscosity, smallest Lambda, friction torque against thermal time)
 beside the time constants the network states, and the steady state of the fixed-point solver
-that real heat capacities reach (twin.thermal.studies, twin.thermal.steady)."""
+that real heat capacities reach (twin.validation.thermal_studies, twin.validation.thermal_steady)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ from pathlib import Path
 
 from service.reports.figures import pyplot, save
 from twin.thermal.network import NODE_NAMES
-from twin.thermal.studies import decay_time_constant_s, startup_transient, transient_time_constants_s
-from twin.thermal.steady import steady_operating_point
+from twin.validation.thermal_studies import decay_time_constant_s, startup_transient, transient_time_constants_s
+from twin.validation.thermal_steady import steady_operating_point
 
 
 def thermal_section(out: Path, quick: bool) -> list[str]:

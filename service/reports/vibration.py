@@ -67,7 +67,7 @@ def vibration_section(out_dir, quick: bool = False) -> list[str]:
     spall's width; Markdown lines."""
     from pathlib import Path
 
-    from twin.vibration.run import simulate_vibration
+    from twin.validation.vibration_simulation import simulate_vibration
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

@@ -136,7 +136,7 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
     from twin.setpoint import SetpointError
-    from twin.vibration.run import simulate_vibration
+    from twin.validation.vibration_simulation import simulate_vibration
 
     from twin import catalog
 
@@ -306,7 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
         "vibration", help="housing acceleration with a local defect: indicators, defect frequencies, envelope peaks",
         description="Run the twin with its outer ring on the housing (Sawalhi & Randall 2008 support, accelerometer "
         "sampled in the kernel) and an optional local defect, discard 0.05 s, analyse `--duration` of the signal "
-        "(twin.vibration.run.simulate_vibration).")
+        "(twin.validation.vibration_simulation.simulate_vibration).")
     vib.add_argument("--bearing", default=DEFAULT_DESIGNATION,
                      help=f"catalog designation (default {DEFAULT_DESIGNATION}; CWRU-DE: the CWRU rig's drive end) "
                      "or a BearingSpec file (.yaml, .yml, .json)")

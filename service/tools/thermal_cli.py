@@ -1,5 +1,5 @@
 """`bearing-twin thermal`: the thermal steady state of a catalogue bearing at one operating point
-(twin.thermal.steady: the network's steady state with the engine's friction in the loop)."""
+(twin.validation.thermal_steady: the network's steady state with the engine's friction in the loop)."""
 
 from __future__ import annotations
 
@@ -16,7 +16,7 @@ def add_thermal_command(sub) -> None:
         "thermal", help="thermal steady state: node temperatures, friction torque, heat by source",
         description="Steady state of the bearing's thermal network (shaft, rings, balls, housing, oil) with the "
         "twin's own friction heat in the loop: the film's viscosity at the inlet temperature the network sets "
-        "(fixed-point iteration, twin.thermal.steady).")
+        "(fixed-point iteration, twin.validation.thermal_steady).")
     p.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
     p.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
     p.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
@@ -35,7 +35,7 @@ def _cmd_thermal(args: argparse.Namespace) -> int:
     from twin import catalog
     from twin.setpoint import SetpointError
     from twin.thermal.settings import ThermalNetworkSettings
-    from twin.thermal.steady import steady_operating_point
+    from twin.validation.thermal_steady import steady_operating_point
 
     if not -30.0 <= args.ambient <= 150.0:
         print(f"error: ambient = {args.ambient!r}: must be in [-30, 150] degC", file=sys.stderr)

@@ -28,7 +28,7 @@ from twin.physics import drag, viscosity
 from twin.spec import BearingSpec, Lubrication, Thermal
 from twin.thermal.network import network_geometry
 from twin.thermal.settings import ThermalNetworkSettings
-from twin.thermal.steady import steady_operating_point
+from twin.validation.thermal_steady import steady_operating_point
 
 pytestmark = pytest.mark.slow
 

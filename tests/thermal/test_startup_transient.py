@@ -2,7 +2,7 @@
 3000 N, ambient 20 degC, in the accelerated mode (heat capacities x 1e-3): the temperatures rise
 with the time constants the network states, the viscosity, Lambda and friction follow, and the
 accelerated run ends where real heat capacities end (the capacity-free fixed-point steady state,
-twin.thermal.steady) within 0.5 K."""
+twin.validation.thermal_steady) within 0.5 K."""
 
 import numpy as np
 import pytest
@@ -10,8 +10,8 @@ import pytest
 from twin import catalog
 from twin.physics.viscosity import dynamic_viscosity_pa_s
 from twin.thermal.network import NODE_NAMES
-from twin.thermal.steady import steady_operating_point
-from twin.thermal.studies import decay_time_constant_s, startup_transient, transient_time_constants_s
+from twin.validation.thermal_steady import steady_operating_point
+from twin.validation.thermal_studies import decay_time_constant_s, startup_transient, transient_time_constants_s
 
 pytestmark = pytest.mark.slow
 OUTER = NODE_NAMES.index("outer_ring")

@@ -1,4 +1,4 @@
-"""`bearing-twin thermal`: the steady state of one operating point (twin.thermal.steady)."""
+"""`bearing-twin thermal`: the steady state of one operating point (twin.validation.thermal_steady)."""
 
 import json
 

@@ -128,7 +128,7 @@ def test_outer_pit_response_is_bounded_by_the_whole_lost_load():
     the excitation, not in the engine's dynamics."""
     from twin import catalog
     from twin.spec import BearingSpec
-    from twin.vibration.run import simulate_vibration
+    from twin.validation.vibration_simulation import simulate_vibration
 
     data = catalog.bearing("CWRU-DE").model_dump()
     data["surface_profile"]["enabled"] = False

@@ -1,7 +1,7 @@
 """The vibration the twin itself produces (issue 14): outer ring on the housing, local defects in
 the contact geometry, the accelerometer sampled in the kernel, the indicators of each window.
 
-Every run is one engine window (the snapshot's `vibration` block, twin.vibration.sensor) of a twin
+Every run is one engine window (the snapshot's `vibration` block, twin.accelerometer) of a twin
 started at its quasi-static equilibrium: the Sawalhi & Randall 2008 housing (twin.vibration.housing
 defaults), 51.2 kHz, and a background of NOISE m/s^2/sqrt(Hz) (1 mg/sqrt(Hz): about ten times a
 general-purpose ICP accelerometer's own noise, standing for the machine's background vibration,

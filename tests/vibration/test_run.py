@@ -11,6 +11,7 @@ from twin.vibration.housing import Housing, sensor_resonance
 from twin.vibration.run import run_vibration
 
 FS = 51200.0
+G6208 = catalog.bearing("6208").geometry
 
 
 @pytest.fixture(scope="module")
@@ -27,7 +28,7 @@ def test_outer_race_signal_reports_bpfo(outer_signal, band):
     """The CLI JSON: defect frequencies from the geometry, three 1 s windows, the largest of the
     five envelope peaks within 1 % of BPFO, kurtosis above Gaussian, finite JSON."""
     freq, x = outer_signal
-    r = run_vibration(x, FS, "6208", 500.0, band=band)
+    r = run_vibration(x, FS, G6208, 500.0, band=band)
     assert r["sample_rate_hz"] == FS and r["windows"] == 3
     assert set(r["defect_frequencies_hz"]) >= {"ftf", "bpfo", "bpfi", "bsf"}
     assert r["defect_frequencies_hz"]["bpfo"] == pytest.approx(freq.bpfo_hz, rel=1e-12)
@@ -43,10 +44,10 @@ def test_outer_race_signal_reports_bpfo(outer_signal, band):
 
 def test_bad_input_is_refused():
     with pytest.raises(ValueError, match="non-finite"):
-        run_vibration(np.array([0.0, np.nan] * 4096), FS, "6208", 500.0)
+        run_vibration(np.array([0.0, np.nan] * 4096), FS, G6208, 500.0)
     with pytest.raises(ValueError, match="samples per window"):
-        run_vibration(np.zeros(100), FS, "6208", 500.0)
+        run_vibration(np.zeros(100), FS, G6208, 500.0)
     with pytest.raises(ValueError, match="band"):
-        run_vibration(np.zeros(51200), FS, "6208", 500.0, band="wideband")
-    with pytest.raises(ValueError, match="designation"):
-        run_vibration(np.zeros(51200), FS, "9999", 500.0)
+        run_vibration(np.zeros(51200), FS, G6208, 500.0, band="wideband")
+    with pytest.raises(ValueError, match="window_s"):
+        run_vibration(np.zeros(51200), FS, G6208, 500.0, window_s=0.0)

@@ -11,8 +11,9 @@ from twin import catalog
 from twin.kernels import layout as L
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.housing import sensor_resonance
-from twin.vibration.run import defect_for
-from twin.vibration.surface import ball_radius_offsets_m, profile_height_m, race_profile_m
+from twin.validation.vibration_simulation import defect_for
+from twin.kernels.profile import profile_height_m
+from twin.vibration.surface import ball_radius_offsets_m, race_profile_m
 
 
 def test_race_profile_has_the_rms_and_the_orders_asked():
@@ -137,7 +138,7 @@ def test_cwru_de_noise_floor_is_the_healthy_records_floor():
 def test_profile_azimuth_is_atan2_to_two_hundredths_of_a_microradian():
     """`azimuth_rad` (Abramowitz & Stegun 4.4.49, |error| <= 2e-8 rad on the octant) against
     math.atan2 over random points of every quadrant, the axes and the diagonals: within 3e-8 rad."""
-    from twin.vibration.surface import azimuth_rad
+    from twin.kernels.profile import azimuth_rad
 
     rng = np.random.default_rng(5)
     pts = list(rng.normal(size=(20000, 2)) * 0.02) + [(0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0),

@@ -2,6 +2,7 @@
 per-contact outputs). Module-level ints are compile-time constants for numba."""
 
 from twin.vibration.defects import N_DEFECT_PARAMS
+from twin.vibration.surface import PROFILE_POINTS  # points of a race profile over its circumference
 
 # ---- model parameter vector (immutable, built by twin.model) --------------------------------
 P_DT = 0
@@ -52,7 +53,6 @@ P_CENTRED_REFRESH = P_LN_ROUGHNESS + 3 # 1: the tribology refresh's inputs centr
 # the healthy bearing's excitation (twin.vibration.surface): race profiles and ball sizes
 P_PROFILE_ON = P_CENTRED_REFRESH + 1   # 1: the profiles and ball sizes open / close the contacts
 P_BALL_SIZE = P_PROFILE_ON + 1         # 16 ball radius offsets [m] (Geometry.ball_count <= 16)
-PROFILE_POINTS = 4096                  # points of a race profile over its circumference
 P_PROFILE_INNER = P_BALL_SIZE + 16     # inner race profile heights [m], angle on the ring from its mark
 P_PROFILE_OUTER = P_PROFILE_INNER + PROFILE_POINTS  # outer race profile heights [m], azimuth from +x
 N_PARAMS = P_PROFILE_OUTER + PROFILE_POINTS

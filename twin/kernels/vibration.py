@@ -39,7 +39,7 @@ from twin.vibration.defects import (
     N_DEFECT_PARAMS, D_BALL, D_CENTRE_COS, D_CENTRE_SIN, D_KIND, D_REACH_COS, KIND_BALL, KIND_INNER, KIND_OUTER,
     contact_defect_drop_m, quat_integrate,
 )
-from twin.vibration.surface import profile_drops
+from twin.kernels.profile import profile_drops
 
 
 @njit(**JIT)

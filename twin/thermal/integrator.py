@@ -4,7 +4,7 @@ C dT/dt = -K T + b, b = G_amb s T_amb + G_sup T_sup + q constant over the period
 T(t + h) = T_inf + exp(-C^-1 K h) (T(t) - T_inf), T_inf = K^-1 b (the steady state). Exact for
 any h (no stability limit: the network's time constants run from a fraction of a second for the
 balls to tens of minutes for the housing); the only error of the multirate coupling is holding
-the heat and the conductances over the period, which twin.thermal.studies.period_study measures.
+the heat and the conductances over the period, which twin.validation.thermal_studies.period_study measures.
 """
 
 from __future__ import annotations

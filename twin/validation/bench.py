@@ -61,7 +61,7 @@ class BenchCase:
     shaft_current_a: float = 0.0
     shear_heating: bool = False
     housing: bool | None = None       # outer ring on the housing (None: the spec's default, off)
-    defect: str | None = None         # local defect of twin.vibration.run.defect_for (outer, inner, ball)
+    defect: str | None = None         # local defect of twin.validation.vibration_simulation.defect_for (outer, inner, ball)
     surface_profile: bool = False     # race profiles and ball sizes exciting the contacts (twin.vibration.surface)
 
 
@@ -97,7 +97,7 @@ def _twin(case: BenchCase, time_step_s: float | str) -> Twin:
                 setpoint=Setpoint(shaft_speed_rad_s=case.shaft_speed_rad_s, radial_load_n=case.radial_load_n,
                                   axial_load_n=case.axial_load_n, shaft_current_a=case.shaft_current_a))
     if case.defect is not None:
-        from twin.vibration.run import defect_for
+        from twin.validation.vibration_simulation import defect_for
 
         twin.set_defects([defect_for(case.defect, spec.geometry)])
     return twin
@@ -124,7 +124,7 @@ def measure(case: BenchCase, time_step_s: float | str = "auto", seconds: float =
            "repeats": repeats, "housing": twin.model.housing_on, "defects": len(twin.defects),
            "status": twin.status}
     if twin.model.housing_on:
-        from twin.vibration.sensor import window_indicators
+        from twin.accelerometer import window_indicators
 
         reader = twin._sensor
         window = np.random.default_rng(0).standard_normal(reader.window_samples)

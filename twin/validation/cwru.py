@@ -3,7 +3,7 @@
 
 Measured: the 5 s float32 excerpts committed in tests/data/cwru (Case Western Reserve University
 Bearing Data Center, engineering.case.edu/bearingdatacenter, 0 hp, 0.007 in EDM faults; manifest
-and source there). Simulated: `twin.vibration.run.simulate_vibration` of the `CWRU-DE` catalog
+and source there). Simulated: `twin.validation.vibration_simulation.simulate_vibration` of the `CWRU-DE` catalog
 entry at the record's speed, the rig's radial load, the record's fault (a pit 0.178 mm across
 and 0.279 mm deep: the data center's 0.007 in diameter, 0.011 in depth) at its position (outer
 race 6:00, 3:00, 12:00 = 0, 90, 180 deg from the load direction), after SETTLE_S of start-up.
@@ -125,7 +125,7 @@ def measured(record: Record, duration_s: float | None = None, data_dir: Path = D
 
 def simulated(record: Record, duration_s: float = 1.0, settle_s: float = SETTLE_S) -> tuple[Analysis, np.ndarray]:
     """The `CWRU-DE` twin in the conditions of `record`: its signal [m/s^2] and analysis."""
-    from twin.vibration.run import simulate_vibration
+    from twin.validation.vibration_simulation import simulate_vibration
 
     _, x = simulate_vibration(
         "CWRU-DE", record.rpm * 2.0 * math.pi / 60.0, None, defect=record.defect,

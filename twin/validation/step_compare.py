@@ -64,7 +64,7 @@ def run_case(designation: str, time_step_s, seconds: float, extra: dict) -> dict
         shaft_speed_rad_s=extra.get("shaft_speed_rad_s", 500.0), radial_load_n=extra.get("radial_load_n", 3000.0),
         axial_load_n=extra.get("axial_load_n", 0.0), shaft_current_a=extra.get("shaft_current_a", 0.0)))
     if extra.get("defect"):
-        from twin.vibration.run import defect_for
+        from twin.validation.vibration_simulation import defect_for
 
         twin.set_defects([defect_for(extra["defect"], spec.geometry)])
     twin.advance(seconds)

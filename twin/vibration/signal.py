@@ -273,7 +273,7 @@ def sensor_push(phases, dec_state, a_m_s2, sigma, ring, ring_state):
 def sensor_push_direct(reversed_taps, ratio, dec_state, a_m_s2, ring, ring_state):
     """The kernel's call: `sensor_push` with the direct-form decimator (`decimator_push_direct`)
     and without noise. The engine adds the sensor noise to the drained samples between frames
-    (twin.vibration.sensor, numpy, a generator per twin): a call site of numba's generator in the
+    (twin.accelerometer, numpy, a generator per twin): a call site of numba's generator in the
     kernel cost ~90 ns per step on the test machine even with the noise off."""
     ready, y = decimator_push_direct(reversed_taps, ratio, dec_state, a_m_s2)
     if ready:

@@ -27,7 +27,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin.kernels import layout as L
+from twin.snapshot import DefectFrequenciesHz, DefectLine, EnvelopePeak, Spectrum, VibrationState
 from twin.vibration.defect_frequencies import loaded_contact_angle_rad
+from twin.vibration.run import run_vibration
 from twin.vibration.signal import noise_sigma, read_ring
 
 WAVEFORM_QUEUE_S = 10.0  # undrained waveform kept for `drain_waveform` [s of signal]; older is dropped
@@ -191,9 +193,6 @@ def contact_angle_of_lanes_rad(model, state) -> float:
 
 def window_indicators(model, window_m_s2: np.ndarray, shaft_speed_rad_s: float, state, end_time_s: float):
     """`twin.snapshot.VibrationState` of one window (module docstring)."""
-    from twin.snapshot import DefectFrequenciesHz, DefectLine, EnvelopePeak, Spectrum, VibrationState
-    from twin.vibration.run import run_vibration
-
     fs = model.decimator.output_rate_hz
     angle = contact_angle_of_lanes_rad(model, state)
     r = run_vibration(window_m_s2, fs, model.spec, shaft_speed_rad_s, contact_angle_rad=angle,
