@@ -187,15 +187,25 @@ class TwinRegistry:
             self.priority.start()              # after the pool: its threads keep their nice
             self._open_outputs()
             if default_twin and self.settings.start_twin:
-                self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing,
-                                 over_capacity_ok=True,
-                                 **({"housing": {"enabled": True}} if self.settings.housing else {}))
+                self.create_twin(id=self.settings.twin_id, over_capacity_ok=True, **self._configured_bearing())
             if self.settings.gc_freeze:
                 freeze_heap()
         except BaseException:
             self.close()
             raise
         return self
+
+    def _configured_bearing(self) -> dict[str, Any]:
+        """The create_twin options of the configured twin: its designation, or the spec of a
+        bearing spec file (`settings.bearing` ending in .yaml, .yml, .json; read on the server by
+        its operator), with the housing when `settings.housing`."""
+        name, housing = self.settings.bearing, self.settings.housing
+        if not name.strip().lower().endswith(catalog.SPEC_FILE_SUFFIXES):
+            return {"designation": name, **({"housing": {"enabled": True}} if housing else {})}
+        spec = catalog.load_spec_file(name.strip())
+        if housing:
+            spec = spec.model_copy(update={"housing": spec.housing.model_copy(update={"enabled": True})})
+        return {"spec": spec}
 
     def close(self) -> None:
         """Stop every runner, detach the bus, close recordings (nothing queued is lost), close
