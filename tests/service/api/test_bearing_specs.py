@@ -103,3 +103,17 @@ def test_openapi_shows_the_spec_fields_with_units(client):
     assert "[-]" in geometry["ball_count"]["description"]
     assert (geometry["ball_count"]["minimum"], geometry["ball_count"]["maximum"]) == (3, 16)
     assert "[Pa]" in schemas["Material"]["properties"]["youngs_modulus_pa"]["description"]
+
+
+def test_the_documented_create_body_creates_its_twin(client):
+    """docs/service.md "Bearings not in the catalog": its JSON body is a valid request."""
+    import json
+    import re
+    from pathlib import Path
+
+    text = (Path(__file__).resolve().parents[3] / "docs" / "service.md").read_text()
+    body = json.loads(re.search(r'```json\n(\{"id": "test-rig".*?)```', text, re.S).group(1))
+    r = client.post("/v1/bearings", json=body)
+    assert r.status_code == 201, r.text
+    assert (r.json()["designation"], r.json()["ball_count"], r.json()["diametral_clearance_m"]) == ("MY-6205", 8, 1e-5)
+    assert client.delete("/v1/bearings/test-rig").status_code == 200
