@@ -287,9 +287,14 @@ class TwinRegistry:
                 spec = spec if isinstance(spec, BearingSpec) else BearingSpec.model_validate(spec)
             except ValidationError as exc:
                 raise InputError(field_errors([{**e, "loc": ("spec", *e["loc"])} for e in exc.errors()])) from None
+            try:
+                twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
+            except (ValueError, ArithmeticError) as exc:   # a valid spec the model cannot compile
+                raise InputError.one("spec", f"bearing {spec.designation!r} cannot be modelled: "
+                                     f"{' '.join(str(exc).split())[:300]}") from None
         else:
-            spec = self._catalog_spec(designation, diametral_clearance_m, lubricant, thermal, housing)
-        twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
+            twin = Twin(self._catalog_spec(designation, diametral_clearance_m, lubricant, thermal, housing),
+                        bearing_id=bearing_id)
         if setpoint is not None:
             try:
                 twin.set_setpoint(setpoint)
