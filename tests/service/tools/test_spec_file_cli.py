@@ -69,3 +69,19 @@ def test_serve_starts_its_twin_from_a_spec_file(tmp_path, support):
             httpx.Client(base_url=srv.url, timeout=60.0) as c:
         info = c.get("/v1/bearings/default").json()
     assert info["designation"] == "MY-6205-8" and info["ball_count"] == 8
+
+
+def test_life_rates_the_spec_file(tmp_path, capsys):
+    """A spec file of the catalog 6205 gives the designation's figures; its own clearance is used
+    unless --clearance is given."""
+    spec = catalog.bearing("6205").model_dump(mode="json")
+    spec["mounting"]["diametral_clearance_m"] = 10e-6
+    path = tmp_path / "6205.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    common = ["--radial-load", "1000", "--speed", "300", "--json"]
+    results = []
+    for args in (["--bearing", "6205", "--clearance", "1e-5"], ["--bearing", str(path)]):
+        assert main(["life", *args, *common]) == 0
+        results.append(json.loads(capsys.readouterr().out))
+    assert results[0] == results[1]
+    assert results[1]["diametral_clearance_m"] == 10e-6
