@@ -14,8 +14,10 @@ from pydantic import BaseModel, ConfigDict, Field
 from service.core.errors import FieldError, InputError
 from twin.setpoint import Setpoint, SetpointUpdate
 from twin import catalog
-from twin.spec import BearingSpec, Clearance, Geometry, Lubricant, Lubrication, Material, Mounting, Surface, Thermal, TwinId
-from twin.vibration.housing import Housing
+from twin.spec import (BearingSpec, Clearance, Electrical, Geometry, Lubricant, Lubrication, Material, Mounting, Surface,
+                       Thermal, TwinId)
+from twin.vibration.housing import Accelerometer, Housing
+from twin.vibration.surface import SurfaceProfile
 
 __all__ = ["BearingCreate", "BearingInfo", "ErrorResponse", "FieldError", "Health", "InputError",
            "RecordingRequest", "RecordingStatus", "ScenarioAccepted", "ScenarioList", "ScenarioRequest",
@@ -253,7 +255,8 @@ def request_bounds() -> dict[str, tuple[Any, Any]]:
     from service.core.scenarios import Scenario, ScenarioRun, ScenarioStep
 
     bounds: dict[str, tuple[Any, Any]] = {}
-    spec_parts = (BearingSpec, Geometry, Material, Surface, Lubricant, Mounting, Lubrication)
+    spec_parts = (BearingSpec, Geometry, Material, Surface, Lubricant, Mounting, Lubrication, Electrical, Housing,
+                  Accelerometer, SurfaceProfile)
     for model in (BearingCreate, RecordingRequest, ScenarioRequest, Scenario, ScenarioRun, ScenarioStep, Thermal,
                   *spec_parts):
         for name, info in model.model_fields.items():

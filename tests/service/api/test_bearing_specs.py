@@ -117,3 +117,11 @@ def test_the_documented_create_body_creates_its_twin(client):
     assert r.status_code == 201, r.text
     assert (r.json()["designation"], r.json()["ball_count"], r.json()["diametral_clearance_m"]) == ("MY-6205", 8, 1e-5)
     assert client.delete("/v1/bearings/test-rig").status_code == 200
+
+
+def test_a_nested_housing_error_gives_both_sides_of_its_range(client, own_spec):
+    bad = copy.deepcopy(own_spec)
+    bad["housing"]["accelerometer"]["sample_rate_hz"] = -1.0
+    err = only_error(client.post("/v1/bearings", json={"spec": bad}))
+    assert err["field"] == "spec.housing.accelerometer.sample_rate_hz"
+    assert None not in err["allowed"] and "allowed range" in err["message"]
