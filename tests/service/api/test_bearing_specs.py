@@ -125,3 +125,11 @@ def test_a_nested_housing_error_gives_both_sides_of_its_range(client, own_spec):
     err = only_error(client.post("/v1/bearings", json={"spec": bad}))
     assert err["field"] == "spec.housing.accelerometer.sample_rate_hz"
     assert None not in err["allowed"] and "allowed range" in err["message"]
+
+
+def test_every_spec_field_in_the_openapi_carries_its_unit(client):
+    schemas = client.get("/openapi.json").json()["components"]["schemas"]
+    missing = [f"{name}.{prop}" for name in ("BearingSpec", "Geometry", "Material", "Surface", "Lubricant", "Mounting",
+                                             "Lubrication", "Electrical", "Thermal")
+               for prop, p in schemas[name]["properties"].items() if "[" not in p.get("description", "")]
+    assert not missing, f"fields without a [unit] in their description: {missing}"
