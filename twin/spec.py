@@ -144,7 +144,7 @@ class Lubricant(BaseModel):
 
     model_config = _FROZEN
 
-    name: str = Field(default="seed-000", max_length=64, description="Lubricant name.")
+    name: str = Field(default="seed-000", max_length=64, description="Lubricant name [text].")
     kinematic_viscosity_40c_m2_s: float = Field(
         default=0.04 / (870.0 * (1.0 - 6.5e-4 * 25.0)), gt=1e-7, le=1e-2,
         description="Kinematic viscosity at 40 degC [m^2/s].")
@@ -232,12 +232,13 @@ class Thermal(BaseModel):
         "a broken-down, conducting contact. null: the resistive part Re(Z) of the twin's own network at the "
         "impedance frequency (an intact film: the heating then saturates at the 250 K cap).")
     current_heating: bool = Field(
-        default=True, description="Feed the current-discharge heating (seed 003 eq. 10) back into the film.")
+        default=True, description="Feed the current-discharge heating (seed 003 eq. 10) back into the film [bool].")
     shear_heating: bool = Field(
         default=False,
         description="Reduce the film by the inlet shear heating of a rolling contact, the Murch-Wilson factor "
         "phi_T = 3.94 / (3.94 + L^0.62), L = beta eta u^2 / k' (Murch and Wilson 1975; twin.physics.thermal). Off by "
-        "default: seed 000, which validates the 6208 twin (Table 3, Fig. 8), is isothermal; the EV preset turns it on.")
+        "default: seed 000, which validates the 6208 twin (Table 3, Fig. 8), is isothermal; the EV preset turns it on "
+        "[bool].")
     film_temperature_exponent: float = Field(
         default=1.38, gt=0.0, le=5.0,
         description="c_T of the loop's current-heating film law h/h_iso = g(dT)^c_T [-], fitted to the current heating "
@@ -256,7 +257,7 @@ class Lubrication(BaseModel):
     method: Literal["flooded", "oil_bath", "jet", "oil_air"] = Field(
         default="flooded",
         description="'flooded': fully flooded contacts, no drag (seed 000); 'oil_bath': a sump at oil_level_m; "
-        "'jet': an oil jet of jet_flow_m3_s at jet_inlet_temperature_c; 'oil_air': oil-air (minimal oil).")
+        "'jet': an oil jet of jet_flow_m3_s at jet_inlet_temperature_c; 'oil_air': oil-air (minimal oil) [text].")
     oil_level_m: float | None = Field(
         default=None, ge=0.0, le=1.0,
         description="oil_bath: height of the oil surface above the bottom of the outer raceway [m]; null: one ball "
@@ -271,7 +272,7 @@ class Lubrication(BaseModel):
         "(Harris and Kotzalas, vol. 2 ch. 3: a few percent under jet lubrication); the mixture's density sets the "
         "ball drag. An input: it depends on the flow and the scavenging of the housing.")
     seal: Literal["open", "2Z", "2RS"] = Field(
-        default="open", description="Seal execution: 'open', '2Z' (shields, no contact), '2RS' (rubbing seals).")
+        default="open", description="Seal execution: 'open', '2Z' (shields, no contact), '2RS' (rubbing seals) [text].")
 
 
 class Mounting(BaseModel):
@@ -290,15 +291,23 @@ class BearingSpec(BaseModel):
 
     model_config = _FROZEN
 
-    designation: str = Field(max_length=32, description="Catalog designation, e.g. '6208'.")
-    kind: Literal["deep_groove", "angular_contact"] = "deep_groove"
-    geometry: Geometry
-    material: Material = Material()
-    surface: Surface = Surface()
-    lubricant: Lubricant = Lubricant()
-    mounting: Mounting = Mounting()
-    electrical: Electrical = Electrical()
-    thermal: Thermal = Thermal()
+    designation: str = Field(max_length=32, description="Catalog designation, e.g. '6208', or the name of a bearing "
+                             "that is not in the catalog [text].")
+    kind: Literal["deep_groove", "angular_contact"] = Field(
+        default="deep_groove", description="'deep_groove' or 'angular_contact' [text].")
+    geometry: Geometry = Field(description="Internal geometry: ball, raceway and groove radii [m], ball count [-], "
+                               "contact angle [deg], ... [object].")
+    material: Material = Field(default=Material(), description="Ring and ball material: E [Pa], nu [-], density "
+                               "[kg/m^3] [object].")
+    surface: Surface = Field(default=Surface(), description="Roughness of races and balls, Ra [m] [object].")
+    lubricant: Lubricant = Field(default=Lubricant(), description="Oil: viscosities [m^2/s], pressure-viscosity "
+                                 "coefficient [1/Pa], ... [object].")
+    mounting: Mounting = Field(default=Mounting(), description="Diametral clearance [m] and the mass on the inner "
+                               "ring [kg] [object].")
+    electrical: Electrical = Field(default=Electrical(), description="Oil permittivity [-], resistivity [ohm m], "
+                                   "breakdown field [V/m], ... [object].")
+    thermal: Thermal = Field(default=Thermal(), description="Electro-thermal options (seed 003): heating switches "
+                             "[bool], R_b [ohm], H_c [m], ... [object].")
     limiting_speed_rad_s: float | None = Field(
         default=None, gt=0.0, le=1e5,
         description="Highest shaft speed the twin admits for this bearing [rad/s]; null: the n d_m rule of thumb of "
@@ -306,15 +315,15 @@ class BearingSpec(BaseModel):
     lubrication: Lubrication = Field(
         default_factory=Lubrication,
         description="Lubrication method and seals (starvation, ball drag, seal friction); the default 'flooded' "
-        "keeps seed 000's fully flooded contacts without churning.")
+        "keeps seed 000's fully flooded contacts without churning [object].")
     housing: Housing = Field(
         default_factory=Housing,
         description="Outer ring + housing support and the accelerometer (twin.vibration.housing; Sawalhi & "
-        "Randall 2008 defaults); `enabled: false` (the default) keeps the rigid, fixed outer ring.")
+        "Randall 2008 defaults); `enabled: false` (the default) keeps the rigid, fixed outer ring [object].")
     surface_profile: SurfaceProfile = Field(
         default_factory=SurfaceProfile,
         description="Race profiles (waviness, roughness) and ball-size spread exciting the contacts "
-        "(twin.vibration.surface); `enabled: false` (the default) keeps perfect geometry.")
+        "(twin.vibration.surface); `enabled: false` (the default) keeps perfect geometry [object].")
 
 
 class ModelOptions(BaseModel):

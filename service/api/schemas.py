@@ -14,8 +14,10 @@ from pydantic import BaseModel, ConfigDict, Field
 from service.core.errors import FieldError, InputError
 from twin.setpoint import Setpoint, SetpointUpdate
 from twin import catalog
-from twin.spec import Clearance, Thermal, TwinId
-from twin.vibration.housing import Housing
+from twin.spec import (BearingSpec, Clearance, Electrical, Geometry, Lubricant, Lubrication, Material, Mounting, Surface,
+                       Thermal, TwinId)
+from twin.vibration.housing import Accelerometer, Housing
+from twin.vibration.surface import SurfaceProfile
 
 __all__ = ["BearingCreate", "BearingInfo", "ErrorResponse", "FieldError", "Health", "InputError",
            "RecordingRequest", "RecordingStatus", "ScenarioAccepted", "ScenarioList", "ScenarioRequest",
@@ -32,16 +34,36 @@ class ErrorResponse(BaseModel):
 
 # ---- bearings -----------------------------------------------------------------------------------
 class BearingCreate(BaseModel):
-    """A new twin: catalog bearing, mounting, lubricant, optional name and initial setpoint."""
+    """A new twin: a catalog bearing (designation, mounting, lubricant) or a whole bearing spec,
+    optional name and initial setpoint."""
 
     model_config = _STRICT
-    id: TwinId | None = Field(default=None, description="Twin name used in URLs and zenoh keys [text: letters, digits, _ . -]; default '<designation>-<n>'.")
-    designation: str = Field(default=catalog.DEFAULT_DESIGNATION, max_length=32, description="Catalog designation, e.g. '6208', '7208', '6200'..'6210' [text].")
+    id: TwinId | None = Field(default=None, description="Twin name used in URLs and zenoh keys [text: letters, digits, _ . -]; default '<designation>-<n>' (the spec's designation with a spec).")
+    designation: str = Field(default=catalog.DEFAULT_DESIGNATION, max_length=32, description="Catalog designation, e.g. '6208', '7208', '6200'..'6210', 'CWRU-DE' [text]; not with spec.")
+    spec: BearingSpec | None = Field(default=None, description="A bearing that is not in the catalog: a whole bearing spec (twin.spec.BearingSpec: designation, geometry [m], material [Pa, kg/m^3], surface, lubricant [m^2/s], mounting [m, kg], electrical, thermal, lubrication, housing, surface_profile; each field with its unit), validated as the catalog's. Instead of designation; it carries the clearance, lubricant, thermal options and housing itself, so those fields stay unset beside it [object].")
     diametral_clearance_m: Clearance = 0.0
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' (0.04 Pa s at 40 degC) or an ISO grade such as 'ISO VG 68' [text].")
     setpoint: SetpointUpdate | None = Field(default=None, description="Initial setpoint (partial, defaults for the rest); the twin is warm-started at it [fields with units].")
     thermal: Thermal | None = Field(default=None, description="Electro-thermal options (seed 003): shear_heating, current_heating, equivalent_resistance_ohm [ohm], crater_depth_m [m], ...; default: the spec's (shear heating off).")
     housing: Housing | None = Field(default=None, description="Housing and accelerometer (twin.vibration.housing.Housing): {\"enabled\": true} puts the outer ring on the housing support (Sawalhi & Randall 2008 defaults) and samples the accelerometer (vibration indicators, waveform); other fields: pedestal_mass_kg [kg], radial_stiffness_n_m [N/m], ..., accelerometer {sample_rate_hz [Hz], ...}; default: rigid outer ring, no vibration.")
+
+    def twin_options(self) -> dict[str, Any]:
+        """The bearing options of `TwinRegistry.create_twin`: `spec`, or the designation and its
+        overrides. InputError naming the field when a spec comes with a designation or with a
+        field that belongs inside the spec."""
+        common: dict[str, Any] = {"setpoint": self.setpoint}
+        if self.spec is None:
+            return {**common, "designation": self.designation,
+                    "diametral_clearance_m": self.diametral_clearance_m, "lubricant": self.lubricant,
+                    "thermal": self.thermal, "housing": self.housing}
+        inside = {"designation": "spec.designation", "diametral_clearance_m": "spec.mounting.diametral_clearance_m",
+                  "lubricant": "spec.lubricant", "thermal": "spec.thermal", "housing": "spec.housing"}
+        for name, where in inside.items():
+            if name in self.model_fields_set:
+                what = ("give either 'designation' (a catalog bearing) or 'spec' (a whole bearing spec), not both"
+                        if name == "designation" else f"with a spec, {name} belongs inside it: set {where}")
+                raise InputError.one(name, what)
+        return {**common, "spec": self.spec}
 
 
 class ScenarioStatus(BaseModel):
@@ -61,7 +83,7 @@ class BearingInfo(BaseModel):
     """One twin of this service."""
 
     id: str = Field(description="Twin name [text].")
-    designation: str = Field(description="Catalog designation [text].")
+    designation: str = Field(description="Catalog designation, or the designation of the spec the twin was created from [text].")
     kind: str = Field(description="'deep_groove' or 'angular_contact' [text].")
     ball_count: int = Field(description="Number of balls [-].")
     diametral_clearance_m: float = Field(description="Diametral clearance Pd [m]; negative = preload.")
@@ -233,7 +255,10 @@ def request_bounds() -> dict[str, tuple[Any, Any]]:
     from service.core.scenarios import Scenario, ScenarioRun, ScenarioStep
 
     bounds: dict[str, tuple[Any, Any]] = {}
-    for model in (BearingCreate, RecordingRequest, ScenarioRequest, Scenario, ScenarioRun, ScenarioStep, Thermal):
+    spec_parts = (BearingSpec, Geometry, Material, Surface, Lubricant, Mounting, Lubrication, Electrical, Housing,
+                  Accelerometer, SurfaceProfile)
+    for model in (BearingCreate, RecordingRequest, ScenarioRequest, Scenario, ScenarioRun, ScenarioStep, Thermal,
+                  *spec_parts):
         for name, info in model.model_fields.items():
             low = high = None
             for m in info.metadata:

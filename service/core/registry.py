@@ -56,7 +56,7 @@ from twin import catalog
 from twin.engine import Twin
 from twin.setpoint import SetpointError, SetpointUpdate
 from twin.snapshot import Snapshot
-from twin.spec import Thermal
+from twin.spec import BearingSpec, Thermal
 
 log = logging.getLogger(__name__)
 
@@ -187,15 +187,25 @@ class TwinRegistry:
             self.priority.start()              # after the pool: its threads keep their nice
             self._open_outputs()
             if default_twin and self.settings.start_twin:
-                self.create_twin(id=self.settings.twin_id, designation=self.settings.bearing,
-                                 over_capacity_ok=True,
-                                 **({"housing": {"enabled": True}} if self.settings.housing else {}))
+                self.create_twin(id=self.settings.twin_id, over_capacity_ok=True, **self._configured_bearing())
             if self.settings.gc_freeze:
                 freeze_heap()
         except BaseException:
             self.close()
             raise
         return self
+
+    def _configured_bearing(self) -> dict[str, Any]:
+        """The create_twin options of the configured twin: its designation, or the spec of a
+        bearing spec file (`settings.bearing` ending in .yaml, .yml, .json; read on the server by
+        its operator), with the housing when `settings.housing`."""
+        name, housing = self.settings.bearing, self.settings.housing
+        if not name.strip().lower().endswith(catalog.SPEC_FILE_SUFFIXES):
+            return {"designation": name, **({"housing": {"enabled": True}} if housing else {})}
+        spec = catalog.load_spec_file(name.strip())
+        if housing:
+            spec = spec.model_copy(update={"housing": spec.housing.model_copy(update={"enabled": True})})
+        return {"spec": spec}
 
     def close(self) -> None:
         """Stop every runner, detach the bus, close recordings (nothing queued is lost), close
@@ -256,18 +266,47 @@ class TwinRegistry:
             return self._twins.get(bearing_id)
 
     def _new_id(self, designation: str) -> str:
+        stem = re.sub(r"[^A-Za-z0-9_.-]+", "-", designation.strip()).strip("-._")[:48] or "bearing"
         n = 1
-        while f"{designation}-{n}" in self._twins or f"{designation}-{n}" in self._reserved:
+        while f"{stem}-{n}" in self._twins or f"{stem}-{n}" in self._reserved:
             n += 1
-        return f"{designation}-{n}"
+        return f"{stem}-{n}"
 
     def build_twin(self, bearing_id: str, designation: str = catalog.DEFAULT_DESIGNATION,
                    diametral_clearance_m: float = 0.0,
                    lubricant: str = "seed-000", setpoint: SetpointUpdate | None = None,
-                   thermal: Thermal | None = None, housing: Any = None) -> Twin:
+                   thermal: Thermal | None = None, housing: Any = None,
+                   spec: BearingSpec | dict | None = None) -> Twin:
         """A warm-started Twin (InputError naming the field if a value is not valid). `housing`:
         twin.vibration.housing.Housing (or its dict); `{"enabled": true}` puts the outer ring on
-        the housing support with the accelerometer."""
+        the housing support with the accelerometer. `spec`: a whole bearing spec
+        (twin.spec.BearingSpec or its dict, errors named 'spec.<path>') in place of the designation
+        and its overrides, which are then ignored."""
+        if spec is not None:
+            try:
+                spec = spec if isinstance(spec, BearingSpec) else BearingSpec.model_validate(spec)
+            except ValidationError as exc:
+                raise InputError(field_errors([{**e, "loc": ("spec", *e["loc"])} for e in exc.errors()])) from None
+            try:
+                twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
+            except (ValueError, ArithmeticError) as exc:   # a valid spec the model cannot compile
+                raise InputError.one("spec", f"bearing {spec.designation!r} cannot be modelled: "
+                                     f"{' '.join(str(exc).split())[:300]}") from None
+        else:
+            twin = Twin(self._catalog_spec(designation, diametral_clearance_m, lubricant, thermal, housing),
+                        bearing_id=bearing_id)
+        if setpoint is not None:
+            try:
+                twin.set_setpoint(setpoint)
+            except SetpointError as exc:
+                raise InputError(setpoint_field_errors(exc, prefix="setpoint.")) from None
+            twin.reset()  # warm start at the requested setpoint
+        return twin
+
+    @staticmethod
+    def _catalog_spec(designation: str, diametral_clearance_m: float, lubricant: str,
+                      thermal: Thermal | None, housing: Any) -> BearingSpec:
+        """The catalog bearing with its overrides (InputError naming the field)."""
         wanted = designation
         designation = designation.strip().upper()
         if designation not in catalog.designations():
@@ -280,29 +319,25 @@ class TwinRegistry:
             extra = {"thermal": thermal} if thermal else {}
             if housing is not None:
                 extra["housing"] = housing
-            spec = catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m,
-                                   lubricant=lub, **extra)
+            return catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m, lubricant=lub, **extra)
         except ValidationError as exc:
             raise InputError(field_errors(exc.errors())) from None
-        twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
-        if setpoint is not None:
-            try:
-                twin.set_setpoint(setpoint)
-            except SetpointError as exc:
-                raise InputError(setpoint_field_errors(exc, prefix="setpoint.")) from None
-            twin.reset()  # warm start at the requested setpoint
-        return twin
 
     def create_twin(self, id: str | None = None, designation: str = catalog.DEFAULT_DESIGNATION, *,
                     over_capacity_ok: bool = False, **options: Any) -> TwinEntry:
         """Create, wire and start a twin (`options`: diametral_clearance_m, lubricant, setpoint,
-        thermal, housing). InputError 409 on a duplicate id or at max_twins, 503 when this host cannot
-        run it in real time (admission 'measured'; `over_capacity_ok`: start it anyway, with a
+        thermal, housing; or spec: a whole BearingSpec, whose designation names the twin by default).
+        InputError 409 on a duplicate id or at max_twins, 503 when this host cannot run it in real time (admission 'measured'; `over_capacity_ok`: start it anyway, with a
         warning: the twin of the configuration), 422 for an invalid value."""
         s = self.settings
         with self._lock:
             if self._closed:
                 raise InputError.one(None, "the service is shutting down", status_code=503)
+            spec = options.get("spec")
+            if isinstance(spec, BearingSpec):
+                designation = spec.designation
+            elif isinstance(spec, dict):
+                designation = str(spec.get("designation", "bearing"))
             bearing_id = id or self._new_id(designation.strip().upper())
             if not TWIN_ID_RE.match(bearing_id):
                 raise InputError.one("id", f"{bearing_id!r}: letters, digits, '_', '.', '-' only "

@@ -4,7 +4,10 @@ Format (schema "bearing-twin/scenario/1"; all times are SIMULATED seconds from t
 
     name: seed000_startup_steady_slowdown    # required, [A-Za-z0-9_.-]
     description: free text                   # optional
-    bearing: "6208"                          # catalog designation (default 6208)
+    bearing: "6208"                          # catalog designation (default 6208), or a bearing
+                                             #   spec: a mapping of twin.spec.BearingSpec fields, or
+                                             #   (scenario files only) a .yaml/.yml/.json spec file,
+                                             #   relative to the scenario file
     diametral_clearance_m: 0.0               # mounting [m], negative = preload (default 0)
     lubricant: seed-000                      # 'seed-000' or 'ISO VG n' (default seed-000)
     thermal: {shear_heating: true}           # electro-thermal options (twin.spec.Thermal; optional)
@@ -35,6 +38,13 @@ Rules:
 * setpoint fields are those of `twin.setpoint.SetpointUpdate` (units in the names); an unknown
   field is an error, and so is a value that is not a number (a bool, a quoted "3000");
 * `bearing: 6208` (a YAML integer) is the designation "6208";
+* `bearing:` as a mapping is a whole bearing spec (twin.spec.BearingSpec: geometry [m], material,
+  lubricant, mounting, housing, surface_profile, ...), validated as the catalog's, errors named
+  `bearing.geometry.ball_count` and so on; `diametral_clearance_m`, `lubricant` and `thermal`
+  written beside it replace the spec's own. A spec file path is read by `load_scenario` (a
+  scenario file: `scenario run`, `scenario check`, the service's named scenarios) relative to the
+  scenario file; an inline scenario posted over HTTP gives the spec as a mapping (the service
+  never reads a file a request names);
 * values are checked against the bearing's limits before anything runs (`check_limits`, by
   `scenario check` as by `scenario run` and the service), so an out-of-range step is refused
   with its position, field and the bearing's own range;
@@ -51,10 +61,11 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 import yaml
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, field_validator,
+                      model_validator)
 
 from service.core.errors import loc_text
 from service.keys import TWIN_ID_PATTERN
@@ -66,6 +77,22 @@ SCENARIO_SCHEMA = "bearing-twin/scenario/1"
 
 _NAME_RE = TWIN_ID_PATTERN   # a scenario or run name names the twin of an offline run
 _FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
+
+
+_DESIGNATION_TAG, _SPEC_TAG = "designation-text", "inline-spec"   # union tags, dropped from error paths
+
+
+def _bearing_kind(value: Any) -> str:
+    return _SPEC_TAG if isinstance(value, (dict, BearingSpec)) else _DESIGNATION_TAG
+
+
+Bearing = Annotated[
+    Annotated[str, Tag(_DESIGNATION_TAG), Field(max_length=32)] | Annotated[BearingSpec, Tag(_SPEC_TAG)],
+    Discriminator(_bearing_kind),
+    Field(description="Catalog designation [text], or a whole bearing spec (twin.spec.BearingSpec, fields with units) "
+          "[object]."),
+]
+"""A scenario's bearing: a catalog designation or an inline BearingSpec."""
 
 
 class ScenarioError(ValueError):
@@ -127,7 +154,7 @@ class ScenarioRun(BaseModel):
     model_config = _FROZEN
     id: str | None = Field(default=None, pattern=_NAME_RE, description="Run name [text]; default run<i>.")
     label: str | None = Field(default=None, max_length=128, description="Human label of the run [text].")
-    bearing: str | None = Field(default=None, max_length=32, description="Catalog designation [text].")
+    bearing: Bearing | None = None
     diametral_clearance_m: Clearance | None = None
     lubricant: str | None = Field(default=None, max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
     thermal: Thermal | None = Field(default=None, description="Electro-thermal options replacing the scenario's (twin.spec.Thermal, units in each field).")
@@ -168,7 +195,7 @@ class Scenario(BaseModel):
 
     name: str = Field(pattern=_NAME_RE, description="Scenario name [text: letters, digits, _ . -].")
     description: str = Field(default="", max_length=4000, description="What the scenario shows [text].")
-    bearing: str = Field(default=catalog.DEFAULT_DESIGNATION, max_length=32, description="Catalog designation [text].")
+    bearing: Bearing = catalog.DEFAULT_DESIGNATION
     diametral_clearance_m: Clearance = 0.0
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
     thermal: Thermal | None = Field(default=None, description="Electro-thermal options of the bearing (twin.spec.Thermal: shear / current heating, R_b, H_c; units in each field); default: the spec's.")
@@ -186,8 +213,8 @@ class Scenario(BaseModel):
 
     @field_validator("bearing")
     @classmethod
-    def _known_bearing(cls, value: str) -> str:
-        return _check_designation(value)
+    def _known_bearing(cls, value: str | BearingSpec) -> str | BearingSpec:
+        return _check_designation(value) if isinstance(value, str) else value
 
     @field_validator("lubricant")
     @classmethod
@@ -198,8 +225,11 @@ class Scenario(BaseModel):
     def _timeline(self) -> Scenario:
         _check_steps(self.steps, self.duration_s, "steps")
         for j, run in enumerate(self.runs or []):
-            if run.bearing is not None:
-                _check_designation(run.bearing)
+            if isinstance(run.bearing, str):
+                try:
+                    _check_designation(run.bearing)
+                except ValueError as exc:
+                    raise ValueError(f"runs[{j}].bearing: {exc}") from None
             if run.lubricant is not None:
                 _check_lubricant(run.lubricant)
             steps = run.steps if run.steps is not None else self.steps
@@ -263,6 +293,10 @@ def _designation_text(value: Any) -> Any:
 
 
 def _check_designation(value: str) -> str:
+    if value.strip().lower().endswith(catalog.SPEC_FILE_SUFFIXES):
+        raise ValueError(f"{value!r} is a bearing spec file: only a scenario file names one (bearing-twin scenario "
+                         "run FILE, a named scenario of the service); an inline scenario gives the spec as a mapping "
+                         "of BearingSpec fields (geometry, material, lubricant, ...)")
     known = catalog.designations()
     if value.strip().upper() not in known:
         raise ValueError(f"unknown bearing {value!r}; known: {', '.join(known)}")
@@ -285,7 +319,7 @@ class ResolvedRun:
     index: int
     id: str
     label: str
-    bearing: str
+    bearing: str | BearingSpec               # catalog designation or a whole spec
     diametral_clearance_m: float
     lubricant: str
     initial: SetpointUpdate
@@ -295,10 +329,24 @@ class ResolvedRun:
     explicit: frozenset[str] = frozenset()   # which of bearing / clearance / lubricant were written
     thermal: Thermal | None = None           # electro-thermal options (None: the spec's defaults)
 
+    @property
+    def designation(self) -> str:
+        """The bearing's designation (the spec's with a spec)."""
+        return self.bearing if isinstance(self.bearing, str) else self.bearing.designation
+
     def check_twin(self, designation: str, diametral_clearance_m: float, lubricant: str,
-                   thermal: Thermal | None = None) -> None:
+                   thermal: Thermal | None = None, spec: BearingSpec | None = None) -> None:
         """Raise ScenarioError if the run asks for another bearing, mounting, lubricant or
-        electro-thermal options than a running twin has (those are fixed when a twin is created)."""
+        electro-thermal options than a running twin has (those are fixed when a twin is created).
+        A run with a bearing spec needs the twin's whole `spec` to be the same."""
+        if isinstance(self.bearing, BearingSpec):
+            if spec is None or self.spec() != spec:
+                raise ScenarioError(
+                    "bearing", f"run {self.id!r} of scenario {self.scenario!r} needs the bearing spec "
+                    f"{self.bearing.designation!r} it gives, this twin has another bearing ({designation!r}): "
+                    "create a twin with that spec (POST /v1/bearings with 'spec') or run the scenario offline "
+                    "(bearing-twin scenario run)", [self.bearing.designation])
+            return
         wanted = {"bearing": (self.bearing, designation),
                   "diametral_clearance_m": (self.diametral_clearance_m, diametral_clearance_m),
                   "lubricant": (catalog.lubricant(self.lubricant).name, lubricant)}
@@ -320,7 +368,18 @@ class ResolvedRun:
                 [self.thermal.model_dump()])
 
     def spec(self) -> BearingSpec:
-        """The bearing this run asks for: designation, mounting, lubricant, thermal options."""
+        """The bearing this run asks for: designation, mounting, lubricant, thermal options (with a
+        spec: the spec, with the clearance, lubricant and thermal options written beside it)."""
+        if isinstance(self.bearing, BearingSpec):
+            update: dict[str, Any] = {}
+            if "diametral_clearance_m" in self.explicit:
+                update["mounting"] = self.bearing.mounting.model_copy(
+                    update={"diametral_clearance_m": self.diametral_clearance_m})
+            if "lubricant" in self.explicit:
+                update["lubricant"] = catalog.lubricant(self.lubricant)
+            if self.thermal is not None:
+                update["thermal"] = self.thermal
+            return self.bearing.model_copy(update=update) if update else self.bearing
         return catalog.bearing(self.bearing, diametral_clearance_m=self.diametral_clearance_m,
                                lubricant=catalog.lubricant(self.lubricant),
                                **({"thermal": self.thermal} if self.thermal else {}))
@@ -370,7 +429,7 @@ class ResolvedRun:
             problems = limits.problems({name: value})
             if problems:
                 p = problems[0]
-                raise ScenarioError(f"{where}{place}.{name}", p.message(limits.bearing or self.bearing),
+                raise ScenarioError(f"{where}{place}.{name}", p.message(limits.bearing or self.designation),
                                     [p.low, p.high])
 
 
@@ -395,7 +454,7 @@ _PATH_PREFIX = re.compile(r"^([A-Za-z_][\w.\[\]]*): (.*)$", re.DOTALL)
 def _locate(error: dict) -> tuple[str, str]:
     """(field path, message) of a pydantic error; model-level errors carry the path in front of
     their message ('steps[2].at_s: ...')."""
-    where = loc_text(error.get("loc", ()), skip=()) or ""
+    where = loc_text([p for p in error.get("loc", ()) if p not in (_DESIGNATION_TAG, _SPEC_TAG)], skip=()) or ""
     msg = str(error.get("msg", "")).removeprefix("Value error, ")
     match = _PATH_PREFIX.match(msg)
     if match:
@@ -430,7 +489,35 @@ def load_scenario(path: str | Path) -> Scenario:
         data = yaml.load(text, Loader=ScenarioLoader)
     except yaml.YAMLError as exc:
         raise ScenarioError(str(path), f"not valid YAML: {' '.join(str(exc).split())}") from exc
+    if isinstance(data, dict):
+        data = _read_spec_files(data, path.parent)
     return scenario_from_dict(data, source=str(path))
+
+
+def _read_spec_files(data: dict, folder: Path) -> dict:
+    """The scenario with every `bearing:` that names a spec file (top level and per run) replaced
+    by the BearingSpec read from it, the path relative to `folder` (the scenario file's).
+    ScenarioError naming `bearing` / `runs[j].bearing` (and the spec's field) when one cannot be read."""
+    def read(value: Any, where: str) -> Any:
+        if not (isinstance(value, str) and value.strip().lower().endswith(catalog.SPEC_FILE_SUFFIXES)):
+            return value
+        file = folder / value.strip()
+        try:
+            return catalog.load_spec_file(str(file))
+        except ValidationError as exc:
+            located = [_locate(e) for e in exc.errors()]
+            message = "; ".join(f"{w}: {m}" if w else m for w, m in located)
+            raise ScenarioError(f"{where}.{located[0][0]}" if located[0][0] else where,
+                                f"spec file {str(file)!r}: {message}") from exc
+        except ValueError as exc:
+            raise ScenarioError(where, str(exc).removeprefix("bearing: ")) from None
+
+    out = {**data, "bearing": read(data["bearing"], "bearing")} if "bearing" in data else dict(data)
+    runs = data.get("runs")
+    if isinstance(runs, list):
+        out["runs"] = [{**run, "bearing": read(run["bearing"], f"runs[{j}].bearing")}
+                       if isinstance(run, dict) and "bearing" in run else run for j, run in enumerate(runs)]
+    return out
 
 
 def list_scenarios(directory: str | Path) -> dict[str, Path]:

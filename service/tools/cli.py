@@ -60,6 +60,7 @@ def _positive_int(text: str) -> int:
 def _cmd_simulate(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
+    from twin import catalog
     from twin.engine import Twin
     from twin.setpoint import SetpointError, SetpointUpdate
     from twin.spec import ModelOptions
@@ -68,7 +69,8 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         options = ModelOptions(time_step_s=args.dt, film_formula=args.film_formula)
         update = SetpointUpdate(shaft_speed_rad_s=args.speed, radial_load_n=args.radial_load,
                                 axial_load_n=args.axial_load, oil_temperature_c=args.oil_temperature)
-        twin = Twin(args.bearing, options=options, diametral_clearance_m=args.clearance, warm=False)
+        twin = Twin(catalog.bearing_or_file(args.bearing), options=options, diametral_clearance_m=args.clearance,
+                    warm=False)
         twin.set_setpoint(update)           # checked once, against this bearing's limits
         twin.reset()                        # warm start at it
         twin.advance(args.duration)
@@ -190,7 +192,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     sim = sub.add_parser("simulate", help="run one twin for a duration, print the final snapshot")
     sim.add_argument("--bearing", default=DEFAULT_DESIGNATION,
-                     help=f"catalog designation (default {DEFAULT_DESIGNATION})")
+                     help=f"catalog designation (default {DEFAULT_DESIGNATION}) or a bearing spec file (.yaml, .json)")
     sim.add_argument("--radial-load", type=float, default=3000.0, help="radial load [N]")
     sim.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     sim.add_argument("--speed", type=float, default=500.0, help="shaft speed [rad/s]")
@@ -230,7 +232,8 @@ def build_parser() -> argparse.ArgumentParser:
     serve.add_argument("--host", help="HTTP bind address (default 127.0.0.1: loopback only; "
                        "0.0.0.0 exposes the API on every interface) [BEARING_TWIN_HOST]")
     serve.add_argument("--port", type=int, help="HTTP port (default 8000) [BEARING_TWIN_PORT]")
-    serve.add_argument("--bearing", help=f"designation of the `default` twin (default {DEFAULT_DESIGNATION}) [BEARING_TWIN_BEARING]")
+    serve.add_argument("--bearing", help=f"designation or bearing spec file (.yaml, .json) of the `default` twin "
+                       f"(default {DEFAULT_DESIGNATION}) [BEARING_TWIN_BEARING]")
     serve.add_argument("--housing", action="store_true", default=None,
                        help="the `default` twin runs on the housing support with the accelerometer "
                        "(vibration; default off) [BEARING_TWIN_HOUSING]")
@@ -436,9 +439,13 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     if args.no_record and args.record is not None:
         print("error: --record and --no-record contradict each other", file=sys.stderr)
         return 2
-    if settings.bearing.strip().upper() not in catalog.designations():
-        print(f"error: bearing: unknown {settings.bearing!r}; known: {', '.join(catalog.designations())}",
-              file=sys.stderr)
+    try:
+        default_spec = catalog.bearing_or_file(settings.bearing)
+    except ValidationError as exc:
+        print(f"error: bearing: {settings.bearing}: {_one_line(exc)}", file=sys.stderr)
+        return 2
+    except ValueError as exc:
+        print(f"error: {exc}", file=sys.stderr)
         return 2
 
 
@@ -452,7 +459,7 @@ def _cmd_serve(args: argparse.Namespace) -> int:
              else "reachable from other machines")
     port = settings.port if settings.port else "<a free port, see uvicorn's line below>"
     print(f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
-          f"twin `{settings.twin_id}` = {settings.bearing.upper()}, {'fast' if settings.fast else 'real-time'} mode",
+          f"twin `{settings.twin_id}` = {default_spec.designation}, {'fast' if settings.fast else 'real-time'} mode",
           flush=True)
     from service.api.app import access_summary
 

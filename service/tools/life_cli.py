@@ -23,12 +23,13 @@ def add_life_command(sub) -> None:
         "point, and the life from the contact loads (Lundberg-Palmgren per raceway, ISO/TS 16281 spirit) of the "
         "twin's quasi-static equilibrium (a short DEM run where the equilibrium does not converge).")
     p.add_argument("--bearing", default=DEFAULT_DESIGNATION,
-                     help=f"catalog designation (default {DEFAULT_DESIGNATION})")
+                   help=f"catalog designation (default {DEFAULT_DESIGNATION}) or a bearing spec file (.yaml, .json)")
     p.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
     p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     p.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
     p.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC]")
-    p.add_argument("--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload")
+    p.add_argument("--clearance", type=float, default=None,
+                   help="diametral clearance [m], negative = preload (default 0, or a spec file's own)")
     p.add_argument("--contamination", choices=_CONTAMINATION, default="normal_cleanliness",
                    help="contamination level (ISO 281 Table 13 / Annex A, oil; default normal_cleanliness)")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -42,13 +43,16 @@ def _fmt(value, spec: str = "{:.4g}") -> str:
 def _cmd_life(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
+    from twin import catalog
     from twin.life.settings import LifeSettings
     from twin.validation.life_rating import rate_operating_point
     from twin.setpoint import SetpointError
 
     try:
-        result = rate_operating_point(args.bearing, args.radial_load, args.axial_load, args.speed,
-                                      oil_temperature_c=args.oil_temperature, diametral_clearance_m=args.clearance,
+        spec = catalog.bearing_or_file(args.bearing)
+        clearance = spec.mounting.diametral_clearance_m if args.clearance is None else args.clearance
+        result = rate_operating_point(spec, args.radial_load, args.axial_load, args.speed,
+                                      oil_temperature_c=args.oil_temperature, diametral_clearance_m=clearance,
                                       settings=LifeSettings(contamination=args.contamination))
     except ValidationError as exc:
         print(f"error: {error_text(exc)}", file=sys.stderr)

@@ -92,8 +92,8 @@ class TableSink:
 
     def begin(self, run: ResolvedRun, runner: TwinRunner, lubricant: str) -> None:
         """A new run on `runner`, whose scenario handle gives each row its phase at publish time."""
-        self._context = {"run": run.id, "run_label": run.label, "bearing": run.bearing,
-                         "diametral_clearance_m": run.diametral_clearance_m, "lubricant": lubricant}
+        self._context = {"run": run.id, "run_label": run.label, "bearing": run.designation,
+                         "diametral_clearance_m": run.spec().mounting.diametral_clearance_m, "lubricant": lubricant}
         self._runner, self._t0 = runner, None
 
     def publish(self, snapshot: Snapshot) -> None:

@@ -17,12 +17,14 @@ def add_thermal_command(sub) -> None:
         description="Steady state of the bearing's thermal network (shaft, rings, balls, housing, oil) with the "
         "twin's own friction heat in the loop: the film's viscosity at the inlet temperature the network sets "
         "(fixed-point iteration, twin.validation.thermal_steady).")
-    p.add_argument("--bearing", default="6208", help="catalog designation (default 6208)")
+    p.add_argument("--bearing", default="6208", help="catalog designation or bearing spec file (.yaml, .json) "
+                   "(default 6208)")
     p.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
     p.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
     p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     p.add_argument("--ambient", type=float, default=20.0, help="ambient (oil bath) temperature [degC]")
-    p.add_argument("--lubricant", default="seed-000", help="'seed-000' or 'ISO VG n' (default seed-000)")
+    p.add_argument("--lubricant", default=None, help="'seed-000' or 'ISO VG n' (default seed-000, or a spec "
+                   "file's own)")
     p.add_argument("--dissipation", choices=("housing", "iso_15312"), default="housing",
                    help="heat path to the surroundings: the housing correlations or ISO 15312's reference dissipation")
     p.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -41,9 +43,11 @@ def _cmd_thermal(args: argparse.Namespace) -> int:
         print(f"error: ambient = {args.ambient!r}: must be in [-30, 150] degC", file=sys.stderr)
         return 2
     try:
-        r = steady_operating_point(args.bearing, args.speed, args.radial_load, args.axial_load, args.ambient,
-                                   ThermalNetworkSettings(dissipation=args.dissipation),
-                                   catalog.lubricant(args.lubricant))
+        spec = catalog.bearing_or_file(args.bearing)
+        if args.lubricant is not None:
+            spec = spec.model_copy(update={"lubricant": catalog.lubricant(args.lubricant)})
+        r = steady_operating_point(spec.designation, args.speed, args.radial_load, args.axial_load, args.ambient,
+                                   ThermalNetworkSettings(dissipation=args.dissipation), spec=spec)
     except ValidationError as exc:
         print(f"error: {error_text(exc)}", file=sys.stderr)
         return 2

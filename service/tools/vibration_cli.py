@@ -123,7 +123,7 @@ def analyse_file(args: argparse.Namespace) -> dict:
         from twin import catalog
 
         try:
-            spec = catalog.bearing(args.bearing)
+            spec = catalog.bearing_or_file(args.bearing)
         except (KeyError, ValueError) as exc:
             raise RecordError("--bearing", str(exc).strip("'\"")) from None
         multiples = defect_multiples_of(spec.geometry)
@@ -176,7 +176,7 @@ def add_analyse_command(vibration_parser: argparse.ArgumentParser) -> None:
     an.add_argument("file", metavar="FILE", help="record: .npy, .csv or .wav")
     an.add_argument("--sample-rate", type=float, default=None, help="sample rate [Hz] (.wav: from the file)")
     an.add_argument("--rpm", type=float, required=True, help="shaft speed [rev/min]")
-    an.add_argument("--bearing", default=None, help="catalog designation: the defect lines from its geometry")
+    an.add_argument("--bearing", default=None, help="catalog designation or bearing spec file (.yaml, .json): the defect lines from its geometry")
     an.add_argument("--line", type=_parse_line, action="append", metavar="NAME=MULTIPLE",
                     help="a defect line as a multiple of the shaft frequency (repeatable; replaces the "
                          "bearing's lines), e.g. --line BPFI=5.4152")

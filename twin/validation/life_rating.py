@@ -17,9 +17,10 @@ from twin.life.settings import LifeSettings
 from twin.model import make_model
 from twin.physics.viscosity import kinematic_viscosity_m2_s
 from twin.setpoint import Setpoint, SetpointLimits
+from twin.spec import BearingSpec
 
 
-def dem_contact_life_mrev(designation: str, radial_load_n: float, axial_load_n: float, shaft_speed_rad_s: float,
+def dem_contact_life_mrev(designation: str | BearingSpec, radial_load_n: float, axial_load_n: float, shaft_speed_rad_s: float,
                           oil_temperature_c: float = 40.0, diametral_clearance_m: float = 0.0,
                           settle_s: float = 0.02, average_s: float = 0.05) -> float:
     """Contact-load life [10^6 rev] from a short DEM run: a warm-started `twin.engine.Twin` at the
@@ -42,17 +43,25 @@ def dem_contact_life_mrev(designation: str, radial_load_n: float, axial_load_n: 
     return math.inf if mean <= 0.0 else 1.0 / mean
 
 
-def rate_operating_point(designation: str, radial_load_n: float, axial_load_n: float, shaft_speed_rad_s: float,
+def rate_operating_point(designation: str | BearingSpec, radial_load_n: float, axial_load_n: float, shaft_speed_rad_s: float,
                          oil_temperature_c: float = 40.0, diametral_clearance_m: float = 0.0,
                          settings: LifeSettings | None = None, lubricant=None) -> dict:
-    """`bearing-twin life`: the life block of a catalogue bearing at one steady operating point,
+    """`bearing-twin life`: the life block of a catalogue bearing (or of a spec, with the clearance
+    and lubricant given here in place of its own) at one steady operating point,
     the contact-load life from the quasi-static equilibrium (`equilibrium_contact_life_mrev`,
     centrifugal force included). Inputs are validated against the
     bearing's limits (SetpointError / ValidationError / ValueError naming the field)."""
 
     settings = settings or LifeSettings()
-    spec = catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m,
-                           **({"lubricant": lubricant} if lubricant is not None else {}))
+    if isinstance(designation, BearingSpec):
+        data = designation.model_dump()
+        data["mounting"]["diametral_clearance_m"] = diametral_clearance_m
+        if lubricant is not None:
+            data["lubricant"] = lubricant
+        spec = BearingSpec.model_validate(data)
+    else:
+        spec = catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m,
+                               **({"lubricant": lubricant} if lubricant is not None else {}))
     model = make_model(spec)
     setpoint = Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n, axial_load_n=axial_load_n,
                         oil_temperature_c=oil_temperature_c)
@@ -70,7 +79,7 @@ def rate_operating_point(designation: str, radial_load_n: float, axial_load_n: f
         try:
             contact_mrev = equilibrium_contact_life_mrev(model, radial_load_n, axial_load_n, shaft_speed_rad_s)
         except ValueError:
-            contact_mrev = dem_contact_life_mrev(designation, radial_load_n, axial_load_n, shaft_speed_rad_s,
+            contact_mrev = dem_contact_life_mrev(spec, radial_load_n, axial_load_n, shaft_speed_rad_s,
                                                  oil_temperature_c, diametral_clearance_m)
             method = ("DEM run (the quasi-static equilibrium did not converge): 20 ms to settle, damage averaged "
                       "over 50 frames of 1 ms")

@@ -52,10 +52,9 @@ def get_bearing(entry: TwinDep) -> BearingInfo:
                              "(measured capacity: the reason and the figures), or the service is stopping"}})
 def create_bearing(body: BearingCreate, registry: RegistryDep) -> BearingInfo:
     """Create and start a twin from a catalog designation, a diametral clearance and a
-    lubricant (warm-started at the optional initial setpoint)."""
-    return bearing_info(registry.create_twin(
-        id=body.id, designation=body.designation, diametral_clearance_m=body.diametral_clearance_m,
-        lubricant=body.lubricant, setpoint=body.setpoint, thermal=body.thermal, housing=body.housing))
+    lubricant, or from a whole bearing spec (`spec`, for a bearing not in the catalog),
+    warm-started at the optional initial setpoint."""
+    return bearing_info(registry.create_twin(id=body.id, **body.twin_options()))
 
 
 @write.delete("/{bearing_id}", responses={**UNKNOWN_TWIN, **INVALID})

@@ -60,7 +60,7 @@ def post_scenario(entry: TwinDep, body: ScenarioRequest, settings: SettingsDep) 
                                  [r.id for r in runs])
         run = matching[0]
     run.check_twin(entry.designation, entry.diametral_clearance_m, entry.lubricant,
-                   entry.twin.model.spec.thermal)
+                   entry.twin.model.spec.thermal, spec=entry.twin.model.spec)
     _handle, replaced = entry.runner.start_scenario(run, restart=body.restart)
     return ScenarioAccepted(accepted=True, bearing_id=entry.id, name=scenario.name, run=run.id,
                             expected_duration_s=run.duration_s, mode=entry.runner.mode,

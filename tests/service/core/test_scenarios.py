@@ -328,3 +328,66 @@ def test_yaml_setpoint_values_are_numbers(tmp_path, value):
     with pytest.raises(ScenarioError) as exc:
         load_scenario(path)
     assert exc.value.field == "initial.radial_load_n" and "valid number" in exc.value.message
+
+
+def _own_spec(**geometry) -> dict:
+    """A 6205 with 8 balls under a designation of its own (a bearing the catalog does not have)."""
+    from twin import catalog
+
+    spec = catalog.bearing("6205").model_dump(mode="json")
+    spec["designation"] = "MY-6205-8"
+    spec["geometry"].update({"ball_count": 8, **geometry})
+    return spec
+
+
+def test_bearing_spec_inline_and_from_a_file_next_to_the_scenario(tmp_path, monkeypatch):
+    pq = pytest.importorskip("pyarrow.parquet")
+    (tmp_path / "specs").mkdir()
+    (tmp_path / "specs" / "own.yaml").write_text(yaml.safe_dump(_own_spec()))
+    path = _write(tmp_path, base(name="own", duration_s=0.01, sample_every_s=0.005, bearing="specs/own.yaml",
+                                 initial={"shaft_speed_rad_s": 300.0, "radial_load_n": 800.0},
+                                 runs=[{"id": "file"}, {"id": "inline", "bearing": _own_spec(),
+                                                        "diametral_clearance_m": 10e-6}]))
+    monkeypatch.chdir(tmp_path / "specs")              # the path is the scenario file's, not the cwd's
+    runs = load_scenario(path).resolved_runs()
+    assert [r.designation for r in runs] == ["MY-6205-8", "MY-6205-8"]
+    assert [r.spec().geometry.ball_count for r in runs] == [8, 8]
+    # a clearance written beside a spec replaces the spec's own
+    assert [r.spec().mounting.diametral_clearance_m for r in runs] == [0.0, 10e-6]
+    out = tmp_path / "own.parquet"
+    assert main(["scenario", "run", str(path), "--table", str(out), "--no-progress"]) == 0
+    rows = pq.read_table(out).to_pylist()
+    assert {r["bearing"] for r in rows} == {"MY-6205-8"}
+    assert {r["run"] for r in rows} == {"file", "inline"}
+    assert [r["diametral_clearance_m"] for r in rows if r["run"] == "inline"][0] == 10e-6
+
+
+def test_bearing_spec_errors_name_the_field(tmp_path):
+    bad = _own_spec(ball_count=20)
+    with pytest.raises(ScenarioError) as exc:
+        scenario_from_dict(base(bearing=bad))
+    assert exc.value.field == "bearing.geometry.ball_count" and "16" in str(exc.value)
+    with pytest.raises(ScenarioError) as exc:
+        scenario_from_dict(base(runs=[{"id": "a", "bearing": bad}]))
+    assert exc.value.field == "runs[0].bearing.geometry.ball_count"
+    # an inline scenario (the HTTP API's) never names a file
+    with pytest.raises(ScenarioError) as exc:
+        scenario_from_dict(base(bearing="own.yaml"))
+    assert exc.value.field == "bearing" and "mapping of BearingSpec fields" in exc.value.message
+    with pytest.raises(ScenarioError) as exc:
+        load_scenario(_write(tmp_path, base(name="missing", bearing="nowhere.json")))
+    assert exc.value.field == "bearing" and "cannot read spec file" in exc.value.message
+    (tmp_path / "bad.yaml").write_text(yaml.safe_dump(bad))
+    with pytest.raises(ScenarioError) as exc:
+        load_scenario(_write(tmp_path, base(name="badfile", runs=[{"id": "a", "bearing": "bad.yaml"}])))
+    assert exc.value.field == "runs[0].bearing.geometry.ball_count" and "bad.yaml" in exc.value.message
+
+
+def test_limits_are_the_spec_bearings():
+    # 400 rad/s is within the catalog 6205's speed range but above this spec's limiting speed
+    spec = {**_own_spec(), "limiting_speed_rad_s": 300.0}
+    scenario = scenario_from_dict(base(bearing=spec, initial={"shaft_speed_rad_s": 400.0}))
+    with pytest.raises(ScenarioError) as exc:
+        scenario.check_bearing_limits()
+    assert exc.value.field == "initial.shaft_speed_rad_s" and exc.value.allowed[1] == pytest.approx(300.0)
+    scenario_from_dict(base(bearing="6205", initial={"shaft_speed_rad_s": 400.0})).check_bearing_limits()
