@@ -18,20 +18,15 @@ from twin.kernels.structures import ModelArrays, StateArrays
 from twin.model import BearingModel, make_model
 from twin.physics.friction import REGIME_NAMES
 from twin.physics.hertz import max_pressure_pa
-from twin.kernels.tribology import T_HMIN_EXP_EU
-from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k,
-                                  equivalent_inlet_temperature_rise_k, murch_wilson_thermal_factor,
-                                  roelands_temperature_viscosity_coefficient_k_inv,
-                                  roelands_temperature_viscosity_pa_s, thermal_film_factor,
-                                  thermal_loading_parameter)
+from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k)
 from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.faults import Fault, FaultKind
-from twin.friction_power import (FrictionPower, ball_drag_power_w, contact_powers_w, mean_immersed_fraction,
-                                 oil_bath_drag_power_w, oil_level_m, seal_moment_n_m, seal_power_w,
-                                 starvation_film_factor)
+from twin.friction_power import (FrictionPower, ball_drag_power_w, contact_powers_w, oil_bath_drag_power_w,
+                                 oil_level_m, seal_moment_n_m, seal_power_w)
 from twin.physics import drag as drag_law
 from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
 from twin.electrical_network import bearing_network
+from twin.inlet_film import InletFilm
 from twin.life.monitor import LifeMonitor
 from twin.life.settings import LifeSettings
 from twin.snapshot import BallState, ContactState, LifeState, Snapshot
@@ -48,9 +43,7 @@ from twin.warmstart import warm_start
 
 FRAME_S = 1e-3  # simulated time per compiled call [s] (1000 steps at dt = 1 us)
 RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
-MIN_FILM_THERMAL_FACTOR = 1e-4  # floor of the thermal film factor [-]
 REST_SPEED_RAD_S = 1.0  # below this mean shaft speed over a frame the shaft counts as at rest [rad/s]
-COUPLING_PERIOD_S = 0.01  # electro-thermal coupling refreshed every 10 ms of simulated time [s]
 
 
 def _finite_or_none(value: float) -> float | None:
@@ -92,10 +85,9 @@ class Twin:
         self._last_good_time_s = 0.0
         self._last_torque_n_m = 0.0
         self._contact_torque_n_m = 0.0   # friction torque of the contacts over the last frame [N m]
-        self._drag_power_w = 0.0          # orbit-mean drag power of the balls at the last coupling [W]
-        self._starvation_factor = 1.0     # film factor of the kinematic starvation [-]
+        self.inlet = InletFilm(self.model)
+        """The inlet's film losses and the balls' drag (twin.inlet_film), refreshed between frames."""
         self._seal_moment_n_m = seal_moment_n_m(spec)
-        self._immersed_fraction = mean_immersed_fraction(spec)
         self._defects: tuple = ()  # the active local defects (twin.vibration.defects)
         self._sensor = SensorReader(self.model) if self.model.housing_on else None
         self._frozen_vibration = None  # a frozen copy's last window (`frozen`); the live twin reads its sensor
@@ -193,7 +185,7 @@ class Twin:
         # the drive power is the contacts' friction plus the balls' drag and the seals' rubbing:
         # the contacts' share is split over the contacts by their lanes, drag heats the oil and
         # the seals the outer ring (twin.thermal.sources.HeatSources.node_heat_w)
-        drag_w = max(float(self._drag_power_w), 0.0)
+        drag_w = max(float(self.inlet.drag_power_w), 0.0)
         seal_w = self._seal_power_w()
         contacts_w = max(th.take_mean_power_w() - drag_w - seal_w, 0.0)
         heat = friction_heat(s.contacts, self.model.ball_count, contacts_w, self._effective_mu)
@@ -205,76 +197,22 @@ class Twin:
     def _thermal_state(self) -> ThermalState | None:
         return self._frozen_thermal if self.thermal is None else self.thermal.block()
 
-    # ---- electro-thermal coupling (seed 003) ------------------------------------------------
+    # ---- the inlet's film losses (twin.inlet_film) ------------------------------------------
     def _update_inlet_viscosity(self, force: bool = False, elapsed_s: float = 0.0) -> None:
-        """Thermal film loss at the inlet, where the film is formed: the current discharge of the
-        race track heats it (seed 003 eq. 10, with the bearing's equivalent resistance) and the
-        film falls by g(dT)^c_T, calibrated against the thermal EHL solver's current heating
-        (twin.validation.thermal_law_fit); the back-flow shear of the inlet (Thermal.shear_heating)
-        reduces it further by the Murch-Wilson factor phi_T = 3.94 / (3.94 + L^0.62),
-        L = beta eta u^2 / k_f at the current-heated inlet (twin.physics.thermal). The film the
-        loop computes is the isothermal film at the oil temperature times both factors; they
-        enter the kernel through the one viscosity it reads: eta_film = eta_oil * factor^(1 / n_u),
-        n_u the film law's exponent of (eta u), so film, Lambda, regime, mu, fluid damping and the
-        rolling resistance all follow. Recomputed at the start of the frame that completes COUPLING_PERIOD_S of simulated
-        time (`elapsed_s`: the frame's length; the drivers change slowly), whatever the step."""
-        self._since_coupling_s = getattr(self, "_since_coupling_s", 0.0) + elapsed_s
-        if not force and self._since_coupling_s < COUPLING_PERIOD_S - 0.5 * self.model.dt_s:
+        """Count `elapsed_s` of the frame and, when due (or `force`), refresh the inlet's film
+        factors (current and shear heating, starvation; twin.inlet_film.InletFilm) into the
+        viscosity the kernel reads."""
+        inlet = self.inlet
+        if not inlet.due(elapsed_s, force):
             return
-        self._since_coupling_s = 0.0
         sp = self._setpoint
         th = self.model.spec.thermal
-        have_state = hasattr(self, "state")
-        current_rise = 0.0
-        if sp.shaft_current_a > 0.0 and th.current_heating and have_state:
-            current_rise = self.current_heating_k()
-        theta0 = self.film_temperature_c() + 273.15
-        eta0, beta = self._oil_viscosity_pa_s, self._oil_beta_k_inv
-        current_factor = 1.0
-        if current_rise > 0.0:
-            current_factor = thermal_film_factor(current_rise, eta0, theta0, beta, th.film_temperature_exponent)
-        shear_factor = 1.0
-        shear_rise = 0.0
-        if th.shear_heating and have_state:
-            theta_c = theta0 + current_rise  # the shear heats an inlet the current has heated
-            eta_c = roelands_temperature_viscosity_pa_s(eta0, theta0, theta_c, beta)
-            beta_c = roelands_temperature_viscosity_coefficient_k_inv(eta0, theta0, theta_c, beta)
-            loading = thermal_loading_parameter(beta_c, eta_c, self.mean_entrainment_speed_m_s(),
-                                                th.oil_thermal_conductivity_w_m_k)
-            shear_factor = murch_wilson_thermal_factor(loading)
-            shear_rise = equivalent_inlet_temperature_rise_k(shear_factor, eta_c, theta_c, beta_c)
-        rise = current_rise + shear_rise
-        speed = float(self.state.scalars[L.X_SHAFT_SPEED]) if have_state else sp.shaft_speed_rad_s
-        lub = self.model.spec.lubricant
-        rho = density_kg_m3(lub.density_15c_kg_m3, sp.oil_temperature_c)
-        starved = starvation_film_factor(self.model.spec, speed, eta0 / rho)
-        self._starvation_factor = starved
-        self._drag_power_w = self._mean_drag_power_w(rho)
-        # floored: below 1e-4 of the isothermal film there is no film to speak of
-        factor = max(MIN_FILM_THERMAL_FACTOR, current_factor * shear_factor * starved)
-        self._current_heating_k = current_rise
-        self._shear_heating_k = shear_rise
-        self._shear_film_factor = shear_factor
-        self._film_thermal_factor = factor
-        self._inlet_viscosity_pa_s = (roelands_temperature_viscosity_pa_s(eta0, theta0, theta0 + rise, beta)
-                                      if rise > 0.0 else eta0)
-        speed_exponent = float(self.model.race_tribology[0, T_HMIN_EXP_EU])  # d ln h / d ln(eta u)
-        self._setpoint_vector[L.S_VISCOSITY] = eta0 * factor ** (1.0 / speed_exponent)
-
-    def _mean_drag_power_w(self, oil_density_kg_m3: float) -> float:
-        """Drag power of the balls [W]: in an oil bath the SKF model's drag moment at the shaft
-        speed (twin.friction_power.oil_bath_drag_power_w); in an oil-air mixture each ball's sphere
-        drag at the cage speed with the mixture's oil share (twin.friction_power.ball_drag_power_w);
-        0 'flooded'."""
-        if self._immersed_fraction <= 0.0 or not hasattr(self, "state"):
-            return 0.0
-        m = self.model
-        if m.spec.lubrication.method == "oil_bath":
-            return oil_bath_drag_power_w(m.spec, float(self.state.scalars[L.X_SHAFT_SPEED]),
-                                         self._oil_viscosity_pa_s / oil_density_kg_m3)
-        v = abs(float(self.state.scalars[L.X_CAGE_SPEED])) * m.pitch_radius_m
-        return m.ball_count * ball_drag_power_w(2.0 * m.ball_radius_m, v, self._immersed_fraction,
-                                                oil_density_kg_m3, self._oil_viscosity_pa_s)
+        current_rise = self.current_heating_k() if sp.shaft_current_a > 0.0 and th.current_heating else 0.0
+        scalars = self.state.scalars
+        self._setpoint_vector[L.S_VISCOSITY] = inlet.update(
+            sp, self.film_temperature_c(), self._oil_viscosity_pa_s, self._oil_beta_k_inv,
+            float(scalars[L.X_SHAFT_SPEED]), float(scalars[L.X_CAGE_SPEED]), current_rise,
+            self.mean_entrainment_speed_m_s() if th.shear_heating else 0.0)
 
     def axial_angular_momentum_n_m_s(self) -> float:
         """Angular momentum of the balls and the cage about the bearing axis [N m s]: the balls'
@@ -411,10 +349,10 @@ class Twin:
         if not (force or self.life_monitor.due(self.time_s)):
             return
         sp = self._setpoint
-        rise = getattr(self, "_current_heating_k", 0.0) + getattr(self, "_shear_heating_k", 0.0)
-        rho = density_kg_m3(self.model.spec.lubricant.density_15c_kg_m3, self.film_temperature_c() + rise)
+        rho = density_kg_m3(self.model.spec.lubricant.density_15c_kg_m3,
+                            self.film_temperature_c() + self.inlet.temperature_rise_k)
         self.life_monitor.update(self.time_s, float(self.state.scalars[L.X_SHAFT_SPEED]), sp.radial_load_n,
-                                 sp.axial_load_n, self._inlet_viscosity_pa_s / rho, self.state.contacts,
+                                 sp.axial_load_n, self.inlet.inlet_viscosity_pa_s / rho, self.state.contacts,
                                  force=force)
 
     def _frame(self, n: int) -> int:
@@ -430,7 +368,7 @@ class Twin:
         momentum_before = self.axial_angular_momentum_n_m_s() if near_rest else 0.0
         status, done = step_n(*self._kernel_args(), n)
         if done < n and status == L.STATUS_OK:    # interrupted (interrupt_frame): n - done not run
-            self._since_coupling_s -= (n - done) * self.model.dt_s
+            self.inlet.since_s -= (n - done) * self.model.dt_s
         if self._sensor is not None:
             self._sensor.after_frame(s, done, float(s.scalars[L.X_SHAFT_SPEED]))
             if status != L.STATUS_OK:
@@ -462,10 +400,10 @@ class Twin:
 
     @property
     def drag_power_w(self) -> float:
-        """Drag power of the balls at the last coupling refresh [W] (`_mean_drag_power_w`: the SKF
-        drag term in an oil bath, sphere drag in an oil-air mixture); the snapshot's torque carries it
+        """Drag power of the balls at the last coupling refresh [W] (twin.inlet_film: the SKF drag
+        term in an oil bath, sphere drag in an oil-air mixture); the snapshot's torque carries it
         as power / omega."""
-        return float(self._drag_power_w)
+        return float(self.inlet.drag_power_w)
 
     @staticmethod
     def _dissipative_torque_n_m(drive_n_m: float, duration_s: float, mean_speed_rad_s: float,
@@ -487,7 +425,7 @@ class Twin:
         speed = abs(float(self.state.scalars[L.X_SHAFT_SPEED]))
         if speed <= 0.0:
             return 0.0
-        return self._drag_power_w / speed + self._seal_moment_n_m
+        return self.inlet.drag_power_w / speed + self._seal_moment_n_m
 
     def _seal_power_w(self) -> float:
         """Power of the rubbing seals at the current shaft speed [W] (twin.friction_power.seal_power_w):
@@ -517,7 +455,7 @@ class Twin:
                     m.spec, float(s.scalars[L.X_SHAFT_SPEED]), self._oil_viscosity_pa_s / rho)
         elif method != "flooded":
             for j in range(m.ball_count):
-                drag_w[j] = ball_drag_power_w(2.0 * m.ball_radius_m, float(orbit_speed[j]), self._immersed_fraction,
+                drag_w[j] = ball_drag_power_w(2.0 * m.ball_radius_m, float(orbit_speed[j]), self.inlet.immersed_fraction,
                                               rho, self._oil_viscosity_pa_s)
         seal_w = self._seal_power_w()
         return FrictionPower(rolling_w=float(rolling.sum()), sliding_w=float(sliding.sum()), spin_w=float(spin.sum()),
@@ -646,6 +584,7 @@ class Twin:
         latest = self.vibration           # flushes the live reader here, in the stepping thread
         frozen = copy.copy(self)
         frozen.state = self.state.copy()
+        frozen.inlet = copy.copy(self.inlet)
         frozen._sensor = None
         frozen._frozen_vibration = latest
         frozen._frozen_thermal = self._thermal_state()
@@ -744,7 +683,7 @@ class Twin:
             inner_ring_displacement_m=tuple(float(a) for a in s.inner_ring_offset_m),
             friction_torque_n_m=float(self._last_torque_n_m),
             friction_power_w=FrictionPowerState(**self.friction_power_w().by_source_w()),
-            viscosity_pa_s=float(self._inlet_viscosity_pa_s),
+            viscosity_pa_s=float(self.inlet.inlet_viscosity_pa_s),
             electrical=ElectricalState(
                 resistance_ohm=_finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,
                 capacitance_reason=net.capacitance_reason,
@@ -753,10 +692,10 @@ class Twin:
                 shaft_current_a=net.shaft_current_a, max_film_field_v_m=net.max_film_field_v_m,
                 current_density_a_m2=net.current_density_a_m2, discharge_risk=net.discharge_risk,
                 reason=net.reason,
-                contact_temperature_rise_k=float(self._current_heating_k + self._shear_heating_k),
-                current_temperature_rise_k=float(self._current_heating_k),
-                shear_temperature_rise_k=float(self._shear_heating_k),
-                film_thermal_factor=float(self._film_thermal_factor)),
+                contact_temperature_rise_k=float(self.inlet.current_heating_k + self.inlet.shear_heating_k),
+                current_temperature_rise_k=float(self.inlet.current_heating_k),
+                shear_temperature_rise_k=float(self.inlet.shear_heating_k),
+                film_thermal_factor=float(self.inlet.film_thermal_factor)),
             balls=balls,
             life=self._life_state(),
             outer_ring_displacement_m=tuple(float(h) for h in s.housing_displacement_m[:3]),

@@ -116,4 +116,4 @@ def test_the_other_candidates_agree_with_skf(runs):
     twin = next(iter(runs.values()))
     bore, od = BORE_OD_MM[twin.model.spec.designation]
     phi_ish = skf_friction.inlet_shear_heating_factor(SPEED_RAD_S * 30.0 / math.pi, 0.5 * (bore + od), nu)
-    assert twin._shear_film_factor == pytest.approx(phi_ish, rel=0.05)
+    assert twin.inlet.shear_film_factor == pytest.approx(phi_ish, rel=0.05)

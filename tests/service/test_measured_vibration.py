@@ -90,10 +90,13 @@ def _active_alarm_ids(http, name, timeout_s=10.0):
     """The ids of the twin's active alarms once the alarm thread has seen the latest window."""
     deadline = time.monotonic() + timeout_s
     while True:
-        body = http.get(f"/v1/bearings/{name}/alarms").json()
+        r = http.get(f"/v1/bearings/{name}/alarms")
+        assert r.status_code == 200, r.text
+        body = r.json()
         ids = {a["alarm_id"] for a in body["active"]}
         if "measured_line" in ids or time.monotonic() > deadline:
             return ids, body
+        time.sleep(0.25)   # a few reads a second: within the service's read rate
 
 
 def test_measured_window_raises_the_stateful_alarm_on_the_healthy_twin_only(service):
