@@ -234,11 +234,12 @@ class Thermal(BaseModel):
     current_heating: bool = Field(
         default=True, description="Feed the current-discharge heating (seed 003 eq. 10) back into the film [bool].")
     shear_heating: bool = Field(
-        default=False,
+        default=True,
         description="Reduce the film by the inlet shear heating of a rolling contact, the Murch-Wilson factor "
-        "phi_T = 3.94 / (3.94 + L^0.62), L = beta eta u^2 / k' (Murch and Wilson 1975; twin.physics.thermal). Off by "
-        "default: seed 000, which validates the 6208 twin (Table 3, Fig. 8), is isothermal; the EV preset turns it on "
-        "[bool].")
+        "phi_T = 3.94 / (3.94 + L^0.62), L = beta eta u^2 / k' (Murch and Wilson 1975; twin.physics.thermal). On by "
+        "default: a real inlet is shear-heated (SKF's frictional-moment model applies the same physics as phi_ish). "
+        "False: the isothermal inlet of seed 000's Hamrock-Dowson solution, which its validations (Table 3, Figs. 8-12; "
+        "twin.validation.studies) state explicitly [bool].")
     film_temperature_exponent: float = Field(
         default=1.38, gt=0.0, le=5.0,
         description="c_T of the loop's current-heating film law h/h_iso = g(dT)^c_T [-], fitted to the current heating "

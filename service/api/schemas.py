@@ -44,7 +44,7 @@ class BearingCreate(BaseModel):
     diametral_clearance_m: Clearance = 0.0
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' (0.04 Pa s at 40 degC) or an ISO grade such as 'ISO VG 68' [text].")
     setpoint: SetpointUpdate | None = Field(default=None, description="Initial setpoint (partial, defaults for the rest); the twin is warm-started at it [fields with units].")
-    thermal: Thermal | None = Field(default=None, description="Electro-thermal options (seed 003): shear_heating, current_heating, equivalent_resistance_ohm [ohm], crater_depth_m [m], ...; default: the spec's (shear heating off).")
+    thermal: Thermal | None = Field(default=None, description="Electro-thermal options (seed 003): shear_heating, current_heating, equivalent_resistance_ohm [ohm], crater_depth_m [m], ...; default: the spec's (shear heating on).")
     housing: Housing | None = Field(default=None, description="Housing and accelerometer (twin.vibration.housing.Housing): {\"enabled\": true} puts the outer ring on the housing support (Sawalhi & Randall 2008 defaults) and samples the accelerometer (vibration indicators, waveform); other fields: pedestal_mass_kg [kg], radial_stiffness_n_m [N/m], ..., accelerometer {sample_rate_hz [Hz], ...}; default: rigid outer ring, no vibration.")
 
     def twin_options(self) -> dict[str, Any]:

@@ -11,6 +11,8 @@ from twin import life
 from twin.engine import Twin
 from twin.model import make_model
 from twin import catalog
+from twin.physics.thermal import roelands_temperature_viscosity_pa_s
+from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 
 
 def test_accumulator_is_miner_sum():
@@ -84,7 +86,17 @@ def test_snapshot_life_block(runs):
     for key in ("kappa", "a_iso", "l10_h", "l10m_h", "l10_contact_loads_h", "damage_fraction", "remaining_life_h"):
         assert block[key] is not None, key
     assert block["l10_h"] == pytest.approx(4438.07, abs=0.05)            # (32.5/3)^3 at 500 rad/s
-    assert block["kappa"] == pytest.approx(5.587, abs=0.01)
+    # kappa = nu / nu1 (ISO 281) of the film inlet: 5.587 for the seed oil at 40 degC unheated; the default
+    # twin's inlet is shear-heated (Thermal.shear_heating, Murch-Wilson) by the published rise dT, so nu
+    # falls by Roelands' eta(T0 + dT) / eta(T0) (seed 003 eq. 3) over rho(T0 + dT) / rho(T0) (4.41 at 500 rad/s)
+    lub, t0 = catalog.bearing("6208").lubricant, 40.0
+    rise = snap.electrical.shear_temperature_rise_k
+    assert rise > 0.0
+    eta0 = dynamic_viscosity_pa_s(lub, t0)
+    eta_ratio = roelands_temperature_viscosity_pa_s(eta0, t0 + 273.15, t0 + 273.15 + rise,
+                                                    temperature_viscosity_coefficient_k_inv(lub, t0)) / eta0
+    rho_ratio = density_kg_m3(lub.density_15c_kg_m3, t0 + rise) / density_kg_m3(lub.density_15c_kg_m3, t0)
+    assert block["kappa"] == pytest.approx(5.587 * eta_ratio / rho_ratio, abs=0.01)
     assert block["dynamic_load_rating_n"] == 32500.0 and block["equivalent_load_n"] == 3000.0
     assert block["remaining_life_h"] == pytest.approx((1 - block["damage_fraction"]) * block["l10m_h"], rel=1e-9)
 

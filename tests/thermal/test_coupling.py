@@ -7,12 +7,21 @@ import pytest
 
 from twin import catalog
 from twin.engine import Twin
-from twin.physics.viscosity import dynamic_viscosity_pa_s
+from twin.physics.thermal import roelands_temperature_viscosity_pa_s
+from twin.physics.viscosity import dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.setpoint import Setpoint
 from twin.spec import ModelOptions
 from twin.thermal.settings import ThermalNetworkSettings
 
 ACCELERATED = ModelOptions(thermal="network", thermal_network=ThermalNetworkSettings(heat_capacity_scale=1e-3))
+
+
+def heated_inlet_viscosity_pa_s(lub, inlet_c: float, shear_rise_k: float) -> float:
+    """The oil's viscosity at the inlet temperature (ASTM D341), heated by the inlet's shear by Roelands
+    (seed 003 eq. 3 with the oil's beta there): the viscosity the film reads with Thermal.shear_heating on."""
+    t0 = inlet_c + 273.15
+    return roelands_temperature_viscosity_pa_s(dynamic_viscosity_pa_s(lub, inlet_c), t0, t0 + shear_rise_k,
+                                               temperature_viscosity_coefficient_k_inv(lub, inlet_c))
 
 
 @pytest.fixture(scope="module")
@@ -30,11 +39,14 @@ def test_starts_at_the_set_temperature_with_its_viscosity(warmed):
     assert th.accelerated and th.heat_capacity_scale == 1e-3
     assert all(t == pytest.approx(20.0, abs=1e-9) for t in th.temperatures_c.values())
     lub = catalog.bearing("6208").lubricant
-    # the film starts at the set temperature's viscosity (ASTM D341), as with the fixed oil temperature
+    # the film starts at the set temperature's viscosity (ASTM D341), as with the fixed oil temperature,
+    # heated at the inlet by its shear (Thermal.shear_heating, on by default: Murch-Wilson)
     fixed = Twin("6208", options=ModelOptions(thermal="fixed"),
                  setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0))
     assert start.viscosity_pa_s == pytest.approx(fixed.snapshot().viscosity_pa_s, rel=1e-12)
-    assert dynamic_viscosity_pa_s(lub, 20.0) == pytest.approx(fixed.snapshot().viscosity_pa_s, rel=1e-12)
+    rise = fixed.snapshot().electrical.shear_temperature_rise_k
+    assert rise > 0.0
+    assert heated_inlet_viscosity_pa_s(lub, 20.0, rise) == pytest.approx(fixed.snapshot().viscosity_pa_s, rel=1e-12)
     assert fixed.snapshot().thermal is None
 
 
@@ -47,10 +59,11 @@ def test_friction_heats_the_bearing_and_thins_the_oil(warmed):
     # energy: the heat is the drive power (friction torque x shaft speed over the period), split by source
     assert sum(th.heat_w.values()) == pytest.approx(th.heat_inner_contacts_w + th.heat_outer_contacts_w, rel=1e-9)
     assert 20.0 < sum(th.heat_w.values()) < 1000.0
-    # the warmer inlet thins the film: viscosity at the network's inlet temperature (ASTM D341)
+    # the warmer inlet thins the film: viscosity at the network's inlet temperature (ASTM D341), shear-heated
     lub = twin.model.spec.lubricant
     assert th.inlet_temperature_c > 25.0
-    assert end.viscosity_pa_s == pytest.approx(dynamic_viscosity_pa_s(lub, th.inlet_temperature_c), rel=1e-9)
+    assert end.viscosity_pa_s == pytest.approx(
+        heated_inlet_viscosity_pa_s(lub, th.inlet_temperature_c, end.electrical.shear_temperature_rise_k), rel=1e-9)
     assert end.viscosity_pa_s < 0.7 * start.viscosity_pa_s
     # expansion: the hotter balls and inner ring close the clearance
     assert th.clearance_change_m < 0.0

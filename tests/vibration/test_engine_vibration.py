@@ -157,17 +157,23 @@ def test_ball_defect_two_bsf_with_cage_sidebands(runs):
     line (within 1 %) comes with sidebands at -+ FTF of about its own size, and FTF harmonics appear
     in the envelope (Randall & Antoni 2011 sec. 2.1). Asserted: 2 x BSF and both sidebands present,
     the 2 x BSF line at least half the largest peak above 4 FTF, and every one of the five largest
-    peaks above 4 FTF within 1 % of 2 x BSF, 4 x BSF or their FTF sidebands."""
+    peaks above 4 FTF within 1 % of a harmonic of BSF up to 4 x BSF or their FTF sidebands, the
+    2 x BSF line above the 1 x BSF one. The defect strikes the inner and the outer race once each per
+    spin; the two strikes are not equal, so the pulse train also carries BSF itself (measured with the
+    default, shear-heated inlet: 1 x BSF 2.2 m/s^2 against 3.2 at 2 x BSF; with seed 000's isothermal
+    inlet the fifth peak is 4 x BSF, 2.4)."""
     twin, v = runs("ball")
     _check_frequencies_from_geometry(twin, v)
     f = v.defect_frequencies_hz
-    family = [k * f.two_bsf + m * f.ftf for k in (1, 2) for m in (-1, 0, 1)]
+    family = [k * f.bsf + m * f.ftf for k in (1, 2, 4) for m in (-1, 0, 1)]
     above = [p for p in v.envelope_peaks_hz if p.frequency_hz > 4.0 * f.ftf]
     assert len(above) >= 3
-    for p in above:  # every large peak above the cage modulation: 2 x BSF, 4 x BSF and their FTF sidebands
+    for p in above:  # every large peak above the cage modulation: BSF, 2 x BSF, 4 x BSF and their FTF sidebands
         assert min(abs(p.frequency_hz / x - 1.0) for x in family) < 0.01, p
     line = v.envelope_lines["two_bsf"].harmonics[0]
     assert line > SIGNIFICANCE * _floor(v) and line > 0.5 * above[0].amplitude
+    bsf = [p.amplitude for p in above if abs(p.frequency_hz / f.bsf - 1.0) < 0.01]
+    assert all(a < line for a in bsf)
     lower, upper = v.envelope_lines["two_bsf"].sidebands
     assert lower > SIGNIFICANCE * _floor(v) and upper > SIGNIFICANCE * _floor(v)
     q = twin.state.ball_orientation

@@ -59,7 +59,7 @@ class BenchCase:
     radial_load_n: float = 3000.0
     axial_load_n: float = 0.0
     shaft_current_a: float = 0.0
-    shear_heating: bool = False
+    shear_heating: bool | None = None  # inlet shear heating (None: the spec's default, on)
     housing: bool | None = None       # outer ring on the housing (None: the spec's default, off)
     defect: str | None = None         # local defect of twin.validation.vibration_simulation.defect_for (outer, inner, ball)
     surface_profile: bool = False     # race profiles and ball sizes exciting the contacts (twin.vibration.surface)
@@ -84,7 +84,7 @@ CASES = (*CASES, EV_20K)
 
 def _twin(case: BenchCase, time_step_s: float | str) -> Twin:
     spec = catalog.bearing(case.designation)
-    if case.shear_heating != spec.thermal.shear_heating:
+    if case.shear_heating is not None and case.shear_heating != spec.thermal.shear_heating:
         spec = BearingSpec.model_validate({**spec.model_dump(), "thermal": {
             **spec.thermal.model_dump(), "shear_heating": case.shear_heating}})
     if case.housing is not None and case.housing != spec.housing.enabled:

@@ -36,7 +36,7 @@ def reference_outputs(case: tuple, settle_s: float = 0.01, window_s: float = 0.0
     """Window means of one case (module docstring), as plain lists and floats (SI)."""
     from twin.engine import Twin
     from twin.setpoint import Setpoint
-    from twin.spec import ModelOptions
+    from twin.spec import BearingSpec, ModelOptions
 
     _, designation, dt, speed, fr, fa = case
     # the sub-rates the reference was made with (commit 5454e19: tribology every 10 us, strip solve
@@ -45,7 +45,10 @@ def reference_outputs(case: tuple, settle_s: float = 0.01, window_s: float = 0.0
     from twin.model import make_model
     from twin.timestep import steps_per_period
 
-    spec = catalog.bearing(designation)
+    # the inlet that engine had: isothermal (seed 000's Hamrock-Dowson film), Thermal.shear_heating off
+    base = catalog.bearing(designation)
+    spec = BearingSpec.model_validate({**base.model_dump(), "thermal": {**base.thermal.model_dump(),
+                                                                         "shear_heating": False}})
     step_s = make_model(spec, ModelOptions(time_step_s=dt)).dt_s
     traction_s = REFERENCE_TRACTION_REFRESHES * steps_per_period(REFERENCE_TRIBOLOGY_PERIOD_S, step_s) * step_s
     # and with the refresh at its own step (centred_refresh=False), as that engine had it: the

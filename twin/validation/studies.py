@@ -37,10 +37,19 @@ class AzimuthZeroSample:
     epsilon: float
 
 
+def isothermal_spec(designation: str = "6208", diametral_clearance_m: float = 0.0) -> BearingSpec:
+    """The catalog bearing with an isothermal inlet (Thermal.shear_heating off): seed 000 solves
+    Hamrock-Dowson's isothermal film (section 2.3, eq. 6), so its Table 3 and Figs. 8-12 are
+    reproduced under that assumption; the twin's default heats the inlet (Murch-Wilson)."""
+    base = catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m)
+    return BearingSpec.model_validate({**base.model_dump(), "thermal": {**base.thermal.model_dump(),
+                                                                         "shear_heating": False}})
+
+
 def _new_twin(speed, load, clearance, options, designation="6208"):
-    return Twin(designation, options=options,
-                setpoint=Setpoint(shaft_speed_rad_s=speed, radial_load_n=load),
-                diametral_clearance_m=clearance)
+    # seed 000's studies: its isothermal inlet (isothermal_spec)
+    return Twin(isothermal_spec(designation, clearance), options=options,
+                setpoint=Setpoint(shaft_speed_rad_s=speed, radial_load_n=load))
 
 
 def sample_at_azimuth_zero(shaft_speed_rad_s: float, radial_load_n: float = 3000.0,

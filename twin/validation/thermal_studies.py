@@ -32,6 +32,7 @@ class Transient:
     min_lambda: np.ndarray           # smallest Lambda of the loaded contacts
     friction_torque_n_m: np.ndarray  # mean over the last network period (its heat / shaft speed)
     heat_w: np.ndarray               # total friction heat
+    shear_rise_k: np.ndarray         # inlet shear heating's equivalent temperature rise (Thermal.shear_heating)
     time_constants_s: tuple[float, ...]   # the network's at the end, real heat capacities, slowest first
     heat_capacity_scale: float
     network: Network                 # as assembled at the last network step (heat capacities scaled)
@@ -61,7 +62,7 @@ def startup_transient(designation: str = "6208", shaft_speed_rad_s: float = 1000
         rows.append(_row(snap, snap.thermal.network_time_s))
     a = np.array(rows)
     tau = tuple(float(x) for x in twin.thermal.time_constants_s())
-    return Transient(a[:, 0], a[:, 1:1 + len(NODE_NAMES)], a[:, -4], a[:, -3], a[:, -2], a[:, -1], tau,
+    return Transient(a[:, 0], a[:, 1:1 + len(NODE_NAMES)], a[:, -5], a[:, -4], a[:, -3], a[:, -2], a[:, -1], tau,
                      heat_capacity_scale, twin.thermal.network)
 
 
@@ -71,7 +72,7 @@ def _row(snap, t: float) -> list[float]:
     heat = sum(th.heat_w.values())
     torque = heat / snap.shaft_speed_rad_s if t > 0.0 and snap.shaft_speed_rad_s > 0.0 else snap.friction_torque_n_m
     return [t, *(th.temperatures_c[n] for n in NODE_NAMES), snap.viscosity_pa_s,
-            min(lams) if lams else float("nan"), torque, heat]
+            min(lams) if lams else float("nan"), torque, heat, snap.electrical.shear_temperature_rise_k]
 
 
 def period_study(thermal_steps_s=(1.0, 5.0, 20.0, 50.0), heat_capacity_scale: float = 1e-3,
