@@ -107,7 +107,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
     plan = twin_plan(twins)
     port, zport = _free_port(), _free_port()
     endpoint = f"tcp/127.0.0.1:{zport}"
-    repo = Path(__file__).resolve().parents[2]
+    repo = Path(__file__).resolve().parents[1]
     env = {**os.environ, "PYTHONUNBUFFERED": "1",
            "PYTHONPATH": os.pathsep.join(filter(None, [str(repo), os.environ.get("PYTHONPATH")]))}
     if force:
@@ -178,6 +178,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
                 first = {t["id"]: t for t in http.get("/health").json()["twins"]}
                 latencies: dict[str, list[float]] = {tid: [] for tid, _ in running}
                 lost = k = 0
+                put_s: list[float] = []
                 next_health = time.perf_counter()
                 t_end = time.perf_counter() + seconds
                 while time.perf_counter() < t_end:
@@ -188,6 +189,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
                     key = twin_key(prefix, tid, STATE)
                     t0 = time.perf_counter()
                     http.put(f"/v1/bearings/{tid}/setpoint", json={"radial_load_n": load}).raise_for_status()
+                    put_s.append(time.perf_counter() - t0)
                     if zenoh_on:
                         seen, wait_until = None, t0 + 1.0
                         while seen is None and time.perf_counter() < wait_until:
@@ -232,6 +234,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
             "dropped": b.get("dropped"), "publish_skipped": b.get("publish_skipped"),
             "cost": b.get("cost"), "setpoints": len(latencies.get(tid, [])),
             "client_latency_ms_p99": ms(_percentile(latencies.get(tid, []), 99)),
+            "service_latency_ms": b.get("setpoint_latency_ms"),
         })
     every = [v for values in latencies.values() for v in values]
     return {
@@ -244,5 +247,6 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
         "client_latency_ms_p99": ms(_percentile(every, 99)),
         "client_latency_ms_max": ms(max(every)) if every else None,
         "client_lost": lost,
+        "http_put_ms_p50": ms(_percentile(put_s, 50)), "http_put_ms_p99": ms(_percentile(put_s, 99)),
         "capacity": health.get("capacity"), "recording_rows": health.get("recording_rows"),
     }

@@ -186,6 +186,7 @@ class TwinHealth(BaseModel):
     last_safe_setpoint: Setpoint | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")
     publish_skipped: int = Field(default=0, description="Captured states dropped before their snapshot was built because the publish worker was behind (real-time mode) [-].")
     cost: TwinCost | None = Field(default=None, description="CPU this twin needs in real time, as measured (its calibration until measured while running) [CPU s / s]; null when not measured.")
+    setpoint_latency_ms: dict[str, Any] | None = Field(default=None, description="Latency of the newest 1000 outside setpoints inside the service [ms]: `apply` (accepted -> applied at a frame boundary), `step` (-> the frame that applies it captured), `build` (-> its snapshot built), `publish` (-> handed to every sink, the zenoh state put), `total`, each {p50, p99, max}, and `count`; null before the first.")
 
 
 class ThreadPriorityHealth(BaseModel):
