@@ -97,14 +97,15 @@ class _Serve:
                 self.proc.wait(10.0)
 
 
-def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float = 20.0, *,
+def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: float = 20.0, *,
                           record: bool = True, zenoh_on: bool = True, force: bool = False,
                           settle_s: float = 3.0, start_timeout_s: float = 300.0) -> dict:
     import httpx
 
-    if twins < 1:
-        raise ValueError(f"twins = {twins!r}: at least 1")
-    plan = twin_plan(twins)
+    auto = twins == "auto"
+    if not auto and not (isinstance(twins, int) and twins >= 1):
+        raise ValueError(f"twins = {twins!r}: at least 1, or 'auto'")
+    plan = twin_plan(1 if auto else int(twins))
     port, zport = _free_port(), _free_port()
     endpoint = f"tcp/127.0.0.1:{zport}"
     repo = Path(__file__).resolve().parents[1]
@@ -143,6 +144,13 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
                     time.sleep(0.2)
                 if first_setpoint:
                     http.put(f"/v1/bearings/{first_id}/setpoint", json=first_setpoint).raise_for_status()
+                capacity_at_start = http.get("/health").json().get("capacity") or {}
+                if auto:
+                    held = capacity_at_start.get("max_twins")
+                    if held is None:
+                        raise RuntimeError("--twins auto: the service states no capacity (admission off, or no "
+                                           "twin calibrated): give a number of twins")
+                    plan = twin_plan(max(1, int(held)))
                 running = [(first_id, first_designation)]
                 for twin_id, designation, setpoint in plan[1:]:
                     body = {"id": twin_id, "designation": designation, **({"setpoint": setpoint} if setpoint else {})}
@@ -238,7 +246,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
         })
     every = [v for values in latencies.values() for v in values]
     return {
-        "twins_requested": twins, "seconds": seconds, "rate_hz": rate_hz, "zenoh": zenoh_on,
+        "twins_requested": twins, "twins_planned": len(plan), "capacity_at_start": capacity_at_start, "seconds": seconds, "rate_hz": rate_hz, "zenoh": zenoh_on,
         "recording": record, "admission": "off" if force else health.get("capacity", {}).get("admission"),
         "frame_s": (last.get(running[0][0]) or {}).get("frame_s"),
         "lateness_s": (last.get(running[0][0]) or {}).get("lateness_s"),
