@@ -97,17 +97,18 @@ class _Serve:
                 self.proc.wait(10.0)
 
 
-def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float = 20.0, *,
+def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: float = 20.0, *,
                           record: bool = True, zenoh_on: bool = True, force: bool = False,
                           settle_s: float = 3.0, start_timeout_s: float = 300.0) -> dict:
     import httpx
 
-    if twins < 1:
-        raise ValueError(f"twins = {twins!r}: at least 1")
-    plan = twin_plan(twins)
+    auto = twins == "auto"
+    if not auto and not (isinstance(twins, int) and twins >= 1):
+        raise ValueError(f"twins = {twins!r}: at least 1, or 'auto'")
+    plan = twin_plan(1 if auto else int(twins))
     port, zport = _free_port(), _free_port()
     endpoint = f"tcp/127.0.0.1:{zport}"
-    repo = Path(__file__).resolve().parents[2]
+    repo = Path(__file__).resolve().parents[1]
     env = {**os.environ, "PYTHONUNBUFFERED": "1",
            "PYTHONPATH": os.pathsep.join(filter(None, [str(repo), os.environ.get("PYTHONPATH")]))}
     if force:
@@ -143,6 +144,13 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
                     time.sleep(0.2)
                 if first_setpoint:
                     http.put(f"/v1/bearings/{first_id}/setpoint", json=first_setpoint).raise_for_status()
+                capacity_at_start = http.get("/health").json().get("capacity") or {}
+                if auto:
+                    held = capacity_at_start.get("max_twins")
+                    if held is None:
+                        raise RuntimeError("--twins auto: the service states no capacity (admission off, or no "
+                                           "twin calibrated): give a number of twins")
+                    plan = twin_plan(max(1, int(held)))
                 running = [(first_id, first_designation)]
                 for twin_id, designation, setpoint in plan[1:]:
                     body = {"id": twin_id, "designation": designation, **({"setpoint": setpoint} if setpoint else {})}
@@ -178,6 +186,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
                 first = {t["id"]: t for t in http.get("/health").json()["twins"]}
                 latencies: dict[str, list[float]] = {tid: [] for tid, _ in running}
                 lost = k = 0
+                put_s: list[float] = []
                 next_health = time.perf_counter()
                 t_end = time.perf_counter() + seconds
                 while time.perf_counter() < t_end:
@@ -188,6 +197,7 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
                     key = twin_key(prefix, tid, STATE)
                     t0 = time.perf_counter()
                     http.put(f"/v1/bearings/{tid}/setpoint", json={"radial_load_n": load}).raise_for_status()
+                    put_s.append(time.perf_counter() - t0)
                     if zenoh_on:
                         seen, wait_until = None, t0 + 1.0
                         while seen is None and time.perf_counter() < wait_until:
@@ -232,10 +242,11 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
             "dropped": b.get("dropped"), "publish_skipped": b.get("publish_skipped"),
             "cost": b.get("cost"), "setpoints": len(latencies.get(tid, [])),
             "client_latency_ms_p99": ms(_percentile(latencies.get(tid, []), 99)),
+            "service_latency_ms": b.get("setpoint_latency_ms"),
         })
     every = [v for values in latencies.values() for v in values]
     return {
-        "twins_requested": twins, "seconds": seconds, "rate_hz": rate_hz, "zenoh": zenoh_on,
+        "twins_requested": twins, "twins_planned": len(plan), "capacity_at_start": capacity_at_start, "seconds": seconds, "rate_hz": rate_hz, "zenoh": zenoh_on,
         "recording": record, "admission": "off" if force else health.get("capacity", {}).get("admission"),
         "frame_s": (last.get(running[0][0]) or {}).get("frame_s"),
         "lateness_s": (last.get(running[0][0]) or {}).get("lateness_s"),
@@ -244,5 +255,6 @@ def run_service_benchmark(twins: int = 1, seconds: float = 10.0, rate_hz: float 
         "client_latency_ms_p99": ms(_percentile(every, 99)),
         "client_latency_ms_max": ms(max(every)) if every else None,
         "client_lost": lost,
+        "http_put_ms_p50": ms(_percentile(put_s, 50)), "http_put_ms_p99": ms(_percentile(put_s, 99)),
         "capacity": health.get("capacity"), "recording_rows": health.get("recording_rows"),
     }

@@ -22,8 +22,9 @@ def build_parser() -> argparse.ArgumentParser:
     bsv = sub.add_parser("bench-service", help="service benchmark: N twins in real time with zenoh and "
                          "recording on: real-time factor and late fraction per twin, HTTP setpoint -> "
                          "zenoh state delay (p50/p99)")
-    bsv.add_argument("--twins", type=_positive_int, default=1,
-                     help="twins to run: 6208, 6205, 7208, 6208 with 5 A, in turn (default 1)")
+    bsv.add_argument("--twins", type=_twins, default=1,
+                     help="twins to run: 6208, 6205, 7208, 6208 with 5 A, in turn (default 1); 'auto': as many "
+                     "as the service's capacity states once the first is calibrated (/health capacity.max_twins)")
     bsv.add_argument("--seconds", type=_positive_float, default=10.0, help="measurement time [s of wall time]")
     bsv.add_argument("--rate", type=_positive_float, default=20.0, help="setpoints per second, all twins [Hz]")
     bsv.add_argument("--force", action="store_true",
@@ -58,11 +59,30 @@ def _cmd_bench_service(args: argparse.Namespace) -> int:
         print(f"  {t['id']:<14} {t['designation']:<5} refused ({t['status']}): {t['message']}")
     print(f"  HTTP PUT -> zenoh state [ms]: p50 {f(r['client_latency_ms_p50'])}, "
           f"p99 {f(r['client_latency_ms_p99'])}, max {f(r['client_latency_ms_max'])}, lost {r['client_lost']}")
+    if r.get("http_put_ms_p50") is not None:
+        print(f"  HTTP PUT round trip [ms]: p50 {f(r['http_put_ms_p50'])}, p99 {f(r['http_put_ms_p99'])}")
+    for t in r["twins"]:
+        stages = t.get("service_latency_ms") or {}
+        if stages:
+            print(f"  {t['id']:<14} in the service [ms, p50/p99]: " + ", ".join(
+                f"{k} {f(v['p50'])}/{f(v['p99'])}" for k, v in stages.items() if isinstance(v, dict)))
     cap = r.get("capacity") or {}
+    if cap.get("formula"):
+        print(f"  capacity: {cap['formula']}")
+    overhead = cap.get("service_overhead") or {}
+    if overhead.get("overhead_fraction") is not None:
+        print(f"  service overhead: {f(overhead['overhead_cpu_s_per_s'], '{:.3f}')} CPU s/s beside the engines' "
+              f"{f(overhead['engine_cpu_s_per_s'], '{:.3f}')} = {f(overhead['overhead_fraction'], '{:.1%}')} "
+              f"(goal <= {overhead['goal_fraction']:.0%})")
     if cap:
         print(f"  capacity: {f(cap.get('used_cpu_s_per_s'), '{:.3f}')} of {f(cap.get('budget_cpu_s_per_s'), '{:.3f}')} "
               f"CPU s per s in use; max twins like the last calibrated one: {cap.get('max_twins')}")
     return 0
+
+
+def _twins(text: str) -> int | str:
+    """--twins: a positive count or 'auto'."""
+    return "auto" if text.strip().lower() == "auto" else _positive_int(text)
 
 
 def f(value: float | None, spec: str = "{:.2f}") -> str:

@@ -162,6 +162,7 @@ class TwinCost(BaseModel):
     engine_cpu_s_per_sim_s: float = Field(description="Engine CPU time per simulated second [CPU s / s]: 1 / the real-time factor the twin would have alone on a core.")
     publish_cpu_s_per_s: float = Field(description="CPU time spent building its snapshots per wall second, at the publish rate [CPU s / s].")
     cpu_s_per_s: float = Field(description="The sum: CPU time the twin needs per wall second in real time [CPU s / s].")
+    publish_fraction: float | None = Field(default=None, description="Snapshot building per engine CPU time [-]; null for an engine that costs nothing.")
 
 
 class Capacity(BaseModel):
@@ -178,6 +179,9 @@ class Capacity(BaseModel):
     max_twins_set: int | None = Field(default=None, description="The max_twins setting; null = unset [-].")
     last_calibration: TwinCost | None = Field(default=None, description="The cost measured at the last twin creation [CPU s / s]; null before one.")
     over_capacity: str | None = Field(default=None, description="Why the configured twin runs although it does not fit; null when it fits [text].")
+    reserve_cores: float = Field(default=0.0, description="CPU kept for the service's other threads, taken from the budget [CPU s / s].")
+    formula: str | None = Field(default=None, description="How max_twins is reached, with the figures of the moment: budget = cores x core_fraction - reserve; max_twins = running + floor((budget - in use) / cost of a twin like the last calibrated) [text].")
+    service_overhead: dict[str, float | None] | None = Field(default=None, description="The process's CPU beside the engines over the last window of at least 1 s between two /health reads (service.core.capacity.ServiceOverheadMeter): `window_s` [s], `process_cpu_s_per_s`, `engine_cpu_s_per_s`, `overhead_cpu_s_per_s`, `overhead_per_twin_cpu_s_per_s` [CPU s / s], `overhead_fraction` (overhead / engines) against `goal_fraction` (0.10) [-]; null before a window closes.")
 
 
 
@@ -208,6 +212,7 @@ class TwinHealth(BaseModel):
     last_safe_setpoint: Setpoint | None = Field(default=None, description="The newest setpoint held without a restart, the fallback [fields with units].")
     publish_skipped: int = Field(default=0, description="Captured states dropped before their snapshot was built because the publish worker was behind (real-time mode) [-].")
     cost: TwinCost | None = Field(default=None, description="CPU this twin needs in real time, as measured (its calibration until measured while running) [CPU s / s]; null when not measured.")
+    setpoint_latency_ms: dict[str, Any] | None = Field(default=None, description="Latency of the newest 1000 outside setpoints inside the service [ms]: `apply` (accepted -> applied at a frame boundary), `step` (-> the frame that applies it captured), `build` (-> its snapshot built), `publish` (-> handed to every sink, the zenoh state put), `total`, each {p50, p99, max}, and `count`; null before the first.")
 
 
 class ThreadPriorityHealth(BaseModel):

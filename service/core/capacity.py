@@ -24,17 +24,35 @@ The rule (docs/service.md "Runner pool"):
   started in any case and said to be over capacity (warning in the log and in /health).
 
 `max_twins` (a setting) is a fixed cap on top; unset, the capacity alone decides (up to 256).
+
+The number of twins the host holds (`Capacity.estimate_max_twins`, /health `capacity.max_twins`,
+`bench-service --twins auto`) is, with C the cores the stepping threads can use, f the
+core_fraction, R the reserve, U the measured cost of the running twins and c the measured cost of
+a twin like the last one calibrated::
+
+    max_twins = running + floor((C f - R - U) / c)          (c <= f, else no more twin fits)
+
+and `Capacity.formula` writes it out with the figures of the moment.
+
+The SERVICE OVERHEAD is what the process spends beside the engines: the Python between frames,
+building and publishing snapshots, the zenoh, recording, alarm and HTTP threads
+(`ServiceOverheadMeter`: the process's CPU time less the engines' thread CPU time, over at least
+a second of wall time). Its share of the engines' own CPU (`overhead_fraction`) has a goal of
+`OVERHEAD_GOAL` (10 %): above it the service, not the physics, limits how many twins a host holds.
 """
 
 from __future__ import annotations
 
 import math
 import os
+import threading
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 
 from twin.engine import Twin
+
+OVERHEAD_GOAL = 0.10   # service CPU beside the engines / the engines' CPU, at most [-]
 
 
 def usable_cores() -> int:
@@ -84,9 +102,16 @@ class TwinCost:
         """Total CPU s per wall s in real time [CPU s / s]."""
         return self.engine_cpu_s_per_sim_s + self.publish_cpu_s_per_s
 
+    @property
+    def publish_fraction(self) -> float | None:
+        """Snapshot building per engine CPU [-] (None for an engine that costs nothing)."""
+        e = self.engine_cpu_s_per_sim_s
+        return self.publish_cpu_s_per_s / e if e > 0 else None
+
     def as_dict(self) -> dict:
         return {"engine_cpu_s_per_sim_s": self.engine_cpu_s_per_sim_s,
-                "publish_cpu_s_per_s": self.publish_cpu_s_per_s, "cpu_s_per_s": self.cpu_s_per_s}
+                "publish_cpu_s_per_s": self.publish_cpu_s_per_s, "cpu_s_per_s": self.cpu_s_per_s,
+                "publish_fraction": self.publish_fraction}
 
 
 def calibrate(twin: Twin, *, sim_s: float = 0.02, frame_steps: int = 5000, publish_rate_hz: float = 50.0,
@@ -168,6 +193,18 @@ class Capacity:
         return Verdict(True, f"admitted: {figures}; in use {used + need:.3f} of {budget:.3f}",
                        need, used, budget, per_twin)
 
+    def formula(self, typical: TwinCost | None, running: int, used_cpu_s_per_s: float) -> str:
+        """How `estimate_max_twins` reaches its number, with the figures of the moment."""
+        head = (f"budget = {self.usable_cores} cores x core_fraction {self.core_fraction:g} - reserve "
+                f"{self.reserve_cores:g} = {self.budget_cpu_s_per_s:.3f} CPU s/s")
+        if typical is None or not (typical.cpu_s_per_s > 0 and math.isfinite(typical.cpu_s_per_s)):
+            return head + "; no twin calibrated yet"
+        n = self.estimate_max_twins(typical, running, used_cpu_s_per_s)
+        return (f"{head}; a twin like the last calibrated needs c = engine {typical.engine_cpu_s_per_sim_s:.3f} + "
+                f"snapshots {typical.publish_cpu_s_per_s:.3f} = {typical.cpu_s_per_s:.3f} CPU s/s; max_twins = "
+                f"{running} running + floor(({self.budget_cpu_s_per_s:.3f} - {used_cpu_s_per_s:.3f} in use) / "
+                f"{typical.cpu_s_per_s:.3f}) = {n}")
+
     def estimate_max_twins(self, typical: TwinCost | None, running: int, used_cpu_s_per_s: float) -> int | None:
         """Twins this host holds in real time: the running ones plus as many more like `typical`
         as the budget has room for (None without a measured cost)."""
@@ -177,3 +214,44 @@ class Capacity:
             return running
         room = max(0.0, self.budget_cpu_s_per_s - used_cpu_s_per_s)
         return running + int(room // typical.cpu_s_per_s)
+
+
+class ServiceOverheadMeter:
+    """The service's CPU beside the engines (see the module docstring): each `sample` compares the
+    process's CPU time and the engines' summed thread CPU time with those of the sample at least
+    `min_window_s` of wall time before, and keeps the last closed window's figures. Thread-safe."""
+
+    def __init__(self, min_window_s: float = 1.0, *, clock: Callable[[], float] = time.monotonic,
+                 cpu_clock: Callable[[], float] = time.process_time):
+        self.min_window_s = float(min_window_s)
+        self._clock = clock
+        self._cpu_clock = cpu_clock
+        self._lock = threading.Lock()
+        self._mark: tuple[float, float, float] | None = None     # (wall, process CPU, engine CPU)
+        self._last: dict | None = None
+
+    def sample(self, engine_cpu_s_total: float, twins: int) -> dict | None:
+        """The last closed window's figures (None before one closes): `process_cpu_s_per_s`,
+        `engine_cpu_s_per_s`, `overhead_cpu_s_per_s` (their difference), its share per twin and of
+        the engines' CPU (`overhead_fraction`) against `goal_fraction` [CPU s / s, -]."""
+        now, cpu = self._clock(), self._cpu_clock()
+        with self._lock:
+            mark = self._mark
+            if mark is None or engine_cpu_s_total < mark[2]:      # first sample, or a twin left
+                self._mark = (now, cpu, engine_cpu_s_total)
+                return self._last
+            wall = now - mark[0]
+            if wall < self.min_window_s:
+                return self._last
+            process = (cpu - mark[1]) / wall
+            engine = (engine_cpu_s_total - mark[2]) / wall
+            overhead = max(0.0, process - engine)
+            self._last = {
+                "window_s": wall, "process_cpu_s_per_s": process, "engine_cpu_s_per_s": engine,
+                "overhead_cpu_s_per_s": overhead,
+                "overhead_per_twin_cpu_s_per_s": overhead / twins if twins > 0 else None,
+                "overhead_fraction": overhead / engine if engine > 0 else None,
+                "goal_fraction": OVERHEAD_GOAL,
+            }
+            self._mark = (now, cpu, engine_cpu_s_total)
+            return self._last

@@ -28,6 +28,8 @@ class SetpointTiming:
 
     accepted_wall_s: float                 # clock() at acceptance
     applied_wall_s: float | None = None    # when the runner applied it (frame boundary)
+    captured_wall_s: float | None = None   # when the frame that reflects it was captured for publication
+    built_wall_s: float | None = None      # when that capture's snapshot was built
     published_wall_s: float | None = None  # when the first snapshot reflecting it was published
     seq: int | None = None                 # that snapshot's seq
 
@@ -37,6 +39,17 @@ class SetpointTiming:
         if self.published_wall_s is None:
             return None
         return self.published_wall_s - self.accepted_wall_s
+
+    def stages_s(self) -> dict[str, float] | None:
+        """The latency by stage [s] (None until published): `apply` accepted -> applied at a frame
+        boundary (the stepping thread's wake-up), `step` applied -> captured (the frame that applies
+        it), `build` captured -> its snapshot built, `publish` built -> handed to every sink (the
+        zenoh state put)."""
+        a, b, c, e, d = (self.accepted_wall_s, self.applied_wall_s, self.captured_wall_s, self.built_wall_s,
+                         self.published_wall_s)
+        if b is None or c is None or e is None or d is None:
+            return None
+        return {"apply": b - a, "step": c - b, "build": e - c, "publish": d - e}
 
 
 Guard = Callable[[Setpoint, SetpointUpdate], None]

@@ -41,7 +41,7 @@ from pydantic import ValidationError
 from service.core.admission import AdmissionGate
 from service.core.alarm_hub import AlarmHub
 from service.core.alarms import AlarmEvent
-from service.core.capacity import Capacity, TwinCost, calibrate, usable_cores
+from service.core.capacity import Capacity, ServiceOverheadMeter, TwinCost, calibrate, usable_cores
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.intake import DefectIntake, SetpointIntake
 from service.core.measured import MeasuredComparator, MeasuredIntake
@@ -147,6 +147,7 @@ class TwinRegistry:
         self.pool = SteppingPool(threads, name="step")
         self.priority = ThreadPriority(self.pool.native_ids, settings.io_thread_nice, settings.stepping_thread_nice,
                                        keep_names=EGRESS_THREAD_NAMES)
+        self.overhead = ServiceOverheadMeter()
         self.capacity = Capacity(threads, settings.capacity_core_fraction,
                                  reserve_cores=settings.capacity_reserve_cores)
         self.last_calibration: TwinCost | None = None
@@ -434,7 +435,9 @@ class TwinRegistry:
         with self._lock:
             costs = self._running_costs()
             running = len(self._twins)
+            engine_cpu_s = sum(e.runner.engine_cpu.cpu_s for e in self._twins.values())
         used = sum(c.cpu_s_per_s for c in costs)
+        overhead = self.overhead.sample(engine_cpu_s, running)
         typical = self.last_calibration
         cap = self.capacity
         estimate = cap.estimate_max_twins(typical, running, used)
@@ -447,6 +450,7 @@ class TwinRegistry:
             "used_cpu_s_per_s": used, "over_budget": used > cap.budget_cpu_s_per_s, "max_twins": estimate, "max_twins_set": self.settings.max_twins,
             "last_calibration": typical.as_dict() if typical is not None else None,
             "over_capacity": self.over_capacity,
+            "formula": cap.formula(typical, running, used), "service_overhead": overhead,
         }
 
     def delete_twin(self, bearing_id: str) -> TwinEntry:

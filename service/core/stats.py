@@ -4,8 +4,12 @@ gathers them with the pacing clock's, the publisher's, the mailbox's and the fau
 
 from __future__ import annotations
 
+import math
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
+
+LATENCY_WINDOW = 1000     # setpoints the /health latency figures cover (the newest)
 
 
 @dataclass
@@ -20,6 +24,31 @@ class LoopCounters:
     def error(self, exc: BaseException) -> None:
         self.errors += 1
         self.last_error = f"{type(exc).__name__}: {exc}"
+
+
+def percentile(values: list[float], q: float) -> float:
+    """The q-th percentile of non-empty `values` by the nearest rank (no interpolation)."""
+    ordered = sorted(values)
+    return ordered[max(0, min(len(ordered) - 1, math.ceil(q / 100.0 * len(ordered)) - 1))]
+
+
+def setpoint_latency_ms(timings: Iterable[Any]) -> dict | None:
+    """Accepted -> published latency of setpoints inside the service, whole and by stage
+    (`SetpointTiming.stages_s`), as {stage: {"p50", "p99", "max"}} [ms] plus `count`; None
+    without a completed timing."""
+    stages: dict[str, list[float]] = {}
+    for t in timings:
+        parts = t.stages_s()
+        if parts is None:
+            continue
+        for name, value in (*parts.items(), ("total", t.latency_s)):
+            stages.setdefault(name, []).append(1e3 * value)
+    if not stages:
+        return None
+    out: dict[str, Any] = {name: {"p50": round(percentile(v, 50), 3), "p99": round(percentile(v, 99), 3),
+                                  "max": round(max(v), 3)} for name, v in stages.items()}
+    out["count"] = len(stages["total"])
+    return out
 
 
 def health_record(runner: Any, *, setpoints_refused: int = 0, setpoints_rate_limited: int = 0) -> dict:
@@ -40,4 +69,5 @@ def health_record(runner: Any, *, setpoints_refused: int = 0, setpoints_rate_lim
         "last_safe_setpoint": runner.last_safe_setpoint.model_dump(),
         "publish_skipped": runner.publisher.skipped,
         "cost": cost.as_dict() if cost is not None else None,
+        "setpoint_latency_ms": setpoint_latency_ms(runner.publisher.recent_timings(LATENCY_WINDOW)),
     }

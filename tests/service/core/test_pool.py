@@ -15,7 +15,7 @@ import time
 
 import pytest
 
-from service.core.capacity import Capacity, CpuMeter, TwinCost, calibrate
+from service.core.capacity import OVERHEAD_GOAL, Capacity, CpuMeter, ServiceOverheadMeter, TwinCost, calibrate
 from service.core.errors import InputError
 from service.core.pacing import PacingClock
 from service.core.pool import EdfQueue, Job, Schedule, SteppingPool
@@ -399,6 +399,34 @@ def test_capacity_rule():
     assert Capacity(1, 0.85, cores=1, reserve_cores=0.5).budget_cpu_s_per_s == pytest.approx(0.85)
     with pytest.raises(ValueError, match="reserve_cores"):
         Capacity(2, 0.85, reserve_cores=-1.0)
+
+
+def test_capacity_formula_states_the_figures_it_counts_with():
+    cap = Capacity(2, 0.85, cores=2, reserve_cores=0.5)            # budget 2 x 0.85 - 0.5 = 1.2
+    assert "no twin calibrated yet" in cap.formula(None, 0, 0.0)
+    twin = TwinCost(0.25, 0.03)                                    # c = 0.28: floor((1.2 - 0.28) / 0.28) = 3
+    text = cap.formula(twin, 1, 0.28)
+    assert cap.estimate_max_twins(twin, 1, 0.28) == 4
+    assert "= 1.200 CPU s/s" in text and "c = engine 0.250 + snapshots 0.030 = 0.280" in text
+    assert text.endswith("1 running + floor((1.200 - 0.280 in use) / 0.280) = 4")
+    assert twin.publish_fraction == pytest.approx(0.12)
+
+
+def test_service_overhead_is_the_process_cpu_beside_the_engines():
+    wall, cpu = [0.0], [0.0]
+    meter = ServiceOverheadMeter(1.0, clock=lambda: wall[0], cpu_clock=lambda: cpu[0])
+    assert meter.sample(0.0, 2) is None                            # the first mark
+    wall[0], cpu[0] = 0.5, 0.3
+    assert meter.sample(0.25, 2) is None                           # the window is not closed yet
+    wall[0], cpu[0] = 2.0, 1.1                                     # 0.55 CPU s/s, engines 0.5
+    out = meter.sample(1.0, 2)
+    assert out["process_cpu_s_per_s"] == pytest.approx(0.55) and out["engine_cpu_s_per_s"] == pytest.approx(0.5)
+    assert out["overhead_cpu_s_per_s"] == pytest.approx(0.05)
+    assert out["overhead_per_twin_cpu_s_per_s"] == pytest.approx(0.025)
+    assert out["overhead_fraction"] == pytest.approx(0.10) and out["goal_fraction"] == OVERHEAD_GOAL
+    wall[0] = 2.5
+    assert meter.sample(1.2, 2) is out                             # kept until the next window closes
+    assert meter.sample(0.1, 1) is out                             # a twin left: a new mark, no negative figure
 
 
 def test_calibration_measures_thread_cpu_per_simulated_second():

@@ -419,3 +419,31 @@ def test_a_setpoint_is_published_at_the_end_of_the_frame_that_applied_it(twin, m
     assert runner.published == 2                       # no other publication since
     (timing,) = runner.setpoint_latencies()
     assert timing.seq == snap.seq and timing.published_wall_s >= timing.applied_wall_s
+
+
+def test_a_setpoint_snapshot_is_delivered_by_the_stepping_thread_in_order(twin, make_runner):
+    """The snapshot that carries an outside setpoint is built and handed to the sinks on the
+    stepping thread (no hop to the publish worker); the 50 Hz snapshots stay on the worker, and
+    the seq numbers stay gapless and increasing across both paths."""
+    sink = ListSink()
+    runner = make_runner(twin, publish_rate_hz=200.0, frame_s=0.005, sinks=[sink]).start()
+    assert wait_until(lambda: runner.published >= 5)
+    for k in range(5):
+        runner.submit(radial_load_n=4000.0 + k)
+        assert sink.wait_for(lambda s, k=k: s.setpoint.radial_load_n == 4000.0 + k) is not None
+    assert wait_until(lambda: len(runner.setpoint_latencies()) == 5)
+    assert runner.stop(timeout=10.0)
+    seqs = [s.seq for s in sink.snapshots]
+    assert seqs == list(range(seqs[0], seqs[0] + len(seqs)))
+    workers = {runner._pool.publisher.thread_name}
+    assert set(runner.stepping_threads) <= sink.threads <= set(runner.stepping_threads) | workers | {"MainThread"}
+    assert workers <= sink.threads
+    for timing in runner.setpoint_latencies():
+        stages = timing.stages_s()
+        assert stages is not None and set(stages) == {"apply", "step", "build", "publish"}
+        assert all(v >= 0.0 for v in stages.values())
+        assert sum(stages.values()) == pytest.approx(timing.latency_s, abs=1e-9)
+    latency = runner.stats()["setpoint_latency_ms"]
+    assert latency["count"] == 5
+    assert set(latency) == {"apply", "step", "build", "publish", "total", "count"}
+    assert latency["total"]["p50"] <= latency["total"]["p99"] <= latency["total"]["max"]
