@@ -17,6 +17,10 @@ _FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
 Regime = Literal["no_contact", "boundary", "mixed", "full_film"]
 
+LAMBDA_KEY = "lambda"
+"""The film parameter's name in every message, entity path and table; `ContactState.lambda_` in
+Python, where `lambda` is a keyword."""
+
 
 class ContactState(BaseModel):
     """One ball-raceway contact."""
@@ -25,7 +29,7 @@ class ContactState(BaseModel):
     load_n: float = Field(description="Normal (elastic Hertz) load [N].")
     h_min_m: float | None = Field(description="Minimum film thickness [m]; null without contact.")
     h_c_m: float | None = Field(description="Central film thickness [m]; null without contact.")
-    lambda_: float | None = Field(alias="lambda", serialization_alias="lambda",
+    lambda_: float | None = Field(alias=LAMBDA_KEY, serialization_alias=LAMBDA_KEY,
                                   description="Film parameter Lambda = h_min / (1.25 sqrt(s1^2 + s2^2)) [-]; null without contact.")
     regime: Regime = Field(description="Lubrication regime (seed 000 Table 2).")
     mu: float = Field(description="Effective friction coefficient |F_t| / Q: net tangential force over normal load of the "

@@ -72,6 +72,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 from service.core.measured import KURTOSIS_MARGIN, LINE_ALARM_DB
 from service.settings import AlarmSettings
+from twin.snapshot import LAMBDA_KEY
 
 __all__ = ["ALARM_IDS", "ISO_20816_3_ZONES", "Alarm", "AlarmEvaluator", "AlarmEvent", "AlarmInputs",
            "AlarmSettings", "AlarmTracker", "Level", "Rule", "VibrationInputs", "inputs_from_snapshot",
@@ -157,15 +158,14 @@ class AlarmInputs:
     residual_k: float | None = None                   # measured - predicted temperature [K]
 
 
-def _get(obj: Any, *names: str) -> Any:
-    """The first of `names` that `obj` (a model, an object or a mapping) has and is not None."""
+def _get(obj: Any, name: str) -> Any:
+    """Field `name` of `obj`: a snapshot model's attribute, or its wire key in the snapshot's dict
+    (`lambda_` is `lambda` on the wire); None when absent."""
     if obj is None:
         return None
-    for name in names:
-        value = obj.get(name) if isinstance(obj, Mapping) else getattr(obj, name, None)
-        if value is not None:
-            return value
-    return None
+    if isinstance(obj, Mapping):
+        return obj.get(LAMBDA_KEY if name == "lambda_" else name)
+    return getattr(obj, name, None)
 
 
 def finite_number(value: Any) -> float | None:
@@ -225,7 +225,7 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
         for c, load in zip(contacts, loads, strict=True):
             if load <= 0.0 or load < cut:
                 continue
-            lam = finite_number(_get(c, "lambda_", "lambda"))
+            lam = finite_number(_get(c, "lambda_"))
             if lam is None:
                 continue
             min_lambda = lam if min_lambda is None else min(min_lambda, lam)

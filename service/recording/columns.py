@@ -19,6 +19,7 @@ import numpy as np
 import rerun as rr
 
 from service.recording.arrow import bar_columns
+from twin.snapshot import LAMBDA_KEY
 from service.recording.layout import (
     CONTACT_SERIES,
     LOAD_ZONE,
@@ -275,7 +276,7 @@ def slow_columns(tw: TwinLayout, batch: Batch) -> None:
     n = len(rows)
     root = tw.root
     c = np.stack([r.contacts for r in rows]).reshape(n, -1, len(CONTACT_FIELDS))   # (n, 2z, K)
-    fields = {"load_n": c[..., F_LOAD], "lambda": c[..., F_LAMBDA], "mu": c[..., F_MU],
+    fields = {"load_n": c[..., F_LOAD], LAMBDA_KEY: c[..., F_LAMBDA], "mu": c[..., F_MU],
               "resistance_log10_kohm": log10_kohm(c[..., F_R]), "capacitance_pf": c[..., F_C] * 1e12}
     has_el = bool(np.isfinite(c[..., F_C]).any())
     for leaf, _title in CONTACT_SERIES:

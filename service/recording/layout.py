@@ -89,6 +89,7 @@ import rerun.blueprint as rrb
 from rerun.encodings import TimeRange
 
 from service.core.alarms import ALARM_IDS
+from twin.snapshot import LAMBDA_KEY
 
 SIM_TIME = "sim_time"
 SEQ = "seq"
@@ -134,10 +135,10 @@ ALARM_STATE_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
 ALARM_LOG_LEVEL = {"warning": "WARN", "critical": "CRITICAL", None: "INFO"}
 
 SIDES = ("inner", "outer")
-LOAD_ZONE = (("load_n", "contact load Q [N]"), ("lambda", "film parameter Lambda [-]"),
+LOAD_ZONE = (("load_n", "contact load Q [N]"), (LAMBDA_KEY, "film parameter Lambda [-]"),
              ("mu", "friction coefficient mu [-]"))
 # per-contact fields: entity leaf, title
-CONTACT_SERIES = (("load_n", "contact load [N]"), ("lambda", "Lambda [-]"), ("mu", "mu [-]"),
+CONTACT_SERIES = (("load_n", "contact load [N]"), (LAMBDA_KEY, "Lambda [-]"), ("mu", "mu [-]"),
                   ("resistance_log10_kohm", "log10 R [kohm]"), ("capacitance_pf", "C [pF]"))
 
 # bearing-level trends (service.recording.trends: a row per window of snapshots, the mean of each

@@ -28,6 +28,7 @@ from typing import Any
 from service.core.alarms import finite_number
 from service.keys import ALIVE, DEFAULT_PREFIX, STATE, all_twins
 from service.tools.client import strict_json
+from twin.snapshot import LAMBDA_KEY
 
 DEFAULT_CONNECT = ["tcp/127.0.0.1:7447"]
 
@@ -118,7 +119,7 @@ class TwinTable:
                 contact = ball.get(side)
                 if not isinstance(contact, dict):
                     continue
-                lam = finite_number(contact.get("lambda"))
+                lam = finite_number(contact.get(LAMBDA_KEY))
                 if lam is not None:
                     lambdas.append(lam)
                 regime = contact.get("regime")
