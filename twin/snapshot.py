@@ -23,9 +23,10 @@ Python, where `lambda` is a keyword."""
 
 
 class ContactState(BaseModel):
-    """One ball-raceway contact."""
+    """One ball-raceway contact. Lambda is `lambda_` in Python (`lambda` is a keyword) and
+    "lambda" on the wire: the model is built with `lambda_` and dumps by alias."""
 
-    model_config = _FROZEN
+    model_config = ConfigDict(**_FROZEN, validate_by_name=True)
     load_n: float = Field(description="Normal (elastic Hertz) load [N].")
     h_min_m: float | None = Field(description="Minimum film thickness [m]; null without contact.")
     h_c_m: float | None = Field(description="Central film thickness [m]; null without contact.")
