@@ -103,7 +103,8 @@ def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: 
     max_density = float(np.max(density)) if density.size else 0.0
     risk, reason = _risk(el, max_field, max_density, voltage, current)
     phase = math.atan2(z_total.imag, z_total.real)
-    capacitance, capacitance_reason = y.imag / omega, None
+    capacitance: float | None = y.imag / omega
+    capacitance_reason: str | None = None
     if phase > CAPACITIVE_PHASE_RAD:
         capacitance = None
         capacitance_reason = (f"not capacitive: impedance phase {math.degrees(phase):.1f} deg above -45 deg at "

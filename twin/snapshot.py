@@ -3,7 +3,7 @@ every field name, JSON without NaN or Infinity (undefined values are null)."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Final, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
@@ -17,7 +17,7 @@ _FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
 Regime = Literal["no_contact", "boundary", "mixed", "full_film"]
 
-LAMBDA_KEY = "lambda"
+LAMBDA_KEY: Final = "lambda"
 """The film parameter's name in every message, entity path and table; `ContactState.lambda_` in
 Python, where `lambda` is a keyword."""
 
