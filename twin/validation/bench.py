@@ -119,11 +119,12 @@ def measure(case: BenchCase, time_step_s: float | Literal["auto"] = "auto", seco
         cpu_factors.append(seconds / max(time.thread_time() - c0, 1e-9))
     dt = twin.model.dt_s
     best, median = max(factors), statistics.median(factors)
-    out: dict[str, Any] = {"time_step_s": dt, "real_time_factor": best, "real_time_factor_median": median,
-           "ns_per_step": dt / best * 1e9, "ns_per_step_median": dt / median * 1e9,
-           "cpu_real_time_factor": max(cpu_factors), "cpu_real_time_factor_median": statistics.median(cpu_factors),
-           "repeats": repeats, "housing": twin.model.housing_on, "defects": len(twin.defects),
-           "status": twin.status}
+    out: dict[str, Any] = {
+        "time_step_s": dt, "real_time_factor": best, "real_time_factor_median": median,
+        "ns_per_step": dt / best * 1e9, "ns_per_step_median": dt / median * 1e9,
+        "cpu_real_time_factor": max(cpu_factors), "cpu_real_time_factor_median": statistics.median(cpu_factors),
+        "repeats": repeats, "housing": twin.model.housing_on, "defects": len(twin.defects),
+        "status": twin.status}
     if twin.model.housing_on:
         from twin.accelerometer import window_indicators
 
