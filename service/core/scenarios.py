@@ -405,10 +405,11 @@ class ResolvedRun:
         for name, value in self.initial.fields.items():
             yield "initial", name, value
         for i, step in enumerate(self.steps):
-            if step.set is None and step.ramp is None:
+            update = step.set if step.set is not None else step.ramp
+            if update is None:
                 continue
             kind = "set" if step.set is not None else "ramp"
-            for name, value in (step.set or step.ramp).fields.items():
+            for name, value in update.fields.items():
                 yield f"steps[{i}].{kind}", name, value
 
     def check_defects(self, geometry, where: str = "") -> None:
