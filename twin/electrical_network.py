@@ -24,6 +24,7 @@ import numpy as np
 from twin.kernels import layout as L
 from twin.model import BearingModel
 from twin.physics.electrical import outer_zone_capacitance_f
+from twin.snapshot import DischargeRisk
 
 _MIN_GAP_M = 1e-9
 CAPACITIVE_PHASE_RAD = -math.pi / 4.0  # the network is capacitive at or below this impedance phase
@@ -47,7 +48,7 @@ class ElectricalNetwork:
     shaft_current_a: float
     max_film_field_v_m: float
     current_density_a_m2: float
-    discharge_risk: str                  # "none" | "possible" | "likely"
+    discharge_risk: DischargeRisk
     reason: str
 
 
@@ -120,7 +121,7 @@ def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: 
         reason=reason)
 
 
-def _risk(el, field, density, voltage, current) -> tuple[str, str]:
+def _risk(el, field, density, voltage, current) -> tuple[DischargeRisk, str]:
     if voltage <= 0.0 and current <= 0.0:
         return "none", "no shaft voltage or current"
     if density >= el.fluting_current_density_a_m2:

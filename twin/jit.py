@@ -12,8 +12,9 @@ on the module-level constants it imports (the lane layout, for instance), so a s
 survive a layout change. The cache therefore lives in a directory named after a digest of every
 source file of `twin/`, so any change of the engine's code compiles afresh. Both that digest and
 numba's per-file stamp (`StrippedSourceLocator`) are taken over the files' syntax trees without
-docstrings (comments never reach the tree), and a kernel is told apart from its namesakes by its
-own code rather than its line number: editing a docstring or a comment keeps the compiled cache.
+their string statements (the docstrings, attribute docstrings included; comments never reach the
+tree), and a kernel is told apart from its namesakes by its own code rather than its line number:
+editing a docstring or a comment keeps the compiled cache.
 """
 
 import ast
@@ -29,15 +30,25 @@ import numba
 from numba.core import caching
 
 
+# the package whose kernels the stripped-source locator serves and whose code names the cache
+ENGINE_ROOT = Path(__file__).resolve().parent
+
+
+def _is_string_statement(node: ast.AST) -> bool:
+    return isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)
+
+
 def _strip_docstrings(tree: ast.AST) -> ast.AST:
-    """The tree without the docstring of the module, of each class and of each function."""
+    """The tree without its string statements: the docstrings of the module, classes and
+    functions, and the attribute docstrings after an assignment (a bare string literal does
+    nothing when run)."""
     for node in ast.walk(tree):
-        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
-            body = node.body
-            first = body[0] if body else None
-            if isinstance(first, ast.Expr) and isinstance(first.value, ast.Constant) \
-                    and isinstance(first.value.value, str):
-                node.body = body[1:] or [ast.Pass()]
+        for field in ("body", "orelse", "finalbody"):
+            body = getattr(node, field, None)
+            if isinstance(body, list) and body and isinstance(body[0], ast.AST):
+                kept = [st for st in body if not _is_string_statement(st)]
+                if len(kept) != len(body):
+                    setattr(node, field, kept or [ast.Pass()])
     return tree
 
 
@@ -83,13 +94,13 @@ class StrippedSourceLocator(_UserLocator):
 
     @classmethod
     def from_function(cls, py_func, py_file):
-        if not py_file.startswith(str(Path(__file__).resolve().parent)):
+        if not py_file.startswith(str(ENGINE_ROOT)):
             return None
         return super().from_function(py_func, py_file)
 
 
 def _engine_cache_dir() -> str:
-    root = Path(__file__).resolve().parent
+    root = ENGINE_ROOT
     digest = hashlib.sha256()
     for path in sorted(root.rglob("*.py")):
         digest.update(path.relative_to(root).as_posix().encode())

@@ -47,6 +47,9 @@ import numpy as np
 from scipy import linalg
 
 from twin.kernels import layout as L
+from twin.kernels.step import ROLLING_REGULARISATION_SPEED
+from twin.kernels.tribology import contact_tribology
+from twin.physics.damping import fluid_damping_n_s_m, hysteretic_damping_n_s_m
 from twin.spec import TIME_STEP_RANGE_S  # noqa: F401  (explicit steps allowed by ModelOptions [s])
 
 AUTO: Final = "auto"
@@ -140,10 +143,6 @@ def _highest_mode(name: str, k: np.ndarray, m: np.ndarray, c: np.ndarray) -> Ele
 def estimate(params: np.ndarray, race_params: np.ndarray, race_tribology: np.ndarray,
              static_load_n: float, reference_viscosity_pa_s: float, ball_count: int) -> CriticalTimeStep:
     """The critical step of the model arrays (`twin.model`), every element at `static_load_n`."""
-    from twin.kernels.step import ROLLING_REGULARISATION_SPEED
-    from twin.kernels.tribology import contact_tribology
-    from twin.physics.damping import fluid_damping_n_s_m, hysteretic_damping_n_s_m
-
     p = params
     q = float(static_load_n)
     m = p[L.P_BALL_MASS]

@@ -36,16 +36,19 @@ import math
 import os
 import statistics
 import time
+from dataclasses import asdict, dataclass
 from typing import Any, Literal
 
 import numpy as np
-from dataclasses import asdict, dataclass
 
 from twin import catalog
+from twin.accelerometer import window_indicators
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 from twin.spec import BearingSpec, ModelOptions
+from twin.validation.step_timing import time_passes
 from twin.validation.studies import EV_BEARING, EV_RADIAL_LOAD_N
+from twin.validation.vibration_simulation import defect_for
 
 MIN_REPEATS = 5
 
@@ -98,8 +101,6 @@ def _twin(case: BenchCase, time_step_s: float | Literal["auto"]) -> Twin:
                 setpoint=Setpoint(shaft_speed_rad_s=case.shaft_speed_rad_s, radial_load_n=case.radial_load_n,
                                   axial_load_n=case.axial_load_n, shaft_current_a=case.shaft_current_a))
     if case.defect is not None:
-        from twin.validation.vibration_simulation import defect_for
-
         twin.set_defects([defect_for(case.defect, spec.geometry)])
     return twin
 
@@ -126,8 +127,6 @@ def measure(case: BenchCase, time_step_s: float | Literal["auto"] = "auto", seco
         "repeats": repeats, "housing": twin.model.housing_on, "defects": len(twin.defects),
         "status": twin.status}
     if twin.model.housing_on:
-        from twin.accelerometer import window_indicators
-
         reader = twin._sensor
         assert reader is not None  # the housing's accelerometer
         window = np.random.default_rng(0).standard_normal(reader.window_samples)
@@ -177,8 +176,6 @@ def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, ca
              "step_1us": measure(c, 1e-6, seconds, repeats)}
             for c in CASES]
     if passes:
-        from twin.validation.step_timing import time_passes
-
         twin = _twin(SERVE_DEFAULT, "auto")
         twin.advance(0.005)
         result["passes"] = time_passes(twin, repeats=repeats)
@@ -191,8 +188,6 @@ def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, ca
 def ev_passes(repeats: int = MIN_REPEATS) -> dict:
     """The step of the EV case pass by pass (`step_timing.time_passes`), with the cost per step
     that real time allows (its auto step) [ns]."""
-    from twin.validation.step_timing import time_passes
-
     twin = _twin(EV_20K, "auto")
     twin.advance(0.005)
     return {**time_passes(twin, repeats=repeats), "time_step_s": twin.model.dt_s,

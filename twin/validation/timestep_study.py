@@ -35,6 +35,7 @@ No I/O here: `bearing-twin timestep-study` prints the tables.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import asdict, dataclass
 from typing import Literal
@@ -403,6 +404,4 @@ def _finite(value):
 
 def as_json(result: dict) -> str:
     """`run_all`'s result as strict JSON (non-finite deviations, i.e. diverged or undefined, as null)."""
-    import json
-
     return json.dumps(_finite(result), allow_nan=False)
