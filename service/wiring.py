@@ -18,12 +18,15 @@ import logging
 import re
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from service.core.admission import AdmissionGate
 from service.core.errors import InputError
 from service.core.registry import Recorder, TwinEntry, TwinRegistry
 from service.settings import ServiceSettings
+
+if TYPE_CHECKING:
+    from service.recording import RerunRecorder
 
 log = logging.getLogger(__name__)
 
@@ -55,7 +58,7 @@ def open_bus(settings: ServiceSettings):
         from service.bus.zenoh_bus import ZenohBus
     owner = {"http": f"http://{settings.host}:{settings.port}"} if settings.port else {}
     try:
-        return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode,
+        return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode or "peer",
                         prefix=settings.zenoh_prefix, owner=owner,
                         access=ZenohAccess.from_settings(settings, enforce=True),
                         # another peer's claim on a twin id counts when zenoh authenticated it, or
@@ -145,6 +148,8 @@ def open_opcua(settings: ServiceSettings, registry: TwinRegistry):
 
 class TwinService(TwinRegistry):
     """The twins of one service, wired to zenoh and rerun as the settings say."""
+
+    recorder: RerunRecorder | None      # the service-wide recording (open_recorder)
 
     def __init__(self, settings: ServiceSettings, gate: AdmissionGate | None = None):
         super().__init__(settings, gate)

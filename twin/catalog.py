@@ -27,7 +27,7 @@ from pathlib import Path
 
 import yaml
 
-from twin.spec import BearingSpec, Geometry, Lubricant, Mounting
+from twin.spec import BearingKind, BearingSpec, Geometry, Lubricant, Mounting
 from twin.vibration.housing import Accelerometer, Housing
 from twin.vibration.surface import SurfaceProfile
 
@@ -205,6 +205,7 @@ def bearing(designation: str = DEFAULT_DESIGNATION, *, diametral_clearance_m: fl
             data.update({k: (v.model_dump() if hasattr(v, "model_dump") else v) for k, v in spec_fields.items()})
             spec = BearingSpec.model_validate(data)
         return spec
+    kind: BearingKind
     if key == "6208":
         geometry, kind = _seed_6208(), "deep_groove"
     elif key in _ANGULAR_7208_DEG:

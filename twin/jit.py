@@ -24,6 +24,7 @@ import inspect
 import os
 import textwrap
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numba
 from numba.core import caching
@@ -65,10 +66,13 @@ def _file_digest(path: str, st_mtime: float, st_size: int) -> bytes:
 
 # numba's cache classes (public names since numba 0.63, underscored before)
 _CACHE_IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
-_USER_LOCATOR = getattr(caching, "UserProvidedCacheLocator", None) or getattr(caching, "_UserProvidedCacheLocator")
+if TYPE_CHECKING:
+    from numba.core.caching import UserProvidedCacheLocator as _UserLocator
+else:
+    _UserLocator = getattr(caching, "UserProvidedCacheLocator", None) or getattr(caching, "_UserProvidedCacheLocator")
 
 
-class StrippedSourceLocator(_USER_LOCATOR):
+class StrippedSourceLocator(_UserLocator):
     """numba's locator for `numba.config.CACHE_DIR`, stamped with the digest of the source file's
     code (`code_digest`) instead of its bytes, and disambiguated by the digest of the function's
     own code instead of its first line number."""
@@ -108,16 +112,16 @@ def _engine_cache_dir() -> str:
     return os.path.join(base, f"numba-{digest.hexdigest()[:16]}")
 
 
-numba.config.CACHE_DIR = _engine_cache_dir()
+numba.config.CACHE_DIR = _engine_cache_dir()  # type: ignore[attr-defined]  # numba.config sets its options at run time
 if StrippedSourceLocator not in _CACHE_IMPL._locator_classes:
     _CACHE_IMPL._locator_classes.insert(0, StrippedSourceLocator)
 
-JIT = dict(nogil=True, cache=True)
+JIT: dict[str, Any] = dict(nogil=True, cache=True)
 
 # Branch-free array loops (contact lanes) use numpy's error model so that divisions carry no
 # zero check and LLVM can vectorise them; their inputs never divide by zero (the ball centre is
 # never on the bearing axis nor on the groove-centre circle).
-JIT_VECTOR = dict(JIT, error_model="numpy")
+JIT_VECTOR: dict[str, Any] = dict(JIT, error_model="numpy")
 
 # The step (`twin.kernels.step.step_n`): numpy's error model too, so that the lane passes inlined
 # into it (numba-level `inline="always"`: no array crosses a call inside the loop, hence no
@@ -126,4 +130,4 @@ JIT_VECTOR = dict(JIT, error_model="numpy")
 # with it, every inlined pass counted its array arguments up and down with atomic operations,
 # ~6 % of the step); a division by zero gives inf / NaN,
 # which the step's finiteness check reports as a status (python's model would raise instead).
-JIT_STEP = dict(JIT_VECTOR, _nrt=False)
+JIT_STEP: dict[str, Any] = dict(JIT_VECTOR, _nrt=False)

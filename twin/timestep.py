@@ -41,6 +41,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 from scipy import linalg
@@ -51,7 +52,7 @@ from twin.kernels.tribology import contact_tribology
 from twin.physics.damping import fluid_damping_n_s_m, hysteretic_damping_n_s_m
 from twin.spec import TIME_STEP_RANGE_S  # noqa: F401  (explicit steps allowed by ModelOptions [s])
 
-AUTO = "auto"
+AUTO: Final = "auto"
 
 # The auto step is this fraction of the critical step. Why 0.8 and not 1: the critical step is
 # exact for a linear oscillator; the model is not linear (the Hertz stiffness grows as
@@ -125,7 +126,7 @@ class CriticalTimeStep:
 def _highest_mode(name: str, k: np.ndarray, m: np.ndarray, c: np.ndarray) -> Element:
     """The mode of K phi = omega^2 M phi with the smallest critical step (modal damping)."""
     omega2, phi = linalg.eigh(k, m)  # phi is mass-normalised: phi^T M phi = 1
-    best = None
+    best: Element | None = None
     for i, w2 in enumerate(omega2):
         if w2 <= 0.0:
             continue
@@ -134,6 +135,8 @@ def _highest_mode(name: str, k: np.ndarray, m: np.ndarray, c: np.ndarray) -> Ele
         e = Element(name, w, float(zeta), central_difference_critical_step_s(w, zeta))
         if best is None or e.critical_step_s < best.critical_step_s:
             best = e
+    if best is None:
+        raise ValueError(f"{name}: no mode of positive stiffness")
     return best
 
 

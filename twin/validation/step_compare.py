@@ -21,6 +21,7 @@ the engine before its speed optimisation (window means, tolerance 1e-6).
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import numpy as np
 
@@ -35,7 +36,7 @@ from twin.validation.vibration_simulation import defect_for
 # states its inlet: isothermal (seed 000's Hamrock-Dowson film, as its 6208 operating point is
 # solved) except the shear-heated one, so a file dumped by one build compares with another's
 # whatever the spec's default of Thermal.shear_heating.
-CASES = {
+CASES: dict[str, tuple[str, float | str, float, dict[str, Any]]] = {
     "6208-auto": ("6208", "auto", 0.1, {"shear_heating": False}),
     "6208-1us": ("6208", 1e-6, 0.05, {"shear_heating": False}),
     "7208-combined-auto": ("7208", "auto", 0.05, {"axial_load_n": 3000.0, "shear_heating": False}),

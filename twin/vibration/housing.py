@@ -221,11 +221,14 @@ def sensor_resonance(housing: Housing) -> tuple[float, float]:
     """(frequency [Hz], damping ratio [-]) of the mode the accelerometer sees the impacts through:
     the one with the largest stretch of the sprung-mass spring, |u_r - e.x_p| / |mode|."""
     e = np.array(housing.accelerometer.axis)
-    best, score = None, -1.0
+    best: tuple[float, float] | None = None
+    score = -1.0
     for f, zeta, shape in modes(housing):
         stretch = abs(shape[3] - e @ shape[:3]) / np.linalg.norm(shape)
         if stretch > score:
             best, score = (f, zeta), stretch
+    if best is None:
+        raise ValueError("housing: no vibration mode")
     return best
 
 
