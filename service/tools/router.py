@@ -34,14 +34,14 @@ def open_router(settings: Any):
     from service.bus.access import ZenohAccess
     from service.bus.zenoh_bus import _one_line, make_config
 
-    access = ZenohAccess.from_settings(settings, enforce=True)
-    config = make_config(settings.zenoh_listen, [], "router", access=access, prefix=settings.zenoh_prefix)
+    access = ZenohAccess.from_settings(settings.zenoh, enforce=True)
+    config = make_config(settings.zenoh.listen, [], "router", access=access, prefix=settings.zenoh.prefix)
     try:
         session = zenoh.open(config)
     except Exception as exc:
         text = _one_line(exc)
         hint = " (is another router or service listening there?)" if "already in use" in text else ""
-        raise RuntimeError(f"zenoh router: cannot listen on {', '.join(settings.zenoh_listen)}: {text}{hint}") from exc
+        raise RuntimeError(f"zenoh router: cannot listen on {', '.join(settings.zenoh.listen)}: {text}{hint}") from exc
     return session, access.describe(listening=True)
 
 
@@ -51,7 +51,7 @@ def run_router(settings: Any, stop: threading.Event, out: Any = None) -> int:
     session, access = open_router(settings)
     try:
         print(f"bearing-twin router: zenoh router {session.info.zid()} listening on "
-              f"{', '.join(settings.zenoh_listen)}, key prefix {settings.zenoh_prefix}; {access}",
+              f"{', '.join(settings.zenoh.listen)}, key prefix {settings.zenoh.prefix}; {access}",
               file=out, flush=True)
         stop.wait()
     finally:
@@ -65,13 +65,14 @@ def _cmd_router(args: argparse.Namespace) -> int:
 
     from service.settings import RouterSettings
 
-    overrides = {}
+    overrides: dict[str, Any] = {}
     if args.listen:
-        overrides["zenoh_listen"] = args.listen
+        overrides["listen"] = args.listen
     if args.prefix:
-        overrides["zenoh_prefix"] = args.prefix
+        overrides["prefix"] = args.prefix
+    given: dict[str, Any] = {"zenoh": overrides}
     try:
-        settings = RouterSettings(**overrides)
+        settings = RouterSettings(**given)
     except ValidationError as exc:
         msg = "; ".join(f"{'.'.join(str(p) for p in e['loc']) or 'settings'}: {e['msg']}".replace(": Value error,", ":")
                         for e in exc.errors())
