@@ -18,7 +18,7 @@ from service.tools.bench_results import save as save_result
 from service.settings import ServiceSettings
 from service.tools.messages import error_text
 from service.tools.scenario_cli import add_scenario_command
-from service.tools.settings_flags import add_settings_flags, flag_overrides
+from service.tools.settings_flags import add_settings_flags, flag_overrides, settings_error_text
 from service.tools.vibration_cli import add_analyse_command
 from twin.catalog import DEFAULT_DESIGNATION
 
@@ -349,10 +349,15 @@ def _cmd_serve(args: argparse.Namespace) -> int:
 
     from twin import catalog
 
+    from pydantic_settings import SettingsError
+
     try:
         settings = _serve_settings(args)
     except ValidationError as exc:
-        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        print(f"error: {settings_error_text(exc, ServiceSettings)}", file=sys.stderr)
+        return 2
+    except SettingsError as exc:                # an environment value that is not JSON where JSON is due
+        print(f"error: {exc}", file=sys.stderr)
         return 2
     given = vars(args)
     if "recording.path" in given and given.get("recording.enabled") is False:

@@ -12,7 +12,7 @@ import typing
 from pathlib import Path
 from typing import Any
 
-from pydantic import BaseModel, SecretStr
+from pydantic import BaseModel, SecretStr, ValidationError
 
 from service.settings import FlatSetting, flat_settings
 
@@ -83,3 +83,21 @@ def flag_of(root: type[BaseModel], path: str) -> str | None:
         if setting.path == path:
             return setting.flags[0] if _flag_options(setting) is not None else None
     raise KeyError(path)
+
+
+def settings_error_text(exc: ValidationError, root: type[BaseModel]) -> str:
+    """A settings ValidationError on one line, each field named as the user may have set it:
+    `http.port (BEARING_TWIN_PORT, --port): Input should be ...`."""
+    names = {(s.group, s.field): s for s in flat_settings(root)}
+    parts = []
+    for error in exc.errors():
+        loc = tuple(str(p) for p in error["loc"])
+        message = str(error["msg"]).removeprefix("Value error, ")
+        setting = names.get((loc[0], loc[1])) if len(loc) >= 2 else None
+        if setting is None:
+            parts.append(f"{'.'.join(loc)}: {message}" if loc else message)
+            continue
+        flag = flag_of(root, setting.path)
+        where = setting.env + (f", {flag}" if flag is not None else "")
+        parts.append(f"{'.'.join(loc)} ({where}): {message}")
+    return "; ".join(parts)

@@ -248,3 +248,19 @@ def test_a_bad_flag_value_is_refused(clean_env):
         build_parser().parse_args(["serve", "--port", "eighty"])
     with pytest.raises(ValidationError, match="publish_rate_hz"):
         _serve_settings(argparse.Namespace(**{"runner.publish_rate_hz": -1.0}))
+
+
+def test_a_serve_error_names_the_group_field_its_variable_and_flag(clean_env, capsys):
+    from service.tools.cli import main
+
+    clean_env.setenv("BEARING_TWIN_PORT", "70000")
+    assert main(["serve"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: http.port (BEARING_TWIN_PORT, --port): ") and "65535" in err
+    clean_env.delenv("BEARING_TWIN_PORT")
+    clean_env.setenv("BEARING_TWIN_ALARMS", "{not json")
+    assert main(["serve"]) == 2
+    assert capsys.readouterr().err.startswith('error: error parsing value for field "alarms"')
+    clean_env.delenv("BEARING_TWIN_ALARMS")
+    assert main(["serve", "--no-zenoh", "--tarpit-max-held", "300"]) == 2
+    assert "tarpit_max_held: 300 held refusals" in capsys.readouterr().err
