@@ -38,7 +38,10 @@ def _flag_options(setting: FlatSetting) -> dict[str, Any] | None:
     if kind is SecretStr:
         return None
     if kind is bool:
-        options.update(action="store_const", const=setting.info.default is not True)
+        on = setting.info.default is not True
+        options.update(action="store_const", const=on)
+        if not on:
+            options["help"] = f"turn off: {options['help']}"
         return options
     if origin is list:
         options.update(action="append")
