@@ -3,9 +3,9 @@ docs/service.md "Alarms")."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Any, Literal
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
 
 class AlarmSettings(BaseModel):
@@ -89,6 +89,12 @@ class AlarmSettings(BaseModel):
         description="A temperature alarm rises after its value stays beyond the threshold this long [s of simulated time].")
     history: int = Field(default=200, ge=1, le=100000,
                          description="Alarm events kept per twin for GET .../alarms [count].")
+
+    @field_validator("machine_group", mode="before")
+    @classmethod
+    def _group_from_text(cls, value: Any) -> Any:
+        """The environment gives text (`BEARING_TWIN_ALARMS__MACHINE_GROUP=1`): "1" and "2" are the groups."""
+        return int(value) if isinstance(value, str) and value.strip() in ("1", "2") else value
 
     @model_validator(mode="after")
     def _ordered(self) -> AlarmSettings:

@@ -264,3 +264,14 @@ def test_a_serve_error_names_the_group_field_its_variable_and_flag(clean_env, ca
     clean_env.delenv("BEARING_TWIN_ALARMS")
     assert main(["serve", "--no-zenoh", "--tarpit-max-held", "300"]) == 2
     assert "tarpit_max_held: 300 held refusals" in capsys.readouterr().err
+
+
+def test_scenario_run_reads_the_alarms_as_serve_does(clean_env):
+    from service.tools.scenario_cli import _alarm_settings_from_env
+
+    assert _alarm_settings_from_env().machine_group == 2                     # ISO 20816-3 default group
+    clean_env.setenv("BEARING_TWIN_ALARMS__MACHINE_GROUP", "1")
+    assert _alarm_settings_from_env().machine_group == 1
+    clean_env.setenv("BEARING_TWIN_ALARMS__MACHINE_GROUP", "3")
+    with pytest.raises(ValueError, match="machine_group"):
+        _alarm_settings_from_env()
