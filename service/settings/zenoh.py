@@ -171,7 +171,7 @@ class RouterZenohSettings(ZenohAccessConfig):
     """The zenoh group of `bearing-twin router`: access, and the endpoints it listens on."""
 
     listen: Annotated[list[str], NoDecode] = Field(
-        default_factory=lambda: list(DEFAULT_ZENOH_LISTEN), json_schema_extra=flat("zenoh_listen", "--listen"),
+        default_factory=lambda: list(DEFAULT_ZENOH_LISTEN), json_schema_extra=flat("zenoh_listen", "--listen", "--zenoh-listen", metavar="ENDPOINT"),
         description="zenoh endpoints the router listens on [zenoh locator, e.g. tcp/0.0.0.0:7447].")
 
     @field_validator("listen", mode="before")

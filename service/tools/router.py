@@ -25,6 +25,9 @@ import sys
 import threading
 from typing import Any
 
+from service.settings import RouterSettings
+from service.tools.settings_flags import add_settings_flags, flag_overrides, settings_error_text
+
 
 def open_router(settings: Any):
     """Open the router session; returns (session, description). RuntimeError (one line) when
@@ -63,20 +66,10 @@ def run_router(settings: Any, stop: threading.Event, out: Any = None) -> int:
 def _cmd_router(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
-    from service.settings import RouterSettings
-
-    overrides: dict[str, Any] = {}
-    if args.listen:
-        overrides["listen"] = args.listen
-    if args.prefix:
-        overrides["prefix"] = args.prefix
-    given: dict[str, Any] = {"zenoh": overrides}
     try:
-        settings = RouterSettings(**given)
+        settings = RouterSettings(**flag_overrides(args))
     except ValidationError as exc:
-        msg = "; ".join(f"{'.'.join(str(p) for p in e['loc']) or 'settings'}: {e['msg']}".replace(": Value error,", ":")
-                        for e in exc.errors())
-        print(f"error: {msg}", file=sys.stderr)
+        print(f"error: {settings_error_text(exc, RouterSettings)}", file=sys.stderr)
         return 2
     stop = threading.Event()
     for sig in (signal.SIGTERM, signal.SIGINT):
@@ -92,10 +85,6 @@ def add_router_command(subparsers: Any) -> argparse.ArgumentParser:
     p = subparsers.add_parser("router", help="a zenoh router for a fleet of services (optionally "
                               "with authentication and access control)",
                               description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--listen", metavar="ENDPOINT", action="append",
-                   help="endpoint to listen on, repeatable (default tcp/127.0.0.1:7447) [BEARING_TWIN_ZENOH_LISTEN]")
-    p.add_argument("--prefix", metavar="PATTERN",
-                   help="key prefix the access rules cover, e.g. plant1/** (default bearing) "
-                   "[BEARING_TWIN_ZENOH_PREFIX]")
+    add_settings_flags(p, RouterSettings, aliases={"zenoh.prefix": ("--prefix",)})
     p.set_defaults(func=_cmd_router)
     return p

@@ -1,4 +1,4 @@
-"""The `serve` flags, generated from the settings model (service.settings): one flag per field of
+"""The `serve` and `router` flags, generated from the settings model (service.settings): one flag per field of
 a group, named after the field's flat name (`--port`, `--zenoh-listen`, `--no-zenoh`), its help
 the field's description. Flags default to nothing (argparse.SUPPRESS), so only the flags given
 override the environment. Secrets (SecretStr: the token, the zenoh password) have no flag: a
@@ -56,9 +56,11 @@ def _flag_options(setting: FlatSetting) -> dict[str, Any] | None:
     return options
 
 
-def add_settings_flags(parser: argparse.ArgumentParser, root: type[BaseModel]) -> None:
+def add_settings_flags(parser: argparse.ArgumentParser, root: type[BaseModel],
+                       aliases: dict[str, tuple[str, ...]] | None = None) -> None:
     """A flag for every field of `root`'s groups that has a flat name and is no secret, in one
-    help section per group."""
+    help section per group; `aliases`: further option strings of a setting of this command
+    (`{"zenoh.prefix": ("--prefix",)}`), shown first."""
     sections: dict[str, Any] = {}
     for setting in flat_settings(root):
         options = _flag_options(setting)
@@ -67,7 +69,8 @@ def add_settings_flags(parser: argparse.ArgumentParser, root: type[BaseModel]) -
         if setting.group not in sections:
             sections[setting.group] = parser.add_argument_group(
                 f"{setting.group} settings", root.model_fields[setting.group].description)
-        sections[setting.group].add_argument(*setting.flags, **options)
+        flags = (*(aliases or {}).get(setting.path, ()), *setting.flags)
+        sections[setting.group].add_argument(*flags, **options)
 
 
 def flag_overrides(args: argparse.Namespace) -> dict[str, Any]:
@@ -98,7 +101,8 @@ def settings_error_text(exc: ValidationError, root: type[BaseModel]) -> str:
         message = str(error["msg"]).removeprefix("Value error, ")
         setting = names.get((loc[0], loc[1])) if len(loc) >= 2 else None
         if setting is None:
-            parts.append(f"{'.'.join(loc)}: {message}" if loc else message)
+            whole_model = not loc or (len(loc) == 1 and loc[0] in root.model_fields)
+            parts.append(message if whole_model else f"{'.'.join(loc)}: {message}")   # a check names its field
             continue
         flag = flag_of(root, setting.path)
         where = setting.env + (f", {flag}" if flag is not None else "")

@@ -275,3 +275,24 @@ def test_scenario_run_reads_the_alarms_as_serve_does(clean_env):
     clean_env.setenv("BEARING_TWIN_ALARMS__MACHINE_GROUP", "3")
     with pytest.raises(ValueError, match="machine_group"):
         _alarm_settings_from_env()
+
+
+def test_router_flags_are_generated_too_and_keep_their_names(clean_env):
+    from service.tools.settings_flags import flag_overrides
+
+    clean_env.setenv("BEARING_TWIN_ZENOH_WRITERS", "scada")
+    parser = build_parser()
+    for argv in (["--listen", "tcp/127.0.0.1:7801", "--prefix", "plant1/**"],
+                 ["--zenoh-listen", "tcp/127.0.0.1:7801", "--zenoh-prefix", "plant1/**"]):
+        s = RouterSettings(**flag_overrides(parser.parse_args(["router", *argv])))
+        assert (s.zenoh.listen, s.zenoh.prefix, s.zenoh.writers) == (["tcp/127.0.0.1:7801"], "plant1/**", ["scada"])
+    assert RouterSettings(**flag_overrides(parser.parse_args(["router"]))).zenoh.listen == ["tcp/127.0.0.1:7447"]
+
+
+def test_a_check_across_fields_of_a_group_is_one_line_naming_its_setting(clean_env, capsys):
+    from service.tools.cli import main
+
+    clean_env.setenv("BEARING_TWIN_ZENOH_USER", "svc")            # a user without a password
+    assert main(["serve"]) == 2
+    assert capsys.readouterr().err == ("error: zenoh_password: zenoh credentials are a user and a password "
+                                       "together (BEARING_TWIN_ZENOH_USER, BEARING_TWIN_ZENOH_PASSWORD)\n")
