@@ -46,12 +46,8 @@ class SecuritySettings(BaseModel):
 
     token: SecretStr | None = Field(
         default=None, json_schema_extra=flat("token"),
-        description="Bearer token [text]: when set, every mutating HTTP request (POST, PUT, DELETE) "
-        "needs `Authorization: Bearer <token>`; unset "
-        "(default) = no authentication. It never travels on zenoh: zenoh has its own access "
-        "control (zenoh_usersfile ...), and without it a service with a token refuses zenoh "
-        "setpoints. Give it in the environment (BEARING_TWIN_TOKEN), not on a "
-        "command line other users can read.")
+        description="Bearer token of every mutating HTTP request (and of reads with read_requires_token) and OPC UA "
+        "password [text]; unset = no authentication; never on zenoh; environment only (docs/operations.md).")
     read_requires_token: bool = Field(
         default=False, json_schema_extra=flat("read_requires_token"),
         description="Also require the token for reads (GET), except GET /health [bool].")

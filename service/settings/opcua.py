@@ -26,12 +26,9 @@ class OpcUaSettings(BaseModel):
         "opc.tcp://127.0.0.1:4840; unset (default) = no OPC UA server.")
     security: SecurityChoice = Field(
         default="auto", json_schema_extra=flat("opcua_security"),
-        description="OPC UA message security the endpoint offers [choice]: `sign` / "
-        "`sign_and_encrypt` = the Basic256Sha256, Aes128_Sha256_RsaOaep and Aes256_Sha256_RsaPss "
-        "policies in that mode; `both` = both modes; `all` = both modes plus the None policy for "
-        "anonymous read-only sessions (a user name is refused there); `none` = only the None policy "
-        "(no certificate; with a token the password then crosses the network in clear). `auto` "
-        "(default) = `both` when a token is set, else `none`.")
+        description="OPC UA message security offered [auto | none | sign | sign_and_encrypt | both | all]: "
+        "Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss in Sign, SignAndEncrypt or both; all adds "
+        "the None policy for anonymous reads; auto = both with a token, else none (docs/service.md \"OPC UA\").")
     certificate: Path | None = Field(
         default=None, json_schema_extra=flat("opcua_certificate", metavar="CERT.der"),
         description="The OPC UA server's certificate [path, DER or PEM], with opcua_private_key; its "

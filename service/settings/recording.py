@@ -35,24 +35,17 @@ class RecordingSettings(BaseModel):
         "0 = no rotation by size.")
     footer: bool = Field(
         default=False, json_schema_extra=flat("record_footer"),
-        description="End each recording segment with rerun's RRD footer (chunk manifest) [bool]. "
-        "On: rerun's own file sink writes the segment and holds the manifest in memory (about 2 kB "
-        "per chunk, about 25 chunks/s per twin) until the segment closes, and a write error shows only "
-        "as a failed flush. Off (default): the service writes the file itself (flat memory, exact "
-        "write-error handling); the viewer and RrdReader.stream() read it, `rerun rrd optimize` adds "
-        "the footer afterwards.")
+        description="End each segment with rerun's RRD footer, written by rerun's file sink that holds the chunk "
+        "manifest in memory until the segment closes [bool]; off: the service writes the file and "
+        "`rerun rrd optimize` adds the footer (docs/service.md).")
     flush_interval_s: float = Field(
         default=1.0, gt=0.0, le=60.0, json_schema_extra=flat("record_flush_interval_s"),
-        description="The recorder sends and writes what it buffered every this often: one rerun chunk "
-        "per entity with all rows of the interval [s]. Each chunk costs about 1.5 kB besides its rows, "
-        "so shorter intervals make larger files with more chunks (0.1 s: about 10x the chunks) and a "
-        "live viewer lags by up to this much.")
+        description="The recorder writes what it buffered this often, one rerun chunk (about 1.5 kB besides its rows) "
+        "per entity [s]; shorter: larger files, and a live viewer lags by up to this much.")
     keep_mb: float = Field(
         default=2000.0, ge=0.0, le=1e9, json_schema_extra=flat("record_keep_mb"),
-        description="Retention: keep the newest segments of the service-wide recordings (this run's and "
-        "earlier runs' in the same folder, same name family) up to this total size and delete older "
-        "ones [MB = 10^6 bytes]; 0 = no size limit. The open segment and per-twin recordings are "
-        "never deleted; nothing else deletes recordings.")
+        description="Retention: the newest segments of the service-wide recordings (same folder and name family) kept "
+        "up to this total, older ones deleted [MB = 10^6 bytes]; 0 = no limit; never the open segment.")
     keep_hours: float = Field(
         default=0.0, ge=0.0, le=1e6, json_schema_extra=flat("record_keep_hours"),
         description="Retention: also delete segments of the service-wide recordings older than this "

@@ -86,22 +86,16 @@ class RunnerSettings(BaseModel):
         "core this process may use.")
     io_thread_nice: int = Field(
         default=-5, ge=-20, le=19, json_schema_extra=flat("io_thread_nice"),
-        description="Nice value given to every thread of the service but the stepping threads and the publish "
-        "worker, the HTTP event loop included (Linux, per thread; service.core.priority) [-]: between the stepping "
-        "threads' and the host's other processes', since these threads hold the GIL the stepping threads wait for. "
-        "Below the process's nice needs root or CAP_SYS_NICE (refused: counted in /health thread_priority errors). "
-        "0: the process's nice.")
+        description="Nice value of the service's threads but the stepping threads and the publish worker, HTTP loop "
+        "included (Linux, per thread) [-]; below the process's nice needs CAP_SYS_NICE; 0 = the process's nice.")
     gc_freeze: bool = Field(
         default=True, json_schema_extra=flat("gc_freeze"),
         description="Freeze the start-up heap out of Python's cyclic garbage collector once the service is open "
-        "(gc.freeze; service.core.heap.freeze_heap): full collections then walk only what was made since, "
-        "instead of stalling every thread for ~70 ms every ~10 s [bool].")
+        "(gc.freeze), so full collections walk only what was made since [bool] (docs/service.md).")
     stepping_thread_nice: int = Field(
         default=-10, ge=-20, le=0, json_schema_extra=flat("stepping_thread_nice"),
-        description="Nice value asked for the stepping threads and the publish worker (Linux, per thread; "
-        "service.core.priority) [-]: real time before every other process of the host. A priority above the "
-        "process's own needs root or CAP_SYS_NICE; without it they keep the process's nice (/health "
-        "thread_priority says which). 0: not raised.")
+        description="Nice value asked for the stepping threads and the publish worker (Linux, per thread) [-]; above "
+        "the process's own needs CAP_SYS_NICE, else they keep it (/health thread_priority); 0 = not raised.")
     admission: Literal["measured", "off"] = Field(
         default="measured", json_schema_extra=flat("admission"),
         description="'measured': a twin created over the API that this host cannot run in real time "
@@ -114,9 +108,8 @@ class RunnerSettings(BaseModel):
         "zenoh, rerun and HTTP threads [-]. One twin may use at most this much of one core.")
     capacity_reserve_cores: float = Field(
         default=0.5, ge=0.0, le=64.0, json_schema_extra=flat("capacity_reserve_cores"),
-        description="Cores' worth of CPU kept from the twins' capacity for the service's own zenoh, rerun, HTTP and "
-        "publishing threads and the machine (never below one twin's share) [cores]. 0.5: on the 2-core VM two default "
-        "6208 twins admitted under 2 x 0.85 ran at 0.93-0.97 of real time with 93-96 % of frames late.")
+        description="CPU kept from the twins' capacity for the service's zenoh, rerun, HTTP and publishing threads and "
+        "the machine, never below one twin's share [cores] (docs/service.md, admission).")
     calibration_s: float = Field(
         default=0.02, ge=0.001, le=1.0, json_schema_extra=flat("calibration_s"),
         description="Simulated time a new twin runs at creation to measure its CPU need [s].")
