@@ -50,6 +50,7 @@ import statistics
 import sys
 import threading
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -100,7 +101,8 @@ class _Deck:
     them all)."""
 
     def __init__(self, rng: random.Random):
-        self.rng, self.cards = rng, []
+        self.rng = rng
+        self.cards: list[str] = []
 
     def deal(self) -> str:
         if not self.cards:
@@ -178,6 +180,7 @@ async def _http_flood_async(spec: dict, go) -> dict:
         end = t0 + spec["seconds"]
 
         async def worker() -> None:
+            headers: dict
             while time.monotonic() < end:
                 if mode == "reads":
                     kind, method, path, body, headers, valid = ("read", "GET", f"/v1/bearings/{bid}/state",
@@ -380,6 +383,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         if cfg.start:
             from loadtest.soak import _Started
 
+            assert token is not None  # generated above when the attack starts the service
             started = _Started(token, None, lambda line: log(line.replace("soak: ", "attack: ", 1)),
                                record=cfg.record, opcua=True)
             url, zenoh_endpoint = started.url, started.zenoh_endpoint
@@ -401,7 +405,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         go, out = ctx.Event(), ctx.Queue()
         common = {"url": url, "bearing_id": cfg.bearing_id, "token": token, "seconds": cfg.seconds,
                   "ranges": ranges}
-        specs = [(_http_flood, {**common, "mode": "hostile", "workers": cfg.concurrency, "seed": rng.randrange(2**32)})]
+        specs: list[tuple[Callable[..., Any], dict[str, Any]]] = [(_http_flood, {**common, "mode": "hostile", "workers": cfg.concurrency, "seed": rng.randrange(2**32)})]
         if cfg.readers:
             specs.append((_http_flood, {**common, "mode": "reads", "token": None, "workers": cfg.readers,
                                         "seed": rng.randrange(2**32)}))
@@ -421,7 +425,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         flood_start = time.monotonic()
         go.set()
         during = _probe(client, url, cfg.bearing_id, cfg.seconds, cfg.probe_every_s, t_ref)
-        parts = {}
+        parts: dict[str, Any] = {}
         deadline = time.monotonic() + 60.0
         while len(parts) < len(specs) and time.monotonic() < deadline:
             try:
@@ -464,7 +468,7 @@ def run_attack(cfg: AttackConfig) -> dict:
 
 
 def _totals(report: dict) -> None:
-    totals = collections.Counter()
+    totals: collections.Counter[str] = collections.Counter()
     for name in ("http_flood", "read_flood"):
         part = report.get(name) or {}
         for code, n in (part.get("status") or {}).items():

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import asyncio
 import collections
+import functools
 import json
 import os
 import secrets
@@ -83,8 +84,7 @@ def squat(spec: dict, go) -> dict:
                 token_ = owner = None
                 if session is not None:
                     token_ = session.liveliness().declare_token(f"{key}/alive")
-                    owner = session.declare_queryable(f"{key}/owner",
-                                                      lambda q, k=key, f=forged: q.reply(f"{k}/owner", f))
+                    owner = session.declare_queryable(f"{key}/owner", functools.partial(_reply, f"{key}/owner", forged))
                 time.sleep(0.2)
                 counts["attempts"] += 1
                 r = http.post("/v1/bearings", json={"id": bid, "designation": "6208"})
@@ -106,6 +106,11 @@ def squat(spec: dict, go) -> dict:
 
 
 # ---- OPC UA ------------------------------------------------------------------------------------
+def _reply(key: str, payload: str, query: Any) -> None:
+    """Answer a zenoh query on `key` with `payload` (the squatter's forged owner record)."""
+    query.reply(key, payload)
+
+
 def _client_cert(folder: Path) -> tuple[str, str, str]:
     from asyncua.crypto import cert_gen
     from cryptography import x509
@@ -173,7 +178,8 @@ async def _logins(spec: dict, cert) -> dict:
 
 
 async def _sessions(spec: dict, cert) -> dict:
-    opened, refused = [], collections.Counter()
+    opened: list[Any] = []
+    refused: collections.Counter[str] = collections.Counter()
     t0 = time.monotonic()
     while time.monotonic() - t0 < spec["seconds"] and len(opened) < spec["max_sessions"] and not refused:
         c = await _client(spec["url"], cert)
@@ -206,7 +212,8 @@ async def _subscriptions(spec: dict, cert) -> dict:
 
     from service.opcua.layout import FOLDERS, NAMESPACE_URI, ROOT_FOLDER
 
-    counter, granted, items, refused = _Count(), [], 0, collections.Counter()
+    counter, granted, items = _Count(), [], 0
+    refused: collections.Counter[str] = collections.Counter()
     t0 = time.monotonic()
     c = await _client(spec["url"], cert)
     async with c:

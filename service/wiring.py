@@ -18,12 +18,15 @@ import logging
 import re
 from datetime import UTC, datetime
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from service.core.admission import AdmissionGate
 from service.core.errors import InputError
 from service.core.registry import Recorder, TwinEntry, TwinRegistry
 from service.settings import ServiceSettings
+
+if TYPE_CHECKING:
+    from service.recording import RerunRecorder
 
 log = logging.getLogger(__name__)
 
@@ -145,6 +148,8 @@ def open_opcua(settings: ServiceSettings, registry: TwinRegistry):
 
 class TwinService(TwinRegistry):
     """The twins of one service, wired to zenoh and rerun as the settings say."""
+
+    recorder: RerunRecorder | None      # the service-wide recording (open_recorder)
 
     def __init__(self, settings: ServiceSettings, gate: AdmissionGate | None = None):
         super().__init__(settings, gate)

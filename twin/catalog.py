@@ -20,10 +20,16 @@
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
-from twin.spec import BearingSpec, Geometry, Lubricant, Mounting
+import yaml
+
+from twin.spec import BearingKind, BearingSpec, Geometry, Lubricant, Mounting
+from twin.vibration.housing import Accelerometer, Housing
+from twin.vibration.surface import SurfaceProfile
 
 # designation: (bore mm, outside diameter mm, ball count, ball diameter mm)
 _DEEP_GROOVE_MM = {
@@ -153,10 +159,6 @@ def _cwru_drive_end() -> BearingSpec:
     the sensor noise calibrated on the healthy record only (values above), sampled at 12 kHz as
     the fault records, the race profiles and ball sizes of `twin.vibration.surface` on (profile RMS
     calibrated on the healthy record, ball-size spread the ISO 3290 G10 default)."""
-    from twin.spec import Mounting as _Mounting
-    from twin.vibration.housing import Accelerometer, Housing
-    from twin.vibration.surface import SurfaceProfile
-
     rb = 0.5 * CWRU_BALL_DIAMETER_M
     pitch = 0.5 * CWRU_PITCH_DIAMETER_M
     z = 9
@@ -172,7 +174,7 @@ def _cwru_drive_end() -> BearingSpec:
                                     noise_density_m_s2_rthz=CWRU_NOISE_DENSITY_M_S2_RTHZ))
     return BearingSpec(
         designation="CWRU-DE", kind="deep_groove", geometry=geometry,
-        mounting=_Mounting(diametral_clearance_m=CWRU_DIAMETRAL_CLEARANCE_M, rotor_mass_kg=CWRU_ROTOR_MASS_KG),
+        mounting=Mounting(diametral_clearance_m=CWRU_DIAMETRAL_CLEARANCE_M, rotor_mass_kg=CWRU_ROTOR_MASS_KG),
         lubricant=Lubricant(), housing=housing,
         surface_profile=SurfaceProfile(enabled=True, race_profile_rms_m=CWRU_RACE_PROFILE_RMS_M))
 
@@ -203,6 +205,7 @@ def bearing(designation: str = DEFAULT_DESIGNATION, *, diametral_clearance_m: fl
             data.update({k: (v.model_dump() if hasattr(v, "model_dump") else v) for k, v in spec_fields.items()})
             spec = BearingSpec.model_validate(data)
         return spec
+    kind: BearingKind
     if key == "6208":
         geometry, kind = _seed_6208(), "deep_groove"
     elif key in _ANGULAR_7208_DEG:
@@ -303,11 +306,6 @@ def load_spec_file(path: str) -> BearingSpec:
     materials, lubricant, mounting, housing, surface profile ...), validated as any spec. Raises
     ValueError naming the file when it cannot be read or parsed, pydantic.ValidationError naming
     the field otherwise."""
-    import json
-    from pathlib import Path
-
-    import yaml
-
     file = Path(path)
     if file.suffix.lower() not in SPEC_FILE_SUFFIXES:
         raise ValueError(f"bearing: spec file {path!r} must end in {', '.join(SPEC_FILE_SUFFIXES)}")

@@ -24,6 +24,7 @@ import numpy as np
 from twin.kernels import layout as L
 from twin.model import BearingModel
 from twin.physics.electrical import outer_zone_capacitance_f
+from twin.snapshot import DischargeRisk
 
 _MIN_GAP_M = 1e-9
 CAPACITIVE_PHASE_RAD = -math.pi / 4.0  # the network is capacitive at or below this impedance phase
@@ -47,7 +48,7 @@ class ElectricalNetwork:
     shaft_current_a: float
     max_film_field_v_m: float
     current_density_a_m2: float
-    discharge_risk: str                  # "none" | "possible" | "likely"
+    discharge_risk: DischargeRisk
     reason: str
 
 
@@ -103,7 +104,8 @@ def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: 
     max_density = float(np.max(density)) if density.size else 0.0
     risk, reason = _risk(el, max_field, max_density, voltage, current)
     phase = math.atan2(z_total.imag, z_total.real)
-    capacitance, capacitance_reason = y.imag / omega, None
+    capacitance: float | None = y.imag / omega
+    capacitance_reason: str | None = None
     if phase > CAPACITIVE_PHASE_RAD:
         capacitance = None
         capacitance_reason = (f"not capacitive: impedance phase {math.degrees(phase):.1f} deg above -45 deg at "
@@ -119,7 +121,7 @@ def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: 
         reason=reason)
 
 
-def _risk(el, field, density, voltage, current) -> tuple[str, str]:
+def _risk(el, field, density, voltage, current) -> tuple[DischargeRisk, str]:
     if voltage <= 0.0 and current <= 0.0:
         return "none", "no shaft voltage or current"
     if density >= el.fluting_current_density_a_m2:

@@ -11,43 +11,40 @@ import math
 
 import numpy as np
 
-from twin import catalog
+from twin import catalog, state_measures
+from twin.accelerometer import SensorReader, WaveformBlock
+from twin.electrical_network import ElectricalNetwork, bearing_network
+from twin.faults import Fault, FaultKind
+from twin.friction_power import (
+    REST_SPEED_RAD_S,
+    FrictionPower,
+    frame_friction_torque_n_m,
+    friction_power_by_source,
+    seal_moment_n_m,
+    seal_power_w,
+)
+from twin.inlet_film import InletFilm
 from twin.kernels import layout as L
 from twin.kernels.step import evaluate, step_n
 from twin.kernels.structures import ModelArrays, StateArrays
-from twin.model import BearingModel, make_model
-from twin.physics.friction import REGIME_NAMES
-from twin.physics.hertz import max_pressure_pa
-from twin.physics.thermal import (MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k)
-from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
-from twin.faults import Fault, FaultKind
-from twin.friction_power import (FrictionPower, ball_drag_power_w, contact_powers_w, oil_bath_drag_power_w,
-                                 oil_level_m, seal_moment_n_m, seal_power_w)
-from twin.physics import drag as drag_law
-from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
-from twin.electrical_network import bearing_network
-from twin.inlet_film import InletFilm
 from twin.life.monitor import LifeMonitor
 from twin.life.settings import LifeSettings
-from twin.snapshot import BallState, ContactState, LifeState, Snapshot
-from twin.snapshot import ElectricalState, FrictionPowerState, ThermalState
+from twin.model import BearingModel, make_model
+from twin.physics.thermal import MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k
+from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
+from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
+from twin.snapshot import FrictionPowerState, LifeState, Snapshot, ThermalState
+from twin.snapshot_blocks import ball_states, electrical_state, finite_or_none
 from twin.spec import BearingSpec, ModelOptions
 from twin.state import MAX_DEFECTS, TwinState, make_state
 from twin.thermal.coupling import ThermalCoupling
 from twin.thermal.expansion import write_groove_lanes
 from twin.thermal.sources import HeatSources, friction_heat
 from twin.vibration.defects import BallDefect, defect_row, validate_defects
-from twin.vibration.housing import housing_equilibrium
-from twin.accelerometer import SensorReader, WaveformBlock
-from twin.warmstart import warm_start
+from twin.warmstart import place_on_housing, warm_start
 
 FRAME_S = 1e-3  # simulated time per compiled call [s] (1000 steps at dt = 1 us)
 RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
-REST_SPEED_RAD_S = 1.0  # below this mean shaft speed over a frame the shaft counts as at rest [rad/s]
-
-
-def _finite_or_none(value: float) -> float | None:
-    return float(value) if math.isfinite(value) else None
 
 
 class Twin:
@@ -214,56 +211,28 @@ class Twin:
             float(scalars[L.X_SHAFT_SPEED]), float(scalars[L.X_CAGE_SPEED]), current_rise,
             self.mean_entrainment_speed_m_s() if th.shear_heating else 0.0)
 
+    # ---- measures of the state (twin.state_measures) ----------------------------------------
     def axial_angular_momentum_n_m_s(self) -> float:
-        """Angular momentum of the balls and the cage about the bearing axis [N m s]: the balls'
-        orbital m (x v_y - y v_x) and spin I omega_z, the cage's I_c omega_c."""
-        s, p = self.state, self.model.params
-        x, v = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s
-        orbital = p[L.P_BALL_MASS] * float(np.sum(x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]))
-        spin = p[L.P_BALL_INERTIA] * float(np.sum(s.ball_angular_velocity_rad_s[:, 2]))
-        return orbital + spin + p[L.P_CAGE_INERTIA] * float(s.scalars[L.X_CAGE_SPEED])
+        """Angular momentum of the balls and the cage about the bearing axis [N m s]."""
+        return state_measures.axial_angular_momentum_n_m_s(self.model, self.state)
 
     def kinetic_energy_j(self) -> float:
         """Kinetic energy of the balls (translation and rotation) and the cage [J]."""
-        s, p = self.state, self.model.params
-        v = (s.ball_velocity_in_bearing_m_s if self.model.housing_on else s.ball_velocity_m_s).ravel()
-        w = s.ball_angular_velocity_rad_s.ravel()
-        return 0.5 * (p[L.P_BALL_MASS] * float(v @ v) + p[L.P_BALL_INERTIA] * float(w @ w)
-                      + p[L.P_CAGE_INERTIA] * float(s.scalars[L.X_CAGE_SPEED]) ** 2)
+        return state_measures.kinetic_energy_j(self.model, self.state)
 
     def mean_entrainment_speed_m_s(self) -> float:
-        """Mean entrainment speed of the loaded inner-race contacts (all inner contacts if none
-        is loaded) [m/s]."""
-        c = self.state.contacts
-        u = c[L.C_ENTRAINMENT, 0::2]
-        loaded = c[L.C_LOAD, 0::2] > 0.0
-        return float(np.mean(np.abs(u[loaded] if loaded.any() else u)))
+        """Mean entrainment speed of the loaded inner-race contacts [m/s]."""
+        return state_measures.mean_entrainment_speed_m_s(self.state)
 
     def loaded_zone_ball_count(self) -> float:
-        """Balls in the inner race's loaded zone (K of seed 003 eq. 10) as the zone's arc in ball
-        pitches: the mean number of loaded balls over a ball pass. The count at an instant jumps
-        by one whenever a ball crosses an edge of the zone, and sampled every 10 ms by the
-        electro-thermal coupling it made the heating a step function of the state (at 1700 rad/s
-        and 20 A: 6.5 or 8.1 K, 25 % apart, by when a sample fell). The edges are interpolated
-        between neighbouring balls on their inner approach (G_DELTA, < 0: gap)."""
-        z = self.model.ball_count
-        delta = self.state.contacts[L.G_DELTA, 0::2]
-        loaded = delta > 0.0
-        if loaded.all() or not loaded.any():
-            return float(z) if loaded.all() else 0.0
-        az = self.ball_azimuths_rad()
-        order = np.argsort(az)
-        az, d = az[order], delta[order]
-        arc = 0.0
-        for j in range(z):
-            k = (j + 1) % z
-            gap = (az[k] - az[j]) % (2.0 * math.pi)
-            if d[j] > 0.0 and d[k] > 0.0:
-                arc += gap
-            elif d[j] > 0.0 or d[k] > 0.0:  # one edge of the zone lies between the two balls
-                inside = d[j] if d[j] > 0.0 else d[k]
-                arc += gap * inside / (abs(d[j]) + abs(d[k]))
-        return arc * z / (2.0 * math.pi)
+        """Balls in the inner race's loaded zone as the zone's arc in ball pitches (K of seed 003
+        eq. 10, twin.state_measures.loaded_zone_ball_count)."""
+        return state_measures.loaded_zone_ball_count(self.model, self.state)
+
+    def ball_azimuths_rad(self) -> np.ndarray:
+        """Ball centre angles about the outer ring's centre from the load line (+x), in (-pi, pi]
+        [rad]."""
+        return state_measures.ball_azimuths_rad(self.state)
 
     def current_heating_k(self) -> float:
         """Race-track temperature rise from the shaft current (seed 003 eq. 10) [K]."""
@@ -312,7 +281,7 @@ class Twin:
         self.state.scalars[L.X_TIME] = t
         m = self.model
         if m.housing_on:
-            self._place_on_housing(sp.radial_load_n if warm else 0.0, sp.axial_load_n if warm else 0.0)
+            place_on_housing(m, self.state, sp.radial_load_n if warm else 0.0, sp.axial_load_n if warm else 0.0)
             self._sensor.reset(t)
         evaluate(*self._kernel_args())
         if self._setpoint.shaft_current_a > 0.0 or m.spec.thermal.shear_heating:
@@ -325,21 +294,6 @@ class Twin:
     def _kernel_args(self) -> tuple[ModelArrays, StateArrays, np.ndarray]:
         """(model, state, setpoint) as `step_n` / `evaluate` take them (without n)."""
         return self.model.arrays(), self.state.arrays(), self._setpoint_vector
-
-    def _place_on_housing(self, radial_load_n: float, axial_load_n: float) -> None:
-        """Warm start on the housing: the outer ring at the static equilibrium of its
-        support under the whole load (at the quasi-static equilibrium the balls pass the applied
-        loads to the outer ring; their centrifugal forces cancel over the ring), the balls and the
-        inner ring moved with it; the decimator and the sample ring restart
-        (twin.vibration.housing.housing_equilibrium)."""
-        s = self.state
-        housing_equilibrium(self.model.housing_params, radial_load_n, 0.0, axial_load_n,
-                            s.housing_displacement_m, s.housing_velocity_m_s, s.housing_acceleration_m_s2)
-        shift = s.housing_displacement_m[:3]
-        s.ball_position_m += shift
-        s.ring_position_m += shift
-        s.decimator_state[:] = 0.0
-        s.sample_ring_state[:] = 0.0
 
     # ---- rating life (twin.life) --------------------------------------------------------------
     def _update_life(self, force: bool = False) -> None:
@@ -374,7 +328,7 @@ class Twin:
             if status != L.STATUS_OK:
                 self._sensor.flush(s)
         if s.scalars[L.X_TORQUE_COUNT] > 0 and status == L.STATUS_OK:
-            self._contact_torque_n_m = self._dissipative_torque_n_m(
+            self._contact_torque_n_m = frame_friction_torque_n_m(
                 s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT], done * self.model.dt_s,
                 0.5 * (speed_before + float(s.scalars[L.X_SHAFT_SPEED])),
                 self.kinetic_energy_j() - energy_before,
@@ -405,20 +359,6 @@ class Twin:
         as power / omega."""
         return float(self.inlet.drag_power_w)
 
-    @staticmethod
-    def _dissipative_torque_n_m(drive_n_m: float, duration_s: float, mean_speed_rad_s: float,
-                                kinetic_energy_change_j: float, momentum_change_n_m_s: float) -> float:
-        """The friction torque of a frame [N m]: the shaft's mean drive torque less the torque that
-        speeds the balls and the cage up (or that they give back as they slow down), which is
-        inertia, not friction. Turning, the shaft's power drive * omega splits into the friction's
-        dissipation and the rate of change of the balls' and cage's kinetic energy E, so
-        M_f = drive - dE/dt / omega. With the shaft at rest (|omega| < REST_SPEED_RAD_S) the shaft
-        does no work and the torque is the one the outer ring holds: drive less the rate of change
-        of the balls' and cage's angular momentum about the axis."""
-        if abs(mean_speed_rad_s) >= REST_SPEED_RAD_S:
-            return drive_n_m - kinetic_energy_change_j / (duration_s * mean_speed_rad_s)
-        return drive_n_m - momentum_change_n_m_s / duration_s
-
     def _churning_and_seal_torque_n_m(self) -> float:
         """Shaft torque of the ball drag and the seals [N m]: the drag power over the shaft speed
         (the shaft supplies it through the balls) and the seals' moment while the shaft turns."""
@@ -434,33 +374,11 @@ class Twin:
 
     def friction_power_w(self) -> FrictionPower:
         """Friction power of the current instant by source and by contact [W]
-        (twin.friction_power): the contacts' rolling, sliding and spin power from the last step's
-        lanes, each ball's drag at its own depth in the oil bath (or in the cavity's oil-air
-        mixture) and the seals' moment times the shaft speed."""
-        s, m = self.state, self.model
-        rolling, sliding, spin = contact_powers_w(s.contacts, s.ball_angular_velocity_rad_s, m.ball_radius_m)
-        lub = m.spec.lubricant
-        rho = density_kg_m3(lub.density_15c_kg_m3, self._setpoint.oil_temperature_c)
-        x, v = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s
-        orbit_speed = np.hypot(v[:, 0], v[:, 1])
-        drag_w = np.zeros(m.ball_count)
-        method = m.spec.lubrication.method
-        if method == "oil_bath":   # the bath's drag shared by the part of each ball in the oil
-            from_bottom = np.arctan2(x[:, 1], x[:, 0])  # the bath's bottom lies on the load line (+x)
-            share = np.array([drag_law.immersed_area_fraction(
-                drag_law.ball_depth_in_bath_m(oil_level_m(m.spec), float(a), m.pitch_radius_m), 2.0 * m.ball_radius_m)
-                for a in from_bottom])
-            if share.sum() > 0.0:
-                drag_w = share / share.sum() * oil_bath_drag_power_w(
-                    m.spec, float(s.scalars[L.X_SHAFT_SPEED]), self._oil_viscosity_pa_s / rho)
-        elif method != "flooded":
-            for j in range(m.ball_count):
-                drag_w[j] = ball_drag_power_w(2.0 * m.ball_radius_m, float(orbit_speed[j]), self.inlet.immersed_fraction,
-                                              rho, self._oil_viscosity_pa_s)
-        seal_w = self._seal_power_w()
-        return FrictionPower(rolling_w=float(rolling.sum()), sliding_w=float(sliding.sum()), spin_w=float(spin.sum()),
-                             drag_w=float(drag_w.sum()), seal_w=seal_w, rolling_contact_w=rolling,
-                             sliding_contact_w=sliding, spin_contact_w=spin, drag_ball_w=drag_w)
+        (twin.friction_power.friction_power_by_source): the contacts' rolling, sliding and spin
+        power from the last step's lanes, each ball's drag at its own depth in the oil bath (or in
+        the cavity's oil-air mixture) and the seals' moment times the shaft speed."""
+        return friction_power_by_source(self.model, self.state, self._setpoint.oil_temperature_c,
+                                        self._oil_viscosity_pa_s, self.inlet.immersed_fraction, self._seal_power_w())
 
     def _recover(self, status: int) -> None:
         """A kernel reported a diverged or overloaded state: restart from the warm start at the
@@ -602,48 +520,7 @@ class Twin:
         return self._sensor.drain_waveform()
 
     # ---- outputs ----------------------------------------------------------------------------
-    def ball_azimuths_rad(self) -> np.ndarray:
-        """Ball centre angles about the outer ring's centre from the load line (+x), in (-pi, pi]
-        [rad]."""
-        x = self.state.ball_position_in_bearing_m
-        return np.arctan2(x[:, 1], x[:, 0])
-
-    def _contact(self, j: int, r: int, net, columns: list | None = None,
-                 resistance: list | None = None, capacitance: list | None = None) -> ContactState:
-        """Contact r (0 inner, 1 outer) of ball j. `columns` (the contact lanes as lists of floats,
-        `contacts.T.tolist()`), `resistance` and `capacitance` (the network's per-contact values as
-        lists): the same values read once for the whole snapshot instead of element by element
-        from the arrays (a third of the snapshot's time)."""
-        k = 2 * j + r
-        c = self.state.contacts[:, k] if columns is None else columns[k]
-        resistance = net.contact_resistance_ohm if resistance is None else resistance
-        capacitance = net.contact_capacitance_f if capacitance is None else capacitance
-        loaded = c[L.C_LOAD] > 0.0
-        regime = REGIME_NAMES[int(c[L.C_REGIME])] if loaded else "no_contact"
-        return ContactState(
-            load_n=float(c[L.C_LOAD]),
-            h_min_m=_finite_or_none(c[L.C_H_MIN]) if loaded else None,
-            h_c_m=_finite_or_none(c[L.C_H_C]) if loaded else None,
-            **{"lambda": _finite_or_none(c[L.C_LAMBDA]) if loaded else None},
-            regime=regime, mu=self._contact_mu(c) if loaded else 0.0,
-            entrainment_speed_m_s=float(c[L.C_ENTRAINMENT]) if loaded else 0.0,
-            slide_roll_ratio=float(c[L.C_SRR]) if loaded else 0.0,
-            contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.G_NZ])))) if loaded else 0.0,
-            max_pressure_pa=float(max_pressure_pa(c[L.C_LOAD], c[L.C_SEMI_MAJOR], c[L.C_SEMI_MINOR])),
-            resistance_ohm=_finite_or_none(resistance[k]),
-            capacitance_f=float(capacitance[k]),
-        )
-
-    def _contact_mu(self, c) -> float:
-        """Published mu of one contact's lane column: with the ellipse friction the effective
-        coefficient |F_t| / Q (the tangential spring's elastic force, which the strips transmit,
-        over the normal load); with the centre-point laws their Coulomb coefficient."""
-        if not self._effective_mu:
-            return float(c[L.C_MU])
-        kt = self.model.options.tangential_stiffness_ratio * 1.5 * c[L.M_STIFFNESS] * c[L.G_SQRT_DELTA]
-        return float(kt * math.sqrt(c[L.T_XI0] ** 2 + c[L.T_XI1] ** 2 + c[L.T_XI2] ** 2) / c[L.C_LOAD])
-
-    def electrical(self):
+    def electrical(self) -> ElectricalNetwork:
         """The bearing's electrical network at the current state (twin.electrical_network)."""
         sp = self._setpoint
         return bearing_network(self.model, self.state.contacts, sp.shaft_voltage_v, sp.shaft_current_a)
@@ -651,51 +528,22 @@ class Twin:
     def snapshot(self, real_time_factor: float | None = None) -> Snapshot:
         """An immutable copy of the public state (schema bearing-twin/state/1)."""
         s = self.state
-        x, v, w = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s, s.ball_angular_velocity_rad_s
-        az = self.ball_azimuths_rad()
-        rho2 = x[:, 0] ** 2 + x[:, 1] ** 2
-        orbital = (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]) / rho2
-        spin = np.linalg.norm(w, axis=1)
         net = self.electrical()
-        columns = s.contacts.T.tolist()
-        resistance = np.asarray(net.contact_resistance_ohm, dtype=float).tolist()
-        capacitance = np.asarray(net.contact_capacitance_f, dtype=float).tolist()
-        az, spin, orbital = az.tolist(), spin.tolist(), orbital.tolist()
-        cage = s.cage_load_n.max(axis=1).tolist()
-        balls = tuple(
-            BallState(index=j, azimuth_rad=az[j], spin_rad_s=spin[j], orbital_speed_rad_s=orbital[j],
-                      cage_load_n=cage[j],
-                      inner=self._contact(j, 0, net, columns, resistance, capacitance),
-                      outer=self._contact(j, 1, net, columns, resistance, capacitance),
-                      resistance_ohm=_finite_or_none(net.ball_resistance_ohm[j]),
-                      capacitance_f=float(net.ball_capacitance_f[j]))
-            for j in range(self.model.ball_count))
+        balls = ball_states(self.model, s, net, self._effective_mu)
         self.seq += 1
-        sp = self._setpoint
         return Snapshot(
             bearing_id=self.bearing_id, designation=self.model.spec.designation, seq=self.seq,
             time_s=self.time_s,
-            real_time_factor=_finite_or_none(real_time_factor) if real_time_factor is not None else None,
+            real_time_factor=finite_or_none(real_time_factor) if real_time_factor is not None else None,
             status=self.status, restarts=self.restarts,
-            setpoint=sp,
+            setpoint=self._setpoint,
             shaft_speed_rad_s=float(s.scalars[L.X_SHAFT_SPEED]),
             cage_speed_rad_s=float(s.scalars[L.X_CAGE_SPEED]),
             inner_ring_displacement_m=tuple(float(a) for a in s.inner_ring_offset_m),
             friction_torque_n_m=float(self._last_torque_n_m),
             friction_power_w=FrictionPowerState(**self.friction_power_w().by_source_w()),
             viscosity_pa_s=float(self.inlet.inlet_viscosity_pa_s),
-            electrical=ElectricalState(
-                resistance_ohm=_finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,
-                capacitance_reason=net.capacitance_reason,
-                impedance_ohm=net.impedance_ohm, phase_rad=net.phase_rad,
-                frequency_hz=net.frequency_hz, shaft_voltage_v=net.shaft_voltage_v,
-                shaft_current_a=net.shaft_current_a, max_film_field_v_m=net.max_film_field_v_m,
-                current_density_a_m2=net.current_density_a_m2, discharge_risk=net.discharge_risk,
-                reason=net.reason,
-                contact_temperature_rise_k=float(self.inlet.current_heating_k + self.inlet.shear_heating_k),
-                current_temperature_rise_k=float(self.inlet.current_heating_k),
-                shear_temperature_rise_k=float(self.inlet.shear_heating_k),
-                film_thermal_factor=float(self.inlet.film_thermal_factor)),
+            electrical=electrical_state(net, self.inlet),
             balls=balls,
             life=self._life_state(),
             outer_ring_displacement_m=tuple(float(h) for h in s.housing_displacement_m[:3]),

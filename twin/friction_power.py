@@ -30,10 +30,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin.kernels import layout as L
+from twin.model import BearingModel
 from twin.physics import drag, seals, starvation
+from twin.physics.viscosity import density_kg_m3
 from twin.spec import BearingSpec, Geometry
+from twin.state import TwinState
 
 ORBIT_SAMPLES = 720  # azimuths of the orbit-mean immersed fraction of an oil bath
+REST_SPEED_RAD_S = 1.0  # below this mean shaft speed over a frame the shaft counts as at rest [rad/s]
 
 
 @dataclass(frozen=True)
@@ -176,3 +180,50 @@ def contact_powers_w(contacts: np.ndarray, ball_angular_velocity_rad_s: np.ndarr
         return np.where(loaded, np.maximum(p, 0.0), 0.0).reshape(z, 2)
 
     return per_contact(rolling), per_contact(sliding), per_contact(spin_w)
+
+
+def friction_power_by_source(model: BearingModel, state: TwinState, oil_temperature_c: float,
+                             oil_viscosity_pa_s: float, immersed_fraction: float,
+                             seal_w: float) -> FrictionPower:
+    """Friction power of the current instant by source and by contact [W]: the contacts' rolling,
+    sliding and spin power from the last step's lanes (`contact_powers_w`), each ball's drag at
+    its own depth in the oil bath (the bath's drag shared by the part of each ball in the oil) or
+    in the cavity's oil-air mixture (`immersed_fraction` of oil, `ball_drag_power_w`) at the oil's
+    density at `oil_temperature_c` [degC] and `oil_viscosity_pa_s`, and the seals' `seal_w`."""
+    s, m = state, model
+    rolling, sliding, spin = contact_powers_w(s.contacts, s.ball_angular_velocity_rad_s, m.ball_radius_m)
+    lub = m.spec.lubricant
+    rho = density_kg_m3(lub.density_15c_kg_m3, oil_temperature_c)
+    x, v = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s
+    orbit_speed = np.hypot(v[:, 0], v[:, 1])
+    drag_w = np.zeros(m.ball_count)
+    method = m.spec.lubrication.method
+    if method == "oil_bath":   # the bath's drag shared by the part of each ball in the oil
+        from_bottom = np.arctan2(x[:, 1], x[:, 0])  # the bath's bottom lies on the load line (+x)
+        share = np.array([drag.immersed_area_fraction(
+            drag.ball_depth_in_bath_m(oil_level_m(m.spec), float(a), m.pitch_radius_m), 2.0 * m.ball_radius_m)
+            for a in from_bottom])
+        if share.sum() > 0.0:
+            drag_w = share / share.sum() * oil_bath_drag_power_w(
+                m.spec, float(s.scalars[L.X_SHAFT_SPEED]), oil_viscosity_pa_s / rho)
+    elif method != "flooded":
+        for j in range(m.ball_count):
+            drag_w[j] = ball_drag_power_w(2.0 * m.ball_radius_m, float(orbit_speed[j]), immersed_fraction,
+                                          rho, oil_viscosity_pa_s)
+    return FrictionPower(rolling_w=float(rolling.sum()), sliding_w=float(sliding.sum()), spin_w=float(spin.sum()),
+                         drag_w=float(drag_w.sum()), seal_w=seal_w, rolling_contact_w=rolling,
+                         sliding_contact_w=sliding, spin_contact_w=spin, drag_ball_w=drag_w)
+
+
+def frame_friction_torque_n_m(drive_n_m: float, duration_s: float, mean_speed_rad_s: float,
+                              kinetic_energy_change_j: float, momentum_change_n_m_s: float) -> float:
+    """The friction torque of a frame [N m]: the shaft's mean drive torque less the torque that
+    speeds the balls and the cage up (or that they give back as they slow down), which is
+    inertia, not friction. Turning, the shaft's power drive * omega splits into the friction's
+    dissipation and the rate of change of the balls' and cage's kinetic energy E, so
+    M_f = drive - dE/dt / omega. With the shaft at rest (|omega| < REST_SPEED_RAD_S) the shaft
+    does no work and the torque is the one the outer ring holds: drive less the rate of change
+    of the balls' and cage's angular momentum about the axis."""
+    if abs(mean_speed_rad_s) >= REST_SPEED_RAD_S:
+        return drive_n_m - kinetic_energy_change_j / (duration_s * mean_speed_rad_s)
+    return drive_n_m - momentum_change_n_m_s / duration_s

@@ -12,8 +12,9 @@ on the module-level constants it imports (the lane layout, for instance), so a s
 survive a layout change. The cache therefore lives in a directory named after a digest of every
 source file of `twin/`, so any change of the engine's code compiles afresh. Both that digest and
 numba's per-file stamp (`StrippedSourceLocator`) are taken over the files' syntax trees without
-docstrings (comments never reach the tree), and a kernel is told apart from its namesakes by its
-own code rather than its line number: editing a docstring or a comment keeps the compiled cache.
+their string statements (the docstrings, attribute docstrings included; comments never reach the
+tree), and a kernel is told apart from its namesakes by its own code rather than its line number:
+editing a docstring or a comment keeps the compiled cache.
 """
 
 import ast
@@ -23,19 +24,31 @@ import inspect
 import os
 import textwrap
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import numba
 from numba.core import caching
 
 
+# the package whose kernels the stripped-source locator serves and whose code names the cache
+ENGINE_ROOT = Path(__file__).resolve().parent
+
+
+def _is_string_statement(node: ast.AST) -> bool:
+    return isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant) and isinstance(node.value.value, str)
+
+
 def _strip_docstrings(tree: ast.AST) -> ast.AST:
-    """The tree without the docstring of the module, of each class and of each function."""
+    """The tree without its string statements: the docstrings of the module, classes and
+    functions, and the attribute docstrings after an assignment (a bare string literal does
+    nothing when run)."""
     for node in ast.walk(tree):
-        if isinstance(node, (ast.Module, ast.ClassDef, ast.FunctionDef, ast.AsyncFunctionDef)):
-            body = node.body
-            if body and isinstance(body[0], ast.Expr) and isinstance(getattr(body[0], "value", None), ast.Constant) \
-                    and isinstance(body[0].value.value, str):
-                node.body = body[1:] or [ast.Pass()]
+        for field in ("body", "orelse", "finalbody"):
+            body = getattr(node, field, None)
+            if isinstance(body, list) and body and isinstance(body[0], ast.AST):
+                kept = [st for st in body if not _is_string_statement(st)]
+                if len(kept) != len(body):
+                    setattr(node, field, kept or [ast.Pass()])
     return tree
 
 
@@ -53,10 +66,13 @@ def _file_digest(path: str, st_mtime: float, st_size: int) -> bytes:
 
 # numba's cache classes (public names since numba 0.63, underscored before)
 _CACHE_IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
-_USER_LOCATOR = getattr(caching, "UserProvidedCacheLocator", None) or getattr(caching, "_UserProvidedCacheLocator")
+if TYPE_CHECKING:
+    from numba.core.caching import UserProvidedCacheLocator as _UserLocator
+else:
+    _UserLocator = getattr(caching, "UserProvidedCacheLocator", None) or getattr(caching, "_UserProvidedCacheLocator")
 
 
-class StrippedSourceLocator(_USER_LOCATOR):
+class StrippedSourceLocator(_UserLocator):
     """numba's locator for `numba.config.CACHE_DIR`, stamped with the digest of the source file's
     code (`code_digest`) instead of its bytes, and disambiguated by the digest of the function's
     own code instead of its first line number."""
@@ -78,13 +94,13 @@ class StrippedSourceLocator(_USER_LOCATOR):
 
     @classmethod
     def from_function(cls, py_func, py_file):
-        if not py_file.startswith(str(Path(__file__).resolve().parent)):
+        if not py_file.startswith(str(ENGINE_ROOT)):
             return None
         return super().from_function(py_func, py_file)
 
 
 def _engine_cache_dir() -> str:
-    root = Path(__file__).resolve().parent
+    root = ENGINE_ROOT
     digest = hashlib.sha256()
     for path in sorted(root.rglob("*.py")):
         digest.update(path.relative_to(root).as_posix().encode())
@@ -96,16 +112,16 @@ def _engine_cache_dir() -> str:
     return os.path.join(base, f"numba-{digest.hexdigest()[:16]}")
 
 
-numba.config.CACHE_DIR = _engine_cache_dir()
+numba.config.CACHE_DIR = _engine_cache_dir()  # type: ignore[attr-defined]  # numba.config sets its options at run time
 if StrippedSourceLocator not in _CACHE_IMPL._locator_classes:
     _CACHE_IMPL._locator_classes.insert(0, StrippedSourceLocator)
 
-JIT = dict(nogil=True, cache=True)
+JIT: dict[str, Any] = dict(nogil=True, cache=True)
 
 # Branch-free array loops (contact lanes) use numpy's error model so that divisions carry no
 # zero check and LLVM can vectorise them; their inputs never divide by zero (the ball centre is
 # never on the bearing axis nor on the groove-centre circle).
-JIT_VECTOR = dict(JIT, error_model="numpy")
+JIT_VECTOR: dict[str, Any] = dict(JIT, error_model="numpy")
 
 # The step (`twin.kernels.step.step_n`): numpy's error model too, so that the lane passes inlined
 # into it (numba-level `inline="always"`: no array crosses a call inside the loop, hence no
@@ -114,4 +130,4 @@ JIT_VECTOR = dict(JIT, error_model="numpy")
 # with it, every inlined pass counted its array arguments up and down with atomic operations,
 # ~6 % of the step); a division by zero gives inf / NaN,
 # which the step's finiteness check reports as a status (python's model would raise instead).
-JIT_STEP = dict(JIT_VECTOR, _nrt=False)
+JIT_STEP: dict[str, Any] = dict(JIT_VECTOR, _nrt=False)

@@ -58,14 +58,15 @@ class BearingModel:
     max_radial_load_n: float
     max_axial_load_n: float
     max_shaft_speed_rad_s: float
-    time_step: timestep.CriticalTimeStep | None = None  # critical step of the scheme (twin.timestep)
+    # twin.vibration: housing H_* vector; reversed FIR taps of the accelerometer decimator (K R,),
+    # without the housing a (1,) zero array, as the kernel's signature takes an array
+    housing_params: np.ndarray
+    decimator_taps: np.ndarray
+    time_step: timestep.CriticalTimeStep  # critical step of the scheme (twin.timestep)
 
     gap_limit_m: tuple[float, float] = (50e-6, 50e-6)   # inner, outer: geometric gap limit of the contact capacitance
     rest_capacitance_f: float = 0.0                     # the rings' lands across the oil-filled annulus [F]
-    # twin.vibration: housing H_* vector, V_* vector, accelerometer decimator
-    housing_params: np.ndarray | None = None
-    decimator: DecimatorDesign | None = None  # None with the rigid outer ring
-    decimator_taps: np.ndarray | None = None  # reversed FIR taps (K R,); without the housing a (1,) zero array, as the kernel's signature takes an array
+    decimator: DecimatorDesign | None = None  # accelerometer decimator; None with the rigid outer ring
 
     def arrays(self) -> ModelArrays:
         """The model's arrays as the kernels take them (`twin.kernels.structures.ModelArrays`)."""

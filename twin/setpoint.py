@@ -108,7 +108,7 @@ class SetpointUpdate(BaseModel):
 
     def merged(self, later: SetpointUpdate) -> SetpointUpdate:
         """This update followed by `later` (later wins per field)."""
-        return SetpointUpdate.model_construct(**{**self.fields, **later.fields})
+        return SetpointUpdate.model_construct(None, **{**self.fields, **later.fields})
 
 
 @dataclass(frozen=True)
@@ -207,7 +207,7 @@ class SetpointLimits(Mapping):
     def __len__(self) -> int:
         return len(self.ranges)
 
-    __hash__ = None   # a mapping (compared by value), not hashable
+    __hash__ = None  # type: ignore[assignment]  # a mapping (compared by value), not hashable
 
     def as_dict(self) -> dict[str, tuple[float, float]]:
         return dict(self.ranges)

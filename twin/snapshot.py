@@ -3,11 +3,12 @@ every field name, JSON without NaN or Infinity (undefined values are null)."""
 
 from __future__ import annotations
 
-from typing import Literal
+from typing import Final, Literal
 
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
+from twin.physics.friction import Regime
 from twin.setpoint import Setpoint
 from twin.vibration.defects import Defect
 
@@ -15,17 +16,18 @@ SCHEMA = "bearing-twin/state/1"
 
 _FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
-Regime = Literal["no_contact", "boundary", "mixed", "full_film"]
+DischargeRisk = Literal["none", "possible", "likely"]
 
-LAMBDA_KEY = "lambda"
+LAMBDA_KEY: Final = "lambda"
 """The film parameter's name in every message, entity path and table; `ContactState.lambda_` in
 Python, where `lambda` is a keyword."""
 
 
 class ContactState(BaseModel):
-    """One ball-raceway contact."""
+    """One ball-raceway contact. Lambda is `lambda_` in Python (`lambda` is a keyword) and
+    "lambda" on the wire: the model is built with `lambda_` and dumps by alias."""
 
-    model_config = _FROZEN
+    model_config = ConfigDict(**_FROZEN, validate_by_name=True)
     load_n: float = Field(description="Normal (elastic Hertz) load [N].")
     h_min_m: float | None = Field(description="Minimum film thickness [m]; null without contact.")
     h_c_m: float | None = Field(description="Central film thickness [m]; null without contact.")
@@ -75,7 +77,7 @@ class ElectricalState(BaseModel):
     shaft_current_a: float = Field(description="Current through the bearing (set, or voltage / |Z|) [A].")
     max_film_field_v_m: float = Field(description="Largest electric field across a film or gap [V/m].")
     current_density_a_m2: float = Field(description="Largest apparent current density over a loaded contact area [A/m^2].")
-    discharge_risk: Literal["none", "possible", "likely"] = Field(description="Electrical discharge risk.")
+    discharge_risk: DischargeRisk = Field(description="Electrical discharge risk.")
     reason: str = Field(description="Why the risk is what it is.")
     contact_temperature_rise_k: float = Field(description="Inlet temperature rise above the oil temperature: current + shear heating, fed into the film [K].")
     current_temperature_rise_k: float = Field(default=0.0, description="Race-track temperature rise from the current discharge (seed 003 eq. 10) [K].")

@@ -29,6 +29,8 @@ Clearance = Annotated[float, Field(ge=-50e-6, le=200e-6,
                                    description="Diametral clearance Pd [m]; negative = preload (seed 000 Appendix A: "
                                    "+-12.6e-6 m).")]
 """Diametral clearance Pd [m], from a 50 um preload to 200 um of play."""
+BearingKind = Literal["deep_groove", "angular_contact"]
+"""The bearing types the engine models."""
 
 
 class Geometry(BaseModel):
@@ -294,7 +296,7 @@ class BearingSpec(BaseModel):
 
     designation: str = Field(max_length=32, description="Catalog designation, e.g. '6208', or the name of a bearing "
                              "that is not in the catalog [text].")
-    kind: Literal["deep_groove", "angular_contact"] = Field(
+    kind: BearingKind = Field(
         default="deep_groove", description="'deep_groove' or 'angular_contact' [text].")
     geometry: Geometry = Field(description="Internal geometry: ball, raceway and groove radii [m], ball count [-], "
                                "contact angle [deg], ... [object].")

@@ -41,14 +41,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
 from scipy import linalg
 
 from twin.kernels import layout as L
+from twin.kernels.step import ROLLING_REGULARISATION_SPEED
+from twin.kernels.tribology import contact_tribology
+from twin.physics.damping import fluid_damping_n_s_m, hysteretic_damping_n_s_m
 from twin.spec import TIME_STEP_RANGE_S  # noqa: F401  (explicit steps allowed by ModelOptions [s])
 
-AUTO = "auto"
+AUTO: Final = "auto"
 
 # The auto step is this fraction of the critical step. Why 0.8 and not 1: the critical step is
 # exact for a linear oscillator; the model is not linear (the Hertz stiffness grows as
@@ -122,7 +126,7 @@ class CriticalTimeStep:
 def _highest_mode(name: str, k: np.ndarray, m: np.ndarray, c: np.ndarray) -> Element:
     """The mode of K phi = omega^2 M phi with the smallest critical step (modal damping)."""
     omega2, phi = linalg.eigh(k, m)  # phi is mass-normalised: phi^T M phi = 1
-    best = None
+    best: Element | None = None
     for i, w2 in enumerate(omega2):
         if w2 <= 0.0:
             continue
@@ -131,16 +135,14 @@ def _highest_mode(name: str, k: np.ndarray, m: np.ndarray, c: np.ndarray) -> Ele
         e = Element(name, w, float(zeta), central_difference_critical_step_s(w, zeta))
         if best is None or e.critical_step_s < best.critical_step_s:
             best = e
+    if best is None:
+        raise ValueError(f"{name}: no mode of positive stiffness")
     return best
 
 
 def estimate(params: np.ndarray, race_params: np.ndarray, race_tribology: np.ndarray,
              static_load_n: float, reference_viscosity_pa_s: float, ball_count: int) -> CriticalTimeStep:
     """The critical step of the model arrays (`twin.model`), every element at `static_load_n`."""
-    from twin.kernels.step import ROLLING_REGULARISATION_SPEED
-    from twin.kernels.tribology import contact_tribology
-    from twin.physics.damping import fluid_damping_n_s_m, hysteretic_damping_n_s_m
-
     p = params
     q = float(static_load_n)
     m = p[L.P_BALL_MASS]

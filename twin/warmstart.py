@@ -15,6 +15,7 @@ from twin.kernels import layout as L
 from twin.kernels.contacts import groove_penetration
 from twin.model import BearingModel
 from twin.state import TwinState
+from twin.vibration.housing import housing_equilibrium
 
 _REG_SPRING_N_M = 1e3  # keeps floating (unloaded) balls and the free axial mode well posed
 
@@ -132,3 +133,18 @@ def warm_start(model: BearingModel, state: TwinState, shaft_speed_rad_s: float, 
         # the equilibrium position (the contact angle the ball actually has)
         state.ball_angular_velocity_rad_s[j] = -(speed / rb) * np.cross(normals[1], e_t)
     return ok
+
+
+def place_on_housing(model: BearingModel, state: TwinState, radial_load_n: float, axial_load_n: float) -> None:
+    """Warm start on the housing: the outer ring at the static equilibrium of its support under
+    the whole load (at the quasi-static equilibrium the balls pass the applied loads to the outer
+    ring; their centrifugal forces cancel over the ring), the balls and the inner ring moved with
+    it; the decimator and the sample ring restart (twin.vibration.housing.housing_equilibrium)."""
+    s = state
+    housing_equilibrium(model.housing_params, radial_load_n, 0.0, axial_load_n,
+                        s.housing_displacement_m, s.housing_velocity_m_s, s.housing_acceleration_m_s2)
+    shift = s.housing_displacement_m[:3]
+    s.ball_position_m += shift
+    s.ring_position_m += shift
+    s.decimator_state[:] = 0.0
+    s.sample_ring_state[:] = 0.0

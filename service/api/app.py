@@ -28,6 +28,7 @@ from __future__ import annotations
 import logging
 import threading
 from contextlib import asynccontextmanager
+from typing import Any
 
 from fastapi import Depends, FastAPI
 from starlette.concurrency import run_in_threadpool
@@ -102,11 +103,11 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
     install_error_handlers(app)
 
     token = [Depends(require_token)] if gate.requires_token else []
-    writes = {"dependencies": token, "responses": {
+    writes: dict[str, Any] = {"dependencies": token, "responses": {
         **(_UNAUTHORIZED if token else {}),
         413: {"model": ErrorResponse, "description": f"Body larger than {settings.security.max_body_bytes} bytes"}}}
-    reads = ({"dependencies": token, "responses": _UNAUTHORIZED}
-             if token and settings.security.read_requires_token else {})
+    reads: dict[str, Any] = ({"dependencies": token, "responses": _UNAUTHORIZED}
+                             if token and settings.security.read_requires_token else {})
     app.include_router(health.router)
     for router in (bearings.read, state.read, alarms.read, defects.read, measured.read, scenarios.read, docs.read):
         app.include_router(router, **reads)

@@ -66,10 +66,12 @@ async def _unexpected(request: Request, exc: Exception):
 
 
 def install_error_handlers(app: FastAPI) -> None:
-    app.add_exception_handler(InputError, _input_error)
-    app.add_exception_handler(RequestValidationError, _request_validation)
-    app.add_exception_handler(ValidationError, _validation)
-    app.add_exception_handler(SetpointError, _setpoint_error)
-    app.add_exception_handler(ScenarioError, _scenario_error)
-    app.add_exception_handler(StarletteHTTPException, _http_error)
-    app.add_exception_handler(Exception, _unexpected)
+    # FastAPI.exception_handler registers each handler for its own exception type (Starlette types
+    # add_exception_handler's handler for any Exception)
+    app.exception_handler(InputError)(_input_error)
+    app.exception_handler(RequestValidationError)(_request_validation)
+    app.exception_handler(ValidationError)(_validation)
+    app.exception_handler(SetpointError)(_setpoint_error)
+    app.exception_handler(ScenarioError)(_scenario_error)
+    app.exception_handler(StarletteHTTPException)(_http_error)
+    app.exception_handler(Exception)(_unexpected)

@@ -64,7 +64,7 @@ class GuardedH11Protocol(H11Protocol):
     header_timeout_s: float = 10.0
     body_timeout_s: float = 30.0
 
-    def connection_made(self, transport) -> None:  # type: ignore[override]
+    def connection_made(self, transport) -> None:
         self._guard: asyncio.TimerHandle | None = None
         self._guarding: str | None = None
         super().connection_made(transport)

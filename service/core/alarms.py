@@ -402,7 +402,7 @@ class AlarmTracker:
     def state(self) -> Alarm:
         lv = self.levels[self.level] if self.active else (self.levels[0] if self.levels else None)
         return Alarm(alarm_id=self.rule.id, category=self.rule.category, description=self.rule.description,
-                     active=self.active, severity=lv.severity if self.active else None,
+                     active=self.active, severity=lv.severity if self.active and lv is not None else None,
                      since_s=self.since_s, since_wall_time_s=self.since_wall_s, value=self.value,
                      threshold=lv.threshold if lv else None, clear_threshold=lv.clear if lv else None,
                      unit=self.rule.unit, message=self.message)
@@ -568,6 +568,7 @@ class AlarmEvaluator:
                snapshot_seq: int | None = None) -> AlarmEvent:
         self.seq += 1
         rule, level = tracker.rule, tracker.level
+        assert tracker.value is not None  # a transition is fed a finite value (AlarmTracker.update)
         lv = tracker.levels[level] if level >= 0 else tracker.levels[0]   # cleared: the first level
         severity = lv.severity if level >= 0 else None
         word = {"raised": "raised", "escalated": "escalated to", "deescalated": "stepped down to",

@@ -6,7 +6,7 @@ vocabulary's errors. Messages never echo the input (it may hold NaN, which JSON 
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 from pydantic import BaseModel, Field
@@ -83,7 +83,7 @@ def _jsonable(value: Any) -> Any:
     return str(value)
 
 
-def field_errors(errors: list[dict], limits: SetpointLimits | None = None,
+def field_errors(errors: Sequence[Mapping[str, Any]], limits: SetpointLimits | None = None,
                  bounds: Mapping[str, tuple[Any, Any]] | None = None) -> list[FieldError]:
     """pydantic error dicts -> FieldErrors naming the field and its allowed range: for setpoint
     fields the bearing's (`limits`) or else the vocabulary's static bounds, for other fields
@@ -95,8 +95,8 @@ def field_errors(errors: list[dict], limits: SetpointLimits | None = None,
         leaf = str(loc[-1]) if loc else None
         msg = str(e.get("msg", "invalid")).removeprefix("Value error, ")
         ctx = e.get("ctx") or {}
-        allowed = None
-        if leaf in SETPOINT_FIELDS:
+        allowed: list[Any] | None = None
+        if leaf is not None and leaf in SETPOINT_FIELDS:
             if limits is not None:
                 low, high = limits[leaf]
                 where = f"for bearing {limits.bearing}" if limits.bearing else "for this bearing"
@@ -106,16 +106,16 @@ def field_errors(errors: list[dict], limits: SetpointLimits | None = None,
             allowed = [low, high]
             msg = f"{msg}; allowed range [{low:g}, {high:g}] {setpoint_unit(leaf)} {where}"
         else:
-            low = ctx.get("ge", ctx.get("gt"))
-            high = ctx.get("le", ctx.get("lt"))
-            if low is not None or high is not None:
+            low_bound = ctx.get("ge", ctx.get("gt"))
+            high_bound = ctx.get("le", ctx.get("lt"))
+            if low_bound is not None or high_bound is not None:
                 known = (bounds or {}).get(leaf or "")
                 if known is not None:
-                    low = known[0] if low is None else low
-                    high = known[1] if high is None else high
-                allowed = [_jsonable(low), _jsonable(high)]
+                    low_bound = known[0] if low_bound is None else low_bound
+                    high_bound = known[1] if high_bound is None else high_bound
+                allowed = [_jsonable(low_bound), _jsonable(high_bound)]
                 unit = unit_of(leaf or "")
-                msg = f"{msg}; allowed range [{_fmt(low)}, {_fmt(high)}]{' ' + unit if unit else ''}"
+                msg = f"{msg}; allowed range [{_fmt(low_bound)}, {_fmt(high_bound)}]{' ' + unit if unit else ''}"
         if e.get("type") == "extra_forbidden" and leaf is not None:
             msg = f"unknown field {leaf!r}"
             if limits is not None and len(loc) <= 2:

@@ -17,7 +17,7 @@ import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
-from service.core.scenarios import ResolvedRun
+from service.core.scenarios import MeasuredTemperature, ResolvedRun
 from twin.setpoint import Setpoint, SetpointUpdate
 
 
@@ -40,7 +40,7 @@ class ScenarioExecutor:
     _initial_done: bool = False
     phase: str | None = None
     defects: list | None = None        # the defects of the steps just passed (taken by the driver)
-    temperature: object | None = None  # the measured temperature of the steps just passed (MeasuredTemperature)
+    temperature: MeasuredTemperature | None = None  # the measured temperature of the steps just passed
 
     def updates(self, t: float, current: Setpoint) -> SetpointUpdate:
         eps = 1e-9
@@ -65,7 +65,7 @@ class ScenarioExecutor:
                 for name in fields:
                     self._ramps.pop(name, None)  # a later set overrides a running ramp
                 out.update(fields)
-            else:
+            elif step.ramp is not None and step.over_s is not None:  # a ramp has its over_s (ScenarioStep)
                 for name, target in step.ramp.fields.items():
                     start_value = out.get(name, getattr(current, name))
                     self._ramps[name] = _ActiveRamp(name, step.at_s, float(step.over_s),
@@ -221,30 +221,31 @@ class ScenarioDriver:
             self._t0_s = elapsed_s
             request.state = "running"
             event = True
-        handle = self._running
+        handle, executor = self._running, self._executor
         if handle is None:
             return event
+        assert executor is not None  # set with the running handle
         if handle.finished:            # cancelled from outside
             self._end(handle)
             return True
         t = elapsed_s - self._t0_s
         handle.scenario_time_s = t
         try:
-            update = self._executor.updates(t, target)
+            update = executor.updates(t, target)
             if update.fields:
                 offer(update)
-            defects, self._executor.defects = self._executor.defects, None
+            defects, executor.defects = executor.defects, None
             if defects is not None and offer_defects is not None:
                 offer_defects(defects)
-            measured, self._executor.temperature = self._executor.temperature, None
+            measured, executor.temperature = executor.temperature, None
             if measured is not None and offer_temperature is not None:
                 offer_temperature(measured.node, measured.temperature_c)
-            handle.phase = self._executor.phase
+            handle.phase = executor.phase
         except Exception as exc:  # noqa: BLE001 - a bad scenario must not stop the twin
             handle.finish("failed", f"{type(exc).__name__}: {exc}", notify=False)
             self._end(handle)
             return True
-        if self._executor.done(t):
+        if executor.done(t):
             handle.scenario_time_s = handle.duration_s
             handle.finish("done", notify=False)
             self._end(handle)

@@ -59,6 +59,7 @@ when a twin is created); `bearing-twin scenario run FILE` creates a fresh twin f
 from __future__ import annotations
 
 import re
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, Literal
@@ -169,8 +170,13 @@ class ScenarioRun(BaseModel):
 
 
 def _drop_empty_steps(steps: list[ScenarioStep]) -> list[ScenarioStep]:
-    return [s for s in steps if s.defects is not None or s.temperature is not None
-            or (s.set or s.ramp).model_dump(exclude_none=True)]
+    return [s for s in steps if s.defects is not None or s.temperature is not None or _sets_fields(s)]
+
+
+def _sets_fields(step: ScenarioStep) -> bool:
+    """Whether the step's setpoint update (set or ramp) names a field."""
+    update = step.set or step.ramp
+    return update is not None and bool(update.model_dump(exclude_none=True))
 
 
 def _check_steps(steps: list[ScenarioStep], duration_s: float, where: str) -> None:
@@ -347,7 +353,7 @@ class ResolvedRun:
                     "create a twin with that spec (POST /v1/bearings with 'spec') or run the scenario offline "
                     "(bearing-twin scenario run)", [self.bearing.designation])
             return
-        wanted = {"bearing": (self.bearing, designation),
+        wanted: dict[str, tuple[Any, Any]] = {"bearing": (self.bearing, designation),
                   "diametral_clearance_m": (self.diametral_clearance_m, diametral_clearance_m),
                   "lubricant": (catalog.lubricant(self.lubricant).name, lubricant)}
         for name in ("bearing", "diametral_clearance_m", "lubricant"):
@@ -399,10 +405,11 @@ class ResolvedRun:
         for name, value in self.initial.fields.items():
             yield "initial", name, value
         for i, step in enumerate(self.steps):
-            if step.set is None and step.ramp is None:
+            update = step.set if step.set is not None else step.ramp
+            if update is None:
                 continue
             kind = "set" if step.set is not None else "ramp"
-            for name, value in (step.set or step.ramp).fields.items():
+            for name, value in update.fields.items():
                 yield f"steps[{i}].{kind}", name, value
 
     def check_defects(self, geometry, where: str = "") -> None:
@@ -451,7 +458,7 @@ def scenario_from_dict(data: Any, *, source: str = "scenario") -> Scenario:
 _PATH_PREFIX = re.compile(r"^([A-Za-z_][\w.\[\]]*): (.*)$", re.DOTALL)
 
 
-def _locate(error: dict) -> tuple[str, str]:
+def _locate(error: Mapping[str, Any]) -> tuple[str, str]:
     """(field path, message) of a pydantic error; model-level errors carry the path in front of
     their message ('steps[2].at_s: ...')."""
     where = loc_text([p for p in error.get("loc", ()) if p not in (_DESIGNATION_TAG, _SPEC_TAG)], skip=()) or ""

@@ -301,8 +301,8 @@ class GuardedSession(InternalSession):
             self.guard.refuse("BadTooManyMonitoredItems", "%d monitored item(s) of a session from %s refused: at most "
                               "%d items and %g notifications/s per session", refused, self.address,
                               limits.max_monitored_items_per_session, limits.max_notifications_per_s)
-            results += [ua.MonitoredItemCreateResult(StatusCode=ua.StatusCode(ua.StatusCodes.BadTooManyMonitoredItems))
-                        for _ in range(refused)]
+            too_many = ua.UInt32(ua.StatusCodes.BadTooManyMonitoredItems)
+            results += [ua.MonitoredItemCreateResult(StatusCode=ua.StatusCode(too_many)) for _ in range(refused)]
         return results
 
     async def modify_monitored_items(self, params: ua.ModifyMonitoredItemsParameters

@@ -230,7 +230,7 @@ class ClientTrust:
                 await check.validate(cert, app_description)
             except ServiceError as exc:
                 log.warning("OPC UA: session refused (%s): client %s, certificate %s, SHA-1 %s (trusted: the "
-                            "certificates in %s)", ua.StatusCode(exc.code).name, app_description.ApplicationUri,
+                            "certificates in %s)", ua.StatusCode(ua.UInt32(exc.code)).name, app_description.ApplicationUri,
                             cert.subject.rfc4514_string(), thumbprint(cert), self.folder)
                 raise
         return validate

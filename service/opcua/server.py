@@ -59,7 +59,7 @@ import logging
 import math
 import threading
 from dataclasses import dataclass
-from datetime import UTC, datetime
+from datetime import UTC
 from typing import Any
 from urllib.parse import urlparse
 
@@ -68,6 +68,7 @@ from asyncua.common.utils import ServiceError
 from asyncua.crypto.permission_rules import User, UserRole
 from asyncua.server.address_space import AttributeService
 from asyncua.server.event_generator import EventGenerator
+from asyncua.server.user_managers import UserManager
 
 from service.core.alarms import AlarmEvent, inputs_from_snapshot
 from service.core.errors import InputError
@@ -102,7 +103,7 @@ class TwinUser(User):
     authenticated: bool = False
 
 
-class TokenUserManager:
+class TokenUserManager(UserManager):
     """asyncua user manager: the service token is the password (see the module docstring).
 
     `secure`: the server offers secure policies (has a certificate); then a password must come
@@ -194,6 +195,11 @@ class _GatedAttributeService(AttributeService):
             else:
                 results.extend(await super().write(ua.WriteParameters(NodesToWrite=[w]), user))
         return results
+
+
+def _node_id(identifier: int | str, namespace: int = 0) -> ua.NodeId:
+    """asyncua annotates NodeId's fields with its own int / str subclasses; it takes the built-ins."""
+    return ua.NodeId(identifier, namespace)  # type: ignore[arg-type]
 
 
 def _status(name: str) -> ua.StatusCode:
@@ -334,12 +340,13 @@ class OpcUaFacade:
         server.set_identity_tokens([ua.AnonymousIdentityToken, ua.UserNameIdentityToken])
         server.iserver.attribute_service = _GatedAttributeService(server.iserver.aspace, self)
         idx = self.namespace_index = await server.register_namespace(NAMESPACE_URI)
-        self._root = await server.nodes.objects.add_folder(ua.NodeId(ROOT_FOLDER, idx), ua.QualifiedName(ROOT_FOLDER, idx))
+        self._root = await server.nodes.objects.add_folder(_node_id(ROOT_FOLDER, idx), ua.QualifiedName(ROOT_FOLDER, idx))
         self._event_type = await server.create_custom_event_type(idx, EVENT_TYPE, ua.ObjectIds.BaseEventType,
                                                                  list(_EVENT_FIELDS))
         await server.start()
         try:
-            sock = server.bserver._server.sockets[0].getsockname()   # the port really bound (0: any)
+            # the port really bound (0: any); asyncua types its listener as an AbstractServer
+            sock = server.bserver._server.sockets[0].getsockname()  # type: ignore[union-attr]
             self.url = f"opc.tcp://{urlparse(self.endpoint).hostname}:{sock[1]}{urlparse(self.endpoint).path}"
         except Exception:  # noqa: BLE001
             self.url = self.endpoint
@@ -394,11 +401,16 @@ class OpcUaFacade:
                 nodes = await self._add_twin(entry)
             await self._update(nodes, entry)
 
+    def _namespace(self) -> int:
+        """The service's namespace index (registered when the server starts)."""
+        assert self.namespace_index is not None
+        return self.namespace_index
+
     def _nid(self, *parts: str) -> ua.NodeId:
-        return ua.NodeId("/".join(parts), self.namespace_index)
+        return _node_id("/".join(parts), self._namespace())
 
     async def _add_twin(self, entry: Any) -> _TwinNodes:
-        obj = await self._root.add_object(self._nid(entry.id), ua.QualifiedName(entry.id, self.namespace_index))
+        obj = await self._root.add_object(self._nid(entry.id), ua.QualifiedName(entry.id, self._namespace()))
         try:
             return await self._populate(entry, obj)
         except BaseException:
@@ -408,7 +420,7 @@ class OpcUaFacade:
             raise
 
     async def _populate(self, entry: Any, obj: Any) -> _TwinNodes:
-        idx, bid = self.namespace_index, entry.id
+        idx, bid = self._namespace(), entry.id
         qn = lambda name: ua.QualifiedName(name, idx)  # noqa: E731
         nodes = _TwinNodes(bid, obj)
         ident = await obj.add_folder(self._nid(bid, "Identification"), qn("Identification"))
@@ -446,7 +458,7 @@ class OpcUaFacade:
                 nodes.last_result = last.nodeid
         # alarm events: from the twin object, and from the Server object (SourceNode = the twin)
         isession = self.server.iserver.isession
-        for emitter, add_ref in ((obj.nodeid, True), (ua.NodeId(ua.ObjectIds.Server), False)):
+        for emitter, add_ref in ((obj.nodeid, True), (_node_id(ua.ObjectIds.Server), False)):
             gen = EventGenerator(isession)
             await gen.init(self._event_type, emitting_node=emitter, add_generates_event=add_ref)
             gen.event.SourceNode, gen.event.SourceName = obj.nodeid, bid
@@ -475,7 +487,7 @@ class OpcUaFacade:
         view = View(snapshot=snap, inputs=inputs_from_snapshot(snap, settings) if snap is not None else None,
                     alarms={a.alarm_id: a for a in hub.states(entry.id)}, target=target, settings=settings,
                     measured=getattr(entry, "measured", None) and entry.measured.latest)
-        now = datetime.now(UTC)
+        now = ua.DateTime.now(UTC)
         for key, (nid, vt, read) in nodes.vars.items():
             try:
                 value = read(view)

@@ -82,6 +82,7 @@ from __future__ import annotations
 import colorsys
 import math
 from dataclasses import dataclass, field
+from typing import Any, Literal
 
 import numpy as np
 import rerun as rr
@@ -99,6 +100,12 @@ REGIME_CODE = {"no_contact": 0, "boundary": 1, "mixed": 2, "full_film": 3}
 REGIME_LABEL = ("no contact", "boundary", "mixed", "full film")
 REGIME_RGB = np.array([[150, 150, 150], [220, 40, 40], [255, 150, 0], [40, 180, 70]], dtype=np.uint8)
 REGIME_ORDER = (3, 2, 1, 0)       # order of the regime_counts series: full film first
+
+
+def _regime_rgb(code: int) -> tuple[int, int, int]:
+    red, green, blue = (int(v) for v in REGIME_RGB[code])
+    return red, green, blue
+
 
 INNER_RGB = (60, 120, 255)
 OUTER_RGB = (200, 80, 255)
@@ -151,7 +158,7 @@ SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
                      ((150, 150, 150), (80, 160, 255), (0, 210, 200))),
     "min_lambda": (("inner [-]", "outer [-]"), (INNER_RGB, OUTER_RGB)),
     "regime_counts": (tuple(REGIME_LABEL[c] for c in REGIME_ORDER),
-                      tuple(tuple(int(v) for v in REGIME_RGB[c]) for c in REGIME_ORDER)),
+                      tuple(_regime_rgb(c) for c in REGIME_ORDER)),
     "temperatures_c": (("oil setpoint [degC]", "contact inlet [degC]"), ((150, 150, 150), (255, 120, 40))),
     "thermal/nodes_c": (("shaft [degC]", "inner ring [degC]", "balls [degC]", "outer ring [degC]", "housing [degC]",
                          "oil [degC]"),
@@ -181,7 +188,7 @@ CAPACITANCE_LEAF = "electrical/capacitance_pf"
 OFF_SCALE_LEAF = f"{CAPACITANCE_LEAF}/off_scale"          # marker: a capacitance off the robust scale
 FILM_BROKEN_LEAF = f"{CAPACITANCE_LEAF}/film_broken"      # marker: no capacitance (metal contact)
 # markers beside every trend where a setpoint or the defects changed (`{trend}/changes`)
-CHANGE_MARKER = dict(names=["setpoint / defect change"], colors=[(40, 40, 40)], markers=["Diamond"],
+CHANGE_MARKER: dict[str, Any] = dict(names=["setpoint / defect change"], colors=[(40, 40, 40)], markers=["Diamond"],
                      marker_sizes=[5.0])
 FAST_SERIES = tuple(SERIES)
 
@@ -246,19 +253,20 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
     s = stream
     s.log(root, rr.AnnotationContext([(c, REGIME_LABEL[c], tuple(int(v) for v in REGIME_RGB[c]))
                                       for c in range(4)]), static=True)
-    if tw.has_geometry:
-        rb = tw.ball_radius_m
+    rb, pitch = tw.ball_radius_m, tw.pitch_radius_m
+    inner, outer = tw.inner_raceway_radius_m, tw.outer_raceway_radius_m
+    if rb is not None and pitch is not None and inner is not None and outer is not None:   # tw.has_geometry
         line = rr.components.Radius.ui_points(1.5)
         s.log(f"{root}/geometry/inner_raceway",
-              rr.LineStrips3D([_circle(tw.inner_raceway_radius_m)], radii=line, colors=_RACEWAY_RGB), static=True)
+              rr.LineStrips3D([_circle(inner)], radii=line, colors=_RACEWAY_RGB), static=True)
         s.log(f"{root}/geometry/outer_raceway",
-              rr.LineStrips3D([_circle(tw.outer_raceway_radius_m)], radii=line, colors=_RACEWAY_RGB), static=True)
+              rr.LineStrips3D([_circle(outer)], radii=line, colors=_RACEWAY_RGB), static=True)
         s.log(f"{root}/geometry/pitch_circle",
-              rr.LineStrips3D([_circle(tw.pitch_radius_m)], radii=rr.components.Radius.ui_points(0.5),
+              rr.LineStrips3D([_circle(pitch)], radii=rr.components.Radius.ui_points(0.5),
                               colors=_PITCH_RGB), static=True)
         s.log(f"{root}/geometry/load_line",
-              rr.Arrows3D(origins=[[tw.outer_raceway_radius_m * 1.05, 0.0, 0.0]],
-                          vectors=[[tw.outer_raceway_radius_m * 0.35, 0.0, 0.0]],
+              rr.Arrows3D(origins=[[outer * 1.05, 0.0, 0.0]],
+                          vectors=[[outer * 0.35, 0.0, 0.0]],
                           colors=[(230, 60, 60)], labels=["Fr"],
                           radii=rr.components.Radius.ui_points(2.0)), static=True)
         s.log(f"{root}/balls", rr.Points3D.from_fields(radii=[rb], show_labels=False), static=True)
@@ -278,10 +286,10 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
     s.log(f"{root}/{FILM_BROKEN_LEAF}", rr.SeriesPoints(names=["film broken: C undefined"], colors=[(220, 40, 40)],
                                                        markers=["Cross"], marker_sizes=[5.0]), static=True)
     z = tw.ball_count
-    names = [f"ball {i} {side}" for i in range(z) for side in SIDES]
-    colors = [ball_rgb(i, z, k) for i in range(z) for k in range(2)]
+    contact_names = [f"ball {i} {side}" for i in range(z) for side in SIDES]
+    contact_colors = [ball_rgb(i, z, k) for i in range(z) for k in range(2)]
     for leaf, _title in CONTACT_SERIES:
-        s.log(f"{root}/contacts/{leaf}", rr.SeriesLines(names=names, colors=colors), static=True)
+        s.log(f"{root}/contacts/{leaf}", rr.SeriesLines(names=contact_names, colors=contact_colors), static=True)
     s.log(f"{root}/electrical/discharge_risk",
           rr.StateConfiguration(values=list(RISK_VALUES), labels=["no discharge risk", "discharge possible",
                                                                   "discharge likely"],
@@ -289,7 +297,7 @@ def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
     if tw.vibration:
         for leaf, (names, colors) in VIBRATION_SERIES.items():
             # a waveform drawn at min-max per pixel keeps its peaks (an average per pixel halves them)
-            policy = "MinMax" if leaf == WAVEFORM_LEAF else None
+            policy: Literal["MinMax"] | None = "MinMax" if leaf == WAVEFORM_LEAF else None
             s.log(f"{root}/{leaf}", rr.SeriesLines(names=list(names), colors=list(colors), aggregation_policy=policy),
                   static=True)
         for leaf, rgb in (("peaks", (80, 160, 255)), ("defect_lines", (230, 60, 60))):
@@ -349,8 +357,9 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = T
 
     top: list = []
     shares: list = []
-    if tw.has_geometry:
-        distance = 3.4 * tw.outer_raceway_radius_m
+    outer = tw.outer_raceway_radius_m
+    if outer is not None:   # tw.has_geometry
+        distance = 3.4 * outer
         top.append(rrb.Spatial3DView(
             name=f"{tag} ({tw.designation}): balls by regime (colours as in 'balls per regime')", origin=root,
             contents=[f"+ {root}/geometry/**", f"+ {root}/balls", f"+ {root}/loads"],
@@ -436,6 +445,7 @@ def blueprint(twins: list[TwinLayout], series_window_s: float | None, live: bool
     trend views (None: the whole recording). `live`: the time cursor follows the newest data (a
     viewer watching the twins); else (a file) it stays where the viewer opens the recording."""
     layouts = [twin_blueprint(tw, series_window_s, live) for tw in twins]
+    body: rrb.Container
     if not layouts:
         body = rrb.Vertical()
     elif len(layouts) == 1:

@@ -32,7 +32,7 @@ import tempfile
 import time
 import urllib.parse
 from pathlib import Path
-from typing import Self
+from typing import IO, Self
 
 log = logging.getLogger("service.recording")
 
@@ -94,7 +94,7 @@ class LiveWebViewer:
         self.grpc_port = int(grpc_port) if grpc_port else self.web_port + 1
         self.memory_limit_mb = float(memory_limit_mb)
         self._proc: subprocess.Popen | None = None
-        self._err = None                  # the rerun process's stderr (a temporary file)
+        self._err: IO[bytes] | None = None  # the rerun process's stderr (a temporary file)
 
     @property
     def _connect_host(self) -> str:
@@ -117,15 +117,15 @@ class LiveWebViewer:
                 raise LiveViewerError(f"rerun_web_port: port {port} on {self.host} is taken")
         cmd = [rerun_command(), "--bind", self.host, "--serve-web", "--port", str(self.grpc_port),
                "--web-viewer-port", str(self.web_port), "--server-memory-limit", f"{self.memory_limit_mb:.0f}MB"]
-        self._err = tempfile.TemporaryFile()
+        err_file = self._err = tempfile.TemporaryFile()
         self._proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                      stderr=self._err, start_new_session=True,
+                                      stderr=err_file, start_new_session=True,
                                       env={**os.environ, "RERUN_ANALYTICS": "0"})
         deadline = time.monotonic() + START_TIMEOUT_S
         while time.monotonic() < deadline:
             if self._proc.poll() is not None:
-                self._err.seek(0)
-                err = self._err.read().decode(errors="replace").strip().splitlines()
+                err_file.seek(0)
+                err = err_file.read().decode(errors="replace").strip().splitlines()
                 self.close()
                 raise LiveViewerError(f"rerun --serve-web exited: {err[-1] if err else 'no message'}")
             if _listening(self._connect_host, self.grpc_port) and _listening(self._connect_host, self.web_port):

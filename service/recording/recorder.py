@@ -551,6 +551,8 @@ class RerunRecorder:
             return
         layouts: dict[bool, Any] = {}
         for out in outs:
+            if out.stream is None:      # a closed output
+                continue
             if out.viewer not in layouts:
                 layouts[out.viewer] = self.blueprint(live=out.viewer)
             self._blueprints.send(layouts[out.viewer], out.stream)

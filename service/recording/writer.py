@@ -291,6 +291,7 @@ class SegmentWriter:
         return self.segment_bytes is not None and out.file.size() >= self.segment_bytes
 
     def _next_segment(self) -> CreatedFile:
+        assert self.path is not None  # the main file is open (open_main)
         index = len(self.segments)
         return create_exclusive(self.path.parent, segment_path(self.path, index).name, make_dirs=False)
 
@@ -298,6 +299,8 @@ class SegmentWriter:
         """Point the main file's stream at the next segment (the stream is kept: rerun-sdk 0.41
         never frees a stream, see `service.recording.streams`)."""
         out = self.primary
+        # the caller checked that the main file is open (rotation_due, Recorder.rotate)
+        assert out is not None and out.file is not None and out.stream is not None
         try:
             created = self._next_segment()
         except RecordingPathError as exc:
@@ -325,12 +328,14 @@ class SegmentWriter:
         return self._segment_opened(out, created)
 
     def _segment_opened(self, out: Output, created: CreatedFile) -> Path | None:
+        file = out.file
+        assert file is not None  # the caller just opened it
         out.rows, out.opened_at = 0, time.monotonic()
         try:
             self.on_start(out)
-            out.file.write(self.write_timeout_s)
+            file.write(self.write_timeout_s)
         except RecordingWriteError as exc:
-            out.file.discard()
+            file.discard()
             self._on_write_error(out, exc, 0, discarded=True)
             return None
         self.segments.append(created.path)
@@ -373,8 +378,11 @@ class SegmentWriter:
     def _sink_to_nowhere(self, out: Output) -> None:
         """While degraded the stream still gets every send: an in-memory sink that is emptied
         after each send (`_discard`) keeps its memory flat."""
+        if out.stream is None:     # a closed output has no sink to replace
+            out.null_sink = None
+            return
         try:
-            out.null_sink = out.stream.binary_stream()      # replaces (and so ends) the failed sink
+            out.null_sink = rr.binary_stream(out.stream)     # replaces (and so ends) the failed sink
         except Exception:  # noqa: BLE001
             out.null_sink = None
 
@@ -391,6 +399,7 @@ class SegmentWriter:
         out = self.primary
         if out is None or out.file is not None or time.monotonic() < self._retry_at or closed:
             return
+        assert out.stream is not None  # a degraded main file keeps its stream (_sink_to_nowhere)
         self._retry_at = time.monotonic() + self.retry_s
         try:
             created = self._next_segment()
@@ -410,6 +419,7 @@ class SegmentWriter:
         if self._segment_opened(out, created) is None:
             return                                    # still failing: _on_write_error ran again
         lost, since = self._lost_since_fault, self._fault_since
+        assert since is not None  # set with the fault (_on_write_error)
         log.warning("rerun: recording again into %s after %s (%d snapshots lost)", created.path, self.fault, lost)
         self.on_resume(f"recording resumed after {time.monotonic() - since:.0f} s: {lost} snapshots were "
                        "not written")

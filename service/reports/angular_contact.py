@@ -31,11 +31,11 @@ def _case(designation: str, radial: float, axial: float, settle_s: float, window
     twin = Twin(designation, setpoint=Setpoint(shaft_speed_rad_s=SPEED_RAD_S, radial_load_n=radial,
                                                axial_load_n=axial))
     twin.advance(settle_s)
-    disp = []
+    samples = []
     for _ in range(max(1, int(round(window_s / 1e-4)))):
         twin.advance(1e-4, frame_steps=100)
-        disp.append(twin.state.inner_ring_offset_m.copy())
-    disp = np.array(disp)
+        samples.append(twin.state.inner_ring_offset_m.copy())
+    disp = np.array(samples)
     snap = twin.snapshot()
     psi = twin.ball_azimuths_rad()
     jones = analytic.jones_equilibrium(twin.model, radial, axial, snap.shaft_speed_rad_s, azimuths_rad=psi)

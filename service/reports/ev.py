@@ -31,11 +31,13 @@ def _fig_reduction(out: Path) -> tuple[str, list]:
     table = tcal.load_table()
     inputs = table["provenance"]["inputs"]
     th = Thermal()
+    resistance = th.equivalent_resistance_ohm
+    assert resistance is not None  # Thermal's default is a resistance
     u = prm.DEFAULT_ENTRAINMENT_SPEED_M_S
     j = int(np.argmin(np.abs(np.asarray(table["entrainment_speeds_m_s"]) - u)))
     rows = []
     for i, current in enumerate(table["currents_a"]):
-        rise = prm.current_temperature_rise_k(current, u, th.equivalent_resistance_ohm)
+        rise = prm.current_temperature_rise_k(current, u, resistance)
         law = tcal.law_factor(rise, u, inputs, th.film_temperature_exponent)
         rows.append((current, rise, 1.0 - table["h_min_factor"][i][j], 1.0 - law))
     plt = pyplot()

@@ -25,7 +25,7 @@ def thermal_section(out: Path, quick: bool) -> list[str]:
     minutes = tr.network_time_s / 60.0
     for k, name in enumerate(NODE_NAMES):
         ax[0, 0].plot(minutes, tr.temperatures_c[:, k], label=name.replace("_", " "))
-        ax[0, 0].axhline(steady.get("temperatures_c")[name], lw=0.6, ls=":", color=ax[0, 0].lines[-1].get_color())
+        ax[0, 0].axhline(steady["temperatures_c"][name], lw=0.6, ls=":", color=ax[0, 0].lines[-1].get_color())
     ax[0, 0].set_ylabel("temperature [degC]")
     ax[0, 0].legend(fontsize=8)
     ax[0, 1].plot(minutes, tr.viscosity_pa_s * 1e3)

@@ -3,6 +3,8 @@ housing acceleration with the defect frequencies marked (matplotlib, Agg)."""
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from service.reports.figures import pyplot, save
@@ -72,7 +74,7 @@ def vibration_section(out_dir, quick: bool = False) -> list[str]:
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     duration = 0.5 if quick else 1.0
-    run = dict(shaft_speed_rad_s=REPORT_SPEED_RAD_S, radial_load_n=3000.0, duration_s=duration,
+    run: dict[str, Any] = dict(shaft_speed_rad_s=REPORT_SPEED_RAD_S, radial_load_n=3000.0, duration_s=duration,
                noise_density_m_s2_rthz=REPORT_NOISE, window_s=duration)
     lines = ["## Vibration: housing acceleration with local defects\n",
              f"6208, 3000 N, {REPORT_SPEED_RAD_S:g} rad/s, outer ring on the Sawalhi & Randall housing, accelerometer "

@@ -99,7 +99,7 @@ def benchmark_solve(grid: int = 129, repeats: int = 3) -> dict:
     from twin.ehl_solver import solve_point_contact
 
     solve_point_contact(grid=grid, thermal=False)  # warm-up
-    times, res = [], None
+    times = []
     for _ in range(max(1, repeats)):
         t0 = time.perf_counter()
         res = solve_point_contact(grid=grid, thermal=False)

@@ -23,7 +23,7 @@ import math
 import queue
 import sys
 import time
-from typing import Any
+from typing import Any, Literal
 
 from service.core.alarms import finite_number
 from service.keys import ALIVE, DEFAULT_PREFIX, STATE, all_twins
@@ -178,10 +178,12 @@ class TwinTable:
 
         table = Table(title=title, caption=f"{len(self.rows)} twin(s)"
                       + (f", {self.invalid} invalid message(s)" if self.invalid else ""))
-        for col, justify in (("bearing", "left"), ("designation", "left"), ("alive", "left"),
-                             ("time s", "right"), ("status", "left"), ("shaft rad/s", "right"),
-                             ("min Lambda", "right"), ("regimes", "left"), ("torque mN m", "right"),
-                             ("discharge", "right"), ("alarms", "left"), ("seq", "right"), ("gaps", "right")):
+        columns: tuple[tuple[str, Literal["left", "right"]], ...] = (
+            ("bearing", "left"), ("designation", "left"), ("alive", "left"), ("time s", "right"),
+            ("status", "left"), ("shaft rad/s", "right"), ("min Lambda", "right"), ("regimes", "left"),
+            ("torque mN m", "right"), ("discharge", "right"), ("alarms", "left"), ("seq", "right"),
+            ("gaps", "right"))
+        for col, justify in columns:
             table.add_column(col, justify=justify)
         for bearing_id, r in sorted(self.rows.items()):
             alive = {True: "[green]alive[/]", False: "[red]gone[/]", None: "?"}[r["alive"]]
@@ -331,7 +333,8 @@ def _cmd_monitor(args: argparse.Namespace) -> int:
     from service.settings import ZenohAccessSettings
 
     try:
-        env = ZenohAccessSettings(**({"zenoh": {"prefix": args.prefix}} if args.prefix else {}))
+        given: dict[str, Any] = {"zenoh": {"prefix": args.prefix}} if args.prefix else {}
+        env = ZenohAccessSettings(**given)
     except ValidationError as exc:
         print("error: monitor: " + "; ".join(str(e["msg"]).removeprefix("Value error, ") for e in exc.errors()),
               file=sys.stderr)

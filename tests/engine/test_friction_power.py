@@ -1,5 +1,5 @@
 """The friction power by source (twin.friction_power, Twin.friction_power_w) and the friction
-torque's definition (Twin._dissipative_torque_n_m)."""
+torque's definition (twin.friction_power.frame_friction_torque_n_m)."""
 
 
 import numpy as np

@@ -3,6 +3,11 @@
 A docstring edit in twin/ must not cost a recompilation of the engine, and any change of code
 must (the cache directory is named after the digest of every source file of twin/)."""
 
+import importlib.util
+
+import numba
+
+from twin import jit
 from twin.jit import StrippedSourceLocator, code_digest
 
 SOURCE = '''
@@ -33,3 +38,70 @@ def test_kernels_use_the_stripped_source_locator():
 
     step_n_cache = step_n._cache  # numba's FunctionCache of the dispatcher
     assert isinstance(step_n_cache._impl.locator, StrippedSourceLocator)
+
+
+KERNEL = '''"""A copied kernel module."""
+from numba import njit
+
+from twin.jit import JIT
+
+SCALE = 1.0
+"""Scale of the force [-]."""
+
+
+@njit(**JIT)
+def spring_force_n(stiffness_n_m, deflection_m):
+    """Linear spring force [N]."""
+    return SCALE * stiffness_n_m * deflection_m
+'''
+
+KERNEL_DOCS_EDITED = '''"""A copied kernel module,
+
+with a longer docstring."""
+from numba import njit
+
+from twin.jit import JIT
+
+# a new comment
+SCALE = 1.0
+"""Scale of the force, an attribute docstring
+over two lines [-]."""
+
+
+@njit(**JIT)
+def spring_force_n(stiffness_n_m, deflection_m):
+    """Linear spring force [N]:
+    F = k x (Hooke)."""
+    # another comment
+    return SCALE * stiffness_n_m * deflection_m
+'''
+
+
+def _compile_and_call(tmp_path, name: str):
+    """Import the copied kernel module under a new module name (a fresh dispatcher), call it once,
+    and return numba's cache statistics for that call: (hits, misses)."""
+    spec = importlib.util.spec_from_file_location(name, tmp_path / "engine_copy" / "law.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    assert module.spring_force_n(2.0e5, 1.0e-6) == 2.0e5 * 1.0e-6
+    stats = module.spring_force_n.stats
+    return sum(stats.cache_hits.values()), sum(stats.cache_misses.values())
+
+
+def test_a_docstring_edit_loads_the_compiled_kernel_from_the_cache(tmp_path, monkeypatch):
+    """numba's own cache, end to end, on a kernel module copied into a temporary package served by
+    the stripped-source locator: a second import after docstrings and comments are edited (the
+    lines shifted, the file's size and time changed) loads the compiled kernel; a code edit
+    compiles afresh."""
+    package = tmp_path / "engine_copy"
+    package.mkdir()
+    law = package / "law.py"
+    monkeypatch.setattr(jit, "ENGINE_ROOT", package.resolve())
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "cache"))
+    law.write_text(KERNEL)
+    assert _compile_and_call(tmp_path, "law_first") == (0, 1)      # compiled and saved
+    law.write_text(KERNEL_DOCS_EDITED)
+    assert KERNEL_DOCS_EDITED.count("\n") >= KERNEL.count("\n") + 5
+    assert _compile_and_call(tmp_path, "law_docs_edited") == (1, 0)  # loaded, not compiled
+    law.write_text(KERNEL_DOCS_EDITED.replace("SCALE * stiffness_n_m", "stiffness_n_m * SCALE"))
+    assert _compile_and_call(tmp_path, "law_code_edited") == (0, 1)

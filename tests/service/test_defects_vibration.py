@@ -242,9 +242,17 @@ def test_a_severe_outer_spall_raises_the_iso_20816_zone_alarm_and_opc_ua_shows_t
     def zone_event():
         events = http.get("/v1/bearings/vib/alarms", params={"events": 1000}).json()["events"]
         return [e for e in events if e["alarm_id"] == "vibration_zone" and e["transition"] == "raised"]
-    (raised,) = support.wait_for(zone_event, lambda e: len(e) == 1, WAIT_S)
-    assert raised["severity"] == "critical" and raised["threshold"] == 4.5 and raised["value"] >= 4.5
+    def critical(events):
+        return [e for e in events if e["severity"] == "critical"]
+
+    # the window's velocity passes zone C on its way to D, and earlier tests of this module may have
+    # left zone-C events: what is asserted is the critical raise and that every raise is justified
+    events = support.wait_for(zone_event, lambda e: bool(critical(e)), WAIT_S)
+    raised = critical(events)[0]
+    assert raised["threshold"] == 4.5 and raised["value"] >= 4.5
     assert "zone D" in raised["message"]
+    for e in events:
+        assert e["value"] >= e["threshold"], e
 
     async def read_window():
         async with Client(srv.service.opcua.url, timeout=20, watchdog_intervall=10.0) as c:

@@ -25,6 +25,7 @@ Regenerate: `bearing-twin ehl calibrate` (or `python -m twin.ehl_solver.film_red
 
 from __future__ import annotations
 
+import argparse
 import datetime as _dt
 import json
 import math
@@ -37,6 +38,7 @@ import numpy as np
 from numba import njit
 
 from twin.ehl_solver import params as prm
+from twin.ehl_solver.solver import solve_point_contact
 from twin.jit import JIT
 from twin.physics.thermal import hamrock_dowson_temperature_film_ratio
 
@@ -51,8 +53,6 @@ ANCHOR_CURRENT_A = 30.0
 
 def _solve(current_a: float, speed: float, *, thermal: bool, grid: int, bearing_resistance_ohm: float,
            load_n: float, base_temperature_c: float, max_iter: int = 200):
-    from twin.ehl_solver.solver import solve_point_contact
-
     return solve_point_contact(load_n, speed, current_a=current_a, thermal=thermal, grid=grid,
                                bearing_resistance_ohm=bearing_resistance_ohm,
                                base_temperature_c=base_temperature_c, max_iter=max_iter)
@@ -305,8 +305,6 @@ def film_reduction_factor(current_a, entrainment_speed_m_s, *, which: str = "h_m
 
 
 def main(argv: list[str] | None = None) -> int:
-    import argparse
-
     parser = argparse.ArgumentParser(description="generate the seed-003 film-reduction table")
     parser.add_argument("--out", default=str(TABLE_PATH), help="output JSON path")
     parser.add_argument("--grid", type=int, default=CALIBRATION_GRID)

@@ -48,6 +48,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.optimize import brentq
+from scipy.special import ellipe, ellipk
+
+from twin.physics import ehl
+from twin.physics.viscosity import dynamic_viscosity_pa_s
+from twin.spec import Lubricant
 
 # --- seed 003 Appendix 2 -------------------------------------------------------------------
 BALL_RADIUS_M = 2.39e-3
@@ -87,9 +93,6 @@ DEFAULT_BEARING_RESISTANCE_OHM = 2.92e-4
 
 def oil_viscosity_pa_s(temperature_c: float) -> float:
     """Dynamic viscosity of the project's seed-000 oil at ambient pressure [Pa s] (ASTM D341)."""
-    from twin.physics.viscosity import dynamic_viscosity_pa_s
-    from twin.spec import Lubricant
-
     return dynamic_viscosity_pa_s(Lubricant(), temperature_c)
 
 
@@ -145,9 +148,6 @@ def hertz_scales(load_n: float, rx_m: float, ry_m: float, e_prime_pa: float) -> 
     """Exact Hertz ellipse (complete elliptic integrals) of gap x^2/2Rx + y^2/2Ry.
 
     E* = E'/2 (Johnson's reduced modulus, E' of Hamrock-Dowson). Circle: a^3 = 3 w R / (2 E')."""
-    from scipy.optimize import brentq
-    from scipy.special import ellipe, ellipk
-
     e_star = 0.5 * e_prime_pa
     if abs(rx_m - ry_m) <= 1e-12 * max(rx_m, ry_m):
         a = (3.0 * load_n * rx_m / (4.0 * e_star)) ** (1.0 / 3.0)
@@ -175,8 +175,6 @@ def hertz_scales(load_n: float, rx_m: float, ry_m: float, e_prime_pa: float) -> 
 def hamrock_dowson_film_m(load_n: float, entrainment_speed_m_s: float, *, rx_m: float, ry_m: float,
                           e_prime_pa: float, eta0_pa_s: float, alpha_pa_inv: float) -> tuple[float, float]:
     """(h_min, h_c) of Hamrock-Dowson (seed 003 ref. [7], seed 000 eq. 6) via twin.physics.ehl."""
-    from twin.physics import ehl
-
     k = (ry_m / rx_m) ** (2.0 / math.pi)
     u = ehl.speed_parameter(eta0_pa_s, entrainment_speed_m_s, e_prime_pa, rx_m)
     w = ehl.load_parameter(load_n, e_prime_pa, rx_m)

@@ -425,9 +425,9 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
     ic, jc = int(np.argmin(np.abs(coarse.x))), int(np.argmin(np.abs(coarse.y)))
     solver.h0 = hd_c / h_scale - coarse.h[ic, jc]
 
-    history = {"dp": [], "load_error": [], "residual": [], "h0": [], "h_c_m": [], "h_min_m": [],
-               "level_n": [], "capped_temperature_nodes": [],
-               "temperature_change_k": []}
+    history: dict[str, list[float]] = {
+        "dp": [], "load_error": [], "residual": [], "h0": [], "h_c_m": [], "h_min_m": [], "level_n": [],
+        "capped_temperature_nodes": [], "temperature_change_k": []}
     message = ""
     converged = False
     iterations = 0

@@ -11,7 +11,7 @@ import math
 import numpy as np
 
 from twin.life.contact_loads import RacewayGeometry, contact_load_damage_per_mrev, contact_loads_from_state
-from twin.life.iso281 import SECONDS_PER_HOUR, IsoLife, iso_life, life_hours, ratings_for
+from twin.life.iso281 import SECONDS_PER_HOUR, BearingRatings, IsoLife, iso_life, life_hours, ratings_for
 from twin.life.settings import LifeSettings
 
 
@@ -86,6 +86,7 @@ class LifeMonitor:
         self.geometry = RacewayGeometry.of(model.spec.geometry)
         self.accumulator = DamageAccumulator(self.settings.initial_damage_fraction)
         self.error: str | None = None
+        self.ratings: BearingRatings | None
         try:
             self.ratings = ratings_for(model.spec)
         except ValueError as exc:

@@ -1,5 +1,7 @@
 """Lubrication regime and friction coefficient against the film parameter (seed 000 Table 2)."""
 
+from typing import Literal
+
 from numba import njit
 
 from twin.jit import JIT
@@ -8,7 +10,8 @@ REGIME_NO_CONTACT = 0
 REGIME_BOUNDARY = 1
 REGIME_MIXED = 2
 REGIME_FULL_FILM = 3
-REGIME_NAMES = ("no_contact", "boundary", "mixed", "full_film")
+Regime = Literal["no_contact", "boundary", "mixed", "full_film"]
+REGIME_NAMES: tuple[Regime, ...] = ("no_contact", "boundary", "mixed", "full_film")
 # seed 000 Table 2: the film parameter Lambda [-] up to which a contact is boundary, then mixed
 BOUNDARY_LAMBDA_MAX = 1.0
 MIXED_LAMBDA_MAX = 3.0

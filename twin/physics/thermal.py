@@ -28,7 +28,7 @@ def roelands_temperature_viscosity_pa_s(eta0_pa_s: float, theta0_k: float, theta
 
 def current_heating_temperature_rise_k(current_a: float, bearing_resistance_ohm: float,
                                        pitch_diameter_m: float, ball_diameter_m: float,
-                                       loaded_balls: int, shaft_frequency_hz: float,
+                                       loaded_balls: float, shaft_frequency_hz: float,
                                        crater_depth_m: float, ball_density_kg_m3: float,
                                        ball_specific_heat_j_kg_k: float, contact_angle_rad: float) -> float:
     """Instantaneous temperature rise of the race track from current discharge per shaft turn,

@@ -36,15 +36,19 @@ import math
 import os
 import statistics
 import time
+from dataclasses import asdict, dataclass
+from typing import Any, Literal
 
 import numpy as np
-from dataclasses import asdict, dataclass
 
 from twin import catalog
+from twin.accelerometer import window_indicators
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 from twin.spec import BearingSpec, ModelOptions
+from twin.validation.step_timing import time_passes
 from twin.validation.studies import EV_BEARING, EV_RADIAL_LOAD_N
+from twin.validation.vibration_simulation import defect_for
 
 MIN_REPEATS = 5
 
@@ -66,7 +70,7 @@ class BenchCase:
 
 
 SERVE_DEFAULT = BenchCase("serve-default")  # Twin("6208")'s default setpoint, what `serve` runs
-CASES = (
+CASES: tuple[BenchCase, ...] = (
     BenchCase("ev-5A-heating", shaft_current_a=5.0, shear_heating=True),
     BenchCase("7208-combined", designation="7208", axial_load_n=3000.0),
     BenchCase("6208-1700rad-7.5kN", shaft_speed_rad_s=1700.0, radial_load_n=7500.0),
@@ -82,7 +86,7 @@ EV_20K = BenchCase("ev-6200-20krpm", designation=EV_BEARING, shaft_speed_rad_s=2
 CASES = (*CASES, EV_20K)
 
 
-def _twin(case: BenchCase, time_step_s: float | str) -> Twin:
+def _twin(case: BenchCase, time_step_s: float | Literal["auto"]) -> Twin:
     spec = catalog.bearing(case.designation)
     if case.shear_heating is not None and case.shear_heating != spec.thermal.shear_heating:
         spec = BearingSpec.model_validate({**spec.model_dump(), "thermal": {
@@ -97,13 +101,11 @@ def _twin(case: BenchCase, time_step_s: float | str) -> Twin:
                 setpoint=Setpoint(shaft_speed_rad_s=case.shaft_speed_rad_s, radial_load_n=case.radial_load_n,
                                   axial_load_n=case.axial_load_n, shaft_current_a=case.shaft_current_a))
     if case.defect is not None:
-        from twin.validation.vibration_simulation import defect_for
-
         twin.set_defects([defect_for(case.defect, spec.geometry)])
     return twin
 
 
-def measure(case: BenchCase, time_step_s: float | str = "auto", seconds: float = 0.2,
+def measure(case: BenchCase, time_step_s: float | Literal["auto"] = "auto", seconds: float = 0.2,
             repeats: int = MIN_REPEATS) -> dict:
     """Best and median real-time factor and ns per step of `repeats` runs of `seconds`; with the
     outer ring on the housing the indicators of one window are timed apart and their share per
@@ -118,15 +120,15 @@ def measure(case: BenchCase, time_step_s: float | str = "auto", seconds: float =
         cpu_factors.append(seconds / max(time.thread_time() - c0, 1e-9))
     dt = twin.model.dt_s
     best, median = max(factors), statistics.median(factors)
-    out = {"time_step_s": dt, "real_time_factor": best, "real_time_factor_median": median,
-           "ns_per_step": dt / best * 1e9, "ns_per_step_median": dt / median * 1e9,
-           "cpu_real_time_factor": max(cpu_factors), "cpu_real_time_factor_median": statistics.median(cpu_factors),
-           "repeats": repeats, "housing": twin.model.housing_on, "defects": len(twin.defects),
-           "status": twin.status}
+    out: dict[str, Any] = {
+        "time_step_s": dt, "real_time_factor": best, "real_time_factor_median": median,
+        "ns_per_step": dt / best * 1e9, "ns_per_step_median": dt / median * 1e9,
+        "cpu_real_time_factor": max(cpu_factors), "cpu_real_time_factor_median": statistics.median(cpu_factors),
+        "repeats": repeats, "housing": twin.model.housing_on, "defects": len(twin.defects),
+        "status": twin.status}
     if twin.model.housing_on:
-        from twin.accelerometer import window_indicators
-
         reader = twin._sensor
+        assert reader is not None  # the housing's accelerometer
         window = np.random.default_rng(0).standard_normal(reader.window_samples)
         costs, cpu_costs = [], []
         for _ in range(repeats):
@@ -174,8 +176,6 @@ def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, ca
              "step_1us": measure(c, 1e-6, seconds, repeats)}
             for c in CASES]
     if passes:
-        from twin.validation.step_timing import time_passes
-
         twin = _twin(SERVE_DEFAULT, "auto")
         twin.advance(0.005)
         result["passes"] = time_passes(twin, repeats=repeats)
@@ -188,8 +188,6 @@ def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, ca
 def ev_passes(repeats: int = MIN_REPEATS) -> dict:
     """The step of the EV case pass by pass (`step_timing.time_passes`), with the cost per step
     that real time allows (its auto step) [ns]."""
-    from twin.validation.step_timing import time_passes
-
     twin = _twin(EV_20K, "auto")
     twin.advance(0.005)
     return {**time_passes(twin, repeats=repeats), "time_step_s": twin.model.dt_s,

@@ -26,7 +26,9 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.signal import welch
 
+from twin.validation.vibration_simulation import simulate_vibration
 from twin.vibration import indicators as ind
 
 G_M_S2 = 9.80665
@@ -125,8 +127,6 @@ def measured(record: Record, duration_s: float | None = None, data_dir: Path = D
 
 def simulated(record: Record, duration_s: float = 1.0, settle_s: float = SETTLE_S) -> tuple[Analysis, np.ndarray]:
     """The `CWRU-DE` twin in the conditions of `record`: its signal [m/s^2] and analysis."""
-    from twin.validation.vibration_simulation import simulate_vibration
-
     _, x = simulate_vibration(
         "CWRU-DE", record.rpm * 2.0 * math.pi / 60.0, None, defect=record.defect,
         defect_size_m=FAULT_WIDTH_M, defect_length_m=FAULT_WIDTH_M, defect_depth_m=FAULT_DEPTH_M,
@@ -174,8 +174,6 @@ def calibrate_housing(x_m_s2: np.ndarray, sample_rate_hz: float = SAMPLE_RATE_HZ
     the peak of its Welch power spectrum (512 points) in `search_hz` and its half-power bandwidth
     (linear interpolation of the crossings), zeta = bandwidth / (2 f). Run once on record 97 to
     set `twin.catalog.CWRU_SPRUNG_*`."""
-    from scipy.signal import welch
-
     f, p = welch(np.asarray(x_m_s2, dtype=float), sample_rate_hz, nperseg=512)
     sel = np.flatnonzero((f > search_hz[0]) & (f < search_hz[1]))
     i = int(sel[np.argmax(p[sel])])
@@ -198,8 +196,6 @@ RESONANCE_BAND_HZ = (2900.0, 3600.0)  # healthy record: the housing resonance th
 def band_rms(x_m_s2: np.ndarray, band_hz: tuple[float, float], sample_rate_hz: float = SAMPLE_RATE_HZ) -> float:
     """RMS [m/s^2] of the signal in a frequency band: Welch power spectrum (1024 points, Hann),
     summed over the bins in [lo, hi)."""
-    from scipy.signal import welch
-
     f, p = welch(np.asarray(x_m_s2, dtype=float), sample_rate_hz, nperseg=1024)
     sel = (f >= band_hz[0]) & (f < band_hz[1])
     return float(math.sqrt(p[sel].sum() * (f[1] - f[0])))

@@ -21,16 +21,22 @@ the engine before its speed optimisation (window means, tolerance 1e-6).
 from __future__ import annotations
 
 import sys
+from typing import Any
 
 import numpy as np
 
+from twin import catalog
+from twin.engine import Twin
 from twin.kernels import layout as L
+from twin.setpoint import Setpoint
+from twin.spec import BearingSpec, ModelOptions
+from twin.validation.vibration_simulation import defect_for
 
 # id: (designation, time step, simulated seconds, extra setpoint / option / spec fields). Every case
 # states its inlet: isothermal (seed 000's Hamrock-Dowson film, as its 6208 operating point is
 # solved) except the shear-heated one, so a file dumped by one build compares with another's
 # whatever the spec's default of Thermal.shear_heating.
-CASES = {
+CASES: dict[str, tuple[str, float | str, float, dict[str, Any]]] = {
     "6208-auto": ("6208", "auto", 0.1, {"shear_heating": False}),
     "6208-1us": ("6208", 1e-6, 0.05, {"shear_heating": False}),
     "7208-combined-auto": ("7208", "auto", 0.05, {"axial_load_n": 3000.0, "shear_heating": False}),
@@ -49,11 +55,6 @@ ROWS = {"load": L.C_LOAD, "lambda": L.C_LAMBDA, "h_min": L.C_H_MIN, "h_c": L.C_H
 
 def run_case(designation: str, time_step_s, seconds: float, extra: dict) -> dict:
     """One case from its warm start: the arrays of the module docstring, by name."""
-    from twin import catalog
-    from twin.engine import Twin
-    from twin.setpoint import Setpoint
-    from twin.spec import BearingSpec, ModelOptions
-
     spec = catalog.bearing(designation)
     if extra.get("housing"):
         spec = BearingSpec.model_validate({**spec.model_dump(), "housing": {**spec.housing.model_dump(), "enabled": True}})
@@ -66,8 +67,6 @@ def run_case(designation: str, time_step_s, seconds: float, extra: dict) -> dict
         shaft_speed_rad_s=extra.get("shaft_speed_rad_s", 500.0), radial_load_n=extra.get("radial_load_n", 3000.0),
         axial_load_n=extra.get("axial_load_n", 0.0), shaft_current_a=extra.get("shaft_current_a", 0.0)))
     if extra.get("defect"):
-        from twin.validation.vibration_simulation import defect_for
-
         twin.set_defects([defect_for(extra["defect"], spec.geometry)])
     twin.advance(seconds)
     s = twin.state

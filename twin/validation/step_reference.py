@@ -17,7 +17,12 @@ import sys
 import numpy as np
 
 from twin import catalog
+from twin.engine import Twin
 from twin.kernels import layout as L
+from twin.model import make_model
+from twin.setpoint import Setpoint
+from twin.spec import BearingSpec, ModelOptions
+from twin.timestep import steps_per_period
 
 # (id, designation, time step, shaft speed [rad/s], radial load [N], axial load [N])
 CASES = (
@@ -34,17 +39,10 @@ REFERENCE_TRACTION_REFRESHES = 20
 
 def reference_outputs(case: tuple, settle_s: float = 0.01, window_s: float = 0.01) -> dict:
     """Window means of one case (module docstring), as plain lists and floats (SI)."""
-    from twin.engine import Twin
-    from twin.setpoint import Setpoint
-    from twin.spec import BearingSpec, ModelOptions
-
     _, designation, dt, speed, fr, fa = case
     # the sub-rates the reference was made with (commit 5454e19: tribology every 10 us, strip solve
     # every 200 us), so that the comparison isolates the step's code from the sub-rate study's defaults
     # (the strip solve then every 20 refreshes: 178 us at the 7208's 4.444 us auto step)
-    from twin.model import make_model
-    from twin.timestep import steps_per_period
-
     # the inlet that engine had: isothermal (seed 000's Hamrock-Dowson film), Thermal.shear_heating off
     base = catalog.bearing(designation)
     spec = BearingSpec.model_validate({**base.model_dump(), "thermal": {**base.thermal.model_dump(),

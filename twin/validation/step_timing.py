@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 import statistics
 import time
+from typing import Any
 
 
 from numba import njit
@@ -180,7 +181,7 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     }
     for fn in runs.values():  # compile
         fn(1)
-    out = {}
+    out: dict[str, Any] = {}
     for name, fn in runs.items():
         if name == "traction_solve":  # a solve costs ~100 steps: a hundredth of the calls, per call
             best, median = _best_median_ns(fn, max(reps // 100, 1), repeats)

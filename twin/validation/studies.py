@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 
@@ -62,7 +63,7 @@ def sample_at_azimuth_zero(shaft_speed_rad_s: float, radial_load_n: float = 3000
     cage = max(twin.model.cage_speed_rad_s(shaft_speed_rad_s), 1e-3)
     window = 2.0 * math.pi / twin.model.ball_count / cage
     dt_sample = min(5e-5, window / 40.0)
-    best = None
+    best: tuple[float, np.ndarray, np.ndarray, float] | None = None
     for _ in range(int(math.ceil(window / dt_sample)) + 1):
         twin.advance(dt_sample, frame_steps=max(1, int(round(dt_sample / twin.model.dt_s))))
         az = twin.ball_azimuths_rad()
@@ -71,6 +72,7 @@ def sample_at_azimuth_zero(shaft_speed_rad_s: float, radial_load_n: float = 3000
             c = twin.state.contacts
             best = (float(az[j]), c[:, 2 * j].copy(), c[:, 2 * j + 1].copy(),
                     np.hypot(*twin.state.inner_ring_offset_m[:2]))
+    assert best is not None  # the loop samples at least once
     az0, ci, co, shift = best
     eps = 0.5 * (1.0 - clearance_m / (2.0 * shift)) if shift > 0 else float("nan")
     return AzimuthZeroSample(
@@ -127,7 +129,7 @@ class EVSample:
     shaft_current_a: float
     oil_temperature_c: float
     equivalent_resistance_ohm: float | None
-    h_min_inner_m: float
+    h_min_inner_m: float | None  # None without contact
     lambda_inner: float
     current_temperature_rise_k: float
     shear_temperature_rise_k: float
@@ -143,7 +145,7 @@ def ev_operating_point(shaft_current_a: float, shaft_speed_rpm: float, *, oil_te
                        options: ModelOptions | None = None):
     """Seed 003's EV case on the 6200 twin (seed-000 oil, shear and current heating on unless
     told otherwise): warm start at the operating point, settle, return (EVSample, snapshot)."""
-    fields = {"shear_heating": shear_heating}
+    fields: dict[str, Any] = {"shear_heating": shear_heating}
     if equivalent_resistance_ohm is not None:
         fields["equivalent_resistance_ohm"] = equivalent_resistance_ohm
     base = catalog.bearing(EV_BEARING)

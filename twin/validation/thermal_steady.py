@@ -59,6 +59,8 @@ def steady_state(twin: Twin, *, settle_s: float = 0.1, tolerance_k: float = 0.1,
     converged, it = False, 0
     for it in range(1, max_iterations + 1):
         twin.advance(settle_s)
+        if th.network is None:
+            raise ValueError(f"settle_s = {settle_s!r}: shorter than the network step (ModelOptions.thermal_period_s)")
         target = steady_state_c(th.network, th.filter.dissipation_factor, ambient, ambient, th.heat.node_heat_w())
         before = th.inlet_temperature_c
         temps = temps + relaxation * (target - temps)

@@ -51,6 +51,9 @@ def startup_transient(designation: str = "6208", shaft_speed_rad_s: float = 1000
     twin = Twin(spec, options=options,
                 setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n,
                                   oil_temperature_c=ambient_c))
+    coupling = twin.thermal
+    if coupling is None:
+        raise ValueError("thermal: the transient needs ModelOptions.thermal = 'network'")
     dt_sim = sample_every_network_s * heat_capacity_scale
     n = int(round(duration_network_s / sample_every_network_s))
     rows = []
@@ -59,11 +62,13 @@ def startup_transient(designation: str = "6208", shaft_speed_rad_s: float = 1000
     for _ in range(n):
         twin.advance(dt_sim)
         snap = twin.snapshot()
-        rows.append(_row(snap, snap.thermal.network_time_s))
+        rows.append(_row(snap, coupling.network_time_s))
+    if coupling.network is None:
+        raise ValueError(f"duration_network_s = {duration_network_s!r}: shorter than one network step")
     a = np.array(rows)
-    tau = tuple(float(x) for x in twin.thermal.time_constants_s())
+    tau = tuple(float(x) for x in coupling.time_constants_s())
     return Transient(a[:, 0], a[:, 1:1 + len(NODE_NAMES)], a[:, -5], a[:, -4], a[:, -3], a[:, -2], a[:, -1], tau,
-                     heat_capacity_scale, twin.thermal.network)
+                     heat_capacity_scale, coupling.network)
 
 
 def _row(snap, t: float) -> list[float]:

@@ -35,8 +35,10 @@ No I/O here: `bearing-twin timestep-study` prints the tables.
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import asdict, dataclass
+from typing import Literal
 
 import numpy as np
 
@@ -133,7 +135,7 @@ class _Run:
     scalars: dict
 
 
-def run_case(case: Case, time_step_s: float | str, **options) -> _Run:
+def run_case(case: Case, time_step_s: float | Literal["auto"], **options) -> _Run:
     """Warm start, settle, average over whole cage revolutions at the given step (`options`:
     further ModelOptions fields)."""
     twin = Twin(case.designation, options=ModelOptions(time_step_s=time_step_s, **options),
@@ -264,7 +266,8 @@ def run_study(cases: list[Case] | None = None, *, quick: bool = False, progress=
         ref = run_case(case, REFERENCE_TIME_STEP_S)
         model = make_model(catalog.bearing(case.designation, diametral_clearance_m=case.diametral_clearance_m))
         auto_dt, crit = model.dt_s, model.time_step.critical_step_s
-        for label, dt in (("auto", timestep.AUTO), ("2x auto", 2.0 * auto_dt)):
+        steps: tuple[tuple[str, float | Literal["auto"]], ...] = (("auto", timestep.AUTO), ("2x auto", 2.0 * auto_dt))
+        for label, dt in steps:
             if progress:
                 progress(case, label)
             run = run_case(case, dt)
@@ -401,6 +404,4 @@ def _finite(value):
 
 def as_json(result: dict) -> str:
     """`run_all`'s result as strict JSON (non-finite deviations, i.e. diverged or undefined, as null)."""
-    import json
-
     return json.dumps(_finite(result), allow_nan=False)

@@ -97,14 +97,16 @@ def simulate_vibration(bearing="6208", shaft_speed_rad_s: float = 500.0, radial_
     blocks = twin.drain_waveform()
     x = np.concatenate([b.samples for b in blocks]).astype(float) if blocks else np.zeros(0)
     angle = contact_angle_of_lanes_rad(twin.model, twin.state)
-    result = run_vibration(x, twin.model.sample_rate_hz, spec, float(twin.state.scalars[L.X_SHAFT_SPEED]),
+    decimator = twin.model.decimator
+    assert decimator is not None  # the housing is on
+    result = run_vibration(x, decimator.output_rate_hz, spec, float(twin.state.scalars[L.X_SHAFT_SPEED]),
                            contact_angle_rad=angle, housing=spec.housing,
                            window_s=spec.housing.accelerometer.window_s, band=band)
     result.update({
         "bearing": spec.designation, "shaft_speed_rad_s": float(twin.state.scalars[L.X_SHAFT_SPEED]),
         "radial_load_n": radial_load_n, "axial_load_n": axial_load_n,
         "defect": twin.defects[0].model_dump() if twin.defects else None,
-        "time_step_s": twin.model.dt_s, "decimation_ratio": twin.model.decimator.ratio,
+        "time_step_s": twin.model.dt_s, "decimation_ratio": decimator.ratio,
         "noise_density_m_s2_rthz": spec.housing.accelerometer.noise_density_m_s2_rthz,
         "status": twin.status,
     })

@@ -37,6 +37,7 @@ import math
 from typing import Literal
 
 import numpy as np
+import scipy.linalg
 from numba import njit
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
@@ -204,8 +205,6 @@ def modes(housing: Housing) -> list[tuple[float, float, np.ndarray]]:
     complex mode shape over the 4 DOFs). From the eigenvalues lambda of the first-order state
     matrix [[0, I], [-M^-1 K, -M^-1 C]]: f = |lambda| / 2 pi, zeta = -Re(lambda) / |lambda|
     (exact for non-proportional damping; overdamped real eigenvalues are not modes and are left out)."""
-    import scipy.linalg
-
     m, c, k = matrices(housing)
     minv = np.linalg.inv(m)
     a = np.block([[np.zeros((4, 4)), np.eye(4)], [-minv @ k, -minv @ c]])
@@ -222,11 +221,14 @@ def sensor_resonance(housing: Housing) -> tuple[float, float]:
     """(frequency [Hz], damping ratio [-]) of the mode the accelerometer sees the impacts through:
     the one with the largest stretch of the sprung-mass spring, |u_r - e.x_p| / |mode|."""
     e = np.array(housing.accelerometer.axis)
-    best, score = None, -1.0
+    best: tuple[float, float] | None = None
+    score = -1.0
     for f, zeta, shape in modes(housing):
         stretch = abs(shape[3] - e @ shape[:3]) / np.linalg.norm(shape)
         if stretch > score:
             best, score = (f, zeta), stretch
+    if best is None:
+        raise ValueError("housing: no vibration mode")
     return best
 
 

@@ -41,6 +41,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import scipy.signal
 
 from twin.vibration.defect_frequencies import DefectFrequencies
 from twin.vibration.kurtogram import fast_kurtogram
@@ -77,8 +78,6 @@ def time_indicators(a_m_s2: np.ndarray) -> dict[str, float]:
 def band_pass(a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[float, float]) -> np.ndarray:
     """The window [m/s^2], mean removed, band-passed to band_hz: the envelope band's filter
     (module docstring: 4th-order Butterworth, zero phase)."""
-    import scipy.signal
-
     x = np.asarray(a_m_s2, dtype=float)
     fs = float(sample_rate_hz)
     lo, hi = band_hz
@@ -143,8 +142,6 @@ def envelope_spectrum(a_m_s2: np.ndarray, sample_rate_hz: float,
                       band_hz: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
     """(frequencies [Hz], amplitude [m/s^2]) of the envelope of a band-passed to band_hz
     (module docstring: Butterworth 4 zero-phase, Hilbert, Hann, amplitude-corrected)."""
-    import scipy.signal
-
     y = band_pass(a_m_s2, sample_rate_hz, band_hz)
     env = np.abs(scipy.signal.hilbert(y))
     env -= env.mean()
@@ -214,8 +211,6 @@ def envelope_peaks(freqs: np.ndarray, amp: np.ndarray, count: int = 5, min_hz: f
     """The `count` largest local maxima of an envelope spectrum in [min_hz, max_hz], largest
     first: [{'frequency_hz', 'amplitude'}] (parabolic interpolation between bins). Defaults: from
     3 bins above 0 Hz to the end."""
-    import scipy.signal
-
     df = freqs[1] - freqs[0]
     lo = 3.0 * df if min_hz is None else min_hz
     hi = freqs[-1] if max_hz is None else max_hz

@@ -81,6 +81,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         if spectra:
             a_start, a_step, a_amp = ind.amplitude_spectrum(seg, fs)
             power_sum = a_amp ** 2 if power_sum is None else power_sum + a_amp ** 2
+    assert amp_sum is not None  # count >= 1 windows
     amp = amp_sum / count
     max_hz = min(0.5 * (hi - lo), 5.0 * top)
     mean = lambda key: float(np.mean([w[key] for w in windows]))  # noqa: E731
@@ -105,6 +106,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         "per_window": windows,
     }
     if spectra:
+        assert power_sum is not None  # summed over the same windows
         e_start, e_step, e_amp = ind.envelope_spectrum_view(freqs, amp, max_hz)
         out["envelope_spectrum"] = {"start_hz": e_start, "step_hz": e_step, "amplitude_m_s2": e_amp}
         out["amplitude_spectrum"] = {"start_hz": a_start, "step_hz": a_step,

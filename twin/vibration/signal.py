@@ -32,6 +32,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.signal
 from numba import njit
 
 from twin.jit import JIT
@@ -116,8 +117,6 @@ def design_decimator(input_rate_hz: float, output_rate_hz: float, attenuation_db
                      stopband_fraction: float = STOPBAND_FRACTION) -> DecimatorDesign:
     """Kaiser-window FIR low-pass for decimation from input_rate_hz to output_rate_hz (module
     docstring). The ratio must be an integer within 1e-6 (see `integer_ratio_time_step`)."""
-    import scipy.signal
-
     ratio_f = input_rate_hz / output_rate_hz
     ratio = int(round(ratio_f))
     if ratio < 2 or abs(ratio_f - ratio) > 1e-6 * ratio_f:

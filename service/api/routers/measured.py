@@ -48,7 +48,9 @@ async def post_measured(entry: TwinDep, request: Request, sample_rate_hz: float 
     else:
         raise InputError.one(None, f"content type {kind!r}: application/json or application/octet-stream",
                              ["application/json", "application/octet-stream"], status_code=415)
-    return await run_in_threadpool(entry.measured.receive, window)
+    comparator = entry.measured
+    assert comparator is not None  # every twin gets one at creation (TwinRegistry)
+    return await run_in_threadpool(comparator.receive, window)
 
 
 @read.get("/{bearing_id}/vibration/comparison", responses={**UNKNOWN_TWIN})

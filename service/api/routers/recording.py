@@ -22,6 +22,6 @@ def post_recording(entry: TwinDep, body: RecordingRequest, registry: RegistryDep
         return RecordingStatus(bearing_id=entry.id, recording=True, path=str(path), rows_logged=0)
     if body.path is not None:
         raise InputError.one("path", "give a path only with action 'start'")
-    path, rows = registry.stop_recording(entry)
+    stopped, rows = registry.stop_recording(entry)
     return RecordingStatus(bearing_id=entry.id, recording=False,
-                           path=str(path) if path is not None else None, rows_logged=rows)
+                           path=str(stopped) if stopped is not None else None, rows_logged=rows)
