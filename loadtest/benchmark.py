@@ -124,7 +124,7 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
         session = sub = None
         from service.settings import ZenohAccessSettings
 
-        prefix = ZenohAccessSettings().zenoh_prefix   # the service it starts inherits the environment
+        prefix = ZenohAccessSettings().zenoh.prefix   # the service it starts inherits the environment
         inbox: queue.SimpleQueue = queue.SimpleQueue()
         url = f"http://127.0.0.1:{port}"
         refused: list[dict] = []

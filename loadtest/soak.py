@@ -384,8 +384,8 @@ def run_soak(cfg: SoakConfig) -> dict:
 
             env = ZenohAccessSettings()
             access = (ZenohAccess(user=started.zenoh_user, password=started.zenoh_password)
-                      if started is not None else ZenohAccess.from_settings(env))
-            prefix = DEFAULT_PREFIX if started is not None else env.zenoh_prefix   # the started one: default
+                      if started is not None else ZenohAccess.from_settings(env.zenoh))
+            prefix = DEFAULT_PREFIX if started is not None else env.zenoh.prefix   # the started one: default
             stream = _Stream(zenoh_endpoint, cfg.bearing_id, prefix, access)
             report["zenoh_access"] = access.describe(listening=False) if access.enabled else "none"
         health0 = client.get(f"{url}/health", headers=headers).json()
@@ -669,7 +669,7 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
         # the trends are window means: a row per window of `per_window` snapshots, carrying the
         # seq of the window's last snapshot (RerunRecorder.SERVICE_OPTIONS)
         per_window = snapshots_per_row or snapshots_per_trend_window(
-            ServiceSettings().publish_rate_hz, float(RerunRecorder.SERVICE_OPTIONS["trend_window_s"]))
+            ServiceSettings().runner.publish_rate_hz, float(RerunRecorder.SERVICE_OPTIONS["trend_window_s"]))
         gaps = window_seq_gaps(s, per_window)
         out["snapshots_per_row"] = per_window
         out["seq_gaps"] = gaps

@@ -51,19 +51,19 @@ def _importing(feature: str, package: str, remedy: str):
 def open_bus(settings: ServiceSettings):
     """The service's zenoh bus, or None when zenoh is disabled. WiringError (one line) when it
     cannot be opened (e.g. the listen port is taken)."""
-    if not settings.enable_zenoh:
+    if not settings.zenoh.enabled:
         return None
     with _importing("zenoh", "service.bus", "install eclipse-zenoh or run with --no-zenoh"):
         from service.bus.access import ZenohAccess
         from service.bus.zenoh_bus import ZenohBus
-    owner = {"http": f"http://{settings.host}:{settings.port}"} if settings.port else {}
+    owner = {"http": f"http://{settings.http.host}:{settings.http.port}"} if settings.http.port else {}
     try:
-        return ZenohBus(listen=settings.zenoh_listen, connect=settings.zenoh_connect, mode=settings.zenoh_mode or "peer",
-                        prefix=settings.zenoh_prefix, owner=owner,
-                        access=ZenohAccess.from_settings(settings, enforce=True),
+        return ZenohBus(listen=settings.zenoh.listen, connect=settings.zenoh.connect, mode=settings.zenoh.mode,
+                        prefix=settings.zenoh.prefix, owner=owner,
+                        access=ZenohAccess.from_settings(settings.zenoh, enforce=True),
                         # another peer's claim on a twin id counts when zenoh authenticated it, or
                         # when nothing is secured; never when only the HTTP API is (service.bus.zenoh_bus)
-                        trust_claims=settings.zenoh_access_control or settings.token is None)
+                        trust_claims=settings.zenoh.access_control or settings.security.token is None)
     except (RuntimeError, ValueError) as exc:
         text = re.sub(r"\s+at \S+\.rs:\d+\.?", "", " ".join(str(exc).split()))   # zenoh's Rust source lines
         hint = (" (is another service listening there? choose another with --zenoh-listen, or --no-zenoh)"
@@ -80,29 +80,29 @@ def _recorder_class():
 def recorder_options(settings: ServiceSettings) -> dict:
     """Trend window, sampling of the bearing now, send interval, segment rotation and footer of
     every recording the service writes."""
-    return dict(**_recorder_class().SERVICE_OPTIONS, flush_interval_s=settings.record_flush_interval_s,
-                segment_s=settings.record_segment_s or None,
-                segment_bytes=round(settings.record_segment_mb * 1e6) or None,
-                write_footer=settings.record_footer)
+    return dict(**_recorder_class().SERVICE_OPTIONS, flush_interval_s=settings.recording.flush_interval_s,
+                segment_s=settings.recording.segment_s or None,
+                segment_bytes=round(settings.recording.segment_mb * 1e6) or None,
+                write_footer=settings.recording.footer)
 
 
 def open_recorder(settings: ServiceSettings, streams: Any = None):
     """The service-wide rerun recorder, or None when recording (and the viewer) are off.
     `streams`: the service's `RerunStreams`, shared with the per-twin recordings (stream creation
     and reclaim must not run concurrently, see `service.recording.RerunStreams`)."""
-    path = settings.recording_path
-    if path is None and not settings.spawn_viewer and settings.rerun_web_port is None:
+    path = settings.recording.active_path
+    if path is None and not settings.recording.spawn_viewer and settings.recording.web_port is None:
         return None
     cls = _recorder_class()
     from service.recording import RecordingPathError, RecordingWriteError, Retention
 
     extra = {} if streams is None else {"streams": streams}
     retention = None
-    if path is not None and (settings.record_keep_mb > 0 or settings.record_keep_hours > 0):
-        retention = Retention.for_recording(path, keep_bytes=round(settings.record_keep_mb * 1e6),
-                                            keep_age_s=settings.record_keep_hours * 3600.0)
+    if path is not None and (settings.recording.keep_mb > 0 or settings.recording.keep_hours > 0):
+        retention = Retention.for_recording(path, keep_bytes=round(settings.recording.keep_mb * 1e6),
+                                            keep_age_s=settings.recording.keep_hours * 3600.0)
     try:
-        return cls(path, spawn_viewer=settings.spawn_viewer, retention=retention, **recorder_options(settings), **extra)
+        return cls(path, spawn_viewer=settings.recording.spawn_viewer, retention=retention, **recorder_options(settings), **extra)
     except (RecordingPathError, RecordingWriteError, OSError) as exc:
         raise WiringError(f"cannot record to {str(path)!r}: {' '.join(str(exc).split())[:300]} "
                           "(--record PATH.rrd elsewhere, or --no-record)") from None
@@ -110,16 +110,16 @@ def open_recorder(settings: ServiceSettings, streams: Any = None):
 
 def open_live_viewer(settings: ServiceSettings, recorder):
     """rerun's web viewer serving the live recording (`service.recording.live`), connected to
-    `recorder`, or None when `settings.rerun_web_port` is unset. WiringError (one line) when it
+    `recorder`, or None when `settings.recording.web_port` is unset. WiringError (one line) when it
     cannot start or the bind is refused (a non-loopback address while a token is set)."""
-    if settings.rerun_web_port is None or recorder is None:
+    if settings.recording.web_port is None or recorder is None:
         return None
     from service.recording.live import LiveViewerError, LiveWebViewer, check_bind
 
     try:
-        check_bind(settings.rerun_web_bind, settings.token is not None)
-        live = LiveWebViewer(settings.rerun_web_port, host=settings.rerun_web_bind,
-                             memory_limit_mb=settings.rerun_web_memory_mb).start()
+        check_bind(settings.recording.web_bind, settings.security.token is not None)
+        live = LiveWebViewer(settings.recording.web_port, host=settings.recording.web_bind,
+                             memory_limit_mb=settings.recording.web_memory_mb).start()
     except (LiveViewerError, ValueError, OSError) as exc:
         raise WiringError(f"rerun web viewer: {exc}") from None
     try:
@@ -132,14 +132,14 @@ def open_live_viewer(settings: ServiceSettings, recorder):
 
 
 def open_opcua(settings: ServiceSettings, registry: TwinRegistry):
-    """The OPC UA facade serving `registry` (started), or None when `settings.opcua` is unset.
+    """The OPC UA facade serving `registry` (started), or None when `settings.opcua.endpoint` is unset.
     WiringError (one line) when it cannot start (e.g. the port is taken)."""
-    if not settings.opcua:
+    if not settings.opcua.endpoint:
         return None
     with _importing("OPC UA", "service.opcua", "install asyncua or run without --opcua"):
         from service.opcua import OpcUaError, OpcUaFacade
     try:
-        return OpcUaFacade(registry, settings.opcua).start()
+        return OpcUaFacade(registry, settings.opcua.endpoint).start()
     except (OpcUaError, ValueError) as exc:
         hint = (" (is another server listening there? choose another port with --opcua)"
                 if "address already in use" in str(exc).lower() or "errno 98" in str(exc).lower() else "")
@@ -154,7 +154,7 @@ class TwinService(TwinRegistry):
     def __init__(self, settings: ServiceSettings, gate: AdmissionGate | None = None):
         super().__init__(settings, gate)
         self._rerun_streams = None          # service.recording.RerunStreams, made on first use
-        self.opcua = None                   # service.opcua.OpcUaFacade when settings.opcua is set
+        self.opcua = None                   # service.opcua.OpcUaFacade when settings.opcua.endpoint is set
         self.live_viewer = None             # service.recording.live.LiveWebViewer when rerun_web_port is set
 
     def rerun_streams(self):
@@ -169,8 +169,8 @@ class TwinService(TwinRegistry):
 
     def _open_outputs(self) -> None:
         self.bus = open_bus(self.settings)
-        if (self.settings.recording_path is not None or self.settings.spawn_viewer
-                or self.settings.rerun_web_port is not None):
+        if (self.settings.recording.active_path is not None or self.settings.recording.spawn_viewer
+                or self.settings.recording.web_port is not None):
             self.recorder = open_recorder(self.settings, self.rerun_streams())
         self.live_viewer = open_live_viewer(self.settings, self.recorder)
         if self.recorder is not None:
@@ -236,7 +236,7 @@ class TwinService(TwinRegistry):
         exclusively, never through a link, never over an existing file (422 naming `path`, the
         file system unchanged). Without a path: `<id>-<UTC>.rrd` (a taken name gets `.runN`)."""
         target = self.resolve_recording_path(entry.id, path)
-        main = getattr(self.recorder, "path", None) or self.settings.recording_path
+        main = getattr(self.recorder, "path", None) or self.settings.recording.active_path
         if main is not None:
             from service.recording import is_segment_of
 

@@ -50,10 +50,10 @@ _UNAUTHORIZED = {401: {"model": ErrorResponse, "description": "Missing or wrong 
 
 def access_summary(settings: ServiceSettings) -> str:
     """One line: whether a token is required, and for what."""
-    if settings.token is None:
+    if settings.security.token is None:
         return ("no token (BEARING_TWIN_TOKEN unset): anyone who can reach the port may change "
                 "setpoints")
-    reads = "reads too (except /health)" if settings.read_requires_token else "reads open"
+    reads = "reads too (except /health)" if settings.security.read_requires_token else "reads open"
     return f"bearer token required for POST/PUT/DELETE (HTTP only, never sent on zenoh); {reads}"
 
 
@@ -65,8 +65,8 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        log.info("bearing-twin: HTTP bound to %s:%s (%s); %s", settings.host, settings.port,
-                 "loopback only" if is_loopback_host(settings.host) else "reachable from other machines",
+        log.info("bearing-twin: HTTP bound to %s:%s (%s); %s", settings.http.host, settings.http.port,
+                 "loopback only" if is_loopback_host(settings.http.host) else "reachable from other machines",
                  access_summary(settings))
         opened = service
         if opened is None:
@@ -97,17 +97,17 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
     app.state.tarpit = TarpitStats()
     app.add_middleware(BodySizeLimit, gate=gate)
     app.add_middleware(ReadRateLimit, gate=gate)      # a refused read costs the least
-    app.add_middleware(TokenGate, gate=gate, reads=settings.read_requires_token)
-    app.add_middleware(Tarpit, gate=gate, delay_s=settings.tarpit_delay_s, max_held=settings.tarpit_max_held,
+    app.add_middleware(TokenGate, gate=gate, reads=settings.security.read_requires_token)
+    app.add_middleware(Tarpit, gate=gate, delay_s=settings.security.tarpit_delay_s, max_held=settings.security.tarpit_max_held,
                        stats=app.state.tarpit)        # outermost: sees every refusal
     install_error_handlers(app)
 
     token = [Depends(require_token)] if gate.requires_token else []
     writes: dict[str, Any] = {"dependencies": token, "responses": {
         **(_UNAUTHORIZED if token else {}),
-        413: {"model": ErrorResponse, "description": f"Body larger than {settings.max_body_bytes} bytes"}}}
+        413: {"model": ErrorResponse, "description": f"Body larger than {settings.security.max_body_bytes} bytes"}}}
     reads: dict[str, Any] = ({"dependencies": token, "responses": _UNAUTHORIZED}
-             if token and settings.read_requires_token else {})
+                             if token and settings.security.read_requires_token else {})
     app.include_router(health.router)
     for router in (bearings.read, state.read, alarms.read, defects.read, measured.read, scenarios.read, docs.read):
         app.include_router(router, **reads)

@@ -192,10 +192,10 @@ def uvicorn_config(app, settings, *, host: str | None = None, port: int | None =
     import uvicorn
 
     config = uvicorn.Config(
-        app, host=settings.host if host is None else host, port=settings.port if port is None else port,
+        app, host=settings.http.host if host is None else host, port=settings.http.port if port is None else port,
         workers=1, log_level=log_level, lifespan="on",
-        http=guarded_protocol(settings.http_header_timeout_s, settings.http_body_timeout_s),
-        timeout_keep_alive=settings.http_keep_alive_s, limit_concurrency=settings.http_max_connections,
+        http=guarded_protocol(settings.http.header_timeout_s, settings.http.body_timeout_s),
+        timeout_keep_alive=settings.http.keep_alive_s, limit_concurrency=settings.http.max_connections,
         **extra)
-    install_access_log_redaction(settings.token_value)   # after uvicorn configured its loggers
+    install_access_log_redaction(settings.security.token_value)   # after uvicorn configured its loggers
     return config

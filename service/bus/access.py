@@ -163,23 +163,23 @@ class ZenohAccess:
 
     @classmethod
     def from_settings(cls, s: Any, *, enforce: bool = False) -> ZenohAccess:
-        """From a `ZenohAccessSettings` (service, router or client settings). `enforce`: build
-        the access-control rules (a node that accepts links); the service's own user is always
-        one of the services."""
+        """From the `zenoh` settings group (`ZenohAccessConfig` of the service, the router or a
+        client). `enforce`: build the access-control rules (a node that accepts links); the
+        service's own user is always one of the services."""
         roles = None
         if enforce:
-            services = tuple(dict.fromkeys([*s.zenoh_services, *([s.zenoh_user] if s.zenoh_user else [])]))
-            roles = Roles(services=services, writers=tuple(s.zenoh_writers), readers=tuple(s.zenoh_readers))
-        return cls(user=s.zenoh_user, password=s.zenoh_password_value, usersfile=s.zenoh_usersfile,
-                   tls_root_ca=s.zenoh_tls_root_ca, tls_certificate=s.zenoh_tls_certificate,
-                   tls_private_key=s.zenoh_tls_private_key, roles=roles)
+            services = tuple(dict.fromkeys([*s.services, *([s.user] if s.user else [])]))
+            roles = Roles(services=services, writers=tuple(s.writers), readers=tuple(s.readers))
+        return cls(user=s.user, password=s.password_value, usersfile=s.usersfile,
+                   tls_root_ca=s.tls_root_ca, tls_certificate=s.tls_certificate,
+                   tls_private_key=s.tls_private_key, roles=roles)
 
     @classmethod
     def from_env(cls) -> ZenohAccess:
         """A client's credentials from BEARING_TWIN_ZENOH_USER / _PASSWORD (and _TLS_*)."""
         from service.settings import ZenohAccessSettings
 
-        return cls.from_settings(ZenohAccessSettings())
+        return cls.from_settings(ZenohAccessSettings().zenoh)
 
     def apply(self, config: Any, prefixes: str | Sequence[str], *, listening: bool) -> None:
         """Insert authentication (and, for a node that accepts links, the rules) into a

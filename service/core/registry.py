@@ -68,13 +68,13 @@ _REC_PATH_RE = re.compile(r"^(?=.{1,256}$)(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/)*[A-Za
 
 def admission_gate(settings: ServiceSettings) -> AdmissionGate:
     """The service's one admission gate (HTTP and zenoh) from its settings."""
-    bus_writes = ("authorized" if settings.zenoh_access_control
-                  else "closed" if settings.token is not None else "open")
-    return AdmissionGate(token=settings.token_value, setpoint_rate_hz=settings.setpoint_rate_hz or None,
-                         setpoint_burst=settings.setpoint_burst, max_payload_bytes=settings.max_body_bytes,
-                         bus_writes=bus_writes, read_rate_hz=settings.read_rate_hz or None,
-                         read_burst=settings.read_burst, error_rate_hz=settings.client_error_rate_hz or None,
-                         error_burst=settings.client_error_burst)
+    bus_writes = ("authorized" if settings.zenoh.access_control
+                  else "closed" if settings.security.token is not None else "open")
+    return AdmissionGate(token=settings.security.token_value, setpoint_rate_hz=settings.security.setpoint_rate_hz or None,
+                         setpoint_burst=settings.security.setpoint_burst, max_payload_bytes=settings.security.max_body_bytes,
+                         bus_writes=bus_writes, read_rate_hz=settings.security.read_rate_hz or None,
+                         read_burst=settings.security.read_burst, error_rate_hz=settings.security.client_error_rate_hz or None,
+                         error_burst=settings.security.client_error_burst)
 
 
 class Channel(SnapshotSink, Protocol):
@@ -143,13 +143,13 @@ class TwinRegistry:
         self._twins: dict[str, TwinEntry] = {}
         self._reserved: set[str] = set()    # ids of twins being built
         self._admitting: dict[str, TwinCost] = {}   # costs of twins admitted, not yet running
-        threads = settings.stepping_threads or usable_cores()
+        threads = settings.runner.stepping_threads or usable_cores()
         self.pool = SteppingPool(threads, name="step")
-        self.priority = ThreadPriority(self.pool.native_ids, settings.io_thread_nice, settings.stepping_thread_nice,
+        self.priority = ThreadPriority(self.pool.native_ids, settings.runner.io_thread_nice, settings.runner.stepping_thread_nice,
                                        keep_names=EGRESS_THREAD_NAMES)
         self.overhead = ServiceOverheadMeter()
-        self.capacity = Capacity(threads, settings.capacity_core_fraction,
-                                 reserve_cores=settings.capacity_reserve_cores)
+        self.capacity = Capacity(threads, settings.runner.capacity_core_fraction,
+                                 reserve_cores=settings.runner.capacity_reserve_cores)
         self.last_calibration: TwinCost | None = None
         self.over_capacity: str | None = None     # why the configured twin runs over capacity
         self._over_capacity_id: str | None = None
@@ -181,15 +181,15 @@ class TwinRegistry:
     # ---- life cycle ------------------------------------------------------------------------
     def open(self, *, default_twin: bool = True) -> TwinRegistry:
         """Open the outputs and start the `default` twin."""
-        if sys.getswitchinterval() > self.settings.gil_switch_interval_s:
-            sys.setswitchinterval(self.settings.gil_switch_interval_s)  # process-wide, see settings
+        if sys.getswitchinterval() > self.settings.runner.gil_switch_interval_s:
+            sys.setswitchinterval(self.settings.runner.gil_switch_interval_s)  # process-wide, see settings
         try:
             self.pool.start()
             self.priority.start()              # after the pool: its threads keep their nice
             self._open_outputs()
-            if default_twin and self.settings.start_twin:
-                self.create_twin(id=self.settings.twin_id, over_capacity_ok=True, **self._configured_bearing())
-            if self.settings.gc_freeze:
+            if default_twin and self.settings.twin.start:
+                self.create_twin(id=self.settings.twin.id, over_capacity_ok=True, **self._configured_bearing())
+            if self.settings.runner.gc_freeze:
                 freeze_heap()
         except BaseException:
             self.close()
@@ -198,9 +198,9 @@ class TwinRegistry:
 
     def _configured_bearing(self) -> dict[str, Any]:
         """The create_twin options of the configured twin: its designation, or the spec of a
-        bearing spec file (`settings.bearing` ending in .yaml, .yml, .json; read on the server by
-        its operator), with the housing when `settings.housing`."""
-        name, housing = self.settings.bearing, self.settings.housing
+        bearing spec file (`settings.twin.bearing` ending in .yaml, .yml, .json; read on the server by
+        its operator), with the housing when `settings.twin.housing`."""
+        name, housing = self.settings.twin.bearing, self.settings.twin.housing
         if not name.strip().lower().endswith(catalog.SPEC_FILE_SUFFIXES):
             return {"designation": name, **({"housing": {"enabled": True}} if housing else {})}
         spec = catalog.load_spec_file(name.strip())
@@ -346,7 +346,7 @@ class TwinRegistry:
             if bearing_id in self._twins or bearing_id in self._reserved:
                 raise InputError.one("id", f"a twin named {bearing_id!r} already exists",
                                      status_code=409)
-            limit = s.twin_limit
+            limit = s.runner.twin_limit
             if len(self._twins) + len(self._reserved) >= limit:
                 raise InputError.one(None, f"this service already runs {len(self._twins)} twins "
                                      f"(max_twins = {limit})", [0, limit], status_code=409)
@@ -356,8 +356,8 @@ class TwinRegistry:
         try:
             twin = self.build_twin(bearing_id, designation, **options)
             cost = self._admit(bearing_id, twin, over_capacity_ok)
-            runner = TwinRunner(twin, fast=s.fast, publish_rate_hz=s.publish_rate_hz, frame_s=s.frame_s,
-                                setpoint_frame_s=s.setpoint_frame_s, lateness_s=s.lateness_s, lead_s=s.frame_lead_s,
+            runner = TwinRunner(twin, fast=s.runner.fast, publish_rate_hz=s.runner.publish_rate_hz, frame_s=s.runner.frame_s,
+                                setpoint_frame_s=s.runner.setpoint_frame_s, lateness_s=s.runner.lateness_s, lead_s=s.runner.frame_lead_s,
                                 pool=self.pool, cost=cost)
             entry = TwinEntry(id=bearing_id, twin=twin, runner=runner,
                               intake=SetpointIntake(bearing_id, self.gate, runner),
@@ -403,10 +403,10 @@ class TwinRegistry:
         InputError 503 with the reason and the figures when it does not fit. Returns its cost
         (None when admission is off or in fast mode)."""
         s = self.settings
-        if s.admission == "off" or s.fast:
+        if s.runner.admission == "off" or s.runner.fast:
             return None
-        cost = calibrate(twin, sim_s=s.calibration_s, frame_steps=max(1, round(s.frame_s / twin.model.dt_s)),
-                         publish_rate_hz=s.publish_rate_hz)
+        cost = calibrate(twin, sim_s=s.runner.calibration_s, frame_steps=max(1, round(s.runner.frame_s / twin.model.dt_s)),
+                         publish_rate_hz=s.runner.publish_rate_hz)
         with self._lock:
             self.last_calibration = cost
             verdict = self.capacity.check(cost, self._running_costs())
@@ -441,13 +441,13 @@ class TwinRegistry:
         typical = self.last_calibration
         cap = self.capacity
         estimate = cap.estimate_max_twins(typical, running, used)
-        if self.settings.max_twins is not None:
-            estimate = self.settings.max_twins if estimate is None else min(estimate, self.settings.max_twins)
+        if self.settings.runner.max_twins is not None:
+            estimate = self.settings.runner.max_twins if estimate is None else min(estimate, self.settings.runner.max_twins)
         return {
-            "admission": "off" if self.settings.fast else self.settings.admission,
+            "admission": "off" if self.settings.runner.fast else self.settings.runner.admission,
             "cores": cap.cores, "stepping_threads": cap.stepping_threads,
             "core_fraction": cap.core_fraction, "reserve_cores": cap.reserve_cores, "budget_cpu_s_per_s": cap.budget_cpu_s_per_s,
-            "used_cpu_s_per_s": used, "over_budget": used > cap.budget_cpu_s_per_s, "max_twins": estimate, "max_twins_set": self.settings.max_twins,
+            "used_cpu_s_per_s": used, "over_budget": used > cap.budget_cpu_s_per_s, "max_twins": estimate, "max_twins_set": self.settings.runner.max_twins,
             "last_calibration": typical.as_dict() if typical is not None else None,
             "over_capacity": self.over_capacity,
             "formula": cap.formula(typical, running, used), "service_overhead": overhead,
@@ -467,7 +467,7 @@ class TwinRegistry:
 
     # ---- per-twin recordings ---------------------------------------------------------------
     def recordings_dir(self) -> Path:
-        rec = self.settings.record
+        rec = self.settings.recording.path
         return rec.parent if rec is not None else Path("recordings")
 
     def resolve_recording_path(self, bearing_id: str, path: str | None) -> Path:
@@ -490,8 +490,8 @@ class TwinRegistry:
 
     def start_recording(self, entry: TwinEntry, path: str | None) -> Path:
         target = self.resolve_recording_path(entry.id, path)
-        if self.settings.recording_path is not None:
-            main = Path(self.settings.recording_path).resolve()
+        if self.settings.recording.active_path is not None:
+            main = Path(self.settings.recording.active_path).resolve()
             t = target.resolve()
             if t == main or (t.parent == main.parent and re.fullmatch(re.escape(main.stem) + r"-\d{4,}\.rrd", t.name)):
                 raise InputError.one("path", f"{str(target)!r} is the service-wide recording or one of its segments")
@@ -538,7 +538,7 @@ class TwinRegistry:
             "uptime_s": time.monotonic() - self.started_wall_s,
             "twins": twins,
             "zenoh": self.bus is not None and not getattr(self.bus, "closed", False),
-            "zenoh_listen": list(self.settings.zenoh_listen) if self.bus is not None else [],
+            "zenoh_listen": list(self.settings.zenoh.listen) if self.bus is not None else [],
             "recording": str(rec.path) if rec is not None and getattr(rec, "path", None) else None,
             "recording_rows": int(getattr(rec, "rows_logged", 0)) if rec is not None else 0,
             "pid": os.getpid(),

@@ -153,12 +153,12 @@ class GuardLimits:
 
     @classmethod
     def from_settings(cls, s: Any) -> GuardLimits:
-        return cls(max_sessions=s.opcua_max_sessions,
-                   max_subscriptions_per_session=s.opcua_max_subscriptions_per_session,
-                   max_monitored_items_per_session=s.opcua_max_monitored_items_per_session,
-                   max_notifications_per_s=s.opcua_max_notifications_per_s,
-                   min_publishing_interval_ms=s.opcua_min_publishing_interval_ms,
-                   max_queue_size=s.opcua_max_queue_size, publish_rate_hz=s.publish_rate_hz)
+        return cls(max_sessions=s.opcua.max_sessions,
+                   max_subscriptions_per_session=s.opcua.max_subscriptions_per_session,
+                   max_monitored_items_per_session=s.opcua.max_monitored_items_per_session,
+                   max_notifications_per_s=s.opcua.max_notifications_per_s,
+                   min_publishing_interval_ms=s.opcua.min_publishing_interval_ms,
+                   max_queue_size=s.opcua.max_queue_size, publish_rate_hz=s.runner.publish_rate_hz)
 
     def item_rate_hz(self, queue_size: int, interval_ms: float) -> float:
         """The most notifications one monitored item may send per second [1/s]."""
@@ -176,7 +176,7 @@ class OpcUaGuard:
     @classmethod
     def from_settings(cls, s: Any) -> OpcUaGuard:
         return cls(GuardLimits.from_settings(s),
-                   LoginThrottle(s.opcua_login_free_failures, s.opcua_login_backoff_s, s.opcua_login_backoff_max_s))
+                   LoginThrottle(s.opcua.login_free_failures, s.opcua.login_backoff_s, s.opcua.login_backoff_max_s))
 
     def install(self, iserver: Any) -> None:
         """Make asyncua's InternalServer create a GuardedSession for every client session, and cap

@@ -239,9 +239,9 @@ class OpcUaFacade:
         self.registry = registry
         self.endpoint = endpoint
         # one publish period (of wall time; in fast mode of simulated time, at least 10 ms)
-        self.period_s = float(period_s) if period_s else max(1.0 / settings.publish_rate_hz,
-                                                              0.01 if settings.fast else 0.0)
-        self.read_requires_token = (settings.read_requires_token if read_requires_token is None
+        self.period_s = float(period_s) if period_s else max(1.0 / settings.runner.publish_rate_hz,
+                                                              0.01 if settings.runner.fast else 0.0)
+        self.read_requires_token = (settings.security.read_requires_token if read_requires_token is None
                                     else read_requires_token)
         self.server_name = server_name
         self.url: str | None = None             # the endpoint actually listened on
@@ -369,15 +369,15 @@ class OpcUaFacade:
 
     async def _load_pki(self, settings: Any) -> None:
         """The server certificate (given or self-signed in opcua_pki_dir) and the trusted clients."""
-        given = getattr(settings, "opcua_certificate", None)
+        given = settings.opcua.certificate
         host = urlparse(self.endpoint).hostname or ""
         try:
             if given is not None:
-                self.pki = await asyncio.to_thread(given_pki, given, settings.opcua_private_key, APPLICATION_URI)
+                self.pki = await asyncio.to_thread(given_pki, given, settings.opcua.private_key, APPLICATION_URI)
             else:
-                self.pki = await asyncio.to_thread(self_signed_pki, settings.opcua_pki_dir, APPLICATION_URI,
+                self.pki = await asyncio.to_thread(self_signed_pki, settings.opcua.pki_dir, APPLICATION_URI,
                                                    [host] if host not in ("0.0.0.0", "::") else [])
-            trusted = getattr(settings, "opcua_trusted_dir", None)
+            trusted = settings.opcua.trusted_dir
             if trusted is not None:
                 self.trust = await ClientTrust(trusted).load()
         except PkiError as exc:

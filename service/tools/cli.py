@@ -15,7 +15,10 @@ from pathlib import Path
 
 from service import __version__
 from service.tools.bench_results import save as save_result
+from service.settings import ServiceSettings
 from service.tools.messages import error_text
+from service.tools.scenario_cli import add_scenario_command
+from service.tools.settings_flags import add_settings_flags, flag_overrides, settings_error_text
 from service.tools.vibration_cli import add_analyse_command
 from twin.catalog import DEFAULT_DESIGNATION
 
@@ -228,82 +231,13 @@ def build_parser() -> argparse.ArgumentParser:
     serve = sub.add_parser(
         "serve", help="run the service: HTTP API, zenoh bus, rerun recording, the `default` twin",
         description="Run the service (one uvicorn worker). Each flag overrides its BEARING_TWIN_* "
-        "environment variable, which overrides the built-in default.")
-    serve.add_argument("--host", help="HTTP bind address (default 127.0.0.1: loopback only; "
-                       "0.0.0.0 exposes the API on every interface) [BEARING_TWIN_HOST]")
-    serve.add_argument("--port", type=int, help="HTTP port (default 8000) [BEARING_TWIN_PORT]")
-    serve.add_argument("--bearing", help=f"designation or bearing spec file (.yaml, .json) of the `default` twin "
-                       f"(default {DEFAULT_DESIGNATION}) [BEARING_TWIN_BEARING]")
-    serve.add_argument("--housing", action="store_true", default=None,
-                       help="the `default` twin runs on the housing support with the accelerometer "
-                       "(vibration; default off) [BEARING_TWIN_HOUSING]")
-    serve.add_argument("--twin-id", metavar="ID",
-                       help="name of the twin started with the service (default `default`; give "
-                       "each service on one zenoh network its own) [BEARING_TWIN_TWIN_ID]")
-    serve.add_argument("--zenoh-listen", metavar="ENDPOINT", action="append",
-                       help="zenoh endpoint to listen on, repeatable (default tcp/127.0.0.1:7447) "
-                       "[BEARING_TWIN_ZENOH_LISTEN]")
-    serve.add_argument("--zenoh-connect", metavar="ENDPOINT", action="append",
-                       help="zenoh router or peer to connect to, repeatable (default none) "
-                       "[BEARING_TWIN_ZENOH_CONNECT]")
-    serve.add_argument("--zenoh-mode", choices=["peer", "client", "router"],
-                       help="zenoh session mode (default client with --zenoh-connect and no "
-                       "--zenoh-listen, else peer) [BEARING_TWIN_ZENOH_MODE]")
-    serve.add_argument("--zenoh-prefix", metavar="PREFIX",
-                       help="key prefix of the twins on zenoh: site / line / asset, e.g. "
-                       "plant1/line2/motor7 (default bearing) [BEARING_TWIN_ZENOH_PREFIX]; zenoh "
-                       "credentials and access rules come from the environment (docs/operations.md \"zenoh "
-                       "access control\")")
-    serve.add_argument("--record", metavar="PATH.rrd",
-                       help="rerun recording (default recordings/bearing-twin-<UTC timestamp>.rrd) "
-                       "[BEARING_TWIN_RECORD]")
-    serve.add_argument("--spawn-viewer", action="store_true", default=None,
-                       help="also stream to a rerun viewer spawned here [BEARING_TWIN_SPAWN_VIEWER]")
-    serve.add_argument("--rerun-web", type=int, metavar="PORT",
-                       help="serve the live recording to rerun's web viewer at http://127.0.0.1:PORT "
-                       "(gRPC proxy on PORT+1) [BEARING_TWIN_RERUN_WEB_PORT]")
-    serve.add_argument("--rerun-web-bind", metavar="ADDRESS",
-                       help="address of the web viewer (default 127.0.0.1; non-loopback refused with a token) "
-                       "[BEARING_TWIN_RERUN_WEB_BIND]")
-    serve.add_argument("--fast", action="store_true", default=None,
-                       help="run the twins as fast as possible, not paced to the wall clock [BEARING_TWIN_FAST]")
-    serve.add_argument("--publish-rate", type=_positive_float, metavar="HZ",
-                       help="snapshot publishing rate [Hz] (default 50) [BEARING_TWIN_PUBLISH_RATE_HZ]")
-    serve.add_argument("--opcua", metavar="opc.tcp://HOST:PORT",
-                       help="also serve the twins over OPC UA on this endpoint, e.g. "
-                       "opc.tcp://127.0.0.1:4840 (default off) [BEARING_TWIN_OPCUA]")
-    serve.add_argument("--opcua-security", choices=["auto", "none", "sign", "sign_and_encrypt", "both", "all"],
-                       help="OPC UA message security: Basic256Sha256, Aes128_Sha256_RsaOaep, "
-                       "Aes256_Sha256_RsaPss in Sign, SignAndEncrypt or both; all = both + None for "
-                       "anonymous reads; none = no certificate, password in clear (default auto: both "
-                       "with a token, else none) [BEARING_TWIN_OPCUA_SECURITY]")
-    serve.add_argument("--opcua-certificate", metavar="CERT.der",
-                       help="OPC UA server certificate, DER or PEM, with --opcua-private-key (default: "
-                       "self-signed in --opcua-pki-dir) [BEARING_TWIN_OPCUA_CERTIFICATE]")
-    serve.add_argument("--opcua-private-key", metavar="KEY.pem",
-                       help="its private key, PEM or DER [BEARING_TWIN_OPCUA_PRIVATE_KEY]")
-    serve.add_argument("--opcua-pki-dir", metavar="DIR",
-                       help="folder of the generated OPC UA server certificate and key (default "
-                       "./opcua-pki) [BEARING_TWIN_OPCUA_PKI_DIR]")
-    serve.add_argument("--opcua-trusted-dir", metavar="DIR",
-                       help="folder of trusted OPC UA client certificates (.der/.pem): only those "
-                       "clients may connect (default: any client certificate) [BEARING_TWIN_OPCUA_TRUSTED_DIR]")
-    serve.add_argument("--no-zenoh", action="store_true", help="debugging: do not start the zenoh bus")
-    serve.add_argument("--no-record", action="store_true", help="debugging: do not record")
+        "environment variable, which overrides the built-in default (docs/configuration.md). Secrets "
+        "(BEARING_TWIN_TOKEN, BEARING_TWIN_ZENOH_PASSWORD) come from the environment only.")
+    add_settings_flags(serve, ServiceSettings)
     serve.add_argument("--log-level", default="info", choices=["critical", "error", "warning", "info", "debug"])
     serve.set_defaults(func=_cmd_serve)
 
-    scenario = sub.add_parser("scenario", help="scenarios: timelines of setpoints and ramps (YAML)")
-    scenario_sub = scenario.add_subparsers(dest="scenario_command", required=True)
-    run = scenario_sub.add_parser("run", help="run a scenario file in fast mode (fresh twin per run)")
-    run.add_argument("file", help="scenario YAML file (see scenarios/ and service/core/scenarios.py)")
-    run.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording")
-    run.add_argument("--table", metavar="OUT.parquet", help="write the per-sample table (Parquet; .csv for CSV)")
-    run.add_argument("--no-progress", action="store_true", help="no progress bar")
-    run.set_defaults(func=_cmd_scenario_run)
-    check = scenario_sub.add_parser("check", help="validate scenario files and print what they do")
-    check.add_argument("files", nargs="+")
-    check.set_defaults(func=_cmd_scenario_check)
+    add_scenario_command(sub)
 
     vib = sub.add_parser(
         "vibration", help="housing acceleration with a local defect: indicators, defect frequencies, envelope peaks",
@@ -398,29 +332,13 @@ def _unavailable(name: str, reason: str) -> int:
     return 2
 
 
-def _serve_settings(args: argparse.Namespace):
-    """BEARING_TWIN_* environment + the flags that were given."""
-    from service.settings import ServiceSettings
-
-    overrides = {}
-    for flag, name in (("host", "host"), ("port", "port"), ("bearing", "bearing"), ("housing", "housing"), ("twin_id", "twin_id"),
-                       ("zenoh_listen", "zenoh_listen"), ("zenoh_connect", "zenoh_connect"),
-                       ("zenoh_mode", "zenoh_mode"), ("zenoh_prefix", "zenoh_prefix"), ("record", "record"),
-                       ("spawn_viewer", "spawn_viewer"), ("fast", "fast"),
-                       ("rerun_web", "rerun_web_port"), ("rerun_web_bind", "rerun_web_bind"),
-                       ("publish_rate", "publish_rate_hz"), ("opcua", "opcua"),
-                       ("opcua_security", "opcua_security"), ("opcua_certificate", "opcua_certificate"),
-                       ("opcua_private_key", "opcua_private_key"), ("opcua_pki_dir", "opcua_pki_dir"),
-                       ("opcua_trusted_dir", "opcua_trusted_dir")):
-        value = getattr(args, flag, None)
-        if value is not None:
-            overrides[name] = value
-    if args.no_zenoh:
-        overrides["enable_zenoh"] = False
-    if args.no_record:
-        overrides["enable_recording"] = False
-    if args.record is not None:
-        overrides["enable_recording"] = True
+def _serve_settings(args: argparse.Namespace) -> ServiceSettings:
+    """BEARING_TWIN_* environment + the flags that were given; `--record PATH` also turns the
+    recording on."""
+    overrides = flag_overrides(args)
+    recording = overrides.get("recording", {})
+    if "path" in recording:
+        recording.setdefault("enabled", True)
     return ServiceSettings(**overrides)
 
 
@@ -431,18 +349,24 @@ def _cmd_serve(args: argparse.Namespace) -> int:
 
     from twin import catalog
 
+    from pydantic_settings import SettingsError
+
     try:
         settings = _serve_settings(args)
     except ValidationError as exc:
-        print(f"error: {_one_line(exc)}", file=sys.stderr)
+        print(f"error: {settings_error_text(exc, ServiceSettings)}", file=sys.stderr)
         return 2
-    if args.no_record and args.record is not None:
+    except SettingsError as exc:                # an environment value that is not JSON where JSON is due
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    given = vars(args)
+    if "recording.path" in given and given.get("recording.enabled") is False:
         print("error: --record and --no-record contradict each other", file=sys.stderr)
         return 2
     try:
-        default_spec = catalog.bearing_or_file(settings.bearing)
+        default_spec = catalog.bearing_or_file(settings.twin.bearing)
     except ValidationError as exc:
-        print(f"error: bearing: {settings.bearing}: {_one_line(exc)}", file=sys.stderr)
+        print(f"error: bearing: {settings.twin.bearing}: {_one_line(exc)}", file=sys.stderr)
         return 2
     except ValueError as exc:
         print(f"error: {exc}", file=sys.stderr)
@@ -454,42 +378,42 @@ def _cmd_serve(args: argparse.Namespace) -> int:
 
     logging.basicConfig(level=getattr(logging, args.log_level.upper()),
                         format="%(asctime)s %(levelname)s %(name)s: %(message)s")
-    host = settings.host
+    host = settings.http.host
     where = ("loopback only; --host 0.0.0.0 to expose it" if is_loopback_host(host)
              else "reachable from other machines")
-    port = settings.port if settings.port else "<a free port, see uvicorn's line below>"
+    port = settings.http.port if settings.http.port else "<a free port, see uvicorn's line below>"
     print(f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
-          f"twin `{settings.twin_id}` = {default_spec.designation}, {'fast' if settings.fast else 'real-time'} mode",
+          f"twin `{settings.twin.id}` = {default_spec.designation}, {'fast' if settings.runner.fast else 'real-time'} mode",
           flush=True)
     from service.api.app import access_summary
 
     print(f"bearing-twin: access: {access_summary(settings)}; setpoints limited to "
-          + (f"{settings.setpoint_rate_hz:g}/s per twin (bursts of {settings.setpoint_burst})"
-             if settings.setpoint_rate_hz else "no rate")
-          + f"; request bodies up to {settings.max_body_bytes} bytes", flush=True)
-    if settings.enable_zenoh:
+          + (f"{settings.security.setpoint_rate_hz:g}/s per twin (bursts of {settings.security.setpoint_burst})"
+             if settings.security.setpoint_rate_hz else "no rate")
+          + f"; request bodies up to {settings.security.max_body_bytes} bytes", flush=True)
+    if settings.zenoh.enabled:
         from service.bus.access import ZenohAccess
 
-        print(f"bearing-twin: zenoh {settings.zenoh_mode} listening on {', '.join(settings.zenoh_listen) or 'nothing'}"
-              + (f", connecting to {', '.join(settings.zenoh_connect)}" if settings.zenoh_connect else "")
-              + f", keys {settings.zenoh_prefix}/<id>/...", flush=True)
-        zenoh_access = ZenohAccess.from_settings(settings, enforce=True).describe(listening=bool(settings.zenoh_listen))
-        if not settings.zenoh_access_control and settings.token is not None:
+        print(f"bearing-twin: zenoh {settings.zenoh.mode} listening on {', '.join(settings.zenoh.listen) or 'nothing'}"
+              + (f", connecting to {', '.join(settings.zenoh.connect)}" if settings.zenoh.connect else "")
+              + f", keys {settings.zenoh.prefix}/<id>/...", flush=True)
+        zenoh_access = ZenohAccess.from_settings(settings.zenoh, enforce=True).describe(listening=bool(settings.zenoh.listen))
+        if not settings.zenoh.access_control and settings.security.token is not None:
             zenoh_access += "; zenoh setpoints refused (the HTTP API needs a token)"
         print(f"bearing-twin: {zenoh_access}", flush=True)
     else:
         print("bearing-twin: zenoh off", flush=True)
-    if settings.opcua:
+    if settings.opcua.endpoint:
         security = settings.opcua_security_mode
-        print(f"bearing-twin: OPC UA on {settings.opcua} (namespace urn:bearing-twin:opcua; "
-              + ("user name + the token as password to write" if settings.token else "anonymous writes allowed")
-              + "; security " + {"none": "None only" + (": the password crosses in clear" if settings.token else ""),
+        print(f"bearing-twin: OPC UA on {settings.opcua.endpoint} (namespace urn:bearing-twin:opcua; "
+              + ("user name + the token as password to write" if settings.security.token else "anonymous writes allowed")
+              + "; security " + {"none": "None only" + (": the password crosses in clear" if settings.security.token else ""),
                                   "sign": "Sign", "sign_and_encrypt": "SignAndEncrypt",
                                   "both": "Sign and SignAndEncrypt",
                                   "all": "Sign, SignAndEncrypt and None (anonymous reads)"}[security]
               + (" with Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss" if security != "none" else "")
-              + (f"; clients trusted: the certificates in {settings.opcua_trusted_dir}"
-                 if settings.opcua_trusted_dir is not None else "")
+              + (f"; clients trusted: the certificates in {settings.opcua.trusted_dir}"
+                 if settings.opcua.trusted_dir is not None else "")
               + ")", flush=True)
     from service.core.errors import InputError
     from service.wiring import TwinService, WiringError
@@ -512,8 +436,8 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     if written is not None:     # the file actually written: <stem>.run2.rrd when the name was taken
         print(f"bearing-twin: recording to {written}", flush=True)
     else:
-        print("bearing-twin: not recording" if settings.recording_path is None
-              else f"bearing-twin: recording to {settings.recording_path}", flush=True)
+        print("bearing-twin: not recording" if settings.recording.active_path is None
+              else f"bearing-twin: recording to {settings.recording.active_path}", flush=True)
     from service.api.server import uvicorn_config
 
     config = uvicorn_config(create_app(settings, service=service), settings, host=host,
@@ -552,105 +476,6 @@ def _interruptible_server_class():
 
 def _InterruptibleServer(config):
     return _interruptible_server_class()(config)
-
-
-def _cmd_scenario_check(args: argparse.Namespace) -> int:
-    from service.core.scenarios import ScenarioError, load_scenario
-
-    status = 0
-    for file in args.files:
-        try:
-            scenario = load_scenario(file)
-            scenario.check_bearing_limits()     # what `scenario run` checks before it runs
-        except ScenarioError as exc:
-            print(f"{file}: error: {exc}", file=sys.stderr)
-            status = 2
-            continue
-        runs = scenario.resolved_runs()
-        print(f"{file}: ok: {scenario.name}, {len(runs)} run(s), {scenario.total_duration_s:g} s simulated, "
-              f"sample every {scenario.sample_every_s:g} s")
-        for w in scenario.warnings:
-            print(f"  warning: {w}")
-    return status
-
-
-def _alarm_settings_from_env():
-    """`BEARING_TWIN_ALARMS` (JSON, as for `serve`), or None for the defaults."""
-    import os
-
-    from service.settings import AlarmSettings
-
-    text = os.environ.get("BEARING_TWIN_ALARMS")
-    return AlarmSettings.model_validate_json(text) if text else None
-
-
-def _cmd_scenario_run(args: argparse.Namespace) -> int:
-    from service.tools.offline import TableSink, run_scenario, write_table
-    from service.core.scenarios import ScenarioError, load_scenario
-
-    try:
-        scenario = load_scenario(args.file)
-        scenario.check_bearing_limits()
-    except ScenarioError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    for w in scenario.warnings:
-        print(f"warning: {w}", file=sys.stderr)
-    try:
-        alarm_settings = _alarm_settings_from_env()
-    except ValueError as exc:                   # pydantic's ValidationError is a ValueError
-        print(f"error: BEARING_TWIN_ALARMS: {' '.join(str(exc).split())[:300]}", file=sys.stderr)
-        return 2
-    for path, suffixes in ((args.record, (".rrd",)), (args.table, (".parquet", ".pq", ".csv"))):
-        if path is not None and not path.lower().endswith(suffixes):
-            print(f"error: {path}: expected a file ending in {' or '.join(suffixes)}", file=sys.stderr)
-            return 2
-    total = scenario.total_duration_s
-    runs = scenario.resolved_runs()
-    print(f"{scenario.name}: {len(runs)} run(s), {total:g} s of simulated time, fast mode", file=sys.stderr)
-    table = TableSink()
-    bar = None
-    if not args.no_progress:
-        from tqdm import tqdm
-
-        bar = tqdm(total=round(total * 1000), unit="ms", desc=scenario.name, file=sys.stderr,
-                   bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} ms simulated "
-                   "[{elapsed}<{remaining}]")
-
-    def progress(done_s: float) -> None:
-        if bar is not None:
-            bar.n = min(bar.total, round(done_s * 1000))
-            bar.refresh()
-
-    try:
-        written: list = []
-        results = run_scenario(scenario, record=args.record, table=table, progress=progress,
-                               on_recording=written.append, alarms=alarm_settings)
-    except ScenarioError as exc:
-        if bar is not None:
-            bar.close()
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    if bar is not None:
-        bar.close()
-    status = 0
-    for r in results:
-        snap = r.final
-        lam = [c.lambda_ for b in (snap.balls if snap else ()) for c in (b.inner, b.outer) if c.lambda_ is not None]
-        summary = (f"min Lambda {min(lam):.2f}, friction torque {snap.friction_torque_n_m * 1e3:.2f} mN m, "
-                   f"status {snap.status}") if snap is not None and lam else (f"status {snap.status}" if snap else "")
-        print(f"  {r.run.id} ({r.run.label}): {r.state}, {r.rows} samples, {r.wall_s:.1f} s wall; {summary}"
-              + (f"; error: {r.error}" if r.error else ""))
-        for e in r.alarms:
-            print(f"    alarm at {e.time_s:.3f} s: {e.message}")
-        if r.state != "done":
-            status = 1
-    if args.table:
-        path = write_table(table.rows, args.table)
-        print(f"table: {path} ({len(table.rows)} rows)")
-    if args.record:      # the file written: <stem>.run2.rrd when the name was taken
-        print(f"recording: {written[0] if written else args.record}")
-    return status
 
 
 def _cmd_report(args: argparse.Namespace) -> int:

@@ -333,7 +333,8 @@ def _cmd_monitor(args: argparse.Namespace) -> int:
     from service.settings import ZenohAccessSettings
 
     try:
-        env = ZenohAccessSettings(**({"zenoh_prefix": args.prefix} if args.prefix else {}))
+        given: dict[str, Any] = {"zenoh": {"prefix": args.prefix}} if args.prefix else {}
+        env = ZenohAccessSettings(**given)
     except ValidationError as exc:
         print("error: monitor: " + "; ".join(str(e["msg"]).removeprefix("Value error, ") for e in exc.errors()),
               file=sys.stderr)
@@ -342,8 +343,8 @@ def _cmd_monitor(args: argparse.Namespace) -> int:
         from service.bus.access import ZenohAccess
 
         run_monitor(args.connect, args.listen, args.keyexpr, duration_s=args.duration, once=args.once,
-                    prefix=env.zenoh_prefix, forget_gone_s=args.forget_after,
-                    access=ZenohAccess.from_settings(env))
+                    prefix=env.zenoh.prefix, forget_gone_s=args.forget_after,
+                    access=ZenohAccess.from_settings(env.zenoh))
     except KeyboardInterrupt:
         return 0
     except Exception as exc:  # noqa: BLE001 - bad endpoint, port in use, ...

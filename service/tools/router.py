@@ -25,6 +25,9 @@ import sys
 import threading
 from typing import Any
 
+from service.settings import RouterSettings
+from service.tools.settings_flags import add_settings_flags, flag_overrides, settings_error_text
+
 
 def open_router(settings: Any):
     """Open the router session; returns (session, description). RuntimeError (one line) when
@@ -34,14 +37,14 @@ def open_router(settings: Any):
     from service.bus.access import ZenohAccess
     from service.bus.zenoh_bus import _one_line, make_config
 
-    access = ZenohAccess.from_settings(settings, enforce=True)
-    config = make_config(settings.zenoh_listen, [], "router", access=access, prefix=settings.zenoh_prefix)
+    access = ZenohAccess.from_settings(settings.zenoh, enforce=True)
+    config = make_config(settings.zenoh.listen, [], "router", access=access, prefix=settings.zenoh.prefix)
     try:
         session = zenoh.open(config)
     except Exception as exc:
         text = _one_line(exc)
         hint = " (is another router or service listening there?)" if "already in use" in text else ""
-        raise RuntimeError(f"zenoh router: cannot listen on {', '.join(settings.zenoh_listen)}: {text}{hint}") from exc
+        raise RuntimeError(f"zenoh router: cannot listen on {', '.join(settings.zenoh.listen)}: {text}{hint}") from exc
     return session, access.describe(listening=True)
 
 
@@ -51,7 +54,7 @@ def run_router(settings: Any, stop: threading.Event, out: Any = None) -> int:
     session, access = open_router(settings)
     try:
         print(f"bearing-twin router: zenoh router {session.info.zid()} listening on "
-              f"{', '.join(settings.zenoh_listen)}, key prefix {settings.zenoh_prefix}; {access}",
+              f"{', '.join(settings.zenoh.listen)}, key prefix {settings.zenoh.prefix}; {access}",
               file=out, flush=True)
         stop.wait()
     finally:
@@ -63,19 +66,10 @@ def run_router(settings: Any, stop: threading.Event, out: Any = None) -> int:
 def _cmd_router(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
-    from service.settings import RouterSettings
-
-    overrides = {}
-    if args.listen:
-        overrides["zenoh_listen"] = args.listen
-    if args.prefix:
-        overrides["zenoh_prefix"] = args.prefix
     try:
-        settings = RouterSettings(**overrides)
+        settings = RouterSettings(**flag_overrides(args))
     except ValidationError as exc:
-        msg = "; ".join(f"{'.'.join(str(p) for p in e['loc']) or 'settings'}: {e['msg']}".replace(": Value error,", ":")
-                        for e in exc.errors())
-        print(f"error: {msg}", file=sys.stderr)
+        print(f"error: {settings_error_text(exc, RouterSettings)}", file=sys.stderr)
         return 2
     stop = threading.Event()
     for sig in (signal.SIGTERM, signal.SIGINT):
@@ -91,10 +85,6 @@ def add_router_command(subparsers: Any) -> argparse.ArgumentParser:
     p = subparsers.add_parser("router", help="a zenoh router for a fleet of services (optionally "
                               "with authentication and access control)",
                               description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("--listen", metavar="ENDPOINT", action="append",
-                   help="endpoint to listen on, repeatable (default tcp/127.0.0.1:7447) [BEARING_TWIN_ZENOH_LISTEN]")
-    p.add_argument("--prefix", metavar="PATTERN",
-                   help="key prefix the access rules cover, e.g. plant1/** (default bearing) "
-                   "[BEARING_TWIN_ZENOH_PREFIX]")
+    add_settings_flags(p, RouterSettings, aliases={"zenoh.prefix": ("--prefix",)})
     p.set_defaults(func=_cmd_router)
     return p

@@ -123,9 +123,9 @@ def test_token_comparison_is_constant_time(monkeypatch):
 def test_settings_token_from_environment(monkeypatch):
     monkeypatch.setenv("BEARING_TWIN_TOKEN", TOKEN)
     s = ServiceSettings()
-    assert s.token_value == TOKEN and TOKEN not in repr(s) and not s.read_requires_token
+    assert s.security.token_value == TOKEN and TOKEN not in repr(s) and not s.security.read_requires_token
     monkeypatch.setenv("BEARING_TWIN_TOKEN", "")
-    assert ServiceSettings().token is None
+    assert ServiceSettings().security.token is None
     monkeypatch.setenv("BEARING_TWIN_TOKEN", "has space")
     with pytest.raises(ValueError) as err:
         ServiceSettings()

@@ -71,7 +71,7 @@ def test_30_s_serve_stays_within_the_recording_budget(hostile, tmp_path):
     assert chunks <= 30 * wall_s
     # trends are window means (RerunRecorder.SERVICE_OPTIONS): a row per window of `per_window`
     # snapshots carrying its last seq; every published snapshot is in a recorded window
-    per_window = snapshots_per_trend_window(ServiceSettings().publish_rate_hz,
+    per_window = snapshots_per_trend_window(ServiceSettings().runner.publish_rate_hz,
                                             RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
     assert seqs[-1] >= published and len(seqs) * per_window >= published - per_window
     assert len(set(seqs.tolist())) == len(seqs) and window_seq_gaps(seqs, per_window) == 0

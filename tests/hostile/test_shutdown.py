@@ -36,7 +36,7 @@ TORQUE = "bearing/default/friction_torque_n_m"
 
 # the service's trends are window means (RerunRecorder.SERVICE_OPTIONS): a row per window of
 # PER_WINDOW snapshots, carrying the seq of the window's last snapshot
-PER_WINDOW = snapshots_per_trend_window(ServiceSettings().publish_rate_hz,
+PER_WINDOW = snapshots_per_trend_window(ServiceSettings().runner.publish_rate_hz,
                                         RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
 
 

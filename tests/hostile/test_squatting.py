@@ -24,7 +24,7 @@ def test_an_anonymous_squatter_blocks_no_create(support):
     endpoint = support.free_endpoint()
     settings = ServiceSettings(enable_recording=False, token=TOKEN, max_twins=2, zenoh_listen=[endpoint],
                                admission="off")
-    assert not settings.zenoh_access_control
+    assert not settings.zenoh.access_control
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=30.0) as srv:
         evil = zenoh.open(make_config([], [endpoint], "peer"))
         try:

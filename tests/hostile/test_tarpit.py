@@ -25,7 +25,7 @@ import httpx
 import pytest
 from pydantic import ValidationError
 
-from service.settings import ServiceSettings
+from service.settings import HttpSettings, SecuritySettings, ServiceSettings
 
 TOKEN = "tarpit-test-token-0123456789"
 DELAY_S = 1.0          # tarpit_delay_s
@@ -220,10 +220,10 @@ def test_tarpit_settings_are_validated(field, value):
 
 
 def test_tarpit_defaults():
-    f = ServiceSettings.model_fields
-    assert f["tarpit_delay_s"].default == 2.0 and f["client_error_rate_hz"].default == 5.0
-    assert f["client_error_burst"].default == 20 and f["tarpit_max_held"].default == 64
-    assert f["tarpit_max_held"].default < f["http_max_connections"].default
+    security, http = SecuritySettings(), HttpSettings()          # the groups' defaults, no environment
+    assert security.tarpit_delay_s == 2.0 and security.client_error_rate_hz == 5.0
+    assert security.client_error_burst == 20 and security.tarpit_max_held == 64
+    assert security.tarpit_max_held < http.max_connections
 
 
 def test_no_error_budget_or_no_delay_means_no_tarpit():

@@ -178,10 +178,10 @@ def test_settings_refuse_what_zenoh_cannot_guard(tmp_path, users, monkeypatch):
         ServiceSettings(zenoh_usersfile=bad)
     assert "line 2" in str(err.value) and "secret" not in str(err.value).replace("bad.txt", "")
     joined = ServiceSettings(zenoh_user="twin", zenoh_password=pw["twin"], zenoh_connect=["tcp/127.0.0.1:2"])
-    assert joined.zenoh_listen == [] and joined.zenoh_mode == "client" and joined.zenoh_access_control
+    assert joined.zenoh.listen == [] and joined.zenoh.mode == "client" and joined.zenoh.access_control
     assert pw["twin"] not in repr(joined)
-    assert ServiceSettings().zenoh_mode == "peer" and not ServiceSettings().zenoh_access_control
-    assert RouterSettings(zenoh_prefix="plant1/**").zenoh_prefix == "plant1/**"
+    assert ServiceSettings().zenoh.mode == "peer" and not ServiceSettings().zenoh.access_control
+    assert RouterSettings(zenoh_prefix="plant1/**").zenoh.prefix == "plant1/**"
 
 
 # ---- the intake: no token in payloads -----------------------------------------------------------

@@ -331,8 +331,8 @@ def test_serve_housing_puts_the_default_twin_on_the_housing():
     from service.tools.cli import _serve_settings, build_parser
 
     settings = _serve_settings(build_parser().parse_args(["serve", "--housing", "--no-zenoh", "--no-record", "--fast"]))
-    assert settings.housing is True
-    assert _serve_settings(build_parser().parse_args(["serve", "--no-zenoh"])).housing is False
+    assert settings.twin.housing is True
+    assert _serve_settings(build_parser().parse_args(["serve", "--no-zenoh"])).twin.housing is False
     registry = TwinRegistry(settings).open()
     try:
         entry = registry.get("default")

@@ -11,7 +11,7 @@ import pytest
 
 from service import keys
 from service.core import registry, scenarios
-from service.settings import ServiceSettings, ZenohAccessSettings
+from service.settings import ServiceSettings, ZenohAccessConfig, ZenohAccessSettings
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -26,7 +26,7 @@ def test_key_builders():
 @pytest.mark.parametrize("good", ["default", "6208-1", "a.b_c-d", "x" * 64])
 def test_twin_ids_accepted_everywhere(good):
     assert keys.check_twin_id(good) == good
-    assert ServiceSettings(twin_id=good).twin_id == good
+    assert ServiceSettings(twin_id=good).twin.id == good
     assert re.match(registry.ID_PATTERN, good)
 
 
@@ -54,7 +54,7 @@ def test_prefixes_refused_by_the_settings_and_the_bus(bad):
 def test_one_definition():
     """The rules live in service.keys only: no other module of service/ or loadtest/ writes the id
     regex, a prefix regex or the default prefix as a literal."""
-    assert ServiceSettings.model_fields["zenoh_prefix"].default == keys.DEFAULT_PREFIX
+    assert ZenohAccessConfig.model_fields["prefix"].default == keys.DEFAULT_PREFIX
     assert registry.ID_PATTERN is keys.TWIN_ID_PATTERN and scenarios._NAME_RE is keys.TWIN_ID_PATTERN
     literals = re.compile(r"\[A-Za-z0-9\]\[A-Za-z0-9_\.-\]|\[A-Za-z0-9_\.:\+=|prefix[^=\n]*=\s*\"bearing\"|"
                           r"default=\"bearing\"")

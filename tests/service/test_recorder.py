@@ -540,7 +540,7 @@ def test_service_settings_reach_the_recorder(tmp_path, monkeypatch):
     from service.wiring import open_recorder
 
     s = ServiceSettings(record=tmp_path / "svc.rrd", enable_zenoh=False)
-    assert s.record_segment_s == 600.0 and s.record_segment_mb == 1000.0 and s.record_footer is False
+    assert s.recording.segment_s == 600.0 and s.recording.segment_mb == 1000.0 and s.recording.footer is False
     rec = open_recorder(s)
     try:
         assert rec.segment_s == 600.0 and rec.segment_bytes == 1_000_000_000 and rec.write_footer is False

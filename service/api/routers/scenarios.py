@@ -17,7 +17,7 @@ write = APIRouter(tags=["scenarios"])
 @read.get("/v1/scenarios", response_model=ScenarioList)
 def get_scenarios(settings: SettingsDep) -> ScenarioList:
     """Named scenarios (files in the scenarios directory)."""
-    directory = settings.scenarios_path
+    directory = settings.twin.scenarios_path
     out: dict[str, str] = {}
     for name, path in list_scenarios(directory).items():
         try:
@@ -42,9 +42,9 @@ def post_scenario(entry: TwinDep, body: ScenarioRequest, settings: SettingsDep) 
     runner (a scenario already running is cancelled). Returns at once."""
     if (body.name is None) == (body.scenario is None):
         raise InputError.one("name", "give either 'name' (a scenario file) or 'scenario' (inline)",
-                             sorted(list_scenarios(settings.scenarios_path)))
+                             sorted(list_scenarios(settings.twin.scenarios_path)))
     if body.name is not None:
-        scenario = find_scenario(body.name, settings.scenarios_path)
+        scenario = find_scenario(body.name, settings.twin.scenarios_path)
     else:
         try:
             scenario = scenario_from_dict(body.scenario)

@@ -504,6 +504,6 @@ def test_configured_twin_starts_over_capacity_and_says_so(monkeypatch):
 def test_max_twins_unset_means_the_capacity_decides():
     from service.settings import ServiceSettings
 
-    assert ServiceSettings().max_twins is None and ServiceSettings().twin_limit == 256
-    assert ServiceSettings(max_twins=3).twin_limit == 3
-    assert math.isclose(ServiceSettings().frame_s, 0.005) and ServiceSettings().lateness_s == 0.005
+    assert ServiceSettings().runner.max_twins is None and ServiceSettings().runner.twin_limit == 256
+    assert ServiceSettings(max_twins=3).runner.twin_limit == 3
+    assert math.isclose(ServiceSettings().runner.frame_s, 0.005) and ServiceSettings().runner.lateness_s == 0.005

@@ -133,7 +133,7 @@ def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
     from service.settings import ServiceSettings
 
     now, _ = _now_and_restored()
-    io, asked = ServiceSettings().io_thread_nice, ServiceSettings().stepping_thread_nice
+    io, asked = ServiceSettings().runner.io_thread_nice, ServiceSettings().runner.stepping_thread_nice
     assert io == -5 and asked == -10 and now == BASE_NICE == 0
     raised = asked if os.geteuid() == 0 else now      # a higher priority needs root / CAP_SYS_NICE
     io_got = io if os.geteuid() == 0 else now

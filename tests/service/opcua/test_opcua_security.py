@@ -69,7 +69,7 @@ def server(support, pki):
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, token=TOKEN, max_twins=2,
                                opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
                                opcua_pki_dir=pki["server"], opcua_trusted_dir=pki["trusted"])
-    assert settings.opcua_security == "auto" and settings.opcua_security_mode == "both"
+    assert settings.opcua.security == "auto" and settings.opcua_security_mode == "both"
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=30.0) as srv:
         yield srv
 

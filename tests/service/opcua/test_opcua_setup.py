@@ -35,15 +35,15 @@ def test_the_token_is_the_password():
 
 
 def test_the_endpoint_setting_and_flag():
-    assert ServiceSettings().opcua is None                                   # off by default
-    assert ServiceSettings(opcua="opc.tcp://127.0.0.1:4840").opcua == "opc.tcp://127.0.0.1:4840"
+    assert ServiceSettings().opcua.endpoint is None                                   # off by default
+    assert ServiceSettings(opcua="opc.tcp://127.0.0.1:4840").opcua.endpoint == "opc.tcp://127.0.0.1:4840"
     with pytest.raises(ValidationError, match="opcua"):
         ServiceSettings(opcua="http://127.0.0.1:4840")
     from service.tools.cli import _serve_settings, build_parser
 
     args = build_parser().parse_args(["serve", "--opcua", "opc.tcp://127.0.0.1:4841"])
     assert isinstance(args, argparse.Namespace)
-    assert _serve_settings(args).opcua == "opc.tcp://127.0.0.1:4841"
+    assert _serve_settings(args).opcua.endpoint == "opc.tcp://127.0.0.1:4841"
 
 
 def test_a_busy_port_is_a_one_line_wiring_error():
@@ -65,11 +65,11 @@ def test_the_security_settings_and_flags(tmp_path):
     """opcua_security `auto`: Sign + SignAndEncrypt with a token, None without; the certificate and
     key go together; a trusted-clients folder needs every session on a secure channel. Each bad
     value is an error naming its field; the serve flags set the same fields."""
-    assert ServiceSettings().opcua_security == "auto" and ServiceSettings().opcua_security_mode == "none"
+    assert ServiceSettings().opcua.security == "auto" and ServiceSettings().opcua_security_mode == "none"
     assert ServiceSettings(token="s3cret").opcua_security_mode == "both"
     assert ServiceSettings(token="s3cret", opcua_security="none").opcua_security_mode == "none"
-    assert ServiceSettings().opcua_pki_dir.name == "opcua-pki"
-    with pytest.raises(ValidationError, match="opcua_security"):
+    assert ServiceSettings().opcua.pki_dir.name == "opcua-pki"
+    with pytest.raises(ValidationError, match=r"opcua\.security"):
         ServiceSettings(opcua_security="encrypt")
     cert = tmp_path / "c.der"
     cert.write_bytes(b"x")
@@ -83,14 +83,14 @@ def test_the_security_settings_and_flags(tmp_path):
         ServiceSettings(opcua_trusted_dir=tmp_path)                      # auto without a token: None
     with pytest.raises(ValidationError, match="opcua_trusted_dir: trusting clients by certificate"):
         ServiceSettings(token="s3cret", opcua_security="all", opcua_trusted_dir=tmp_path)
-    assert ServiceSettings(opcua_security="sign", opcua_trusted_dir=tmp_path).opcua_trusted_dir == tmp_path
+    assert ServiceSettings(opcua_security="sign", opcua_trusted_dir=tmp_path).opcua.trusted_dir == tmp_path
     from service.tools.cli import _serve_settings, build_parser
 
     args = build_parser().parse_args(["serve", "--opcua", "opc.tcp://127.0.0.1:4841", "--opcua-security",
                                       "sign_and_encrypt", "--opcua-pki-dir", str(tmp_path / "pki"),
                                       "--opcua-trusted-dir", str(tmp_path)])
     settings = _serve_settings(args)
-    assert (settings.opcua_security, settings.opcua_pki_dir, settings.opcua_trusted_dir) == \
+    assert (settings.opcua.security, settings.opcua.pki_dir, settings.opcua.trusted_dir) == \
         ("sign_and_encrypt", tmp_path / "pki", tmp_path)
     with pytest.raises(SystemExit):
         build_parser().parse_args(["serve", "--opcua-security", "encrypt"])

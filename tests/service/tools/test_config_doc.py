@@ -1,9 +1,10 @@
 """docs/configuration.md is generated from the settings models (service.tools.config_doc) and is
-current: a default or description changed in service/settings.py without regenerating fails here."""
+current: a default, description, environment name or flag changed in service/settings/ without
+regenerating fails here."""
 
 from __future__ import annotations
 
-from service.settings import ServiceSettings
+from service.settings import ServiceSettings, flat_settings
 from service.tools.config_doc import DOC, configuration_markdown, main
 
 
@@ -15,10 +16,12 @@ def test_configuration_doc_is_current():
 
 def test_every_setting_has_a_row_with_its_default(tmp_path):
     text = configuration_markdown()
-    for name, field in ServiceSettings.model_fields.items():
-        assert f"`BEARING_TWIN_{name.upper()}`" in text, name
-        assert field.description, f"{name} has no description"
-    assert "| `BEARING_TWIN_PORT` | `8000` |" in text
+    for setting in flat_settings(ServiceSettings):
+        assert f"| `{setting.env}` |" in text, setting.flat
+        assert f"`{setting.nested_env}`" in text, setting.path
+        assert setting.info.description, f"{setting.path} has no description"
+    assert "| `BEARING_TWIN_PORT` | `8000` | `BEARING_TWIN_HTTP__PORT` | `--port` |" in text
+    assert "| `BEARING_TWIN_TOKEN` | unset | `BEARING_TWIN_SECURITY__TOKEN` | (environment only) |" in text
     stale = tmp_path / "configuration.md"
     stale.write_text(text.replace("`8000`", "`8001`"))
     assert main(["--check", "--out", str(stale)]) == 1
