@@ -43,7 +43,6 @@ import collections
 import json
 import math
 import multiprocessing as mp
-import os
 import random
 import secrets
 import statistics
@@ -56,6 +55,7 @@ from typing import Any
 
 from loadtest import attack_watchers
 from service.keys import DEFAULT_PREFIX
+from service.settings import ZenohAccessSettings
 from service.tools.client import (TargetConfig, add_target_arguments, check_loopback, strict_json,
                                   target_arguments, url_is_loopback)
 
@@ -412,7 +412,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         if zenoh_endpoint:
             specs.append((_zenoh_flood, {"endpoint": zenoh_endpoint, "bearing_id": cfg.bearing_id,
                                          "prefix": DEFAULT_PREFIX if started is not None else
-                                         os.environ.get("BEARING_TWIN_ZENOH_PREFIX", DEFAULT_PREFIX),
+                                         ZenohAccessSettings().zenoh.prefix,
                                          "user": zuser, "password": zpass, "seconds": cfg.seconds,
                                          "rate_hz": cfg.zenoh_rate_hz, "seed": rng.randrange(2**32)}))
         specs += attack_watchers.specs(cfg, started, url, zenoh_endpoint, token)

@@ -20,12 +20,14 @@ import asyncio
 import collections
 import functools
 import json
-import os
 import secrets
 import tempfile
 import time
 from pathlib import Path
 from typing import Any
+
+from service.keys import DEFAULT_PREFIX
+from service.settings import ZenohAccessSettings
 
 FORGED_HOST = "evil-squatter"        # the forged owner text; never to be found in an answer
 WATCHERS = ("squat", "opcua_logins", "opcua_sessions", "opcua_subscriptions")
@@ -37,8 +39,8 @@ def specs(cfg: Any, started: Any, url: str, zenoh_endpoint: str | None, token: s
     if cfg.squat and zenoh_endpoint:
         specs.append((run_part, {"mode": "squat", "flood": squat, "url": url, "token": token,
                                    "endpoint": zenoh_endpoint, "seconds": cfg.seconds, "max_ids": 3,
-                                   "prefix": "bearing" if started is not None else
-                                   os.environ.get("BEARING_TWIN_ZENOH_PREFIX", "bearing")}))
+                                   "prefix": DEFAULT_PREFIX if started is not None else
+                                   ZenohAccessSettings().zenoh.prefix}))
     opcua_url = started.opcua_url if started is not None else cfg.opcua_url
     if opcua_url:
         common = {"flood": opcua, "url": opcua_url, "seconds": cfg.seconds, "bearing_id": cfg.bearing_id,
