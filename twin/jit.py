@@ -58,18 +58,18 @@ def code_digest(source: str) -> bytes:
     return hashlib.sha256(ast.dump(tree, include_attributes=False).encode()).digest()
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _file_digest(path: str, st_mtime: float, st_size: int) -> bytes:
     # (mtime, size) in the memo key: a file edited while the process runs is digested again
     return code_digest(Path(path).read_text(encoding="utf-8"))
 
 
 # numba's cache classes (public names since numba 0.63, underscored before)
-_CACHE_IMPL = getattr(caching, "CacheImpl", None) or getattr(caching, "_CacheImpl")
+_CACHE_IMPL = getattr(caching, "CacheImpl", None) or caching._CacheImpl  # type: ignore[attr-defined]
 if TYPE_CHECKING:
     from numba.core.caching import UserProvidedCacheLocator as _UserLocator
 else:
-    _UserLocator = getattr(caching, "UserProvidedCacheLocator", None) or getattr(caching, "_UserProvidedCacheLocator")
+    _UserLocator = getattr(caching, "UserProvidedCacheLocator", None) or caching._UserProvidedCacheLocator
 
 
 class StrippedSourceLocator(_UserLocator):

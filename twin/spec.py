@@ -79,7 +79,7 @@ class Geometry(BaseModel):
         "the seal friction; null: d + 0.32 (D - d), the inner-ring shoulder of the 62 series.")
 
     @model_validator(mode="after")
-    def _fits(self) -> "Geometry":
+    def _fits(self) -> Geometry:
         rb = self.ball_radius_m
         for name in ("inner_groove_radius_m", "outer_groove_radius_m"):
             rg = getattr(self, name)
@@ -165,7 +165,7 @@ class Lubricant(BaseModel):
         "101: 0.05-0.08 for mineral oils; the middle of that range).")
 
     @model_validator(mode="after")
-    def _order(self) -> "Lubricant":
+    def _order(self) -> Lubricant:
         if self.kinematic_viscosity_100c_m2_s >= self.kinematic_viscosity_40c_m2_s:
             raise ValueError("kinematic_viscosity_100c_m2_s must be below kinematic_viscosity_40c_m2_s")
         return self
@@ -203,7 +203,7 @@ class Electrical(BaseModel):
         default=0.7e6, gt=0.0, description="Above this apparent current density fluting is likely [A/m^2].")
 
     @model_validator(mode="after")
-    def _thresholds(self) -> "Electrical":
+    def _thresholds(self) -> Electrical:
         if self.fluting_current_density_a_m2 <= self.harmless_current_density_a_m2:
             raise ValueError("fluting_current_density_a_m2 must exceed harmless_current_density_a_m2")
         return self

@@ -50,7 +50,7 @@ from twin.kernels import layout as L
 from twin.kernels.step import ROLLING_REGULARISATION_SPEED
 from twin.kernels.tribology import contact_tribology
 from twin.physics.damping import fluid_damping_n_s_m, hysteretic_damping_n_s_m
-from twin.spec import TIME_STEP_RANGE_S  # noqa: F401  (explicit steps allowed by ModelOptions [s])
+from twin.spec import TIME_STEP_RANGE_S
 
 AUTO: Final = "auto"
 

@@ -31,7 +31,7 @@ class RacewayGeometry:
     ball_count: int
 
     @classmethod
-    def of(cls, geometry) -> "RacewayGeometry":
+    def of(cls, geometry) -> RacewayGeometry:
         """From a `twin.spec.Geometry`."""
         return cls(2.0 * geometry.ball_radius_m, 2.0 * geometry.pitch_radius_m, geometry.inner_groove_radius_m,
                    geometry.outer_groove_radius_m, geometry.ball_count)

@@ -78,7 +78,7 @@ def run_study(cases: list[ts.Case] | None = None, periods=PERIODS, *, against_1u
     cases = cases if cases is not None else ts.envelope_cases()
     rows = []
     for case in cases:
-        def run(label, dt, trib, trac):
+        def run(label, dt, trib, trac, case=case):
             if progress:
                 progress(case, label)
             return ts.run_case(case, dt, tribology_period_s=trib, traction_period_s=trac)

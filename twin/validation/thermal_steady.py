@@ -56,8 +56,9 @@ def steady_state(twin: Twin, *, settle_s: float = 0.1, tolerance_k: float = 0.1,
     ambient = th.ambient_c
     temps = np.full(len(NODE_NAMES), ambient + start_rise_k)
     twin.hold_thermal_state(temps)
-    converged, it = False, 0
-    for it in range(1, max_iterations + 1):
+    converged, iterations = False, 0
+    for iteration in range(1, max_iterations + 1):
+        iterations = iteration
         twin.advance(settle_s)
         if th.network is None:
             raise ValueError(f"settle_s = {settle_s!r}: shorter than the network step (ModelOptions.thermal_period_s)")
@@ -73,7 +74,7 @@ def steady_state(twin: Twin, *, settle_s: float = 0.1, tolerance_k: float = 0.1,
     speed = snap.shaft_speed_rad_s
     return SteadyState({n: float(t) for n, t in zip(NODE_NAMES, temps)}, float(th.inlet_temperature_c),
                        th.heat.total_w / speed if speed > 0.0 else 0.0, th.heat, float(snap.viscosity_pa_s),
-                       min(lams) if lams else None, th.expansion.diametral_clearance_change_m, it, converged,
+                       min(lams) if lams else None, th.expansion.diametral_clearance_change_m, iterations, converged,
                        tuple(float(x) for x in th.time_constants_s()))
 
 

@@ -149,7 +149,6 @@ def run_case(case: Case, time_step_s: float | Literal["auto"], **options) -> _Ru
     revolutions = max(1, math.ceil(MIN_WINDOW_S / period - 1e-9))
     total_steps = int(round(revolutions * period / dt))
     n_samples = SAMPLES_PER_REVOLUTION * revolutions
-    z = twin.model.ball_count
     b = AZIMUTH_BINS
     load_sum = np.zeros((2, b))
     count = np.zeros((2, b))

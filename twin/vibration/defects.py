@@ -51,7 +51,7 @@ rigid-body text).
 from __future__ import annotations
 
 import math
-from typing import Annotated, Literal, Union
+from typing import Annotated, Literal
 
 import numpy as np
 from numba import njit
@@ -103,7 +103,7 @@ class _Pit(BaseModel):
                                  description="Radius of the rounded edges [m]; 0 = sharp edges.")
 
     @model_validator(mode="after")
-    def _edges(self) -> "_Pit":
+    def _edges(self) -> _Pit:
         half = 0.5 * min(self.width_m, self.length_m)
         if self.edge_radius_m > half:
             raise ValueError(f"edge_radius_m = {self.edge_radius_m:g} m: must be in [0, {half:g}] m "
@@ -119,7 +119,7 @@ class OuterRaceSpall(_Pit):
                                description="Azimuth of the spall centre [deg] from +x (load direction) about +z.")
 
     @model_validator(mode="after")
-    def _fits(self, info: ValidationInfo) -> "OuterRaceSpall":
+    def _fits(self, info: ValidationInfo) -> OuterRaceSpall:
         _check_race(self, info, outer=True)
         return self
 
@@ -134,7 +134,7 @@ class InnerRaceSpall(_Pit):
         "is at azimuth 0 when the shaft angle is 0), about +z.")
 
     @model_validator(mode="after")
-    def _fits(self, info: ValidationInfo) -> "InnerRaceSpall":
+    def _fits(self, info: ValidationInfo) -> InnerRaceSpall:
         _check_race(self, info, outer=False)
         return self
 
@@ -157,7 +157,7 @@ class BallDefect(_Pit):
         return (math.sin(t) * math.cos(p), math.sin(t) * math.sin(p), math.cos(t))
 
     @model_validator(mode="after")
-    def _fits(self, info: ValidationInfo) -> "BallDefect":
+    def _fits(self, info: ValidationInfo) -> BallDefect:
         geometry = _geometry(info)
         if geometry is None:
             return self
@@ -174,7 +174,7 @@ class BallDefect(_Pit):
         return self
 
 
-Defect = Annotated[Union[OuterRaceSpall, InnerRaceSpall, BallDefect], Field(discriminator="kind")]
+Defect = Annotated[OuterRaceSpall | InnerRaceSpall | BallDefect, Field(discriminator="kind")]
 _DEFECT = TypeAdapter(Defect)
 _DEFECTS = TypeAdapter(list[Defect])
 

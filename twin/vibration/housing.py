@@ -145,7 +145,7 @@ class Housing(BaseModel):
     accelerometer: Accelerometer = Accelerometer()
 
     @model_validator(mode="after")
-    def _resonance_in_band(self) -> "Housing":
+    def _resonance_in_band(self) -> Housing:
         if not self.enabled:  # no signal is sampled
             return self
         f = sensor_resonance(self)[0]
