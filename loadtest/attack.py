@@ -56,14 +56,20 @@ from typing import Any
 from loadtest import attack_watchers
 from service.keys import DEFAULT_PREFIX
 from service.settings import ZenohAccessSettings
-from service.tools.client import (TargetConfig, add_target_arguments, check_loopback, strict_json,
-                                  target_arguments, url_is_loopback)
+from service.tools.client import (
+    TargetConfig,
+    add_target_arguments,
+    check_loopback,
+    strict_json,
+    target_arguments,
+    url_is_loopback,
+)
 
 MAX_SECONDS = 600.0
 MAX_CONCURRENCY = 64
 TARGET_RTF = 0.95
 TARGET_HEALTH_P99_MS = 100.0
-_OVER_CAP = 70 * 1024          # a body just above the default 64 KiB cap
+_OVER_CAP = 70 * 1024  # a body just above the default 64 KiB cap
 
 
 @dataclass
@@ -76,9 +82,9 @@ class AttackConfig(TargetConfig):
     zenoh_rate_hz: float = 500.0
     baseline_s: float = 3.0
     probe_every_s: float = 0.05
-    opcua_url: str | None = None          # OPC UA endpoint of the service (loopback), None: no OPC UA floods
-    squat: bool = True                     # with zenoh: the twin-id squatting
-    record: bool = field(default=False, kw_only=True)   # with start: off by default (the figures are the API's)
+    opcua_url: str | None = None  # OPC UA endpoint of the service (loopback), None: no OPC UA floods
+    squat: bool = True  # with zenoh: the twin-id squatting
+    record: bool = field(default=False, kw_only=True)  # with start: off by default (the figures are the API's)
 
 
 def _percentile(values: list[float], q: float) -> float | None:
@@ -90,9 +96,28 @@ def _percentile(values: list[float], q: float) -> float | None:
 
 
 # ---- the HTTP floods (child processes) ---------------------------------------------------------
-_KINDS = ("valid", "valid", "nan", "inf", "range", "type", "unknown-field", "garbage", "malformed", "big",
-          "no-token", "wrong-token", "unknown-twin", "unknown-path", "bad-method", "create-invalid",
-          "delete-unknown", "state", "state", "bearings")
+_KINDS = (
+    "valid",
+    "valid",
+    "nan",
+    "inf",
+    "range",
+    "type",
+    "unknown-field",
+    "garbage",
+    "malformed",
+    "big",
+    "no-token",
+    "wrong-token",
+    "unknown-twin",
+    "unknown-path",
+    "bad-method",
+    "create-invalid",
+    "delete-unknown",
+    "state",
+    "state",
+    "bearings",
+)
 
 
 class _Deck:
@@ -111,8 +136,9 @@ class _Deck:
         return self.cards.pop()
 
 
-def _hostile_request(rng: random.Random, bid: str, token: str | None, valid: dict,
-                     kind: str | None = None) -> tuple[str, str, str, bytes | None, dict, bool | None]:
+def _hostile_request(
+    rng: random.Random, bid: str, token: str | None, valid: dict, kind: str | None = None
+) -> tuple[str, str, str, bytes | None, dict, bool | None]:
     """(kind, method, path, body, headers, valid?) of one flood request (`kind`: one of `_KINDS`,
     default a random one): valid True = a valid setpoint (200 or 429 expected), False = hostile
     (4xx expected), None = a read (200 or 4xx)."""
@@ -122,10 +148,15 @@ def _hostile_request(rng: random.Random, bid: str, token: str | None, valid: dic
     kind = kind or rng.choice(_KINDS)
     if kind == "valid":
         return kind, "PUT", sp, json.dumps(valid).encode(), {**auth, **js}, True
-    bodies = {"nan": b'{"shaft_speed_rad_s": NaN}', "inf": b'{"radial_load_n": Infinity}',
-              "range": b'{"shaft_speed_rad_s": 1e9}', "type": b'{"radial_load_n": "three thousand"}',
-              "unknown-field": b'{"warp_factor": 9}', "malformed": b'{"radial_load_n": 3000',
-              "garbage": bytes(rng.randrange(256) for _ in range(40))}
+    bodies = {
+        "nan": b'{"shaft_speed_rad_s": NaN}',
+        "inf": b'{"radial_load_n": Infinity}',
+        "range": b'{"shaft_speed_rad_s": 1e9}',
+        "type": b'{"radial_load_n": "three thousand"}',
+        "unknown-field": b'{"warp_factor": 9}',
+        "malformed": b'{"radial_load_n": 3000',
+        "garbage": bytes(rng.randrange(256) for _ in range(40)),
+    }
     if kind in bodies:
         return kind, "PUT", sp, bodies[kind], {**auth, **js}, False
     if kind == "big":
@@ -133,18 +164,45 @@ def _hostile_request(rng: random.Random, bid: str, token: str | None, valid: dic
     if kind == "no-token":
         return kind, "PUT", sp, json.dumps(valid).encode(), js, not token
     if kind == "wrong-token":
-        return (kind, "PUT", sp, json.dumps(valid).encode(),
-                {"Authorization": "Bearer wrong-" + secrets.token_hex(4), **js}, not token)
+        return (
+            kind,
+            "PUT",
+            sp,
+            json.dumps(valid).encode(),
+            {"Authorization": "Bearer wrong-" + secrets.token_hex(4), **js},
+            not token,
+        )
     if kind == "unknown-twin":
-        return kind, "PUT", f"/v1/bearings/no-such-{rng.randrange(10**6)}/setpoint", json.dumps(valid).encode(), {**auth, **js}, False
+        return (
+            kind,
+            "PUT",
+            f"/v1/bearings/no-such-{rng.randrange(10**6)}/setpoint",
+            json.dumps(valid).encode(),
+            {**auth, **js},
+            False,
+        )
     if kind == "unknown-path":
-        return kind, "GET", rng.choice(["/v1/nothing", "/admin", "/v1/bearings/%00/state", "/../../etc/passwd",
-                                        "/v1/bearings/" + "a" * 300]), None, {}, False
+        return (
+            kind,
+            "GET",
+            rng.choice(
+                ["/v1/nothing", "/admin", "/v1/bearings/%00/state", "/../../etc/passwd", "/v1/bearings/" + "a" * 300]
+            ),
+            None,
+            {},
+            False,
+        )
     if kind == "bad-method":
         return kind, rng.choice(["DELETE", "PATCH", "POST"]), "/health", b"{}", js, False
     if kind == "create-invalid":
-        body = rng.choice([b'{"id": "x y", "designation": "6208"}', b'{"id": "ok1", "designation": "9999"}',
-                           b'{"designation": 6208, "id": []}', b"[]"])
+        body = rng.choice(
+            [
+                b'{"id": "x y", "designation": "6208"}',
+                b'{"id": "ok1", "designation": "9999"}',
+                b'{"designation": 6208, "id": []}',
+                b"[]",
+            ]
+        )
         return kind, "POST", "/v1/bearings", body, {**auth, **js}, False
     if kind == "delete-unknown":
         return kind, "DELETE", f"/v1/bearings/no-such-{rng.randrange(10**6)}", None, auth, False
@@ -183,13 +241,19 @@ async def _http_flood_async(spec: dict, go) -> dict:
             headers: dict
             while time.monotonic() < end:
                 if mode == "reads":
-                    kind, method, path, body, headers, valid = ("read", "GET", f"/v1/bearings/{bid}/state",
-                                                                None, {}, None)
+                    kind, method, path, body, headers, valid = (
+                        "read",
+                        "GET",
+                        f"/v1/bearings/{bid}/state",
+                        None,
+                        {},
+                        None,
+                    )
                 else:
-                    setpoint = {n: round(rng.uniform(lo, hi), 3) for n, (lo, hi) in ranges.items()
-                                if rng.random() < 0.6} or {"oil_temperature_c": 40.0}
-                    kind, method, path, body, headers, valid = _hostile_request(rng, bid, token, setpoint,
-                                                                                deck.deal())
+                    setpoint = {
+                        n: round(rng.uniform(lo, hi), 3) for n, (lo, hi) in ranges.items() if rng.random() < 0.6
+                    } or {"oil_temperature_c": 40.0}
+                    kind, method, path, body, headers, valid = _hostile_request(rng, bid, token, setpoint, deck.deal())
                 kinds[kind] += 1
                 try:
                     r = await client.request(method, path, content=body, headers=headers)
@@ -220,8 +284,16 @@ async def _http_flood_async(spec: dict, go) -> dict:
 
         await asyncio.gather(*(worker() for _ in range(workers)))
         elapsed, cpu = time.monotonic() - t0, time.process_time() - cpu0
-    return {"mode": mode, "workers": workers, "seconds": round(elapsed, 2), "cpu_s": round(cpu, 2), "status": dict(status),
-            "kinds": dict(kinds), "counts": dict(counts), "unexpected": unexpected}
+    return {
+        "mode": mode,
+        "workers": workers,
+        "seconds": round(elapsed, 2),
+        "cpu_s": round(cpu, 2),
+        "status": dict(status),
+        "kinds": dict(kinds),
+        "counts": dict(counts),
+        "unexpected": unexpected,
+    }
 
 
 # ---- the zenoh flood (child process) -----------------------------------------------------------
@@ -238,8 +310,7 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
     from service.bus.access import ZenohAccess
     from service.bus.zenoh_bus import client_config
 
-    access = (ZenohAccess(user=spec["user"], password=spec["password"]) if spec.get("user")
-              else ZenohAccess.from_env())
+    access = ZenohAccess(user=spec["user"], password=spec["password"]) if spec.get("user") else ZenohAccess.from_env()
     prefix, bid = spec["prefix"], spec["bearing_id"]
     rng = random.Random(spec["seed"])
     lock = threading.Lock()
@@ -250,7 +321,7 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
         try:
             msg = strict_json(sample.payload.to_bytes())
             key = "accepted" if msg.get("accepted") else f"refused_{msg.get('status', 'other')}"
-        except Exception:   # noqa: BLE001
+        except Exception:  # noqa: BLE001
             key = "unreadable"
         with lock:
             results[key] += 1
@@ -261,7 +332,7 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
             bad = 0
         except ValueError:
             bad = 1
-        except Exception:   # noqa: BLE001
+        except Exception:  # noqa: BLE001
             bad = 0
         with lock:
             state["messages"] += 1
@@ -270,16 +341,22 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
     session = zenoh.open(client_config([spec["endpoint"]], access=access, prefix=prefix))
     sent = 0
     try:
-        subs = [session.declare_subscriber(f"{prefix}/{bid}/setpoint/result", on_result),
-                session.declare_subscriber(f"{prefix}/{bid}/state", on_state)]
-        pub = session.declare_publisher(f"{prefix}/{bid}/setpoint",
-                                        congestion_control=zenoh.CongestionControl.BLOCK)
-        time.sleep(0.5)      # routes
+        subs = [
+            session.declare_subscriber(f"{prefix}/{bid}/setpoint/result", on_result),
+            session.declare_subscriber(f"{prefix}/{bid}/state", on_state),
+        ]
+        pub = session.declare_publisher(f"{prefix}/{bid}/setpoint", congestion_control=zenoh.CongestionControl.BLOCK)
+        time.sleep(0.5)  # routes
         go.wait(120.0)
         t0, cpu0 = time.monotonic(), time.process_time()
         end, period, next_t = t0 + spec["seconds"], 1.0 / spec["rate_hz"], t0
-        payloads = [b'{"shaft_speed_rad_s": NaN}', b'{"radial_load_n": -5}', b'{"warp": 1}', b"\xff\xfe",
-                    b'{"shaft_speed_rad_s": 400.0, "token": "x"}']
+        payloads = [
+            b'{"shaft_speed_rad_s": NaN}',
+            b'{"radial_load_n": -5}',
+            b'{"warp": 1}',
+            b"\xff\xfe",
+            b'{"shaft_speed_rad_s": 400.0, "token": "x"}',
+        ]
         while time.monotonic() < end:
             if rng.random() < 0.5:
                 pub.put(json.dumps({"oil_temperature_c": round(rng.uniform(30.0, 60.0), 2)}).encode())
@@ -293,7 +370,7 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
             elif delay < -1.0:
                 next_t = time.monotonic()
         elapsed, cpu = time.monotonic() - t0, time.process_time() - cpu0
-        deadline = time.monotonic() + 5.0         # the last results
+        deadline = time.monotonic() + 5.0  # the last results
         while time.monotonic() < deadline:
             with lock:
                 if sum(results.values()) >= sent:
@@ -306,10 +383,16 @@ def _zenoh_flood_run(spec: dict, go) -> dict:
         session.close()
     with lock:
         answered = sum(results.values())
-        return {"mode": "zenoh", "seconds": round(elapsed, 2), "cpu_s": round(cpu, 2), "sent": sent,
-                "results": dict(results),
-                "unanswered": max(0, sent - answered), "state_messages": state["messages"],
-                "non_finite": state["non_finite"]}
+        return {
+            "mode": "zenoh",
+            "seconds": round(elapsed, 2),
+            "cpu_s": round(cpu, 2),
+            "sent": sent,
+            "results": dict(results),
+            "unanswered": max(0, sent - answered),
+            "state_messages": state["messages"],
+            "non_finite": state["non_finite"],
+        }
 
 
 # ---- this process: the /health probe -----------------------------------------------------------
@@ -328,7 +411,7 @@ def _probe(client, url: str, bid: str, seconds: float, every_s: float, t_ref: fl
             tw = next((x for x in r.json().get("twins", []) if x.get("id") == bid), None)
             if tw is not None:
                 rec["rtf"], rec["late"] = tw.get("real_time_factor"), tw.get("late_fraction")
-        except Exception:   # noqa: BLE001 - a failed probe is counted (ok False)
+        except Exception:  # noqa: BLE001 - a failed probe is counted (ok False)
             pass
         out.append(rec)
         time.sleep(max(0.0, every_s - (time.monotonic() - t)))
@@ -342,12 +425,17 @@ def _probe_figures(probes: list[dict]) -> dict:
 
     def r(x, n=2):
         return round(x, n) if x is not None else None
-    return {"probes": len(probes), "failed": sum(1 for p in probes if not p["ok"]),
-            "health_p50_ms": r(_percentile(ms, 50)), "health_p99_ms": r(_percentile(ms, 99)),
-            "health_max_ms": r(max(ms) if ms else None),
-            "real_time_factor_median": r(statistics.median(rtf) if rtf else None, 4),
-            "real_time_factor_min": r(min(rtf) if rtf else None, 4),
-            "late_fraction_last": r(late[-1] if late else None, 4)}
+
+    return {
+        "probes": len(probes),
+        "failed": sum(1 for p in probes if not p["ok"]),
+        "health_p50_ms": r(_percentile(ms, 50)),
+        "health_p99_ms": r(_percentile(ms, 99)),
+        "health_max_ms": r(max(ms) if ms else None),
+        "real_time_factor_median": r(statistics.median(rtf) if rtf else None, 4),
+        "real_time_factor_min": r(min(rtf) if rtf else None, 4),
+        "late_fraction_last": r(late[-1] if late else None, 4),
+    }
 
 
 def run_attack(cfg: AttackConfig) -> dict:
@@ -373,8 +461,13 @@ def run_attack(cfg: AttackConfig) -> dict:
     if cfg.start and token is None:
         token = secrets.token_urlsafe(24)
     url, zenoh_endpoint = cfg.url.rstrip("/"), cfg.zenoh_connect
-    report: dict[str, Any] = {"seconds": cfg.seconds, "started_service": cfg.start, "bearing_id": cfg.bearing_id,
-                              "concurrency": cfg.concurrency, "readers": cfg.readers}
+    report: dict[str, Any] = {
+        "seconds": cfg.seconds,
+        "started_service": cfg.start,
+        "bearing_id": cfg.bearing_id,
+        "concurrency": cfg.concurrency,
+        "readers": cfg.readers,
+    }
     client = httpx.Client(timeout=30.0)
     ctx = mp.get_context("spawn")
     procs: list = []
@@ -384,8 +477,9 @@ def run_attack(cfg: AttackConfig) -> dict:
             from loadtest.soak import _Started
 
             assert token is not None  # generated above when the attack starts the service
-            started = _Started(token, None, lambda line: log(line.replace("soak: ", "attack: ", 1)),
-                               record=cfg.record, opcua=True)
+            started = _Started(
+                token, None, lambda line: log(line.replace("soak: ", "attack: ", 1)), record=cfg.record, opcua=True
+            )
             url, zenoh_endpoint = started.url, started.zenoh_endpoint
             zuser, zpass = started.zenoh_user, started.zenoh_password
             started.wait_ready(client)
@@ -403,24 +497,39 @@ def run_attack(cfg: AttackConfig) -> dict:
         baseline = _probe(client, url, cfg.bearing_id, cfg.baseline_s, cfg.probe_every_s, t_ref)
 
         go, out = ctx.Event(), ctx.Queue()
-        common = {"url": url, "bearing_id": cfg.bearing_id, "token": token, "seconds": cfg.seconds,
-                  "ranges": ranges}
-        specs: list[tuple[Callable[..., Any], dict[str, Any]]] = [(_http_flood, {**common, "mode": "hostile", "workers": cfg.concurrency, "seed": rng.randrange(2**32)})]
+        common = {"url": url, "bearing_id": cfg.bearing_id, "token": token, "seconds": cfg.seconds, "ranges": ranges}
+        specs: list[tuple[Callable[..., Any], dict[str, Any]]] = [
+            (_http_flood, {**common, "mode": "hostile", "workers": cfg.concurrency, "seed": rng.randrange(2**32)})
+        ]
         if cfg.readers:
-            specs.append((_http_flood, {**common, "mode": "reads", "token": None, "workers": cfg.readers,
-                                        "seed": rng.randrange(2**32)}))
+            specs.append(
+                (
+                    _http_flood,
+                    {**common, "mode": "reads", "token": None, "workers": cfg.readers, "seed": rng.randrange(2**32)},
+                )
+            )
         if zenoh_endpoint:
-            specs.append((_zenoh_flood, {"endpoint": zenoh_endpoint, "bearing_id": cfg.bearing_id,
-                                         "prefix": DEFAULT_PREFIX if started is not None else
-                                         ZenohAccessSettings().zenoh.prefix,
-                                         "user": zuser, "password": zpass, "seconds": cfg.seconds,
-                                         "rate_hz": cfg.zenoh_rate_hz, "seed": rng.randrange(2**32)}))
+            specs.append(
+                (
+                    _zenoh_flood,
+                    {
+                        "endpoint": zenoh_endpoint,
+                        "bearing_id": cfg.bearing_id,
+                        "prefix": DEFAULT_PREFIX if started is not None else ZenohAccessSettings().zenoh.prefix,
+                        "user": zuser,
+                        "password": zpass,
+                        "seconds": cfg.seconds,
+                        "rate_hz": cfg.zenoh_rate_hz,
+                        "seed": rng.randrange(2**32),
+                    },
+                )
+            )
         specs += attack_watchers.specs(cfg, started, url, zenoh_endpoint, token)
         for target, spec in specs:
             p = ctx.Process(target=target, args=(spec, go, out), daemon=True)
             p.start()
             procs.append(p)
-        time.sleep(3.0)            # the children import httpx / zenoh and connect
+        time.sleep(3.0)  # the children import httpx / zenoh and connect
         log(f"attack: {cfg.seconds:g} s of floods ({', '.join(s.get('mode', 'zenoh') for _, s in specs)})")
         flood_start = time.monotonic()
         go.set()
@@ -430,7 +539,7 @@ def run_attack(cfg: AttackConfig) -> dict:
         while len(parts) < len(specs) and time.monotonic() < deadline:
             try:
                 part = out.get(timeout=1.0)
-            except Exception:   # noqa: BLE001 - queue.Empty
+            except Exception:  # noqa: BLE001 - queue.Empty
                 continue
             parts[part.get("mode", "?")] = part
         settled = [p for p in during if p["t"] >= flood_start - t_ref + 1.0] or during
@@ -443,11 +552,18 @@ def run_attack(cfg: AttackConfig) -> dict:
             report[name] = parts.get(name)
         report["missing_parts"] = [s.get("mode", "zenoh") for _, s in specs if s.get("mode", "zenoh") not in parts]
         health = client.get(f"{url}/health").json()
-        report["service"] = {"status": health.get("status"), "http_tarpit": health.get("http_tarpit"),
-                             "thread_priority": health.get("thread_priority"),
-                             "twins": [{k: t.get(k) for k in ("id", "real_time_factor", "late_fraction",
-                                                              "errors", "restarts", "overruns", "frames")}
-                                       for t in health.get("twins", [])]}
+        report["service"] = {
+            "status": health.get("status"),
+            "http_tarpit": health.get("http_tarpit"),
+            "thread_priority": health.get("thread_priority"),
+            "twins": [
+                {
+                    k: t.get(k)
+                    for k in ("id", "real_time_factor", "late_fraction", "errors", "restarts", "overruns", "frames")
+                }
+                for t in health.get("twins", [])
+            ],
+        }
         if started is not None:
             report["shutdown"] = started.stop()
     finally:
@@ -480,15 +596,26 @@ def _totals(report: dict) -> None:
             part["rate_hz"] = round(sum((part.get("status") or {}).values()) / part["seconds"], 1)
     z = report.get("zenoh_flood") or {}
     cpu = {}
-    for name in ("http_flood", "read_flood", "zenoh_flood"):     # the attackers' own CPU [cores]: taken from the twin too
+    for name in ("http_flood", "read_flood", "zenoh_flood"):  # the attackers' own CPU [cores]: taken from the twin too
         part = report.get(name) or {}
         if part.get("seconds") and part.get("cpu_s") is not None:
             cpu[name] = round(part["cpu_s"] / part["seconds"], 3)
     report["attacker_cpu_cores"] = {**cpu, "total": round(sum(cpu.values()), 3)} if cpu else None
     totals["nan_checked"] += z.get("state_messages", 0)
     totals["non_finite"] += z.get("non_finite", 0)
-    report["totals"] = {k: totals.get(k, 0) for k in ("2xx", "4xx", "5xx", "transport_errors", "valid_refused",
-                                                       "hostile_accepted", "nan_checked", "non_finite")}
+    report["totals"] = {
+        k: totals.get(k, 0)
+        for k in (
+            "2xx",
+            "4xx",
+            "5xx",
+            "transport_errors",
+            "valid_refused",
+            "hostile_accepted",
+            "nan_checked",
+            "non_finite",
+        )
+    }
     if z:
         report["totals"]["zenoh_sent"] = z.get("sent", 0)
         report["totals"]["zenoh_unanswered"] = z.get("unanswered", 0)
@@ -519,62 +646,88 @@ def _verdict(report: dict) -> None:
     report["failures"] = failures
     report["ok"] = not failures
     rtf, p99 = f.get("real_time_factor_median"), f.get("health_p99_ms")
-    report["targets"] = {"real_time_factor_median_min": TARGET_RTF, "health_p99_ms_max": TARGET_HEALTH_P99_MS,
-                         "real_time_factor_median": rtf, "health_p99_ms": p99,
-                         "met": bool(rtf is not None and p99 is not None and rtf >= TARGET_RTF
-                                     and p99 <= TARGET_HEALTH_P99_MS)}
+    report["targets"] = {
+        "real_time_factor_median_min": TARGET_RTF,
+        "health_p99_ms_max": TARGET_HEALTH_P99_MS,
+        "real_time_factor_median": rtf,
+        "health_p99_ms": p99,
+        "met": bool(rtf is not None and p99 is not None and rtf >= TARGET_RTF and p99 <= TARGET_HEALTH_P99_MS),
+    }
 
 
 def format_report(r: dict) -> str:
     b, f, t = r.get("baseline") or {}, r.get("flood") or {}, r["totals"]
-    lines = [f"attack on {r.get('url')} for {r['seconds']:g} s (twin {r['bearing_id']}, HTTP concurrency "
-             f"{r['concurrency']}, {r['readers']} unauthenticated readers"
-             + (", zenoh flood" if r.get("zenoh_flood") else "") + ")"]
+    lines = [
+        f"attack on {r.get('url')} for {r['seconds']:g} s (twin {r['bearing_id']}, HTTP concurrency "
+        f"{r['concurrency']}, {r['readers']} unauthenticated readers"
+        + (", zenoh flood" if r.get("zenoh_flood") else "")
+        + ")"
+    ]
     for name, part in (("hostile HTTP", r.get("http_flood")), ("read flood", r.get("read_flood"))):
         if part and not part.get("crashed"):
-            lines.append(f"  {name}: {sum(part['status'].values())} answers at {part.get('rate_hz')} /s; "
-                         f"status {dict(sorted(part['status'].items()))}; transport errors "
-                         f"{part['counts'].get('transport_errors', 0)}")
+            lines.append(
+                f"  {name}: {sum(part['status'].values())} answers at {part.get('rate_hz')} /s; "
+                f"status {dict(sorted(part['status'].items()))}; transport errors "
+                f"{part['counts'].get('transport_errors', 0)}"
+            )
     z = r.get("zenoh_flood")
     if z and not z.get("crashed"):
         lines.append(f"  zenoh: {z['sent']} setpoints, results {z['results']}, unanswered {z['unanswered']}")
-    lines.append(f"  totals: 2xx {t['2xx']}, 4xx {t['4xx']}, 5xx {t['5xx']}; NaN checks {t['nan_checked']}, "
-                 f"non-finite {t['non_finite']}")
+    lines.append(
+        f"  totals: 2xx {t['2xx']}, 4xx {t['4xx']}, 5xx {t['5xx']}; NaN checks {t['nan_checked']}, "
+        f"non-finite {t['non_finite']}"
+    )
     if r.get("attacker_cpu_cores"):
         lines.append(f"  attackers' own CPU [cores]: {r['attacker_cpu_cores']}")
     lines += attack_watchers.summary_lines(r)
     tarpit = (r.get("service") or {}).get("http_tarpit")
     if tarpit:
-        lines.append(f"  tarpit: {tarpit.get('held', 0)} refusals held {tarpit.get('delay_s')} s, "
-                     f"{tarpit.get('answered_at_once', 0)} answered at once")
-    lines.append(f"  idle:  real-time factor median {b.get('real_time_factor_median')}, /health p50 "
-                 f"{b.get('health_p50_ms')} ms, p99 {b.get('health_p99_ms')} ms")
-    lines.append(f"  flood: real-time factor median {f.get('real_time_factor_median')} (min "
-                 f"{f.get('real_time_factor_min')}), /health p50 {f.get('health_p50_ms')} ms, p99 "
-                 f"{f.get('health_p99_ms')} ms, max {f.get('health_max_ms')} ms")
+        lines.append(
+            f"  tarpit: {tarpit.get('held', 0)} refusals held {tarpit.get('delay_s')} s, "
+            f"{tarpit.get('answered_at_once', 0)} answered at once"
+        )
+    lines.append(
+        f"  idle:  real-time factor median {b.get('real_time_factor_median')}, /health p50 "
+        f"{b.get('health_p50_ms')} ms, p99 {b.get('health_p99_ms')} ms"
+    )
+    lines.append(
+        f"  flood: real-time factor median {f.get('real_time_factor_median')} (min "
+        f"{f.get('real_time_factor_min')}), /health p50 {f.get('health_p50_ms')} ms, p99 "
+        f"{f.get('health_p99_ms')} ms, max {f.get('health_max_ms')} ms"
+    )
     tg = r["targets"]
-    lines.append(f"  targets (median RTF >= {tg['real_time_factor_median_min']}, /health p99 <= "
-                 f"{tg['health_p99_ms_max']:g} ms): {'met' if tg['met'] else 'NOT met'}")
+    lines.append(
+        f"  targets (median RTF >= {tg['real_time_factor_median_min']}, /health p99 <= "
+        f"{tg['health_p99_ms_max']:g} ms): {'met' if tg['met'] else 'NOT met'}"
+    )
     lines.append("  OK" if r["ok"] else "  FAILED: " + "; ".join(r["failures"]))
     return "\n".join(lines)
 
 
 def add_attack_command(sub) -> None:
-    p = sub.add_parser("attack", help="bounded loopback abuse run: hostile HTTP flood, read flood, optional "
-                       "zenoh flood; real-time factor and /health latency under load",
-                       description=__doc__.split("\n\n")[0])
+    p = sub.add_parser(
+        "attack",
+        help="bounded loopback abuse run: hostile HTTP flood, read flood, optional "
+        "zenoh flood; real-time factor and /health latency under load",
+        description=__doc__.split("\n\n")[0],
+    )
     p.add_argument("--seconds", type=float, required=True, help=f"length of the floods [s] (<= {MAX_SECONDS:g})")
     add_target_arguments(
-        p, url_help="service URL, loopback only (ignored with --start)",
+        p,
+        url_help="service URL, loopback only (ignored with --start)",
         zenoh_help="zenoh endpoint of the service for the zenoh flood, loopback only (credentials: "
         "BEARING_TWIN_ZENOH_USER / _PASSWORD)",
         start_help="launch an own `bearing-twin serve` on free loopback ports (token, zenoh access control, no "
         "recording unless --record) and flood zenoh too",
-        twin_help="twin to attack and measure (default `default`)")
+        twin_help="twin to attack and measure (default `default`)",
+    )
     p.add_argument("--record", action="store_true", help="with --start: the service records as `serve` does")
-    p.add_argument("--opcua", metavar="opc.tcp://127.0.0.1:PORT",
-                   help="OPC UA endpoint of the service for the login, session and subscription floods (loopback "
-                   "only; with --start: its own)")
+    p.add_argument(
+        "--opcua",
+        metavar="opc.tcp://127.0.0.1:PORT",
+        help="OPC UA endpoint of the service for the login, session and subscription floods (loopback "
+        "only; with --start: its own)",
+    )
     p.add_argument("--no-squat", action="store_true", help="no zenoh twin-id squatting")
     p.add_argument("--concurrency", type=int, default=32, help="hostile HTTP requests in flight (default 32)")
     p.add_argument("--readers", type=int, default=4, help="unauthenticated GET state readers (default 4; 0: none)")
@@ -586,10 +739,18 @@ def add_attack_command(sub) -> None:
 
 
 def _cmd_attack(args) -> int:
-    cfg = AttackConfig(seconds=args.seconds, **target_arguments(args), concurrency=args.concurrency,
-                       readers=args.readers, zenoh_rate_hz=args.zenoh_rate, baseline_s=args.baseline,
-                       record=args.record, opcua_url=args.opcua, squat=not args.no_squat,
-                       log=lambda line: print(line, file=sys.stderr, flush=True))
+    cfg = AttackConfig(
+        seconds=args.seconds,
+        **target_arguments(args),
+        concurrency=args.concurrency,
+        readers=args.readers,
+        zenoh_rate_hz=args.zenoh_rate,
+        baseline_s=args.baseline,
+        record=args.record,
+        opcua_url=args.opcua,
+        squat=not args.no_squat,
+        log=lambda line: print(line, file=sys.stderr, flush=True),
+    )
     try:
         report = run_attack(cfg)
     except (RuntimeError, ValueError) as exc:

@@ -29,7 +29,7 @@ from typing import Any
 from service.keys import DEFAULT_PREFIX
 from service.settings import ZenohAccessSettings
 
-FORGED_HOST = "evil-squatter"        # the forged owner text; never to be found in an answer
+FORGED_HOST = "evil-squatter"  # the forged owner text; never to be found in an answer
 WATCHERS = ("squat", "opcua_logins", "opcua_sessions", "opcua_subscriptions")
 
 
@@ -37,17 +37,35 @@ def specs(cfg: Any, started: Any, url: str, zenoh_endpoint: str | None, token: s
     """(target, spec) of each flood of this module the attack `cfg` asks for (a child process each)."""
     specs = []
     if cfg.squat and zenoh_endpoint:
-        specs.append((run_part, {"mode": "squat", "flood": squat, "url": url, "token": token,
-                                   "endpoint": zenoh_endpoint, "seconds": cfg.seconds, "max_ids": 3,
-                                   "prefix": DEFAULT_PREFIX if started is not None else
-                                   ZenohAccessSettings().zenoh.prefix}))
+        specs.append(
+            (
+                run_part,
+                {
+                    "mode": "squat",
+                    "flood": squat,
+                    "url": url,
+                    "token": token,
+                    "endpoint": zenoh_endpoint,
+                    "seconds": cfg.seconds,
+                    "max_ids": 3,
+                    "prefix": DEFAULT_PREFIX if started is not None else ZenohAccessSettings().zenoh.prefix,
+                },
+            )
+        )
     opcua_url = started.opcua_url if started is not None else cfg.opcua_url
     if opcua_url:
-        common = {"flood": opcua, "url": opcua_url, "seconds": cfg.seconds, "bearing_id": cfg.bearing_id,
-                  "secure": started is not None or bool(token)}
-        specs += [(run_part, {**common, "mode": "opcua_logins"}),
-                  (run_part, {**common, "mode": "opcua_sessions", "max_sessions": 200}),
-                  (run_part, {**common, "mode": "opcua_subscriptions", "subscriptions": 50, "items": 100})]
+        common = {
+            "flood": opcua,
+            "url": opcua_url,
+            "seconds": cfg.seconds,
+            "bearing_id": cfg.bearing_id,
+            "secure": started is not None or bool(token),
+        }
+        specs += [
+            (run_part, {**common, "mode": "opcua_logins"}),
+            (run_part, {**common, "mode": "opcua_sessions", "max_sessions": 200}),
+            (run_part, {**common, "mode": "opcua_subscriptions", "subscriptions": 50, "items": 100}),
+        ]
     return specs
 
 
@@ -70,7 +88,7 @@ def squat(spec: dict, go) -> dict:
     prefix, url, token = spec["prefix"], spec["url"], spec["token"]
     headers = {"Authorization": f"Bearer {token}"} if token else {}
     counts: collections.Counter = collections.Counter()
-    try:                                     # no credentials: refused where zenoh access control is on
+    try:  # no credentials: refused where zenoh access control is on
         session = zenoh.open(client_config([spec["endpoint"]], access=ZenohAccess(), prefix=prefix))
     except Exception:  # noqa: BLE001 - the link was refused: the creates run without a claim
         session = None
@@ -81,8 +99,16 @@ def squat(spec: dict, go) -> dict:
             while time.monotonic() - t0 < spec["seconds"] and counts["attempts"] < spec["max_ids"]:
                 bid = f"squat-{secrets.token_hex(3)}"
                 key = f"{prefix}/{bid}"
-                forged = json.dumps({"key": key, "bearing_id": bid, "pid": 1, "host": FORGED_HOST,
-                                     "http": f"http://{FORGED_HOST}", "zid": "0"})
+                forged = json.dumps(
+                    {
+                        "key": key,
+                        "bearing_id": bid,
+                        "pid": 1,
+                        "host": FORGED_HOST,
+                        "http": f"http://{FORGED_HOST}",
+                        "zid": "0",
+                    }
+                )
                 token_ = owner = None
                 if session is not None:
                     token_ = session.liveliness().declare_token(f"{key}/alive")
@@ -90,8 +116,13 @@ def squat(spec: dict, go) -> dict:
                 time.sleep(0.2)
                 counts["attempts"] += 1
                 r = http.post("/v1/bearings", json={"id": bid, "designation": "6208"})
-                counts["created" if r.status_code == 201 else "blocked" if r.status_code == 409
-                       else f"status_{r.status_code}"] += 1
+                counts[
+                    "created"
+                    if r.status_code == 201
+                    else "blocked"
+                    if r.status_code == 409
+                    else f"status_{r.status_code}"
+                ] += 1
                 counts["echoed"] += FORGED_HOST in r.text
                 if r.status_code == 201:
                     http.delete(f"/v1/bearings/{bid}")
@@ -101,10 +132,13 @@ def squat(spec: dict, go) -> dict:
     finally:
         if session is not None:
             session.close()
-    return {"mode": "squat", "seconds": round(time.monotonic() - t0, 2), "peer_linked": session is not None,
-            **{k: counts.get(k, 0) for k in
-            ("attempts", "created", "blocked", "echoed")}, "other": {k: v for k, v in counts.items()
-                                                                     if k.startswith("status_")}}
+    return {
+        "mode": "squat",
+        "seconds": round(time.monotonic() - t0, 2),
+        "peer_linked": session is not None,
+        **{k: counts.get(k, 0) for k in ("attempts", "created", "blocked", "echoed")},
+        "other": {k: v for k, v in counts.items() if k.startswith("status_")},
+    }
 
 
 # ---- OPC UA ------------------------------------------------------------------------------------
@@ -121,9 +155,13 @@ def _client_cert(folder: Path) -> tuple[str, str, str]:
 
     uri = "urn:bearing-twin-attack:client"
     key = cert_gen.generate_private_key()
-    cert = cert_gen.generate_self_signed_app_certificate(key, "attack", {"organizationName": "attack"},
-                                                         [x509.UniformResourceIdentifier(uri)],
-                                                         extended=[ExtendedKeyUsageOID.CLIENT_AUTH])
+    cert = cert_gen.generate_self_signed_app_certificate(
+        key,
+        "attack",
+        {"organizationName": "attack"},
+        [x509.UniformResourceIdentifier(uri)],
+        extended=[ExtendedKeyUsageOID.CLIENT_AUTH],
+    )
     cert_path, key_path = folder / "attack.der", folder / "attack-key.pem"
     cert_path.write_bytes(cert.public_bytes(serialization.Encoding.DER))
     key_path.write_bytes(cert_gen.dump_private_key_as_pem(key))
@@ -175,8 +213,13 @@ async def _logins(spec: dict, cert) -> dict:
         except Exception as exc:  # noqa: BLE001 - every refusal is counted by its status
             counts[f"refused_{_status_name(exc)}"] += 1
             c.disconnect_socket()
-    return {"mode": spec["mode"], "seconds": round(time.monotonic() - t0, 2), "tried": counts.pop("tried", 0),
-            "accepted": counts.pop("accepted", 0), "refused": dict(counts)}
+    return {
+        "mode": spec["mode"],
+        "seconds": round(time.monotonic() - t0, 2),
+        "tried": counts.pop("tried", 0),
+        "accepted": counts.pop("accepted", 0),
+        "refused": dict(counts),
+    }
 
 
 async def _sessions(spec: dict, cert) -> dict:
@@ -191,14 +234,18 @@ async def _sessions(spec: dict, cert) -> dict:
         except Exception as exc:  # noqa: BLE001
             refused[_status_name(exc)] += 1
             c.disconnect_socket()
-    await asyncio.sleep(max(0.0, spec["seconds"] - (time.monotonic() - t0)))     # hold them
+    await asyncio.sleep(max(0.0, spec["seconds"] - (time.monotonic() - t0)))  # hold them
     for c in opened:
         try:
             await c.disconnect()
         except Exception:  # noqa: BLE001 - the server may have dropped it
             pass
-    return {"mode": spec["mode"], "seconds": round(time.monotonic() - t0, 2), "opened": len(opened),
-            "refused": dict(refused)}
+    return {
+        "mode": spec["mode"],
+        "seconds": round(time.monotonic() - t0, 2),
+        "opened": len(opened),
+        "refused": dict(refused),
+    }
 
 
 class _Count:
@@ -221,9 +268,12 @@ async def _subscriptions(spec: dict, cert) -> dict:
     async with c:
         idx = await c.get_namespace_index(NAMESPACE_URI)
         twin = await c.nodes.objects.get_child([f"{idx}:{ROOT_FOLDER}", f"{idx}:{spec['bearing_id']}"])
-        nodes = [await twin.get_child([f"{idx}:{folder}", f"{idx}:{var.name}"])
-                 for folder, vars_ in FOLDERS.items() for var in vars_]
-        nodes = (nodes * (spec["items"] // max(1, len(nodes)) + 1))[:spec["items"]]
+        nodes = [
+            await twin.get_child([f"{idx}:{folder}", f"{idx}:{var.name}"])
+            for folder, vars_ in FOLDERS.items()
+            for var in vars_
+        ]
+        nodes = (nodes * (spec["items"] // max(1, len(nodes)) + 1))[: spec["items"]]
         for _ in range(spec["subscriptions"]):
             try:
                 sub = await c.create_subscription(1, counter)
@@ -235,11 +285,18 @@ async def _subscriptions(spec: dict, cert) -> dict:
             items += sum(isinstance(r, int) for r in results)
             refused["BadTooManyMonitoredItems"] += sum(not isinstance(r, int) for r in results)
         n0, t1 = counter.n, time.monotonic()
-        await asyncio.sleep(max(2.0, spec["seconds"] - (t1 - t0)))      # the rate over at least 2 s
+        await asyncio.sleep(max(2.0, spec["seconds"] - (t1 - t0)))  # the rate over at least 2 s
         elapsed, received = time.monotonic() - t1, counter.n - n0
-    return {"mode": spec["mode"], "seconds": round(time.monotonic() - t0, 2), "subscriptions": len(granted),
-            "publishing_interval_ms": sorted(set(granted)), "items": items, "refused": dict(refused),
-            "notifications": counter.n, "notifications_per_s": round(received / elapsed, 1)}
+    return {
+        "mode": spec["mode"],
+        "seconds": round(time.monotonic() - t0, 2),
+        "subscriptions": len(granted),
+        "publishing_interval_ms": sorted(set(granted)),
+        "items": items,
+        "refused": dict(refused),
+        "notifications": counter.n,
+        "notifications_per_s": round(received / elapsed, 1),
+    }
 
 
 # ---- the verdict and the report's lines ----------------------------------------------------------
@@ -260,17 +317,23 @@ def summary_lines(r: dict) -> list[str]:
     lines = []
     sq = r.get("squat")
     if sq and not sq.get("crashed"):
-        lines.append(f"  squat: {sq['attempts']} ids claimed by an anonymous peer (linked: {sq['peer_linked']}), "
-                     f"created {sq['created']}, blocked {sq['blocked']}, text echoed {sq['echoed']}")
+        lines.append(
+            f"  squat: {sq['attempts']} ids claimed by an anonymous peer (linked: {sq['peer_linked']}), "
+            f"created {sq['created']}, blocked {sq['blocked']}, text echoed {sq['echoed']}"
+        )
     lg = r.get("opcua_logins")
     if lg and not lg.get("crashed"):
-        lines.append(f"  OPC UA logins: {lg['tried']} guesses in {lg['seconds']} s, accepted {lg['accepted']}, "
-                     f"refused {lg['refused']}")
+        lines.append(
+            f"  OPC UA logins: {lg['tried']} guesses in {lg['seconds']} s, accepted {lg['accepted']}, "
+            f"refused {lg['refused']}"
+        )
     ss = r.get("opcua_sessions")
     if ss and not ss.get("crashed"):
         lines.append(f"  OPC UA sessions: {ss['opened']} opened, then refused {ss['refused']}")
     sb = r.get("opcua_subscriptions")
     if sb and not sb.get("crashed"):
-        lines.append(f"  OPC UA subscriptions: {sb['subscriptions']} granted at {sb['publishing_interval_ms']} ms, "
-                     f"{sb['items']} items, refused {sb['refused']}; {sb['notifications_per_s']} notifications/s")
+        lines.append(
+            f"  OPC UA subscriptions: {sb['subscriptions']} granted at {sb['publishing_interval_ms']} ms, "
+            f"{sb['items']} items, refused {sb['refused']}; {sb['notifications_per_s']} notifications/s"
+        )
     return lines

@@ -74,8 +74,12 @@ from service.tools.client import TargetConfig, add_target_arguments, strict_json
 
 _FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c")
 # valid values stay well inside what the DEM holds (the limits allow loads it cannot hold)
-_SAFE = {"shaft_speed_rad_s": (50.0, 1500.0), "radial_load_n": (500.0, 9000.0),
-         "axial_load_n": (-1500.0, 1500.0), "oil_temperature_c": (20.0, 90.0)}
+_SAFE = {
+    "shaft_speed_rad_s": (50.0, 1500.0),
+    "radial_load_n": (500.0, 9000.0),
+    "axial_load_n": (-1500.0, 1500.0),
+    "oil_temperature_c": (20.0, 90.0),
+}
 _INVALID_EXPECTED = {400, 401, 413, 422}
 _BIG = 128 * 1024
 
@@ -92,7 +96,7 @@ class SoakConfig(TargetConfig):
     max_memory_growth_pct: float = 5.0
     publish_rate_hz: float | None = None
     keep_dir: bool = False
-    record_segment_s: float | None = None   # with start: the service's BEARING_TWIN_RECORD_SEGMENT_S [s]
+    record_segment_s: float | None = None  # with start: the service's BEARING_TWIN_RECORD_SEGMENT_S [s]
 
 
 def _free_port() -> int:
@@ -124,8 +128,15 @@ class _Started:
     """`bearing-twin serve` as a subprocess on free loopback ports, token and zenoh access control
     (a users file with the writer `soak`, its password in `zenoh_password`) in its environment."""
 
-    def __init__(self, token: str, publish_rate_hz: float | None, log, record: bool = True,
-                 record_segment_s: float | None = None, opcua: bool = False):
+    def __init__(
+        self,
+        token: str,
+        publish_rate_hz: float | None,
+        log,
+        record: bool = True,
+        record_segment_s: float | None = None,
+        opcua: bool = False,
+    ):
         """`opcua`: serve OPC UA too, on a free loopback port (`opcua_url`; security `auto`)."""
         self.dir = Path(tempfile.mkdtemp(prefix="bearing-twin-soak-"))
         self.zenoh_user, self.zenoh_password = "soak", secrets.token_urlsafe(18)
@@ -137,8 +148,20 @@ class _Started:
         self.zenoh_endpoint = f"tcp/127.0.0.1:{_free_port()}"
         self.rrd = self.dir / "soak.rrd" if record else None
         self.log_path = self.dir / "serve.log"
-        cmd = [sys.executable, "-m", "service.cli", "serve", "--host", "127.0.0.1", "--port", str(self.port),
-               "--zenoh-listen", self.zenoh_endpoint, "--log-level", "warning"]
+        cmd = [
+            sys.executable,
+            "-m",
+            "service.cli",
+            "serve",
+            "--host",
+            "127.0.0.1",
+            "--port",
+            str(self.port),
+            "--zenoh-listen",
+            self.zenoh_endpoint,
+            "--log-level",
+            "warning",
+        ]
         cmd += ["--record", str(self.rrd)] if self.rrd is not None else ["--no-record"]
         self.opcua_url = f"opc.tcp://127.0.0.1:{_free_port()}" if opcua else None
         if self.opcua_url:
@@ -149,24 +172,33 @@ class _Started:
         # the service of this source tree, not whichever one the temporary folder would import
         source = str(Path(service.__file__).resolve().parents[1])
         env["PYTHONPATH"] = os.pathsep.join(filter(None, [source, os.environ.get("PYTHONPATH")]))
-        env.update({"BEARING_TWIN_TOKEN": token, "PYTHONUNBUFFERED": "1",
-                    "BEARING_TWIN_ZENOH_USERSFILE": str(users), "BEARING_TWIN_ZENOH_WRITERS": self.zenoh_user})
+        env.update(
+            {
+                "BEARING_TWIN_TOKEN": token,
+                "PYTHONUNBUFFERED": "1",
+                "BEARING_TWIN_ZENOH_USERSFILE": str(users),
+                "BEARING_TWIN_ZENOH_WRITERS": self.zenoh_user,
+            }
+        )
         if record_segment_s is not None:
             env["BEARING_TWIN_RECORD_SEGMENT_S"] = repr(float(record_segment_s))
         self._log_file = open(self.log_path, "wb")
-        self.proc = subprocess.Popen(cmd, cwd=self.dir, env=env, stdout=self._log_file,
-                                     stderr=subprocess.STDOUT)
+        self.proc = subprocess.Popen(cmd, cwd=self.dir, env=env, stdout=self._log_file, stderr=subprocess.STDOUT)
         self.url = f"http://127.0.0.1:{self.port}"
         if log:
-            log(f"soak: started `bearing-twin serve` (pid {self.proc.pid}) on {self.url}, zenoh "
-                f"{self.zenoh_endpoint}, recording {self.rrd or 'off'}")
+            log(
+                f"soak: started `bearing-twin serve` (pid {self.proc.pid}) on {self.url}, zenoh "
+                f"{self.zenoh_endpoint}, recording {self.rrd or 'off'}"
+            )
 
     def wait_ready(self, client, timeout_s: float = 180.0) -> None:
         deadline = time.monotonic() + timeout_s
         while time.monotonic() < deadline:
             if self.proc.poll() is not None:
-                raise RuntimeError(f"the service exited at start (status {self.proc.returncode}):\n"
-                                   + self.log_path.read_text(errors="replace")[-3000:])
+                raise RuntimeError(
+                    f"the service exited at start (status {self.proc.returncode}):\n"
+                    + self.log_path.read_text(errors="replace")[-3000:]
+                )
             try:
                 if client.get(f"{self.url}/health", timeout=2.0).status_code == 200:
                     return
@@ -219,9 +251,10 @@ class _Stream:
         self.non_finite = 0
         self.first_at: float | None = None
         self.results: collections.deque = collections.deque()
-        self._subs = [self.session.declare_subscriber(all_twins(prefix, STATE), self._on_state),
-                      self.session.declare_subscriber(twin_key(prefix, bearing_id, SETPOINT_RESULT),
-                                                      self._on_result)]
+        self._subs = [
+            self.session.declare_subscriber(all_twins(prefix, STATE), self._on_state),
+            self.session.declare_subscriber(twin_key(prefix, bearing_id, SETPOINT_RESULT), self._on_result),
+        ]
         self.publisher_key = twin_key(prefix, bearing_id, SETPOINT)
 
     def _on_state(self, sample) -> None:
@@ -360,16 +393,22 @@ def run_soak(cfg: SoakConfig) -> dict:
     if cfg.start and token is None:
         token, token_source = secrets.token_urlsafe(24), "generated"
     url, zenoh_endpoint = cfg.url.rstrip("/"), cfg.zenoh_connect
-    report: dict[str, Any] = {"minutes": cfg.minutes, "rate_hz": cfg.rate_hz, "started_service": cfg.start,
-                              "token": token_source, "bearing_id": cfg.bearing_id}
+    report: dict[str, Any] = {
+        "minutes": cfg.minutes,
+        "rate_hz": cfg.rate_hz,
+        "started_service": cfg.start,
+        "token": token_source,
+        "bearing_id": cfg.bearing_id,
+    }
     headers = {"Authorization": f"Bearer {token}"} if token else {}
     client = httpx.Client(timeout=30.0)
     stream = None
     try:
         if cfg.start:
-            assert token is not None            # generated above when not given
-            started = _Started(token, cfg.publish_rate_hz, log, record=cfg.record,
-                               record_segment_s=cfg.record_segment_s)
+            assert token is not None  # generated above when not given
+            started = _Started(
+                token, cfg.publish_rate_hz, log, record=cfg.record, record_segment_s=cfg.record_segment_s
+            )
             url, zenoh_endpoint = started.url, started.zenoh_endpoint
             started.wait_ready(client)
         report.update(url=url, zenoh=zenoh_endpoint)
@@ -383,9 +422,12 @@ def run_soak(cfg: SoakConfig) -> dict:
             from service.settings import ZenohAccessSettings
 
             env = ZenohAccessSettings()
-            access = (ZenohAccess(user=started.zenoh_user, password=started.zenoh_password)
-                      if started is not None else ZenohAccess.from_settings(env.zenoh))
-            prefix = DEFAULT_PREFIX if started is not None else env.zenoh.prefix   # the started one: default
+            access = (
+                ZenohAccess(user=started.zenoh_user, password=started.zenoh_password)
+                if started is not None
+                else ZenohAccess.from_settings(env.zenoh)
+            )
+            prefix = DEFAULT_PREFIX if started is not None else env.zenoh.prefix  # the started one: default
             stream = _Stream(zenoh_endpoint, cfg.bearing_id, prefix, access)
             report["zenoh_access"] = access.describe(listening=False) if access.enabled else "none"
         health0 = client.get(f"{url}/health", headers=headers).json()
@@ -394,14 +436,18 @@ def run_soak(cfg: SoakConfig) -> dict:
         body = _drive(cfg, client, url, headers, driver, stream, pid if local else None, log, report)
         report.update(body)
         if stream is not None:
-            time.sleep(1.0)   # the last results and states
+            time.sleep(1.0)  # the last results and states
             _pair_results(report, stream)
             with stream.lock:
                 report["stream"] = {
-                    "messages": stream.messages, "twins": len(stream.last_seq), "seq_gaps": stream.gaps,
-                    "dropped_messages": stream.dropped, "out_of_order": stream.out_of_order,
+                    "messages": stream.messages,
+                    "twins": len(stream.last_seq),
+                    "seq_gaps": stream.gaps,
+                    "dropped_messages": stream.dropped,
+                    "out_of_order": stream.out_of_order,
                     "non_finite": stream.non_finite,
-                    "rate_hz": round(stream.messages / max(report["duration_s"], 1e-9), 2)}
+                    "rate_hz": round(stream.messages / max(report["duration_s"], 1e-9), 2),
+                }
             last_stream_seq = stream.last_seq.get(cfg.bearing_id)
         else:
             report["stream"] = None
@@ -411,9 +457,11 @@ def run_soak(cfg: SoakConfig) -> dict:
                 stream.close()
                 stream = None
             report["shutdown"] = started.stop()
-            report["recording"] = (_check_recording(started.rrd, cfg.bearing_id,
-                                                    report.get("recording_rows_reported", 0), last_stream_seq)
-                                   if started.rrd is not None else None)
+            report["recording"] = (
+                _check_recording(started.rrd, cfg.bearing_id, report.get("recording_rows_reported", 0), last_stream_seq)
+                if started.rrd is not None
+                else None
+            )
             report["service_log"] = str(started.log_path)
     finally:
         if stream is not None:
@@ -452,13 +500,19 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
             try:
                 h = client.get(f"{url}/health", headers=headers, timeout=10.0).json()
                 tw = next((t for t in h["twins"] if t["id"] == cfg.bearing_id), None)
-                samples.append({"t": now, "twin": tw, "recording_rows": h.get("recording_rows", 0),
-                                "rss_bytes": h.get("rss_bytes")})
+                samples.append(
+                    {
+                        "t": now,
+                        "twin": tw,
+                        "recording_rows": h.get("recording_rows", 0),
+                        "rss_bytes": h.get("rss_bytes"),
+                    }
+                )
             except Exception as exc:  # noqa: BLE001
                 counts["health_errors"] += 1
                 unexpected.append(f"/health: {type(exc).__name__}: {exc}")
                 h = {}
-            value, source = (_rss_bytes(pid) if pid is not None else (h.get("rss_bytes"), "health"))
+            value, source = _rss_bytes(pid) if pid is not None else (h.get("rss_bytes"), "health")
             if value is not None:
                 rss.append((now, value))
                 rss_source = source
@@ -526,8 +580,10 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
                 _pair_results(report, stream)
             if time.monotonic() - last_progress >= 30.0:
                 last_progress = time.monotonic()
-                log(f"soak: {time.monotonic() - t0:.0f} / {duration:.0f} s, {sum(status_counts.values())} "
-                    f"HTTP answers, {len(unexpected)} unexpected")
+                log(
+                    f"soak: {time.monotonic() - t0:.0f} / {duration:.0f} s, {sum(status_counts.values())} "
+                    f"HTTP answers, {len(unexpected)} unexpected"
+                )
             next_t += period
             delay = next_t - time.monotonic()
             if delay > 0:
@@ -540,32 +596,44 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
         sampler.join(30.0)
 
     out: dict[str, Any] = {"duration_s": round(elapsed, 2), "warmup_s": warmup}
-    out["setpoints"] = {k: counts[k] for k in ("http_valid", "http_invalid", "zenoh_valid", "zenoh_invalid",
-                                                "rate_limited")}
-    out["http"] = {"status_counts": {str(k): v for k, v in sorted(status_counts.items())},
-                   "server_errors": counts["server_errors"], "transport_errors": counts["transport_errors"],
-                   "state_reads": counts["state_reads"], "non_finite_states": counts["non_finite_states"],
-                   "health_errors": counts["health_errors"]}
+    out["setpoints"] = {
+        k: counts[k] for k in ("http_valid", "http_invalid", "zenoh_valid", "zenoh_invalid", "rate_limited")
+    }
+    out["http"] = {
+        "status_counts": {str(k): v for k, v in sorted(status_counts.items())},
+        "server_errors": counts["server_errors"],
+        "transport_errors": counts["transport_errors"],
+        "state_reads": counts["state_reads"],
+        "non_finite_states": counts["non_finite_states"],
+        "health_errors": counts["health_errors"],
+    }
     out["unexpected"] = unexpected[:50]
     out["unexpected_count"] = len(unexpected)
     out["memory"] = _memory(rss, warmup, rss_source)
     twins = [s for s in samples if s["twin"] is not None]
     after = [s for s in twins if s["t"] >= warmup] or twins
     rtf = [s["twin"]["real_time_factor"] for s in after if s["twin"].get("real_time_factor") is not None]
-    out["real_time_factor"] = {"median": round(statistics.median(rtf), 4) if rtf else None,
-                               "min": round(min(rtf), 4) if rtf else None, "samples": len(rtf)}
+    out["real_time_factor"] = {
+        "median": round(statistics.median(rtf), 4) if rtf else None,
+        "min": round(min(rtf), 4) if rtf else None,
+        "samples": len(rtf),
+    }
     if twins:
         first, last = twins[0]["twin"], twins[-1]["twin"]
         frames = last["frames"] - first["frames"]
         overruns = last["overruns"] - first["overruns"]
-        out["runner"] = {"frames": frames, "overruns": overruns,
-                         "overrun_fraction": round(overruns / frames, 4) if frames else None,
-                         "resyncs": last["resyncs"] - first["resyncs"],
-                         "errors": last["errors"] - first["errors"], "restarts": last["restarts"] - first["restarts"],
-                         "fallbacks": last.get("fallbacks", 0) - first.get("fallbacks", 0),
-                         "sink_dropped": last["dropped"] - first["dropped"],
-                         "setpoints_accepted": last["setpoints_accepted"] - first["setpoints_accepted"],
-                         "status": last["status"]}
+        out["runner"] = {
+            "frames": frames,
+            "overruns": overruns,
+            "overrun_fraction": round(overruns / frames, 4) if frames else None,
+            "resyncs": last["resyncs"] - first["resyncs"],
+            "errors": last["errors"] - first["errors"],
+            "restarts": last["restarts"] - first["restarts"],
+            "fallbacks": last.get("fallbacks", 0) - first.get("fallbacks", 0),
+            "sink_dropped": last["dropped"] - first["dropped"],
+            "setpoints_accepted": last["setpoints_accepted"] - first["setpoints_accepted"],
+            "status": last["status"],
+        }
         out["recording_rows_reported"] = twins[-1]["recording_rows"]
     else:
         out["runner"] = None
@@ -575,8 +643,9 @@ def _drive(cfg, client, url, headers, driver, stream, pid, log, report) -> dict:
 def _pair_results(report: dict, stream: _Stream) -> None:
     """Pair zenoh results with what was sent, in order."""
     expectations: collections.deque = report["_expect"]
-    z = report.setdefault("zenoh_results", {"received": 0, "accepted": 0, "refused": {}, "unexpected": 0,
-                                            "missing": 0, "examples": []})
+    z = report.setdefault(
+        "zenoh_results", {"received": 0, "accepted": 0, "refused": {}, "unexpected": 0, "missing": 0, "examples": []}
+    )
     for msg in stream.take_results():
         z["received"] += 1
         valid = expectations.popleft() if expectations else None
@@ -587,9 +656,12 @@ def _pair_results(report: dict, stream: _Stream) -> None:
             key = str(msg.get("status", "?"))
             z["refused"][key] = z["refused"].get(key, 0) + 1
         # 429: rate limit; 403: the service has an HTTP token and no zenoh access control
-        bad = (valid is None or accepted is None
-               or (valid and accepted is not True and msg.get("status") not in (429, 403))
-               or (not valid and accepted is True))
+        bad = (
+            valid is None
+            or accepted is None
+            or (valid and accepted is not True and msg.get("status") not in (429, 403))
+            or (not valid and accepted is True)
+        )
         if bad:
             z["unexpected"] += 1
             if len(z["examples"]) < 10:
@@ -611,26 +683,48 @@ def warmup_s(duration_s: float) -> float:
 
 def _memory(rss: list[tuple[float, int]], warmup: float, source: str | None) -> dict:
     if not rss:
-        return {"source": source, "samples": 0, "baseline_mb": None, "final_mb": None, "max_mb": None,
-                "growth_pct": None, "judged": False}
+        return {
+            "source": source,
+            "samples": 0,
+            "baseline_mb": None,
+            "final_mb": None,
+            "max_mb": None,
+            "growth_pct": None,
+            "judged": False,
+        }
     base = next((v for t, v in rss if t >= warmup), rss[0][1])
     window = rss[-1][0] - warmup
     tail = [v for _, v in rss[-3:]]
     final = statistics.median(tail)
-    return {"source": source, "samples": len(rss), "baseline_mb": round(base / 2**20, 2),
-            "final_mb": round(final / 2**20, 2), "max_mb": round(max(v for _, v in rss) / 2**20, 2),
-            "series_mb": [[round(t, 1), round(v / 2**20, 2)] for t, v in rss],
-            "window_s": round(max(window, 0.0), 1), "judged": window >= MIN_JUDGED_WINDOW_S,
-            "growth_pct": round((final - base) / base * 100.0, 3) if base else None}
+    return {
+        "source": source,
+        "samples": len(rss),
+        "baseline_mb": round(base / 2**20, 2),
+        "final_mb": round(final / 2**20, 2),
+        "max_mb": round(max(v for _, v in rss) / 2**20, 2),
+        "series_mb": [[round(t, 1), round(v / 2**20, 2)] for t, v in rss],
+        "window_s": round(max(window, 0.0), 1),
+        "judged": window >= MIN_JUDGED_WINDOW_S,
+        "growth_pct": round((final - base) / base * 100.0, 3) if base else None,
+    }
 
 
-def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_stream_seq: int | None,
-                     snapshots_per_row: int | None = None) -> dict:
+def _check_recording(
+    path: Path, bearing_id: str, rows_reported: int, last_stream_seq: int | None, snapshots_per_row: int | None = None
+) -> dict:
     """Read every segment of the recording `path` once (see the module doc). `snapshots_per_row`:
     snapshots a trend row stands for (None: the service's, `RerunRecorder.SERVICE_OPTIONS`)."""
-    out: dict[str, Any] = {"path": str(path), "rows_reported": rows_reported, "rows_read": None,
-                           "seq_gaps": None, "duplicates": None, "segments": 0, "segment_files": [],
-                           "complete": False, "error": None}
+    out: dict[str, Any] = {
+        "path": str(path),
+        "rows_reported": rows_reported,
+        "rows_read": None,
+        "seq_gaps": None,
+        "duplicates": None,
+        "segments": 0,
+        "segment_files": [],
+        "complete": False,
+        "error": None,
+    }
     try:
         import numpy as np
 
@@ -648,8 +742,14 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
         for seg in segments:
             reader = _reader(seg)
             recordings = reader.recordings()
-            info = {"file": seg.name, "bytes": seg.stat().st_size, "rows": 0, "blueprints": len(reader.blueprints()),
-                    "static_geometry": False, "recording_id": recordings[0].recording_id if recordings else None}
+            info = {
+                "file": seg.name,
+                "bytes": seg.stat().st_size,
+                "rows": 0,
+                "blueprints": len(reader.blueprints()),
+                "static_geometry": False,
+                "recording_id": recordings[0].recording_id if recordings else None,
+            }
             if recordings:
                 recording_ids.add(info["recording_id"])
                 for chunk in reader.stream(store=recordings[0]):
@@ -669,17 +769,22 @@ def _check_recording(path: Path, bearing_id: str, rows_reported: int, last_strea
         # the trends are window means: a row per window of `per_window` snapshots, carrying the
         # seq of the window's last snapshot (RerunRecorder.SERVICE_OPTIONS)
         per_window = snapshots_per_row or snapshots_per_trend_window(
-            ServiceSettings().runner.publish_rate_hz, float(RerunRecorder.SERVICE_OPTIONS["trend_window_s"]))
+            ServiceSettings().runner.publish_rate_hz, float(RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
+        )
         gaps = window_seq_gaps(s, per_window)
         out["snapshots_per_row"] = per_window
         out["seq_gaps"] = gaps
         out["duplicates"] = int((d == 0).sum())
         out["first_seq"] = int(s[0]) if len(s) else None
         out["last_seq"] = int(s[-1]) if len(s) else None
-        out["complete"] = bool(segments_ok and len(recording_ids) == 1
-                               and len(s) * per_window >= max(rows_reported - per_window, 1)
-                               and gaps == 0 and out["duplicates"] == 0
-                               and (last_stream_seq is None or (len(s) and int(s[-1]) >= last_stream_seq)))
+        out["complete"] = bool(
+            segments_ok
+            and len(recording_ids) == 1
+            and len(s) * per_window >= max(rows_reported - per_window, 1)
+            and gaps == 0
+            and out["duplicates"] == 0
+            and (last_stream_seq is None or (len(s) and int(s[-1]) >= last_stream_seq))
+        )
     except Exception as exc:  # noqa: BLE001
         out["error"] = f"{type(exc).__name__}: {exc}"
     return out
@@ -696,8 +801,10 @@ def _verdict(report: dict, cfg: SoakConfig) -> None:
     s = report.get("stream")
     if s is not None:
         if s["seq_gaps"] or s["out_of_order"] or s["non_finite"]:
-            failures.append(f"state stream: {s['seq_gaps']} seq gaps ({s['dropped_messages']} messages), "
-                            f"{s['out_of_order']} out of order, {s['non_finite']} non-finite")
+            failures.append(
+                f"state stream: {s['seq_gaps']} seq gaps ({s['dropped_messages']} messages), "
+                f"{s['out_of_order']} out of order, {s['non_finite']} non-finite"
+            )
         if not s["messages"]:
             failures.append("no state message received over zenoh")
     runner = report.get("runner") or {}
@@ -736,47 +843,69 @@ def _shutdown_text(sd: dict) -> str:
 def format_report(r: dict) -> str:
     """Human-readable summary."""
     f = lambda v, spec="{:.3f}": "-" if v is None else spec.format(v)  # noqa: E731
-    lines = [f"soak: {r['duration_s']:.0f} s against {r.get('url')} (zenoh {r.get('zenoh') or 'off'}), "
-             f"{'own service' if r['started_service'] else 'external service'}, token {r.get('token') or 'none'}"]
+    lines = [
+        f"soak: {r['duration_s']:.0f} s against {r.get('url')} (zenoh {r.get('zenoh') or 'off'}), "
+        f"{'own service' if r['started_service'] else 'external service'}, token {r.get('token') or 'none'}"
+    ]
     sp = r["setpoints"]
-    lines.append(f"  setpoints: HTTP {sp['http_valid']} valid + {sp['http_invalid']} invalid, zenoh "
-                 f"{sp['zenoh_valid']} valid + {sp['zenoh_invalid']} invalid; rate-limited {sp['rate_limited']}")
+    lines.append(
+        f"  setpoints: HTTP {sp['http_valid']} valid + {sp['http_invalid']} invalid, zenoh "
+        f"{sp['zenoh_valid']} valid + {sp['zenoh_invalid']} invalid; rate-limited {sp['rate_limited']}"
+    )
     h = r["http"]
-    lines.append(f"  HTTP answers {h['status_counts']}; 5xx {h['server_errors']}, transport errors "
-                 f"{h['transport_errors']}, state reads {h['state_reads']} (non-finite {h['non_finite_states']})")
+    lines.append(
+        f"  HTTP answers {h['status_counts']}; 5xx {h['server_errors']}, transport errors "
+        f"{h['transport_errors']}, state reads {h['state_reads']} (non-finite {h['non_finite_states']})"
+    )
     z = r.get("zenoh_results")
     if z:
-        lines.append(f"  zenoh results: {z['received']} ({z['accepted']} accepted, refused {z['refused']}), "
-                     f"unexpected {z['unexpected']}, missing {z['missing']}; access {r.get('zenoh_access')}")
+        lines.append(
+            f"  zenoh results: {z['received']} ({z['accepted']} accepted, refused {z['refused']}), "
+            f"unexpected {z['unexpected']}, missing {z['missing']}; access {r.get('zenoh_access')}"
+        )
         if z["refused"].get("403"):
-            lines.append("  note: zenoh setpoints refused with 403: the service needs an HTTP token and has "
-                         "no zenoh access control (docs/operations.md \"zenoh access control\")")
+            lines.append(
+                "  note: zenoh setpoints refused with 403: the service needs an HTTP token and has "
+                'no zenoh access control (docs/operations.md "zenoh access control")'
+            )
     s = r.get("stream")
     if s:
-        lines.append(f"  state stream: {s['messages']} messages ({s['rate_hz']:.1f}/s), seq gaps {s['seq_gaps']} "
-                     f"({s['dropped_messages']} dropped), out of order {s['out_of_order']}, non-finite {s['non_finite']}")
+        lines.append(
+            f"  state stream: {s['messages']} messages ({s['rate_hz']:.1f}/s), seq gaps {s['seq_gaps']} "
+            f"({s['dropped_messages']} dropped), out of order {s['out_of_order']}, non-finite {s['non_finite']}"
+        )
     m = r["memory"]
-    lines.append(f"  memory ({m['source']}): {f(m['baseline_mb'], '{:.1f}')} -> {f(m['final_mb'], '{:.1f}')} MB "
-                 f"(max {f(m['max_mb'], '{:.1f}')}), growth {f(m['growth_pct'], '{:.2f}')} % after {r['warmup_s']:.0f} s warm-up"
-                 + ("" if m.get("judged") else f" (not judged: {m.get('window_s', 0):.0f} s measured, a leak needs "
-                    f"{MIN_JUDGED_WINDOW_S:.0f} s to tell from settling)"))
+    lines.append(
+        f"  memory ({m['source']}): {f(m['baseline_mb'], '{:.1f}')} -> {f(m['final_mb'], '{:.1f}')} MB "
+        f"(max {f(m['max_mb'], '{:.1f}')}), growth {f(m['growth_pct'], '{:.2f}')} % after {r['warmup_s']:.0f} s warm-up"
+        + (
+            ""
+            if m.get("judged")
+            else f" (not judged: {m.get('window_s', 0):.0f} s measured, a leak needs "
+            f"{MIN_JUDGED_WINDOW_S:.0f} s to tell from settling)"
+        )
+    )
     rtf = r["real_time_factor"]
     lines.append(f"  real-time factor: median {f(rtf['median'])}, min {f(rtf['min'])}")
     ru = r.get("runner")
     if ru:
-        lines.append(f"  runner: {ru['frames']} frames, overruns {ru['overruns']} ({f(ru['overrun_fraction'], '{:.1%}')}), "
-                     f"resyncs {ru['resyncs']}, errors {ru['errors']}, restarts {ru['restarts']}, fallbacks "
-                     f"{ru['fallbacks']}, sink drops {ru['sink_dropped']}")
+        lines.append(
+            f"  runner: {ru['frames']} frames, overruns {ru['overruns']} ({f(ru['overrun_fraction'], '{:.1%}')}), "
+            f"resyncs {ru['resyncs']}, errors {ru['errors']}, restarts {ru['restarts']}, fallbacks "
+            f"{ru['fallbacks']}, sink drops {ru['sink_dropped']}"
+        )
     if r.get("shutdown"):
         sd = r["shutdown"]
         lines.append(f"  SIGTERM: {_shutdown_text(sd)}")
     if r.get("recording"):
         rec = r["recording"]
         mb = sum(f["bytes"] for f in rec.get("segment_files", [])) / 1e6
-        lines.append(f"  recording {rec['path']}: {rec.get('segments', 1)} segment(s), {mb:.1f} MB, "
-                     f"{rec['rows_read']} rows read back, {rec['rows_reported']} "
-                     f"reported, seq gaps {rec['seq_gaps']}, duplicates {rec.get('duplicates')}, complete {rec['complete']}"
-                     + (f", error {rec['error']}" if rec.get("error") else ""))
+        lines.append(
+            f"  recording {rec['path']}: {rec.get('segments', 1)} segment(s), {mb:.1f} MB, "
+            f"{rec['rows_read']} rows read back, {rec['rows_reported']} "
+            f"reported, seq gaps {rec['seq_gaps']}, duplicates {rec.get('duplicates')}, complete {rec['complete']}"
+            + (f", error {rec['error']}" if rec.get("error") else "")
+        )
     for u in r.get("unexpected", [])[:10]:
         lines.append(f"  unexpected: {u}")
     lines.append("  OK" if r["ok"] else "  FAILED: " + "; ".join(r["failures"]))
@@ -784,27 +913,44 @@ def format_report(r: dict) -> str:
 
 
 def add_soak_command(sub) -> None:
-    p = sub.add_parser("soak", help="long run: random valid and invalid setpoints over HTTP and zenoh; "
-                       "memory growth, seq gaps, real-time factor, overruns, errors, recording check",
-                       description=__doc__.split("\n\n")[0])
-    p.add_argument("--minutes", type=float, required=True, help="wall-clock length of the run [min] (bounded: <= 10080)")
+    p = sub.add_parser(
+        "soak",
+        help="long run: random valid and invalid setpoints over HTTP and zenoh; "
+        "memory growth, seq gaps, real-time factor, overruns, errors, recording check",
+        description=__doc__.split("\n\n")[0],
+    )
+    p.add_argument(
+        "--minutes", type=float, required=True, help="wall-clock length of the run [min] (bounded: <= 10080)"
+    )
     add_target_arguments(
-        p, url_help="service URL (ignored with --start)",
+        p,
+        url_help="service URL (ignored with --start)",
         zenoh_help="zenoh endpoint of the service, e.g. tcp/127.0.0.1:7447 (default: no zenoh unless --start)",
         start_help="launch an own `bearing-twin serve` on free loopback ports, recording into a temp dir; stop "
         "it with SIGTERM at the end and read the recording back",
-        twin_help="twin to drive (default `default`)")
-    p.add_argument("--rate", type=float, default=10.0, help="setpoints per second, HTTP and zenoh together (default 10)")
+        twin_help="twin to drive (default `default`)",
+    )
+    p.add_argument(
+        "--rate", type=float, default=10.0, help="setpoints per second, HTTP and zenoh together (default 10)"
+    )
     p.add_argument("--invalid", type=float, default=0.3, help="share of invalid setpoints (default 0.3)")
     p.add_argument("--sample", type=float, default=2.0, help="health / memory sampling period [s] (default 2)")
     p.add_argument("--max-memory-growth", type=float, default=5.0, help="memory growth limit for `ok` [%%] (default 5)")
     p.add_argument("--seed", type=int, help="random seed")
     p.add_argument("--keep", action="store_true", help="with --start: keep the temp dir (recording, service log)")
-    p.add_argument("--no-record", action="store_true", help="with --start: run the service without its recording "
-                   "(to tell the service's own memory from the rerun SDK's)")
-    p.add_argument("--record-segment-s", type=float, metavar="SECONDS",
-                   help="with --start: the service's recording rotation period [s] (BEARING_TWIN_RECORD_SEGMENT_S; "
-                   "default: the service's, 600 s)")
+    p.add_argument(
+        "--no-record",
+        action="store_true",
+        help="with --start: run the service without its recording "
+        "(to tell the service's own memory from the rerun SDK's)",
+    )
+    p.add_argument(
+        "--record-segment-s",
+        type=float,
+        metavar="SECONDS",
+        help="with --start: the service's recording rotation period [s] (BEARING_TWIN_RECORD_SEGMENT_S; "
+        "default: the service's, 600 s)",
+    )
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=_cmd_soak)
 
@@ -819,10 +965,18 @@ def _cmd_soak(args) -> int:
     if not (0.0 <= args.invalid <= 1.0):
         print("error: --invalid is a share in [0, 1]", file=sys.stderr)
         return 2
-    cfg = SoakConfig(minutes=args.minutes, **target_arguments(args), rate_hz=args.rate,
-                     invalid_fraction=args.invalid, sample_s=args.sample,
-                     max_memory_growth_pct=args.max_memory_growth, keep_dir=args.keep, record=not args.no_record,
-                     record_segment_s=args.record_segment_s, log=lambda line: print(line, file=sys.stderr, flush=True))
+    cfg = SoakConfig(
+        minutes=args.minutes,
+        **target_arguments(args),
+        rate_hz=args.rate,
+        invalid_fraction=args.invalid,
+        sample_s=args.sample,
+        max_memory_growth_pct=args.max_memory_growth,
+        keep_dir=args.keep,
+        record=not args.no_record,
+        record_segment_s=args.record_segment_s,
+        log=lambda line: print(line, file=sys.stderr, flush=True),
+    )
     try:
         report = run_soak(cfg)
     except (RuntimeError, ValueError) as exc:

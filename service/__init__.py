@@ -3,6 +3,6 @@
 from importlib.metadata import PackageNotFoundError, version
 
 try:
-    __version__ = version("bearing-twin")   # written once, in pyproject.toml
-except PackageNotFoundError:                # a source tree that is not installed
+    __version__ = version("bearing-twin")  # written once, in pyproject.toml
+except PackageNotFoundError:  # a source tree that is not installed
     __version__ = "0+unknown"

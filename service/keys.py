@@ -21,8 +21,20 @@ import re
 
 from twin.spec import TWIN_ID_PATTERN
 
-__all__ = ["DEFAULT_PREFIX", "PREFIX_PATTERN", "PREFIX_PATTERN_WILDCARD", "PREFIX_RE", "PREFIX_WILDCARD_RE",
-           "TWIN_ID_PATTERN", "TWIN_ID_RE", "all_twins", "ball_key", "check_prefix", "check_twin_id", "twin_key"]
+__all__ = [
+    "DEFAULT_PREFIX",
+    "PREFIX_PATTERN",
+    "PREFIX_PATTERN_WILDCARD",
+    "PREFIX_RE",
+    "PREFIX_WILDCARD_RE",
+    "TWIN_ID_PATTERN",
+    "TWIN_ID_RE",
+    "all_twins",
+    "ball_key",
+    "check_prefix",
+    "check_twin_id",
+    "twin_key",
+]
 
 DEFAULT_PREFIX = "bearing"
 
@@ -34,8 +46,10 @@ PREFIX_MAX_CHUNKS = 8
 PREFIX_PATTERN = rf"^{PREFIX_CHUNK}(?:/{PREFIX_CHUNK}){{0,{PREFIX_MAX_CHUNKS - 1}}}$"
 """A concrete key prefix: 1-8 chunks separated by '/', no wildcards."""
 PREFIX_RE = re.compile(PREFIX_PATTERN)
-PREFIX_PATTERN_WILDCARD = (rf"^(?:{PREFIX_CHUNK}|\*|\*\*)(?:/(?:{PREFIX_CHUNK}|\*|\*\*))"
-                           rf"{{0,{PREFIX_MAX_CHUNKS - 1}}}$")
+PREFIX_PATTERN_WILDCARD = (
+    rf"^(?:{PREFIX_CHUNK}|\*|\*\*)(?:/(?:{PREFIX_CHUNK}|\*|\*\*))"
+    rf"{{0,{PREFIX_MAX_CHUNKS - 1}}}$"
+)
 """A prefix pattern of the router and the monitor: chunks, '*' or '**' (e.g. plant1/**)."""
 PREFIX_WILDCARD_RE = re.compile(PREFIX_PATTERN_WILDCARD)
 
@@ -57,16 +71,17 @@ VIBRATION_COMPARISON = "vibration/comparison"
 def check_prefix(prefix: str) -> str:
     """A concrete key prefix (1-8 chunks, no wildcards), else ValueError."""
     if not isinstance(prefix, str) or not PREFIX_RE.match(prefix):
-        raise ValueError(f"key prefix {prefix!r}: 1-{PREFIX_MAX_CHUNKS} chunks of letters, digits, '_', '.', '-' "
-                         "separated by '/', no wildcards (e.g. plant1/line2/motor7)")
+        raise ValueError(
+            f"key prefix {prefix!r}: 1-{PREFIX_MAX_CHUNKS} chunks of letters, digits, '_', '.', '-' "
+            "separated by '/', no wildcards (e.g. plant1/line2/motor7)"
+        )
     return prefix
 
 
 def check_twin_id(twin_id: str) -> str:
     """A valid twin id, else ValueError."""
     if not isinstance(twin_id, str) or not TWIN_ID_RE.match(twin_id):
-        raise ValueError(f"twin id {twin_id!r}: 1-64 letters, digits, '_', '.', '-', starting with a letter or "
-                         "a digit")
+        raise ValueError(f"twin id {twin_id!r}: 1-64 letters, digits, '_', '.', '-', starting with a letter or a digit")
     return twin_id
 
 

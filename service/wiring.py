@@ -30,9 +30,16 @@ if TYPE_CHECKING:
 
 log = logging.getLogger(__name__)
 
-__all__ = ["TwinEntry", "TwinService", "WiringError", "open_bus", "open_live_viewer", "open_opcua",
-           "open_recorder",
-           "recorder_options"]
+__all__ = [
+    "TwinEntry",
+    "TwinService",
+    "WiringError",
+    "open_bus",
+    "open_live_viewer",
+    "open_opcua",
+    "open_recorder",
+    "recorder_options",
+]
 
 
 class WiringError(RuntimeError):
@@ -58,16 +65,24 @@ def open_bus(settings: ServiceSettings):
         from service.bus.zenoh_bus import ZenohBus
     owner = {"http": f"http://{settings.http.host}:{settings.http.port}"} if settings.http.port else {}
     try:
-        return ZenohBus(listen=settings.zenoh.listen, connect=settings.zenoh.connect, mode=settings.zenoh.mode,
-                        prefix=settings.zenoh.prefix, owner=owner,
-                        access=ZenohAccess.from_settings(settings.zenoh, enforce=True),
-                        # another peer's claim on a twin id counts when zenoh authenticated it, or
-                        # when nothing is secured; never when only the HTTP API is (service.bus.zenoh_bus)
-                        trust_claims=settings.zenoh.access_control or settings.security.token is None)
+        return ZenohBus(
+            listen=settings.zenoh.listen,
+            connect=settings.zenoh.connect,
+            mode=settings.zenoh.mode,
+            prefix=settings.zenoh.prefix,
+            owner=owner,
+            access=ZenohAccess.from_settings(settings.zenoh, enforce=True),
+            # another peer's claim on a twin id counts when zenoh authenticated it, or
+            # when nothing is secured; never when only the HTTP API is (service.bus.zenoh_bus)
+            trust_claims=settings.zenoh.access_control or settings.security.token is None,
+        )
     except (RuntimeError, ValueError) as exc:
-        text = re.sub(r"\s+at \S+\.rs:\d+\.?", "", " ".join(str(exc).split()))   # zenoh's Rust source lines
-        hint = (" (is another service listening there? choose another with --zenoh-listen, or --no-zenoh)"
-                if "already in use" in text else "")
+        text = re.sub(r"\s+at \S+\.rs:\d+\.?", "", " ".join(str(exc).split()))  # zenoh's Rust source lines
+        hint = (
+            " (is another service listening there? choose another with --zenoh-listen, or --no-zenoh)"
+            if "already in use" in text
+            else ""
+        )
         raise WiringError(text + hint) from exc
 
 
@@ -80,10 +95,13 @@ def _recorder_class():
 def recorder_options(settings: ServiceSettings) -> dict:
     """Trend window, sampling of the bearing now, send interval, segment rotation and footer of
     every recording the service writes."""
-    return dict(**_recorder_class().SERVICE_OPTIONS, flush_interval_s=settings.recording.flush_interval_s,
-                segment_s=settings.recording.segment_s or None,
-                segment_bytes=round(settings.recording.segment_mb * 1e6) or None,
-                write_footer=settings.recording.footer)
+    return dict(
+        **_recorder_class().SERVICE_OPTIONS,
+        flush_interval_s=settings.recording.flush_interval_s,
+        segment_s=settings.recording.segment_s or None,
+        segment_bytes=round(settings.recording.segment_mb * 1e6) or None,
+        write_footer=settings.recording.footer,
+    )
 
 
 def open_recorder(settings: ServiceSettings, streams: Any = None):
@@ -99,13 +117,22 @@ def open_recorder(settings: ServiceSettings, streams: Any = None):
     extra = {} if streams is None else {"streams": streams}
     retention = None
     if path is not None and (settings.recording.keep_mb > 0 or settings.recording.keep_hours > 0):
-        retention = Retention.for_recording(path, keep_bytes=round(settings.recording.keep_mb * 1e6),
-                                            keep_age_s=settings.recording.keep_hours * 3600.0)
+        retention = Retention.for_recording(
+            path, keep_bytes=round(settings.recording.keep_mb * 1e6), keep_age_s=settings.recording.keep_hours * 3600.0
+        )
     try:
-        return cls(path, spawn_viewer=settings.recording.spawn_viewer, retention=retention, **recorder_options(settings), **extra)
+        return cls(
+            path,
+            spawn_viewer=settings.recording.spawn_viewer,
+            retention=retention,
+            **recorder_options(settings),
+            **extra,
+        )
     except (RecordingPathError, RecordingWriteError, OSError) as exc:
-        raise WiringError(f"cannot record to {str(path)!r}: {' '.join(str(exc).split())[:300]} "
-                          "(--record PATH.rrd elsewhere, or --no-record)") from None
+        raise WiringError(
+            f"cannot record to {str(path)!r}: {' '.join(str(exc).split())[:300]} "
+            "(--record PATH.rrd elsewhere, or --no-record)"
+        ) from None
 
 
 def open_live_viewer(settings: ServiceSettings, recorder):
@@ -118,8 +145,11 @@ def open_live_viewer(settings: ServiceSettings, recorder):
 
     try:
         check_bind(settings.recording.web_bind, settings.security.token is not None)
-        live = LiveWebViewer(settings.recording.web_port, host=settings.recording.web_bind,
-                             memory_limit_mb=settings.recording.web_memory_mb).start()
+        live = LiveWebViewer(
+            settings.recording.web_port,
+            host=settings.recording.web_bind,
+            memory_limit_mb=settings.recording.web_memory_mb,
+        ).start()
     except (LiveViewerError, ValueError, OSError) as exc:
         raise WiringError(f"rerun web viewer: {exc}") from None
     try:
@@ -141,21 +171,24 @@ def open_opcua(settings: ServiceSettings, registry: TwinRegistry):
     try:
         return OpcUaFacade(registry, settings.opcua.endpoint).start()
     except (OpcUaError, ValueError) as exc:
-        hint = (" (is another server listening there? choose another port with --opcua)"
-                if "address already in use" in str(exc).lower() or "errno 98" in str(exc).lower() else "")
+        hint = (
+            " (is another server listening there? choose another port with --opcua)"
+            if "address already in use" in str(exc).lower() or "errno 98" in str(exc).lower()
+            else ""
+        )
         raise WiringError(f"{exc}{hint}") from exc
 
 
 class TwinService(TwinRegistry):
     """The twins of one service, wired to zenoh and rerun as the settings say."""
 
-    recorder: RerunRecorder | None      # the service-wide recording (open_recorder)
+    recorder: RerunRecorder | None  # the service-wide recording (open_recorder)
 
     def __init__(self, settings: ServiceSettings, gate: AdmissionGate | None = None):
         super().__init__(settings, gate)
-        self._rerun_streams = None          # service.recording.RerunStreams, made on first use
-        self.opcua = None                   # service.opcua.OpcUaFacade when settings.opcua.endpoint is set
-        self.live_viewer = None             # service.recording.live.LiveWebViewer when rerun_web_port is set
+        self._rerun_streams = None  # service.recording.RerunStreams, made on first use
+        self.opcua = None  # service.opcua.OpcUaFacade when settings.opcua.endpoint is set
+        self.live_viewer = None  # service.recording.live.LiveWebViewer when rerun_web_port is set
 
     def rerun_streams(self):
         """The `RerunStreams` that makes and frees every rerun stream of this service."""
@@ -169,12 +202,15 @@ class TwinService(TwinRegistry):
 
     def _open_outputs(self) -> None:
         self.bus = open_bus(self.settings)
-        if (self.settings.recording.active_path is not None or self.settings.recording.spawn_viewer
-                or self.settings.recording.web_port is not None):
+        if (
+            self.settings.recording.active_path is not None
+            or self.settings.recording.spawn_viewer
+            or self.settings.recording.web_port is not None
+        ):
             self.recorder = open_recorder(self.settings, self.rerun_streams())
         self.live_viewer = open_live_viewer(self.settings, self.recorder)
         if self.recorder is not None:
-            self.alarms.subscribe(self.recorder.log_alarm)     # alarm events into the recording
+            self.alarms.subscribe(self.recorder.log_alarm)  # alarm events into the recording
         self.alarms.subscribe(self._alarm_to_twin_recording)
         self.opcua = open_opcua(self.settings, self)
         if self.opcua is not None:
@@ -212,7 +248,7 @@ class TwinService(TwinRegistry):
         super()._unwire(e)
         if recorder is not None:
             try:
-                recorder.remove_twin(e.id)   # its rows are written, its entry freed
+                recorder.remove_twin(e.id)  # its rows are written, its entry freed
             except Exception:
                 log.exception("removing twin %s from the recording", e.id)
 
@@ -250,7 +286,9 @@ class TwinService(TwinRegistry):
             self.stop_recording(entry)
             try:
                 if path:
-                    created = create_exclusive(self.recordings_dir(), target.relative_to(self.recordings_dir()).as_posix())
+                    created = create_exclusive(
+                        self.recordings_dir(), target.relative_to(self.recordings_dir()).as_posix()
+                    )
                 else:
                     created = create_recording(target, rename=True)
             except RecordingPathError as exc:
@@ -258,9 +296,10 @@ class TwinService(TwinRegistry):
             try:
                 rec = recorder_cls(created, **recorder_options(self.settings), streams=streams)
             except (OSError, RuntimeError, ValueError, RecordingWriteError) as exc:
-                created.discard()            # removed (it was made for this start), descriptors closed
-                raise InputError.one("path", f"cannot record to {str(target)!r}: "
-                                     f"{' '.join(str(exc).split())[:200]}") from None
+                created.discard()  # removed (it was made for this start), descriptors closed
+                raise InputError.one(
+                    "path", f"cannot record to {str(target)!r}: {' '.join(str(exc).split())[:200]}"
+                ) from None
             rec.add_twin_from(entry.twin, context=lambda: entry.runner.scenario)
             entry.recording, entry.recording_path = rec, created.path
             entry.runner.add_sink(rec)
@@ -272,10 +311,12 @@ class TwinService(TwinRegistry):
         that cannot write (`service.recording.recorder` "Faults")."""
         recs = [r for r in [self.recorder, *(e.recording for e in self.entries())] if r is not None]
         faults = [f"{getattr(r, 'path', None)}: {r.fault}" for r in recs if getattr(r, "fault", None)]
-        return {"recording_status": "off" if not recs else "degraded" if faults else "ok",
-                "recording_error": "; ".join(faults) or None,
-                "recording_write_errors": sum(int(getattr(r, "write_errors", 0)) for r in recs),
-                "recording_rows_lost": sum(int(getattr(r, "rows_lost", 0)) for r in recs)}
+        return {
+            "recording_status": "off" if not recs else "degraded" if faults else "ok",
+            "recording_error": "; ".join(faults) or None,
+            "recording_write_errors": sum(int(getattr(r, "write_errors", 0)) for r in recs),
+            "recording_rows_lost": sum(int(getattr(r, "rows_lost", 0)) for r in recs),
+        }
 
     def health(self) -> dict:
         out = super().health()
@@ -291,5 +332,5 @@ class TwinService(TwinRegistry):
         try:
             return recorder_cls(path, **recorder_options(self.settings), streams=streams)
         except BaseException:
-            streams.reclaim()            # the stream made for the file that failed
+            streams.reclaim()  # the stream made for the file that failed
             raise

@@ -10,8 +10,7 @@ import pytest
 def _load_support():
     # --import-mode=importlib and no tests/__init__.py: tests/support.py is not importable by
     # name from test modules, so it is loaded by path here and shared as a fixture
-    spec = importlib.util.spec_from_file_location("bearing_twin_test_support",
-                                                  Path(__file__).with_name("support.py"))
+    spec = importlib.util.spec_from_file_location("bearing_twin_test_support", Path(__file__).with_name("support.py"))
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
@@ -34,7 +33,9 @@ os.environ.setdefault("BEARING_TWIN_GC_FREEZE", "0")
 # Nor do in-process services hold refusals in the tarpit (service.api.middleware.Tarpit): the functional tests
 # send invalid requests from one address on purpose, far above a client's error budget.
 # tests/hostile/test_tarpit.py checks the tarpit with settings of its own.
-os.environ.setdefault("BEARING_TWIN_TARPIT_DELAY_S", "0")   # process-wide too: each in-process service would freeze the pytest heap
+os.environ.setdefault(
+    "BEARING_TWIN_TARPIT_DELAY_S", "0"
+)  # process-wide too: each in-process service would freeze the pytest heap
 
 
 @pytest.fixture(scope="session")

@@ -33,13 +33,16 @@ def free_endpoint() -> str:
 
 def strict_loads(payload) -> Any:
     """json.loads that fails on NaN / Infinity literals."""
+
     def reject(name):
         raise AssertionError(f"JSON carries {name}")
+
     return json.loads(payload, parse_constant=reject)
 
 
-def wait_for(fetch: Callable[[], Any], predicate: Callable[[Any], bool], timeout: float = 30.0,
-             interval: float = 0.02) -> Any:
+def wait_for(
+    fetch: Callable[[], Any], predicate: Callable[[Any], bool], timeout: float = 30.0, interval: float = 0.02
+) -> Any:
     """Poll `fetch()` every `interval` s until `predicate` holds on its value; at most `timeout` s."""
     deadline = time.monotonic() + timeout
     while True:
@@ -77,8 +80,15 @@ class Peer:
     `Sample` per message in `inbox`; `wait_for` waits at most `timeout_s`. `prefix`: the twins'
     key prefix (result keys)."""
 
-    def __init__(self, endpoint: str, timeout_s: float = PEER_WAIT_S, *, mode: str = "peer",
-                 access: Any = None, prefix: str = "bearing"):
+    def __init__(
+        self,
+        endpoint: str,
+        timeout_s: float = PEER_WAIT_S,
+        *,
+        mode: str = "peer",
+        access: Any = None,
+        prefix: str = "bearing",
+    ):
         import zenoh
 
         from service.bus.zenoh_bus import make_config
@@ -91,8 +101,10 @@ class Peer:
 
     def subscribe(self, keyexpr: str, liveliness: bool = False):
         """Subscribe to `keyexpr` (liveliness tokens with history when `liveliness`)."""
+
         def cb(sample):
             self.inbox.put(Sample(str(sample.key_expr), sample.kind, sample.payload.to_bytes()))
+
         if liveliness:
             sub = self.session.liveliness().declare_subscriber(keyexpr, cb, history=True)
         else:
@@ -100,8 +112,13 @@ class Peer:
         self._subs.append(sub)  # keep a reference
         return sub
 
-    def wait_for(self, predicate: Callable[[Sample], bool], timeout_s: float | None = None,
-                 poke: Callable[[], object] | None = None, poke_every_s: float = 0.0) -> Sample:
+    def wait_for(
+        self,
+        predicate: Callable[[Sample], bool],
+        timeout_s: float | None = None,
+        poke: Callable[[], object] | None = None,
+        poke_every_s: float = 0.0,
+    ) -> Sample:
         """The first sample satisfying `predicate` (samples before it are consumed); `poke()` is
         called while waiting, at most once every `poke_every_s` (0: before every inbox read)."""
         timeout_s = self.timeout_s if timeout_s is None else timeout_s
@@ -119,8 +136,7 @@ class Peer:
                 return item
         raise AssertionError("timed out waiting for a zenoh message")
 
-    def result_after(self, key: str, payload, bearing_id: str = "default",
-                     timeout_s: float | None = None) -> dict:
+    def result_after(self, key: str, payload, bearing_id: str = "default", timeout_s: float | None = None) -> dict:
         """Put a setpoint and return the next message on its result key (strict JSON)."""
         self.drain()
         self.session.put(key, payload)
@@ -160,8 +176,14 @@ class ThreadServer:
         self.app = create_app(settings)
         from service.api.server import uvicorn_config
 
-        config = uvicorn_config(self.app, self.app.state.settings, host="127.0.0.1", port=0,
-                                log_level="warning", timeout_graceful_shutdown=2)
+        config = uvicorn_config(
+            self.app,
+            self.app.state.settings,
+            host="127.0.0.1",
+            port=0,
+            log_level="warning",
+            timeout_graceful_shutdown=2,
+        )
         self.server = uvicorn.Server(config)
         self.thread = threading.Thread(target=self.server.run, daemon=True)
         self.start_timeout_s, self.stop_timeout_s = start_timeout_s, stop_timeout_s

@@ -35,17 +35,26 @@ def test_performance_page_shows_the_newest_bench_result():
 
 
 def test_code_speaks_in_the_present_tense():
-    hits = [f"{path.relative_to(ROOT)}:{n}: {line.strip()[:100]}"
-            for package in ("twin", "service") for path in sorted((ROOT / package).rglob("*.py"))
-            for n, line in enumerate(path.read_text().splitlines(), 1) if HISTORY.search(line)]
+    hits = [
+        f"{path.relative_to(ROOT)}:{n}: {line.strip()[:100]}"
+        for package in ("twin", "service")
+        for path in sorted((ROOT / package).rglob("*.py"))
+        for n, line in enumerate(path.read_text().splitlines(), 1)
+        if HISTORY.search(line)
+    ]
     assert not hits, "issue numbers or dates in code (history goes to CHANGELOG.md):\n" + "\n".join(hits)
 
 
 def test_docs_site_builds_strict(tmp_path):
     pytest.importorskip("mkdocs")
     pytest.importorskip("material")
-    res = subprocess.run([sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
-                         cwd=ROOT, capture_output=True, text=True, timeout=300)
+    res = subprocess.run(
+        [sys.executable, "-m", "mkdocs", "build", "--strict", "--site-dir", str(tmp_path / "site")],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=300,
+    )
     assert res.returncode == 0, res.stdout[-3000:] + res.stderr[-3000:]
     assert (tmp_path / "site" / "index.html").exists()
     shutil.rmtree(tmp_path / "site")

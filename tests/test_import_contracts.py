@@ -24,10 +24,20 @@ ROOT = Path(__file__).resolve().parents[1]
 def test_the_contracts_are_declared():
     config = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["importlinter"]
     contracts = {c["id"]: c for c in config["contracts"]}
-    assert set(contracts) == {"engine", "runtime", "core", "layers", "service-acyclic", "twin-acyclic", "twin-layers",
-                              "loadtest"}
+    assert set(contracts) == {
+        "engine",
+        "runtime",
+        "core",
+        "layers",
+        "service-acyclic",
+        "twin-acyclic",
+        "twin-layers",
+        "loadtest",
+    }
     assert contracts["service-acyclic"]["type"] == "acyclic_siblings"
-    assert contracts["twin-acyclic"]["type"] == "acyclic_siblings" and contracts["twin-acyclic"]["ancestors"] == ["twin"]
+    assert contracts["twin-acyclic"]["type"] == "acyclic_siblings" and contracts["twin-acyclic"]["ancestors"] == [
+        "twin"
+    ]
     assert set(contracts["service-acyclic"]["ancestors"]) == {"service", "loadtest"}
     assert {"loadtest", "httpx"} <= set(contracts["loadtest"]["forbidden_modules"])
     assert {"service", "fastapi", "zenoh", "rerun"} <= set(contracts["engine"]["forbidden_modules"])
@@ -59,9 +69,11 @@ def test_a_broken_rule_is_caught(tmp_path, monkeypatch):
     (pkg / "core" / "__init__.py").write_text("")
     (pkg / "core" / "bad.py").write_text("def handler():\n    import fastapi\n    return fastapi\n")
     config = tmp_path / "contracts.toml"
-    config.write_text('[tool.importlinter]\nroot_packages = ["demo"]\ninclude_external_packages = true\n\n'
-                      '[[tool.importlinter.contracts]]\nname = "core has no web"\ntype = "forbidden"\n'
-                      'source_modules = ["demo.core"]\nforbidden_modules = ["fastapi"]\n')
+    config.write_text(
+        '[tool.importlinter]\nroot_packages = ["demo"]\ninclude_external_packages = true\n\n'
+        '[[tool.importlinter.contracts]]\nname = "core has no web"\ntype = "forbidden"\n'
+        'source_modules = ["demo.core"]\nforbidden_modules = ["fastapi"]\n'
+    )
     monkeypatch.syspath_prepend(str(tmp_path))
     sys.modules.pop("demo", None)
     assert lint.lint_imports(config_filename=str(config), no_cache=True, no_logo=True) == 1
@@ -75,9 +87,11 @@ def test_a_hidden_cycle_is_caught(tmp_path, monkeypatch):
     (pkg / "paths.py").write_text("def taken():\n    from demo_cycle.segments import numbered\n    return numbered\n")
     (pkg / "segments.py").write_text("from demo_cycle.paths import taken\n\nnumbered = taken\n")
     config = tmp_path / "contracts.toml"
-    config.write_text('[tool.importlinter]\nroot_packages = ["demo_cycle"]\n\n'
-                      '[[tool.importlinter.contracts]]\nname = "acyclic"\ntype = "acyclic_siblings"\n'
-                      'ancestors = ["demo_cycle"]\n')
+    config.write_text(
+        '[tool.importlinter]\nroot_packages = ["demo_cycle"]\n\n'
+        '[[tool.importlinter.contracts]]\nname = "acyclic"\ntype = "acyclic_siblings"\n'
+        'ancestors = ["demo_cycle"]\n'
+    )
     monkeypatch.syspath_prepend(str(tmp_path))
     sys.modules.pop("demo_cycle", None)
     assert lint.lint_imports(config_filename=str(config), no_cache=True, no_logo=True) == 1
@@ -92,9 +106,11 @@ def test_an_unplaced_module_and_an_upward_import_are_caught(tmp_path, monkeypatc
     (pkg / "facade.py").write_text("from demo_layers.laws import law\n")
     (pkg / "laws.py").write_text("def law():\n    return 1.0\n")
     config = tmp_path / "contracts.toml"
-    config.write_text('[tool.importlinter]\nroot_packages = ["demo_layers"]\n\n'
-                      '[[tool.importlinter.contracts]]\nname = "layers"\ntype = "layers"\n'
-                      'containers = ["demo_layers"]\nexhaustive = true\nlayers = ["facade", "laws"]\n')
+    config.write_text(
+        '[tool.importlinter]\nroot_packages = ["demo_layers"]\n\n'
+        '[[tool.importlinter.contracts]]\nname = "layers"\ntype = "layers"\n'
+        'containers = ["demo_layers"]\nexhaustive = true\nlayers = ["facade", "laws"]\n'
+    )
     monkeypatch.syspath_prepend(str(tmp_path))
     for name in ("demo_layers", "demo_layers.facade", "demo_layers.laws"):
         sys.modules.pop(name, None)
@@ -114,6 +130,9 @@ def test_twin_imports_at_module_top():
         tree = ast.parse(path.read_text(encoding="utf-8"))
         for fn in ast.walk(tree):
             if isinstance(fn, (ast.FunctionDef, ast.AsyncFunctionDef)):
-                local += [f"{path.relative_to(ROOT)}:{st.lineno}" for st in ast.walk(fn)
-                          if isinstance(st, (ast.Import, ast.ImportFrom))]
+                local += [
+                    f"{path.relative_to(ROOT)}:{st.lineno}"
+                    for st in ast.walk(fn)
+                    if isinstance(st, (ast.Import, ast.ImportFrom))
+                ]
     assert local == []

@@ -33,8 +33,9 @@ TIMEOUT_S = 600
 
 def _blocks(lang: str) -> list[str]:
     """The fenced ```lang blocks of README.md and docs/*.md, in file order."""
-    return [block for path in DOC_FILES
-            for block in re.findall(rf"```{lang}\n(.*?)```", path.read_text(), flags=re.DOTALL)]
+    return [
+        block for path in DOC_FILES for block in re.findall(rf"```{lang}\n(.*?)```", path.read_text(), flags=re.DOTALL)
+    ]
 
 
 def readme_shell_lines() -> list[str]:
@@ -44,7 +45,7 @@ def readme_shell_lines() -> list[str]:
     for block in _blocks("sh"):
         text = block.replace("\\\n", " ")
         for line in text.splitlines():
-            line = re.sub(r"\s+#\s.*$", "", line).strip()     # trailing comment
+            line = re.sub(r"\s+#\s.*$", "", line).strip()  # trailing comment
             line = " ".join(line.split())
             if line and not line.startswith("#") and line not in out:
                 out.append(line)
@@ -58,19 +59,26 @@ SKIPPED = {
     r"pip install": "installation",
     r"docker ": "no docker in the test environment",
     r"host[AB]\$|anywhere\$|router\$": "several hosts: tests/service/test_end_to_end.py, test_fleet.py and "
-                                         "tests/hostile/test_zenoh_access.py run them on loopback",
+    "tests/hostile/test_zenoh_access.py run them on loopback",
     r"bearing-twin router": "runs until stopped: tests/service/test_fleet.py runs it",
     r"bearing-twin-loadtest soak --minutes 60 --url": "needs a service of its own: the --start variant is run",
     r"bearing-twin-loadtest attack --seconds 60 --url": "needs a service of its own: the --start variant is run",
     r"export BEARING_TWIN_TOKEN": "run by test_token_and_opcua_commands",
 }
-SERVED = (r"bearing-twin serve", r"curl ", r"bearing-twin monitor")   # run by test_serve_and_its_clients
+SERVED = (r"bearing-twin serve", r"curl ", r"bearing-twin monitor")  # run by test_serve_and_its_clients
 
 
-def _cli(*args: str, cwd: Path, env: dict | None = None, timeout: float = TIMEOUT_S,
-         module: str = "service.cli") -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", module, *args], cwd=cwd, capture_output=True, text=True,
-                          timeout=timeout, env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})})
+def _cli(
+    *args: str, cwd: Path, env: dict | None = None, timeout: float = TIMEOUT_S, module: str = "service.cli"
+) -> subprocess.CompletedProcess:
+    return subprocess.run(
+        [sys.executable, "-m", module, *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})},
+    )
 
 
 def _free_port() -> int:
@@ -87,30 +95,91 @@ def _scenario_files() -> list[str]:
 ONE_SHOT = {
     "bearing-twin scenario check": lambda out: ["scenario", "check", *_scenario_files()],
     "bearing-twin scenario run scenarios/seed000_startup_steady_slowdown.yaml": lambda out: [
-        "scenario", "run", "scenarios/seed000_startup_steady_slowdown.yaml", "--record", str(out / "out.rrd"),
-        "--table", str(out / "out.parquet"), "--no-progress"],
+        "scenario",
+        "run",
+        "scenarios/seed000_startup_steady_slowdown.yaml",
+        "--record",
+        str(out / "out.rrd"),
+        "--table",
+        str(out / "out.parquet"),
+        "--no-progress",
+    ],
     "bearing-twin scenario run scenarios/seed000_speed_sweep.yaml": lambda out: [
-        "scenario", "run", "scenarios/seed000_speed_sweep.yaml", "--table", str(out / "speed.parquet"),
-        "--record", str(out / "speed.rrd"), "--no-progress"],
+        "scenario",
+        "run",
+        "scenarios/seed000_speed_sweep.yaml",
+        "--table",
+        str(out / "speed.parquet"),
+        "--record",
+        str(out / "speed.rrd"),
+        "--no-progress",
+    ],
     "bearing-twin report": lambda out: ["report", "--out", str(out / "reports"), "--quick"],
     "bearing-twin simulate --bearing 6208": lambda out: [
-        "simulate", "--bearing", "6208", "--radial-load", "3000", "--speed", "500", "--duration", "0.05", "--json"],
+        "simulate",
+        "--bearing",
+        "6208",
+        "--radial-load",
+        "3000",
+        "--speed",
+        "500",
+        "--duration",
+        "0.05",
+        "--json",
+    ],
     "bearing-twin simulate --bearing 7208": lambda out: [
-        "simulate", "--bearing", "7208", "--radial-load", "3000", "--axial-load", "3000", "--clearance", "-1e-5",
-        "--dt", "1e-6"],
-    "bearing-twin bench": lambda out: ["bench", "--json", "--seconds", "0.01", "--repeats", "5",  # >= 5 repeats
-                                       "--save", str(out / "results")],
+        "simulate",
+        "--bearing",
+        "7208",
+        "--radial-load",
+        "3000",
+        "--axial-load",
+        "3000",
+        "--clearance",
+        "-1e-5",
+        "--dt",
+        "1e-6",
+    ],
+    "bearing-twin bench": lambda out: [
+        "bench",
+        "--json",
+        "--seconds",
+        "0.01",
+        "--repeats",
+        "5",  # >= 5 repeats
+        "--save",
+        str(out / "results"),
+    ],
     "bearing-twin timestep-study": lambda out: ["timestep-study", "--quick", "--json"],
-    "bearing-twin life": lambda out: ["life", "--bearing", "6208", "--radial-load", "3000", "--speed", "500",
-                                      "--json"],
+    "bearing-twin life": lambda out: ["life", "--bearing", "6208", "--radial-load", "3000", "--speed", "500", "--json"],
     "bearing-twin ehl solve": lambda out: ["ehl", "solve", "--current", "20", "--grid", "65", "--json"],
     "bearing-twin-loadtest bench-service": lambda out: ["bench-service", "--seconds", "3", "--json"],
     "bearing-twin-loadtest soak --minutes 10 --start": lambda out: ["soak", "--minutes", "0.3", "--start", "--json"],
-    "bearing-twin-loadtest attack --seconds 60 --start": lambda out: ["attack", "--seconds", "3", "--start",
-                                                                      "--baseline", "1", "--json"],
-    "bearing-twin vibration": lambda out: ["vibration", "--bearing", "6208", "--speed", "523", "--radial-load", "3000",
-                                           "--defect", "outer", "--duration", "0.1", "--json",
-                                           "--plot", str(out / "vib.png")],
+    "bearing-twin-loadtest attack --seconds 60 --start": lambda out: [
+        "attack",
+        "--seconds",
+        "3",
+        "--start",
+        "--baseline",
+        "1",
+        "--json",
+    ],
+    "bearing-twin vibration": lambda out: [
+        "vibration",
+        "--bearing",
+        "6208",
+        "--speed",
+        "523",
+        "--radial-load",
+        "3000",
+        "--defect",
+        "outer",
+        "--duration",
+        "0.1",
+        "--json",
+        "--plot",
+        str(out / "vib.png"),
+    ],
 }
 PYTHON_MODULES = {"python -m twin.validation.thermal_law_fit": ["-m", "twin.validation.thermal_law_fit"]}
 
@@ -148,7 +217,7 @@ def test_one_shot_command(prefix, tmp_path):
     assert "Traceback" not in res.stderr
     if "--json" in ONE_SHOT[prefix](tmp_path):
         json.loads(res.stdout.splitlines()[-1] if prefix.startswith("bearing-twin bench ") else res.stdout)
-    if "--save" in ONE_SHOT[prefix](tmp_path):   # the dated result file: machine and versions beside the figures
+    if "--save" in ONE_SHOT[prefix](tmp_path):  # the dated result file: machine and versions beside the figures
         (saved,) = (tmp_path / "results").glob("*-bench.json")
         data = json.loads(saved.read_text())
         assert data["environment"]["cpu_model"] and data["environment"]["versions"]["numba"]
@@ -157,8 +226,14 @@ def test_one_shot_command(prefix, tmp_path):
 
 @pytest.mark.parametrize("prefix", sorted(PYTHON_MODULES))
 def test_python_module_command(prefix, tmp_path):
-    res = subprocess.run([sys.executable, *PYTHON_MODULES[prefix]], cwd=tmp_path, capture_output=True, text=True,
-                         timeout=TIMEOUT_S, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    res = subprocess.run(
+        [sys.executable, *PYTHON_MODULES[prefix]],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert res.returncode == 0, res.stderr
 
 
@@ -166,7 +241,7 @@ def test_python_module_command(prefix, tmp_path):
 # block runs on its own, as printed
 SERVED_PYTHON = {"import zenoh": "test_serve_and_its_clients", "import asyncio": "test_token_and_opcua_commands"}
 # what a standalone block must print (first line -> text in its output), beside exiting 0
-PYTHON_PRINTS = {"from twin import Twin                     # the public face": "2073.6"}   # the 6208's limit
+PYTHON_PRINTS = {"from twin import Twin                     # the public face": "2073.6"}  # the 6208's limit
 
 
 def standalone_python_blocks() -> list[str]:
@@ -185,8 +260,14 @@ def test_every_python_block_is_covered():
 
 @pytest.mark.parametrize("block", standalone_python_blocks(), ids=lambda b: b.splitlines()[0][:40].strip())
 def test_python_block(block, tmp_path):
-    res = subprocess.run([sys.executable, "-c", block], cwd=tmp_path, capture_output=True, text=True,
-                         timeout=TIMEOUT_S, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    res = subprocess.run(
+        [sys.executable, "-c", block],
+        cwd=tmp_path,
+        capture_output=True,
+        text=True,
+        timeout=TIMEOUT_S,
+        env={**os.environ, "PYTHONPATH": str(ROOT)},
+    )
     assert res.returncode == 0, res.stderr
     for prefix, text in PYTHON_PRINTS.items():
         if block.startswith(prefix):
@@ -199,10 +280,23 @@ class _Serve:
     def __init__(self, cwd: Path, env: dict | None = None, extra: tuple[str, ...] = ()):
         self.port, self.zenoh = _free_port(), f"tcp/127.0.0.1:{_free_port()}"
         self.proc = subprocess.Popen(
-            [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port), "--zenoh-listen", self.zenoh,
-             *extra],
-            cwd=cwd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
-            env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})})
+            [
+                sys.executable,
+                "-m",
+                "service.cli",
+                "serve",
+                "--port",
+                str(self.port),
+                "--zenoh-listen",
+                self.zenoh,
+                *extra,
+            ],
+            cwd=cwd,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})},
+        )
 
     def wait_healthy(self, timeout_s: float = 180.0) -> None:
         import httpx
@@ -219,16 +313,22 @@ class _Serve:
         raise AssertionError("serve did not answer /health")
 
     def stop(self) -> str:
-        self.proc.send_signal(signal.SIGINT)          # Ctrl-C, as the README says
+        self.proc.send_signal(signal.SIGINT)  # Ctrl-C, as the README says
         out, _ = self.proc.communicate(timeout=60)
-        assert self.proc.returncode == 130, out      # 128 + SIGINT, after a clean shutdown
+        assert self.proc.returncode == 130, out  # 128 + SIGINT, after a clean shutdown
         return out
 
 
 def _shell(line: str, port: int, cwd: Path, env: dict | None = None) -> subprocess.CompletedProcess:
     line = line.replace("localhost:8000", f"127.0.0.1:{port}")
-    return subprocess.run(["bash", "-c", line], cwd=cwd, capture_output=True, text=True,
-                          timeout=120, env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})})
+    return subprocess.run(
+        ["bash", "-c", line],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        timeout=120,
+        env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})},
+    )
 
 
 @pytest.mark.skipif(shutil.which("curl") is None, reason="curl not installed")
@@ -244,7 +344,7 @@ def test_serve_and_its_clients(tmp_path):
         for line in curls:
             res = _shell(line, serve.port, tmp_path)
             assert res.returncode == 0 and res.stdout.strip(), (line, res.stderr)
-            assert '"detail"' not in res.stdout, (line, res.stdout[:500])      # no error answer
+            assert '"detail"' not in res.stdout, (line, res.stdout[:500])  # no error answer
         # the README's zenoh client snippet, on this service's endpoint
         (snippet,) = [b for b in _blocks("python") if b.startswith("import zenoh")]
         snippet = snippet.replace("tcp/127.0.0.1:7447", serve.zenoh)
@@ -263,8 +363,9 @@ def _documented_token() -> str:
     """The token made by the documented `export BEARING_TWIN_TOKEN=...` line."""
     (block,) = [b for b in _blocks("sh") if b.startswith("export BEARING_TWIN_TOKEN")]
     export = block.splitlines()[0]
-    token = subprocess.run(["bash", "-c", f"{export} && printf %s \"$BEARING_TWIN_TOKEN\""], capture_output=True,
-                           text=True, timeout=60).stdout
+    token = subprocess.run(
+        ["bash", "-c", f'{export} && printf %s "$BEARING_TWIN_TOKEN"'], capture_output=True, text=True, timeout=60
+    ).stdout
     assert len(token) >= 32
     return token
 
@@ -286,16 +387,21 @@ def test_token_and_opcua_commands(tmp_path):
         serve.wait_healthy()
         assert (tmp_path / "opcua-pki" / "server-cert.der").exists()
         for block in blocks:
-            res = subprocess.run([sys.executable, "-c", block.replace("opc.tcp://127.0.0.1:4840", opcua)],
-                                 cwd=tmp_path, capture_output=True, text=True, timeout=120,
-                                 env={**os.environ, "PYTHONPATH": str(ROOT), **env})
+            res = subprocess.run(
+                [sys.executable, "-c", block.replace("opc.tcp://127.0.0.1:4840", opcua)],
+                cwd=tmp_path,
+                capture_output=True,
+                text=True,
+                timeout=120,
+                env={**os.environ, "PYTHONPATH": str(ROOT), **env},
+            )
             assert res.returncode == 0, res.stdout + res.stderr
         assert (tmp_path / "client.der").exists()
-        float(res.stdout.split()[0])                                    # min_lambda read over OPC UA
+        float(res.stdout.split()[0])  # min_lambda read over OPC UA
         import httpx
 
         state = httpx.get(f"http://127.0.0.1:{serve.port}/v1/bearings/default", timeout=10.0).json()
-        assert state["setpoint"]["radial_load_n"] == 5000.0            # the OPC UA write landed
+        assert state["setpoint"]["radial_load_n"] == 5000.0  # the OPC UA write landed
         (line,) = [line for line in readme_shell_lines() if line.startswith("curl ") and "Authorization" in line]
         res = _shell(line, serve.port, tmp_path, env)
         assert res.returncode == 0 and '"radial_load_n":5000.0' in res.stdout, res.stdout + res.stderr

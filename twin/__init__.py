@@ -19,12 +19,28 @@ from __future__ import annotations
 import importlib
 from typing import TYPE_CHECKING, Any
 
-__all__ = ["BearingSpec", "Fault", "Setpoint", "SetpointError", "SetpointLimits", "SetpointUpdate",
-           "Snapshot", "Twin", "catalog"]
+__all__ = [
+    "BearingSpec",
+    "Fault",
+    "Setpoint",
+    "SetpointError",
+    "SetpointLimits",
+    "SetpointUpdate",
+    "Snapshot",
+    "Twin",
+    "catalog",
+]
 
-_WHERE = {"Twin": "twin.engine", "Setpoint": "twin.setpoint", "SetpointUpdate": "twin.setpoint",
-          "SetpointLimits": "twin.setpoint", "SetpointError": "twin.setpoint",
-          "Snapshot": "twin.snapshot", "BearingSpec": "twin.spec", "Fault": "twin.faults"}
+_WHERE = {
+    "Twin": "twin.engine",
+    "Setpoint": "twin.setpoint",
+    "SetpointUpdate": "twin.setpoint",
+    "SetpointLimits": "twin.setpoint",
+    "SetpointError": "twin.setpoint",
+    "Snapshot": "twin.snapshot",
+    "BearingSpec": "twin.spec",
+    "Fault": "twin.faults",
+}
 
 if TYPE_CHECKING:
     from twin import catalog

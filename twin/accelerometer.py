@@ -154,9 +154,15 @@ class SensorReader:
 
     def drain_waveform(self) -> list[WaveformBlock]:
         """The samples not yet taken, as contiguous blocks (oldest first); empties the queue."""
-        out = [WaveformBlock(t0_s=float(t0), sample_rate_hz=self.sample_rate_hz,
-                             samples=np.concatenate(parts).astype(np.float32, copy=False), lost_before=int(lost))
-               for t0, parts, _, lost in self._queue]
+        out = [
+            WaveformBlock(
+                t0_s=float(t0),
+                sample_rate_hz=self.sample_rate_hz,
+                samples=np.concatenate(parts).astype(np.float32, copy=False),
+                lost_before=int(lost),
+            )
+            for t0, parts, _, lost in self._queue
+        ]
         self._queue.clear()
         self._queued = 0
         self._break = True
@@ -168,14 +174,15 @@ class SensorReader:
         n = samples.size
         while i < n:
             take = min(n - i, self.window_samples - self._fill)
-            self._window[self._fill:self._fill + take] = samples[i:i + take]
+            self._window[self._fill : self._fill + take] = samples[i : i + take]
             self._speed_sum += take * shaft_speed_rad_s
             self._fill += take
             i += take
             if self._fill == self.window_samples:
                 end = t0 + (i - 1) / self.sample_rate_hz
-                self.latest = window_indicators(self.model, self._window, self._speed_sum / self.window_samples,
-                                                state, end)
+                self.latest = window_indicators(
+                    self.model, self._window, self._speed_sum / self.window_samples, state, end
+                )
                 self._fill = 0
                 self._speed_sum = 0.0
                 done = True
@@ -195,24 +202,49 @@ def window_indicators(model, window_m_s2: np.ndarray, shaft_speed_rad_s: float, 
     """`twin.snapshot.VibrationState` of one window (module docstring)."""
     fs = model.decimator.output_rate_hz
     angle = contact_angle_of_lanes_rad(model, state)
-    r = run_vibration(window_m_s2, fs, model.spec, shaft_speed_rad_s, contact_angle_rad=angle,
-                      housing=model.spec.housing, window_s=window_m_s2.size / fs, spectra=True)
-    lines = {name: DefectLine(frequency_hz=v["frequency_hz"], harmonics=tuple(v["harmonics"]),
-                              sidebands=(v["sidebands"]["lower"], v["sidebands"]["upper"]) if "sidebands" in v else None)
-             for name, v in r["defect_lines"].items()}
+    r = run_vibration(
+        window_m_s2,
+        fs,
+        model.spec,
+        shaft_speed_rad_s,
+        contact_angle_rad=angle,
+        housing=model.spec.housing,
+        window_s=window_m_s2.size / fs,
+        spectra=True,
+    )
+    lines = {
+        name: DefectLine(
+            frequency_hz=v["frequency_hz"],
+            harmonics=tuple(v["harmonics"]),
+            sidebands=(v["sidebands"]["lower"], v["sidebands"]["upper"]) if "sidebands" in v else None,
+        )
+        for name, v in r["defect_lines"].items()
+    }
     return VibrationState(
-        window_end_s=float(end_time_s), window_s=r["window_s"], sample_rate_hz=fs,
-        shaft_speed_rad_s=float(shaft_speed_rad_s), contact_angle_rad=float(angle),
-        rms_m_s2=r["rms_m_s2"], peak_m_s2=r["peak_m_s2"], crest_factor=r["crest_factor"],
-        kurtosis=r["kurtosis"], band_kurtosis=r["band_kurtosis"], velocity_rms_mm_s=r["velocity_rms_mm_s"],
+        window_end_s=float(end_time_s),
+        window_s=r["window_s"],
+        sample_rate_hz=fs,
+        shaft_speed_rad_s=float(shaft_speed_rad_s),
+        contact_angle_rad=float(angle),
+        rms_m_s2=r["rms_m_s2"],
+        peak_m_s2=r["peak_m_s2"],
+        crest_factor=r["crest_factor"],
+        kurtosis=r["kurtosis"],
+        band_kurtosis=r["band_kurtosis"],
+        velocity_rms_mm_s=r["velocity_rms_mm_s"],
         defect_frequencies_hz=DefectFrequenciesHz(**r["defect_frequencies_hz"]),
         envelope_band_hz=tuple(r["envelope_band_hz"]),
         envelope_peaks_hz=tuple(EnvelopePeak(**p) for p in r["envelope_peaks_hz"]),
-        envelope_noise_floor_m_s2=r["noise_floor_m_s2"], envelope_lines=lines,
+        envelope_noise_floor_m_s2=r["noise_floor_m_s2"],
+        envelope_lines=lines,
         envelope_spectrum=_spectrum(Spectrum, r["envelope_spectrum"]),
-        amplitude_spectrum=_spectrum(Spectrum, r["amplitude_spectrum"]))
+        amplitude_spectrum=_spectrum(Spectrum, r["amplitude_spectrum"]),
+    )
 
 
 def _spectrum(cls, s: dict):
-    return cls(start_hz=float(s["start_hz"]), step_hz=float(s["step_hz"]),
-               amplitude_m_s2=tuple(np.asarray(s["amplitude_m_s2"], dtype=float).tolist()))
+    return cls(
+        start_hz=float(s["start_hz"]),
+        step_hz=float(s["step_hz"]),
+        amplitude_m_s2=tuple(np.asarray(s["amplitude_m_s2"], dtype=float).tolist()),
+    )

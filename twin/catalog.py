@@ -51,12 +51,35 @@ DEFAULT_DESIGNATION = "6208"
 _POCKET_CLEARANCE_M = 30e-6
 
 # ISO 15 ring width B [mm] of the dimension series 02 (62xx, 72xx): the rings' lands' capacitance
-_RING_WIDTH_MM = {"6200": 9.0, "6201": 10.0, "6202": 11.0, "6203": 12.0, "6204": 14.0, "6205": 15.0,
-                  "6206": 16.0, "6207": 17.0, "6208": 18.0, "6209": 19.0, "6210": 20.0, "7208": 18.0}
+_RING_WIDTH_MM = {
+    "6200": 9.0,
+    "6201": 10.0,
+    "6202": 11.0,
+    "6203": 12.0,
+    "6204": 14.0,
+    "6205": 15.0,
+    "6206": 16.0,
+    "6207": 17.0,
+    "6208": 18.0,
+    "6209": 19.0,
+    "6210": 20.0,
+    "7208": 18.0,
+}
 
 # ISO 3448 grade (nu_40 in mm^2/s) -> nu_100 [mm^2/s] of a VI ~ 100 mineral oil (ASTM D2270 table)
-_ISO_VG_NU100_MM2_S = {10: 2.6, 15: 3.3, 22: 4.2, 32: 5.4, 46: 6.8, 68: 8.7, 100: 11.1,
-                       150: 14.5, 220: 18.8, 320: 24.0, 460: 30.5}
+_ISO_VG_NU100_MM2_S = {
+    10: 2.6,
+    15: 3.3,
+    22: 4.2,
+    32: 5.4,
+    46: 6.8,
+    68: 8.7,
+    100: 11.1,
+    150: 14.5,
+    220: 18.8,
+    320: 24.0,
+    460: 30.5,
+}
 
 
 # ISO 15312 thermal reference speed [r/min] of the SKF executions (SKF Rolling bearings catalogue,
@@ -71,17 +94,27 @@ def thermal_reference_speed_rad_s(designation: str) -> float:
     """ISO 15312 thermal reference speed of a catalog bearing [rad/s] (SKF product tables)."""
     key = designation.strip().upper()
     if key not in _THERMAL_REFERENCE_SPEED_RPM:
-        raise ValueError(f"designation = {designation!r}: a thermal reference speed is known for "
-                         f"{', '.join(sorted(_THERMAL_REFERENCE_SPEED_RPM))}")
+        raise ValueError(
+            f"designation = {designation!r}: a thermal reference speed is known for "
+            f"{', '.join(sorted(_THERMAL_REFERENCE_SPEED_RPM))}"
+        )
     return _THERMAL_REFERENCE_SPEED_RPM[key] * math.pi / 30.0
 
 
 def _seed_6208() -> Geometry:
     return Geometry(
-        ball_radius_m=6.3e-3, ball_count=9, inner_raceway_radius_m=24.0e-3,
-        outer_raceway_radius_m=36.6e-3, inner_groove_radius_m=6.552e-3,
-        outer_groove_radius_m=6.552e-3, cage_element_radius_m=4.19e-3,
-        nominal_contact_angle_deg=0.0, cage_mass_kg=0.02, bore_diameter_m=40e-3, outside_diameter_m=80e-3)
+        ball_radius_m=6.3e-3,
+        ball_count=9,
+        inner_raceway_radius_m=24.0e-3,
+        outer_raceway_radius_m=36.6e-3,
+        inner_groove_radius_m=6.552e-3,
+        outer_groove_radius_m=6.552e-3,
+        cage_element_radius_m=4.19e-3,
+        nominal_contact_angle_deg=0.0,
+        cage_mass_kg=0.02,
+        bore_diameter_m=40e-3,
+        outside_diameter_m=80e-3,
+    )
 
 
 # angular-contact executions of the 7208 with seed 004's geometry: designation -> contact angle
@@ -92,10 +125,18 @@ def _seed_7208(contact_angle_deg: float) -> Geometry:
     rb = 6.3e-3
     groove = 0.5 * (1.0 + 0.14) * 2.0 * rb  # B = 0.14 (seed 004 section 3) -> 7.182 mm
     return Geometry(
-        ball_radius_m=rb, ball_count=13, inner_raceway_radius_m=24.0e-3,
-        outer_raceway_radius_m=36.6e-3, inner_groove_radius_m=groove, outer_groove_radius_m=groove,
-        cage_element_radius_m=1.01e-3, nominal_contact_angle_deg=contact_angle_deg, cage_mass_kg=0.025,
-        bore_diameter_m=40e-3, outside_diameter_m=80e-3)
+        ball_radius_m=rb,
+        ball_count=13,
+        inner_raceway_radius_m=24.0e-3,
+        outer_raceway_radius_m=36.6e-3,
+        inner_groove_radius_m=groove,
+        outer_groove_radius_m=groove,
+        cage_element_radius_m=1.01e-3,
+        nominal_contact_angle_deg=contact_angle_deg,
+        cage_mass_kg=0.025,
+        bore_diameter_m=40e-3,
+        outside_diameter_m=80e-3,
+    )
 
 
 def _deep_groove(bore_mm: float, od_mm: float, z: int, dw_mm: float) -> Geometry:
@@ -103,11 +144,17 @@ def _deep_groove(bore_mm: float, od_mm: float, z: int, dw_mm: float) -> Geometry
     pitch = 0.25 * (bore_mm + od_mm) * 1e-3
     half_chord = 2.0 * pitch * math.sin(math.pi / (2 * z))
     return Geometry(
-        ball_radius_m=rb, ball_count=z, inner_raceway_radius_m=pitch - rb,
-        outer_raceway_radius_m=pitch + rb, inner_groove_radius_m=0.52 * 2 * rb,
+        ball_radius_m=rb,
+        ball_count=z,
+        inner_raceway_radius_m=pitch - rb,
+        outer_raceway_radius_m=pitch + rb,
+        inner_groove_radius_m=0.52 * 2 * rb,
         outer_groove_radius_m=0.52 * 2 * rb,
         cage_element_radius_m=half_chord - rb - _POCKET_CLEARANCE_M,
-        cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3, bore_diameter_m=bore_mm * 1e-3, outside_diameter_m=od_mm * 1e-3)
+        cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3,
+        bore_diameter_m=bore_mm * 1e-3,
+        outside_diameter_m=od_mm * 1e-3,
+    )
 
 
 # ---- the CWRU drive-end test bearing ---------------------------------------------------------
@@ -115,8 +162,8 @@ def _deep_groove(bore_mm: float, od_mm: float, z: int, dw_mm: float) -> Geometry
 # a 2 hp Reliance induction motor whose drive-end shaft runs in an SKF 6205-2RS JEM, the
 # accelerometer on a magnetic base at 12 o'clock on the motor housing.
 _INCH_M = 0.0254
-CWRU_BALL_DIAMETER_M = 0.3126 * _INCH_M   # 7.940 mm (data center: bearing specification)
-CWRU_PITCH_DIAMETER_M = 1.537 * _INCH_M   # 39.04 mm
+CWRU_BALL_DIAMETER_M = 0.3126 * _INCH_M  # 7.940 mm (data center: bearing specification)
+CWRU_PITCH_DIAMETER_M = 1.537 * _INCH_M  # 39.04 mm
 # Not published; estimated. The rotor of a 2 hp 4-pole induction motor (NEMA 145T frame: core about
 # 90 mm across and 100 mm long, 5 kg of steel and copper, 1.5 kg of shaft) is ~6.5 kg; the drive-end
 # bearing carries half of it plus half of the coupling to the torque transducer (~1 kg): 3.75 kg on
@@ -164,19 +211,36 @@ def _cwru_drive_end() -> BearingSpec:
     z = 9
     half_chord = 2.0 * pitch * math.sin(math.pi / (2 * z))
     geometry = Geometry(
-        ball_radius_m=rb, ball_count=z, inner_raceway_radius_m=pitch - rb, outer_raceway_radius_m=pitch + rb,
-        inner_groove_radius_m=0.52 * 2 * rb, outer_groove_radius_m=0.52 * 2 * rb,
+        ball_radius_m=rb,
+        ball_count=z,
+        inner_raceway_radius_m=pitch - rb,
+        outer_raceway_radius_m=pitch + rb,
+        inner_groove_radius_m=0.52 * 2 * rb,
+        outer_groove_radius_m=0.52 * 2 * rb,
         cage_element_radius_m=half_chord - rb - _POCKET_CLEARANCE_M,
-        cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3, ring_width_m=15.0e-3)
+        cage_mass_kg=0.02 * (pitch / 30.3e-3) ** 3,
+        ring_width_m=15.0e-3,
+    )
     housing = Housing(
-        enabled=True, sprung_stiffness_n_m=CWRU_SPRUNG_STIFFNESS_N_M, sprung_damping_n_s_m=CWRU_SPRUNG_DAMPING_N_S_M,
-        accelerometer=Accelerometer(azimuth_deg=180.0, sample_rate_hz=12000.0, window_s=1.0,
-                                    noise_density_m_s2_rthz=CWRU_NOISE_DENSITY_M_S2_RTHZ))
+        enabled=True,
+        sprung_stiffness_n_m=CWRU_SPRUNG_STIFFNESS_N_M,
+        sprung_damping_n_s_m=CWRU_SPRUNG_DAMPING_N_S_M,
+        accelerometer=Accelerometer(
+            azimuth_deg=180.0,
+            sample_rate_hz=12000.0,
+            window_s=1.0,
+            noise_density_m_s2_rthz=CWRU_NOISE_DENSITY_M_S2_RTHZ,
+        ),
+    )
     return BearingSpec(
-        designation="CWRU-DE", kind="deep_groove", geometry=geometry,
+        designation="CWRU-DE",
+        kind="deep_groove",
+        geometry=geometry,
         mounting=Mounting(diametral_clearance_m=CWRU_DIAMETRAL_CLEARANCE_M, rotor_mass_kg=CWRU_ROTOR_MASS_KG),
-        lubricant=Lubricant(), housing=housing,
-        surface_profile=SurfaceProfile(enabled=True, race_profile_rms_m=CWRU_RACE_PROFILE_RMS_M))
+        lubricant=Lubricant(),
+        housing=housing,
+        surface_profile=SurfaceProfile(enabled=True, race_profile_rms_m=CWRU_RACE_PROFILE_RMS_M),
+    )
 
 
 def default_radial_load_n(designation: str) -> float | None:
@@ -190,8 +254,13 @@ def designations() -> list[str]:
     return sorted(["6208", "7208", "7208AC", "7208C", "CWRU-DE", *_DEEP_GROOVE_MM])
 
 
-def bearing(designation: str = DEFAULT_DESIGNATION, *, diametral_clearance_m: float = 0.0,
-            lubricant: Lubricant | None = None, **spec_fields) -> BearingSpec:
+def bearing(
+    designation: str = DEFAULT_DESIGNATION,
+    *,
+    diametral_clearance_m: float = 0.0,
+    lubricant: Lubricant | None = None,
+    **spec_fields,
+) -> BearingSpec:
     """The spec of a catalog bearing with the given mounting clearance [m] and lubricant."""
     key = designation.strip().upper()
     if key == "CWRU-DE":
@@ -218,8 +287,14 @@ def bearing(designation: str = DEFAULT_DESIGNATION, *, diametral_clearance_m: fl
     if width is not None and geometry.ring_width_m is None:
         geometry = geometry.model_copy(update={"ring_width_m": width * 1e-3})
     mounting = Mounting(diametral_clearance_m=diametral_clearance_m)
-    return BearingSpec(designation=key, kind=kind, geometry=geometry, mounting=mounting,
-                       lubricant=lubricant or Lubricant(), **spec_fields)
+    return BearingSpec(
+        designation=key,
+        kind=kind,
+        geometry=geometry,
+        mounting=mounting,
+        lubricant=lubricant or Lubricant(),
+        **spec_fields,
+    )
 
 
 def lubricant(name: str = "seed-000") -> Lubricant:
@@ -229,10 +304,14 @@ def lubricant(name: str = "seed-000") -> Lubricant:
         return Lubricant()
     if key.isdigit() and int(key) in _ISO_VG_NU100_MM2_S:
         grade = int(key)
-        return Lubricant(name=f"ISO VG {grade}", kinematic_viscosity_40c_m2_s=grade * 1e-6,
-                         kinematic_viscosity_100c_m2_s=_ISO_VG_NU100_MM2_S[grade] * 1e-6)
-    raise ValueError(f"lubricant: unknown {name!r}; use 'seed-000' or 'ISO VG n' with n in "
-                     f"{sorted(_ISO_VG_NU100_MM2_S)}")
+        return Lubricant(
+            name=f"ISO VG {grade}",
+            kinematic_viscosity_40c_m2_s=grade * 1e-6,
+            kinematic_viscosity_100c_m2_s=_ISO_VG_NU100_MM2_S[grade] * 1e-6,
+        )
+    raise ValueError(
+        f"lubricant: unknown {name!r}; use 'seed-000' or 'ISO VG n' with n in {sorted(_ISO_VG_NU100_MM2_S)}"
+    )
 
 
 # ---- load ratings (rating life, twin.life) ---------------------------------------------------
@@ -242,22 +321,25 @@ def lubricant(name: str = "seed-000") -> Lubricant:
 # tests/life against ISO 281:2007 clause 5.1 (C from the geometry) and ISO 76 (C0 = f0 Z Dw^2
 # cos(alpha)): every entry agrees with the twin's own geometry within 10 %.
 
+
 @dataclass(frozen=True)
 class LoadRatings:
     """Catalogue load ratings of one bearing execution (SI)."""
 
     designation: str
-    contact_angle_deg: float         # nominal contact angle of the catalogued execution [deg]
-    dynamic_load_rating_n: float     # basic dynamic radial load rating C [N] (ISO 281)
-    static_load_rating_n: float      # basic static radial load rating C0 [N] (ISO 76)
-    fatigue_load_limit_n: float      # fatigue load limit Pu = Cu of ISO 281:2007 clause 9.3 [N]
-    source: str                      # where the numbers come from
+    contact_angle_deg: float  # nominal contact angle of the catalogued execution [deg]
+    dynamic_load_rating_n: float  # basic dynamic radial load rating C [N] (ISO 281)
+    static_load_rating_n: float  # basic static radial load rating C0 [N] (ISO 76)
+    fatigue_load_limit_n: float  # fatigue load limit Pu = Cu of ISO 281:2007 clause 9.3 [N]
+    source: str  # where the numbers come from
 
 
 _SKF_2018 = "SKF Rolling bearings catalogue (PUB BU/P1 17000/1 EN, 2018) and skf.com product page, SKF Explorer"
 _SKF_7208B = "SKF General Catalogue 6000/I EN (2008), single row angular contact ball bearing 7208 BEP (40 deg)"
-_GB_292 = ("GB/T 292 single row angular contact ball bearings as tabulated in Chinese machine-design handbooks "
-           "(C, C0); Pu not catalogued there: C0 / 23.5, the C0/Pu ratio of every SKF entry of this table")
+_GB_292 = (
+    "GB/T 292 single row angular contact ball bearings as tabulated in Chinese machine-design handbooks "
+    "(C, C0); Pu not catalogued there: C0 / 23.5, the C0/Pu ratio of every SKF entry of this table"
+)
 
 # designation: (contact angle deg, C kN, C0 kN, Pu kN, source)
 _LOAD_RATINGS_KN = {
@@ -285,11 +367,18 @@ def load_ratings(designation: str) -> LoadRatings:
     key = designation.strip().upper().replace(" ", "").replace("-", "")
     key = _RATING_ALIASES.get(key, key)
     if key not in _LOAD_RATINGS_KN:
-        raise ValueError(f"designation: no load ratings for {designation!r}; known: "
-                         f"{', '.join(sorted(_LOAD_RATINGS_KN))}")
+        raise ValueError(
+            f"designation: no load ratings for {designation!r}; known: {', '.join(sorted(_LOAD_RATINGS_KN))}"
+        )
     angle, c, c0, pu, source = _LOAD_RATINGS_KN[key]
-    return LoadRatings(designation=key, contact_angle_deg=angle, dynamic_load_rating_n=c * 1e3,
-                       static_load_rating_n=c0 * 1e3, fatigue_load_limit_n=pu * 1e3, source=source)
+    return LoadRatings(
+        designation=key,
+        contact_angle_deg=angle,
+        dynamic_load_rating_n=c * 1e3,
+        static_load_rating_n=c0 * 1e3,
+        fatigue_load_limit_n=pu * 1e3,
+        source=source,
+    )
 
 
 def rated_designations() -> list[str]:
@@ -316,8 +405,9 @@ def load_spec_file(path: str) -> BearingSpec:
     try:
         data = json.loads(text) if file.suffix.lower() == ".json" else yaml.safe_load(text)
     except (json.JSONDecodeError, yaml.YAMLError) as exc:
-        raise ValueError(f"bearing: spec file {path!r} is not valid {file.suffix[1:].upper()}: "
-                         f"{str(exc).splitlines()[0]}") from None
+        raise ValueError(
+            f"bearing: spec file {path!r} is not valid {file.suffix[1:].upper()}: {str(exc).splitlines()[0]}"
+        ) from None
     if not isinstance(data, dict):
         raise ValueError(f"bearing: spec file {path!r} must hold a mapping of BearingSpec fields")
     return BearingSpec.model_validate(data)

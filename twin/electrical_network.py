@@ -34,15 +34,15 @@ CAPACITIVE_PHASE_RAD = -math.pi / 4.0  # the network is capacitive at or below t
 class ElectricalNetwork:
     """Network values and indicators (SI)."""
 
-    contact_resistance_ohm: np.ndarray   # (2Z,), inf for open contacts
-    contact_capacitance_f: np.ndarray    # (2Z,)
-    ball_resistance_ohm: np.ndarray      # (Z,) series R_in + R_out, inf if either is open
-    ball_capacitance_f: np.ndarray       # (Z,) series C_in C_out / (C_in + C_out)
-    resistance_ohm: float                # 1 / Re(Y) at the frequency (inf: no conduction)
-    capacitance_f: float | None          # Im(Y) / omega where the network is capacitive, else None
-    capacitance_reason: str | None       # why capacitance_f is None (None when it is published)
-    impedance_ohm: float                 # |Z|
-    phase_rad: float                     # arg Z (-pi/2: capacitive, 0: resistive)
+    contact_resistance_ohm: np.ndarray  # (2Z,), inf for open contacts
+    contact_capacitance_f: np.ndarray  # (2Z,)
+    ball_resistance_ohm: np.ndarray  # (Z,) series R_in + R_out, inf if either is open
+    ball_capacitance_f: np.ndarray  # (Z,) series C_in C_out / (C_in + C_out)
+    resistance_ohm: float  # 1 / Re(Y) at the frequency (inf: no conduction)
+    capacitance_f: float | None  # Im(Y) / omega where the network is capacitive, else None
+    capacitance_reason: str | None  # why capacitance_f is None (None when it is published)
+    impedance_ohm: float  # |Z|
+    phase_rad: float  # arg Z (-pi/2: capacitive, 0: resistive)
     frequency_hz: float
     shaft_voltage_v: float
     shaft_current_a: float
@@ -55,12 +55,17 @@ class ElectricalNetwork:
 def _open_contact_capacitance(model: BearingModel, r: int, gap_m: np.ndarray) -> np.ndarray:
     el = model.spec.electrical
     rx, ry = model.race_params[r, L.R_RX], model.race_params[r, L.R_RY]
-    return np.array([outer_zone_capacitance_f(el.oil_relative_permittivity, rx, ry, max(g, _MIN_GAP_M),
-                                              model.gap_limit_m[r]) for g in gap_m])
+    return np.array(
+        [
+            outer_zone_capacitance_f(el.oil_relative_permittivity, rx, ry, max(g, _MIN_GAP_M), model.gap_limit_m[r])
+            for g in gap_m
+        ]
+    )
 
 
-def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: float,
-                    shaft_current_a: float) -> ElectricalNetwork:
+def bearing_network(
+    model: BearingModel, contacts: np.ndarray, shaft_voltage_v: float, shaft_current_a: float
+) -> ElectricalNetwork:
     """Evaluate the network for the contact rows `contacts` (TwinState.contacts view)."""
     el = model.spec.electrical
     z = model.ball_count
@@ -108,34 +113,55 @@ def bearing_network(model: BearingModel, contacts: np.ndarray, shaft_voltage_v: 
     capacitance_reason: str | None = None
     if phase > CAPACITIVE_PHASE_RAD:
         capacitance = None
-        capacitance_reason = (f"not capacitive: impedance phase {math.degrees(phase):.1f} deg above -45 deg at "
-                              f"{el.frequency_hz:g} Hz (conduction through asperity contacts dominates); "
-                              f"|Z| = {abs(z_total):.4g} ohm")
+        capacitance_reason = (
+            f"not capacitive: impedance phase {math.degrees(phase):.1f} deg above -45 deg at "
+            f"{el.frequency_hz:g} Hz (conduction through asperity contacts dominates); "
+            f"|Z| = {abs(z_total):.4g} ohm"
+        )
     return ElectricalNetwork(
-        contact_resistance_ohm=r_c, contact_capacitance_f=c_c, ball_resistance_ohm=r_ball,
-        ball_capacitance_f=c_ball, resistance_ohm=(1.0 / y.real) if y.real > 0 else math.inf,
-        capacitance_f=capacitance, capacitance_reason=capacitance_reason, impedance_ohm=abs(z_total),
+        contact_resistance_ohm=r_c,
+        contact_capacitance_f=c_c,
+        ball_resistance_ohm=r_ball,
+        ball_capacitance_f=c_ball,
+        resistance_ohm=(1.0 / y.real) if y.real > 0 else math.inf,
+        capacitance_f=capacitance,
+        capacitance_reason=capacitance_reason,
+        impedance_ohm=abs(z_total),
         phase_rad=phase,
-        frequency_hz=el.frequency_hz, shaft_voltage_v=voltage, shaft_current_a=current,
-        max_film_field_v_m=max_field, current_density_a_m2=max_density, discharge_risk=risk,
-        reason=reason)
+        frequency_hz=el.frequency_hz,
+        shaft_voltage_v=voltage,
+        shaft_current_a=current,
+        max_film_field_v_m=max_field,
+        current_density_a_m2=max_density,
+        discharge_risk=risk,
+        reason=reason,
+    )
 
 
 def _risk(el, field, density, voltage, current) -> tuple[DischargeRisk, str]:
     if voltage <= 0.0 and current <= 0.0:
         return "none", "no shaft voltage or current"
     if density >= el.fluting_current_density_a_m2:
-        return "likely", (f"apparent current density {density / 1e6:.2f} A/mm^2 above the fluting threshold "
-                          f"{el.fluting_current_density_a_m2 / 1e6:.2f} A/mm^2")
+        return "likely", (
+            f"apparent current density {density / 1e6:.2f} A/mm^2 above the fluting threshold "
+            f"{el.fluting_current_density_a_m2 / 1e6:.2f} A/mm^2"
+        )
     if field >= el.breakdown_field_v_m:
-        return "likely", (f"film field {field / 1e6:.1f} V/um above the oil's breakdown strength "
-                          f"{el.breakdown_field_v_m / 1e6:.1f} V/um: discharges through the film")
+        return "likely", (
+            f"film field {field / 1e6:.1f} V/um above the oil's breakdown strength "
+            f"{el.breakdown_field_v_m / 1e6:.1f} V/um: discharges through the film"
+        )
     if density >= el.harmless_current_density_a_m2:
-        return "possible", (f"apparent current density {density / 1e6:.2f} A/mm^2 between the harmless "
-                            f"{el.harmless_current_density_a_m2 / 1e6:.2f} and fluting "
-                            f"{el.fluting_current_density_a_m2 / 1e6:.2f} A/mm^2 thresholds")
+        return "possible", (
+            f"apparent current density {density / 1e6:.2f} A/mm^2 between the harmless "
+            f"{el.harmless_current_density_a_m2 / 1e6:.2f} and fluting "
+            f"{el.fluting_current_density_a_m2 / 1e6:.2f} A/mm^2 thresholds"
+        )
     if field >= 0.5 * el.breakdown_field_v_m:
-        return "possible", (f"film field {field / 1e6:.1f} V/um above half the breakdown strength "
-                            f"{el.breakdown_field_v_m / 1e6:.1f} V/um")
-    return "none", (f"current density {density / 1e6:.3f} A/mm^2 and film field {field / 1e6:.2f} V/um "
-                    "below the thresholds")
+        return "possible", (
+            f"film field {field / 1e6:.1f} V/um above half the breakdown strength "
+            f"{el.breakdown_field_v_m / 1e6:.1f} V/um"
+        )
+    return "none", (
+        f"current density {density / 1e6:.3f} A/mm^2 and film field {field / 1e6:.2f} V/um below the thresholds"
+    )

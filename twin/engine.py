@@ -56,10 +56,17 @@ class Twin:
     >>> twin.snapshot().balls[0].inner.load_n
     """
 
-    def __init__(self, bearing: str | BearingSpec = "6208", *, options: ModelOptions | None = None,
-                 setpoint: Setpoint | None = None, bearing_id: str = "default",
-                 diametral_clearance_m: float | None = None, warm: bool = True,
-                 life: LifeSettings | None = None):
+    def __init__(
+        self,
+        bearing: str | BearingSpec = "6208",
+        *,
+        options: ModelOptions | None = None,
+        setpoint: Setpoint | None = None,
+        bearing_id: str = "default",
+        diametral_clearance_m: float | None = None,
+        warm: bool = True,
+        life: LifeSettings | None = None,
+    ):
         spec = bearing if isinstance(bearing, BearingSpec) else catalog.bearing(bearing)
         if diametral_clearance_m is not None:
             mounting = spec.mounting.model_copy(update={"diametral_clearance_m": diametral_clearance_m})
@@ -75,13 +82,13 @@ class Twin:
         """Allowed [low, high] of each setpoint field for this bearing (twin.setpoint)."""
         self.seq = 0
         self.restarts = 0
-        self.frame_interrupted = False   # the last advance ended early (interrupt_frame)
-        self.fault: Fault | None = None   # the last fault (None: none since start or the last new setpoint)
+        self.frame_interrupted = False  # the last advance ended early (interrupt_frame)
+        self.fault: Fault | None = None  # the last fault (None: none since start or the last new setpoint)
         self.halted = False
         self._last_restart_time_s = -math.inf
         self._last_good_time_s = 0.0
         self._last_torque_n_m = 0.0
-        self._contact_torque_n_m = 0.0   # friction torque of the contacts over the last frame [N m]
+        self._contact_torque_n_m = 0.0  # friction torque of the contacts over the last frame [N m]
         self.inlet = InletFilm(self.model)
         """The inlet's film losses and the balls' drag (twin.inlet_film), refreshed between frames."""
         self._seal_moment_n_m = seal_moment_n_m(spec)
@@ -95,8 +102,12 @@ class Twin:
             opts = self.model.options
             period = opts.thermal_period_s * opts.thermal_network.heat_capacity_scale  # thermal -> simulated time
             frames = max(1, int(round(period / FRAME_S)))
-            self.thermal = ThermalCoupling(self.model, opts.thermal_network, frames * FRAME_S,
-                                           (setpoint or self.default_setpoint()).oil_temperature_c)
+            self.thermal = ThermalCoupling(
+                self.model,
+                opts.thermal_network,
+                frames * FRAME_S,
+                (setpoint or self.default_setpoint()).oil_temperature_c,
+            )
         c = self.state.contacts
         self._groove_lanes = (c[L.M_GROOVE_CENTRE_RADIUS].copy(), c[L.M_GROOVE_CLEARANCE].copy())
         self._apply(self.limits.admit(setpoint or self.default_setpoint()))
@@ -110,8 +121,9 @@ class Twin:
         m = self.model
         radial = min(3000.0, round(0.25 * m.max_radial_load_n))
         axial = min(radial, round(0.25 * m.max_axial_load_n)) if m.spec.kind == "angular_contact" else 0.0
-        return Setpoint(shaft_speed_rad_s=min(500.0, 0.5 * m.max_shaft_speed_rad_s),
-                        radial_load_n=radial, axial_load_n=axial)
+        return Setpoint(
+            shaft_speed_rad_s=min(500.0, 0.5 * m.max_shaft_speed_rad_s), radial_load_n=radial, axial_load_n=axial
+        )
 
     # ---- setpoint ---------------------------------------------------------------------------
     @property
@@ -170,7 +182,7 @@ class Twin:
         t = np.asarray(temperature_c, dtype=float)
         if t.shape != th.temperature_c.shape or not np.all(np.isfinite(t)) or t.min() < -60.0 or t.max() > 400.0:
             raise ValueError(f"temperature_c: {th.temperature_c.size} finite node temperatures in [-60, 400] degC")
-        th.filter.x[:t.size] = t
+        th.filter.x[: t.size] = t
         write_groove_lanes(self.state.contacts, self._groove_lanes, th.expansion, self.model.ball_count)
         self._refresh_oil_viscosity()
 
@@ -207,9 +219,15 @@ class Twin:
         current_rise = self.current_heating_k() if sp.shaft_current_a > 0.0 and th.current_heating else 0.0
         scalars = self.state.scalars
         self._setpoint_vector[L.S_VISCOSITY] = inlet.update(
-            sp, self.film_temperature_c(), self._oil_viscosity_pa_s, self._oil_beta_k_inv,
-            float(scalars[L.X_SHAFT_SPEED]), float(scalars[L.X_CAGE_SPEED]), current_rise,
-            self.mean_entrainment_speed_m_s() if th.shear_heating else 0.0)
+            sp,
+            self.film_temperature_c(),
+            self._oil_viscosity_pa_s,
+            self._oil_beta_k_inv,
+            float(scalars[L.X_SHAFT_SPEED]),
+            float(scalars[L.X_CAGE_SPEED]),
+            current_rise,
+            self.mean_entrainment_speed_m_s() if th.shear_heating else 0.0,
+        )
 
     # ---- measures of the state (twin.state_measures) ----------------------------------------
     def axial_angular_momentum_n_m_s(self) -> float:
@@ -244,10 +262,21 @@ class Twin:
             net = self.electrical()
             r_b = net.impedance_ohm * math.cos(net.phase_rad)
         loaded = self.loaded_zone_ball_count()
-        return min(MAX_CURRENT_HEATING_K, current_heating_temperature_rise_k(
-            sp.shaft_current_a, r_b, 2.0 * m.pitch_radius_m, 2.0 * m.ball_radius_m, loaded,
-            float(self.state.scalars[L.X_SHAFT_SPEED]) / (2.0 * math.pi), th.crater_depth_m,
-            m.spec.material.density_kg_m3, th.ball_specific_heat_j_kg_k, m.contact_angle_rad))
+        return min(
+            MAX_CURRENT_HEATING_K,
+            current_heating_temperature_rise_k(
+                sp.shaft_current_a,
+                r_b,
+                2.0 * m.pitch_radius_m,
+                2.0 * m.ball_radius_m,
+                loaded,
+                float(self.state.scalars[L.X_SHAFT_SPEED]) / (2.0 * math.pi),
+                th.crater_depth_m,
+                m.spec.material.density_kg_m3,
+                th.ball_specific_heat_j_kg_k,
+                m.contact_angle_rad,
+            ),
+        )
 
     def set_setpoint(self, update: SetpointUpdate | Setpoint | Admitted | None = None, **fields) -> Setpoint:
         """Apply a setpoint: a partial `SetpointUpdate` (or keyword fields), a complete
@@ -257,8 +286,7 @@ class Twin:
         if not (isinstance(update, Admitted) and update.limits == self.limits):
             if isinstance(update, Admitted):
                 update = update.setpoint
-            update = self.limits.admit(update if update is not None else SetpointUpdate(**fields),
-                                       self._setpoint)
+            update = self.limits.admit(update if update is not None else SetpointUpdate(**fields), self._setpoint)
         applied = self._apply(update)
         if self.halted:  # a new setpoint: try again from the warm start
             self.halted = False
@@ -267,8 +295,7 @@ class Twin:
         return applied
 
     # ---- running ----------------------------------------------------------------------------
-    def reset(self, *, warm: bool = True, shaft_speed_rad_s: float | None = None,
-              keep_time: bool = False) -> None:
+    def reset(self, *, warm: bool = True, shaft_speed_rad_s: float | None = None, keep_time: bool = False) -> None:
         """Restart from the quasi-static equilibrium at the current setpoint (or unloaded when
         `warm` is False), at `shaft_speed_rad_s` if given; `keep_time` keeps the simulated clock."""
         sp = self._setpoint
@@ -303,11 +330,18 @@ class Twin:
         if not (force or self.life_monitor.due(self.time_s)):
             return
         sp = self._setpoint
-        rho = density_kg_m3(self.model.spec.lubricant.density_15c_kg_m3,
-                            self.film_temperature_c() + self.inlet.temperature_rise_k)
-        self.life_monitor.update(self.time_s, float(self.state.scalars[L.X_SHAFT_SPEED]), sp.radial_load_n,
-                                 sp.axial_load_n, self.inlet.inlet_viscosity_pa_s / rho, self.state.contacts,
-                                 force=force)
+        rho = density_kg_m3(
+            self.model.spec.lubricant.density_15c_kg_m3, self.film_temperature_c() + self.inlet.temperature_rise_k
+        )
+        self.life_monitor.update(
+            self.time_s,
+            float(self.state.scalars[L.X_SHAFT_SPEED]),
+            sp.radial_load_n,
+            sp.axial_load_n,
+            self.inlet.inlet_viscosity_pa_s / rho,
+            self.state.contacts,
+            force=force,
+        )
 
     def _frame(self, n: int) -> int:
         self._update_inlet_viscosity(elapsed_s=n * self.model.dt_s)
@@ -321,7 +355,7 @@ class Twin:
         near_rest = abs(speed_before) < REST_SPEED_RAD_S + self.model.options.speed_ramp_rad_s2 * n * self.model.dt_s
         momentum_before = self.axial_angular_momentum_n_m_s() if near_rest else 0.0
         status, done = step_n(*self._kernel_args(), n)
-        if done < n and status == L.STATUS_OK:    # interrupted (interrupt_frame): n - done not run
+        if done < n and status == L.STATUS_OK:  # interrupted (interrupt_frame): n - done not run
             self.inlet.since_s -= (n - done) * self.model.dt_s
         if self._sensor is not None:
             self._sensor.after_frame(s, done, float(s.scalars[L.X_SHAFT_SPEED]))
@@ -329,10 +363,12 @@ class Twin:
                 self._sensor.flush(s)
         if s.scalars[L.X_TORQUE_COUNT] > 0 and status == L.STATUS_OK:
             self._contact_torque_n_m = frame_friction_torque_n_m(
-                s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT], done * self.model.dt_s,
+                s.scalars[L.X_TORQUE_SUM] / s.scalars[L.X_TORQUE_COUNT],
+                done * self.model.dt_s,
                 0.5 * (speed_before + float(s.scalars[L.X_SHAFT_SPEED])),
                 self.kinetic_energy_j() - energy_before,
-                (self.axial_angular_momentum_n_m_s() - momentum_before) if near_rest else 0.0)
+                (self.axial_angular_momentum_n_m_s() - momentum_before) if near_rest else 0.0,
+            )
             self._last_torque_n_m = self._contact_torque_n_m + self._churning_and_seal_torque_n_m()
         if status != L.STATUS_OK:
             self._recover(status)
@@ -377,8 +413,14 @@ class Twin:
         (twin.friction_power.friction_power_by_source): the contacts' rolling, sliding and spin
         power from the last step's lanes, each ball's drag at its own depth in the oil bath (or in
         the cavity's oil-air mixture) and the seals' moment times the shaft speed."""
-        return friction_power_by_source(self.model, self.state, self._setpoint.oil_temperature_c,
-                                        self._oil_viscosity_pa_s, self.inlet.immersed_fraction, self._seal_power_w())
+        return friction_power_by_source(
+            self.model,
+            self.state,
+            self._setpoint.oil_temperature_c,
+            self._oil_viscosity_pa_s,
+            self.inlet.immersed_fraction,
+            self._seal_power_w(),
+        )
 
     def _recover(self, status: int) -> None:
         """A kernel reported a diverged or overloaded state: restart from the warm start at the
@@ -399,8 +441,7 @@ class Twin:
         self.state.scalars[L.X_TIME] = t
         self.reset(keep_time=True)
 
-    def advance(self, seconds: float, frame_steps: int | None = None, *,
-                max_restarts: int | None = None) -> int:
+    def advance(self, seconds: float, frame_steps: int | None = None, *, max_restarts: int | None = None) -> int:
         """Integrate `seconds` of simulated time (a whole number of steps, the nearest) in frames of
         `frame_steps` steps (default: FRAME_S of simulated time).
 
@@ -423,10 +464,10 @@ class Twin:
             remaining -= max(self._frame(n), 1)  # a failing frame still consumes a step: no hang
             if max_restarts is not None and self.restarts - first >= max_restarts:
                 return max(remaining, 0)
-            if self.halted:   # the setpoint cannot be held: stop instead of a warm start per step
+            if self.halted:  # the setpoint cannot be held: stop instead of a warm start per step
                 return max(remaining, 0)
             if remaining > 0 and self._setpoint_vector[L.S_STOP] != 0.0:
-                self.frame_interrupted = True    # interrupt_frame: the caller has input waiting
+                self.frame_interrupted = True  # interrupt_frame: the caller has input waiting
                 return remaining
         return 0
 
@@ -499,7 +540,7 @@ class Twin:
         Call it from the thread that steps this twin: the copy never touches the live reader (its
         cursor, waveform queue and window are the stepping thread's alone), so the samples it
         drains stay contiguous."""
-        latest = self.vibration           # flushes the live reader here, in the stepping thread
+        latest = self.vibration  # flushes the live reader here, in the stepping thread
         frozen = copy.copy(self)
         frozen.state = self.state.copy()
         frozen.inlet = copy.copy(self.inlet)
@@ -532,10 +573,13 @@ class Twin:
         balls = ball_states(self.model, s, net, self._effective_mu)
         self.seq += 1
         return Snapshot(
-            bearing_id=self.bearing_id, designation=self.model.spec.designation, seq=self.seq,
+            bearing_id=self.bearing_id,
+            designation=self.model.spec.designation,
+            seq=self.seq,
             time_s=self.time_s,
             real_time_factor=finite_or_none(real_time_factor) if real_time_factor is not None else None,
-            status=self.status, restarts=self.restarts,
+            status=self.status,
+            restarts=self.restarts,
             setpoint=self._setpoint,
             shaft_speed_rad_s=float(s.scalars[L.X_SHAFT_SPEED]),
             cage_speed_rad_s=float(s.scalars[L.X_CAGE_SPEED]),
@@ -547,7 +591,10 @@ class Twin:
             balls=balls,
             life=self._life_state(),
             outer_ring_displacement_m=tuple(float(h) for h in s.housing_displacement_m[:3]),
-            defects=self._defects, vibration=self.vibration, thermal=self._thermal_state())
+            defects=self._defects,
+            vibration=self.vibration,
+            thermal=self._thermal_state(),
+        )
 
     def _life_state(self) -> LifeState | None:
         block = self.life_monitor.block(self.time_s)

@@ -14,8 +14,8 @@ from enum import StrEnum
 class FaultKind(StrEnum):
     """What the engine did."""
 
-    RESTARTED = "restarted"   # warm-restarted at the setpoint in force, simulated time kept
-    HALTED = "halted"         # failed again right after a restart: waits for a new setpoint
+    RESTARTED = "restarted"  # warm-restarted at the setpoint in force, simulated time kept
+    HALTED = "halted"  # failed again right after a restart: waits for a new setpoint
 
 
 @dataclass(frozen=True)
@@ -26,11 +26,13 @@ class Fault:
     kind: FaultKind
     cause: str
     time_s: float
-    restart_window_s: float = 0.0   # HALTED: the failure came within this much of a restart [s]
+    restart_window_s: float = 0.0  # HALTED: the failure came within this much of a restart [s]
 
     def describe(self) -> str:
         """The snapshot's `status` text."""
         if self.kind is FaultKind.HALTED:
-            return (f"halted: {self.cause} again within {self.restart_window_s * 1e3:.0f} ms of a "
-                    f"restart at t = {self.time_s:.6f} s; the setpoint cannot be held, waiting for a new one")
+            return (
+                f"halted: {self.cause} again within {self.restart_window_s * 1e3:.0f} ms of a "
+                f"restart at t = {self.time_s:.6f} s; the setpoint cannot be held, waiting for a new one"
+            )
         return f"restarted: {self.cause} at t = {self.time_s:.6f} s"

@@ -62,8 +62,13 @@ class FrictionPower:
 
     def by_source_w(self) -> dict[str, float]:
         """{'rolling', 'sliding', 'spin', 'drag', 'seal'} -> power [W]."""
-        return {"rolling": self.rolling_w, "sliding": self.sliding_w, "spin": self.spin_w,
-                "drag": self.drag_w, "seal": self.seal_w}
+        return {
+            "rolling": self.rolling_w,
+            "sliding": self.sliding_w,
+            "spin": self.spin_w,
+            "drag": self.drag_w,
+            "seal": self.seal_w,
+        }
 
 
 def boundary_dimensions_m(geometry: Geometry) -> tuple[float, float]:
@@ -83,8 +88,9 @@ def starvation_film_factor(spec: BearingSpec, shaft_speed_rad_s: float, kinemati
     if method == "flooded":
         return 1.0
     d, big_d = boundary_dimensions_m(spec.geometry)
-    return starvation.kinematic_replenishment_factor(shaft_speed_rad_s, kinematic_viscosity_m2_s, d, big_d,
-                                                     starvation.K_RS[method], starvation.K_Z[spec.kind])
+    return starvation.kinematic_replenishment_factor(
+        shaft_speed_rad_s, kinematic_viscosity_m2_s, d, big_d, starvation.K_RS[method], starvation.K_Z[spec.kind]
+    )
 
 
 def seal_moment_n_m(spec: BearingSpec) -> float:
@@ -114,16 +120,20 @@ def mean_immersed_fraction(spec: BearingSpec) -> float:
     pitch = 0.5 * (g.inner_raceway_radius_m + g.outer_raceway_radius_m)
     level = oil_level_m(spec)
     az = (np.arange(ORBIT_SAMPLES) + 0.5) * (2.0 * math.pi / ORBIT_SAMPLES)
-    return float(np.mean([drag.immersed_area_fraction(drag.ball_depth_in_bath_m(level, a, pitch), 2.0 * g.ball_radius_m)
-                          for a in az]))
+    return float(
+        np.mean(
+            [drag.immersed_area_fraction(drag.ball_depth_in_bath_m(level, a, pitch), 2.0 * g.ball_radius_m) for a in az]
+        )
+    )
 
 
 def oil_bath_drag_power_w(spec: BearingSpec, shaft_speed_rad_s: float, kinematic_viscosity_m2_s: float) -> float:
     """Drag power of all the balls in the spec's oil bath [W]: the SKF model's M_drag
     (twin.physics.drag.oil_bath_drag_moment_n_m) at the spec's oil level, times |omega|."""
     d, big_d = boundary_dimensions_m(spec.geometry)
-    moment = drag.oil_bath_drag_moment_n_m(d, big_d, oil_level_m(spec), shaft_speed_rad_s, kinematic_viscosity_m2_s,
-                                           starvation.K_Z[spec.kind])
+    moment = drag.oil_bath_drag_moment_n_m(
+        d, big_d, oil_level_m(spec), shaft_speed_rad_s, kinematic_viscosity_m2_s, starvation.K_Z[spec.kind]
+    )
     return moment * abs(shaft_speed_rad_s)
 
 
@@ -132,8 +142,13 @@ def seal_power_w(seal_moment_n_m: float, shaft_speed_rad_s: float) -> float:
     return max(seal_moment_n_m * abs(shaft_speed_rad_s), 0.0)
 
 
-def ball_drag_power_w(ball_diameter_m: float, orbital_speed_m_s: float, oil_fraction: float,
-                      oil_density_kg_m3: float, oil_viscosity_pa_s: float) -> float:
+def ball_drag_power_w(
+    ball_diameter_m: float,
+    orbital_speed_m_s: float,
+    oil_fraction: float,
+    oil_density_kg_m3: float,
+    oil_viscosity_pa_s: float,
+) -> float:
     """Drag power of one ball [W]: the share `oil_fraction` of its frontal disc in oil, the rest in
     air (twin.physics.drag), times its orbital speed."""
     v = abs(orbital_speed_m_s)
@@ -142,8 +157,9 @@ def ball_drag_power_w(ball_diameter_m: float, orbital_speed_m_s: float, oil_frac
     return (oil_fraction * f_oil + (1.0 - oil_fraction) * f_air) * v
 
 
-def contact_powers_w(contacts: np.ndarray, ball_angular_velocity_rad_s: np.ndarray,
-                     ball_radius_m: float) -> tuple[np.ndarray, ...]:
+def contact_powers_w(
+    contacts: np.ndarray, ball_angular_velocity_rad_s: np.ndarray, ball_radius_m: float
+) -> tuple[np.ndarray, ...]:
     """(rolling, sliding, spin) power of every ball-raceway contact [W], each (Z, 2), from the
     contact lanes (N_ROWS, 2Z) of the last step, the balls' angular velocities (Z, 3) and radius.
 
@@ -158,18 +174,18 @@ def contact_powers_w(contacts: np.ndarray, ball_angular_velocity_rad_s: np.ndarr
     loaded = c[L.G_DELTA] > 0.0
     n = c[[L.G_NX, L.G_NY, L.G_NZ]]
     e = c[[L.O_EX, L.O_EY, L.O_EZ]]
-    roll_force = c[L.C_ROLLING_PER_SPEED] * e            # on the ball [N]
+    roll_force = c[L.C_ROLLING_PER_SPEED] * e  # on the ball [N]
     spin = c[L.K_SPIN]
-    q = c[[L.K_PX, L.K_PY, L.K_PZ]] + ball_radius_m * n   # contact point relative to the ring centre
+    q = c[[L.K_PX, L.K_PY, L.K_PZ]] + ball_radius_m * n  # contact point relative to the ring centre
     ring_velocity = c[[L.K_OVX, L.K_OVY, L.K_OVZ]].copy()
     ring_velocity[0] -= spin * q[1]
     ring_velocity[1] += spin * q[0]
     centre_over_ring = c[[L.K_VX, L.K_VY, L.K_VZ]] - ring_velocity
     rolling = -np.sum(roll_force * centre_over_ring, axis=0)
     f = c[[L.O_FX, L.O_FY, L.O_FZ]]
-    f_t = f - np.sum(f * n, axis=0) * n - roll_force     # the friction force on the ball, tangential
+    f_t = f - np.sum(f * n, axis=0) * n - roll_force  # the friction force on the ball, tangential
     slip = c[[L.O_SX, L.O_SY, L.O_SZ]]
-    w_rel = np.repeat(ball_angular_velocity_rad_s.T, 2, axis=1)   # (3, 2Z)
+    w_rel = np.repeat(ball_angular_velocity_rad_s.T, 2, axis=1)  # (3, 2Z)
     w_rel[2] -= spin
     m2 = c[[L.E_M2X, L.E_M2Y, L.E_M2Z]]
     sliding = -np.sum(f_t * slip, axis=0) - np.sum(m2 * w_rel, axis=0)
@@ -182,9 +198,14 @@ def contact_powers_w(contacts: np.ndarray, ball_angular_velocity_rad_s: np.ndarr
     return per_contact(rolling), per_contact(sliding), per_contact(spin_w)
 
 
-def friction_power_by_source(model: BearingModel, state: TwinState, oil_temperature_c: float,
-                             oil_viscosity_pa_s: float, immersed_fraction: float,
-                             seal_w: float) -> FrictionPower:
+def friction_power_by_source(
+    model: BearingModel,
+    state: TwinState,
+    oil_temperature_c: float,
+    oil_viscosity_pa_s: float,
+    immersed_fraction: float,
+    seal_w: float,
+) -> FrictionPower:
     """Friction power of the current instant by source and by contact [W]: the contacts' rolling,
     sliding and spin power from the last step's lanes (`contact_powers_w`), each ball's drag at
     its own depth in the oil bath (the bath's drag shared by the part of each ball in the oil) or
@@ -198,25 +219,47 @@ def friction_power_by_source(model: BearingModel, state: TwinState, oil_temperat
     orbit_speed = np.hypot(v[:, 0], v[:, 1])
     drag_w = np.zeros(m.ball_count)
     method = m.spec.lubrication.method
-    if method == "oil_bath":   # the bath's drag shared by the part of each ball in the oil
+    if method == "oil_bath":  # the bath's drag shared by the part of each ball in the oil
         from_bottom = np.arctan2(x[:, 1], x[:, 0])  # the bath's bottom lies on the load line (+x)
-        share = np.array([drag.immersed_area_fraction(
-            drag.ball_depth_in_bath_m(oil_level_m(m.spec), float(a), m.pitch_radius_m), 2.0 * m.ball_radius_m)
-            for a in from_bottom])
+        share = np.array(
+            [
+                drag.immersed_area_fraction(
+                    drag.ball_depth_in_bath_m(oil_level_m(m.spec), float(a), m.pitch_radius_m), 2.0 * m.ball_radius_m
+                )
+                for a in from_bottom
+            ]
+        )
         if share.sum() > 0.0:
-            drag_w = share / share.sum() * oil_bath_drag_power_w(
-                m.spec, float(s.scalars[L.X_SHAFT_SPEED]), oil_viscosity_pa_s / rho)
+            drag_w = (
+                share
+                / share.sum()
+                * oil_bath_drag_power_w(m.spec, float(s.scalars[L.X_SHAFT_SPEED]), oil_viscosity_pa_s / rho)
+            )
     elif method != "flooded":
         for j in range(m.ball_count):
-            drag_w[j] = ball_drag_power_w(2.0 * m.ball_radius_m, float(orbit_speed[j]), immersed_fraction,
-                                          rho, oil_viscosity_pa_s)
-    return FrictionPower(rolling_w=float(rolling.sum()), sliding_w=float(sliding.sum()), spin_w=float(spin.sum()),
-                         drag_w=float(drag_w.sum()), seal_w=seal_w, rolling_contact_w=rolling,
-                         sliding_contact_w=sliding, spin_contact_w=spin, drag_ball_w=drag_w)
+            drag_w[j] = ball_drag_power_w(
+                2.0 * m.ball_radius_m, float(orbit_speed[j]), immersed_fraction, rho, oil_viscosity_pa_s
+            )
+    return FrictionPower(
+        rolling_w=float(rolling.sum()),
+        sliding_w=float(sliding.sum()),
+        spin_w=float(spin.sum()),
+        drag_w=float(drag_w.sum()),
+        seal_w=seal_w,
+        rolling_contact_w=rolling,
+        sliding_contact_w=sliding,
+        spin_contact_w=spin,
+        drag_ball_w=drag_w,
+    )
 
 
-def frame_friction_torque_n_m(drive_n_m: float, duration_s: float, mean_speed_rad_s: float,
-                              kinetic_energy_change_j: float, momentum_change_n_m_s: float) -> float:
+def frame_friction_torque_n_m(
+    drive_n_m: float,
+    duration_s: float,
+    mean_speed_rad_s: float,
+    kinetic_energy_change_j: float,
+    momentum_change_n_m_s: float,
+) -> float:
     """The friction torque of a frame [N m]: the shaft's mean drive torque less the torque that
     speeds the balls and the cage up (or that they give back as they slow down), which is
     inertia, not friction. Turning, the shaft's power drive * omega splits into the friction's

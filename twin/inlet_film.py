@@ -25,14 +25,17 @@ from __future__ import annotations
 
 import math
 
-from twin.friction_power import (ball_drag_power_w, mean_immersed_fraction, oil_bath_drag_power_w,
-                                 starvation_film_factor)
+from twin.friction_power import ball_drag_power_w, mean_immersed_fraction, oil_bath_drag_power_w, starvation_film_factor
 from twin.kernels.tribology import T_HMIN_EXP_EU
 from twin.model import BearingModel
-from twin.physics.thermal import (equivalent_inlet_temperature_rise_k, murch_wilson_thermal_factor,
-                                  roelands_temperature_viscosity_coefficient_k_inv,
-                                  roelands_temperature_viscosity_pa_s, thermal_film_factor,
-                                  thermal_loading_parameter)
+from twin.physics.thermal import (
+    equivalent_inlet_temperature_rise_k,
+    murch_wilson_thermal_factor,
+    roelands_temperature_viscosity_coefficient_k_inv,
+    roelands_temperature_viscosity_pa_s,
+    thermal_film_factor,
+    thermal_loading_parameter,
+)
 from twin.physics.viscosity import density_kg_m3
 from twin.setpoint import Setpoint
 
@@ -47,14 +50,14 @@ class InletFilm:
     def __init__(self, model: BearingModel):
         self.model = model
         self.immersed_fraction = mean_immersed_fraction(model.spec)
-        self.since_s = 0.0                 # simulated time since the last refresh [s]
-        self.current_heating_k = 0.0       # inlet temperature rise of the shaft current [K]
-        self.shear_heating_k = 0.0         # equivalent inlet temperature rise of the shear heating [K]
-        self.shear_film_factor = 1.0       # Murch-Wilson factor [-]
-        self.starvation_factor = 1.0       # kinematic starvation factor [-]
-        self.film_thermal_factor = 1.0     # the product of the three, floored [-]
-        self.inlet_viscosity_pa_s = math.nan   # the oil's viscosity at the heated inlet [Pa s]
-        self.drag_power_w = 0.0            # orbit-mean drag power of the balls [W]
+        self.since_s = 0.0  # simulated time since the last refresh [s]
+        self.current_heating_k = 0.0  # inlet temperature rise of the shaft current [K]
+        self.shear_heating_k = 0.0  # equivalent inlet temperature rise of the shear heating [K]
+        self.shear_film_factor = 1.0  # Murch-Wilson factor [-]
+        self.starvation_factor = 1.0  # kinematic starvation factor [-]
+        self.film_thermal_factor = 1.0  # the product of the three, floored [-]
+        self.inlet_viscosity_pa_s = math.nan  # the oil's viscosity at the heated inlet [Pa s]
+        self.drag_power_w = 0.0  # orbit-mean drag power of the balls [W]
 
     @property
     def temperature_rise_k(self) -> float:
@@ -66,9 +69,17 @@ class InletFilm:
         self.since_s += elapsed_s
         return force or self.since_s >= COUPLING_PERIOD_S - 0.5 * self.model.dt_s
 
-    def update(self, setpoint: Setpoint, film_temperature_c: float, oil_viscosity_pa_s: float,
-               oil_beta_k_inv: float, shaft_speed_rad_s: float, cage_speed_rad_s: float,
-               current_rise_k: float, entrainment_speed_m_s: float) -> float:
+    def update(
+        self,
+        setpoint: Setpoint,
+        film_temperature_c: float,
+        oil_viscosity_pa_s: float,
+        oil_beta_k_inv: float,
+        shaft_speed_rad_s: float,
+        cage_speed_rad_s: float,
+        current_rise_k: float,
+        entrainment_speed_m_s: float,
+    ) -> float:
         """Refresh every factor at the current conditions; the viscosity the kernel is to read
         [Pa s]. `current_rise_k`: the race track's current heating (0 without current heating);
         `entrainment_speed_m_s`: the loaded contacts' mean entrainment speed (read only with shear
@@ -86,8 +97,7 @@ class InletFilm:
             theta_c = theta0 + current_rise_k  # the shear heats an inlet the current has heated
             eta_c = roelands_temperature_viscosity_pa_s(eta0, theta0, theta_c, beta)
             beta_c = roelands_temperature_viscosity_coefficient_k_inv(eta0, theta0, theta_c, beta)
-            loading = thermal_loading_parameter(beta_c, eta_c, entrainment_speed_m_s,
-                                                th.oil_thermal_conductivity_w_m_k)
+            loading = thermal_loading_parameter(beta_c, eta_c, entrainment_speed_m_s, th.oil_thermal_conductivity_w_m_k)
             shear_factor = murch_wilson_thermal_factor(loading)
             shear_rise = equivalent_inlet_temperature_rise_k(shear_factor, eta_c, theta_c, beta_c)
         rise = current_rise_k + shear_rise
@@ -101,13 +111,15 @@ class InletFilm:
         self.shear_heating_k = shear_rise
         self.shear_film_factor = shear_factor
         self.film_thermal_factor = factor
-        self.inlet_viscosity_pa_s = (roelands_temperature_viscosity_pa_s(eta0, theta0, theta0 + rise, beta)
-                                     if rise > 0.0 else eta0)
+        self.inlet_viscosity_pa_s = (
+            roelands_temperature_viscosity_pa_s(eta0, theta0, theta0 + rise, beta) if rise > 0.0 else eta0
+        )
         speed_exponent = float(self.model.race_tribology[0, T_HMIN_EXP_EU])  # d ln h / d ln(eta u)
         return eta0 * factor ** (1.0 / speed_exponent)
 
-    def _mean_drag_power_w(self, oil_density_kg_m3: float, oil_viscosity_pa_s: float, shaft_speed_rad_s: float,
-                           cage_speed_rad_s: float) -> float:
+    def _mean_drag_power_w(
+        self, oil_density_kg_m3: float, oil_viscosity_pa_s: float, shaft_speed_rad_s: float, cage_speed_rad_s: float
+    ) -> float:
         """Drag power of the balls [W]: in an oil bath the SKF model's drag moment at the shaft
         speed (twin.friction_power.oil_bath_drag_power_w); in an oil-air mixture each ball's sphere
         drag at the cage speed with the mixture's oil share (twin.friction_power.ball_drag_power_w);
@@ -118,5 +130,6 @@ class InletFilm:
         if m.spec.lubrication.method == "oil_bath":
             return oil_bath_drag_power_w(m.spec, shaft_speed_rad_s, oil_viscosity_pa_s / oil_density_kg_m3)
         v = abs(cage_speed_rad_s) * m.pitch_radius_m
-        return m.ball_count * ball_drag_power_w(2.0 * m.ball_radius_m, v, self.immersed_fraction,
-                                                oil_density_kg_m3, oil_viscosity_pa_s)
+        return m.ball_count * ball_drag_power_w(
+            2.0 * m.ball_radius_m, v, self.immersed_fraction, oil_density_kg_m3, oil_viscosity_pa_s
+        )

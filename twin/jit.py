@@ -107,8 +107,8 @@ def _engine_cache_dir() -> str:
         st = path.stat()
         digest.update(_file_digest(str(path), st.st_mtime, st.st_size))
     base = os.environ.get("NUMBA_CACHE_DIR") or os.path.join(
-        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"),
-        "bearing-twin")
+        os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache"), "bearing-twin"
+    )
     return os.path.join(base, f"numba-{digest.hexdigest()[:16]}")
 
 

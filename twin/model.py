@@ -23,8 +23,7 @@ from twin.kernels import layout as L
 from twin.kernels.structures import ModelArrays
 from twin.kernels.tribology import N_TRIBOLOGY, T_PIVOT, tribology_coefficients
 from twin.physics import hertz
-from twin.physics.electrical import (ball_raceway_gap_integral_m, coaxial_capacitance_f,
-                                     equivalent_gap_limit_m)
+from twin.physics.electrical import ball_raceway_gap_integral_m, coaxial_capacitance_f, equivalent_gap_limit_m
 from twin.physics.traction import deformed_surface_radius_m, hertz_strip_table
 from twin.physics.viscosity import dynamic_viscosity_pa_s
 from twin.spec import BearingSpec, ModelOptions
@@ -38,7 +37,7 @@ from twin.vibration.signal import DecimatorDesign, design_decimator, integer_rat
 STATIC_PRESSURE_LIMIT_PA = 4.2e9
 MODEL_PRESSURE_FACTOR = 1.0
 DEFAULT_SHOULDER_DEPTH_RATIO = 0.18  # groove depth / ball diameter when the geometry gives none
-GAP_LIMIT_REFERENCE_GAP_M = 1e-6     # central gap at which the exact gap integral is matched
+GAP_LIMIT_REFERENCE_GAP_M = 1e-6  # central gap at which the exact gap integral is matched
 
 
 @dataclass(frozen=True)
@@ -64,8 +63,8 @@ class BearingModel:
     decimator_taps: np.ndarray
     time_step: timestep.CriticalTimeStep  # critical step of the scheme (twin.timestep)
 
-    gap_limit_m: tuple[float, float] = (50e-6, 50e-6)   # inner, outer: geometric gap limit of the contact capacitance
-    rest_capacitance_f: float = 0.0                     # the rings' lands across the oil-filled annulus [F]
+    gap_limit_m: tuple[float, float] = (50e-6, 50e-6)  # inner, outer: geometric gap limit of the contact capacitance
+    rest_capacitance_f: float = 0.0  # the rings' lands across the oil-filled annulus [F]
     decimator: DecimatorDesign | None = None  # accelerometer decimator; None with the rigid outer ring
 
     def arrays(self) -> ModelArrays:
@@ -75,7 +74,7 @@ class BearingModel:
     @property
     def vibration_params(self) -> np.ndarray:
         """The V_* vector (twin.kernels.layout), a view of params[P_VIB:]."""
-        return self.params[L.P_VIB:L.P_VIB + L.N_VIB_PARAMS]
+        return self.params[L.P_VIB : L.P_VIB + L.N_VIB_PARAMS]
 
     @property
     def housing_on(self) -> bool:
@@ -155,7 +154,10 @@ def contact_constants(spec: BearingSpec, inner: bool, sin_alpha: float, e_prime:
     c = hertz.elliptic_constants(rx, ry)
     r = hertz.curvature_sum_radius_m(rx, ry)
     return {
-        "rx_m": rx, "ry_m": ry, "ellipticity": c.ellipticity, "first_kind": c.first_kind,
+        "rx_m": rx,
+        "ry_m": ry,
+        "ellipticity": c.ellipticity,
+        "first_kind": c.first_kind,
         "second_kind": c.second_kind,
         "stiffness_n_m15": hertz.stiffness_from_constants(c.ellipticity, c.first_kind, c.second_kind, r, e_prime),
         # semi-axes grow as Q^(1/3): the law at Q = 1 N is the coefficient
@@ -175,8 +177,7 @@ def _race_row(spec: BearingSpec, inner: bool, alpha: float, e_prime: float) -> n
         row[L.R_GROOVE_CENTRE_RADIUS] = pitch + offset * math.cos(alpha)
         row[L.R_GROOVE_CENTRE_Z] = offset * math.sin(alpha)
     else:
-        row[L.R_GROOVE_CENTRE_RADIUS] = (pitch - offset * math.cos(alpha)
-                                         + 0.5 * spec.mounting.diametral_clearance_m)
+        row[L.R_GROOVE_CENTRE_RADIUS] = pitch - offset * math.cos(alpha) + 0.5 * spec.mounting.diametral_clearance_m
         row[L.R_GROOVE_CENTRE_Z] = -offset * math.sin(alpha)
     c = contact_constants(spec, inner, math.sin(alpha), e_prime)
     row[L.R_GROOVE_RADIUS] = groove
@@ -189,13 +190,22 @@ def _race_row(spec: BearingSpec, inner: bool, alpha: float, e_prime: float) -> n
     return row
 
 
-def _tribology_row(spec: BearingSpec, options: ModelOptions, inner: bool, sin_alpha: float,
-                   e_prime: float, g_param: float) -> tuple[float, np.ndarray]:
+def _tribology_row(
+    spec: BearingSpec, options: ModelOptions, inner: bool, sin_alpha: float, e_prime: float, g_param: float
+) -> tuple[float, np.ndarray]:
     """(K [N/m^1.5], tribology coefficients) of one race at |sin(alpha)| = sin_alpha."""
     c = contact_constants(spec, inner, sin_alpha, e_prime)
-    tri = tribology_coefficients(c["rx_m"], c["ry_m"], c["ellipticity"], e_prime, g_param,
-                                 spec.geometry.ball_radius_m, c["semi_major_coef"],
-                                 c["semi_minor_coef"], options.film_formula)
+    tri = tribology_coefficients(
+        c["rx_m"],
+        c["ry_m"],
+        c["ellipticity"],
+        e_prime,
+        g_param,
+        spec.geometry.ball_radius_m,
+        c["semi_major_coef"],
+        c["semi_minor_coef"],
+        options.film_formula,
+    )
     return c["stiffness_n_m15"], tri
 
 
@@ -207,7 +217,7 @@ def make_angle_table(spec: BearingSpec, options: ModelOptions, e_prime: float, g
         for i in range(L.ANGLE_POINTS):
             k, tri = _tribology_row(spec, options, r == 0, i * L.ANGLE_STEP, e_prime, g_param)
             table[r, i, L.A_STIFFNESS] = k
-            table[r, i, L.A_TRIBOLOGY:] = tri
+            table[r, i, L.A_TRIBOLOGY :] = tri
     return table
 
 
@@ -221,9 +231,20 @@ def interpolate_angle_table(table: np.ndarray, race: int, sin_alpha: float) -> n
 
 
 @lru_cache(maxsize=64)
-def _geometry_capacitance(rb: float, inner_groove: float, outer_groove: float, pitch: float, alpha: float,
-                          shoulder: float, width: float | None, permittivity: float,
-                          rx_in: float, ry_in: float, rx_out: float, ry_out: float) -> tuple[float, float, float]:
+def _geometry_capacitance(
+    rb: float,
+    inner_groove: float,
+    outer_groove: float,
+    pitch: float,
+    alpha: float,
+    shoulder: float,
+    width: float | None,
+    permittivity: float,
+    rx_in: float,
+    ry_in: float,
+    rx_out: float,
+    ry_out: float,
+) -> tuple[float, float, float]:
     """(gap limit inner [m], gap limit outer [m], rest capacitance [F]) from the geometry: the exact
     ball-groove gap integral matched at 1 um by the paraboloid law's gap limit
     (twin.physics.electrical.equivalent_gap_limit_m), and the rings' lands as a coaxial capacitor
@@ -235,8 +256,7 @@ def _geometry_capacitance(rb: float, inner_groove: float, outer_groove: float, p
         offset = groove - rb
         centre = pitch + offset * math.cos(alpha) if inner else pitch - offset * math.cos(alpha)
         land = centre - groove + shoulder if inner else centre + groove - shoulder
-        integral = ball_raceway_gap_integral_m(rb, groove, centre, alpha, inner, land, width,
-                                               GAP_LIMIT_REFERENCE_GAP_M)
+        integral = ball_raceway_gap_integral_m(rb, groove, centre, alpha, inner, land, width, GAP_LIMIT_REFERENCE_GAP_M)
         limits.append(equivalent_gap_limit_m(integral, rx, ry, GAP_LIMIT_REFERENCE_GAP_M))
         lands.append(land)
         reach = groove * groove - (centre - land) ** 2
@@ -262,11 +282,11 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     alpha = math.radians(g.nominal_contact_angle_deg)
     e_prime = hertz.effective_modulus_pa(mat.youngs_modulus_pa, mat.poisson_ratio)
     shear = hertz.shear_modulus_pa(mat.youngs_modulus_pa, mat.poisson_ratio)
-    ball_mass = mat.density_kg_m3 * 4.0 / 3.0 * math.pi * rb ** 3
+    ball_mass = mat.density_kg_m3 * 4.0 / 3.0 * math.pi * rb**3
     ball_inertia = 0.4 * ball_mass * rb * rb
     pitch = g.pitch_radius_m
     cage_inertia = g.cage_mass_kg * pitch * pitch
-    cage_mass_at_pitch = cage_inertia / pitch ** 2
+    cage_mass_at_pitch = cage_inertia / pitch**2
     half_chord = 2.0 * pitch * math.sin(math.pi / (2 * z))
     # cage elements sit at half pitch between balls; keep at least 20 um pocket clearance
     contact_distance = min(rb + g.cage_element_radius_m, half_chord - 20e-6)
@@ -279,8 +299,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_CAGE_INERTIA] = cage_inertia
     p[L.P_CAGE_RADIUS] = pitch
     p[L.P_CAGE_CONTACT_DISTANCE] = contact_distance
-    p[L.P_CAGE_STIFFNESS] = hertz.ball_ball_stiffness_n_m15(rb, g.cage_element_radius_m, shear,
-                                                           mat.poisson_ratio)
+    p[L.P_CAGE_STIFFNESS] = hertz.ball_ball_stiffness_n_m15(rb, g.cage_element_radius_m, shear, mat.poisson_ratio)
     p[L.P_CAGE_REDUCED_MASS] = ball_mass * cage_mass_at_pitch / (ball_mass + cage_mass_at_pitch)
     p[L.P_CAGE_STEP_COS] = math.cos(2.0 * math.pi / z)  # the step's cage pass turns element to element
     p[L.P_CAGE_STEP_SIN] = math.sin(2.0 * math.pi / z)
@@ -293,7 +312,9 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_ALPHA_E] = options.restitution_coefficient_s_m
     p[L.P_RAMP] = options.speed_ramp_rad_s2
     p[L.P_FILM_FORMULA] = 0.0 if options.film_formula == "hamrock_dowson" else 1.0
-    p[L.P_FRICTION_MODEL] = {"stribeck_line": 0.0, "asperity_share": 1.0, "ellipse_traction": 2.0}[options.friction_model]
+    p[L.P_FRICTION_MODEL] = {"stribeck_line": 0.0, "asperity_share": 1.0, "ellipse_traction": 2.0}[
+        options.friction_model
+    ]
     p[L.P_ROLLING] = 1.0 if options.rolling_resistance else 0.0
     p[L.P_BALL_REDUCED_TANGENT_MASS] = ball_mass / (1.0 + ball_mass * rb * rb / ball_inertia)
     p[L.P_MAX_PENETRATION] = 0.01 * rb
@@ -309,36 +330,59 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_DEFORMED_RADIUS] = deformed_surface_radius_m(rb, g.inner_groove_radius_m)
     p[L.P_DEFORMED_RADIUS + 1] = deformed_surface_radius_m(rb, g.outer_groove_radius_m)
     strips = hertz_strip_table(options.traction_strips)
-    p[L.P_STRIP_TABLE:L.P_STRIP_TABLE + strips.size] = strips.ravel()
+    p[L.P_STRIP_TABLE : L.P_STRIP_TABLE + strips.size] = strips.ravel()
 
     race = np.stack([_race_row(spec, True, alpha, e_prime), _race_row(spec, False, alpha, e_prime)])
     shoulder = g.shoulder_depth_m if g.shoulder_depth_m is not None else DEFAULT_SHOULDER_DEPTH_RATIO * 2.0 * rb
     gap_in, gap_out, rest = _geometry_capacitance(
-        rb, g.inner_groove_radius_m, g.outer_groove_radius_m, pitch, alpha, shoulder, g.ring_width_m,
-        el.oil_relative_permittivity, float(race[0, L.R_RX]), float(race[0, L.R_RY]), float(race[1, L.R_RX]),
-        float(race[1, L.R_RY]))
+        rb,
+        g.inner_groove_radius_m,
+        g.outer_groove_radius_m,
+        pitch,
+        alpha,
+        shoulder,
+        g.ring_width_m,
+        el.oil_relative_permittivity,
+        float(race[0, L.R_RX]),
+        float(race[0, L.R_RY]),
+        float(race[1, L.R_RX]),
+        float(race[1, L.R_RY]),
+    )
     p[L.P_GAP_LIMIT] = gap_in
     p[L.P_GAP_LIMIT_OUTER] = gap_out
     # load limits: analytic Qmax = Fr / (Z Jr), Jr(0.5) = 0.2288 (seed 000 eq. A3)
-    q_limit = min(_load_at_pressure(race[0], MODEL_PRESSURE_FACTOR * STATIC_PRESSURE_LIMIT_PA),
-                  _load_at_pressure(race[1], MODEL_PRESSURE_FACTOR * STATIC_PRESSURE_LIMIT_PA))
+    q_limit = min(
+        _load_at_pressure(race[0], MODEL_PRESSURE_FACTOR * STATIC_PRESSURE_LIMIT_PA),
+        _load_at_pressure(race[1], MODEL_PRESSURE_FACTOR * STATIC_PRESSURE_LIMIT_PA),
+    )
     max_radial = q_limit * z * 0.2288 * max(math.cos(alpha), 0.2)
     max_axial = q_limit * z * max(math.sin(alpha), 0.2)
     # limiting speed by the n dm rule of thumb (1.2e6 mm/min for oil-lubricated ball bearings)
     max_speed = 1.2e6 / (2.0 * pitch * 1e3) * 2.0 * math.pi / 60.0
     if spec.limiting_speed_rad_s is not None:  # the bearing's own limiting speed, where the spec gives it
         max_speed = spec.limiting_speed_rad_s
-    tribology = np.stack([
-        tribology_coefficients(race[r, L.R_RX], race[r, L.R_RY], race[r, L.R_K_ELLIPTICITY], e_prime,
-                               p[L.P_G_PARAM], rb, race[r, L.R_SEMI_MAJOR_COEF],
-                               race[r, L.R_SEMI_MINOR_COEF], options.film_formula)
-        for r in range(2)])
+    tribology = np.stack(
+        [
+            tribology_coefficients(
+                race[r, L.R_RX],
+                race[r, L.R_RY],
+                race[r, L.R_K_ELLIPTICITY],
+                e_prime,
+                p[L.P_G_PARAM],
+                rb,
+                race[r, L.R_SEMI_MAJOR_COEF],
+                race[r, L.R_SEMI_MINOR_COEF],
+                options.film_formula,
+            )
+            for r in range(2)
+        ]
+    )
     angle_table = make_angle_table(spec, options, e_prime, p[L.P_G_PARAM])
     # the step: the number asked for, or the auto step from the stiffest element at the static
     # capacity q_limit (twin.timestep); the tribology sub-rate is a period, as steps of this dt
     critical = timestep.estimate(
-        p, race, tribology, q_limit,
-        dynamic_viscosity_pa_s(spec.lubricant, timestep.REFERENCE_OIL_TEMPERATURE_C), z)
+        p, race, tribology, q_limit, dynamic_viscosity_pa_s(spec.lubricant, timestep.REFERENCE_OIL_TEMPERATURE_C), z
+    )
     p[L.P_DT] = timestep.resolve_time_step_s(options.time_step_s, critical)
     housing = spec.housing
     decimator = None
@@ -351,7 +395,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     taps = decimator.reversed_taps if decimator is not None else np.zeros(1)
     # the defect drops (twin.kernels.vibration) take the raceway and curvature radii at the
     # nominal contact angle (the drop is second order in the pit's size over these radii)
-    v = p[L.P_VIB:L.P_VIB + L.N_VIB_PARAMS]  # a view: written into p
+    v = p[L.P_VIB : L.P_VIB + L.N_VIB_PARAMS]  # a view: written into p
     v[L.V_HOUSING_ON] = 1.0 if housing.enabled else 0.0
     v[L.V_DECIMATION_RATIO] = decimator.ratio if decimator is not None else 1.0
     v[L.V_INNER_RACEWAY_RADIUS] = g.inner_raceway_radius_m
@@ -361,7 +405,8 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     v[L.V_INNER_RX], v[L.V_OUTER_RX] = race[0, L.R_RX], race[1, L.R_RX]
     # a = coef Q^(1/3) and Q = K delta^1.5 (seed 000 eq. 2), so a / sqrt(delta) = coef K^(1/3)
     v[L.V_INNER_FOOTPRINT], v[L.V_OUTER_FOOTPRINT] = (
-        race[r, L.R_SEMI_MAJOR_COEF] * race[r, L.R_STIFFNESS] ** (1.0 / 3.0) for r in (0, 1))
+        race[r, L.R_SEMI_MAJOR_COEF] * race[r, L.R_STIFFNESS] ** (1.0 / 3.0) for r in (0, 1)
+    )
     p[L.P_SUBSTEPS] = timestep.steps_per_period(options.tribology_period_s, p[L.P_DT])
     p[L.P_CENTRED_REFRESH] = 1.0 if options.centred_refresh else 0.0
     p[L.P_PROFILE_ON] = 1.0 if spec.surface_profile.enabled else 0.0
@@ -376,11 +421,23 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     for a in (p, race, tribology, angle_table, taps, hp):
         a.setflags(write=False)
     return BearingModel(
-        spec=spec, options=options, params=p, race_params=race,
-        race_tribology=tribology, angle_table=angle_table,
-        ball_count=z, pitch_radius_m=pitch,
-        contact_angle_rad=alpha, inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),
-        max_radial_load_n=float(max_radial), max_axial_load_n=float(max_axial),
-        max_shaft_speed_rad_s=float(max_speed), time_step=critical, gap_limit_m=(gap_in, gap_out),
-        rest_capacitance_f=rest, housing_params=hp, decimator=decimator,
-        decimator_taps=taps)
+        spec=spec,
+        options=options,
+        params=p,
+        race_params=race,
+        race_tribology=tribology,
+        angle_table=angle_table,
+        ball_count=z,
+        pitch_radius_m=pitch,
+        contact_angle_rad=alpha,
+        inner_ring_radius_at_contact_m=pitch - rb * math.cos(alpha),
+        max_radial_load_n=float(max_radial),
+        max_axial_load_n=float(max_axial),
+        max_shaft_speed_rad_s=float(max_speed),
+        time_step=critical,
+        gap_limit_m=(gap_in, gap_out),
+        rest_capacitance_f=rest,
+        housing_params=hp,
+        decimator=decimator,
+        decimator_taps=taps,
+    )

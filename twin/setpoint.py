@@ -36,8 +36,8 @@ class SetpointField:
     name: str
     unit: str
     description: str
-    low: float      # static lower bound, in `unit`
-    high: float     # static upper bound, in `unit`
+    low: float  # static lower bound, in `unit`
+    high: float  # static upper bound, in `unit`
     default: float  # in `unit`
 
 
@@ -64,10 +64,12 @@ _CONFIG = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=Fal
 
 def _field(name: str, *, partial: bool) -> Any:
     f = FIELD[name]
-    return Field(default=None if partial else f.default,
-                 description=f"{f.description} [{f.unit}]; the bearing's own limits apply "
-                 f"(GET /v1/bearings/{{id}} 'limits'), within [{f.low:g}, {f.high:g}].",
-                 json_schema_extra={"minimum": f.low, "maximum": f.high})
+    return Field(
+        default=None if partial else f.default,
+        description=f"{f.description} [{f.unit}]; the bearing's own limits apply "
+        f"(GET /v1/bearings/{{id}} 'limits'), within [{f.low:g}, {f.high:g}].",
+        json_schema_extra={"minimum": f.low, "maximum": f.high},
+    )
 
 
 class Setpoint(BaseModel):
@@ -123,8 +125,10 @@ class OutOfRange:
 
     def message(self, bearing: str) -> str:
         where = f" for bearing {bearing}" if bearing else " for this bearing"
-        return (f"{self.field} = {self.value:g} {self.unit} is outside the allowed range "
-                f"[{self.low:g}, {self.high:g}] {self.unit}{where}")
+        return (
+            f"{self.field} = {self.value:g} {self.unit} is outside the allowed range "
+            f"[{self.low:g}, {self.high:g}] {self.unit}{where}"
+        )
 
 
 class SetpointError(ValueError):
@@ -134,8 +138,13 @@ class SetpointError(ValueError):
     def __init__(self, problems: list[OutOfRange], bearing: str = ""):
         self.problems, self.bearing = problems, bearing
         first = problems[0]
-        self.field, self.value, self.low, self.high, self.unit = (first.field, first.value, first.low,
-                                                                  first.high, first.unit)
+        self.field, self.value, self.low, self.high, self.unit = (
+            first.field,
+            first.value,
+            first.low,
+            first.high,
+            first.unit,
+        )
         super().__init__("; ".join(p.message(bearing) for p in problems))
 
     def messages(self) -> list[tuple[str, str, list[float]]]:
@@ -158,14 +167,14 @@ class SetpointLimits(Mapping):
     like a dict `{field: (low, high)}`."""
 
     ranges: Mapping[str, tuple[float, float]]
-    bearing: str = ""   # designation, quoted in the errors
+    bearing: str = ""  # designation, quoted in the errors
 
     def __post_init__(self) -> None:
         missing = [n for n in NAMES if n not in self.ranges]
         if missing:
             raise ValueError(f"limits without {missing}")
         clipped = {}
-        for name in NAMES:     # inside the static bounds, in the vocabulary's order
+        for name in NAMES:  # inside the static bounds, in the vocabulary's order
             low, high = self.ranges[name]
             f = FIELD[name]
             clipped[name] = (float(max(low, f.low)), float(min(high, f.high)))
@@ -177,8 +186,15 @@ class SetpointLimits(Mapping):
         return cls({f.name: (f.low, f.high) for f in FIELDS})
 
     @classmethod
-    def for_bearing(cls, designation: str, *, max_shaft_speed_rad_s: float, max_radial_load_n: float,
-                    max_axial_load_n: float, angular_contact: bool) -> SetpointLimits:
+    def for_bearing(
+        cls,
+        designation: str,
+        *,
+        max_shaft_speed_rad_s: float,
+        max_radial_load_n: float,
+        max_axial_load_n: float,
+        angular_contact: bool,
+    ) -> SetpointLimits:
         """A bearing's limits: speed and loads from its model (an angular-contact bearing takes
         axial load in one direction only), the rest the static bounds."""
         ranges = {f.name: (f.low, f.high) for f in FIELDS}
@@ -190,10 +206,13 @@ class SetpointLimits(Mapping):
     @classmethod
     def for_model(cls, model: Any) -> SetpointLimits:
         """The limits of a compiled `twin.model.BearingModel`."""
-        return cls.for_bearing(model.spec.designation, max_shaft_speed_rad_s=model.max_shaft_speed_rad_s,
-                               max_radial_load_n=model.max_radial_load_n,
-                               max_axial_load_n=model.max_axial_load_n,
-                               angular_contact=model.spec.kind == "angular_contact")
+        return cls.for_bearing(
+            model.spec.designation,
+            max_shaft_speed_rad_s=model.max_shaft_speed_rad_s,
+            max_radial_load_n=model.max_radial_load_n,
+            max_axial_load_n=model.max_axial_load_n,
+            angular_contact=model.spec.kind == "angular_contact",
+        )
 
     def __getitem__(self, name: str) -> tuple[float, float]:
         return self.ranges[name]

@@ -40,8 +40,9 @@ def contact_mu(model: BearingModel, column: list[float], effective_mu: bool) -> 
     return float(kt * math.sqrt(c[L.T_XI0] ** 2 + c[L.T_XI1] ** 2 + c[L.T_XI2] ** 2) / c[L.C_LOAD])
 
 
-def contact_state(model: BearingModel, column: list[float], resistance_ohm: float, capacitance_f: float,
-                  effective_mu: bool) -> ContactState:
+def contact_state(
+    model: BearingModel, column: list[float], resistance_ohm: float, capacitance_f: float, effective_mu: bool
+) -> ContactState:
     """One contact's block from its lane column and its parallel-RC values; the film, regime,
     friction and kinematics are null / no_contact / 0 when it carries no load."""
     c = column
@@ -52,7 +53,8 @@ def contact_state(model: BearingModel, column: list[float], resistance_ohm: floa
         h_min_m=finite_or_none(c[L.C_H_MIN]) if loaded else None,
         h_c_m=finite_or_none(c[L.C_H_C]) if loaded else None,
         lambda_=finite_or_none(c[L.C_LAMBDA]) if loaded else None,
-        regime=regime, mu=contact_mu(model, c, effective_mu) if loaded else 0.0,
+        regime=regime,
+        mu=contact_mu(model, c, effective_mu) if loaded else 0.0,
         entrainment_speed_m_s=float(c[L.C_ENTRAINMENT]) if loaded else 0.0,
         slide_roll_ratio=float(c[L.C_SRR]) if loaded else 0.0,
         contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.G_NZ])))) if loaded else 0.0,
@@ -62,8 +64,9 @@ def contact_state(model: BearingModel, column: list[float], resistance_ohm: floa
     )
 
 
-def ball_states(model: BearingModel, state: TwinState, net: ElectricalNetwork,
-                effective_mu: bool) -> tuple[BallState, ...]:
+def ball_states(
+    model: BearingModel, state: TwinState, net: ElectricalNetwork, effective_mu: bool
+) -> tuple[BallState, ...]:
     """Every ball's block: azimuth, spin, orbital speed about the bearing axis, cage load, its
     inner (k = 2j) and outer (k = 2j + 1) contacts and their series RC."""
     s = state
@@ -82,25 +85,39 @@ def ball_states(model: BearingModel, state: TwinState, net: ElectricalNetwork,
         return contact_state(model, columns[k], resistance[k], capacitance[k], effective_mu)
 
     return tuple(
-        BallState(index=j, azimuth_rad=az[j], spin_rad_s=spin[j], orbital_speed_rad_s=orbital[j],
-                  cage_load_n=cage[j], inner=contact(2 * j), outer=contact(2 * j + 1),
-                  resistance_ohm=finite_or_none(net.ball_resistance_ohm[j]),
-                  capacitance_f=float(net.ball_capacitance_f[j]))
-        for j in range(model.ball_count))
+        BallState(
+            index=j,
+            azimuth_rad=az[j],
+            spin_rad_s=spin[j],
+            orbital_speed_rad_s=orbital[j],
+            cage_load_n=cage[j],
+            inner=contact(2 * j),
+            outer=contact(2 * j + 1),
+            resistance_ohm=finite_or_none(net.ball_resistance_ohm[j]),
+            capacitance_f=float(net.ball_capacitance_f[j]),
+        )
+        for j in range(model.ball_count)
+    )
 
 
 def electrical_state(net: ElectricalNetwork, inlet: InletFilm) -> ElectricalState:
     """The bearing's electrical block: the network's impedance and discharge indicators, and the
     inlet's current and shear heating with the film factor they give."""
     return ElectricalState(
-        resistance_ohm=finite_or_none(net.resistance_ohm), capacitance_f=net.capacitance_f,
+        resistance_ohm=finite_or_none(net.resistance_ohm),
+        capacitance_f=net.capacitance_f,
         capacitance_reason=net.capacitance_reason,
-        impedance_ohm=net.impedance_ohm, phase_rad=net.phase_rad,
-        frequency_hz=net.frequency_hz, shaft_voltage_v=net.shaft_voltage_v,
-        shaft_current_a=net.shaft_current_a, max_film_field_v_m=net.max_film_field_v_m,
-        current_density_a_m2=net.current_density_a_m2, discharge_risk=net.discharge_risk,
+        impedance_ohm=net.impedance_ohm,
+        phase_rad=net.phase_rad,
+        frequency_hz=net.frequency_hz,
+        shaft_voltage_v=net.shaft_voltage_v,
+        shaft_current_a=net.shaft_current_a,
+        max_film_field_v_m=net.max_film_field_v_m,
+        current_density_a_m2=net.current_density_a_m2,
+        discharge_risk=net.discharge_risk,
         reason=net.reason,
         contact_temperature_rise_k=float(inlet.current_heating_k + inlet.shear_heating_k),
         current_temperature_rise_k=float(inlet.current_heating_k),
         shear_temperature_rise_k=float(inlet.shear_heating_k),
-        film_thermal_factor=float(inlet.film_thermal_factor))
+        film_thermal_factor=float(inlet.film_thermal_factor),
+    )

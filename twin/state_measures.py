@@ -39,8 +39,11 @@ def kinetic_energy_j(model: BearingModel, state: TwinState) -> float:
     p = model.params
     v = (state.ball_velocity_in_bearing_m_s if model.housing_on else state.ball_velocity_m_s).ravel()
     w = state.ball_angular_velocity_rad_s.ravel()
-    return 0.5 * (p[L.P_BALL_MASS] * float(v @ v) + p[L.P_BALL_INERTIA] * float(w @ w)
-                  + p[L.P_CAGE_INERTIA] * float(state.scalars[L.X_CAGE_SPEED]) ** 2)
+    return 0.5 * (
+        p[L.P_BALL_MASS] * float(v @ v)
+        + p[L.P_BALL_INERTIA] * float(w @ w)
+        + p[L.P_CAGE_INERTIA] * float(state.scalars[L.X_CAGE_SPEED]) ** 2
+    )
 
 
 def mean_entrainment_speed_m_s(state: TwinState) -> float:

@@ -62,7 +62,7 @@ AUTO: Final = "auto"
 # step for these. Accuracy is not what sets it: `twin.validation.timestep_study` shows that the outputs at
 # the auto step agree with 1 us within the study's tolerances over the operating envelope.
 SAFETY_FACTOR = 0.8
-FRAME_S = 1e-3                    # the auto step divides the 1 ms frame
+FRAME_S = 1e-3  # the auto step divides the 1 ms frame
 REFERENCE_OIL_TEMPERATURE_C = 40.0  # ISO 3448 reference temperature, the seeds' oil temperature
 
 
@@ -85,16 +85,16 @@ class Element:
     """One stiff element of the model, linearised at the static capacity."""
 
     name: str
-    omega_rad_s: float        # highest circular frequency of the element [rad/s]
-    damping_ratio: float      # of that mode [-]
-    critical_step_s: float    # central-difference stability limit [s]
+    omega_rad_s: float  # highest circular frequency of the element [rad/s]
+    damping_ratio: float  # of that mode [-]
+    critical_step_s: float  # central-difference stability limit [s]
 
 
 @dataclass(frozen=True)
 class CriticalTimeStep:
     """The critical step of a compiled model and the elements it comes from."""
 
-    static_load_n: float            # ball load at which the elements are linearised [N]
+    static_load_n: float  # ball load at which the elements are linearised [N]
     reference_viscosity_pa_s: float  # oil viscosity of the fluid-damping bound [Pa s]
     elements: tuple[Element, ...]
 
@@ -115,12 +115,23 @@ class CriticalTimeStep:
 
     def as_dict(self) -> dict:
         """Plain-data form (SI, units in the keys)."""
-        return {"critical_time_step_s": self.critical_step_s, "limiting_element": self.limiting_element,
-                "auto_time_step_s": self.auto_time_step_s, "safety_factor": SAFETY_FACTOR,
-                "static_load_n": self.static_load_n,
-                "reference_viscosity_pa_s": self.reference_viscosity_pa_s,
-                "elements": [{"name": e.name, "omega_rad_s": e.omega_rad_s, "damping_ratio": e.damping_ratio,
-                              "critical_time_step_s": e.critical_step_s} for e in self.elements]}
+        return {
+            "critical_time_step_s": self.critical_step_s,
+            "limiting_element": self.limiting_element,
+            "auto_time_step_s": self.auto_time_step_s,
+            "safety_factor": SAFETY_FACTOR,
+            "static_load_n": self.static_load_n,
+            "reference_viscosity_pa_s": self.reference_viscosity_pa_s,
+            "elements": [
+                {
+                    "name": e.name,
+                    "omega_rad_s": e.omega_rad_s,
+                    "damping_ratio": e.damping_ratio,
+                    "critical_time_step_s": e.critical_step_s,
+                }
+                for e in self.elements
+            ],
+        }
 
 
 def _highest_mode(name: str, k: np.ndarray, m: np.ndarray, c: np.ndarray) -> Element:
@@ -140,8 +151,14 @@ def _highest_mode(name: str, k: np.ndarray, m: np.ndarray, c: np.ndarray) -> Ele
     return best
 
 
-def estimate(params: np.ndarray, race_params: np.ndarray, race_tribology: np.ndarray,
-             static_load_n: float, reference_viscosity_pa_s: float, ball_count: int) -> CriticalTimeStep:
+def estimate(
+    params: np.ndarray,
+    race_params: np.ndarray,
+    race_tribology: np.ndarray,
+    static_load_n: float,
+    reference_viscosity_pa_s: float,
+    ball_count: int,
+) -> CriticalTimeStep:
     """The critical step of the model arrays (`twin.model`), every element at `static_load_n`."""
     p = params
     q = float(static_load_n)
@@ -164,9 +181,15 @@ def estimate(params: np.ndarray, race_params: np.ndarray, race_tribology: np.nda
         ct.append(p[L.P_CT_RATIO] * 2.0 * math.sqrt(p[L.P_KT_RATIO] * k * m_t))
         roll = 0.0
         if p[L.P_ROLLING] != 0.0:
-            tri = contact_tribology(q, ROLLING_REGULARISATION_SPEED, reference_viscosity_pa_s,
-                                    p[L.P_ROUGHNESS], *race_tribology[r, :15],
-                                    int(p[L.P_FRICTION_MODEL]), True)
+            tri = contact_tribology(
+                q,
+                ROLLING_REGULARISATION_SPEED,
+                reference_viscosity_pa_s,
+                p[L.P_ROUGHNESS],
+                *race_tribology[r, :15],
+                int(p[L.P_FRICTION_MODEL]),
+                True,
+            )
             roll = tri[8] / ROLLING_REGULARISATION_SPEED
         croll.append(roll)
     ki, ko = kn
@@ -175,29 +198,36 @@ def estimate(params: np.ndarray, race_params: np.ndarray, race_tribology: np.nda
     # ball normal: (ball, inner ring) along the contact line; the ring also rests on the others
     normal = _highest_mode(
         "ball normal (inner + outer Hertz contacts, inner-ring mass)",
-        np.array([[ki + ko, -ki], [-ki, ki * (1 + rest)]]), np.diag([m, m_ring]),
-        np.array([[ci + co, -ci], [-ci, ci * (1 + rest)]]))
+        np.array([[ki + ko, -ki], [-ki, ki * (1 + rest)]]),
+        np.diag([m, m_ring]),
+        np.array([[ci + co, -ci], [-ci, ci * (1 + rest)]]),
+    )
     # ball tangential: translation x and rotation theta; contact slips x + Rb theta, x - Rb theta
     g = (np.array([1.0, rb]), np.array([1.0, -rb]))
     k_tan = kt[0] * np.outer(g[0], g[0]) + kt[1] * np.outer(g[1], g[1])
-    c_tan = (ct[0] * np.outer(g[0], g[0]) + ct[1] * np.outer(g[1], g[1])
-             + np.diag([croll[0] + croll[1], 0.0]))
-    tangential = _highest_mode("ball tangential (two tangential springs, translation + rotation)",
-                               k_tan, np.diag([m, inertia]), c_tan)
+    c_tan = ct[0] * np.outer(g[0], g[0]) + ct[1] * np.outer(g[1], g[1]) + np.diag([croll[0] + croll[1], 0.0])
+    tangential = _highest_mode(
+        "ball tangential (two tangential springs, translation + rotation)", k_tan, np.diag([m, inertia]), c_tan
+    )
     r_stiff = int(np.argmax(kt))
     w_single = math.sqrt(kt[r_stiff] / m_t)
-    single = Element("one tangential contact, reduced mass m / (1 + m Rb^2 / I)", w_single,
-                     float(p[L.P_CT_RATIO]), central_difference_critical_step_s(w_single, p[L.P_CT_RATIO]))
+    single = Element(
+        "one tangential contact, reduced mass m / (1 + m Rb^2 / I)",
+        w_single,
+        float(p[L.P_CT_RATIO]),
+        central_difference_critical_step_s(w_single, p[L.P_CT_RATIO]),
+    )
     k_cage = hertz_tangent_stiffness_n_m(p[L.P_CAGE_STIFFNESS], q)
     w_cage = math.sqrt(k_cage / p[L.P_CAGE_REDUCED_MASS])
-    cage = Element("ball-cage element (critical damping)", w_cage, 1.0,
-                   central_difference_critical_step_s(w_cage, 1.0))
-    return CriticalTimeStep(static_load_n=q, reference_viscosity_pa_s=float(reference_viscosity_pa_s),
-                            elements=(normal, tangential, single, cage))
+    cage = Element("ball-cage element (critical damping)", w_cage, 1.0, central_difference_critical_step_s(w_cage, 1.0))
+    return CriticalTimeStep(
+        static_load_n=q,
+        reference_viscosity_pa_s=float(reference_viscosity_pa_s),
+        elements=(normal, tangential, single, cage),
+    )
 
 
-def auto_time_step_s(critical_step_s: float, safety_factor: float = SAFETY_FACTOR,
-                     frame_s: float = FRAME_S) -> float:
+def auto_time_step_s(critical_step_s: float, safety_factor: float = SAFETY_FACTOR, frame_s: float = FRAME_S) -> float:
     """safety_factor x critical_step_s rounded down to frame_s / n, n a whole number [s]."""
     target = min(safety_factor * critical_step_s, TIME_STEP_RANGE_S[1])
     return frame_s / math.ceil(frame_s / target - 1e-9)

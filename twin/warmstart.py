@@ -36,16 +36,23 @@ def _equilibrium_residual(x_um, model: BearingModel, azimuths, fr, fa, cage_spee
         fball = np.zeros(3)
         for r, centre in ((0, ring), (1, np.zeros(3))):
             rel = ball - centre
-            delta, nx, ny, nz = groove_penetration(rel[0], rel[1], rel[2], race[r, L.R_GROOVE_CENTRE_RADIUS],
-                                                   race[r, L.R_GROOVE_CENTRE_Z], race[r, L.R_GROOVE_RADIUS], rb)
+            delta, nx, ny, nz = groove_penetration(
+                rel[0],
+                rel[1],
+                rel[2],
+                race[r, L.R_GROOVE_CENTRE_RADIUS],
+                race[r, L.R_GROOVE_CENTRE_Z],
+                race[r, L.R_GROOVE_RADIUS],
+                rb,
+            )
             if delta > 0.0:
-                q = model.stiffness_at(r, nz) * delta ** 1.5
+                q = model.stiffness_at(r, nz) * delta**1.5
                 f = -q * np.array([nx, ny, nz])
                 fball += f
                 if r == 0:
                     ring_force -= f
-        fball[0] += m * cage_speed ** 2 * rho * c
-        fball[1] += m * cage_speed ** 2 * rho * s
+        fball[0] += m * cage_speed**2 * rho * c
+        fball[1] += m * cage_speed**2 * rho * s
         fball -= _REG_SPRING_N_M * np.array([x[3 + 2 * j] * c, x[3 + 2 * j] * s, zb])
         res[3 + 2 * j] = fball[0] * c + fball[1] * s
         res[4 + 2 * j] = fball[2]
@@ -72,8 +79,7 @@ def _initial_guess_um(model: BearingModel, azimuths, fr, fa) -> np.ndarray:
     x = np.zeros(3 + 2 * z)
     x[0], x[2] = delta_r, delta_a
     for j in range(z):
-        total = (delta_r * math.cos(azimuths[j]) * math.cos(alpha) + delta_a * math.sin(alpha)
-                 - 0.5 * pd)
+        total = delta_r * math.cos(azimuths[j]) * math.cos(alpha) + delta_a * math.sin(alpha) - 0.5 * pd
         d_out = outer_share * max(total, 0.0)
         x[3 + 2 * j] = d_out * math.cos(alpha) + 0.5 * pd
         x[4 + 2 * j] = d_out * math.sin(alpha)
@@ -86,18 +92,28 @@ def solve_equilibrium(model: BearingModel, azimuths, radial_load_n, axial_load_n
     args = (model, azimuths, radial_load_n, axial_load_n, cage_speed_rad_s)
     x0 = _initial_guess_um(model, azimuths, radial_load_n, axial_load_n)
     scale = max(radial_load_n, abs(axial_load_n), 1.0)
-    sol = optimize.root(_equilibrium_residual, x0, args=args, method="hybr",
-                        options={"xtol": 1e-13, "maxfev": 20000})
+    sol = optimize.root(_equilibrium_residual, x0, args=args, method="hybr", options={"xtol": 1e-13, "maxfev": 20000})
     if np.max(np.abs(_equilibrium_residual(sol.x, *args))) > 1e-6 * scale:
-        sol = optimize.root(_equilibrium_residual, sol.x, args=args, method="lm",
-                            options={"xtol": 1e-15, "ftol": 1e-15, "maxiter": 20000})
+        sol = optimize.root(
+            _equilibrium_residual,
+            sol.x,
+            args=args,
+            method="lm",
+            options={"xtol": 1e-15, "ftol": 1e-15, "maxiter": 20000},
+        )
     ok = bool(np.max(np.abs(_equilibrium_residual(sol.x, *args))) <= 1e-6 * scale)
     x = sol.x * 1e-6
     return x[:3], x[3::2], x[4::2], ok
 
 
-def warm_start(model: BearingModel, state: TwinState, shaft_speed_rad_s: float, radial_load_n: float,
-               axial_load_n: float, cage_angle_rad: float = 0.0) -> bool:
+def warm_start(
+    model: BearingModel,
+    state: TwinState,
+    shaft_speed_rad_s: float,
+    radial_load_n: float,
+    axial_load_n: float,
+    cage_angle_rad: float = 0.0,
+) -> bool:
     """Fill `state` with the quasi-static equilibrium and rolling kinematics; returns whether the
     equilibrium solver converged."""
     z = model.ball_count
@@ -122,8 +138,15 @@ def warm_start(model: BearingModel, state: TwinState, shaft_speed_rad_s: float, 
         normals = []
         for r, centre in ((0, ring), (1, np.zeros(3))):
             rel = ball - centre
-            _, nx, ny, nz = groove_penetration(rel[0], rel[1], rel[2], race[r, L.R_GROOVE_CENTRE_RADIUS],
-                                               race[r, L.R_GROOVE_CENTRE_Z], race[r, L.R_GROOVE_RADIUS], rb)
+            _, nx, ny, nz = groove_penetration(
+                rel[0],
+                rel[1],
+                rel[2],
+                race[r, L.R_GROOVE_CENTRE_RADIUS],
+                race[r, L.R_GROOVE_CENTRE_Z],
+                race[r, L.R_GROOVE_RADIUS],
+                rb,
+            )
             rows[L.M_STIFFNESS, 2 * j + r] = model.stiffness_at(r, nz)
             normals.append(np.array([nx, ny, nz]))
         e_t = np.array([-s, c, 0.0])
@@ -141,8 +164,15 @@ def place_on_housing(model: BearingModel, state: TwinState, radial_load_n: float
     ring; their centrifugal forces cancel over the ring), the balls and the inner ring moved with
     it; the decimator and the sample ring restart (twin.vibration.housing.housing_equilibrium)."""
     s = state
-    housing_equilibrium(model.housing_params, radial_load_n, 0.0, axial_load_n,
-                        s.housing_displacement_m, s.housing_velocity_m_s, s.housing_acceleration_m_s2)
+    housing_equilibrium(
+        model.housing_params,
+        radial_load_n,
+        0.0,
+        axial_load_n,
+        s.housing_displacement_m,
+        s.housing_velocity_m_s,
+        s.housing_acceleration_m_s2,
+    )
     shift = s.housing_displacement_m[:3]
     s.ball_position_m += shift
     s.ring_position_m += shift

@@ -37,8 +37,19 @@ from service import __version__
 from service.api.deps import require_token
 from service.api.errors import install_error_handlers
 from service.api.middleware import BodySizeLimit, ReadRateLimit, Tarpit, TarpitStats, TokenGate
-from service.api.routers import (alarms, bearings, defects, docs, health, measured, recording, scenarios, setpoint,
-                                 state, temperature)
+from service.api.routers import (
+    alarms,
+    bearings,
+    defects,
+    docs,
+    health,
+    measured,
+    recording,
+    scenarios,
+    setpoint,
+    state,
+    temperature,
+)
 from service.api.schemas import ErrorResponse
 from service.core.registry import TwinRegistry, admission_gate
 from service.settings import ServiceSettings, is_loopback_host
@@ -51,8 +62,7 @@ _UNAUTHORIZED = {401: {"model": ErrorResponse, "description": "Missing or wrong 
 def access_summary(settings: ServiceSettings) -> str:
     """One line: whether a token is required, and for what."""
     if settings.security.token is None:
-        return ("no token (BEARING_TWIN_TOKEN unset): anyone who can reach the port may change "
-                "setpoints")
+        return "no token (BEARING_TWIN_TOKEN unset): anyone who can reach the port may change setpoints"
     reads = "reads too (except /health)" if settings.security.read_requires_token else "reads open"
     return f"bearer token required for POST/PUT/DELETE (HTTP only, never sent on zenoh); {reads}"
 
@@ -65,9 +75,13 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
 
     @asynccontextmanager
     async def lifespan(app: FastAPI):
-        log.info("bearing-twin: HTTP bound to %s:%s (%s); %s", settings.http.host, settings.http.port,
-                 "loopback only" if is_loopback_host(settings.http.host) else "reachable from other machines",
-                 access_summary(settings))
+        log.info(
+            "bearing-twin: HTTP bound to %s:%s (%s); %s",
+            settings.http.host,
+            settings.http.port,
+            "loopback only" if is_loopback_host(settings.http.host) else "reachable from other machines",
+            access_summary(settings),
+        )
         opened = service
         if opened is None:
             from service.wiring import TwinService
@@ -75,7 +89,7 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
             opened = TwinService(settings, gate=gate)
             await run_in_threadpool(opened.open)
         app.state.service = opened
-        opened.priority.keep_thread(threading.get_native_id())   # the event loop answers /health in time
+        opened.priority.keep_thread(threading.get_native_id())  # the event loop answers /health in time
         try:
             yield
         finally:
@@ -89,30 +103,50 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
         description="Setpoints in, live contact state out. Units are in every field name and "
         "description (SI, oil temperature in degC). State schema 'bearing-twin/state/1'; the same "
         "snapshots stream on zenoh `bearing/{id}/state` and `bearing/{id}/ball/{i}`.",
-        lifespan=lifespan, openapi_url=None, docs_url=None, redoc_url=None,
+        lifespan=lifespan,
+        openapi_url=None,
+        docs_url=None,
+        redoc_url=None,
     )
     app.state.settings = settings
     app.state.gate = gate
     app.state.service = None
     app.state.tarpit = TarpitStats()
     app.add_middleware(BodySizeLimit, gate=gate)
-    app.add_middleware(ReadRateLimit, gate=gate)      # a refused read costs the least
+    app.add_middleware(ReadRateLimit, gate=gate)  # a refused read costs the least
     app.add_middleware(TokenGate, gate=gate, reads=settings.security.read_requires_token)
-    app.add_middleware(Tarpit, gate=gate, delay_s=settings.security.tarpit_delay_s, max_held=settings.security.tarpit_max_held,
-                       stats=app.state.tarpit)        # outermost: sees every refusal
+    app.add_middleware(
+        Tarpit,
+        gate=gate,
+        delay_s=settings.security.tarpit_delay_s,
+        max_held=settings.security.tarpit_max_held,
+        stats=app.state.tarpit,
+    )  # outermost: sees every refusal
     install_error_handlers(app)
 
     token = [Depends(require_token)] if gate.requires_token else []
-    writes: dict[str, Any] = {"dependencies": token, "responses": {
-        **(_UNAUTHORIZED if token else {}),
-        413: {"model": ErrorResponse, "description": f"Body larger than {settings.security.max_body_bytes} bytes"}}}
-    reads: dict[str, Any] = ({"dependencies": token, "responses": _UNAUTHORIZED}
-                             if token and settings.security.read_requires_token else {})
+    writes: dict[str, Any] = {
+        "dependencies": token,
+        "responses": {
+            **(_UNAUTHORIZED if token else {}),
+            413: {"model": ErrorResponse, "description": f"Body larger than {settings.security.max_body_bytes} bytes"},
+        },
+    }
+    reads: dict[str, Any] = (
+        {"dependencies": token, "responses": _UNAUTHORIZED} if token and settings.security.read_requires_token else {}
+    )
     app.include_router(health.router)
     for router in (bearings.read, state.read, alarms.read, defects.read, measured.read, scenarios.read, docs.read):
         app.include_router(router, **reads)
-    for router in (bearings.write, setpoint.write, defects.write, measured.write, scenarios.write, recording.write,
-                   temperature.write):
+    for router in (
+        bearings.write,
+        setpoint.write,
+        defects.write,
+        measured.write,
+        scenarios.write,
+        recording.write,
+        temperature.write,
+    ):
         app.include_router(router, **writes)
     docs.mount_assets(app)
     return app

@@ -17,8 +17,7 @@ from service.core.errors import InputError
 from service.core.registry import TwinEntry, TwinRegistry
 from service.settings import ServiceSettings
 
-bearer = HTTPBearer(scheme_name="bearerToken", auto_error=False,
-                    description="BEARING_TWIN_TOKEN of the service")
+bearer = HTTPBearer(scheme_name="bearerToken", auto_error=False, description="BEARING_TWIN_TOKEN of the service")
 
 
 def refusal_error(refusal: Refusal) -> InputError:
@@ -29,8 +28,7 @@ def refusal_error(refusal: Refusal) -> InputError:
         headers["WWW-Authenticate"] = 'Bearer realm="bearing-twin"'
     if refusal.retry_after_s is not None:
         headers["Retry-After"] = str(max(1, math.ceil(refusal.retry_after_s)))
-    return InputError.one(refusal.field, refusal.message, refusal.allowed, status_code=refusal.status,
-                          headers=headers)
+    return InputError.one(refusal.field, refusal.message, refusal.allowed, status_code=refusal.status, headers=headers)
 
 
 async def get_settings(request: Request) -> ServiceSettings:
@@ -61,12 +59,15 @@ async def get_twin(bearing_id: str, registry: RegistryDep) -> TwinEntry:
 TwinDep = Annotated[TwinEntry, Depends(get_twin)]
 
 
-async def require_token(gate: GateDep,
-                        credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]) -> None:
+async def require_token(
+    gate: GateDep, credentials: Annotated[HTTPAuthorizationCredentials | None, Depends(bearer)]
+) -> None:
     """401 unless the request carries `Authorization: Bearer <the service token>`."""
-    refusal = gate.check_token(credentials.credentials if credentials is not None else None,
-                               missing="missing bearer token: send 'Authorization: Bearer <token>'",
-                               field="Authorization")
+    refusal = gate.check_token(
+        credentials.credentials if credentials is not None else None,
+        missing="missing bearer token: send 'Authorization: Bearer <token>'",
+        field="Authorization",
+    )
     if refusal is not None:
         raise refusal_error(refusal)
 

@@ -20,8 +20,9 @@ log = logging.getLogger(__name__)
 
 
 def error_response(status: int, errors: list[FieldError], headers: dict | None = None) -> JSONResponse:
-    return JSONResponse(status_code=status, content={"detail": [e.model_dump() for e in errors]},
-                        headers=headers or None)
+    return JSONResponse(
+        status_code=status, content={"detail": [e.model_dump() for e in errors]}, headers=headers or None
+    )
 
 
 def _limits_of(request: Request):
@@ -55,14 +56,16 @@ async def _scenario_error(request: Request, exc: ScenarioError):
 
 
 async def _http_error(request: Request, exc: StarletteHTTPException):
-    return error_response(exc.status_code, [FieldError(field=None, message=str(exc.detail))],
-                          getattr(exc, "headers", None))
+    return error_response(
+        exc.status_code, [FieldError(field=None, message=str(exc.detail))], getattr(exc, "headers", None)
+    )
 
 
 async def _unexpected(request: Request, exc: Exception):
     log.exception("unexpected error on %s %s", request.method, request.url.path)
-    return error_response(500, [FieldError(field=None, message=f"internal error ({type(exc).__name__}); "
-                                           "see the service log")])
+    return error_response(
+        500, [FieldError(field=None, message=f"internal error ({type(exc).__name__}); see the service log")]
+    )
 
 
 def install_error_handlers(app: FastAPI) -> None:

@@ -94,15 +94,22 @@ class ReadRateLimit:
         self.prefix = prefix
 
     async def __call__(self, scope, receive, send) -> None:
-        if (scope["type"] == "http" and self.gate.read_rate_hz is not None
-                and scope.get("method", "GET").upper() in ("GET", "HEAD")
-                and scope.get("path", "").startswith(self.prefix)):
+        if (
+            scope["type"] == "http"
+            and self.gate.read_rate_hz is not None
+            and scope.get("method", "GET").upper() in ("GET", "HEAD")
+            and scope.get("path", "").startswith(self.prefix)
+        ):
             client = scope.get("client")
             refusal = self.gate.take_read(client[0] if client else "unknown")
             if refusal is not None:
                 retry = str(max(1, math.ceil(refusal.retry_after_s or 0.0)))
-                await _answer(send, 429, error_body(refusal.message, refusal.field, refusal.allowed),
-                              [(b"retry-after", retry.encode())])
+                await _answer(
+                    send,
+                    429,
+                    error_body(refusal.message, refusal.field, refusal.allowed),
+                    [(b"retry-after", retry.encode())],
+                )
                 return
         await self.app(scope, receive, send)
 
@@ -121,14 +128,21 @@ class TokenGate:
         self.prefix = prefix
 
     async def __call__(self, scope, receive, send) -> None:
-        if (scope["type"] == "http" and self.gate.requires_token
-                and scope.get("method", "GET").upper() in self.methods
-                and scope.get("path", "").startswith(self.prefix)):
+        if (
+            scope["type"] == "http"
+            and self.gate.requires_token
+            and scope.get("method", "GET").upper() in self.methods
+            and scope.get("path", "").startswith(self.prefix)
+        ):
             given = bearer_token(_headers(scope).get(b"authorization"))
             refusal = self.gate.check_token(given, missing=_MISSING_TOKEN, field="Authorization")
             if refusal is not None:
-                await _answer(send, 401, error_body(refusal.message, refusal.field, refusal.allowed),
-                              [(b"www-authenticate", b'Bearer realm="bearing-twin"')])
+                await _answer(
+                    send,
+                    401,
+                    error_body(refusal.message, refusal.field, refusal.allowed),
+                    [(b"www-authenticate", b'Bearer realm="bearing-twin"')],
+                )
                 return
         await self.app(scope, receive, send)
 
@@ -139,20 +153,34 @@ class TarpitStats:
 
     delay_s: float = 0.0
     max_held: int = 0
-    held_now: int = 0            # refusals being held now
-    held: int = 0                # refusals held so far
-    answered_at_once: int = 0    # over budget, but max_held were held already
+    held_now: int = 0  # refusals being held now
+    held: int = 0  # refusals held so far
+    answered_at_once: int = 0  # over budget, but max_held were held already
 
     def record(self) -> dict:
-        return {"active": self.delay_s > 0, "delay_s": self.delay_s, "max_held": self.max_held,
-                "held_now": self.held_now, "held": self.held, "answered_at_once": self.answered_at_once}
+        return {
+            "active": self.delay_s > 0,
+            "delay_s": self.delay_s,
+            "max_held": self.max_held,
+            "held_now": self.held_now,
+            "held": self.held,
+            "answered_at_once": self.answered_at_once,
+        }
 
 
 class Tarpit:
     """See the module docstring. `stats`: shared with /health."""
 
-    def __init__(self, app, *, gate: AdmissionGate, delay_s: float, max_held: int,
-                 stats: TarpitStats | None = None, exempt: frozenset[str] = frozenset({"/health"})):
+    def __init__(
+        self,
+        app,
+        *,
+        gate: AdmissionGate,
+        delay_s: float,
+        max_held: int,
+        stats: TarpitStats | None = None,
+        exempt: frozenset[str] = frozenset({"/health"}),
+    ):
         self.app = app
         self.gate = gate
         self.delay_s = float(delay_s)
@@ -160,7 +188,7 @@ class Tarpit:
         self.exempt = exempt
         self.active = self.delay_s > 0 and gate.error_rate_hz is not None
         self.stats = stats if stats is not None else TarpitStats()
-        self.stats.delay_s = self.delay_s if self.active else 0.0      # record(): active = delay_s > 0
+        self.stats.delay_s = self.delay_s if self.active else 0.0  # record(): active = delay_s > 0
         self.stats.max_held = self.max_held
 
     async def __call__(self, scope, receive, send) -> None:
@@ -172,8 +200,11 @@ class Tarpit:
         stats = self.stats
 
         async def send_held(message) -> None:
-            if (message["type"] == "http.response.start" and 400 <= message.get("status", 200) < 500
-                    and not self.gate.take_error(address)):
+            if (
+                message["type"] == "http.response.start"
+                and 400 <= message.get("status", 200) < 500
+                and not self.gate.take_error(address)
+            ):
                 if stats.held_now < self.max_held:
                     message = _with_retry_after(message, self.delay_s)
                     stats.held_now += 1
@@ -209,7 +240,7 @@ def _with_retry_after(message: dict, delay_s: float) -> dict:
 def _headers(scope) -> dict[bytes, bytes]:
     out: dict[bytes, bytes] = {}
     for name, value in scope.get("headers") or ():
-        out.setdefault(name.lower(), value)   # the first of repeated headers
+        out.setdefault(name.lower(), value)  # the first of repeated headers
     return out
 
 
@@ -222,11 +253,20 @@ def _replay(body: bytes, receive: Callable[[], Awaitable[dict]]) -> Callable[[],
             sent = True
             return {"type": "http.request", "body": body, "more_body": False}
         return await receive()
+
     return replay
 
 
 async def _answer(send, status: int, body: bytes, headers: list | None = None) -> None:
-    await send({"type": "http.response.start", "status": status,
-                "headers": [(b"content-type", b"application/json"),
-                            (b"content-length", str(len(body)).encode()), *(headers or ())]})
+    await send(
+        {
+            "type": "http.response.start",
+            "status": status,
+            "headers": [
+                (b"content-type", b"application/json"),
+                (b"content-length", str(len(body)).encode()),
+                *(headers or ()),
+            ],
+        }
+    )
     await send({"type": "http.response.body", "body": body})

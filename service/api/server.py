@@ -34,8 +34,7 @@ from uvicorn.protocols.http.h11_impl import H11Protocol
 log = logging.getLogger(__name__)
 
 REDACTED = "[redacted]"
-_SECRET_NAME = re.compile(r"token|key|secret|passw|pwd|auth|credential|signature|sig$|session",
-                          re.IGNORECASE)
+_SECRET_NAME = re.compile(r"token|key|secret|passw|pwd|auth|credential|signature|sig$|session", re.IGNORECASE)
 
 
 # ---- slow clients ------------------------------------------------------------------------------
@@ -84,16 +83,16 @@ class GuardedH11Protocol(H11Protocol):
             self._disarm()
             return
         state = self.conn.their_state
-        if state is h11.IDLE:                   # request line and headers not complete yet
+        if state is h11.IDLE:  # request line and headers not complete yet
             self._arm("headers", self.header_timeout_s)
-        elif state is h11.SEND_BODY:            # headers in, body still coming
+        elif state is h11.SEND_BODY:  # headers in, body still coming
             self._arm("body", self.body_timeout_s)
-        else:                                   # request complete (or the connection is ending)
+        else:  # request complete (or the connection is ending)
             self._disarm()
 
     def _arm(self, what: str, timeout_s: float) -> None:
         if self._guarding == what:
-            return                              # a drip does not push the deadline back
+            return  # a drip does not push the deadline back
         self._disarm()
         self._guarding = what
         self._guard = self.loop.call_later(timeout_s, self._expired, what, timeout_s)
@@ -115,23 +114,40 @@ class GuardedH11Protocol(H11Protocol):
         n = closures.count(what)
         if n <= 5 or n % 100 == 0:
             client = f"{self.client[0]}:{self.client[1]}" if self.client else "a client"
-            log.warning("closed the connection of %s: request %s not complete within %g s "
-                        "(%d such so far)", client, what, timeout_s, n)
+            log.warning(
+                "closed the connection of %s: request %s not complete within %g s (%d such so far)",
+                client,
+                what,
+                timeout_s,
+                n,
+            )
         cycle = self.cycle if what == "body" else None
         if cycle is None or not cycle.response_started:
-            body = json.dumps({"detail": [{
-                "field": what, "message": f"request {what} not complete within {timeout_s:g} s",
-                "allowed": [0, timeout_s]}]}).encode()
-            transport.write(b"HTTP/1.1 408 Request Timeout\r\ncontent-type: application/json\r\n"
-                            b"connection: close\r\ncontent-length: " + str(len(body)).encode()
-                            + b"\r\n\r\n" + body)
+            body = json.dumps(
+                {
+                    "detail": [
+                        {
+                            "field": what,
+                            "message": f"request {what} not complete within {timeout_s:g} s",
+                            "allowed": [0, timeout_s],
+                        }
+                    ]
+                }
+            ).encode()
+            transport.write(
+                b"HTTP/1.1 408 Request Timeout\r\ncontent-type: application/json\r\n"
+                b"connection: close\r\ncontent-length: " + str(len(body)).encode() + b"\r\n\r\n" + body
+            )
         transport.close()
 
 
 def guarded_protocol(header_timeout_s: float, body_timeout_s: float) -> type[GuardedH11Protocol]:
     """A `GuardedH11Protocol` class with these deadlines [s] (uvicorn instantiates the class)."""
-    return type("GuardedH11Protocol", (GuardedH11Protocol,),
-                {"header_timeout_s": float(header_timeout_s), "body_timeout_s": float(body_timeout_s)})
+    return type(
+        "GuardedH11Protocol",
+        (GuardedH11Protocol,),
+        {"header_timeout_s": float(header_timeout_s), "body_timeout_s": float(body_timeout_s)},
+    )
 
 
 # ---- the access log ----------------------------------------------------------------------------
@@ -150,8 +166,12 @@ def redact_path(path: str, secrets: Iterable[str] = ()) -> str:
     for secret in secrets:
         if not secret:
             continue
-        for form in {secret, urllib.parse.quote(secret, safe=""), urllib.parse.quote_plus(secret),
-                     urllib.parse.quote(secret)}:
+        for form in {
+            secret,
+            urllib.parse.quote(secret, safe=""),
+            urllib.parse.quote_plus(secret),
+            urllib.parse.quote(secret),
+        }:
             path = path.replace(form, REDACTED)
     return path
 
@@ -185,17 +205,24 @@ def install_access_log_redaction(token: str | None) -> RedactAccessLog:
 
 
 # ---- uvicorn -----------------------------------------------------------------------------------
-def uvicorn_config(app, settings, *, host: str | None = None, port: int | None = None,
-                   log_level: str = "info", **extra):
+def uvicorn_config(
+    app, settings, *, host: str | None = None, port: int | None = None, log_level: str = "info", **extra
+):
     """The uvicorn.Config serving `app` with the settings' slow-client limits (one worker, h11
     with deadlines, keep-alive, concurrency) and the access-log redaction installed."""
     import uvicorn
 
     config = uvicorn.Config(
-        app, host=settings.http.host if host is None else host, port=settings.http.port if port is None else port,
-        workers=1, log_level=log_level, lifespan="on",
+        app,
+        host=settings.http.host if host is None else host,
+        port=settings.http.port if port is None else port,
+        workers=1,
+        log_level=log_level,
+        lifespan="on",
         http=guarded_protocol(settings.http.header_timeout_s, settings.http.body_timeout_s),
-        timeout_keep_alive=settings.http.keep_alive_s, limit_concurrency=settings.http.max_connections,
-        **extra)
-    install_access_log_redaction(settings.security.token_value)   # after uvicorn configured its loggers
+        timeout_keep_alive=settings.http.keep_alive_s,
+        limit_concurrency=settings.http.max_connections,
+        **extra,
+    )
+    install_access_log_redaction(settings.security.token_value)  # after uvicorn configured its loggers
     return config

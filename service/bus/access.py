@@ -87,8 +87,7 @@ _SERVICE = [
     (["declare_queryable", "reply"], "egress", ["owner"]),
     (["declare_liveliness_subscriber", "liveliness_query", "liveliness_token"], "egress", ["alive"]),
 ]
-ROLE_RULES = {"readers": _READ_IN + _READ_OUT, "writers": _READ_IN + _READ_OUT + _WRITE,
-              "services": _SERVICE}
+ROLE_RULES = {"readers": _READ_IN + _READ_OUT, "writers": _READ_IN + _READ_OUT + _WRITE, "services": _SERVICE}
 
 
 @dataclass(frozen=True)
@@ -124,8 +123,15 @@ def acl_config(prefixes: str | Sequence[str], roles: Roles, *, tls: bool = False
         ids = []
         for n, (messages, flow, suffixes) in enumerate(ROLE_RULES[role]):
             rule_id = f"{role}-{n}"
-            rules.append({"id": rule_id, "messages": messages, "flows": [flow], "permission": "allow",
-                          "key_exprs": sorted({twin_key(p, s) for p in prefixes for s in suffixes})})
+            rules.append(
+                {
+                    "id": rule_id,
+                    "messages": messages,
+                    "flows": [flow],
+                    "permission": "allow",
+                    "key_exprs": sorted({twin_key(p, s) for p in prefixes for s in suffixes}),
+                }
+            )
             ids.append(rule_id)
         subject_ids = [f"{role}-users"]
         subjects.append({"id": f"{role}-users", "usernames": list(names)})
@@ -133,8 +139,7 @@ def acl_config(prefixes: str | Sequence[str], roles: Roles, *, tls: bool = False
             subjects.append({"id": f"{role}-certs", "cert_common_names": list(names)})
             subject_ids.append(f"{role}-certs")
         policies.append({"id": role, "rules": ids, "subjects": subject_ids})
-    return {"enabled": True, "default_permission": "deny", "rules": rules, "subjects": subjects,
-            "policies": policies}
+    return {"enabled": True, "default_permission": "deny", "rules": rules, "subjects": subjects, "policies": policies}
 
 
 @dataclass(frozen=True)
@@ -170,9 +175,15 @@ class ZenohAccess:
         if enforce:
             services = tuple(dict.fromkeys([*s.services, *([s.user] if s.user else [])]))
             roles = Roles(services=services, writers=tuple(s.writers), readers=tuple(s.readers))
-        return cls(user=s.user, password=s.password_value, usersfile=s.usersfile,
-                   tls_root_ca=s.tls_root_ca, tls_certificate=s.tls_certificate,
-                   tls_private_key=s.tls_private_key, roles=roles)
+        return cls(
+            user=s.user,
+            password=s.password_value,
+            usersfile=s.usersfile,
+            tls_root_ca=s.tls_root_ca,
+            tls_certificate=s.tls_certificate,
+            tls_private_key=s.tls_private_key,
+            roles=roles,
+        )
 
     @classmethod
     def from_env(cls) -> ZenohAccess:
@@ -190,12 +201,17 @@ class ZenohAccess:
             config.insert_json5("transport/auth/usrpwd/user", json.dumps(self.user))
             config.insert_json5("transport/auth/usrpwd/password", json.dumps(self.password))
         if self.usersfile is not None and listening:
-            config.insert_json5("transport/auth/usrpwd/dictionary_file",
-                                json.dumps(str(Path(self.usersfile).resolve())))
+            config.insert_json5(
+                "transport/auth/usrpwd/dictionary_file", json.dumps(str(Path(self.usersfile).resolve()))
+            )
         if self.tls:
-            tls = {"root_ca_certificate": self.tls_root_ca, "listen_certificate": self.tls_certificate,
-                   "listen_private_key": self.tls_private_key, "connect_certificate": self.tls_certificate,
-                   "connect_private_key": self.tls_private_key}
+            tls = {
+                "root_ca_certificate": self.tls_root_ca,
+                "listen_certificate": self.tls_certificate,
+                "listen_private_key": self.tls_private_key,
+                "connect_certificate": self.tls_certificate,
+                "connect_private_key": self.tls_private_key,
+            }
             for key, path in tls.items():
                 config.insert_json5(f"transport/link/tls/{key}", json.dumps(str(Path(path).resolve())))
             config.insert_json5("transport/link/tls/enable_mtls", "true")
@@ -214,8 +230,9 @@ class ZenohAccess:
         if listening and self.usersfile is not None:
             parts.append(f"accepts the users of {str(self.usersfile)!r}")
         if listening and self.roles is not None:
-            parts.append("rules: " + "; ".join(f"{role} {', '.join(names) or '(none)'}"
-                                                for role, names in self.roles.items()))
+            parts.append(
+                "rules: " + "; ".join(f"{role} {', '.join(names) or '(none)'}" for role, names in self.roles.items())
+            )
         elif not listening:
             parts.append("the rules of the router (or service) it connects to apply")
         return "zenoh access control on: " + ", ".join(parts)

@@ -23,8 +23,17 @@ import zenoh
 
 from service.bus.twin_outbox import undeclare
 from service.bus.wire import Bus, JSON_ENCODING, dumps, one_line, payload
-from service.keys import (DEFECTS, DEFECTS_RESULT, OWNER, SETPOINT, SETPOINT_RESULT, SNAPSHOT, VIBRATION_COMPARISON,
-                          VIBRATION_MEASURED, twin_key)
+from service.keys import (
+    DEFECTS,
+    DEFECTS_RESULT,
+    OWNER,
+    SETPOINT,
+    SETPOINT_RESULT,
+    SNAPSHOT,
+    VIBRATION_COMPARISON,
+    VIBRATION_MEASURED,
+    twin_key,
+)
 from twin.snapshot import Snapshot
 
 log = logging.getLogger(__name__)
@@ -37,9 +46,17 @@ Handler = Callable[[bytes], dict]
 class TwinInbox:
     """The subscribers, queryables and result publishers of one twin, and its control thread."""
 
-    def __init__(self, bus: Bus, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
-                 on_setpoint: Handler, *, on_defects: Handler | None = None, on_measured: Handler | None = None,
-                 known_state: Callable[[Snapshot], str | None] = lambda _s: None):
+    def __init__(
+        self,
+        bus: Bus,
+        bearing_id: str,
+        get_snapshot: Callable[[], Snapshot | None],
+        on_setpoint: Handler,
+        *,
+        on_defects: Handler | None = None,
+        on_measured: Handler | None = None,
+        known_state: Callable[[Snapshot], str | None] = lambda _s: None,
+    ):
         self.bus = bus
         self.bearing_id = bearing_id
         self.prefix = twin_key(bus.prefix, bearing_id)
@@ -49,12 +66,12 @@ class TwinInbox:
         self._on_defects = on_defects
         self._on_measured = on_measured
         self.setpoints_received = 0
-        self.setpoints_refused_busy = 0   # setpoints refused (429 on the result key): control queue full
+        self.setpoints_refused_busy = 0  # setpoints refused (429 on the result key): control queue full
         self.queries_answered = 0
-        self._busy_pending = 0      # of those, refusals not yet published
-        self._busy_marked = 0       # 1 while a ("busy", None) marker waits in the control queue
+        self._busy_pending = 0  # of those, refusals not yet published
+        self._busy_marked = 0  # 1 while a ("busy", None) marker waits in the control queue
         self._closed = False
-        self._gone = False          # result publishers undeclared
+        self._gone = False  # result publishers undeclared
         self._control: collections.deque = collections.deque()
         self._control_cond = threading.Condition()
         session = bus.session
@@ -62,23 +79,29 @@ class TwinInbox:
         # BLOCK, not DROP: a result is never lost in zenoh's transmission queue (with DROP, 13-18 of
         # 30 000 results of an `attack --record` zenoh flood never arrived); the back-pressure is the
         # control thread's bounded queue, which refuses further setpoints with 429
-        self._result_pub = session.declare_publisher(key(SETPOINT_RESULT), encoding=JSON_ENCODING,
-                                                     congestion_control=zenoh.CongestionControl.BLOCK)
+        self._result_pub = session.declare_publisher(
+            key(SETPOINT_RESULT), encoding=JSON_ENCODING, congestion_control=zenoh.CongestionControl.BLOCK
+        )
         self._setpoint_sub = session.declare_subscriber(
-            key(SETPOINT), lambda sample: self._enqueue(("setpoint", payload(sample))))
+            key(SETPOINT), lambda sample: self._enqueue(("setpoint", payload(sample)))
+        )
         self._defects_sub = self._defects_result_pub = None
         if on_defects is not None:
-            self._defects_result_pub = session.declare_publisher(key(DEFECTS_RESULT), encoding=JSON_ENCODING,
-                                                                 congestion_control=zenoh.CongestionControl.BLOCK)
+            self._defects_result_pub = session.declare_publisher(
+                key(DEFECTS_RESULT), encoding=JSON_ENCODING, congestion_control=zenoh.CongestionControl.BLOCK
+            )
             self._defects_sub = session.declare_subscriber(
-                key(DEFECTS), lambda sample: self._enqueue(("defects", payload(sample))))
+                key(DEFECTS), lambda sample: self._enqueue(("defects", payload(sample)))
+            )
         # measured accelerometer windows (service.core.measured: binary frame in, comparison out)
         self._measured_sub = self._comparison_pub = None
         if on_measured is not None:
-            self._comparison_pub = session.declare_publisher(key(VIBRATION_COMPARISON), encoding=JSON_ENCODING,
-                                                             congestion_control=zenoh.CongestionControl.BLOCK)
+            self._comparison_pub = session.declare_publisher(
+                key(VIBRATION_COMPARISON), encoding=JSON_ENCODING, congestion_control=zenoh.CongestionControl.BLOCK
+            )
             self._measured_sub = session.declare_subscriber(
-                key(VIBRATION_MEASURED), lambda sample: self._enqueue(("measured", payload(sample))))
+                key(VIBRATION_MEASURED), lambda sample: self._enqueue(("measured", payload(sample)))
+            )
         self._queryable = session.declare_queryable(key(SNAPSHOT), lambda query: self._enqueue(("query", query)))
         self._owner_queryable = session.declare_queryable(key(OWNER), lambda query: self._enqueue(("owner", query)))
         self._thread = threading.Thread(target=self._loop, name=f"zenoh-ctl-{bearing_id}", daemon=True)
@@ -89,8 +112,13 @@ class TwinInbox:
         handled until `stop`."""
         with self._control_cond:
             self._closed = True
-        for entity in (self._setpoint_sub, self._defects_sub, self._measured_sub, self._queryable,
-                       self._owner_queryable):
+        for entity in (
+            self._setpoint_sub,
+            self._defects_sub,
+            self._measured_sub,
+            self._queryable,
+            self._owner_queryable,
+        ):
             if entity is not None:
                 undeclare(entity)
 
@@ -118,11 +146,11 @@ class TwinInbox:
                 if item[0] == "setpoint":
                     self.setpoints_refused_busy += 1
                     self._busy_pending += 1
-                    if not self._busy_marked:        # one marker, beyond the bound
+                    if not self._busy_marked:  # one marker, beyond the bound
                         self._busy_marked = 1
                         self._control.append(("busy", None))
                         self._control_cond.notify()
-                elif item[0] == "defects":           # rare: refused at once on its result key
+                elif item[0] == "defects":  # rare: refused at once on its result key
                     self.setpoints_refused_busy += 1
                     if not self._gone and self._defects_result_pub is not None:
                         with contextlib.suppress(Exception):
@@ -183,10 +211,16 @@ class TwinInbox:
     def _busy_refusal(self, what: str) -> str:
         """The result-key refusal (status 429) of a message of kind `what` (plural) that found
         the control queue full."""
-        return dumps({"accepted": False, "status": 429, "retry_after_s": 0.1,
-                      "error": f"too many {what} waiting for twin {self.bearing_id!r} "
-                      f"({CONTROL_QUEUE_SIZE} queued, the most this twin queues): refused, retry",
-                      "bearing_id": self.bearing_id})
+        return dumps(
+            {
+                "accepted": False,
+                "status": 429,
+                "retry_after_s": 0.1,
+                "error": f"too many {what} waiting for twin {self.bearing_id!r} "
+                f"({CONTROL_QUEUE_SIZE} queued, the most this twin queues): refused, retry",
+                "bearing_id": self.bearing_id,
+            }
+        )
 
     def _refuse_busy(self) -> None:
         """Publish one 429 refusal for each setpoint that found the control queue full."""
@@ -217,8 +251,11 @@ class TwinInbox:
 
     def _handle_owner_query(self, query: zenoh.Query) -> None:
         try:
-            query.reply(twin_key(self.bus.prefix, self.bearing_id, OWNER), dumps(self.bus.owner(self.bearing_id)),
-                        encoding=JSON_ENCODING)
+            query.reply(
+                twin_key(self.bus.prefix, self.bearing_id, OWNER),
+                dumps(self.bus.owner(self.bearing_id)),
+                encoding=JSON_ENCODING,
+            )
         finally:
             with contextlib.suppress(Exception):
                 query.drop()

@@ -66,8 +66,13 @@ def spectrum_json(spectrum: Any) -> dict | None:
     if spectrum is None:
         return None
     amp = spectrum.amplitude_m_s2
-    return {"start_hz": spectrum.start_hz, "step_hz": spectrum.step_hz, "bins": len(amp), "units": "m/s^2",
-            "amplitude_m_s2": [float(f"{a:.6g}") for a in amp]}
+    return {
+        "start_hz": spectrum.start_hz,
+        "step_hz": spectrum.step_hz,
+        "bins": len(amp),
+        "units": "m/s^2",
+        "amplitude_m_s2": [float(f"{a:.6g}") for a in amp],
+    }
 
 
 def payload(sample: zenoh.Sample) -> bytes:

@@ -89,11 +89,11 @@ class TokenBucket:
 class Refusal:
     """Why the gate refused: the status to answer with, the field at fault and a message."""
 
-    status: int                       # 401, 403, 413 or 429
+    status: int  # 401, 403, 413 or 429
     field: str | None
     message: str
     allowed: list | None = None
-    retry_after_s: float | None = None   # 429: when a setpoint will be admitted again [s]
+    retry_after_s: float | None = None  # 429: when a setpoint will be admitted again [s]
 
 
 class AdmissionGate:
@@ -104,13 +104,22 @@ class AdmissionGate:
     (module docstring); default "closed" when a token is given, else "open"."""
 
     BUS_WRITES = ("open", "authorized", "closed")
-    MAX_READ_CLIENTS = 10_000     # read budgets kept (least recently seen client dropped first)
+    MAX_READ_CLIENTS = 10_000  # read budgets kept (least recently seen client dropped first)
 
-    def __init__(self, *, token: str | None = None, setpoint_rate_hz: float | None = None,
-                 setpoint_burst: int = 100, max_payload_bytes: int | None = None,
-                 bus_writes: str | None = None, read_rate_hz: float | None = None,
-                 read_burst: int = 200, error_rate_hz: float | None = None, error_burst: int = 20,
-                 clock: Callable[[], float] = time.monotonic):
+    def __init__(
+        self,
+        *,
+        token: str | None = None,
+        setpoint_rate_hz: float | None = None,
+        setpoint_burst: int = 100,
+        max_payload_bytes: int | None = None,
+        bus_writes: str | None = None,
+        read_rate_hz: float | None = None,
+        read_burst: int = 200,
+        error_rate_hz: float | None = None,
+        error_burst: int = 20,
+        clock: Callable[[], float] = time.monotonic,
+    ):
         self.token = token
         if bus_writes is None:
             bus_writes = "closed" if token is not None else "open"
@@ -120,17 +129,17 @@ class AdmissionGate:
         self.setpoint_rate_hz = float(setpoint_rate_hz) if setpoint_rate_hz else None
         self.setpoint_burst = int(setpoint_burst)
         if self.setpoint_rate_hz is not None:
-            TokenBucket(self.setpoint_rate_hz, self.setpoint_burst)   # ValueError on bad settings
+            TokenBucket(self.setpoint_rate_hz, self.setpoint_burst)  # ValueError on bad settings
         self.read_rate_hz = float(read_rate_hz) if read_rate_hz else None
         self.read_burst = int(read_burst)
         if self.read_rate_hz is not None:
-            TokenBucket(self.read_rate_hz, self.read_burst)           # ValueError on bad settings
+            TokenBucket(self.read_rate_hz, self.read_burst)  # ValueError on bad settings
         self._readers: collections.OrderedDict[str, TokenBucket] = collections.OrderedDict()
         self.reads_limited = 0
         self.error_rate_hz = float(error_rate_hz) if error_rate_hz else None
         self.error_burst = int(error_burst)
         if self.error_rate_hz is not None:
-            TokenBucket(self.error_rate_hz, self.error_burst)         # ValueError on bad settings
+            TokenBucket(self.error_rate_hz, self.error_burst)  # ValueError on bad settings
         self._failing: collections.OrderedDict[str, TokenBucket] = collections.OrderedDict()
         self.errors_over_budget = 0
         self.max_payload_bytes = max_payload_bytes
@@ -144,8 +153,9 @@ class AdmissionGate:
     def requires_token(self) -> bool:
         return self.token is not None
 
-    def check_token(self, given: str | bytes | None, *, missing: str = "missing token",
-                    field: str | None = "token") -> Refusal | None:
+    def check_token(
+        self, given: str | bytes | None, *, missing: str = "missing token", field: str | None = "token"
+    ) -> Refusal | None:
         """None if `given` is the token (or none is configured), else a 401 Refusal; `missing`
         is the message when nothing was given (it says how to send it on that transport)."""
         if self.token is None:
@@ -162,10 +172,14 @@ class AdmissionGate:
             return None
         with self._lock:
             self.unauthorized += 1
-        return Refusal(403, None, "zenoh setpoints are refused: the HTTP API of this service needs a "
-                       "token, and zenoh access control is off, so anyone could send them; configure "
-                       "zenoh access control (BEARING_TWIN_ZENOH_USERSFILE and BEARING_TWIN_ZENOH_WRITERS, "
-                       "or join a secured router) or send the setpoint over HTTP")
+        return Refusal(
+            403,
+            None,
+            "zenoh setpoints are refused: the HTTP API of this service needs a "
+            "token, and zenoh access control is off, so anyone could send them; configure "
+            "zenoh access control (BEARING_TWIN_ZENOH_USERSFILE and BEARING_TWIN_ZENOH_WRITERS, "
+            "or join a secured router) or send the setpoint over HTTP",
+        )
 
     def check_size(self, size: int, what: str = "payload") -> Refusal | None:
         """None if `size` [bytes] is within the cap, else a 413 Refusal."""
@@ -174,8 +188,7 @@ class AdmissionGate:
             return None
         with self._lock:
             self.too_large += 1
-        return Refusal(413, "body", f"{what} of {size} bytes is larger than the limit of {cap} bytes",
-                       [0, cap])
+        return Refusal(413, "body", f"{what} of {size} bytes is larger than the limit of {cap} bytes", [0, cap])
 
     def take_setpoint(self, bearing_id: str) -> Refusal | None:
         """Take one setpoint from the twin's budget: None, or a 429 Refusal with retry_after_s."""
@@ -185,13 +198,19 @@ class AdmissionGate:
             bucket = self._buckets.get(bearing_id)
             if bucket is None:
                 bucket = self._buckets[bearing_id] = TokenBucket(
-                    self.setpoint_rate_hz, self.setpoint_burst, clock=self._clock)
+                    self.setpoint_rate_hz, self.setpoint_burst, clock=self._clock
+                )
         ok, retry_after = bucket.take()
         if ok:
             return None
-        return Refusal(429, None, f"too many setpoints for twin {bearing_id!r}: at most "
-                       f"{self.setpoint_rate_hz:g} per second (bursts of {self.setpoint_burst}); "
-                       f"retry after {retry_after:.3f} s", retry_after_s=retry_after)
+        return Refusal(
+            429,
+            None,
+            f"too many setpoints for twin {bearing_id!r}: at most "
+            f"{self.setpoint_rate_hz:g} per second (bursts of {self.setpoint_burst}); "
+            f"retry after {retry_after:.3f} s",
+            retry_after_s=retry_after,
+        )
 
     def take_read(self, client: str) -> Refusal | None:
         """Take one read from the budget of `client` (its address): None, or a 429 Refusal naming
@@ -203,10 +222,15 @@ class AdmissionGate:
             return None
         with self._lock:
             self.reads_limited += 1
-        return Refusal(429, None, f"too many reads from {client}: at most {self.read_rate_hz:g} per "
-                       f"second per client (read_rate_hz, bursts of {self.read_burst}: read_burst); "
-                       f"retry after {retry_after:.3f} s", [0, self.read_rate_hz],
-                       retry_after_s=retry_after)
+        return Refusal(
+            429,
+            None,
+            f"too many reads from {client}: at most {self.read_rate_hz:g} per "
+            f"second per client (read_rate_hz, bursts of {self.read_burst}: read_burst); "
+            f"retry after {retry_after:.3f} s",
+            [0, self.read_rate_hz],
+            retry_after_s=retry_after,
+        )
 
     def take_error(self, client: str) -> bool:
         """Count one refused request (an HTTP 4xx answer) of `client` (its address) against its
@@ -221,8 +245,9 @@ class AdmissionGate:
                 self.errors_over_budget += 1
         return ok
 
-    def _client_bucket(self, buckets: collections.OrderedDict[str, TokenBucket], client: str,
-                       rate_hz: float, burst: int) -> TokenBucket:
+    def _client_bucket(
+        self, buckets: collections.OrderedDict[str, TokenBucket], client: str, rate_hz: float, burst: int
+    ) -> TokenBucket:
         """The bucket of `client` in `buckets` (made on first sight; the least recently seen of
         more than MAX_READ_CLIENTS dropped)."""
         with self._lock:

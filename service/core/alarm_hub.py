@@ -45,8 +45,13 @@ class MeasuredItem:
 class AlarmHub:
     """Alarm evaluators of every twin of one service (see the module docstring)."""
 
-    def __init__(self, settings: AlarmSettings | None = None, *, queue_size: int = 256,
-                 wall_clock: Callable[[], float] = time.time):
+    def __init__(
+        self,
+        settings: AlarmSettings | None = None,
+        *,
+        queue_size: int = 256,
+        wall_clock: Callable[[], float] = time.time,
+    ):
         self.settings = settings or AlarmSettings()
         self._wall_clock = wall_clock
         self._queue: collections.deque[Snapshot | MeasuredItem] = collections.deque(maxlen=queue_size)

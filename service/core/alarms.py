@@ -74,9 +74,23 @@ from service.core.measured import KURTOSIS_MARGIN, LINE_ALARM_DB
 from service.settings import AlarmSettings
 from twin.snapshot import LAMBDA_KEY
 
-__all__ = ["ALARM_IDS", "ISO_20816_3_ZONES", "Alarm", "AlarmEvaluator", "AlarmEvent", "AlarmInputs",
-           "AlarmSettings", "AlarmTracker", "Level", "Rule", "VibrationInputs", "inputs_from_snapshot",
-           "vibration_inputs", "vibration_zone", "zone_boundaries"]
+__all__ = [
+    "ALARM_IDS",
+    "ISO_20816_3_ZONES",
+    "Alarm",
+    "AlarmEvaluator",
+    "AlarmEvent",
+    "AlarmInputs",
+    "AlarmSettings",
+    "AlarmTracker",
+    "Level",
+    "Rule",
+    "VibrationInputs",
+    "inputs_from_snapshot",
+    "vibration_inputs",
+    "vibration_zone",
+    "zone_boundaries",
+]
 
 EVENT_SCHEMA = "bearing-twin/alarm/1"
 
@@ -96,15 +110,24 @@ ISO_20816_3_ZONES: Mapping[tuple[int, str], tuple[float, float, float]] = {
     (2, "flexible"): (2.3, 4.5, 7.1),
 }
 
-DEFECT_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")   # keys of VibrationState.envelope_lines
-_TIME_EPS_S = 1e-9   # a delay of 0.2 s is over at t = 0.3 after 0.1 (0.3 - 0.1 = 0.19999999999999998)
+DEFECT_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")  # keys of VibrationState.envelope_lines
+_TIME_EPS_S = 1e-9  # a delay of 0.2 s is over at t = 0.3 after 0.1 (0.3 - 0.1 = 0.19999999999999998)
 DISCHARGE_LEVELS = {"none": 0.0, "possible": 1.0, "likely": 2.0}
 
 # the alarms on measured accelerometer windows (service.core.measured): fed by `update_measured`
 MEASURED_ALARMS = ("measured_line", "measured_kurtosis")
-ALARM_IDS: tuple[str, ...] = ("vibration_zone", "lubrication_kappa", "lubrication_boundary",
-                              "electrical_discharge", *(f"defect_{n}" for n in DEFECT_LINES), "life_used",
-                              "temperature_zone", "temperature_rate", "temperature_unexplained", *MEASURED_ALARMS)
+ALARM_IDS: tuple[str, ...] = (
+    "vibration_zone",
+    "lubrication_kappa",
+    "lubrication_boundary",
+    "electrical_discharge",
+    *(f"defect_{n}" for n in DEFECT_LINES),
+    "life_used",
+    "temperature_zone",
+    "temperature_rate",
+    "temperature_unexplained",
+    *MEASURED_ALARMS,
+)
 
 
 def _line_name(name: str) -> str:
@@ -117,8 +140,10 @@ def zone_boundaries(machine_group: int, support: str) -> tuple[float, float, flo
     try:
         return ISO_20816_3_ZONES[(int(machine_group), support)]
     except KeyError:
-        raise ValueError(f"no ISO 20816-3 zones for machine group {machine_group!r} and support "
-                         f"{support!r}; known: {sorted(ISO_20816_3_ZONES)}") from None
+        raise ValueError(
+            f"no ISO 20816-3 zones for machine group {machine_group!r} and support "
+            f"{support!r}; known: {sorted(ISO_20816_3_ZONES)}"
+        ) from None
 
 
 def vibration_zone(velocity_rms_mm_s: float, machine_group: int = 2, support: str = "rigid") -> str:
@@ -134,28 +159,28 @@ def vibration_zone(velocity_rms_mm_s: float, machine_group: int = 2, support: st
 class VibrationInputs:
     """What the vibration indicators give the alarms (twin.vibration.indicators)."""
 
-    velocity_rms_mm_s: float | None = None                     # ISO 20816 band 10-1000 Hz [mm/s]
+    velocity_rms_mm_s: float | None = None  # ISO 20816 band 10-1000 Hz [mm/s]
     line_amplitudes_m_s2: Mapping[str, float] = field(default_factory=dict)  # envelope, fundamental [m/s^2]
-    noise_floor_m_s2: float | None = None                      # median envelope amplitude [m/s^2]
+    noise_floor_m_s2: float | None = None  # median envelope amplitude [m/s^2]
 
 
 @dataclass(frozen=True)
 class AlarmInputs:
     """One twin at one instant, as the alarms see it (SI unless the name says otherwise)."""
 
-    time_s: float                                     # simulated time [s]
-    seq: int | None = None                            # the snapshot's seq (None: not from a snapshot)
-    min_loaded_lambda: float | None = None            # smallest Lambda over the loaded contacts [-]
-    boundary_contacts: int = 0                        # loaded contacts with Lambda <= boundary_lambda
-    kappa: float | None = None                        # ISO 281 viscosity ratio [-]
-    discharge_risk: str | None = None                 # 'none' | 'possible' | 'likely'
+    time_s: float  # simulated time [s]
+    seq: int | None = None  # the snapshot's seq (None: not from a snapshot)
+    min_loaded_lambda: float | None = None  # smallest Lambda over the loaded contacts [-]
+    boundary_contacts: int = 0  # loaded contacts with Lambda <= boundary_lambda
+    kappa: float | None = None  # ISO 281 viscosity ratio [-]
+    discharge_risk: str | None = None  # 'none' | 'possible' | 'likely'
     discharge_reason: str = ""
-    damage_fraction: float | None = None              # Palmgren-Miner damage [-]
+    damage_fraction: float | None = None  # Palmgren-Miner damage [-]
     vibration: VibrationInputs | None = None
-    outer_ring_c: float | None = None                 # outer-ring temperature [degC]
-    outer_ring_rate_k_per_min: float | None = None    # its rate of rise [K/min]
-    unexplained_heating: bool | None = None           # the estimator gated the last measurement
-    residual_k: float | None = None                   # measured - predicted temperature [K]
+    outer_ring_c: float | None = None  # outer-ring temperature [degC]
+    outer_ring_rate_k_per_min: float | None = None  # its rate of rise [K/min]
+    unexplained_heating: bool | None = None  # the estimator gated the last measurement
+    residual_k: float | None = None  # measured - predicted temperature [K]
 
 
 def _get(obj: Any, name: str) -> Any:
@@ -198,9 +223,11 @@ def vibration_inputs(block: Any) -> VibrationInputs | None:
             a = _line_amplitude(entry)
             if a is not None and name in DEFECT_LINES:
                 lines[str(name)] = a
-    return VibrationInputs(velocity_rms_mm_s=finite_number(_get(block, "velocity_rms_mm_s")),
-                           line_amplitudes_m_s2=lines,
-                           noise_floor_m_s2=finite_number(_get(block, "envelope_noise_floor_m_s2")))
+    return VibrationInputs(
+        velocity_rms_mm_s=finite_number(_get(block, "velocity_rms_mm_s")),
+        line_amplitudes_m_s2=lines,
+        noise_floor_m_s2=finite_number(_get(block, "envelope_noise_floor_m_s2")),
+    )
 
 
 def _seq(value: Any) -> int | None:
@@ -239,7 +266,8 @@ def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -
     return AlarmInputs(
         time_s=float(_get(snapshot, "time_s") or 0.0),
         seq=_seq(_get(snapshot, "seq")),
-        min_loaded_lambda=min_lambda, boundary_contacts=boundary,
+        min_loaded_lambda=min_lambda,
+        boundary_contacts=boundary,
         kappa=finite_number(_get(life, "kappa")),
         discharge_risk=_get(electrical, "discharge_risk"),
         discharge_reason=str(_get(electrical, "reason") or ""),
@@ -284,8 +312,12 @@ class AlarmEvent(BaseModel):
     OPC UA events (docs/service.md "Alarms")."""
 
     model_config = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
-    schema_: str = Field(default=EVENT_SCHEMA, alias="schema", serialization_alias="schema",
-                         description="Message schema identifier [text].")
+    schema_: str = Field(
+        default=EVENT_SCHEMA,
+        alias="schema",
+        serialization_alias="schema",
+        description="Message schema identifier [text].",
+    )
     seq: int = Field(description="Per-twin counter of alarm events [-].")
     bearing_id: str = Field(description="Twin name [text].")
     alarm_id: str = Field(description="Alarm id, e.g. 'lubrication_boundary' [text].")
@@ -293,11 +325,15 @@ class AlarmEvent(BaseModel):
     transition: Transition = Field(description="raised | escalated | deescalated | cleared [text].")
     active: bool = Field(description="Whether the alarm is active after this event [bool].")
     severity: Severity | None = Field(description="Level after the event; null when cleared [text].")
-    opcua_severity: int = Field(description="OPC UA event severity 1..1000 (warning 500, critical 800, cleared 100) [-].")
+    opcua_severity: int = Field(
+        description="OPC UA event severity 1..1000 (warning 500, critical 800, cleared 100) [-]."
+    )
     since_s: float | None = Field(description="Simulated time the alarm was raised; null when cleared [s].")
     time_s: float = Field(description="Simulated time of this event [s].")
-    snapshot_seq: int | None = Field(default=None, description="seq of the snapshot that caused the event; null when "
-                                     "the inputs came from elsewhere [-].")
+    snapshot_seq: int | None = Field(
+        default=None,
+        description="seq of the snapshot that caused the event; null when the inputs came from elsewhere [-].",
+    )
     wall_time_s: float = Field(description="Wall-clock time of this event, seconds since the Unix epoch [s].")
     value: float = Field(description="The watched value at the event [unit].")
     threshold: float = Field(description="Raise threshold of the level concerned [unit].")
@@ -322,7 +358,9 @@ class Alarm(BaseModel):
     active: bool = Field(description="Whether it is active [bool].")
     severity: Severity | None = Field(description="warning | critical; null when inactive [text].")
     since_s: float | None = Field(description="Simulated time it was raised; null when inactive [s].")
-    since_wall_time_s: float | None = Field(description="Wall-clock time it was raised (Unix epoch); null when inactive [s].")
+    since_wall_time_s: float | None = Field(
+        description="Wall-clock time it was raised (Unix epoch); null when inactive [s]."
+    )
     value: float | None = Field(description="Latest value; null when undefined (e.g. no vibration block) [unit].")
     threshold: float | None = Field(description="Raise threshold of the active level, else of the first level [unit].")
     clear_threshold: float | None = Field(description="Clear threshold of that level [unit].")
@@ -335,13 +373,13 @@ class AlarmTracker:
 
     def __init__(self, rule: Rule):
         self.rule = rule
-        self.level = -1                       # index into the levels, -1 inactive
-        self.since_s: float | None = None     # simulated time raised
+        self.level = -1  # index into the levels, -1 inactive
+        self.since_s: float | None = None  # simulated time raised
         self.since_wall_s: float | None = None
         self.value: float | None = None
         self.levels: tuple[Level, ...] = ()
         self.message = ""
-        self._pending_level = -1              # level waiting for its on-delay
+        self._pending_level = -1  # level waiting for its on-delay
         self._pending_since: float | None = None
         self._clear_since: float | None = None
         self._last_t: float | None = None
@@ -353,13 +391,14 @@ class AlarmTracker:
     def _reset_timers(self) -> None:
         self._pending_level, self._pending_since, self._clear_since = -1, None, None
 
-    def update(self, t: float, value: float | None, levels: Iterable[Level], message: str = "",
-               wall_s: float = 0.0) -> Transition | None:
+    def update(
+        self, t: float, value: float | None, levels: Iterable[Level], message: str = "", wall_s: float = 0.0
+    ) -> Transition | None:
         """Feed the value at simulated time `t`; the transition it causes, if any."""
         levels = tuple(levels)
         self.levels = levels
         if self._last_t is not None and t < self._last_t:
-            self._reset_timers()              # the clock went back (a restarted twin)
+            self._reset_timers()  # the clock went back (a restarted twin)
         self._last_t = t
         if value is None or not math.isfinite(value) or not levels:
             self.value = None if value is None or not math.isfinite(value) else value
@@ -370,7 +409,7 @@ class AlarmTracker:
         raised = max((i for i, lv in enumerate(levels) if rule.beyond(value, lv.threshold)), default=-1)
         held = max((i for i, lv in enumerate(levels) if rule.beyond(value, lv.clear)), default=-1)
         held = max(held, raised)
-        if raised > self.level:                           # towards a worse level: on-delay
+        if raised > self.level:  # towards a worse level: on-delay
             self._clear_since = None
             if self._pending_since is None:
                 self._pending_since = t
@@ -385,7 +424,7 @@ class AlarmTracker:
                 return "escalated"
             return None
         self._pending_level, self._pending_since = -1, None
-        if held < self.level:                             # back past the clear threshold: off-delay
+        if held < self.level:  # back past the clear threshold: off-delay
             if self._clear_since is None:
                 self._clear_since = t
             if t - self._clear_since >= rule.clear_hold_s - _TIME_EPS_S:
@@ -401,11 +440,20 @@ class AlarmTracker:
 
     def state(self) -> Alarm:
         lv = self.levels[self.level] if self.active else (self.levels[0] if self.levels else None)
-        return Alarm(alarm_id=self.rule.id, category=self.rule.category, description=self.rule.description,
-                     active=self.active, severity=lv.severity if self.active and lv is not None else None,
-                     since_s=self.since_s, since_wall_time_s=self.since_wall_s, value=self.value,
-                     threshold=lv.threshold if lv else None, clear_threshold=lv.clear if lv else None,
-                     unit=self.rule.unit, message=self.message)
+        return Alarm(
+            alarm_id=self.rule.id,
+            category=self.rule.category,
+            description=self.rule.description,
+            active=self.active,
+            severity=lv.severity if self.active and lv is not None else None,
+            since_s=self.since_s,
+            since_wall_time_s=self.since_wall_s,
+            value=self.value,
+            threshold=lv.threshold if lv else None,
+            clear_threshold=lv.clear if lv else None,
+            unit=self.rule.unit,
+            message=self.message,
+        )
 
 
 # ---- the alarms of one twin --------------------------------------------------------------------
@@ -420,8 +468,9 @@ def _below(severity: Severity, threshold: float, ratio: float) -> Level:
 class AlarmEvaluator:
     """Every alarm of one twin (module docstring); `update(inputs)` returns the events."""
 
-    def __init__(self, bearing_id: str, settings: AlarmSettings | None = None,
-                 wall_clock: Callable[[], float] = time.time):
+    def __init__(
+        self, bearing_id: str, settings: AlarmSettings | None = None, wall_clock: Callable[[], float] = time.time
+    ):
         s = self.settings = settings or AlarmSettings()
         self.bearing_id = bearing_id
         self._wall_clock = wall_clock
@@ -429,41 +478,122 @@ class AlarmEvaluator:
         zones = zone_boundaries(s.machine_group, s.support)
         self.zones = zones
         hold = s.clear_hold_s
-        table = (f"ISO 20816-3:2022 Table A.{s.machine_group}, group {s.machine_group}, {s.support} "
-                 f"support: A/B {zones[0]:g}, B/C {zones[1]:g}, C/D {zones[2]:g} mm/s")
+        table = (
+            f"ISO 20816-3:2022 Table A.{s.machine_group}, group {s.machine_group}, {s.support} "
+            f"support: A/B {zones[0]:g}, B/C {zones[1]:g}, C/D {zones[2]:g} mm/s"
+        )
         rules = [
-            Rule("vibration_zone", "vibration", "mm/s", "above", s.vibration_delay_s, hold,
-                 f"Velocity RMS 10-1000 Hz in zone C (warning) or D (critical) of {table}"),
-            Rule("lubrication_kappa", "lubrication", "-", "below", s.lubrication_delay_s, hold,
-                 f"kappa = nu / nu1 (ISO 281:2007 clause 9.3) below {s.kappa_threshold:g} for "
-                 f"{s.lubrication_delay_s:g} s"),
-            Rule("lubrication_boundary", "lubrication", "-", "below", s.lubrication_delay_s, hold,
-                 f"a loaded contact in the boundary regime (Lambda <= {s.boundary_lambda:g}, seed 000 "
-                 f"Table 2) for {s.lubrication_delay_s:g} s; value: the smallest Lambda of the "
-                 f"contacts carrying >= {s.loaded_contact_fraction:g} x the largest load"),
-            Rule("electrical_discharge", "electrical", "-", "above", s.discharge_delay_s, hold,
-                 "electrical discharge risk: possible (warning), likely (critical); value 0/1/2 = "
-                 "none/possible/likely"),
-            *(Rule(f"defect_{n}", "defect", "m/s^2", "above", s.defect_delay_s, hold,
-                   f"envelope amplitude at {_line_name(n)} above {s.defect_amplitude_m_s2:g} m/s^2 and "
-                   f"{s.defect_significance:g} x the envelope noise floor") for n in DEFECT_LINES),
-            Rule("life_used", "life", "-", "above", 0.0, hold,
-                 f"Palmgren-Miner damage fraction above {s.life_used_warning:g} (warning), "
-                 f"{s.life_used_critical:g} (critical)"),
-            Rule("temperature_zone", "thermal", "degC", "above", s.temperature_delay_s, hold,
-                 f"outer ring above {s.temperature_warning_c:g} degC (warning; ISO 13709 / API 610 oil sump "
-                 f"limit 82 degC) or {s.temperature_critical_c:g} degC (critical)"),
-            Rule("temperature_rate", "thermal", "K/min", "above", s.temperature_delay_s, hold,
-                 f"outer ring rising faster than {s.temperature_rate_warning_k_per_min:g} K/min (warning) or "
-                 f"{s.temperature_rate_critical_k_per_min:g} K/min (critical) over a minute of thermal time"),
-            Rule("temperature_unexplained", "thermal", "-", "above", 0.0, hold,
-                 "measured temperature beyond what the friction and the dissipation explain (the estimator's "
-                 "innovation gate); value 1 = unexplained"),
-            Rule("measured_line", "vibration", "dB", "above", 0.0, hold,
-                 f"a measured window shows a defect line at least {LINE_ALARM_DB:g} dB over its background for "
-                 "a defect the twin does not hold; value: the highest such line"),
-            Rule("measured_kurtosis", "vibration", "-", "above", 0.0, hold,
-                 f"measured kurtosis above the twin's by more than {KURTOSIS_MARGIN:g}; value: measured - predicted"),
+            Rule(
+                "vibration_zone",
+                "vibration",
+                "mm/s",
+                "above",
+                s.vibration_delay_s,
+                hold,
+                f"Velocity RMS 10-1000 Hz in zone C (warning) or D (critical) of {table}",
+            ),
+            Rule(
+                "lubrication_kappa",
+                "lubrication",
+                "-",
+                "below",
+                s.lubrication_delay_s,
+                hold,
+                f"kappa = nu / nu1 (ISO 281:2007 clause 9.3) below {s.kappa_threshold:g} for "
+                f"{s.lubrication_delay_s:g} s",
+            ),
+            Rule(
+                "lubrication_boundary",
+                "lubrication",
+                "-",
+                "below",
+                s.lubrication_delay_s,
+                hold,
+                f"a loaded contact in the boundary regime (Lambda <= {s.boundary_lambda:g}, seed 000 "
+                f"Table 2) for {s.lubrication_delay_s:g} s; value: the smallest Lambda of the "
+                f"contacts carrying >= {s.loaded_contact_fraction:g} x the largest load",
+            ),
+            Rule(
+                "electrical_discharge",
+                "electrical",
+                "-",
+                "above",
+                s.discharge_delay_s,
+                hold,
+                "electrical discharge risk: possible (warning), likely (critical); value 0/1/2 = none/possible/likely",
+            ),
+            *(
+                Rule(
+                    f"defect_{n}",
+                    "defect",
+                    "m/s^2",
+                    "above",
+                    s.defect_delay_s,
+                    hold,
+                    f"envelope amplitude at {_line_name(n)} above {s.defect_amplitude_m_s2:g} m/s^2 and "
+                    f"{s.defect_significance:g} x the envelope noise floor",
+                )
+                for n in DEFECT_LINES
+            ),
+            Rule(
+                "life_used",
+                "life",
+                "-",
+                "above",
+                0.0,
+                hold,
+                f"Palmgren-Miner damage fraction above {s.life_used_warning:g} (warning), "
+                f"{s.life_used_critical:g} (critical)",
+            ),
+            Rule(
+                "temperature_zone",
+                "thermal",
+                "degC",
+                "above",
+                s.temperature_delay_s,
+                hold,
+                f"outer ring above {s.temperature_warning_c:g} degC (warning; ISO 13709 / API 610 oil sump "
+                f"limit 82 degC) or {s.temperature_critical_c:g} degC (critical)",
+            ),
+            Rule(
+                "temperature_rate",
+                "thermal",
+                "K/min",
+                "above",
+                s.temperature_delay_s,
+                hold,
+                f"outer ring rising faster than {s.temperature_rate_warning_k_per_min:g} K/min (warning) or "
+                f"{s.temperature_rate_critical_k_per_min:g} K/min (critical) over a minute of thermal time",
+            ),
+            Rule(
+                "temperature_unexplained",
+                "thermal",
+                "-",
+                "above",
+                0.0,
+                hold,
+                "measured temperature beyond what the friction and the dissipation explain (the estimator's "
+                "innovation gate); value 1 = unexplained",
+            ),
+            Rule(
+                "measured_line",
+                "vibration",
+                "dB",
+                "above",
+                0.0,
+                hold,
+                f"a measured window shows a defect line at least {LINE_ALARM_DB:g} dB over its background for "
+                "a defect the twin does not hold; value: the highest such line",
+            ),
+            Rule(
+                "measured_kurtosis",
+                "vibration",
+                "-",
+                "above",
+                0.0,
+                hold,
+                f"measured kurtosis above the twin's by more than {KURTOSIS_MARGIN:g}; value: measured - predicted",
+            ),
         ]
         self.trackers: dict[str, AlarmTracker] = {r.id: AlarmTracker(r) for r in rules}
         r = s.clear_ratio
@@ -474,10 +604,14 @@ class AlarmEvaluator:
             # ordinal value: warning at 1 (possible), critical at 2 (likely); clear = one step down
             "electrical_discharge": (Level("warning", 1.0, 0.5), Level("critical", 2.0, 1.5)),
             "life_used": (_above("warning", s.life_used_warning, r), _above("critical", s.life_used_critical, r)),
-            "temperature_zone": (_above("warning", s.temperature_warning_c, r),
-                                 _above("critical", s.temperature_critical_c, r)),
-            "temperature_rate": (_above("warning", s.temperature_rate_warning_k_per_min, r),
-                                 _above("critical", s.temperature_rate_critical_k_per_min, r)),
+            "temperature_zone": (
+                _above("warning", s.temperature_warning_c, r),
+                _above("critical", s.temperature_critical_c, r),
+            ),
+            "temperature_rate": (
+                _above("warning", s.temperature_rate_warning_k_per_min, r),
+                _above("critical", s.temperature_rate_critical_k_per_min, r),
+            ),
             "temperature_unexplained": (Level("critical", 1.0, 0.5),),
             "measured_line": (_above("warning", LINE_ALARM_DB, r),),
             "measured_kurtosis": (_above("warning", KURTOSIS_MARGIN, r),),
@@ -498,17 +632,26 @@ class AlarmEvaluator:
         vib = x.vibration
         out: dict[str, tuple[float | None, str]] = {}
         v = vib.velocity_rms_mm_s if vib is not None else None
-        out["vibration_zone"] = (v, "" if v is None else
-                                 f"velocity RMS {v:.3g} mm/s: ISO 20816-3 zone "
-                                 f"{vibration_zone(v, s.machine_group, s.support)}")
+        out["vibration_zone"] = (
+            v,
+            ""
+            if v is None
+            else f"velocity RMS {v:.3g} mm/s: ISO 20816-3 zone {vibration_zone(v, s.machine_group, s.support)}",
+        )
         out["lubrication_kappa"] = (x.kappa, "" if x.kappa is None else f"kappa = {x.kappa:.3g}")
         lam = x.min_loaded_lambda
-        out["lubrication_boundary"] = (lam, "" if lam is None else
-                                       f"smallest Lambda of the loaded contacts {lam:.3g}; "
-                                       f"{x.boundary_contacts} loaded contact(s) in the boundary regime")
+        out["lubrication_boundary"] = (
+            lam,
+            ""
+            if lam is None
+            else f"smallest Lambda of the loaded contacts {lam:.3g}; "
+            f"{x.boundary_contacts} loaded contact(s) in the boundary regime",
+        )
         risk = x.discharge_risk
-        out["electrical_discharge"] = (DISCHARGE_LEVELS.get(risk) if risk is not None else None,
-                                       f"discharge risk {risk}: {x.discharge_reason}" if risk else "")
+        out["electrical_discharge"] = (
+            DISCHARGE_LEVELS.get(risk) if risk is not None else None,
+            f"discharge risk {risk}: {x.discharge_reason}" if risk else "",
+        )
         lines = vib.line_amplitudes_m_s2 if vib is not None else {}
         for n in DEFECT_LINES:
             a = lines.get(n)
@@ -521,8 +664,10 @@ class AlarmEvaluator:
         out["temperature_rate"] = (rate, "" if rate is None else f"outer ring rising {rate:.2f} K/min")
         u = x.unexplained_heating
         res = "" if x.residual_k is None else f" (measured - predicted {x.residual_k:+.1f} K)"
-        out["temperature_unexplained"] = (None if u is None else float(u),
-                                          "" if u is None else ("unexplained heating" if u else "explained") + res)
+        out["temperature_unexplained"] = (
+            None if u is None else float(u),
+            "" if u is None else ("unexplained heating" if u else "explained") + res,
+        )
         return out
 
     def update(self, inputs: AlarmInputs) -> list[AlarmEvent]:
@@ -550,10 +695,15 @@ class AlarmEvaluator:
         measured = finite_number((comparison.get("measured") or {}).get("kurtosis"))
         predicted = finite_number((comparison.get("predicted") or {}).get("kurtosis"))
         excess = None if measured is None or predicted is None else measured - predicted
-        values = {"measured_line": (line_db, f"window {comparison.get('window')}: {line_text}"),
-                  "measured_kurtosis": (excess, "" if excess is None else
-                                        f"window {comparison.get('window')}: kurtosis {measured:.2f} measured, "
-                                        f"{predicted:.2f} predicted")}
+        values = {
+            "measured_line": (line_db, f"window {comparison.get('window')}: {line_text}"),
+            "measured_kurtosis": (
+                excess,
+                ""
+                if excess is None
+                else f"window {comparison.get('window')}: kurtosis {measured:.2f} measured, {predicted:.2f} predicted",
+            ),
+        }
         events = []
         wall = self._wall_clock()
         seq = comparison.get("twin_seq")
@@ -564,22 +714,40 @@ class AlarmEvaluator:
                 events.append(self._event(tracker, transition, t, wall, seq if isinstance(seq, int) else None))
         return events
 
-    def _event(self, tracker: AlarmTracker, transition: Transition, t: float, wall: float,
-               snapshot_seq: int | None = None) -> AlarmEvent:
+    def _event(
+        self, tracker: AlarmTracker, transition: Transition, t: float, wall: float, snapshot_seq: int | None = None
+    ) -> AlarmEvent:
         self.seq += 1
         rule, level = tracker.rule, tracker.level
         assert tracker.value is not None  # a transition is fed a finite value (AlarmTracker.update)
-        lv = tracker.levels[level] if level >= 0 else tracker.levels[0]   # cleared: the first level
+        lv = tracker.levels[level] if level >= 0 else tracker.levels[0]  # cleared: the first level
         severity = lv.severity if level >= 0 else None
-        word = {"raised": "raised", "escalated": "escalated to", "deescalated": "stepped down to",
-                "cleared": "cleared"}[transition]
+        word = {
+            "raised": "raised",
+            "escalated": "escalated to",
+            "deescalated": "stepped down to",
+            "cleared": "cleared",
+        }[transition]
         text = f"{rule.id} {word}{'' if severity is None else ' ' + severity}: {tracker.message}"
-        return AlarmEvent(seq=self.seq, bearing_id=self.bearing_id, alarm_id=rule.id,
-                          category=rule.category, transition=transition, active=level >= 0,
-                          severity=severity, opcua_severity=OPCUA_SEVERITY[severity],
-                          since_s=tracker.since_s, time_s=t, snapshot_seq=snapshot_seq, wall_time_s=wall,
-                          value=float(tracker.value), threshold=lv.threshold, clear_threshold=lv.clear,
-                          unit=rule.unit, message=text)
+        return AlarmEvent(
+            seq=self.seq,
+            bearing_id=self.bearing_id,
+            alarm_id=rule.id,
+            category=rule.category,
+            transition=transition,
+            active=level >= 0,
+            severity=severity,
+            opcua_severity=OPCUA_SEVERITY[severity],
+            since_s=tracker.since_s,
+            time_s=t,
+            snapshot_seq=snapshot_seq,
+            wall_time_s=wall,
+            value=float(tracker.value),
+            threshold=lv.threshold,
+            clear_threshold=lv.clear,
+            unit=rule.unit,
+            message=text,
+        )
 
     def states(self) -> list[Alarm]:
         """Every alarm's state (active or not), in the order of ALARM_IDS."""

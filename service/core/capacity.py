@@ -52,7 +52,7 @@ from dataclasses import dataclass
 
 from twin.engine import Twin
 
-OVERHEAD_GOAL = 0.10   # service CPU beside the engines / the engines' CPU, at most [-]
+OVERHEAD_GOAL = 0.10  # service CPU beside the engines / the engines' CPU, at most [-]
 
 
 def usable_cores() -> int:
@@ -69,7 +69,7 @@ class CpuMeter:
 
     def __init__(self, window: float):
         self.window = float(window)
-        self.cpu_s = 0.0           # totals since the start
+        self.cpu_s = 0.0  # totals since the start
         self.work = 0.0
         self._cpu_open = 0.0
         self._work_open = 0.0
@@ -94,8 +94,8 @@ class CpuMeter:
 class TwinCost:
     """CPU a twin needs in real time (see the module docstring)."""
 
-    engine_cpu_s_per_sim_s: float    # CPU s per simulated s of the engine (1 / lone real-time factor)
-    publish_cpu_s_per_s: float       # CPU s per wall s spent building its snapshots
+    engine_cpu_s_per_sim_s: float  # CPU s per simulated s of the engine (1 / lone real-time factor)
+    publish_cpu_s_per_s: float  # CPU s per wall s spent building its snapshots
 
     @property
     def cpu_s_per_s(self) -> float:
@@ -109,19 +109,28 @@ class TwinCost:
         return self.publish_cpu_s_per_s / e if e > 0 else None
 
     def as_dict(self) -> dict:
-        return {"engine_cpu_s_per_sim_s": self.engine_cpu_s_per_sim_s,
-                "publish_cpu_s_per_s": self.publish_cpu_s_per_s, "cpu_s_per_s": self.cpu_s_per_s,
-                "publish_fraction": self.publish_fraction}
+        return {
+            "engine_cpu_s_per_sim_s": self.engine_cpu_s_per_sim_s,
+            "publish_cpu_s_per_s": self.publish_cpu_s_per_s,
+            "cpu_s_per_s": self.cpu_s_per_s,
+            "publish_fraction": self.publish_fraction,
+        }
 
 
-def calibrate(twin: Twin, *, sim_s: float = 0.02, frame_steps: int = 5000, publish_rate_hz: float = 50.0,
-              cpu_clock: Callable[[], float] = time.thread_time) -> TwinCost:
+def calibrate(
+    twin: Twin,
+    *,
+    sim_s: float = 0.02,
+    frame_steps: int = 5000,
+    publish_rate_hz: float = 50.0,
+    cpu_clock: Callable[[], float] = time.thread_time,
+) -> TwinCost:
     """Measure a twin's cost: a warm-up frame (JIT cache load), then `sim_s` of simulated time in
     two halves (the cheaper half counts: a preemption or page fault is not the twin's), and two
     snapshots (the second counts). The twin's simulated clock moves on by `sim_s` plus one
     frame: the same trajectory it would have run anyway."""
     dt = twin.model.dt_s
-    twin.advance(min(sim_s, 0.001), frame_steps=frame_steps)          # warm-up
+    twin.advance(min(sim_s, 0.001), frame_steps=frame_steps)  # warm-up
     half = max(dt, 0.5 * sim_s)
     rates = []
     for _ in range(2):
@@ -132,7 +141,7 @@ def calibrate(twin: Twin, *, sim_s: float = 0.02, frame_steps: int = 5000, publi
     c0 = cpu_clock()
     twin.snapshot()
     snap_cpu = cpu_clock() - c0
-    twin.seq -= 2            # the calibration snapshots are not published
+    twin.seq -= 2  # the calibration snapshots are not published
     return TwinCost(engine_cpu_s_per_sim_s=min(rates), publish_cpu_s_per_s=snap_cpu * publish_rate_hz)
 
 
@@ -151,8 +160,9 @@ class Verdict:
 class Capacity:
     """The host's capacity for twins in real time (see the module docstring)."""
 
-    def __init__(self, stepping_threads: int, core_fraction: float = 0.85, cores: int | None = None,
-                 reserve_cores: float = 0.0):
+    def __init__(
+        self, stepping_threads: int, core_fraction: float = 0.85, cores: int | None = None, reserve_cores: float = 0.0
+    ):
         if not (0.0 < core_fraction <= 1.0):
             raise ValueError(f"core_fraction = {core_fraction!r}: must be in (0, 1]")
         if not (0.0 <= reserve_cores <= 64.0):
@@ -181,29 +191,50 @@ class Capacity:
         used = sum(c.cpu_s_per_s for c in running)
         need = new.cpu_s_per_s
         budget, per_twin = self.budget_cpu_s_per_s, self.per_twin_cpu_s_per_s
-        figures = (f"it needs {need:.3f} CPU s per s (engine {new.engine_cpu_s_per_sim_s:.3f} CPU s per "
-                   f"simulated s, snapshots {new.publish_cpu_s_per_s:.3f})")
+        figures = (
+            f"it needs {need:.3f} CPU s per s (engine {new.engine_cpu_s_per_sim_s:.3f} CPU s per "
+            f"simulated s, snapshots {new.publish_cpu_s_per_s:.3f})"
+        )
         if need > per_twin:
-            return Verdict(False, f"this host cannot run the twin in real time: {figures}, one core gives "
-                           f"a twin at most {per_twin:.3f} (core_fraction)", need, used, budget, per_twin)
+            return Verdict(
+                False,
+                f"this host cannot run the twin in real time: {figures}, one core gives "
+                f"a twin at most {per_twin:.3f} (core_fraction)",
+                need,
+                used,
+                budget,
+                per_twin,
+            )
         if used + need > budget:
-            return Verdict(False, f"this host has no capacity left for the twin in real time: {figures}, "
-                           f"the twins running use {used:.3f} of {budget:.3f} ({self.usable_cores} cores x "
-                           f"core_fraction {self.core_fraction:g}, less {self.reserve_cores:g} reserved for the service)", need, used, budget, per_twin)
-        return Verdict(True, f"admitted: {figures}; in use {used + need:.3f} of {budget:.3f}",
-                       need, used, budget, per_twin)
+            return Verdict(
+                False,
+                f"this host has no capacity left for the twin in real time: {figures}, "
+                f"the twins running use {used:.3f} of {budget:.3f} ({self.usable_cores} cores x "
+                f"core_fraction {self.core_fraction:g}, less {self.reserve_cores:g} reserved for the service)",
+                need,
+                used,
+                budget,
+                per_twin,
+            )
+        return Verdict(
+            True, f"admitted: {figures}; in use {used + need:.3f} of {budget:.3f}", need, used, budget, per_twin
+        )
 
     def formula(self, typical: TwinCost | None, running: int, used_cpu_s_per_s: float) -> str:
         """How `estimate_max_twins` reaches its number, with the figures of the moment."""
-        head = (f"budget = {self.usable_cores} cores x core_fraction {self.core_fraction:g} - reserve "
-                f"{self.reserve_cores:g} = {self.budget_cpu_s_per_s:.3f} CPU s/s")
+        head = (
+            f"budget = {self.usable_cores} cores x core_fraction {self.core_fraction:g} - reserve "
+            f"{self.reserve_cores:g} = {self.budget_cpu_s_per_s:.3f} CPU s/s"
+        )
         if typical is None or not (typical.cpu_s_per_s > 0 and math.isfinite(typical.cpu_s_per_s)):
             return head + "; no twin calibrated yet"
         n = self.estimate_max_twins(typical, running, used_cpu_s_per_s)
-        return (f"{head}; a twin like the last calibrated needs c = engine {typical.engine_cpu_s_per_sim_s:.3f} + "
-                f"snapshots {typical.publish_cpu_s_per_s:.3f} = {typical.cpu_s_per_s:.3f} CPU s/s; max_twins = "
-                f"{running} running + floor(({self.budget_cpu_s_per_s:.3f} - {used_cpu_s_per_s:.3f} in use) / "
-                f"{typical.cpu_s_per_s:.3f}) = {n}")
+        return (
+            f"{head}; a twin like the last calibrated needs c = engine {typical.engine_cpu_s_per_sim_s:.3f} + "
+            f"snapshots {typical.publish_cpu_s_per_s:.3f} = {typical.cpu_s_per_s:.3f} CPU s/s; max_twins = "
+            f"{running} running + floor(({self.budget_cpu_s_per_s:.3f} - {used_cpu_s_per_s:.3f} in use) / "
+            f"{typical.cpu_s_per_s:.3f}) = {n}"
+        )
 
     def estimate_max_twins(self, typical: TwinCost | None, running: int, used_cpu_s_per_s: float) -> int | None:
         """Twins this host holds in real time: the running ones plus as many more like `typical`
@@ -221,13 +252,18 @@ class ServiceOverheadMeter:
     process's CPU time and the engines' summed thread CPU time with those of the sample at least
     `min_window_s` of wall time before, and keeps the last closed window's figures. Thread-safe."""
 
-    def __init__(self, min_window_s: float = 1.0, *, clock: Callable[[], float] = time.monotonic,
-                 cpu_clock: Callable[[], float] = time.process_time):
+    def __init__(
+        self,
+        min_window_s: float = 1.0,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        cpu_clock: Callable[[], float] = time.process_time,
+    ):
         self.min_window_s = float(min_window_s)
         self._clock = clock
         self._cpu_clock = cpu_clock
         self._lock = threading.Lock()
-        self._mark: tuple[float, float, float] | None = None     # (wall, process CPU, engine CPU)
+        self._mark: tuple[float, float, float] | None = None  # (wall, process CPU, engine CPU)
         self._last: dict | None = None
 
     def sample(self, engine_cpu_s_total: float, twins: int) -> dict | None:
@@ -237,7 +273,7 @@ class ServiceOverheadMeter:
         now, cpu = self._clock(), self._cpu_clock()
         with self._lock:
             mark = self._mark
-            if mark is None or engine_cpu_s_total < mark[2]:      # first sample, or a twin left
+            if mark is None or engine_cpu_s_total < mark[2]:  # first sample, or a twin left
                 self._mark = (now, cpu, engine_cpu_s_total)
                 return self._last
             wall = now - mark[0]
@@ -247,7 +283,9 @@ class ServiceOverheadMeter:
             engine = (engine_cpu_s_total - mark[2]) / wall
             overhead = max(0.0, process - engine)
             self._last = {
-                "window_s": wall, "process_cpu_s_per_s": process, "engine_cpu_s_per_s": engine,
+                "window_s": wall,
+                "process_cpu_s_per_s": process,
+                "engine_cpu_s_per_s": engine,
                 "overhead_cpu_s_per_s": overhead,
                 "overhead_per_twin_cpu_s_per_s": overhead / twins if twins > 0 else None,
                 "overhead_fraction": overhead / engine if engine > 0 else None,

@@ -24,9 +24,9 @@ from pydantic import ValidationError
 
 from service.core.errors import FieldError, InputError
 
-try:                                 # the engine's limit (twin.state, with the vibration engine)
+try:  # the engine's limit (twin.state, with the vibration engine)
     from twin.state import MAX_DEFECTS
-except ImportError:                  # pragma: no cover - an engine without defects
+except ImportError:  # pragma: no cover - an engine without defects
     MAX_DEFECTS = 8
 
 __all__ = ["MAX_DEFECTS", "DefectBox", "parse_defects"]
@@ -54,8 +54,9 @@ def parse_defects(data: Any, geometry, *, prefix: str = "defects") -> tuple:
     if isinstance(data, dict) and set(data) == {"defects"}:
         data = data["defects"]
     if not isinstance(data, (list, tuple)):
-        raise InputError.one(prefix, f"a list of defects (objects with kind outer | inner | ball), got "
-                             f"{type(data).__name__}")
+        raise InputError.one(
+            prefix, f"a list of defects (objects with kind outer | inner | ball), got {type(data).__name__}"
+        )
     if len(data) > MAX_DEFECTS:
         raise InputError.one(prefix, f"{len(data)} defects given: at most {MAX_DEFECTS} at once", [0, MAX_DEFECTS])
     items = [d.model_dump() if hasattr(d, "model_dump") else d for d in data]
@@ -68,7 +69,7 @@ def parse_defects(data: Any, geometry, *, prefix: str = "defects") -> tuple:
         for e in exc.errors(include_url=False):
             message = str(e.get("msg", "invalid")).removeprefix("Value error, ")
             field = _loc(prefix, tuple(e.get("loc", ())))
-            named = _NAMED.match(message)        # a model-level check names its field first
+            named = _NAMED.match(message)  # a model-level check names its field first
             if named and not field.endswith(f".{named.group(1)}"):
                 field = f"{field}.{named.group(1)}"
             errors.append(FieldError(field=field, message=message))

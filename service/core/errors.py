@@ -19,30 +19,42 @@ from twin.setpoint import unit as setpoint_unit
 class FieldError(BaseModel):
     """One thing wrong with a request."""
 
-    field: str | None = Field(description="Where: the field name or path (e.g. 'radial_load_n', 'steps[2].at_s'); null when the request as a whole is wrong [text].")
+    field: str | None = Field(
+        description="Where: the field name or path (e.g. 'radial_load_n', 'steps[2].at_s'); null when the request as a whole is wrong [text]."
+    )
     message: str = Field(description="What is wrong, with the allowed range and unit when there is one [text].")
-    allowed: list[Any] | None = Field(default=None, description="Allowed [low, high] in the field's unit, or the allowed names; null when not applicable [field unit].")
+    allowed: list[Any] | None = Field(
+        default=None,
+        description="Allowed [low, high] in the field's unit, or the allowed names; null when not applicable [field unit].",
+    )
 
 
 class InputError(Exception):
     """Bad input: the FieldErrors, the HTTP status to answer with and extra response headers."""
 
-    def __init__(self, errors: list[FieldError], status_code: int = 422,
-                 headers: Mapping[str, str] | None = None):
+    def __init__(self, errors: list[FieldError], status_code: int = 422, headers: Mapping[str, str] | None = None):
         self.errors, self.status_code = errors, status_code
         self.headers = dict(headers or {})
         super().__init__("; ".join(f"{e.field}: {e.message}" if e.field else e.message for e in errors))
 
     @classmethod
-    def one(cls, field: str | None, message: str, allowed: list | None = None,
-            status_code: int = 422, headers: Mapping[str, str] | None = None) -> InputError:
+    def one(
+        cls,
+        field: str | None,
+        message: str,
+        allowed: list | None = None,
+        status_code: int = 422,
+        headers: Mapping[str, str] | None = None,
+    ) -> InputError:
         return cls([FieldError(field=field, message=message, allowed=allowed)], status_code, headers)
 
 
 def setpoint_field_errors(exc: SetpointError, prefix: str = "") -> list[FieldError]:
     """A SetpointError (fields outside the bearing's range) as FieldErrors."""
-    return [FieldError(field=f"{prefix}{name}", message=message, allowed=allowed)
-            for name, message, allowed in exc.messages()]
+    return [
+        FieldError(field=f"{prefix}{name}", message=message, allowed=allowed)
+        for name, message, allowed in exc.messages()
+    ]
 
 
 def loc_text(loc: tuple | list, skip: tuple[str, ...] = ("body",)) -> str | None:
@@ -59,8 +71,18 @@ def loc_text(loc: tuple | list, skip: tuple[str, ...] = ("body",)) -> str | None
     return out or None
 
 
-_UNIT_SUFFIXES = (("_rad_s", "rad/s"), ("_m2_s", "m^2/s"), ("_pa_s", "Pa s"), ("_hz", "Hz"),
-                  ("_n", "N"), ("_m", "m"), ("_c", "degC"), ("_s", "s"), ("_a", "A"), ("_v", "V"))
+_UNIT_SUFFIXES = (
+    ("_rad_s", "rad/s"),
+    ("_m2_s", "m^2/s"),
+    ("_pa_s", "Pa s"),
+    ("_hz", "Hz"),
+    ("_n", "N"),
+    ("_m", "m"),
+    ("_c", "degC"),
+    ("_s", "s"),
+    ("_a", "A"),
+    ("_v", "V"),
+)
 
 
 def unit_of(field: str) -> str:
@@ -83,8 +105,11 @@ def _jsonable(value: Any) -> Any:
     return str(value)
 
 
-def field_errors(errors: Sequence[Mapping[str, Any]], limits: SetpointLimits | None = None,
-                 bounds: Mapping[str, tuple[Any, Any]] | None = None) -> list[FieldError]:
+def field_errors(
+    errors: Sequence[Mapping[str, Any]],
+    limits: SetpointLimits | None = None,
+    bounds: Mapping[str, tuple[Any, Any]] | None = None,
+) -> list[FieldError]:
     """pydantic error dicts -> FieldErrors naming the field and its allowed range: for setpoint
     fields the bearing's (`limits`) or else the vocabulary's static bounds, for other fields
     both sides of the declared range (`bounds`, since pydantic names only the side crossed)."""

@@ -34,46 +34,50 @@ class Fallback:
     not_held: Setpoint
     safe: Setpoint
     cause: str
-    count: int          # fallbacks of this twin so far, this one included
+    count: int  # fallbacks of this twin so far, this one included
 
     def describe(self) -> str:
         changed = [n for n in NAMES if getattr(self.not_held, n) != getattr(self.safe, n)]
         what = self.not_held.describe(changed) if changed else "the setpoint in force"
         back = f" ({self.safe.describe(changed)})" if changed else ""
-        return (f"setpoint not held ({self.cause}): {what}; restarted from the warm start at the "
-                f"last safe setpoint{back}; fallbacks: {self.count}")
+        return (
+            f"setpoint not held ({self.cause}): {what}; restarted from the warm start at the "
+            f"last safe setpoint{back}; fallbacks: {self.count}"
+        )
 
 
 class FaultPolicy:
     """Safe setpoints, fallbacks and values not held of one twin (see the module docstring).
     `advance_frame` runs in the runner thread; `check_held` in whichever thread offers a setpoint."""
 
-    def __init__(self, initial: Setpoint, limits: SetpointLimits, *, safe_after_frames: int = 20,
-                 max_restarts_per_frame: int = 2):
+    def __init__(
+        self, initial: Setpoint, limits: SetpointLimits, *, safe_after_frames: int = 20, max_restarts_per_frame: int = 2
+    ):
         self.limits = limits
         self.safe_after_frames = max(1, int(safe_after_frames))
         self.max_restarts_per_frame = max(1, int(max_restarts_per_frame))
-        self.steps_left = 0      # steps of the last frame not run: it was interrupted (Twin.interrupt_frame)
+        self.steps_left = 0  # steps of the last frame not run: it was interrupted (Twin.interrupt_frame)
         self._safe: collections.deque[Setpoint] = collections.deque([initial], maxlen=8)
         self._held_setpoint = initial
         self._held_frames = 0
-        self._restart_streak = 0           # consecutive frames with an engine restart
+        self._restart_streak = 0  # consecutive frames with an engine restart
         self.fallbacks = 0
-        self.not_held: dict[str, tuple[float, str]] = {}   # field -> (lowest |value| not held, why)
+        self.not_held: dict[str, tuple[float, str]] = {}  # field -> (lowest |value| not held, why)
 
     @property
     def last_safe(self) -> Setpoint:
         """The newest setpoint held for `safe_after_frames` frames without a restart."""
         return self._safe[-1]
 
-    def advance_frame(self, twin: Twin, frame_s: float, frame_steps: int,
-                      on_fallback: Callable[[Setpoint], None]) -> Fallback | None:
+    def advance_frame(
+        self, twin: Twin, frame_s: float, frame_steps: int, on_fallback: Callable[[Setpoint], None]
+    ) -> Fallback | None:
         """One frame of physics; on a setpoint the twin cannot hold, fall back (`on_fallback(safe)`
         is called before the twin goes on at the safe setpoint) and return what happened."""
         before = twin.restarts
         self.steps_left = 0
         left = twin.advance(frame_s, frame_steps=frame_steps, max_restarts=self.max_restarts_per_frame) or 0
-        if getattr(twin, "frame_interrupted", False):   # ended early for waiting input: not a fault
+        if getattr(twin, "frame_interrupted", False):  # ended early for waiting input: not a fault
             self.steps_left, left = left, 0
         if twin.restarts == before:
             self._restart_streak = 0
@@ -84,7 +88,7 @@ class FaultPolicy:
         if left <= 0 and self._restart_streak < 2:
             return None
         fallback = self._fall_back(twin, on_fallback)
-        if left > 0:   # the rest of the frame at the safe setpoint (bounded as well)
+        if left > 0:  # the rest of the frame at the safe setpoint (bounded as well)
             rest = twin.advance(left * twin.model.dt_s, frame_steps=frame_steps, max_restarts=1) or 0
             if getattr(twin, "frame_interrupted", False):
                 self.steps_left = rest
@@ -101,7 +105,7 @@ class FaultPolicy:
         current = twin.setpoint
         cause = twin.fault.cause if twin.fault is not None else "not held"
         if current == self._safe[-1] and self._restart_streak >= 3 and len(self._safe) > 1:
-            self._safe.pop()            # even the last safe one is not held: go further back
+            self._safe.pop()  # even the last safe one is not held: go further back
         safe = self._safe[-1]
         self._learn_not_held(current, safe, cause)
         on_fallback(safe)
@@ -114,7 +118,7 @@ class FaultPolicy:
 
     def _learn_not_held(self, current: Setpoint, safe: Setpoint, cause: str) -> None:
         rose = [n for n in _LOAD_FIELDS if abs(getattr(current, n)) > abs(getattr(safe, n))]
-        if len(rose) == 1:              # one cause only: remember the value
+        if len(rose) == 1:  # one cause only: remember the value
             name = rose[0]
             value = abs(getattr(current, name))
             known = self.not_held.get(name)
@@ -129,10 +133,14 @@ class FaultPolicy:
             if name in fields and abs(getattr(new, name)) >= value:
                 low, high = self.limits[name]
                 u = unit(name)
-                errors.append(FieldError(
-                    field=name, allowed=[max(low, -value), min(high, value)],
-                    message=f"{name} = {getattr(new, name):g} {u}: this twin could not hold "
-                    f"{value:g} {u} ({why}) and fell back to its last safe setpoint; values of "
-                    f"{value:g} {u} and beyond are refused (re-create the twin to try again)"))
+                errors.append(
+                    FieldError(
+                        field=name,
+                        allowed=[max(low, -value), min(high, value)],
+                        message=f"{name} = {getattr(new, name):g} {u}: this twin could not hold "
+                        f"{value:g} {u} ({why}) and fell back to its last safe setpoint; values of "
+                        f"{value:g} {u} and beyond are refused (re-create the twin to try again)",
+                    )
+                )
         if errors:
             raise InputError(errors)

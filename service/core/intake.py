@@ -21,8 +21,10 @@ from service.core.admission import AdmissionGate, Refusal
 from service.core.errors import InputError
 from service.core.runner import TwinRunner, parse_update
 
-_TOKEN_FIELD = ("zenoh setpoints carry no token (every subscriber of the key could read it): who "
-                "may write is zenoh's access control (BEARING_TWIN_ZENOH_WRITERS); remove the field")
+_TOKEN_FIELD = (
+    "zenoh setpoints carry no token (every subscriber of the key could read it): who "
+    "may write is zenoh's access control (BEARING_TWIN_ZENOH_WRITERS); remove the field"
+)
 
 
 class SetpointIntake:
@@ -31,7 +33,7 @@ class SetpointIntake:
     def __init__(self, bearing_id: str, gate: AdmissionGate, runner: TwinRunner):
         self.bearing_id, self.gate, self.runner = bearing_id, gate, runner
         self._lock = threading.Lock()
-        self.refused = 0          # payloads refused, any reason
+        self.refused = 0  # payloads refused, any reason
 
     def __call__(self, payload: bytes | str) -> dict:
         try:
@@ -49,8 +51,12 @@ class SetpointIntake:
             return {"accepted": True, **self._apply(data)}
         except InputError as exc:
             self._count()
-            return {"accepted": False, "status": exc.status_code, "error": str(exc),
-                    "detail": [e.model_dump() for e in exc.errors]}
+            return {
+                "accepted": False,
+                "status": exc.status_code,
+                "error": str(exc),
+                "detail": [e.model_dump() for e in exc.errors],
+            }
         except Exception as exc:  # noqa: BLE001 - a refusal, never a crash
             self._count()
             return {"accepted": False, "status": 422, "error": f"{type(exc).__name__}: {exc}"}

@@ -26,12 +26,12 @@ from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
 class SetpointTiming:
     """When a setpoint was accepted and when it was first seen in a published snapshot."""
 
-    accepted_wall_s: float                 # clock() at acceptance
-    applied_wall_s: float | None = None    # when the runner applied it (frame boundary)
-    captured_wall_s: float | None = None   # when the frame that reflects it was captured for publication
-    built_wall_s: float | None = None      # when that capture's snapshot was built
+    accepted_wall_s: float  # clock() at acceptance
+    applied_wall_s: float | None = None  # when the runner applied it (frame boundary)
+    captured_wall_s: float | None = None  # when the frame that reflects it was captured for publication
+    built_wall_s: float | None = None  # when that capture's snapshot was built
     published_wall_s: float | None = None  # when the first snapshot reflecting it was published
-    seq: int | None = None                 # that snapshot's seq
+    seq: int | None = None  # that snapshot's seq
 
     @property
     def latency_s(self) -> float | None:
@@ -45,8 +45,13 @@ class SetpointTiming:
         boundary (the stepping thread's wake-up), `step` applied -> captured (the frame that applies
         it), `build` captured -> its snapshot built, `publish` built -> handed to every sink (the
         zenoh state put)."""
-        a, b, c, e, d = (self.accepted_wall_s, self.applied_wall_s, self.captured_wall_s, self.built_wall_s,
-                         self.published_wall_s)
+        a, b, c, e, d = (
+            self.accepted_wall_s,
+            self.applied_wall_s,
+            self.captured_wall_s,
+            self.built_wall_s,
+            self.published_wall_s,
+        )
         if b is None or c is None or e is None or d is None:
             return None
         return {"apply": b - a, "step": c - b, "build": e - c, "publish": d - e}
@@ -58,16 +63,15 @@ Guard = Callable[[Setpoint, SetpointUpdate], None]
 class Mailbox:
     """Latest accepted setpoint of one twin and the one waiting for the next frame."""
 
-    def __init__(self, setpoint: Setpoint, limits: SetpointLimits, *,
-                 clock: Callable[[], float] = time.perf_counter):
+    def __init__(self, setpoint: Setpoint, limits: SetpointLimits, *, clock: Callable[[], float] = time.perf_counter):
         self.limits = limits
         self._clock = clock
         self._lock = threading.Lock()
         self._target = setpoint
         self._pending: Admitted | None = None
         self._timings: list[SetpointTiming] = []
-        self.accepted = 0          # timed offers accepted
-        self.applied = 0           # pending setpoints taken by the runner
+        self.accepted = 0  # timed offers accepted
+        self.applied = 0  # pending setpoints taken by the runner
 
     @property
     def target(self) -> Setpoint:

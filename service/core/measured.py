@@ -63,12 +63,12 @@ STANDARD_GRAVITY_M_S2 = 9.80665
 UNITS = {"m/s2": 1.0, "g": STANDARD_GRAVITY_M_S2}
 UNIT_CODES = {0: "m/s2", 1: "g"}
 MIN_SAMPLES = 1024
-MAX_SAMPLES = 2 ** 21
+MAX_SAMPLES = 2**21
 MIN_RATE_HZ = 500.0
 MAX_RATE_HZ = 1.0e6
 MAGIC = b"BTVM"
 LAYOUT_VERSION = 1
-HEADER = struct.Struct("<4sBBHddII")        # 32 bytes, module docstring
+HEADER = struct.Struct("<4sBBHddII")  # 32 bytes, module docstring
 LINE_OF_DEFECT = {"outer": "BPFO", "inner": "BPFI", "ball": "2xBSF"}
 TWIN_LINE_KEY = {"BPFO": "bpfo", "BPFI": "bpfi", "2xBSF": "two_bsf"}
 LINE_ALARM_DB = 16.0
@@ -93,8 +93,9 @@ def _rate(value) -> float:
     except (TypeError, ValueError):
         fs = float("nan")
     if not (math.isfinite(fs) and MIN_RATE_HZ <= fs <= MAX_RATE_HZ):
-        raise InputError.one("sample_rate_hz", f"must be a number in [{MIN_RATE_HZ:g}, {MAX_RATE_HZ:g}] Hz",
-                             [MIN_RATE_HZ, MAX_RATE_HZ])
+        raise InputError.one(
+            "sample_rate_hz", f"must be a number in [{MIN_RATE_HZ:g}, {MAX_RATE_HZ:g}] Hz", [MIN_RATE_HZ, MAX_RATE_HZ]
+        )
     return fs
 
 
@@ -114,19 +115,23 @@ def _shaft(value, fs: float) -> float | None:
     if f == 0.0:
         return None
     if not (math.isfinite(f) and 0.0 < f <= fs / 20.0):
-        raise InputError.one("shaft_hz", f"must be 0 (the twin's shaft speed) or in (0, {fs / 20.0:g}] Hz "
-                             "(fs / 20)", [0.0, fs / 20.0])
+        raise InputError.one(
+            "shaft_hz", f"must be 0 (the twin's shaft speed) or in (0, {fs / 20.0:g}] Hz (fs / 20)", [0.0, fs / 20.0]
+        )
     return f
 
 
 def _samples(values: np.ndarray, units: str) -> np.ndarray:
     if values.ndim != 1 or not MIN_SAMPLES <= values.size <= MAX_SAMPLES:
-        raise InputError.one("samples", f"{values.size} samples: need {MIN_SAMPLES} to {MAX_SAMPLES}",
-                             [MIN_SAMPLES, MAX_SAMPLES])
+        raise InputError.one(
+            "samples", f"{values.size} samples: need {MIN_SAMPLES} to {MAX_SAMPLES}", [MIN_SAMPLES, MAX_SAMPLES]
+        )
     bad = np.flatnonzero(~np.isfinite(values))
     if bad.size:
-        raise InputError.one("samples", f"{bad.size} non-finite samples (first at index {int(bad[0])}); "
-                             "every sample must be a finite number")
+        raise InputError.one(
+            "samples",
+            f"{bad.size} non-finite samples (first at index {int(bad[0])}); every sample must be a finite number",
+        )
     return values.astype(float) * UNITS[units]
 
 
@@ -174,7 +179,7 @@ def window_from_frame(payload: bytes) -> MeasuredWindow:
         raise InputError.one("header", f"magic {MAGIC!r} and layout version {LAYOUT_VERSION} expected")
     if code not in UNIT_CODES:
         raise InputError.one("units", "unit code must be 0 (m/s2) or 1 (g)", [0, 1])
-    body = payload[HEADER.size:]
+    body = payload[HEADER.size :]
     if len(body) != 4 * n:
         raise InputError.one("n", f"header says {n} samples, the frame carries {len(body)} bytes ({4 * n} expected)")
     return window_from_float32(body, fs, UNIT_CODES[code], shaft)
@@ -186,8 +191,15 @@ _FIELD_OF_ANALYSIS = {"signal_m_s2": "samples", "sample_rate_hz": "sample_rate_h
 class MeasuredComparator:
     """One twin's measured-against-predicted comparison (module docstring); thread-safe."""
 
-    def __init__(self, bearing_id: str, geometry, runner=None, *, line_alarm_db: float = LINE_ALARM_DB,
-                 kurtosis_margin: float = KURTOSIS_MARGIN):
+    def __init__(
+        self,
+        bearing_id: str,
+        geometry,
+        runner=None,
+        *,
+        line_alarm_db: float = LINE_ALARM_DB,
+        kurtosis_margin: float = KURTOSIS_MARGIN,
+    ):
         self.bearing_id = bearing_id
         self.runner = runner
         self.multiples = defect_multiples_of(geometry)
@@ -195,7 +207,7 @@ class MeasuredComparator:
         self._lock = threading.Lock()
         self._latest: dict | None = None
         self.windows = 0
-        self.listeners: list = []      # callables taking each comparison (the rerun recorder); must not block
+        self.listeners: list = []  # callables taking each comparison (the rerun recorder); must not block
         self.listener_errors = 0
 
     @property
@@ -215,29 +227,47 @@ class MeasuredComparator:
             speed = abs(float(getattr(snapshot, "shaft_speed_rad_s", 0.0) or 0.0))
             shaft_hz = speed / (2.0 * math.pi)
             if not shaft_hz > 0.0:
-                raise InputError.one("shaft_hz", "the twin's shaft stands still: give the window's shaft_hz",
-                                     [0.0, window.sample_rate_hz / 20.0])
+                raise InputError.one(
+                    "shaft_hz",
+                    "the twin's shaft stands still: give the window's shaft_hz",
+                    [0.0, window.sample_rate_hz / 20.0],
+                )
         try:
             analysis = analyse_signal(window.samples_m_s2, window.sample_rate_hz, shaft_hz, self.multiples)
         except AnalysisInputError as exc:
             raise InputError.one(_FIELD_OF_ANALYSIS.get(exc.field, exc.field), str(exc).split(": ", 1)[1]) from None
         predicted = self._predicted(snapshot, defects)
         measured = analysis.to_dict()
-        residual = {key: (measured[key] - predicted[key] if predicted.get(key) is not None else None)
-                    for key in ("rms_m_s2", "kurtosis", "crest_factor")}
+        residual = {
+            key: (measured[key] - predicted[key] if predicted.get(key) is not None else None)
+            for key in ("rms_m_s2", "kurtosis", "crest_factor")
+        }
         heights = {d.name: d.height_db for d in analysis.defect_lines}
         residual["line_height_db"] = {
-            name: (heights[name] - predicted["line_height_db"][name]
-                   if predicted["line_height_db"].get(name) is not None else None) for name in TWIN_LINE_KEY}
+            name: (
+                heights[name] - predicted["line_height_db"][name]
+                if predicted["line_height_db"].get(name) is not None
+                else None
+            )
+            for name in TWIN_LINE_KEY
+        }
         alarms = self._alarms(analysis, heights, predicted)
         with self._lock:
             self.windows += 1
-            out = {"bearing_id": self.bearing_id, "window": self.windows, "received_wall_s": time.time(),
-                   "twin_time_s": float(snapshot.time_s) if snapshot is not None else None,
-                   "twin_seq": int(snapshot.seq) if snapshot is not None else None,
-                   "shaft_hz": shaft_hz, "units_received": window.units,
-                   "measured": measured, "predicted": predicted, "residual": residual,
-                   "alarm": bool(alarms), "alarms": alarms}
+            out = {
+                "bearing_id": self.bearing_id,
+                "window": self.windows,
+                "received_wall_s": time.time(),
+                "twin_time_s": float(snapshot.time_s) if snapshot is not None else None,
+                "twin_seq": int(snapshot.seq) if snapshot is not None else None,
+                "shaft_hz": shaft_hz,
+                "units_received": window.units,
+                "measured": measured,
+                "predicted": predicted,
+                "residual": residual,
+                "alarm": bool(alarms),
+                "alarms": alarms,
+            }
             self._latest = out
         for listener in list(self.listeners):
             try:
@@ -256,11 +286,22 @@ class MeasuredComparator:
                 line = vib.envelope_lines.get(key)
                 if line is not None and floor > 0.0 and line.harmonics and line.harmonics[0] > 0.0:
                     heights[name] = 20.0 * math.log10(line.harmonics[0] / floor)
-            return {"source": "twin_vibration_window", "defect_kinds": kinds, "rms_m_s2": vib.rms_m_s2,
-                    "kurtosis": vib.kurtosis, "crest_factor": vib.crest_factor, "line_height_db": heights}
-        return {"source": "healthy_gaussian" if not kinds else "defects_only", "defect_kinds": kinds,
-                "rms_m_s2": None, "kurtosis": GAUSSIAN_KURTOSIS if not kinds else None, "crest_factor": None,
-                "line_height_db": heights}
+            return {
+                "source": "twin_vibration_window",
+                "defect_kinds": kinds,
+                "rms_m_s2": vib.rms_m_s2,
+                "kurtosis": vib.kurtosis,
+                "crest_factor": vib.crest_factor,
+                "line_height_db": heights,
+            }
+        return {
+            "source": "healthy_gaussian" if not kinds else "defects_only",
+            "defect_kinds": kinds,
+            "rms_m_s2": None,
+            "kurtosis": GAUSSIAN_KURTOSIS if not kinds else None,
+            "crest_factor": None,
+            "line_height_db": heights,
+        }
 
     def _alarms(self, analysis, heights: dict, predicted: dict) -> list[dict]:
         alarms = []
@@ -268,16 +309,28 @@ class MeasuredComparator:
         for kind, name in LINE_OF_DEFECT.items():
             if name in heights and heights[name] >= self.line_alarm_db and kind not in kinds:
                 line = analysis.line(name)
-                alarms.append({"code": "unexplained_line", "line": name, "height_db": heights[name],
-                               "frequency_hz": line.peak_hz,
-                               "message": f"measured {name} line at {line.peak_hz:.1f} Hz stands "
-                                          f"{heights[name]:.1f} dB over its +-20 Hz background "
-                                          f"(alarm at {self.line_alarm_db:g} dB); the twin has no {kind} defect"})
+                alarms.append(
+                    {
+                        "code": "unexplained_line",
+                        "line": name,
+                        "height_db": heights[name],
+                        "frequency_hz": line.peak_hz,
+                        "message": f"measured {name} line at {line.peak_hz:.1f} Hz stands "
+                        f"{heights[name]:.1f} dB over its +-20 Hz background "
+                        f"(alarm at {self.line_alarm_db:g} dB); the twin has no {kind} defect",
+                    }
+                )
         k_pred = predicted.get("kurtosis")
         if k_pred is not None and analysis.kurtosis - k_pred > self.kurtosis_margin:
-            alarms.append({"code": "kurtosis_above_twin", "measured": analysis.kurtosis, "predicted": k_pred,
-                           "message": f"measured kurtosis {analysis.kurtosis:.2f} exceeds the twin's {k_pred:.2f} "
-                                      f"by more than {self.kurtosis_margin:g}"})
+            alarms.append(
+                {
+                    "code": "kurtosis_above_twin",
+                    "measured": analysis.kurtosis,
+                    "predicted": k_pred,
+                    "message": f"measured kurtosis {analysis.kurtosis:.2f} exceeds the twin's {k_pred:.2f} "
+                    f"by more than {self.kurtosis_margin:g}",
+                }
+            )
         return alarms
 
 
@@ -293,15 +346,22 @@ class MeasuredIntake:
 
     def __call__(self, payload: bytes) -> dict:
         try:
-            refusal = (self.gate.check_bus_writer() or self.gate.check_size(len(payload))
-                       or self.gate.take_setpoint(self.bearing_id))
+            refusal = (
+                self.gate.check_bus_writer()
+                or self.gate.check_size(len(payload))
+                or self.gate.take_setpoint(self.bearing_id)
+            )
             if refusal is not None:
                 return self._refused(refusal)
             return {"accepted": True, **self.comparator.receive(window_from_frame(bytes(payload)))}
         except InputError as exc:
             self.refused += 1
-            return {"accepted": False, "status": exc.status_code, "error": str(exc),
-                    "detail": [e.model_dump() for e in exc.errors]}
+            return {
+                "accepted": False,
+                "status": exc.status_code,
+                "error": str(exc),
+                "detail": [e.model_dump() for e in exc.errors],
+            }
         except Exception as exc:  # noqa: BLE001 - a refusal, never a crash
             self.refused += 1
             return {"accepted": False, "status": 422, "error": f"{type(exc).__name__}: {exc}"}

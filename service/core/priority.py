@@ -79,7 +79,7 @@ def _process_nice() -> int:
         return 0
 
 
-BASE_NICE = _process_nice()   # the main thread's nice when the service was imported
+BASE_NICE = _process_nice()  # the main thread's nice when the service was imported
 
 
 def thread_nice(native_id: int) -> int | None:
@@ -117,24 +117,30 @@ class ThreadPriority:
     renices the threads it has not seen (returns how many it changed); `start()` sweeps now and
     then every `sweep_s` [s] in a daemon thread (itself reniced); `close()` stops it."""
 
-    _live: ClassVar[weakref.WeakSet[ThreadPriority]] = weakref.WeakSet()   # several services in one process (tests)
+    _live: ClassVar[weakref.WeakSet[ThreadPriority]] = weakref.WeakSet()  # several services in one process (tests)
 
-    def __init__(self, keep: Callable[[], set[int]], io_nice: int, stepping_nice: int = 0, sweep_s: float = 1.0,
-                 keep_names: re.Pattern | None = None):
+    def __init__(
+        self,
+        keep: Callable[[], set[int]],
+        io_nice: int,
+        stepping_nice: int = 0,
+        sweep_s: float = 1.0,
+        keep_names: re.Pattern | None = None,
+    ):
         self.keep = keep
         self.keep_names = keep_names
         self.io_nice = int(io_nice)
         self.stepping_nice = int(stepping_nice)
         self.sweep_s = float(sweep_s)
         self.supported = sys.platform.startswith("linux") and hasattr(os, "setpriority")
-        self.reniced = 0                  # threads given io_nice so far
-        self.errors = 0                   # io_nice refused (counted, never raised)
-        self.raise_refused = 0            # stepping_nice refused: no CAP_SYS_NICE (counted)
-        self.egress_refused = 0           # a keep_names thread could not be brought back (no CAP_SYS_NICE)
-        self._named: set[int] = set()     # threads kept by their name
-        self._seen: set[int] = set()      # threads given io_nice (or found at it)
-        self._placed: set[int] = set()    # stepping and kept threads already placed
-        self._extra: set[int] = set()     # keep_thread
+        self.reniced = 0  # threads given io_nice so far
+        self.errors = 0  # io_nice refused (counted, never raised)
+        self.raise_refused = 0  # stepping_nice refused: no CAP_SYS_NICE (counted)
+        self.egress_refused = 0  # a keep_names thread could not be brought back (no CAP_SYS_NICE)
+        self._named: set[int] = set()  # threads kept by their name
+        self._seen: set[int] = set()  # threads given io_nice (or found at it)
+        self._placed: set[int] = set()  # stepping and kept threads already placed
+        self._extra: set[int] = set()  # keep_thread
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
 
@@ -162,7 +168,7 @@ class ThreadPriority:
             return
         try:
             os.setpriority(os.PRIO_PROCESS, tid, nice)
-        except OSError:                   # a higher priority needs CAP_SYS_NICE: keeps its own
+        except OSError:  # a higher priority needs CAP_SYS_NICE: keeps its own
             self.raise_refused += 1
 
     def sweep(self) -> int:
@@ -178,7 +184,7 @@ class ThreadPriority:
             self._placed.add(tid)
             self._place(tid, self.kept_nice)
         spared = stepping | self._extra
-        for other in list(ThreadPriority._live):     # another service's stepping threads
+        for other in list(ThreadPriority._live):  # another service's stepping threads
             if other is not self:
                 spared |= other.keep() | other._extra
         changed = 0
@@ -196,12 +202,12 @@ class ThreadPriority:
             try:
                 os.setpriority(os.PRIO_PROCESS, tid, self.io_nice)
                 changed += 1
-            except OSError as exc:     # gone meanwhile, or not permitted
+            except OSError as exc:  # gone meanwhile, or not permitted
                 self.errors += 1
                 if self.errors <= 3:
                     log.debug("thread %d: nice %d refused: %s", tid, self.io_nice, exc)
         live = set(tids)
-        self._seen &= live             # ids are reused after a thread ends
+        self._seen &= live  # ids are reused after a thread ends
         self._placed &= live
         self._named &= live
         self.reniced += changed
@@ -215,7 +221,7 @@ class ThreadPriority:
             return
         try:
             os.setpriority(os.PRIO_PROCESS, tid, self.kept_nice)
-        except OSError:                   # lowering a nice value needs CAP_SYS_NICE
+        except OSError:  # lowering a nice value needs CAP_SYS_NICE
             self.egress_refused += 1
 
     def start(self) -> ThreadPriority:
@@ -225,8 +231,11 @@ class ThreadPriority:
         self.sweep()
         self._thread = threading.Thread(target=self._run, name="thread-priority", daemon=True)
         self._thread.start()
-        log.debug("stepping threads at nice %s, the service's other threads at nice %d",
-                  sorted({thread_nice(t) for t in self.keep()} - {None}), self.io_nice)
+        log.debug(
+            "stepping threads at nice %s, the service's other threads at nice %d",
+            sorted({thread_nice(t) for t in self.keep()} - {None}),
+            self.io_nice,
+        )
         return self
 
     def _run(self) -> None:
@@ -244,10 +253,14 @@ class ThreadPriority:
 
     def record(self) -> dict:
         """For /health: whether it acts, the nice values asked and found, the counts."""
-        return {"active": self.active, "io_thread_nice": self.io_nice if self.active else 0,
-                "stepping_thread_nice_asked": self.stepping_nice if self.active else BASE_NICE,
-                "stepping_thread_nice": sorted({thread_nice(t) for t in self.keep()} - {None}),
-                "threads_reniced": self.reniced, "errors": self.errors,
-                "stepping_priority_refused": self.raise_refused,
-                "egress_threads": sorted({thread_nice(t) for t in self._named} - {None}),
-                "egress_priority_refused": self.egress_refused}
+        return {
+            "active": self.active,
+            "io_thread_nice": self.io_nice if self.active else 0,
+            "stepping_thread_nice_asked": self.stepping_nice if self.active else BASE_NICE,
+            "stepping_thread_nice": sorted({thread_nice(t) for t in self.keep()} - {None}),
+            "threads_reniced": self.reniced,
+            "errors": self.errors,
+            "stepping_priority_refused": self.raise_refused,
+            "egress_threads": sorted({thread_nice(t) for t in self._named} - {None}),
+            "egress_priority_refused": self.egress_refused,
+        }

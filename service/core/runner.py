@@ -68,8 +68,8 @@ log = logging.getLogger(__name__)
 
 __all__ = ["ScenarioHandle", "SetpointTiming", "TwinRunner", "parse_update"]
 
-IDLE_POLL_S = 0.05      # an idle twin (no scenario) looks at its mailbox this often [s]
-ERROR_PAUSE_S = 0.01    # pause after a caught error [s]
+IDLE_POLL_S = 0.05  # an idle twin (no scenario) looks at its mailbox this often [s]
+ERROR_PAUSE_S = 0.01  # pause after a caught error [s]
 
 
 def parse_update(data: Any, limits: SetpointLimits) -> SetpointUpdate:
@@ -78,8 +78,11 @@ def parse_update(data: Any, limits: SetpointLimits) -> SetpointUpdate:
     if isinstance(data, SetpointUpdate):
         return data
     if not isinstance(data, dict):
-        raise InputError.one(None, f"a setpoint is a JSON object of fields {sorted(limits.ranges)}, got "
-                             f"{type(data).__name__}", sorted(limits.ranges))
+        raise InputError.one(
+            None,
+            f"a setpoint is a JSON object of fields {sorted(limits.ranges)}, got {type(data).__name__}",
+            sorted(limits.ranges),
+        )
     try:
         return SetpointUpdate.model_validate(data)
     except ValidationError as exc:
@@ -89,15 +92,29 @@ def parse_update(data: Any, limits: SetpointLimits) -> SetpointUpdate:
 class TwinRunner:
     """Runs one `Twin` frame by frame in a stepping pool (see the module docstring)."""
 
-    def __init__(self, twin: Twin, *, fast: bool = False, publish_rate_hz: float = 50.0,
-                 frame_s: float = 0.001, sinks: Iterable[SnapshotSink] = (),
-                 rtf_window_s: float = 1.0, resync_after_s: float = 0.25,
-                 idle_without_scenario: bool = False, max_consecutive_errors: int = 20,
-                 setpoint_publish_min_interval_s: float = 0.002, timing_history: int = 10000,
-                 safe_after_frames: int = 20, max_restarts_per_frame: int = 2,
-                 lateness_s: float = 0.005, setpoint_frame_s: float | None = 0.001, lead_s: float = 0.0,
-                 pool: SteppingPool | None = None, cost: TwinCost | None = None,
-                 clock: Callable[[], float] = time.perf_counter):
+    def __init__(
+        self,
+        twin: Twin,
+        *,
+        fast: bool = False,
+        publish_rate_hz: float = 50.0,
+        frame_s: float = 0.001,
+        sinks: Iterable[SnapshotSink] = (),
+        rtf_window_s: float = 1.0,
+        resync_after_s: float = 0.25,
+        idle_without_scenario: bool = False,
+        max_consecutive_errors: int = 20,
+        setpoint_publish_min_interval_s: float = 0.002,
+        timing_history: int = 10000,
+        safe_after_frames: int = 20,
+        max_restarts_per_frame: int = 2,
+        lateness_s: float = 0.005,
+        setpoint_frame_s: float | None = 0.001,
+        lead_s: float = 0.0,
+        pool: SteppingPool | None = None,
+        cost: TwinCost | None = None,
+        clock: Callable[[], float] = time.perf_counter,
+    ):
         if not (publish_rate_hz > 0 and math.isfinite(publish_rate_hz)):
             raise ValueError(f"publish_rate_hz = {publish_rate_hz!r}: must be > 0 [Hz]")
         dt = twin.model.dt_s
@@ -116,25 +133,36 @@ class TwinRunner:
         self.idle_without_scenario = idle_without_scenario
         self.max_consecutive_errors = max_consecutive_errors
         self.limits: SetpointLimits = twin.limits
-        self.calibration: TwinCost | None = cost    # measured at admission (service.core.capacity)
+        self.calibration: TwinCost | None = cost  # measured at admission (service.core.capacity)
         self._clock = clock
 
         self.mailbox = Mailbox(twin.setpoint, self.limits, clock=clock)
-        self.defect_box = DefectBox()        # local defects waiting for the next frame
+        self.defect_box = DefectBox()  # local defects waiting for the next frame
         self._measurement_lock = threading.Lock()
-        self._measurement: tuple[str, float] | None = None   # a measured temperature for the next frame
-        self.faults = FaultPolicy(twin.setpoint, self.limits, safe_after_frames=safe_after_frames,
-                                  max_restarts_per_frame=max_restarts_per_frame)
-        self.pacing = PacingClock(fast=self.fast, publish_period_s=1.0 / self.publish_rate_hz, clock=clock,
-                                  rtf_window_s=rtf_window_s, resync_after_s=resync_after_s,
-                                  setpoint_publish_min_interval_s=setpoint_publish_min_interval_s,
-                                  lateness_s=lateness_s, lead_s=lead_s)
-        self.publisher = Publisher(self.bearing_id, sinks, timing_history=timing_history,
-                                   lossless=self.fast, clock=clock)
+        self._measurement: tuple[str, float] | None = None  # a measured temperature for the next frame
+        self.faults = FaultPolicy(
+            twin.setpoint,
+            self.limits,
+            safe_after_frames=safe_after_frames,
+            max_restarts_per_frame=max_restarts_per_frame,
+        )
+        self.pacing = PacingClock(
+            fast=self.fast,
+            publish_period_s=1.0 / self.publish_rate_hz,
+            clock=clock,
+            rtf_window_s=rtf_window_s,
+            resync_after_s=resync_after_s,
+            setpoint_publish_min_interval_s=setpoint_publish_min_interval_s,
+            lateness_s=lateness_s,
+            lead_s=lead_s,
+        )
+        self.publisher = Publisher(
+            self.bearing_id, sinks, timing_history=timing_history, lossless=self.fast, clock=clock
+        )
         self.scenarios = ScenarioDriver()
         self.counters = LoopCounters()
-        self.engine_cpu = CpuMeter(window=2.0)   # CPU s per simulated s of this twin's frames
-        self._sim_steps = 0                  # steps advanced by this runner (integer: no drift)
+        self.engine_cpu = CpuMeter(window=2.0)  # CPU s per simulated s of this twin's frames
+        self._sim_steps = 0  # steps advanced by this runner (integer: no drift)
         self._consecutive = 0
         self._reanchor = False
         self._stop = threading.Event()
@@ -196,8 +224,12 @@ class TwinRunner:
             return None
         return TwinCost(
             engine_cpu_s_per_sim_s=engine if engine is not None else cal.engine_cpu_s_per_sim_s,
-            publish_cpu_s_per_s=(snap * self.publish_rate_hz if snap is not None
-                                 else (cal.publish_cpu_s_per_s if cal is not None else 0.0)))
+            publish_cpu_s_per_s=(
+                snap * self.publish_rate_hz
+                if snap is not None
+                else (cal.publish_cpu_s_per_s if cal is not None else 0.0)
+            ),
+        )
 
     @property
     def target_setpoint(self) -> Setpoint:
@@ -261,8 +293,12 @@ class TwinRunner:
         field and its range; 409 with the fixed oil temperature), handed to the twin at the next
         frame boundary (the latest wins)."""
         if self.twin.thermal is None:
-            raise InputError.one("node", "the twin runs with the fixed oil temperature (ModelOptions.thermal = "
-                                 "'fixed'): no thermal network to follow a measurement", status_code=409)
+            raise InputError.one(
+                "node",
+                "the twin runs with the fixed oil temperature (ModelOptions.thermal = "
+                "'fixed'): no thermal network to follow a measurement",
+                status_code=409,
+            )
         if node not in MEASURABLE_NODES:
             raise InputError.one("node", f"{node!r} cannot be measured", allowed=list(MEASURABLE_NODES))
         if not (math.isfinite(temperature_c) and -60.0 <= temperature_c <= 400.0):
@@ -277,7 +313,9 @@ class TwinRunner:
         if pending is not None and self.twin.thermal is not None:
             self.twin.measure_temperature(*pending)
 
-    def start_scenario(self, run: ResolvedRun, *, restart: bool = False) -> tuple[ScenarioHandle, ScenarioHandle | None]:
+    def start_scenario(
+        self, run: ResolvedRun, *, restart: bool = False
+    ) -> tuple[ScenarioHandle, ScenarioHandle | None]:
         """Hand a scenario run to the runner (a running one is cancelled). Values are checked
         against the bearing's limits first (ScenarioError). Returns (handle, replaced)."""
         run.check_limits(self.limits, where="scenario.")
@@ -311,7 +349,7 @@ class TwinRunner:
         if self._job is not None:
             raise RuntimeError("runner already started")
         if publish_initial:
-            self.publisher.capture(self.twin, None)      # no worker yet: built here, now
+            self.publisher.capture(self.twin, None)  # no worker yet: built here, now
         else:
             self.publisher.set_latest(self.twin.snapshot(real_time_factor=None))
         if self._pool is None:
@@ -325,7 +363,7 @@ class TwinRunner:
     def request_stop(self) -> None:
         """Ask the runner to stop at the end of its frame (does not wait; a real-time frame in
         progress ends at its next step)."""
-        self._interrupt()        # before the stop flag: `left_pool` withdraws it after
+        self._interrupt()  # before the stop flag: `left_pool` withdraws it after
         self._stop.set()
         self._wake()
 
@@ -405,7 +443,7 @@ class TwinRunner:
         dt = self.twin.model.dt_s
         c0 = time.thread_time()
         fallback = self.faults.advance_frame(self.twin, steps * dt, steps, on_fallback=self.mailbox.reset)
-        done = steps - self.faults.steps_left        # fewer when an outside input interrupted it
+        done = steps - self.faults.steps_left  # fewer when an outside input interrupted it
         self.engine_cpu.add(time.thread_time() - c0, done * dt)
         if fallback is not None:
             self._on_fallback(fallback)
@@ -419,14 +457,19 @@ class TwinRunner:
             return None
         pacing = self.pacing
         if not self.fast:
-            self.twin.clear_frame_interrupt()   # before the mailbox: a later input interrupts again
+            self.twin.clear_frame_interrupt()  # before the mailbox: a later input interrupts again
         try:
             if self._reanchor:
                 pacing.reanchor(self.sim_elapsed_s)
                 self._reanchor = False
-            event = self.scenarios.tick(self.sim_elapsed_s, self.mailbox.target,
-                                        lambda u: self._offer(u, timed=False), self._restart_at,
-                                        self._offer_scenario_defects, self._offer_scenario_temperature)
+            event = self.scenarios.tick(
+                self.sim_elapsed_s,
+                self.mailbox.target,
+                lambda u: self._offer(u, timed=False),
+                self._restart_at,
+                self._offer_scenario_defects,
+                self._offer_scenario_temperature,
+            )
             changed, outside = self._apply_mailbox()
             if self.idle_without_scenario and not self.scenarios.active:
                 if (event and pacing.last_publish_sim != self.sim_elapsed_s) or changed:
@@ -447,13 +490,14 @@ class TwinRunner:
             self._notify_ended()
             if self._consecutive >= self.max_consecutive_errors:
                 self.counters.failed = True
-                self.publisher.note = (f"failed: runner stopped after {self._consecutive} errors in a "
-                                       f"row; last: {self.last_error}")
+                self.publisher.note = (
+                    f"failed: runner stopped after {self._consecutive} errors in a row; last: {self.last_error}"
+                )
                 log.error("twin %s: %s", self.bearing_id, self.publisher.note)
                 self._safe_publish()
                 return None
             self._reanchor = True
-            retry = self._clock() + ERROR_PAUSE_S    # due then (not after every other twin's frames)
+            retry = self._clock() + ERROR_PAUSE_S  # due then (not after every other twin's frames)
             return Schedule(retry, math.inf if self.fast else retry)
         now = self._clock()
         sim = self.sim_elapsed_s

@@ -39,7 +39,7 @@ class ScenarioExecutor:
     _ramps: dict[str, _ActiveRamp] = field(default_factory=dict)
     _initial_done: bool = False
     phase: str | None = None
-    defects: list | None = None        # the defects of the steps just passed (taken by the driver)
+    defects: list | None = None  # the defects of the steps just passed (taken by the driver)
     temperature: MeasuredTemperature | None = None  # the measured temperature of the steps just passed
 
     def updates(self, t: float, current: Setpoint) -> SetpointUpdate:
@@ -55,9 +55,9 @@ class ScenarioExecutor:
             if step.phase is not None:
                 self.phase = step.phase
             if step.defects is not None:
-                self.defects = list(step.defects)     # the latest step wins
+                self.defects = list(step.defects)  # the latest step wins
             if step.temperature is not None:
-                self.temperature = step.temperature   # the latest step wins
+                self.temperature = step.temperature  # the latest step wins
             if step.set is None and step.ramp is None:
                 continue
             if step.set is not None:
@@ -68,8 +68,9 @@ class ScenarioExecutor:
             elif step.ramp is not None and step.over_s is not None:  # a ramp has its over_s (ScenarioStep)
                 for name, target in step.ramp.fields.items():
                     start_value = out.get(name, getattr(current, name))
-                    self._ramps[name] = _ActiveRamp(name, step.at_s, float(step.over_s),
-                                                    float(start_value), float(target))
+                    self._ramps[name] = _ActiveRamp(
+                        name, step.at_s, float(step.over_s), float(start_value), float(target)
+                    )
         for name, ramp in list(self._ramps.items()):
             x = (t - ramp.start_s) / ramp.over_s
             if x >= 1.0 - eps:
@@ -91,7 +92,7 @@ class ScenarioHandle:
     def __init__(self, run: ResolvedRun, restart: bool = False):
         self.run = run
         self.restart = restart
-        self.state = "pending"      # pending -> running -> done | cancelled | failed
+        self.state = "pending"  # pending -> running -> done | cancelled | failed
         self.scenario_time_s = 0.0
         self.phase: str | None = None
         self.error: str | None = None
@@ -134,9 +135,16 @@ class ScenarioHandle:
         return self.done.wait(timeout)
 
     def status(self) -> dict:
-        return {"name": self.name, "run": self.run.id, "state": self.state,
-                "scenario_time_s": self.scenario_time_s, "duration_s": self.duration_s,
-                "progress": self.progress, "phase": self.phase, "error": self.error}
+        return {
+            "name": self.name,
+            "run": self.run.id,
+            "state": self.state,
+            "scenario_time_s": self.scenario_time_s,
+            "duration_s": self.duration_s,
+            "progress": self.progress,
+            "phase": self.phase,
+            "error": self.error,
+        }
 
 
 class ScenarioDriver:
@@ -145,11 +153,11 @@ class ScenarioDriver:
     def __init__(self) -> None:
         self._lock = threading.Lock()
         self._request: ScenarioHandle | None = None
-        self._running: ScenarioHandle | None = None     # runner thread
+        self._running: ScenarioHandle | None = None  # runner thread
         self._last: ScenarioHandle | None = None
         self._executor: ScenarioExecutor | None = None
         self._t0_s = 0.0
-        self._ended: ScenarioHandle | None = None       # ended in the runner, not yet notified
+        self._ended: ScenarioHandle | None = None  # ended in the runner, not yet notified
 
     # ---- any thread ----------------------------------------------------------------------------
     def start(self, run: ResolvedRun, *, restart: bool = False) -> tuple[ScenarioHandle, ScenarioHandle | None]:
@@ -171,7 +179,7 @@ class ScenarioDriver:
         if request is not None:
             request.finish("cancelled")
         if current is not None:
-            current.finish("cancelled")   # the runner thread notices and drops it
+            current.finish("cancelled")  # the runner thread notices and drops it
         return current or request
 
     @property
@@ -199,10 +207,15 @@ class ScenarioDriver:
         return ended
 
     # ---- runner thread -------------------------------------------------------------------------
-    def tick(self, elapsed_s: float, target: Setpoint, offer: Callable[[SetpointUpdate], object],
-             restart_at: Callable[[SetpointUpdate], None],
-             offer_defects: Callable[[list], object] | None = None,
-             offer_temperature: Callable[[str, float], object] | None = None) -> bool:
+    def tick(
+        self,
+        elapsed_s: float,
+        target: Setpoint,
+        offer: Callable[[SetpointUpdate], object],
+        restart_at: Callable[[SetpointUpdate], None],
+        offer_defects: Callable[[list], object] | None = None,
+        offer_temperature: Callable[[str, float], object] | None = None,
+    ) -> bool:
         """Before a frame at `elapsed_s` of the runner's simulated time: take over a new scenario
         (`restart_at(initial)` when it asks for a warm restart), `offer` its updates and
         `offer_defects` its steps' defects, finish it when its time is up. Returns whether a
@@ -225,7 +238,7 @@ class ScenarioDriver:
         if handle is None:
             return event
         assert executor is not None  # set with the running handle
-        if handle.finished:            # cancelled from outside
+        if handle.finished:  # cancelled from outside
             self._end(handle)
             return True
         t = elapsed_s - self._t0_s

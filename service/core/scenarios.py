@@ -65,8 +65,7 @@ from pathlib import Path
 from typing import Annotated, Any, Literal
 
 import yaml
-from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, field_validator,
-                      model_validator)
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, field_validator, model_validator
 
 from service.core.errors import loc_text
 from service.keys import TWIN_ID_PATTERN
@@ -76,11 +75,11 @@ from twin.spec import BearingSpec, Clearance, Thermal
 
 SCENARIO_SCHEMA = "bearing-twin/scenario/1"
 
-_NAME_RE = TWIN_ID_PATTERN   # a scenario or run name names the twin of an offline run
+_NAME_RE = TWIN_ID_PATTERN  # a scenario or run name names the twin of an offline run
 _FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
 
-_DESIGNATION_TAG, _SPEC_TAG = "designation-text", "inline-spec"   # union tags, dropped from error paths
+_DESIGNATION_TAG, _SPEC_TAG = "designation-text", "inline-spec"  # union tags, dropped from error paths
 
 
 def _bearing_kind(value: Any) -> str:
@@ -90,8 +89,10 @@ def _bearing_kind(value: Any) -> str:
 Bearing = Annotated[
     Annotated[str, Tag(_DESIGNATION_TAG), Field(max_length=32)] | Annotated[BearingSpec, Tag(_SPEC_TAG)],
     Discriminator(_bearing_kind),
-    Field(description="Catalog designation [text], or a whole bearing spec (twin.spec.BearingSpec, fields with units) "
-          "[object]."),
+    Field(
+        description="Catalog designation [text], or a whole bearing spec (twin.spec.BearingSpec, fields with units) "
+        "[object]."
+    ),
 ]
 """A scenario's bearing: a catalog designation or an inline BearingSpec."""
 
@@ -118,18 +119,31 @@ class ScenarioStep(BaseModel):
 
     model_config = _FROZEN
     at_s: float = Field(ge=0.0, description="Start of the step, from the scenario start [s of simulated time].")
-    set: SetpointUpdate | None = Field(default=None, description="Step change: partial setpoint applied at at_s (fields with units).")
-    ramp: SetpointUpdate | None = Field(default=None, description="Ramp targets: partial setpoint reached linearly at at_s + over_s (fields with units).")
-    over_s: float | None = Field(default=None, gt=0.0, description="Ramp duration [s of simulated time]; only with ramp.")
-    phase: str | None = Field(default=None, max_length=64, description="Optional label of the phase this step starts [text].")
+    set: SetpointUpdate | None = Field(
+        default=None, description="Step change: partial setpoint applied at at_s (fields with units)."
+    )
+    ramp: SetpointUpdate | None = Field(
+        default=None,
+        description="Ramp targets: partial setpoint reached linearly at at_s + over_s (fields with units).",
+    )
+    over_s: float | None = Field(
+        default=None, gt=0.0, description="Ramp duration [s of simulated time]; only with ramp."
+    )
+    phase: str | None = Field(
+        default=None, max_length=64, description="Optional label of the phase this step starts [text]."
+    )
     defects: list[dict[str, Any]] | None = Field(
-        default=None, max_length=64,
+        default=None,
+        max_length=64,
         description="Local defects in force from at_s (twin.vibration.defects vocabulary: kind outer | "
         "inner | ball, width_m, length_m, depth_m [m], ...; [] clears them), checked against the bearing's "
-        "geometry before the run starts.")
+        "geometry before the run starts.",
+    )
     temperature: MeasuredTemperature | None = Field(
-        default=None, description="A measured temperature at at_s for the thermal network to follow (the twin's "
-        "setpoint oil_temperature_c is the ambient; needs ModelOptions.thermal = 'network').")
+        default=None,
+        description="A measured temperature at at_s for the thermal network to follow (the twin's "
+        "setpoint oil_temperature_c is the ambient; needs ModelOptions.thermal = 'network').",
+    )
 
     @model_validator(mode="after")
     def _one_action(self) -> ScenarioStep:
@@ -157,9 +171,16 @@ class ScenarioRun(BaseModel):
     label: str | None = Field(default=None, max_length=128, description="Human label of the run [text].")
     bearing: Bearing | None = None
     diametral_clearance_m: Clearance | None = None
-    lubricant: str | None = Field(default=None, max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
-    thermal: Thermal | None = Field(default=None, description="Electro-thermal options replacing the scenario's (twin.spec.Thermal, units in each field).")
-    initial: SetpointUpdate | None = Field(default=None, description="Initial setpoint, merged over the scenario's (fields with units).")
+    lubricant: str | None = Field(
+        default=None, max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text]."
+    )
+    thermal: Thermal | None = Field(
+        default=None,
+        description="Electro-thermal options replacing the scenario's (twin.spec.Thermal, units in each field).",
+    )
+    initial: SetpointUpdate | None = Field(
+        default=None, description="Initial setpoint, merged over the scenario's (fields with units)."
+    )
     steps: list[ScenarioStep] | None = Field(default=None, description="Steps replacing the scenario's.")
     duration_s: float | None = Field(default=None, gt=0.0, le=3600.0, description="Run length [s of simulated time].")
 
@@ -184,14 +205,17 @@ def _check_steps(steps: list[ScenarioStep], duration_s: float, where: str) -> No
     previous = 0.0
     for i, step in enumerate(steps):
         if step.at_s < previous:
-            raise ValueError(f"{where}[{i}].at_s: {step.at_s:g} s is before the previous step "
-                             f"({previous:g} s); steps must be in order of at_s")
+            raise ValueError(
+                f"{where}[{i}].at_s: {step.at_s:g} s is before the previous step "
+                f"({previous:g} s); steps must be in order of at_s"
+            )
         previous = step.at_s
         if step.at_s >= duration_s and step.at_s > 0.0:
             raise ValueError(f"{where}[{i}].at_s: {step.at_s:g} s must be below duration_s = {duration_s:g} s")
         if step.end_s > duration_s + 1e-12:
-            raise ValueError(f"{where}[{i}].over_s: the ramp ends at {step.end_s:g} s, after "
-                             f"duration_s = {duration_s:g} s")
+            raise ValueError(
+                f"{where}[{i}].over_s: the ramp ends at {step.end_s:g} s, after duration_s = {duration_s:g} s"
+            )
 
 
 class Scenario(BaseModel):
@@ -204,12 +228,24 @@ class Scenario(BaseModel):
     bearing: Bearing = catalog.DEFAULT_DESIGNATION
     diametral_clearance_m: Clearance = 0.0
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
-    thermal: Thermal | None = Field(default=None, description="Electro-thermal options of the bearing (twin.spec.Thermal: shear / current heating, R_b, H_c; units in each field); default: the spec's.")
-    initial: SetpointUpdate = Field(default_factory=SetpointUpdate, description="Setpoint applied at t = 0 (fields with units).")
+    thermal: Thermal | None = Field(
+        default=None,
+        description="Electro-thermal options of the bearing (twin.spec.Thermal: shear / current heating, R_b, H_c; units in each field); default: the spec's.",
+    )
+    initial: SetpointUpdate = Field(
+        default_factory=SetpointUpdate, description="Setpoint applied at t = 0 (fields with units)."
+    )
     duration_s: float = Field(gt=0.0, le=3600.0, description="Scenario length [s of simulated time].")
-    sample_every_s: float = Field(default=0.001, ge=1e-5, le=10.0, description="Sample period of the table and recording [s of simulated time].")
+    sample_every_s: float = Field(
+        default=0.001, ge=1e-5, le=10.0, description="Sample period of the table and recording [s of simulated time]."
+    )
     steps: list[ScenarioStep] = Field(default_factory=list, description="Timed setpoints and ramps, in order of at_s.")
-    runs: list[ScenarioRun] | None = Field(default=None, min_length=1, max_length=100, description="Optional runs with other mountings / bearings / timelines.")
+    runs: list[ScenarioRun] | None = Field(
+        default=None,
+        min_length=1,
+        max_length=100,
+        description="Optional runs with other mountings / bearings / timelines.",
+    )
     warnings: list[str] = Field(default_factory=list, description="Notes of the loader on what it did not take [text].")
 
     @field_validator("bearing", mode="before")
@@ -239,8 +275,9 @@ class Scenario(BaseModel):
             if run.lubricant is not None:
                 _check_lubricant(run.lubricant)
             steps = run.steps if run.steps is not None else self.steps
-            _check_steps(steps, run.duration_s or self.duration_s,
-                         f"runs[{j}].steps" if run.steps is not None else "steps")
+            _check_steps(
+                steps, run.duration_s or self.duration_s, f"runs[{j}].steps" if run.steps is not None else "steps"
+            )
         ids = [r.id for r in self.resolved_runs()]
         if len(set(ids)) != len(ids):
             raise ValueError(f"runs: run ids must be unique, got {ids}")
@@ -251,28 +288,52 @@ class Scenario(BaseModel):
         """Every run with the top-level defaults filled in (one run when `runs` is absent)."""
         top = frozenset(self.model_fields_set & {"bearing", "diametral_clearance_m", "lubricant"})
         if not self.runs:
-            return [ResolvedRun(scenario=self.name, index=0, id="run0", label=self.name,
-                                bearing=self.bearing, diametral_clearance_m=self.diametral_clearance_m,
-                                lubricant=self.lubricant, initial=self.initial, thermal=self.thermal,
-                                steps=_drop_empty_steps(self.steps), duration_s=self.duration_s,
-                                sample_every_s=self.sample_every_s, explicit=top)]
+            return [
+                ResolvedRun(
+                    scenario=self.name,
+                    index=0,
+                    id="run0",
+                    label=self.name,
+                    bearing=self.bearing,
+                    diametral_clearance_m=self.diametral_clearance_m,
+                    lubricant=self.lubricant,
+                    initial=self.initial,
+                    thermal=self.thermal,
+                    steps=_drop_empty_steps(self.steps),
+                    duration_s=self.duration_s,
+                    sample_every_s=self.sample_every_s,
+                    explicit=top,
+                )
+            ]
         out = []
         for j, run in enumerate(self.runs):
             initial = self.initial
             if run.initial is not None:
-                initial = SetpointUpdate(**{**self.initial.model_dump(exclude_none=True),
-                                            **run.initial.model_dump(exclude_none=True)})
-            out.append(ResolvedRun(
-                scenario=self.name, index=j, id=run.id or f"run{j}", label=run.label or run.id or f"run{j}",
-                bearing=run.bearing or self.bearing,
-                diametral_clearance_m=(self.diametral_clearance_m if run.diametral_clearance_m is None
-                                       else run.diametral_clearance_m),
-                lubricant=run.lubricant or self.lubricant, initial=initial,
-                thermal=run.thermal if run.thermal is not None else self.thermal,
-                steps=_drop_empty_steps(run.steps if run.steps is not None else self.steps),
-                duration_s=run.duration_s or self.duration_s, sample_every_s=self.sample_every_s,
-                explicit=top | frozenset(k for k in ("bearing", "diametral_clearance_m", "lubricant")
-                                         if getattr(run, k) is not None)))
+                initial = SetpointUpdate(
+                    **{**self.initial.model_dump(exclude_none=True), **run.initial.model_dump(exclude_none=True)}
+                )
+            out.append(
+                ResolvedRun(
+                    scenario=self.name,
+                    index=j,
+                    id=run.id or f"run{j}",
+                    label=run.label or run.id or f"run{j}",
+                    bearing=run.bearing or self.bearing,
+                    diametral_clearance_m=(
+                        self.diametral_clearance_m if run.diametral_clearance_m is None else run.diametral_clearance_m
+                    ),
+                    lubricant=run.lubricant or self.lubricant,
+                    initial=initial,
+                    thermal=run.thermal if run.thermal is not None else self.thermal,
+                    steps=_drop_empty_steps(run.steps if run.steps is not None else self.steps),
+                    duration_s=run.duration_s or self.duration_s,
+                    sample_every_s=self.sample_every_s,
+                    explicit=top
+                    | frozenset(
+                        k for k in ("bearing", "diametral_clearance_m", "lubricant") if getattr(run, k) is not None
+                    ),
+                )
+            )
         return out
 
     def check_bearing_limits(self) -> None:
@@ -300,9 +361,11 @@ def _designation_text(value: Any) -> Any:
 
 def _check_designation(value: str) -> str:
     if value.strip().lower().endswith(catalog.SPEC_FILE_SUFFIXES):
-        raise ValueError(f"{value!r} is a bearing spec file: only a scenario file names one (bearing-twin scenario "
-                         "run FILE, a named scenario of the service); an inline scenario gives the spec as a mapping "
-                         "of BearingSpec fields (geometry, material, lubricant, ...)")
+        raise ValueError(
+            f"{value!r} is a bearing spec file: only a scenario file names one (bearing-twin scenario "
+            "run FILE, a named scenario of the service); an inline scenario gives the spec as a mapping "
+            "of BearingSpec fields (geometry, material, lubricant, ...)"
+        )
     known = catalog.designations()
     if value.strip().upper() not in known:
         raise ValueError(f"unknown bearing {value!r}; known: {', '.join(known)}")
@@ -325,37 +388,48 @@ class ResolvedRun:
     index: int
     id: str
     label: str
-    bearing: str | BearingSpec               # catalog designation or a whole spec
+    bearing: str | BearingSpec  # catalog designation or a whole spec
     diametral_clearance_m: float
     lubricant: str
     initial: SetpointUpdate
     steps: list[ScenarioStep]
     duration_s: float
     sample_every_s: float
-    explicit: frozenset[str] = frozenset()   # which of bearing / clearance / lubricant were written
-    thermal: Thermal | None = None           # electro-thermal options (None: the spec's defaults)
+    explicit: frozenset[str] = frozenset()  # which of bearing / clearance / lubricant were written
+    thermal: Thermal | None = None  # electro-thermal options (None: the spec's defaults)
 
     @property
     def designation(self) -> str:
         """The bearing's designation (the spec's with a spec)."""
         return self.bearing if isinstance(self.bearing, str) else self.bearing.designation
 
-    def check_twin(self, designation: str, diametral_clearance_m: float, lubricant: str,
-                   thermal: Thermal | None = None, spec: BearingSpec | None = None) -> None:
+    def check_twin(
+        self,
+        designation: str,
+        diametral_clearance_m: float,
+        lubricant: str,
+        thermal: Thermal | None = None,
+        spec: BearingSpec | None = None,
+    ) -> None:
         """Raise ScenarioError if the run asks for another bearing, mounting, lubricant or
         electro-thermal options than a running twin has (those are fixed when a twin is created).
         A run with a bearing spec needs the twin's whole `spec` to be the same."""
         if isinstance(self.bearing, BearingSpec):
             if spec is None or self.spec() != spec:
                 raise ScenarioError(
-                    "bearing", f"run {self.id!r} of scenario {self.scenario!r} needs the bearing spec "
+                    "bearing",
+                    f"run {self.id!r} of scenario {self.scenario!r} needs the bearing spec "
                     f"{self.bearing.designation!r} it gives, this twin has another bearing ({designation!r}): "
                     "create a twin with that spec (POST /v1/bearings with 'spec') or run the scenario offline "
-                    "(bearing-twin scenario run)", [self.bearing.designation])
+                    "(bearing-twin scenario run)",
+                    [self.bearing.designation],
+                )
             return
-        wanted: dict[str, tuple[Any, Any]] = {"bearing": (self.bearing, designation),
-                  "diametral_clearance_m": (self.diametral_clearance_m, diametral_clearance_m),
-                  "lubricant": (catalog.lubricant(self.lubricant).name, lubricant)}
+        wanted: dict[str, tuple[Any, Any]] = {
+            "bearing": (self.bearing, designation),
+            "diametral_clearance_m": (self.diametral_clearance_m, diametral_clearance_m),
+            "lubricant": (catalog.lubricant(self.lubricant).name, lubricant),
+        }
         for name in ("bearing", "diametral_clearance_m", "lubricant"):
             if name not in self.explicit:
                 continue
@@ -363,15 +437,20 @@ class ResolvedRun:
             same = abs(want - have) <= 1e-12 if isinstance(want, float) else str(want) == str(have)
             if not same:
                 raise ScenarioError(
-                    name, f"run {self.id!r} of scenario {self.scenario!r} needs {name} = {want!r}, "
+                    name,
+                    f"run {self.id!r} of scenario {self.scenario!r} needs {name} = {want!r}, "
                     f"this twin has {have!r}: create a twin with it (POST /v1/bearings) or run the "
-                    f"scenario offline (bearing-twin scenario run)", [want])
+                    f"scenario offline (bearing-twin scenario run)",
+                    [want],
+                )
         if self.thermal is not None and thermal is not None and self.thermal != thermal:
             raise ScenarioError(
-                "thermal", f"run {self.id!r} of scenario {self.scenario!r} needs thermal = "
+                "thermal",
+                f"run {self.id!r} of scenario {self.scenario!r} needs thermal = "
                 f"{self.thermal.model_dump()}, this twin has {thermal.model_dump()}: create a twin with it "
                 f"(POST /v1/bearings with 'thermal') or run the scenario offline (bearing-twin scenario run)",
-                [self.thermal.model_dump()])
+                [self.thermal.model_dump()],
+            )
 
     def spec(self) -> BearingSpec:
         """The bearing this run asks for: designation, mounting, lubricant, thermal options (with a
@@ -380,15 +459,19 @@ class ResolvedRun:
             update: dict[str, Any] = {}
             if "diametral_clearance_m" in self.explicit:
                 update["mounting"] = self.bearing.mounting.model_copy(
-                    update={"diametral_clearance_m": self.diametral_clearance_m})
+                    update={"diametral_clearance_m": self.diametral_clearance_m}
+                )
             if "lubricant" in self.explicit:
                 update["lubricant"] = catalog.lubricant(self.lubricant)
             if self.thermal is not None:
                 update["thermal"] = self.thermal
             return self.bearing.model_copy(update=update) if update else self.bearing
-        return catalog.bearing(self.bearing, diametral_clearance_m=self.diametral_clearance_m,
-                               lubricant=catalog.lubricant(self.lubricant),
-                               **({"thermal": self.thermal} if self.thermal else {}))
+        return catalog.bearing(
+            self.bearing,
+            diametral_clearance_m=self.diametral_clearance_m,
+            lubricant=catalog.lubricant(self.lubricant),
+            **({"thermal": self.thermal} if self.thermal else {}),
+        )
 
     def bearing_limits(self) -> SetpointLimits:
         """The setpoint limits of this run's bearing (its compiled model)."""
@@ -436,8 +519,9 @@ class ResolvedRun:
             problems = limits.problems({name: value})
             if problems:
                 p = problems[0]
-                raise ScenarioError(f"{where}{place}.{name}", p.message(limits.bearing or self.designation),
-                                    [p.low, p.high])
+                raise ScenarioError(
+                    f"{where}{place}.{name}", p.message(limits.bearing or self.designation), [p.low, p.high]
+                )
 
 
 # ---- loading ----------------------------------------------------------------------------------
@@ -445,7 +529,9 @@ def scenario_from_dict(data: Any, *, source: str = "scenario") -> Scenario:
     """Validate a parsed scenario. Raises ScenarioError naming the field (first error) and
     keeps pydantic's full error list in `__cause__`."""
     if not isinstance(data, dict):
-        raise ScenarioError(source, f"a scenario is a mapping (name, duration_s, steps, ...), got {type(data).__name__}")
+        raise ScenarioError(
+            source, f"a scenario is a mapping (name, duration_s, steps, ...), got {type(data).__name__}"
+        )
     try:
         return Scenario.model_validate(data)
     except ValidationError as exc:
@@ -477,12 +563,16 @@ class ScenarioLoader(yaml.SafeLoader):
 
 ScenarioLoader.add_implicit_resolver(
     "tag:yaml.org,2002:float",
-    re.compile(r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
+    re.compile(
+        r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
                 |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
                 |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
                 |[-+]?\.(?:inf|Inf|INF)
-                |\.(?:nan|NaN|NAN))$""", re.X),
-    list("-+0123456789."))
+                |\.(?:nan|NaN|NAN))$""",
+        re.X,
+    ),
+    list("-+0123456789."),
+)
 
 
 def load_scenario(path: str | Path) -> Scenario:
@@ -505,6 +595,7 @@ def _read_spec_files(data: dict, folder: Path) -> dict:
     """The scenario with every `bearing:` that names a spec file (top level and per run) replaced
     by the BearingSpec read from it, the path relative to `folder` (the scenario file's).
     ScenarioError naming `bearing` / `runs[j].bearing` (and the spec's field) when one cannot be read."""
+
     def read(value: Any, where: str) -> Any:
         if not (isinstance(value, str) and value.strip().lower().endswith(catalog.SPEC_FILE_SUFFIXES)):
             return value
@@ -514,16 +605,21 @@ def _read_spec_files(data: dict, folder: Path) -> dict:
         except ValidationError as exc:
             located = [_locate(e) for e in exc.errors()]
             message = "; ".join(f"{w}: {m}" if w else m for w, m in located)
-            raise ScenarioError(f"{where}.{located[0][0]}" if located[0][0] else where,
-                                f"spec file {str(file)!r}: {message}") from exc
+            raise ScenarioError(
+                f"{where}.{located[0][0]}" if located[0][0] else where, f"spec file {str(file)!r}: {message}"
+            ) from exc
         except ValueError as exc:
             raise ScenarioError(where, str(exc).removeprefix("bearing: ")) from None
 
     out = {**data, "bearing": read(data["bearing"], "bearing")} if "bearing" in data else dict(data)
     runs = data.get("runs")
     if isinstance(runs, list):
-        out["runs"] = [{**run, "bearing": read(run["bearing"], f"runs[{j}].bearing")}
-                       if isinstance(run, dict) and "bearing" in run else run for j, run in enumerate(runs)]
+        out["runs"] = [
+            {**run, "bearing": read(run["bearing"], f"runs[{j}].bearing")}
+            if isinstance(run, dict) and "bearing" in run
+            else run
+            for j, run in enumerate(runs)
+        ]
     return out
 
 
@@ -542,7 +638,5 @@ def find_scenario(name: str, directory: str | Path) -> Scenario:
     """Load the named scenario from a directory (by file stem). Raises ScenarioError('name', ...)."""
     known = list_scenarios(directory)
     if name not in known:
-        raise ScenarioError("name", f"unknown scenario {name!r}; known: {', '.join(known) or 'none'}",
-                            sorted(known))
+        raise ScenarioError("name", f"unknown scenario {name!r}; known: {', '.join(known) or 'none'}", sorted(known))
     return load_scenario(known[name])
-

@@ -21,5 +21,3 @@ class SnapshotSink(Protocol):
 
     def close(self) -> None:
         """Flush what is queued and release resources (idempotent)."""
-
-

@@ -9,17 +9,17 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
-LATENCY_WINDOW = 1000     # setpoints the /health latency figures cover (the newest)
+LATENCY_WINDOW = 1000  # setpoints the /health latency figures cover (the newest)
 
 
 @dataclass
 class LoopCounters:
     """Written by the runner thread only."""
 
-    frames: int = 0            # frames advanced
-    errors: int = 0            # exceptions caught in the loop (each followed by a warm restart)
+    frames: int = 0  # frames advanced
+    errors: int = 0  # exceptions caught in the loop (each followed by a warm restart)
     last_error: str | None = None
-    failed: bool = False       # stopped after too many errors in a row
+    failed: bool = False  # stopped after too many errors in a row
 
     def error(self, exc: BaseException) -> None:
         self.errors += 1
@@ -45,8 +45,10 @@ def setpoint_latency_ms(timings: Iterable[Any]) -> dict | None:
             stages.setdefault(name, []).append(1e3 * value)
     if not stages:
         return None
-    out: dict[str, Any] = {name: {"p50": round(percentile(v, 50), 3), "p99": round(percentile(v, 99), 3),
-                                  "max": round(max(v), 3)} for name, v in stages.items()}
+    out: dict[str, Any] = {
+        name: {"p50": round(percentile(v, 50), 3), "p99": round(percentile(v, 99), 3), "max": round(max(v), 3)}
+        for name, v in stages.items()
+    }
     out["count"] = len(stages["total"])
     return out
 
@@ -57,15 +59,26 @@ def health_record(runner: Any, *, setpoints_refused: int = 0, setpoints_rate_lim
     latest = runner.latest
     cost = runner.cost
     return {
-        "id": runner.bearing_id, "running": runner.running, "mode": runner.mode,
+        "id": runner.bearing_id,
+        "running": runner.running,
+        "mode": runner.mode,
         "status": latest.status if latest is not None else runner.publisher.status_text(runner.twin.status),
         "time_s": latest.time_s if latest is not None else runner.twin.time_s,
-        "real_time_factor": runner.real_time_factor, "late_fraction": runner.late_fraction,
-        "lateness_s": runner.pacing.lateness_s, "frame_s": runner.frame_s, "frames": runner.frames,
-        "overruns": runner.overruns, "resyncs": runner.resyncs, "published": runner.published,
-        "dropped": runner.dropped, "errors": runner.errors, "restarts": runner.twin.restarts,
-        "setpoints_accepted": runner.setpoints_accepted, "setpoints_refused": setpoints_refused,
-        "setpoints_rate_limited": setpoints_rate_limited, "fallbacks": runner.fallbacks,
+        "real_time_factor": runner.real_time_factor,
+        "late_fraction": runner.late_fraction,
+        "lateness_s": runner.pacing.lateness_s,
+        "frame_s": runner.frame_s,
+        "frames": runner.frames,
+        "overruns": runner.overruns,
+        "resyncs": runner.resyncs,
+        "published": runner.published,
+        "dropped": runner.dropped,
+        "errors": runner.errors,
+        "restarts": runner.twin.restarts,
+        "setpoints_accepted": runner.setpoints_accepted,
+        "setpoints_refused": setpoints_refused,
+        "setpoints_rate_limited": setpoints_rate_limited,
+        "fallbacks": runner.fallbacks,
         "last_safe_setpoint": runner.last_safe_setpoint.model_dump(),
         "publish_skipped": runner.publisher.skipped,
         "cost": cost.as_dict() if cost is not None else None,

@@ -46,7 +46,7 @@ from asyncua.server.internal_session import InternalSession
 
 log = logging.getLogger(__name__)
 
-MAX_TRACKED_ADDRESSES = 4096           # client addresses the login throttle remembers (oldest dropped)
+MAX_TRACKED_ADDRESSES = 4096  # client addresses the login throttle remembers (oldest dropped)
 _REFUSALS = {"BadUserAccessDenied", "BadTooManySessions", "BadTooManySubscriptions", "BadTooManyMonitoredItems"}
 
 
@@ -57,20 +57,25 @@ class _Burst:
     first_s: float
     last_s: float
     failures: int = 0
-    refused: int = 0                   # refused during the backoff, password not tried
+    refused: int = 0  # refused during the backoff, password not tried
 
 
 class LoginThrottle:
     """Backoff of failed logins per client address (see the module docstring). `clock`: monotonic
     seconds (injectable for tests)."""
 
-    def __init__(self, free_failures: int = 3, backoff_s: float = 1.0, backoff_max_s: float = 60.0,
-                 clock: Callable[[], float] = time.monotonic):
+    def __init__(
+        self,
+        free_failures: int = 3,
+        backoff_s: float = 1.0,
+        backoff_max_s: float = 60.0,
+        clock: Callable[[], float] = time.monotonic,
+    ):
         self.free_failures = int(free_failures)
         self.backoff_s, self.backoff_max_s = float(backoff_s), float(backoff_max_s)
         self.clock = clock
         self._bursts: collections.OrderedDict[str, _Burst] = collections.OrderedDict()
-        self.failures = 0                  # since start, all addresses
+        self.failures = 0  # since start, all addresses
         self.refused = 0
 
     def wait_s(self, address: str) -> float:
@@ -101,9 +106,14 @@ class LoginThrottle:
             burst = self._bursts[address] = _Burst(now, now)
             while len(self._bursts) > MAX_TRACKED_ADDRESSES:
                 self._end(*self._bursts.popitem(last=False))
-            log.warning("OPC UA: failed login from %s; after %d failures its logins wait %g s, doubling up to %g s "
-                        "(password not tried meanwhile); the burst is summarised when it stops", address,
-                        self.free_failures, self.backoff_s, self.backoff_max_s)
+            log.warning(
+                "OPC UA: failed login from %s; after %d failures its logins wait %g s, doubling up to %g s "
+                "(password not tried meanwhile); the burst is summarised when it stops",
+                address,
+                self.free_failures,
+                self.backoff_s,
+                self.backoff_max_s,
+            )
         self._bursts.move_to_end(address)
         burst.failures += 1
         burst.last_s = now
@@ -121,13 +131,21 @@ class LoginThrottle:
             self._end(address, self._bursts.pop(address))
 
     def _end(self, address: str, burst: _Burst) -> None:
-        log.warning("OPC UA: %d failed login(s) from %s in %.1f s (%d more refused during the backoff, password "
-                    "not tried)", burst.failures, address, burst.last_s - burst.first_s, burst.refused)
+        log.warning(
+            "OPC UA: %d failed login(s) from %s in %.1f s (%d more refused during the backoff, password not tried)",
+            burst.failures,
+            address,
+            burst.last_s - burst.first_s,
+            burst.refused,
+        )
 
     def figures(self) -> dict:
         """Counts since start (any thread: reads a copy of the addresses)."""
-        return {"failed_logins": self.failures, "refused_in_backoff": self.refused, "addresses_in_backoff":
-                sum(1 for a in list(self._bursts) if self.wait_s(a) > 0)}
+        return {
+            "failed_logins": self.failures,
+            "refused_in_backoff": self.refused,
+            "addresses_in_backoff": sum(1 for a in list(self._bursts) if self.wait_s(a) > 0),
+        }
 
 
 class QuietRefusals(logging.Filter):
@@ -149,16 +167,19 @@ class GuardLimits:
     max_notifications_per_s: float = 1000.0
     min_publishing_interval_ms: float = 50.0
     max_queue_size: int = 10
-    publish_rate_hz: float = 50.0      # how often a variable changes at most (the twins' publish rate) [1/s]
+    publish_rate_hz: float = 50.0  # how often a variable changes at most (the twins' publish rate) [1/s]
 
     @classmethod
     def from_settings(cls, s: Any) -> GuardLimits:
-        return cls(max_sessions=s.opcua.max_sessions,
-                   max_subscriptions_per_session=s.opcua.max_subscriptions_per_session,
-                   max_monitored_items_per_session=s.opcua.max_monitored_items_per_session,
-                   max_notifications_per_s=s.opcua.max_notifications_per_s,
-                   min_publishing_interval_ms=s.opcua.min_publishing_interval_ms,
-                   max_queue_size=s.opcua.max_queue_size, publish_rate_hz=s.runner.publish_rate_hz)
+        return cls(
+            max_sessions=s.opcua.max_sessions,
+            max_subscriptions_per_session=s.opcua.max_subscriptions_per_session,
+            max_monitored_items_per_session=s.opcua.max_monitored_items_per_session,
+            max_notifications_per_s=s.opcua.max_notifications_per_s,
+            min_publishing_interval_ms=s.opcua.min_publishing_interval_ms,
+            max_queue_size=s.opcua.max_queue_size,
+            publish_rate_hz=s.runner.publish_rate_hz,
+        )
 
     def item_rate_hz(self, queue_size: int, interval_ms: float) -> float:
         """The most notifications one monitored item may send per second [1/s]."""
@@ -171,12 +192,14 @@ class OpcUaGuard:
     def __init__(self, limits: GuardLimits, logins: LoginThrottle):
         self.limits, self.logins = limits, logins
         self.sessions: set[GuardedSession] = set()
-        self.refused: collections.Counter = collections.Counter()     # status name -> count
+        self.refused: collections.Counter = collections.Counter()  # status name -> count
 
     @classmethod
     def from_settings(cls, s: Any) -> OpcUaGuard:
-        return cls(GuardLimits.from_settings(s),
-                   LoginThrottle(s.opcua.login_free_failures, s.opcua.login_backoff_s, s.opcua.login_backoff_max_s))
+        return cls(
+            GuardLimits.from_settings(s),
+            LoginThrottle(s.opcua.login_free_failures, s.opcua.login_backoff_s, s.opcua.login_backoff_max_s),
+        )
 
     def install(self, iserver: Any) -> None:
         """Make asyncua's InternalServer create a GuardedSession for every client session, and cap
@@ -186,10 +209,13 @@ class OpcUaGuard:
         def create_session(name: Any, user: Any = None, external: bool = False) -> InternalSession:
             kwargs = {} if user is None else {"user": user}
             if not external:
-                return InternalSession(iserver, iserver.aspace, iserver.subscription_service, name,
-                                       external=False, **kwargs)
-            return GuardedSession(self, iserver, iserver.aspace, iserver.subscription_service, name,
-                                  external=True, **kwargs)
+                return InternalSession(
+                    iserver, iserver.aspace, iserver.subscription_service, name, external=False, **kwargs
+                )
+            return GuardedSession(
+                self, iserver, iserver.aspace, iserver.subscription_service, name, external=True, **kwargs
+            )
+
         iserver.create_session = create_session
         logging.getLogger("asyncua.server.uaprocessor").addFilter(QuietRefusals())
 
@@ -219,8 +245,12 @@ class GuardedSession(InternalSession):
     async def create_session(self, params: ua.CreateSessionParameters, sockname: Any = None) -> ua.CreateSessionResult:
         limits = self.guard.limits
         if len(self.guard.sessions) >= limits.max_sessions:
-            raise self.guard.refuse("BadTooManySessions", "session from %s refused: %d open (opcua_max_sessions)",
-                                    self.address, limits.max_sessions)
+            raise self.guard.refuse(
+                "BadTooManySessions",
+                "session from %s refused: %d open (opcua_max_sessions)",
+                self.address,
+                limits.max_sessions,
+            )
         result = await super().create_session(params, sockname)
         self.guard.sessions.add(self)
         return result
@@ -229,8 +259,9 @@ class GuardedSession(InternalSession):
         self.guard.sessions.discard(self)
         await super().close_session(delete_subs)
 
-    def activate_session(self, params: ua.ActivateSessionParameters, peer_certificate: bytes | None
-                         ) -> ua.ActivateSessionResult:
+    def activate_session(
+        self, params: ua.ActivateSessionParameters, peer_certificate: bytes | None
+    ) -> ua.ActivateSessionResult:
         logins = self.guard.logins
         password = isinstance(params.UserIdentityToken, ua.UserNameIdentityToken)
         if password and logins.wait_s(self.address) > 0:
@@ -242,22 +273,32 @@ class GuardedSession(InternalSession):
             if exc.code == ua.StatusCodes.BadUserAccessDenied:
                 logins.failed(self.address)
             raise
-        if password:                                 # an anonymous session ends no burst of guesses
+        if password:  # an anonymous session ends no burst of guesses
             logins.succeeded(self.address)
         return result
 
     # ---- subscriptions and monitored items -----------------------------------------------------
     def _own_subscriptions(self) -> dict[int, Any]:
-        return {sid: sub for sid, sub in self.subscription_service.subscriptions.items()
-                if sub.session_id == self.session_id}
+        return {
+            sid: sub
+            for sid, sub in self.subscription_service.subscriptions.items()
+            if sub.session_id == self.session_id
+        }
 
-    async def create_subscription(self, params: ua.CreateSubscriptionParameters, callback: Callable[..., Any],
-                                  request_callback: Callable[..., Any] | None = None) -> ua.CreateSubscriptionResult:
+    async def create_subscription(
+        self,
+        params: ua.CreateSubscriptionParameters,
+        callback: Callable[..., Any],
+        request_callback: Callable[..., Any] | None = None,
+    ) -> ua.CreateSubscriptionResult:
         limits = self.guard.limits
         if len(self._own_subscriptions()) >= limits.max_subscriptions_per_session:
-            raise self.guard.refuse("BadTooManySubscriptions", "subscription of a session from %s refused: "
-                                    "%d per session (opcua_max_subscriptions_per_session)", self.address,
-                                    limits.max_subscriptions_per_session)
+            raise self.guard.refuse(
+                "BadTooManySubscriptions",
+                "subscription of a session from %s refused: %d per session (opcua_max_subscriptions_per_session)",
+                self.address,
+                limits.max_subscriptions_per_session,
+            )
         requested = params.RequestedPublishingInterval
         if not math.isfinite(requested) or requested < limits.min_publishing_interval_ms:
             params.RequestedPublishingInterval = limits.min_publishing_interval_ms
@@ -273,8 +314,9 @@ class GuardedSession(InternalSession):
         self.item_rates = {i: v for i, v in self.item_rates.items() if v[0] in live}
         return self.item_rates
 
-    async def create_monitored_items(self, params: ua.CreateMonitoredItemsParameters
-                                     ) -> list[ua.MonitoredItemCreateResult]:
+    async def create_monitored_items(
+        self, params: ua.CreateMonitoredItemsParameters
+    ) -> list[ua.MonitoredItemCreateResult]:
         limits = self.guard.limits
         sub = self._own_subscriptions().get(params.SubscriptionId)
         if sub is None:
@@ -298,20 +340,28 @@ class GuardedSession(InternalSession):
             if result.StatusCode.is_good():
                 self.item_rates[result.MonitoredItemId] = (params.SubscriptionId, queue, rate)
         if refused:
-            self.guard.refuse("BadTooManyMonitoredItems", "%d monitored item(s) of a session from %s refused: at most "
-                              "%d items and %g notifications/s per session", refused, self.address,
-                              limits.max_monitored_items_per_session, limits.max_notifications_per_s)
+            self.guard.refuse(
+                "BadTooManyMonitoredItems",
+                "%d monitored item(s) of a session from %s refused: at most "
+                "%d items and %g notifications/s per session",
+                refused,
+                self.address,
+                limits.max_monitored_items_per_session,
+                limits.max_notifications_per_s,
+            )
             too_many = ua.UInt32(ua.StatusCodes.BadTooManyMonitoredItems)
             results += [ua.MonitoredItemCreateResult(StatusCode=ua.StatusCode(too_many)) for _ in range(refused)]
         return results
 
-    async def modify_monitored_items(self, params: ua.ModifyMonitoredItemsParameters
-                                     ) -> list[ua.MonitoredItemModifyResult]:
+    async def modify_monitored_items(
+        self, params: ua.ModifyMonitoredItemsParameters
+    ) -> list[ua.MonitoredItemModifyResult]:
         """An item's queue may shrink, never grow (its notification rate was counted at creation)."""
         for item in params.ItemsToModify:
             counted = self.item_rates.get(item.MonitoredItemId)
-            item.RequestedParameters.QueueSize = min(self._queue(item.RequestedParameters.QueueSize),
-                                                     counted[1] if counted else 1)
+            item.RequestedParameters.QueueSize = min(
+                self._queue(item.RequestedParameters.QueueSize), counted[1] if counted else 1
+            )
         return await super().modify_monitored_items(params)
 
     async def delete_monitored_items(self, params: ua.DeleteMonitoredItemsParameters) -> list[ua.StatusCode]:

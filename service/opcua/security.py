@@ -38,8 +38,11 @@ from cryptography.x509.oid import ExtendedKeyUsageOID
 log = logging.getLogger(__name__)
 
 _T = ua.SecurityPolicyType
-SIGN_AND_ENCRYPT = [_T.Basic256Sha256_SignAndEncrypt, _T.Aes128Sha256RsaOaep_SignAndEncrypt,
-                    _T.Aes256Sha256RsaPss_SignAndEncrypt]
+SIGN_AND_ENCRYPT = [
+    _T.Basic256Sha256_SignAndEncrypt,
+    _T.Aes128Sha256RsaOaep_SignAndEncrypt,
+    _T.Aes256Sha256RsaPss_SignAndEncrypt,
+]
 SIGN = [_T.Basic256Sha256_Sign, _T.Aes128Sha256RsaOaep_Sign, _T.Aes256Sha256RsaPss_Sign]
 POLICIES: dict[str, list[ua.SecurityPolicyType]] = {
     "none": [_T.NoSecurity],
@@ -49,7 +52,7 @@ POLICIES: dict[str, list[ua.SecurityPolicyType]] = {
     "all": SIGN_AND_ENCRYPT + SIGN + [_T.NoSecurity],
 }
 CERT_FILE, KEY_FILE = "server-cert.der", "server-key.pem"
-CERT_DAYS = 5 * 365                    # validity of a generated certificate [days]
+CERT_DAYS = 5 * 365  # validity of a generated certificate [days]
 
 
 class PkiError(ValueError):
@@ -84,8 +87,11 @@ def _load_cert(path: Path, field: str) -> x509.Certificate:
 def _load_key(path: Path, field: str) -> rsa.RSAPrivateKey:
     try:
         data = Path(path).read_bytes()
-        key = (serialization.load_pem_private_key(data, None) if b"-----BEGIN" in data
-               else serialization.load_der_private_key(data, None))
+        key = (
+            serialization.load_pem_private_key(data, None)
+            if b"-----BEGIN" in data
+            else serialization.load_der_private_key(data, None)
+        )
     except (OSError, ValueError, TypeError) as exc:
         raise PkiError(f"{field}: cannot read an unencrypted private key from {str(path)!r} ({exc})") from None
     if not isinstance(key, rsa.RSAPrivateKey):
@@ -101,7 +107,8 @@ def _same_key(cert: x509.Certificate, key: rsa.RSAPrivateKey) -> bool:
 def _uris(cert: x509.Certificate) -> list[str]:
     try:
         return cert.extensions.get_extension_for_class(x509.SubjectAlternativeName).value.get_values_for_type(
-            x509.UniformResourceIdentifier)
+            x509.UniformResourceIdentifier
+        )
     except x509.ExtensionNotFound:
         return []
 
@@ -113,8 +120,10 @@ def _problem(cert: x509.Certificate, application_uri: str) -> str | None:
     if cert.not_valid_before_utc > now:
         return f"it is valid only from {cert.not_valid_before_utc:%Y-%m-%d}"
     if application_uri not in _uris(cert):
-        return (f"its subjectAltName has no URI {application_uri} (OPC UA Part 6 6.2.2: the "
-                "application URI; it holds " + (", ".join(_uris(cert)) or "none") + ")")
+        return (
+            f"its subjectAltName has no URI {application_uri} (OPC UA Part 6 6.2.2: the "
+            "application URI; it holds " + (", ".join(_uris(cert)) or "none") + ")"
+        )
     return None
 
 
@@ -159,10 +168,10 @@ def self_signed_pki(pki_dir: Path, application_uri: str, hosts: list[str]) -> Se
         if mode & 0o077:
             log.warning("OPC UA: the server key %s is readable by others (mode %o); chmod 600 it", key_path, mode)
     else:
-        key = cert_gen.generate_private_key()                  # RSA 2048, e 65537
+        key = cert_gen.generate_private_key()  # RSA 2048, e 65537
         try:
             fd = os.open(key_path, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
-        except FileExistsError:                                # another process made it just now
+        except FileExistsError:  # another process made it just now
             return self_signed_pki(pki_dir, application_uri, hosts)
         except OSError as exc:
             raise PkiError(f"opcua_pki_dir: cannot write the key {str(key_path)!r} ({exc})") from None
@@ -179,15 +188,20 @@ def self_signed_pki(pki_dir: Path, application_uri: str, hosts: list[str]) -> Se
         if cert is not None:
             problem = "it is for another key" if not _same_key(cert, key) else _problem(cert, application_uri)
             if problem is not None:
-                log.warning("OPC UA: the server certificate %s (SHA-1 %s) is replaced: %s", cert_path,
-                            thumbprint(cert), problem)
+                log.warning(
+                    "OPC UA: the server certificate %s (SHA-1 %s) is replaced: %s", cert_path, thumbprint(cert), problem
+                )
                 cert = None
     generated_cert = cert is None
     if cert is None:
         cert = cert_gen.generate_self_signed_app_certificate(
-            key, "bearing-twin OPC UA server", {"organizationName": "bearing-twin"},
+            key,
+            "bearing-twin OPC UA server",
+            {"organizationName": "bearing-twin"},
             [x509.UniformResourceIdentifier(application_uri), *_host_names(hosts)],
-            extended=[ExtendedKeyUsageOID.SERVER_AUTH, ExtendedKeyUsageOID.CLIENT_AUTH], days=CERT_DAYS)
+            extended=[ExtendedKeyUsageOID.SERVER_AUTH, ExtendedKeyUsageOID.CLIENT_AUTH],
+            days=CERT_DAYS,
+        )
         tmp = cert_path.with_suffix(".tmp")
         tmp.write_bytes(cert.public_bytes(serialization.Encoding.DER))
         os.replace(tmp, cert_path)
@@ -199,8 +213,12 @@ class ClientTrust:
     when its certificate, or a CA certificate that signed it, is in the folder (asyncua TrustStore,
     reloaded at each start of the server)."""
 
-    OPTIONS = (CertificateValidatorOptions.TIME_RANGE | CertificateValidatorOptions.URI
-               | CertificateValidatorOptions.TRUSTED | CertificateValidatorOptions.PEER_CLIENT)
+    OPTIONS = (
+        CertificateValidatorOptions.TIME_RANGE
+        | CertificateValidatorOptions.URI
+        | CertificateValidatorOptions.TRUSTED
+        | CertificateValidatorOptions.PEER_CLIENT
+    )
 
     def __init__(self, folder: Path):
         self.folder = Path(folder)
@@ -211,13 +229,16 @@ class ClientTrust:
         try:
             await self.store.load()
         except (OSError, ValueError) as exc:
-            raise PkiError(f"opcua_trusted_dir: cannot read the certificates in {str(self.folder)!r} "
-                           f"({' '.join(str(exc).split())})") from None
+            raise PkiError(
+                f"opcua_trusted_dir: cannot read the certificates in {str(self.folder)!r} "
+                f"({' '.join(str(exc).split())})"
+            ) from None
         # the files asyncua's TrustStore reads: names with a dot ending in der or pem
         self.count = sum(1 for p in self.folder.glob("*.*") if p.name.lower().endswith(("der", "pem")))
         if self.count == 0:
-            raise PkiError(f"opcua_trusted_dir: {str(self.folder)!r} holds no .der or .pem certificate: "
-                           "no client could connect")
+            raise PkiError(
+                f"opcua_trusted_dir: {str(self.folder)!r} holds no .der or .pem certificate: no client could connect"
+            )
         return self
 
     def validator(self):
@@ -229,10 +250,17 @@ class ClientTrust:
             try:
                 await check.validate(cert, app_description)
             except ServiceError as exc:
-                log.warning("OPC UA: session refused (%s): client %s, certificate %s, SHA-1 %s (trusted: the "
-                            "certificates in %s)", ua.StatusCode(ua.UInt32(exc.code)).name, app_description.ApplicationUri,
-                            cert.subject.rfc4514_string(), thumbprint(cert), self.folder)
+                log.warning(
+                    "OPC UA: session refused (%s): client %s, certificate %s, SHA-1 %s (trusted: the "
+                    "certificates in %s)",
+                    ua.StatusCode(ua.UInt32(exc.code)).name,
+                    app_description.ApplicationUri,
+                    cert.subject.rfc4514_string(),
+                    thumbprint(cert),
+                    self.folder,
+                )
                 raise
+
         return validate
 
     def refusal(self, der: bytes | None) -> str | None:

@@ -72,24 +72,54 @@ from asyncua.server.user_managers import UserManager
 
 from service.core.alarms import AlarmEvent, inputs_from_snapshot
 from service.core.errors import InputError
-from service.opcua.layout import (APPLICATION_URI, EVENT_TYPE, FOLDERS, LAST_RESULT, NAMESPACE_URI, ROOT_FOLDER, SETPOINT_VARS,
-                                  View, identification)
+from service.opcua.layout import (
+    APPLICATION_URI,
+    EVENT_TYPE,
+    FOLDERS,
+    LAST_RESULT,
+    NAMESPACE_URI,
+    ROOT_FOLDER,
+    SETPOINT_VARS,
+    View,
+    identification,
+)
 from service.opcua.guard import OpcUaGuard
 from service.opcua.security import POLICIES, ClientTrust, PkiError, ServerPki, given_pki, self_signed_pki
 
 log = logging.getLogger(__name__)
 
-_VT = {"Double": ua.VariantType.Double, "String": ua.VariantType.String, "UInt32": ua.VariantType.UInt32,
-       "Int64": ua.VariantType.Int64, "Boolean": ua.VariantType.Boolean}
-_NUMERIC = {ua.VariantType.Double, ua.VariantType.Float, ua.VariantType.SByte, ua.VariantType.Byte,
-            ua.VariantType.Int16, ua.VariantType.UInt16, ua.VariantType.Int32, ua.VariantType.UInt32,
-            ua.VariantType.Int64, ua.VariantType.UInt64}
-_EVENT_FIELDS = (("alarm_id", ua.VariantType.String), ("category", ua.VariantType.String),
-                 ("transition", ua.VariantType.String), ("active", ua.VariantType.Boolean),
-                 ("level", ua.VariantType.String), ("value", ua.VariantType.Double),
-                 ("threshold", ua.VariantType.Double), ("clear_threshold", ua.VariantType.Double),
-                 ("unit", ua.VariantType.String), ("since_s", ua.VariantType.Double),
-                 ("time_s", ua.VariantType.Double))
+_VT = {
+    "Double": ua.VariantType.Double,
+    "String": ua.VariantType.String,
+    "UInt32": ua.VariantType.UInt32,
+    "Int64": ua.VariantType.Int64,
+    "Boolean": ua.VariantType.Boolean,
+}
+_NUMERIC = {
+    ua.VariantType.Double,
+    ua.VariantType.Float,
+    ua.VariantType.SByte,
+    ua.VariantType.Byte,
+    ua.VariantType.Int16,
+    ua.VariantType.UInt16,
+    ua.VariantType.Int32,
+    ua.VariantType.UInt32,
+    ua.VariantType.Int64,
+    ua.VariantType.UInt64,
+}
+_EVENT_FIELDS = (
+    ("alarm_id", ua.VariantType.String),
+    ("category", ua.VariantType.String),
+    ("transition", ua.VariantType.String),
+    ("active", ua.VariantType.Boolean),
+    ("level", ua.VariantType.String),
+    ("value", ua.VariantType.Double),
+    ("threshold", ua.VariantType.Double),
+    ("clear_threshold", ua.VariantType.Double),
+    ("unit", ua.VariantType.String),
+    ("since_s", ua.VariantType.Double),
+    ("time_s", ua.VariantType.Double),
+)
 
 
 class OpcUaError(RuntimeError):
@@ -110,11 +140,18 @@ class TokenUserManager(UserManager):
     encrypted with the server's key and a user name is refused on a None channel. `trust`: the
     trusted client certificates, checked against the secure channel's certificate."""
 
-    def __init__(self, gate: Any, read_requires_token: bool = False, *, secure: bool = False,
-                 none_offered: bool = True, trust: ClientTrust | None = None):
+    def __init__(
+        self,
+        gate: Any,
+        read_requires_token: bool = False,
+        *,
+        secure: bool = False,
+        none_offered: bool = True,
+        trust: ClientTrust | None = None,
+    ):
         self.gate, self.read_requires_token = gate, read_requires_token
         self.secure, self.none_offered, self.trust = secure, none_offered, trust
-        self.password_encrypted: bool | None = None     # set by `decrypt_user_token` just before get_user
+        self.password_encrypted: bool | None = None  # set by `decrypt_user_token` just before get_user
 
     def wrap(self, iserver: Any) -> None:
         """Watch asyncua's InternalServer.decrypt_user_token: it runs in ActivateSession right before
@@ -124,12 +161,14 @@ class TokenUserManager(UserManager):
         def decrypt_user_token(isession: Any, token: ua.UserNameIdentityToken):
             self.password_encrypted = bool(token.EncryptionAlgorithm)
             return decrypt(isession, token)
+
         iserver.decrypt_user_token = decrypt_user_token
 
-    def get_user(self, iserver: Any, username: str | None = None, password: str | None = None,
-                 certificate: Any = None) -> User | None:
+    def get_user(
+        self, iserver: Any, username: str | None = None, password: str | None = None, certificate: Any = None
+    ) -> User | None:
         encrypted, self.password_encrypted = self.password_encrypted, None
-        if not certificate and not self.none_offered:      # asyncua gives b"" on a None channel
+        if not certificate and not self.none_offered:  # asyncua gives b"" on a None channel
             # asyncua opens a None channel even when None is not offered (discovery needs one);
             # no session may be activated on it
             log.warning("OPC UA: a session on the None security policy is refused (not offered)")
@@ -137,12 +176,13 @@ class TokenUserManager(UserManager):
         if self.trust is not None:
             refusal = self.trust.refusal(certificate)
             if refusal is not None:
-                log.warning("OPC UA: session refused (%s): the client certificate is not in %s", refusal,
-                            self.trust.folder)
+                log.warning(
+                    "OPC UA: session refused (%s): the client certificate is not in %s", refusal, self.trust.folder
+                )
                 raise ServiceError(getattr(ua.StatusCodes, refusal))
         if username is None and password is None:
             if self.gate.requires_token and self.read_requires_token:
-                self.gate.check_token(None)            # counted as unauthorized
+                self.gate.check_token(None)  # counted as unauthorized
                 return None
             # role User: asyncua's ruleset gives the Anonymous role nothing, not even reads
             return TwinUser(role=UserRole.User, name=None, authenticated=not self.gate.requires_token)
@@ -150,11 +190,13 @@ class TokenUserManager(UserManager):
             log.warning("OPC UA: a user name on the None security policy is refused (only anonymous reads there)")
             raise ServiceError(ua.StatusCodes.BadIdentityTokenRejected)
         if self.secure and encrypted is False:
-            log.warning("OPC UA: a password sent unencrypted is refused (the endpoint asks for it encrypted "
-                        "with the server certificate); the token may have been exposed")
+            log.warning(
+                "OPC UA: a password sent unencrypted is refused (the endpoint asks for it encrypted "
+                "with the server certificate); the token may have been exposed"
+            )
             raise ServiceError(ua.StatusCodes.BadIdentityTokenRejected)
         if self.gate.check_token(password or "") is not None:
-            return None                                # BadUserAccessDenied at ActivateSession
+            return None  # BadUserAccessDenied at ActivateSession
         return TwinUser(role=UserRole.User, name=username or "user", authenticated=True)
 
 
@@ -174,7 +216,7 @@ class _Server(Server):
                     t.SecurityPolicyUri = policy.URI
 
 
-_ADMIN = User(role=UserRole.Admin)       # asyncua's default user of a server-side write
+_ADMIN = User(role=UserRole.Admin)  # asyncua's default user of a server-side write
 
 
 class _GatedAttributeService(AttributeService):
@@ -187,7 +229,7 @@ class _GatedAttributeService(AttributeService):
     async def write(self, params: ua.WriteParameters, user: User = _ADMIN) -> list[ua.StatusCode]:
         setpoints = self._facade._setpoint_nodes
         if user.role == UserRole.Admin or not any(w.NodeId in setpoints for w in params.NodesToWrite):
-            return await super().write(params, user)     # the server's own writes, other nodes
+            return await super().write(params, user)  # the server's own writes, other nodes
         results: list[ua.StatusCode] = []
         for w in params.NodesToWrite:
             if w.NodeId in setpoints:
@@ -212,7 +254,7 @@ class _TwinNodes:
     def __init__(self, bearing_id: str, obj: Any):
         self.bearing_id = bearing_id
         self.obj = obj
-        self.vars: dict[str, tuple[ua.NodeId, ua.VariantType, Any]] = {}   # key -> (node id, type, reader)
+        self.vars: dict[str, tuple[ua.NodeId, ua.VariantType, Any]] = {}  # key -> (node id, type, reader)
         self.last: dict[str, Any] = {}
         self.seq: int | None = None
         self.generators: list[EventGenerator] = []
@@ -222,9 +264,16 @@ class _TwinNodes:
 class OpcUaFacade:
     """The OPC UA server of a service (see the module docstring)."""
 
-    def __init__(self, registry: Any, endpoint: str, *, period_s: float | None = None,
-                 read_requires_token: bool | None = None, server_name: str = "bearing-twin",
-                 security: str | None = None):
+    def __init__(
+        self,
+        registry: Any,
+        endpoint: str,
+        *,
+        period_s: float | None = None,
+        read_requires_token: bool | None = None,
+        server_name: str = "bearing-twin",
+        security: str | None = None,
+    ):
         parsed = urlparse(endpoint)
         if parsed.scheme != "opc.tcp" or not parsed.hostname or parsed.port is None:
             raise ValueError(f"opcua = {endpoint!r}: expected opc.tcp://HOST:PORT[/path]")
@@ -233,18 +282,22 @@ class OpcUaFacade:
         self.security = security if security is not None else settings.opcua_security_mode
         if self.security not in POLICIES:
             raise ValueError(f"opcua_security = {self.security!r}: expected one of {', '.join(POLICIES)}")
-        self.pki: ServerPki | None = None        # the server certificate in use (secure modes)
+        self.pki: ServerPki | None = None  # the server certificate in use (secure modes)
         self.trust: ClientTrust | None = None
         self.guard = OpcUaGuard.from_settings(settings)
         self.registry = registry
         self.endpoint = endpoint
         # one publish period (of wall time; in fast mode of simulated time, at least 10 ms)
-        self.period_s = float(period_s) if period_s else max(1.0 / settings.runner.publish_rate_hz,
-                                                              0.01 if settings.runner.fast else 0.0)
-        self.read_requires_token = (settings.security.read_requires_token if read_requires_token is None
-                                    else read_requires_token)
+        self.period_s = (
+            float(period_s)
+            if period_s
+            else max(1.0 / settings.runner.publish_rate_hz, 0.01 if settings.runner.fast else 0.0)
+        )
+        self.read_requires_token = (
+            settings.security.read_requires_token if read_requires_token is None else read_requires_token
+        )
         self.server_name = server_name
-        self.url: str | None = None             # the endpoint actually listened on
+        self.url: str | None = None  # the endpoint actually listened on
         self.namespace_index: int | None = None
         self.updates = 0
         self.events_sent = 0
@@ -280,7 +333,7 @@ class OpcUaFacade:
             try:
                 loop.call_soon_threadsafe(stop.set)
             except RuntimeError:
-                pass                                    # the loop already ended
+                pass  # the loop already ended
         if self._thread is not None and self._thread is not threading.current_thread():
             self._thread.join(timeout_s)
 
@@ -318,11 +371,17 @@ class OpcUaFacade:
         if secure:
             await self._load_pki(settings)
         elif self.registry.gate.requires_token:
-            log.warning("OPC UA: opcua_security = none with a token: the token (the OPC UA password) "
-                        "crosses the network in clear")
-        users = TokenUserManager(self.registry.gate, self.read_requires_token, secure=secure,
-                                 none_offered=ua.SecurityPolicyType.NoSecurity in POLICIES[self.security],
-                                 trust=self.trust)
+            log.warning(
+                "OPC UA: opcua_security = none with a token: the token (the OPC UA password) "
+                "crosses the network in clear"
+            )
+        users = TokenUserManager(
+            self.registry.gate,
+            self.read_requires_token,
+            secure=secure,
+            none_offered=ua.SecurityPolicyType.NoSecurity in POLICIES[self.security],
+            trust=self.trust,
+        )
         server = self.server = _Server(user_manager=users)
         server.secure = secure
         await server.init()
@@ -340,9 +399,12 @@ class OpcUaFacade:
         server.set_identity_tokens([ua.AnonymousIdentityToken, ua.UserNameIdentityToken])
         server.iserver.attribute_service = _GatedAttributeService(server.iserver.aspace, self)
         idx = self.namespace_index = await server.register_namespace(NAMESPACE_URI)
-        self._root = await server.nodes.objects.add_folder(_node_id(ROOT_FOLDER, idx), ua.QualifiedName(ROOT_FOLDER, idx))
-        self._event_type = await server.create_custom_event_type(idx, EVENT_TYPE, ua.ObjectIds.BaseEventType,
-                                                                 list(_EVENT_FIELDS))
+        self._root = await server.nodes.objects.add_folder(
+            _node_id(ROOT_FOLDER, idx), ua.QualifiedName(ROOT_FOLDER, idx)
+        )
+        self._event_type = await server.create_custom_event_type(
+            idx, EVENT_TYPE, ua.ObjectIds.BaseEventType, list(_EVENT_FIELDS)
+        )
         await server.start()
         try:
             # the port really bound (0: any); asyncua types its listener as an AbstractServer
@@ -375,8 +437,12 @@ class OpcUaFacade:
             if given is not None:
                 self.pki = await asyncio.to_thread(given_pki, given, settings.opcua.private_key, APPLICATION_URI)
             else:
-                self.pki = await asyncio.to_thread(self_signed_pki, settings.opcua.pki_dir, APPLICATION_URI,
-                                                   [host] if host not in ("0.0.0.0", "::") else [])
+                self.pki = await asyncio.to_thread(
+                    self_signed_pki,
+                    settings.opcua.pki_dir,
+                    APPLICATION_URI,
+                    [host] if host not in ("0.0.0.0", "::") else [],
+                )
             trusted = settings.opcua.trusted_dir
             if trusted is not None:
                 self.trust = await ClientTrust(trusted).load()
@@ -384,11 +450,20 @@ class OpcUaFacade:
             raise OpcUaError(str(exc)) from None
         pki = self.pki
         made = " (made now)" if pki.generated_certificate else ""
-        log.info("OPC UA server certificate %s%s: SHA-1 thumbprint %s, valid until %s; key %s", pki.certificate,
-                 made, pki.thumbprint_sha1, f"{pki.not_after:%Y-%m-%d}", pki.private_key)
+        log.info(
+            "OPC UA server certificate %s%s: SHA-1 thumbprint %s, valid until %s; key %s",
+            pki.certificate,
+            made,
+            pki.thumbprint_sha1,
+            f"{pki.not_after:%Y-%m-%d}",
+            pki.private_key,
+        )
         if self.trust is not None:
-            log.info("OPC UA: only clients with a certificate in %s (%d file(s)) may open a session",
-                     self.trust.folder, self.trust.count)
+            log.info(
+                "OPC UA: only clients with a certificate in %s (%d file(s)) may open a session",
+                self.trust.folder,
+                self.trust.count,
+            )
 
     # ---- twins ---------------------------------------------------------------------------------
     async def _sync(self) -> None:
@@ -416,7 +491,7 @@ class OpcUaFacade:
         except BaseException:
             for nid in [n for n, (b, _) in self._setpoint_nodes.items() if b == entry.id]:
                 del self._setpoint_nodes[nid]
-            await self.server.delete_nodes([obj], recursive=True)    # tried again next time
+            await self.server.delete_nodes([obj], recursive=True)  # tried again next time
             raise
 
     async def _populate(self, entry: Any, obj: Any) -> _TwinNodes:
@@ -426,9 +501,12 @@ class OpcUaFacade:
         ident = await obj.add_folder(self._nid(bid, "Identification"), qn("Identification"))
         for name, vtype, desc, value in identification(entry):
             vt = _VT[vtype]
-            node = await ident.add_variable(self._nid(bid, "Identification", name), qn(name),
-                                            ua.Variant(value if value is not None else ua.get_default_value(vt), vt),
-                                            varianttype=vt)
+            node = await ident.add_variable(
+                self._nid(bid, "Identification", name),
+                qn(name),
+                ua.Variant(value if value is not None else ua.get_default_value(vt), vt),
+                varianttype=vt,
+            )
             await node.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(desc))))
             if value is None:
                 await self.server.write_attribute_value(node.nodeid, ua.DataValue(StatusCode=_status("BadNoValue")))
@@ -436,25 +514,41 @@ class OpcUaFacade:
             fnode = await obj.add_folder(self._nid(bid, folder), qn(folder))
             for var in variables:
                 vt = _VT[var.type]
-                node = await fnode.add_variable(self._nid(bid, folder, var.name), qn(var.name),
-                                                ua.Variant(ua.get_default_value(vt), vt), varianttype=vt)
+                node = await fnode.add_variable(
+                    self._nid(bid, folder, var.name),
+                    qn(var.name),
+                    ua.Variant(ua.get_default_value(vt), vt),
+                    varianttype=vt,
+                )
                 await self.server.write_attribute_value(
-                    node.nodeid, ua.DataValue(StatusCode=_status("BadWaitingForInitialData")))
-                await node.write_attribute(ua.AttributeIds.Description,
-                                           ua.DataValue(ua.Variant(ua.LocalizedText(var.description))))
+                    node.nodeid, ua.DataValue(StatusCode=_status("BadWaitingForInitialData"))
+                )
+                await node.write_attribute(
+                    ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(var.description)))
+                )
                 nodes.vars[f"{folder}/{var.name}"] = (node.nodeid, vt, var.read)
                 if folder == "Setpoint":
                     await node.set_writable(True)
                     low, high = entry.runner.limits[var.name]
-                    await node.add_property(self._nid(bid, folder, var.name, "EURange"), qn("EURange"),
-                                            ua.Range(low, high))
+                    await node.add_property(
+                        self._nid(bid, folder, var.name, "EURange"), qn("EURange"), ua.Range(low, high)
+                    )
                     self._setpoint_nodes[node.nodeid] = (bid, var.name)
             if folder == "Setpoint":
-                last = await fnode.add_variable(self._nid(bid, folder, LAST_RESULT), qn(LAST_RESULT), "",
-                                                varianttype=ua.VariantType.String)
-                await last.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(
-                    "What became of the latest write to a Setpoint variable, JSON: accepted, status, "
-                    "field, error naming the field and the bearing's range [text]."))))
+                last = await fnode.add_variable(
+                    self._nid(bid, folder, LAST_RESULT), qn(LAST_RESULT), "", varianttype=ua.VariantType.String
+                )
+                await last.write_attribute(
+                    ua.AttributeIds.Description,
+                    ua.DataValue(
+                        ua.Variant(
+                            ua.LocalizedText(
+                                "What became of the latest write to a Setpoint variable, JSON: accepted, status, "
+                                "field, error naming the field and the bearing's range [text]."
+                            )
+                        )
+                    ),
+                )
                 nodes.last_result = last.nodeid
         # alarm events: from the twin object, and from the Server object (SourceNode = the twin)
         isession = self.server.iserver.isession
@@ -484,9 +578,14 @@ class OpcUaFacade:
         nodes.last["Setpoint/_target"] = target
         hub = self.registry.alarms
         settings = hub.settings
-        view = View(snapshot=snap, inputs=inputs_from_snapshot(snap, settings) if snap is not None else None,
-                    alarms={a.alarm_id: a for a in hub.states(entry.id)}, target=target, settings=settings,
-                    measured=getattr(entry, "measured", None) and entry.measured.latest)
+        view = View(
+            snapshot=snap,
+            inputs=inputs_from_snapshot(snap, settings) if snap is not None else None,
+            alarms={a.alarm_id: a for a in hub.states(entry.id)},
+            target=target,
+            settings=settings,
+            measured=getattr(entry, "measured", None) and entry.measured.latest,
+        )
         now = ua.DateTime.now(UTC)
         for key, (nid, vt, read) in nodes.vars.items():
             try:
@@ -499,11 +598,17 @@ class OpcUaFacade:
                 continue
             nodes.last[key] = value
             if value is None:
-                dv = ua.DataValue(StatusCode=_status("BadNoValue" if snap is not None else "BadWaitingForInitialData"),
-                                  SourceTimestamp=now, ServerTimestamp=now)
+                dv = ua.DataValue(
+                    StatusCode=_status("BadNoValue" if snap is not None else "BadWaitingForInitialData"),
+                    SourceTimestamp=now,
+                    ServerTimestamp=now,
+                )
             else:
-                dv = ua.DataValue(ua.Variant(float(value) if vt == ua.VariantType.Double else value, vt),
-                                  SourceTimestamp=now, ServerTimestamp=now)
+                dv = ua.DataValue(
+                    ua.Variant(float(value) if vt == ua.VariantType.Double else value, vt),
+                    SourceTimestamp=now,
+                    ServerTimestamp=now,
+                )
             await self.server.write_attribute_value(nid, dv)
         self.updates += 1
 
@@ -534,15 +639,20 @@ class OpcUaFacade:
                 if message is not None:
                     body["error"] = message
                 await self.server.write_attribute_value(
-                    nodes.last_result, ua.DataValue(ua.Variant(json.dumps(body, allow_nan=False), ua.VariantType.String)))
+                    nodes.last_result,
+                    ua.DataValue(ua.Variant(json.dumps(body, allow_nan=False), ua.VariantType.String)),
+                )
             return _status(status) if status != "Good" else ua.StatusCode()
 
         if w.AttributeId != ua.AttributeIds.Value:
             return _status("BadNotWritable")
         gate = self.registry.gate
         if gate.requires_token and not getattr(user, "authenticated", False):
-            refusal = gate.check_token(None, missing="anonymous writes are refused: this service has a token; "
-                                       "connect with a user name and the token as password")
+            refusal = gate.check_token(
+                None,
+                missing="anonymous writes are refused: this service has a token; "
+                "connect with a user name and the token as password",
+            )
             return await answer("BadUserAccessDenied", refusal.message if refusal else None)
         variant = w.Value.Value if w.Value is not None else None
         if variant is None or variant.VariantType not in _NUMERIC or variant.is_array:
@@ -563,7 +673,8 @@ class OpcUaFacade:
             return await answer("BadOutOfRange" if out_of_range else "BadTypeMismatch", str(exc))
         if nodes is not None:
             nid = self._nid(bearing_id, "Setpoint", name)
-            await self.server.write_attribute_value(nid, ua.DataValue(ua.Variant(float(getattr(setpoint, name)),
-                                                                                 ua.VariantType.Double)))
+            await self.server.write_attribute_value(
+                nid, ua.DataValue(ua.Variant(float(getattr(setpoint, name)), ua.VariantType.Double))
+            )
             nodes.last[f"Setpoint/{name}"] = getattr(setpoint, name)
         return await answer("Good", setpoint=setpoint.model_dump())

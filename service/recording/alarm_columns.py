@@ -22,10 +22,10 @@ class AlarmRow:
 
     bearing_id: str
     alarm_id: str
-    transition: str                   # raised | escalated | deescalated | cleared
-    severity: str | None              # warning | critical | None (cleared)
-    time_s: float                     # simulated time of the event [s]
-    seq: int | None                   # seq of the snapshot that caused it
+    transition: str  # raised | escalated | deescalated | cleared
+    severity: str | None  # warning | critical | None (cleared)
+    time_s: float  # simulated time of the event [s]
+    seq: int | None  # seq of the snapshot that caused it
     value: float
     threshold: float
     clear_threshold: float
@@ -37,12 +37,19 @@ class AlarmRow:
         """From an `AlarmEvent` (or its dict)."""
         get: Callable[..., Any] = event.get if isinstance(event, Mapping) else (lambda k, d=None: getattr(event, k, d))
         seq = get("snapshot_seq")
-        return cls(bearing_id=str(get("bearing_id")), alarm_id=str(get("alarm_id")),
-                   transition=str(get("transition")), severity=get("severity"),
-                   time_s=float(get("time_s")), seq=int(seq) if isinstance(seq, int) else None,
-                   value=float(get("value")), threshold=float(get("threshold")),
-                   clear_threshold=float(get("clear_threshold")), unit=str(get("unit") or "-"),
-                   message=str(get("message") or ""))
+        return cls(
+            bearing_id=str(get("bearing_id")),
+            alarm_id=str(get("alarm_id")),
+            transition=str(get("transition")),
+            severity=get("severity"),
+            time_s=float(get("time_s")),
+            seq=int(seq) if isinstance(seq, int) else None,
+            value=float(get("value")),
+            threshold=float(get("threshold")),
+            clear_threshold=float(get("clear_threshold")),
+            unit=str(get("unit") or "-"),
+            message=str(get("message") or ""),
+        )
 
     @property
     def state(self) -> str:
@@ -51,8 +58,10 @@ class AlarmRow:
     @property
     def text(self) -> str:
         unit = "" if self.unit == "-" else f" {self.unit}"
-        return (f"{self.message} [value {format_number(self.value)}{unit}, raise at {format_number(self.threshold)}{unit}, "
-                f"clear at {format_number(self.clear_threshold)}{unit}]")
+        return (
+            f"{self.message} [value {format_number(self.value)}{unit}, raise at {format_number(self.threshold)}{unit}, "
+            f"clear at {format_number(self.clear_threshold)}{unit}]"
+        )
 
 
 def _alarm_index(times_ns: np.ndarray, seqs: list[int | None]) -> list:
@@ -78,11 +87,22 @@ def alarm_columns(tw: TwinLayout, rows: list[AlarmRow], offset_s: float) -> list
                 continue
             t = np.round((np.array([r.time_s for r in part]) + offset_s) * 1e9).astype(np.int64)
             seqs = [r.seq for r in part]
-            out.append((f"{tw.root}/alarms/{alarm_id}", _alarm_index(t, seqs),
-                        rr.TextLog.columns(text=[r.text for r in part],
-                                           level=[ALARM_LOG_LEVEL.get(r.severity, "INFO") for r in part])))
-            out.append((f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, seqs),
-                        rr.StateChange.columns(state=[r.state for r in part])))
+            out.append(
+                (
+                    f"{tw.root}/alarms/{alarm_id}",
+                    _alarm_index(t, seqs),
+                    rr.TextLog.columns(
+                        text=[r.text for r in part], level=[ALARM_LOG_LEVEL.get(r.severity, "INFO") for r in part]
+                    ),
+                )
+            )
+            out.append(
+                (
+                    f"{tw.root}/alarm_states/{alarm_id}",
+                    _alarm_index(t, seqs),
+                    rr.StateChange.columns(state=[r.state for r in part]),
+                )
+            )
     return out
 
 
@@ -114,21 +134,35 @@ def measured_columns(tw: TwinLayout, comparisons: list[Mapping], offset_s: float
         scalars(f"{base}/{key}/measured", [c["measured"][key] for c in rows])
         scalars(f"{base}/{key}/predicted", [c["predicted"].get(key) for c in rows])
     for name in MEASURED_LINES:
-        scalars(f"{base}/line_height_db/{name}",
-                [next((d["height_db"] for d in c["measured"]["defect_lines"] if d["name"] == name), None)
-                 for c in rows])
-    texts = [("; ".join(a["message"] for a in c["alarms"]) or f"window {c['window']}: explained by the twin",
-              "WARN" if c["alarms"] else "INFO") for c in rows]
-    out.append((f"{base}/alarms", _alarm_index(t, seqs),
-                rr.TextLog.columns(text=[x for x, _ in texts], level=[lv for _, lv in texts])))
+        scalars(
+            f"{base}/line_height_db/{name}",
+            [next((d["height_db"] for d in c["measured"]["defect_lines"] if d["name"] == name), None) for c in rows],
+        )
+    texts = [
+        (
+            "; ".join(a["message"] for a in c["alarms"]) or f"window {c['window']}: explained by the twin",
+            "WARN" if c["alarms"] else "INFO",
+        )
+        for c in rows
+    ]
+    out.append(
+        (
+            f"{base}/alarms",
+            _alarm_index(t, seqs),
+            rr.TextLog.columns(text=[x for x, _ in texts], level=[lv for _, lv in texts]),
+        )
+    )
     return out
 
 
-def alarm_states_in_force(tw: TwinLayout, states: Mapping[str, str], time_s: float, seq: int | None,
-                          offset_s: float) -> list:
+def alarm_states_in_force(
+    tw: TwinLayout, states: Mapping[str, str], time_s: float, seq: int | None, offset_s: float
+) -> list:
     """StateChange rows of every alarm's state when a new output (a segment) started, at
     `time_s` (its first row), so that its state timeline does not begin empty."""
     active = list(states.items())
     t = np.array([round((time_s + offset_s) * 1e9)], dtype=np.int64)
-    return [(f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, [seq]), rr.StateChange.columns(state=[state]))
-            for alarm_id, state in active]
+    return [
+        (f"{tw.root}/alarm_states/{alarm_id}", _alarm_index(t, [seq]), rr.StateChange.columns(state=[state]))
+        for alarm_id, state in active
+    ]

@@ -21,9 +21,9 @@ from service.recording.vibration_columns import WaveRow
 
 @dataclass(frozen=True)
 class WaveformArchive:
-    burst_s: float = 0.1           # [s of simulated time] length of each burst
-    every_s: float = 60.0          # [s of simulated time] a burst starts at every multiple of this
-    after_event_s: float = 1.0     # [s of simulated time] kept whole after an event
+    burst_s: float = 0.1  # [s of simulated time] length of each burst
+    every_s: float = 60.0  # [s of simulated time] a burst starts at every multiple of this
+    after_event_s: float = 1.0  # [s of simulated time] kept whole after an event
     spectrum_every_s: float = 30.0  # [s of simulated time] the files get a window's spectra this often
 
     def __post_init__(self) -> None:
@@ -47,13 +47,18 @@ class WaveformArchive:
                 continue
             edges = np.flatnonzero(np.diff(np.concatenate([[0], mask.view(np.int8), [0]])))
             for a, b in zip(edges[::2], edges[1::2], strict=True):
-                out.append(WaveRow(seq=r.seq, t0_s=float(t[a]), sample_rate_hz=r.sample_rate_hz,
-                                   samples=r.samples[a:b]))
+                out.append(
+                    WaveRow(seq=r.seq, t0_s=float(t[a]), sample_rate_hz=r.sample_rate_hz, samples=r.samples[a:b])
+                )
         return out
 
 
-SPECTRUM_LEAVES = ("vibration/spectrum", "vibration/envelope/spectrum", "vibration/envelope/cursor/",
-                   "vibration/spectrum_envelope_band")
+SPECTRUM_LEAVES = (
+    "vibration/spectrum",
+    "vibration/envelope/spectrum",
+    "vibration/envelope/cursor/",
+    "vibration/spectrum_envelope_band",
+)
 
 
 def is_spectrum(path: str) -> bool:

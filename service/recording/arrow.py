@@ -27,8 +27,9 @@ def tensor_rows(values) -> pa.Array:
     `BarChart.columns` takes one tensor for all rows)."""
     global _TENSOR_TYPE
     if _TENSOR_TYPE is None:
-        _TENSOR_TYPE = rr.components.TensorDataBatch(
-            rr.encodings.TensorData(array=np.zeros(1, np.float32))).as_arrow_array().type
+        _TENSOR_TYPE = (
+            rr.components.TensorDataBatch(rr.encodings.TensorData(array=np.zeros(1, np.float32))).as_arrow_array().type
+        )
     if isinstance(values, np.ndarray):
         values = np.ascontiguousarray(values, dtype=np.float32)
         n, k = values.shape
@@ -40,8 +41,9 @@ def tensor_rows(values) -> pa.Array:
     offsets = np.zeros(n + 1, dtype=np.int32)
     np.cumsum(sizes, out=offsets[1:])
     f_shape, f_names, f_buffer = _TENSOR_TYPE[0], _TENSOR_TYPE[1], _TENSOR_TYPE[2]
-    shape = pa.ListArray.from_arrays(pa.array(np.arange(n + 1, dtype=np.int32)),
-                                     pa.array(sizes.astype(np.uint64)), type=f_shape.type)
+    shape = pa.ListArray.from_arrays(
+        pa.array(np.arange(n + 1, dtype=np.int32)), pa.array(sizes.astype(np.uint64)), type=f_shape.type
+    )
     utype = f_buffer.type
     children = []
     code = None
@@ -52,20 +54,34 @@ def tensor_rows(values) -> pa.Array:
             children.append(pa.ListArray.from_arrays(pa.array(offsets), pa.array(values.reshape(-1)), type=ft.type))
         else:
             children.append(pa.array([], type=ft.type))
-    buffer = pa.Array.from_buffers(utype, n, [None, pa.py_buffer(np.full(n, code, dtype=np.int8).tobytes()),
-                                              pa.py_buffer(np.arange(n, dtype=np.int32).tobytes())],
-                                   children=children)
-    return pa.StructArray.from_arrays([shape, pa.nulls(n, type=f_names.type), buffer],
-                                      fields=[f_shape, f_names, f_buffer])
+    buffer = pa.Array.from_buffers(
+        utype,
+        n,
+        [
+            None,
+            pa.py_buffer(np.full(n, code, dtype=np.int8).tobytes()),
+            pa.py_buffer(np.arange(n, dtype=np.int32).tobytes()),
+        ],
+        children=children,
+    )
+    return pa.StructArray.from_arrays(
+        [shape, pa.nulls(n, type=f_names.type), buffer], fields=[f_shape, f_names, f_buffer]
+    )
 
 
 def bar_columns(values, abscissa, widths=None) -> list:
     """BarChart columns, a row per row of values / abscissa (arrays (n, k) or lists of 1-D
     arrays); widths: the bar widths of each row (a list of 1-D arrays), else the static ones."""
-    out = [rr.ComponentColumn(rr.BarChart.descriptor_values(), ArrowColumn(tensor_rows(values))),
-           rr.ComponentColumn(rr.BarChart.descriptor_abscissa(), ArrowColumn(tensor_rows(abscissa)))]
+    out = [
+        rr.ComponentColumn(rr.BarChart.descriptor_values(), ArrowColumn(tensor_rows(values))),
+        rr.ComponentColumn(rr.BarChart.descriptor_abscissa(), ArrowColumn(tensor_rows(abscissa))),
+    ]
     if widths is not None:
-        out.append(rr.ComponentColumn(rr.BarChart.descriptor_widths(),
-                                      rr.components.LengthBatch(np.concatenate(widths).astype(np.float32)),
-                                      lengths=np.array([len(w) for w in widths])))
+        out.append(
+            rr.ComponentColumn(
+                rr.BarChart.descriptor_widths(),
+                rr.components.LengthBatch(np.concatenate(widths).astype(np.float32)),
+                lengths=np.array([len(w) for w in widths]),
+            )
+        )
     return out

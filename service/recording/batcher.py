@@ -31,12 +31,12 @@ from service.recording.layout import TwinLayout, send_static
 
 log = logging.getLogger("service.recorder")
 
-_MAX_ENDED = 1024           # remembered end times of removed twins (a re-created id continues after them)
-_NEW_RUN_GAP_S = 1.0        # simulated seconds between a removed twin's last row and its re-creation
+_MAX_ENDED = 1024  # remembered end times of removed twins (a re-created id continues after them)
+_NEW_RUN_GAP_S = 1.0  # simulated seconds between a removed twin's last row and its re-creation
 
 
 def scenario_text(handle) -> str | None:
-    """"scenario NAME: STATE, phase PHASE" of a scenario handle (duck-typed), or None."""
+    """ "scenario NAME: STATE, phase PHASE" of a scenario handle (duck-typed), or None."""
     if handle is None:
         return None
     name = getattr(handle, "name", None) or "?"
@@ -55,25 +55,25 @@ def scenario_text(handle) -> str | None:
 class TwinRows(TwinLayout):
     """A recorded twin: its layout, and its rows not sent yet."""
 
-    rows: list = field(default_factory=list)          # rows not sent yet
-    slow_rows: list = field(default_factory=list)     # rows whose per-contact series are not sent yet
+    rows: list = field(default_factory=list)  # rows not sent yet
+    slow_rows: list = field(default_factory=list)  # rows whose per-contact series are not sent yet
     slow_since: float = field(default_factory=time.monotonic)
-    last_time_s: float = -math.inf                    # simulated time of the last row kept
-    last_seq: int | None = None                       # seq of the last snapshot seen
-    slow_prev_time_s: float | None = None             # time of the row before slow_rows[0]
-    prev_time_s: float | None = None                  # time of the row before rows[0]
-    time_offset_s: float = 0.0                        # added to sim_time (a re-created twin)
-    continue_after_s: float | None = None             # where the previous run of this id ended
-    note: str | None = None                           # logged (with a line break) before the next row
-    alarm_rows: list = field(default_factory=list)    # alarm events not sent yet (alarm_columns.AlarmRow)
+    last_time_s: float = -math.inf  # simulated time of the last row kept
+    last_seq: int | None = None  # seq of the last snapshot seen
+    slow_prev_time_s: float | None = None  # time of the row before slow_rows[0]
+    prev_time_s: float | None = None  # time of the row before rows[0]
+    time_offset_s: float = 0.0  # added to sim_time (a re-created twin)
+    continue_after_s: float | None = None  # where the previous run of this id ended
+    note: str | None = None  # logged (with a line break) before the next row
+    alarm_rows: list = field(default_factory=list)  # alarm events not sent yet (alarm_columns.AlarmRow)
     alarm_states: dict = field(default_factory=dict)  # alarm id -> latest state seen (ALARM_STATES)
-    alarm_carry: dict = field(default_factory=dict)   # a new output: the states to log again
-    wave_rows: list = field(default_factory=list)     # accelerometer samples not sent yet (vibration_columns.WaveRow)
+    alarm_carry: dict = field(default_factory=dict)  # a new output: the states to log again
+    wave_rows: list = field(default_factory=list)  # accelerometer samples not sent yet (vibration_columns.WaveRow)
     measured_rows: list = field(default_factory=list)  # measured-window comparisons not sent yet (dicts)
-    trend_rows: list = field(default_factory=list)    # rows of the trend window still open (sent: not yet)
-    wave_events_s: list = field(default_factory=list) # simulated times of recent events (WaveformArchive)
-    wave_defects: tuple = ()                          # the defects of the last row seen
-    spectrum_filed_s: float = -math.inf               # simulated time of the last spectra sent to the files
+    trend_rows: list = field(default_factory=list)  # rows of the trend window still open (sent: not yet)
+    wave_events_s: list = field(default_factory=list)  # simulated times of recent events (WaveformArchive)
+    wave_defects: tuple = ()  # the defects of the last row seen
+    spectrum_filed_s: float = -math.inf  # simulated time of the last spectra sent to the files
 
     def keep_state_of(self, old: TwinRows) -> None:
         """The same twin registered again (new geometry): keep its rows and state."""
@@ -87,9 +87,18 @@ class TwinRows(TwinLayout):
 class RowBatcher:
     """Queues of snapshots, alarm events and waveforms; rows per twin; columns per send."""
 
-    def __init__(self, *, queue_size: int, slow_interval_s: float, min_interval_s: float,
-                 wake: threading.Event, trend_window_s: float | None = None, now_interval_s: float = 0.0,
-                 waveform_archive: WaveformArchive | None = None, contacts_interval_s: float = 0.0):
+    def __init__(
+        self,
+        *,
+        queue_size: int,
+        slow_interval_s: float,
+        min_interval_s: float,
+        wake: threading.Event,
+        trend_window_s: float | None = None,
+        now_interval_s: float = 0.0,
+        waveform_archive: WaveformArchive | None = None,
+        contacts_interval_s: float = 0.0,
+    ):
         """`trend_window_s` [s of simulated time]: a trend row per window (`service.recording.
         trends`; None: a row per snapshot, no min / max); `now_interval_s` [s of simulated
         time]: the 3D, load-zone and per-contact entities get the first snapshot of each such
@@ -130,7 +139,7 @@ class RowBatcher:
         if positions_m is not None:
             try:
                 pos = np.array(positions_m, dtype=float).reshape(-1, 3)
-            except (TypeError, ValueError) as exc:   # never raise into the runner: draw from azimuth
+            except (TypeError, ValueError) as exc:  # never raise into the runner: draw from azimuth
                 log.warning("rerun recorder: positions_m ignored: %s", exc)
         context = None
         ctx = self.context.get(str(getattr(snapshot, "bearing_id", "")))
@@ -171,9 +180,15 @@ class RowBatcher:
 
     def publish_waveform(self, bearing_id: str, blocks: list, seq: int | None = None) -> None:
         try:
-            rows = [V.WaveRow(seq=-1 if seq is None else int(seq), t0_s=float(b.t0_s),
-                              sample_rate_hz=float(b.sample_rate_hz), samples=np.asarray(b.samples, dtype=np.float32))
-                    for b in blocks]
+            rows = [
+                V.WaveRow(
+                    seq=-1 if seq is None else int(seq),
+                    t0_s=float(b.t0_s),
+                    sample_rate_hz=float(b.sample_rate_hz),
+                    samples=np.asarray(b.samples, dtype=np.float32),
+                )
+                for b in blocks
+            ]
         except Exception as exc:  # noqa: BLE001 - never raise into the publisher
             self.errors += 1
             log.warning("rerun recorder: waveform skipped: %s", exc)
@@ -191,7 +206,7 @@ class RowBatcher:
             tw.keep_state_of(old)
         else:
             tw.continue_after_s = self.ended.pop(tw.bearing_id, None)
-            tw.alarm_carry = dict.fromkeys(ALARM_IDS, "inactive")   # the state timelines start with it
+            tw.alarm_carry = dict.fromkeys(ALARM_IDS, "inactive")  # the state timelines start with it
         self.twins[tw.bearing_id] = tw
         if context is not None:
             self.context[tw.bearing_id] = context
@@ -234,7 +249,7 @@ class RowBatcher:
             tw = self.twins.get(bearing_id)
             if tw is not None:
                 for w in wave_rows:
-                    if w.seq < 0:          # no seq given: the snapshot it came with is the last one seen
+                    if w.seq < 0:  # no seq given: the snapshot it came with is the last one seen
                         w.seq = tw.last_seq if tw.last_seq is not None else 0
                 tw.wave_rows.extend(wave_rows)
         for comparison in measured:
@@ -248,7 +263,7 @@ class RowBatcher:
                 tw.alarm_states[row.alarm_id] = row.state
         if not items:
             return
-        if not has_outputs:        # nowhere to write (no file, no viewer): nothing to convert
+        if not has_outputs:  # nowhere to write (no file, no viewer): nothing to convert
             self.skipped += len(items)
             return
         for snapshot, pos, context in items:
@@ -256,8 +271,12 @@ class RowBatcher:
                 self._row_of(snapshot, pos, context)
             except Exception as exc:  # noqa: BLE001 - a bad snapshot is skipped and counted
                 self.errors += 1
-                log.warning("rerun recorder: snapshot %s/%s skipped: %s",
-                            getattr(snapshot, "bearing_id", "?"), getattr(snapshot, "seq", "?"), exc)
+                log.warning(
+                    "rerun recorder: snapshot %s/%s skipped: %s",
+                    getattr(snapshot, "bearing_id", "?"),
+                    getattr(snapshot, "seq", "?"),
+                    exc,
+                )
 
     def _row_of(self, snapshot, pos, context) -> None:
         tw = self.twins.get(snapshot.bearing_id)
@@ -267,8 +286,11 @@ class RowBatcher:
         gap = None
         if tw.last_seq is not None and seq != tw.last_seq + 1:
             missing = seq - tw.last_seq - 1
-            gap = (f"{missing} snapshots not recorded (seq {tw.last_seq + 1}..{seq - 1})" if missing > 0
-                   else f"seq went back from {tw.last_seq} to {seq}")
+            gap = (
+                f"{missing} snapshots not recorded (seq {tw.last_seq + 1}..{seq - 1})"
+                if missing > 0
+                else f"seq went back from {tw.last_seq} to {seq}"
+            )
         tw.last_seq = seq
         t = float(snapshot.time_s)
         if self.min_interval_s > 0.0 and tw.last_time_s <= t < tw.last_time_s + self.min_interval_s:
@@ -279,11 +301,13 @@ class RowBatcher:
         if pos is not None and pos.shape != (tw.ball_count, 3):
             raise ValueError(f"positions_m has shape {pos.shape}, expected ({tw.ball_count}, 3)")
         row = C.extract(snapshot, pos, context)
-        if tw.continue_after_s is not None:      # a new run of a removed twin's id
+        if tw.continue_after_s is not None:  # a new run of a removed twin's id
             start = tw.continue_after_s + _NEW_RUN_GAP_S
             tw.time_offset_s = max(0.0, start - t)
-            gap = (f"new run of twin {tw.bearing_id}: its simulated time {t:g} s is shown at "
-                   f"{t + tw.time_offset_s:g} s (after the previous run)")
+            gap = (
+                f"new run of twin {tw.bearing_id}: its simulated time {t:g} s is shown at "
+                f"{t + tw.time_offset_s:g} s (after the previous run)"
+            )
             tw.continue_after_s = None
         elif t < tw.last_time_s:
             gap = gap or f"simulated time went back from {tw.last_time_s:g} s to {t:g} s"
@@ -294,10 +318,13 @@ class RowBatcher:
         tw.rows.append(row)
 
     def _auto_register(self, snapshot) -> TwinRows:
-        log.warning("rerun recorder: twin %r was not added with add_twin: recording its series without geometry",
-                    snapshot.bearing_id)
-        tw = TwinRows(bearing_id=str(snapshot.bearing_id), designation=str(snapshot.designation),
-                      ball_count=len(snapshot.balls))
+        log.warning(
+            "rerun recorder: twin %r was not added with add_twin: recording its series without geometry",
+            snapshot.bearing_id,
+        )
+        tw = TwinRows(
+            bearing_id=str(snapshot.bearing_id), designation=str(snapshot.designation), ball_count=len(snapshot.balls)
+        )
         self.register(tw, None, [])
         return tw
 
@@ -336,7 +363,7 @@ class RowBatcher:
             return outputs
         t = rows[-1].time_s
         if t >= tw.spectrum_filed_s + archive.spectrum_every_s or t < tw.spectrum_filed_s:
-            if path.endswith("/vibration/spectrum_envelope_band"):    # the last of a window's spectra
+            if path.endswith("/vibration/spectrum_envelope_band"):  # the last of a window's spectra
                 tw.spectrum_filed_s = t
             return outputs
         return [o for o in outputs if o.viewer]
@@ -365,7 +392,7 @@ class RowBatcher:
             if not outs or not part:
                 continue
             triples = V.waveform_columns(tw, part, tw.time_offset_s)
-            if k:                                   # the archive: a line break before every burst
+            if k:  # the archive: a line break before every burst
                 triples += V.waveform_breaks(tw, part, tw.time_offset_s)
             for path, indexes, columns in triples:
                 for out in outs:
@@ -391,8 +418,12 @@ class RowBatcher:
             first = rows[0] if rows else None
             carry, tw.alarm_carry = tw.alarm_carry, {}
             triples += A.alarm_states_in_force(
-                tw, carry, first.time_s if first else alarm_rows[0].time_s,
-                first.seq if first else alarm_rows[0].seq, tw.time_offset_s)
+                tw,
+                carry,
+                first.time_s if first else alarm_rows[0].time_s,
+                first.seq if first else alarm_rows[0].seq,
+                tw.time_offset_s,
+            )
         if alarm_rows:
             triples += A.alarm_columns(tw, alarm_rows, tw.time_offset_s)
         if rows:
@@ -415,8 +446,9 @@ class RowBatcher:
             if self.trend_window_s is None:
                 triples += trends.trend_columns(tw, [[r] for r in rows], tw.time_offset_s, bands=False)
             else:
-                windows, tw.trend_rows = trends.split_windows(tw.trend_rows + rows, self.trend_window_s,
-                                                              final=force_slow)
+                windows, tw.trend_rows = trends.split_windows(
+                    tw.trend_rows + rows, self.trend_window_s, final=force_slow
+                )
                 triples += trends.trend_columns(tw, windows, tw.time_offset_s)
         if tw.slow_rows and (force_slow or now_s - tw.slow_since >= self.slow_interval_s):
             slow, tw.slow_rows = tw.slow_rows, []

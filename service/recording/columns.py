@@ -34,12 +34,26 @@ from service.recording.layout import (
 # contact fields per ball and side, in this order (getattr with a None default)
 CONTACT_FIELDS = ("load_n", "lambda_", "mu", "contact_angle_rad", "resistance_ohm", "capacitance_f")
 F_LOAD, F_LAMBDA, F_MU, F_ANGLE, F_R, F_C = range(len(CONTACT_FIELDS))
-SETPOINT_FIELDS = ("shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c",
-                   "shaft_current_a", "shaft_voltage_v")
+SETPOINT_FIELDS = (
+    "shaft_speed_rad_s",
+    "radial_load_n",
+    "axial_load_n",
+    "oil_temperature_c",
+    "shaft_current_a",
+    "shaft_voltage_v",
+)
 THERMAL_NODES = ("shaft", "inner_ring", "balls", "outer_ring", "housing", "oil")
 THERMAL_SOURCES = ("rolling", "sliding", "spin", "drag", "seal")
-_ELECTRICAL_FIELDS = ("resistance_ohm", "capacitance_f", "impedance_ohm", "shaft_voltage_v", "shaft_current_a",
-                      "max_film_field_v_m", "current_density_a_m2", "contact_temperature_rise_k")
+_ELECTRICAL_FIELDS = (
+    "resistance_ohm",
+    "capacitance_f",
+    "impedance_ohm",
+    "shaft_voltage_v",
+    "shaft_current_a",
+    "max_film_field_v_m",
+    "current_density_a_m2",
+    "contact_temperature_rise_k",
+)
 
 
 @dataclass(slots=True)
@@ -50,22 +64,22 @@ class Row:
     seq: int
     status: str
     restarts: int
-    setpoint: tuple | None            # SETPOINT_FIELDS, or None
+    setpoint: tuple | None  # SETPOINT_FIELDS, or None
     shaft_speed_rad_s: float
     cage_speed_rad_s: float
     friction_torque_n_m: float
-    contacts: np.ndarray              # (Z, 2, len(CONTACT_FIELDS)) float64
-    regimes: np.ndarray               # (Z, 2) int8, REGIME_CODE
-    azimuth_rad: np.ndarray           # (Z,)
-    electrical: dict                  # numeric bearing-level fields of _ELECTRICAL_FIELDS
-    risk: str | None                  # "none" | "possible" | "likely" | None
+    contacts: np.ndarray  # (Z, 2, len(CONTACT_FIELDS)) float64
+    regimes: np.ndarray  # (Z, 2) int8, REGIME_CODE
+    azimuth_rad: np.ndarray  # (Z,)
+    electrical: dict  # numeric bearing-level fields of _ELECTRICAL_FIELDS
+    risk: str | None  # "none" | "possible" | "likely" | None
     risk_reason: str | None
-    context: str | None               # scenario state given with the snapshot (recorder.publish)
+    context: str | None  # scenario state given with the snapshot (recorder.publish)
     positions_m: np.ndarray | None
-    gap_before: str | None = None     # why the line breaks before this row (lost rows, new run)
-    defects: tuple | None = None      # the active local defects as text (None: not in the snapshot)
-    vibration: Any = None   # the snapshot's vibration block (twin.snapshot.VibrationState) or None
-    thermal: tuple | None = None      # THERMAL_NODES temperatures [degC] then THERMAL_SOURCES heat [W]
+    gap_before: str | None = None  # why the line breaks before this row (lost rows, new run)
+    defects: tuple | None = None  # the active local defects as text (None: not in the snapshot)
+    vibration: Any = None  # the snapshot's vibration block (twin.snapshot.VibrationState) or None
+    thermal: tuple | None = None  # THERMAL_NODES temperatures [degC] then THERMAL_SOURCES heat [W]
 
 
 _FIELD_CACHE: dict = {}
@@ -79,7 +93,7 @@ def _present(obj, names: tuple[str, ...]) -> tuple[str | None, ...]:
     found = _FIELD_CACHE.get(key)
     if found is None:
         declared = getattr(cls, "model_fields", None)
-        if not isinstance(declared, dict):   # duck-typed object: look at this instance
+        if not isinstance(declared, dict):  # duck-typed object: look at this instance
             return tuple(n if hasattr(obj, n) else None for n in names)
         found = tuple(n if n in declared else None for n in names)
         _FIELD_CACHE[key] = found
@@ -115,8 +129,11 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
     risk = reason = None
     el = getattr(snapshot, "electrical", None) if _present(snapshot, ("electrical",))[0] else None
     if el is not None:
-        items = el if isinstance(el, Mapping) else {k: getattr(el, k, None) for k in
-                                                    (*_ELECTRICAL_FIELDS, "discharge_risk", "reason")}
+        items = (
+            el
+            if isinstance(el, Mapping)
+            else {k: getattr(el, k, None) for k in (*_ELECTRICAL_FIELDS, "discharge_risk", "reason")}
+        )
         for key in _ELECTRICAL_FIELDS:
             v = _num(items.get(key))
             if math.isfinite(v):
@@ -131,18 +148,33 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
     block = getattr(snapshot, "thermal", None) if _present(snapshot, ("thermal",))[0] else None
     thermal = None
     if block is not None:
-        thermal = (*(_num(block.temperatures_c.get(n)) for n in THERMAL_NODES),
-                   *(_num(block.heat_w.get(n)) for n in THERMAL_SOURCES))
+        thermal = (
+            *(_num(block.temperatures_c.get(n)) for n in THERMAL_NODES),
+            *(_num(block.heat_w.get(n)) for n in THERMAL_SOURCES),
+        )
     sp = getattr(snapshot, "setpoint", None) if _present(snapshot, ("setpoint",))[0] else None
     setpoint = tuple(_num(getattr(sp, f, None)) for f in SETPOINT_FIELDS) if sp is not None else None
-    return Row(time_s=float(snapshot.time_s), seq=int(snapshot.seq), status=str(snapshot.status),
-               restarts=int(getattr(snapshot, "restarts", 0) or 0), setpoint=setpoint,
-               shaft_speed_rad_s=_num(getattr(snapshot, "shaft_speed_rad_s", None)),
-               cage_speed_rad_s=_num(snapshot.cage_speed_rad_s),
-               friction_torque_n_m=_num(snapshot.friction_torque_n_m),
-               contacts=contacts, regimes=regimes, azimuth_rad=azimuth,
-               electrical=electrical, risk=risk, risk_reason=reason, context=context,
-               positions_m=positions_m, defects=defects, vibration=vibration, thermal=thermal)
+    return Row(
+        time_s=float(snapshot.time_s),
+        seq=int(snapshot.seq),
+        status=str(snapshot.status),
+        restarts=int(getattr(snapshot, "restarts", 0) or 0),
+        setpoint=setpoint,
+        shaft_speed_rad_s=_num(getattr(snapshot, "shaft_speed_rad_s", None)),
+        cage_speed_rad_s=_num(snapshot.cage_speed_rad_s),
+        friction_torque_n_m=_num(snapshot.friction_torque_n_m),
+        contacts=contacts,
+        regimes=regimes,
+        azimuth_rad=azimuth,
+        electrical=electrical,
+        risk=risk,
+        risk_reason=reason,
+        context=context,
+        positions_m=positions_m,
+        defects=defects,
+        vibration=vibration,
+        thermal=thermal,
+    )
 
 
 def _defect_text(d) -> str:
@@ -150,9 +182,11 @@ def _defect_text(d) -> str:
     get = d.get if isinstance(d, Mapping) else (lambda k, default=None: getattr(d, k, default))
     kind = get("kind")
     size = f"{format_number(get('width_m', 0.0) * 1e3)} x {format_number(get('length_m', 0.0) * 1e3)} mm, {format_number(get('depth_m', 0.0) * 1e6)} um deep"
-    where = {"outer": f"outer spall {size} at azimuth {format_number(get('azimuth_deg', 0.0))} deg",
-             "inner": f"inner spall {size} at ring angle {format_number(get('ring_angle_deg', 0.0))} deg",
-             "ball": f"ball {get('ball_index', 0)} defect {size}"}
+    where = {
+        "outer": f"outer spall {size} at azimuth {format_number(get('azimuth_deg', 0.0))} deg",
+        "inner": f"inner spall {size} at ring angle {format_number(get('ring_angle_deg', 0.0))} deg",
+        "ball": f"ball {get('ball_index', 0)} defect {size}",
+    }
     return where.get(str(kind), f"{kind} defect {size}")
 
 
@@ -230,33 +264,46 @@ def now_columns(tw: TwinLayout, batch: Batch) -> None:
     rows = batch.rows
     n, z = len(rows), tw.ball_count
     root = tw.root
-    c = np.stack([r.contacts for r in rows])                    # (n, z, 2, K)
-    reg = np.stack([r.regimes for r in rows])                   # (n, z, 2)
-    az = np.stack([r.azimuth_rad for r in rows])                # (n, z)
-    ball_reg = ball_regime(reg)                                # (n, z)
+    c = np.stack([r.contacts for r in rows])  # (n, z, 2, K)
+    reg = np.stack([r.regimes for r in rows])  # (n, z, 2)
+    az = np.stack([r.azimuth_rad for r in rows])  # (n, z)
+    ball_reg = ball_regime(reg)  # (n, z)
     load = c[..., F_LOAD]
 
     # 3D: balls by regime, contact loads as arrows
     if tw.has_geometry:
         cos_az, sin_az = np.cos(az), np.sin(az)
         rp = tw.pitch_radius_m
-        pos = np.stack([rp * cos_az, rp * sin_az, np.zeros_like(az)], axis=-1)   # (n, z, 3)
+        pos = np.stack([rp * cos_az, rp * sin_az, np.zeros_like(az)], axis=-1)  # (n, z, 3)
         for j, r in enumerate(rows):
             if r.positions_m is not None:
                 pos[j] = r.positions_m
-        batch.out.append((f"{root}/balls", batch.index(), rr.Points3D.columns(
-            positions=pos.reshape(-1, 3).astype(np.float32), class_ids=ball_reg.reshape(-1)).partition(np.full(n, z))))
+        batch.out.append(
+            (
+                f"{root}/balls",
+                batch.index(),
+                rr.Points3D.columns(
+                    positions=pos.reshape(-1, 3).astype(np.float32), class_ids=ball_reg.reshape(-1)
+                ).partition(np.full(n, z)),
+            )
+        )
         if tw.load_scale_m_per_n is None:
             peak = float(np.nanmax(load)) if load.size and np.isfinite(load).any() else 0.0
             if peak > 0.0:
                 tw.load_scale_m_per_n = 2.0 * (tw.ball_radius_m or 0.0) / peak
         scale = tw.load_scale_m_per_n or 0.0
-        a = np.nan_to_num(c[:, :, 0, F_ANGLE])          # inner contacts: from the ball centre inwards
+        a = np.nan_to_num(c[:, :, 0, F_ANGLE])  # inner contacts: from the ball centre inwards
         length = np.nan_to_num(load[:, :, 0]) * scale
         vectors = np.stack([-np.cos(a) * cos_az, -np.cos(a) * sin_az, np.sin(a)], axis=-1) * length[..., None]
-        batch.out.append((f"{root}/loads", batch.index(), rr.Arrows3D.columns(
-            origins=pos.reshape(-1, 3).astype(np.float32),
-            vectors=vectors.reshape(-1, 3).astype(np.float32)).partition(np.full(n, z))))
+        batch.out.append(
+            (
+                f"{root}/loads",
+                batch.index(),
+                rr.Arrows3D.columns(
+                    origins=pos.reshape(-1, 3).astype(np.float32), vectors=vectors.reshape(-1, 3).astype(np.float32)
+                ).partition(np.full(n, z)),
+            )
+        )
 
     # the load zone now: bars against azimuth [deg] in (-180, 180], inner left of outer
     deg = np.degrees(np.angle(np.exp(1j * az)))
@@ -265,9 +312,14 @@ def now_columns(tw: TwinLayout, batch: Batch) -> None:
         for side, name in enumerate(SIDES):
             values = c[:, :, side, f]
             if f == F_LAMBDA:
-                values = np.where(np.isfinite(values), values, 0.0)   # no contact: no bar
-            batch.out.append((f"{root}/load_zone/{leaf}/{name}", batch.index(),
-                              bar_columns(values, deg + (w / 2 if side else -w / 2))))
+                values = np.where(np.isfinite(values), values, 0.0)  # no contact: no bar
+            batch.out.append(
+                (
+                    f"{root}/load_zone/{leaf}/{name}",
+                    batch.index(),
+                    bar_columns(values, deg + (w / 2 if side else -w / 2)),
+                )
+            )
 
 
 def slow_columns(tw: TwinLayout, batch: Batch) -> None:
@@ -275,9 +327,14 @@ def slow_columns(tw: TwinLayout, batch: Batch) -> None:
     rows = batch.rows
     n = len(rows)
     root = tw.root
-    c = np.stack([r.contacts for r in rows]).reshape(n, -1, len(CONTACT_FIELDS))   # (n, 2z, K)
-    fields = {"load_n": c[..., F_LOAD], LAMBDA_KEY: c[..., F_LAMBDA], "mu": c[..., F_MU],
-              "resistance_log10_kohm": log10_kohm(c[..., F_R]), "capacitance_pf": c[..., F_C] * 1e12}
+    c = np.stack([r.contacts for r in rows]).reshape(n, -1, len(CONTACT_FIELDS))  # (n, 2z, K)
+    fields = {
+        "load_n": c[..., F_LOAD],
+        LAMBDA_KEY: c[..., F_LAMBDA],
+        "mu": c[..., F_MU],
+        "resistance_log10_kohm": log10_kohm(c[..., F_R]),
+        "capacitance_pf": c[..., F_C] * 1e12,
+    }
     has_el = bool(np.isfinite(c[..., F_C]).any())
     for leaf, _title in CONTACT_SERIES:
         if leaf in ("resistance_log10_kohm", "capacitance_pf") and not has_el:
@@ -314,15 +371,18 @@ def events(tw: TwinLayout, batch: Batch) -> None:
         # a running scenario changes the setpoint at every frame of a ramp: its phase rows stand
         # for those, and the setpoint is logged (as the change since the last row) when the
         # phase changes or the scenario ends
-        in_phase = (r.context is not None and ": running" in r.context and r.context == last.get("logged_context"))
+        in_phase = r.context is not None and ": running" in r.context and r.context == last.get("logged_context")
         if r.setpoint is not None and r.setpoint != last.get("setpoint") and not in_phase:
             old = last.get("setpoint")
             if old is None:
                 what = ", ".join(f"{n} = {format_number(v)}" for n, v in zip(SETPOINT_FIELDS, r.setpoint, strict=True))
                 texts.append((j, f"setpoint in force: {what}", "INFO"))
             else:
-                what = ", ".join(f"{n} {format_number(a)} -> {format_number(b)}"
-                                 for n, a, b in zip(SETPOINT_FIELDS, old, r.setpoint, strict=True) if a != b)
+                what = ", ".join(
+                    f"{n} {format_number(a)} -> {format_number(b)}"
+                    for n, a, b in zip(SETPOINT_FIELDS, old, r.setpoint, strict=True)
+                    if a != b
+                )
                 texts.append((j, f"setpoint: {what}", "INFO"))
             last["setpoint"] = r.setpoint
         last["logged_context"] = r.context
@@ -337,21 +397,41 @@ def events(tw: TwinLayout, batch: Batch) -> None:
         elif status_changed:
             texts.append((j, f"status: {r.status}", "INFO" if r.status == "ok" else "WARN"))
         if r.defects is not None and r.defects != last.get("defects", ()):
-            texts.append((j, "defects: " + "; ".join(r.defects) if r.defects else "defects cleared",
-                          "WARN" if r.defects else "INFO"))
+            texts.append(
+                (
+                    j,
+                    "defects: " + "; ".join(r.defects) if r.defects else "defects cleared",
+                    "WARN" if r.defects else "INFO",
+                )
+            )
         if r.defects is not None:
             last["defects"] = r.defects
         if r.risk is not None and r.risk != last.get("risk"):
             risks.append((j, r.risk if r.risk in RISK_VALUES else "none"))
             if last.get("risk") is not None:
-                texts.append((j, f"discharge risk {r.risk}: {r.risk_reason or ''}".rstrip(": "),
-                              "ERROR" if r.risk == "likely" else "WARN" if r.risk == "possible" else "INFO"))
+                texts.append(
+                    (
+                        j,
+                        f"discharge risk {r.risk}: {r.risk_reason or ''}".rstrip(": "),
+                        "ERROR" if r.risk == "likely" else "WARN" if r.risk == "possible" else "INFO",
+                    )
+                )
             last["risk"] = r.risk
     if texts:
         sel = np.array([j for j, _, _ in texts])
-        batch.out.append((f"{tw.root}/events", batch.index(sel),
-                          rr.TextLog.columns(text=[t for _, t, _ in texts], level=[lv for _, _, lv in texts])))
+        batch.out.append(
+            (
+                f"{tw.root}/events",
+                batch.index(sel),
+                rr.TextLog.columns(text=[t for _, t, _ in texts], level=[lv for _, _, lv in texts]),
+            )
+        )
     if risks:
         sel = np.array([j for j, _ in risks])
-        batch.out.append((f"{tw.root}/electrical/discharge_risk", batch.index(sel),
-                          rr.StateChange.columns(state=[s for _, s in risks])))
+        batch.out.append(
+            (
+                f"{tw.root}/electrical/discharge_risk",
+                batch.index(sel),
+                rr.StateChange.columns(state=[s for _, s in risks]),
+            )
+        )

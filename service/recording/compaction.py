@@ -40,10 +40,23 @@ def compact(path: str | Path, timeout_s: float = COMPACT_TIMEOUT_S) -> bool:
     tmp.close()
     try:
         nice = shutil.which("nice")
-        cmd = [*([nice, "-n", "10"] if nice else []), rerun_command(), "rrd", "optimize", str(path),
-               "-o", str(tmp.path)]
-        r = subprocess.run(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                           timeout=timeout_s, env={**os.environ, "RERUN_ANALYTICS": "0"})
+        cmd = [
+            *([nice, "-n", "10"] if nice else []),
+            rerun_command(),
+            "rrd",
+            "optimize",
+            str(path),
+            "-o",
+            str(tmp.path),
+        ]
+        r = subprocess.run(
+            cmd,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=subprocess.PIPE,
+            timeout=timeout_s,
+            env={**os.environ, "RERUN_ANALYTICS": "0"},
+        )
         if r.returncode != 0 or tmp.path.stat().st_size == 0:
             err = r.stderr.decode(errors="replace").strip().splitlines()
             raise RuntimeError(err[-1] if err else f"exit code {r.returncode}")

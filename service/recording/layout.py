@@ -99,7 +99,7 @@ SEQ = "seq"
 REGIME_CODE = {"no_contact": 0, "boundary": 1, "mixed": 2, "full_film": 3}
 REGIME_LABEL = ("no contact", "boundary", "mixed", "full film")
 REGIME_RGB = np.array([[150, 150, 150], [220, 40, 40], [255, 150, 0], [40, 180, 70]], dtype=np.uint8)
-REGIME_ORDER = (3, 2, 1, 0)       # order of the regime_counts series: full film first
+REGIME_ORDER = (3, 2, 1, 0)  # order of the regime_counts series: full film first
 
 
 def _regime_rgb(code: int) -> tuple[int, int, int]:
@@ -113,15 +113,15 @@ _RACEWAY_RGB = (170, 170, 180)
 _PITCH_RGB = (90, 90, 100)
 RISK_VALUES = ("none", "possible", "likely")
 RISK_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
-VIB_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")          # VibrationState.defect_frequencies_hz keys
-ENVELOPE_BAR_HZ = 12.0            # bar width of the envelope charts [Hz] (visible on a 0-2 kHz axis)
+VIB_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")  # VibrationState.defect_frequencies_hz keys
+ENVELOPE_BAR_HZ = 12.0  # bar width of the envelope charts [Hz] (visible on a 0-2 kHz axis)
 VIB_LINE_LABELS = ("FTF", "BPFO", "BPFI", "BSF", "2 x BSF")
 VIB_LINE_RGB = ((150, 150, 150), (230, 60, 60), (80, 160, 255), (0, 200, 120), (255, 170, 0))
-CURSOR_NAMES = ("FTF", "BPFO", "BPFI", "BSF", "2xBSF")   # entity names of the envelope cursors (VIB_LINES order)
-CURSOR_HARMONICS = 3              # cursors at 1x .. 3x each defect frequency
-CURSOR_WIDTH_FRACTION = 400.0     # a cursor is (spectrum range / this) wide, at least 2 bins (~1.5 px)
+CURSOR_NAMES = ("FTF", "BPFO", "BPFI", "BSF", "2xBSF")  # entity names of the envelope cursors (VIB_LINES order)
+CURSOR_HARMONICS = 3  # cursors at 1x .. 3x each defect frequency
+CURSOR_WIDTH_FRACTION = 400.0  # a cursor is (spectrum range / this) wide, at least 2 bins (~1.5 px)
 CURSOR_ALPHA = 150
-SPECTRUM_RGB = (40, 70, 150)      # the full spectra's bars
+SPECTRUM_RGB = (40, 70, 150)  # the full spectra's bars
 # a spectrum's bars are at least (its range / this) wide: a 1 Hz bin of a 0-2.3 kHz envelope
 # spectrum is a quarter of a pixel and would not show; wider bars overlap, the tallest shows
 # (what an analyser's display does: the peak of the bins under each pixel)
@@ -132,8 +132,10 @@ VIBRATION_SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], .
     WAVEFORM_LEAF: (("acceleration [m/s^2]",), ((80, 160, 255),)),
     "vibration/acceleration_rms_peak_m_s2": (("RMS [m/s^2]", "peak [m/s^2]"), ((80, 160, 255), (230, 60, 60))),
     "vibration/velocity_rms_mm_s": (("velocity RMS 10-1000 Hz [mm/s]",), ((255, 200, 0),)),
-    "vibration/kurtosis": (("kurtosis", "band kurtosis", "crest factor"),
-                           ((230, 60, 60), (255, 150, 0), (150, 150, 150))),
+    "vibration/kurtosis": (
+        ("kurtosis", "band kurtosis", "crest factor"),
+        ((230, 60, 60), (255, 150, 0), (150, 150, 150)),
+    ),
     "vibration/defect_frequencies_hz": (VIB_LINE_LABELS, VIB_LINE_RGB),
     "vibration/envelope_lines_m_s2": ((*VIB_LINE_LABELS, "noise floor"), (*VIB_LINE_RGB, (90, 90, 100))),
 }
@@ -142,29 +144,40 @@ ALARM_STATE_RGBA = (0x28B446FF, 0xFF9600FF, 0xDC2828FF)
 ALARM_LOG_LEVEL = {"warning": "WARN", "critical": "CRITICAL", None: "INFO"}
 
 SIDES = ("inner", "outer")
-LOAD_ZONE = (("load_n", "contact load Q [N]"), (LAMBDA_KEY, "film parameter Lambda [-]"),
-             ("mu", "friction coefficient mu [-]"))
+LOAD_ZONE = (
+    ("load_n", "contact load Q [N]"),
+    (LAMBDA_KEY, "film parameter Lambda [-]"),
+    ("mu", "friction coefficient mu [-]"),
+)
 # per-contact fields: entity leaf, title
-CONTACT_SERIES = (("load_n", "contact load [N]"), (LAMBDA_KEY, "Lambda [-]"), ("mu", "mu [-]"),
-                  ("resistance_log10_kohm", "log10 R [kohm]"), ("capacitance_pf", "C [pF]"))
+CONTACT_SERIES = (
+    ("load_n", "contact load [N]"),
+    (LAMBDA_KEY, "Lambda [-]"),
+    ("mu", "mu [-]"),
+    ("resistance_log10_kohm", "log10 R [kohm]"),
+    ("capacitance_pf", "C [pF]"),
+)
 
 # bearing-level trends (service.recording.trends: a row per window of snapshots, the mean of each
 # series): entity leaf -> (series names with their unit, colours)
 SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
     "friction_torque_n_m": (("friction torque [N m]",), ((255, 200, 0),)),
-    "loads_n": (("Qmax [N]", "Fr setpoint [N]", "Fa setpoint [N]"),
-                ((230, 60, 60), (80, 160, 255), (160, 120, 255))),
-    "speeds_rad_s": (("shaft setpoint [rad/s]", "shaft [rad/s]", "cage [rad/s]"),
-                     ((150, 150, 150), (80, 160, 255), (0, 210, 200))),
+    "loads_n": (("Qmax [N]", "Fr setpoint [N]", "Fa setpoint [N]"), ((230, 60, 60), (80, 160, 255), (160, 120, 255))),
+    "speeds_rad_s": (
+        ("shaft setpoint [rad/s]", "shaft [rad/s]", "cage [rad/s]"),
+        ((150, 150, 150), (80, 160, 255), (0, 210, 200)),
+    ),
     "min_lambda": (("inner [-]", "outer [-]"), (INNER_RGB, OUTER_RGB)),
-    "regime_counts": (tuple(REGIME_LABEL[c] for c in REGIME_ORDER),
-                      tuple(_regime_rgb(c) for c in REGIME_ORDER)),
+    "regime_counts": (tuple(REGIME_LABEL[c] for c in REGIME_ORDER), tuple(_regime_rgb(c) for c in REGIME_ORDER)),
     "temperatures_c": (("oil setpoint [degC]", "contact inlet [degC]"), ((150, 150, 150), (255, 120, 40))),
-    "thermal/nodes_c": (("shaft [degC]", "inner ring [degC]", "balls [degC]", "outer ring [degC]", "housing [degC]",
-                         "oil [degC]"),
-                        ((150, 150, 150), INNER_RGB, (255, 120, 40), OUTER_RGB, (120, 90, 60), (230, 200, 40))),
-    "thermal/heat_w": (("rolling [W]", "sliding [W]", "spin [W]", "drag [W]", "seal [W]"),
-                       ((80, 160, 255), (230, 60, 60), (160, 120, 255), (0, 210, 200), (150, 150, 150))),
+    "thermal/nodes_c": (
+        ("shaft [degC]", "inner ring [degC]", "balls [degC]", "outer ring [degC]", "housing [degC]", "oil [degC]"),
+        ((150, 150, 150), INNER_RGB, (255, 120, 40), OUTER_RGB, (120, 90, 60), (230, 200, 40)),
+    ),
+    "thermal/heat_w": (
+        ("rolling [W]", "sliding [W]", "spin [W]", "drag [W]", "seal [W]"),
+        ((80, 160, 255), (230, 60, 60), (160, 120, 255), (0, 210, 200), (150, 150, 150)),
+    ),
     "electrical/capacitance_pf": (("bearing C [pF]",), ((0, 200, 255),)),
     "electrical/resistance_log10_kohm": (("log10 R [kohm]", "log10 |Z| [kohm]"), ((255, 200, 0), (200, 200, 200))),
     "electrical/shaft_voltage_v": (("shaft voltage [V]", "setpoint [V]"), ((255, 120, 40), (150, 150, 150))),
@@ -176,20 +189,28 @@ SERIES: dict[str, tuple[tuple[str, ...], tuple[tuple[int, int, int], ...]]] = {
 # (thin, translucent: the band the ball-pass ripple spans); the setpoints and the regime counts
 # have none
 TREND_BANDS: dict[str, tuple[int, ...]] = {
-    "friction_torque_n_m": (0,), "loads_n": (0,), "speeds_rad_s": (1, 2), "min_lambda": (0, 1),
-    "temperatures_c": (1,), "electrical/capacitance_pf": (0,), "electrical/resistance_log10_kohm": (0, 1),
-    "electrical/shaft_voltage_v": (0,), "electrical/shaft_current_ma": (0,),
-    "electrical/film_field_v_per_um": (0,), "electrical/current_density_a_per_mm2": (0,),
+    "friction_torque_n_m": (0,),
+    "loads_n": (0,),
+    "speeds_rad_s": (1, 2),
+    "min_lambda": (0, 1),
+    "temperatures_c": (1,),
+    "electrical/capacitance_pf": (0,),
+    "electrical/resistance_log10_kohm": (0, 1),
+    "electrical/shaft_voltage_v": (0,),
+    "electrical/shaft_current_ma": (0,),
+    "electrical/film_field_v_per_um": (0,),
+    "electrical/current_density_a_per_mm2": (0,),
 }
 BAND_ALPHA = 110
-TREND_WIDTH = 1.5                 # [ui points] the window means
-BAND_WIDTH = 0.75                 # [ui points] their min / max
+TREND_WIDTH = 1.5  # [ui points] the window means
+BAND_WIDTH = 0.75  # [ui points] their min / max
 CAPACITANCE_LEAF = "electrical/capacitance_pf"
-OFF_SCALE_LEAF = f"{CAPACITANCE_LEAF}/off_scale"          # marker: a capacitance off the robust scale
-FILM_BROKEN_LEAF = f"{CAPACITANCE_LEAF}/film_broken"      # marker: no capacitance (metal contact)
+OFF_SCALE_LEAF = f"{CAPACITANCE_LEAF}/off_scale"  # marker: a capacitance off the robust scale
+FILM_BROKEN_LEAF = f"{CAPACITANCE_LEAF}/film_broken"  # marker: no capacitance (metal contact)
 # markers beside every trend where a setpoint or the defects changed (`{trend}/changes`)
-CHANGE_MARKER: dict[str, Any] = dict(names=["setpoint / defect change"], colors=[(40, 40, 40)], markers=["Diamond"],
-                     marker_sizes=[5.0])
+CHANGE_MARKER: dict[str, Any] = dict(
+    names=["setpoint / defect change"], colors=[(40, 40, 40)], markers=["Diamond"], marker_sizes=[5.0]
+)
 FAST_SERIES = tuple(SERIES)
 
 
@@ -215,7 +236,7 @@ class TwinLayout:
     inner_raceway_radius_m: float | None = None
     outer_raceway_radius_m: float | None = None
     load_scale_m_per_n: float | None = None
-    vibration: bool = False           # the twin has the housing and accelerometer
+    vibration: bool = False  # the twin has the housing and accelerometer
     # state of the event rows, per output segment (reset when a segment starts)
     last: dict = field(default_factory=dict)
 
@@ -243,81 +264,146 @@ def trend_style(leaf: str, names: tuple[str, ...], colors: tuple) -> rr.SeriesLi
     lo = [f"{names[i].split(' [')[0]} min-max" if len(names) > 1 else "min-max" for i in band]
     hi = lo
     faded = [(*colors[i], BAND_ALPHA) for i in band]
-    return rr.SeriesLines(names=[*names, *lo, *hi], colors=[(*c, 255) for c in colors] + faded + faded,
-                          widths=[TREND_WIDTH] * len(names) + [BAND_WIDTH] * (2 * len(band)))
+    return rr.SeriesLines(
+        names=[*names, *lo, *hi],
+        colors=[(*c, 255) for c in colors] + faded + faded,
+        widths=[TREND_WIDTH] * len(names) + [BAND_WIDTH] * (2 * len(band)),
+    )
 
 
 def send_static(stream: rr.RecordingStream, tw: TwinLayout) -> None:
     """The static data of one twin: geometry, legends, series names and colours."""
     root = tw.root
     s = stream
-    s.log(root, rr.AnnotationContext([(c, REGIME_LABEL[c], tuple(int(v) for v in REGIME_RGB[c]))
-                                      for c in range(4)]), static=True)
+    s.log(
+        root,
+        rr.AnnotationContext([(c, REGIME_LABEL[c], tuple(int(v) for v in REGIME_RGB[c])) for c in range(4)]),
+        static=True,
+    )
     rb, pitch = tw.ball_radius_m, tw.pitch_radius_m
     inner, outer = tw.inner_raceway_radius_m, tw.outer_raceway_radius_m
-    if rb is not None and pitch is not None and inner is not None and outer is not None:   # tw.has_geometry
+    if rb is not None and pitch is not None and inner is not None and outer is not None:  # tw.has_geometry
         line = rr.components.Radius.ui_points(1.5)
-        s.log(f"{root}/geometry/inner_raceway",
-              rr.LineStrips3D([_circle(inner)], radii=line, colors=_RACEWAY_RGB), static=True)
-        s.log(f"{root}/geometry/outer_raceway",
-              rr.LineStrips3D([_circle(outer)], radii=line, colors=_RACEWAY_RGB), static=True)
-        s.log(f"{root}/geometry/pitch_circle",
-              rr.LineStrips3D([_circle(pitch)], radii=rr.components.Radius.ui_points(0.5),
-                              colors=_PITCH_RGB), static=True)
-        s.log(f"{root}/geometry/load_line",
-              rr.Arrows3D(origins=[[outer * 1.05, 0.0, 0.0]],
-                          vectors=[[outer * 0.35, 0.0, 0.0]],
-                          colors=[(230, 60, 60)], labels=["Fr"],
-                          radii=rr.components.Radius.ui_points(2.0)), static=True)
+        s.log(
+            f"{root}/geometry/inner_raceway",
+            rr.LineStrips3D([_circle(inner)], radii=line, colors=_RACEWAY_RGB),
+            static=True,
+        )
+        s.log(
+            f"{root}/geometry/outer_raceway",
+            rr.LineStrips3D([_circle(outer)], radii=line, colors=_RACEWAY_RGB),
+            static=True,
+        )
+        s.log(
+            f"{root}/geometry/pitch_circle",
+            rr.LineStrips3D([_circle(pitch)], radii=rr.components.Radius.ui_points(0.5), colors=_PITCH_RGB),
+            static=True,
+        )
+        s.log(
+            f"{root}/geometry/load_line",
+            rr.Arrows3D(
+                origins=[[outer * 1.05, 0.0, 0.0]],
+                vectors=[[outer * 0.35, 0.0, 0.0]],
+                colors=[(230, 60, 60)],
+                labels=["Fr"],
+                radii=rr.components.Radius.ui_points(2.0),
+            ),
+            static=True,
+        )
         s.log(f"{root}/balls", rr.Points3D.from_fields(radii=[rb], show_labels=False), static=True)
         s.log(f"{root}/loads", rr.Arrows3D.from_fields(colors=[INNER_RGB], radii=[0.08 * rb]), static=True)
     for field_, _title in LOAD_ZONE:
         for side, name in enumerate(SIDES):
-            s.log(f"{root}/load_zone/{field_}/{name}", [
-                rr.components.ColorBatch([INNER_RGB if side == 0 else OUTER_RGB]).described(
-                    rr.BarChart.descriptor_color()),
-                rr.components.LengthBatch(np.full(tw.ball_count, tw.bar_width_deg, dtype=np.float32)).described(
-                    rr.BarChart.descriptor_widths())], static=True)
+            s.log(
+                f"{root}/load_zone/{field_}/{name}",
+                [
+                    rr.components.ColorBatch([INNER_RGB if side == 0 else OUTER_RGB]).described(
+                        rr.BarChart.descriptor_color()
+                    ),
+                    rr.components.LengthBatch(np.full(tw.ball_count, tw.bar_width_deg, dtype=np.float32)).described(
+                        rr.BarChart.descriptor_widths()
+                    ),
+                ],
+                static=True,
+            )
     for leaf, (names, colors) in SERIES.items():
         s.log(f"{root}/{leaf}", trend_style(leaf, names, colors), static=True)
         s.log(f"{root}/{leaf}/changes", rr.SeriesPoints(**CHANGE_MARKER), static=True)
-    s.log(f"{root}/{OFF_SCALE_LEAF}", rr.SeriesPoints(names=["off scale (value in events)"], colors=[(220, 40, 40)],
-                                                     markers=["Up"], marker_sizes=[5.0]), static=True)
-    s.log(f"{root}/{FILM_BROKEN_LEAF}", rr.SeriesPoints(names=["film broken: C undefined"], colors=[(220, 40, 40)],
-                                                       markers=["Cross"], marker_sizes=[5.0]), static=True)
+    s.log(
+        f"{root}/{OFF_SCALE_LEAF}",
+        rr.SeriesPoints(
+            names=["off scale (value in events)"], colors=[(220, 40, 40)], markers=["Up"], marker_sizes=[5.0]
+        ),
+        static=True,
+    )
+    s.log(
+        f"{root}/{FILM_BROKEN_LEAF}",
+        rr.SeriesPoints(
+            names=["film broken: C undefined"], colors=[(220, 40, 40)], markers=["Cross"], marker_sizes=[5.0]
+        ),
+        static=True,
+    )
     z = tw.ball_count
     contact_names = [f"ball {i} {side}" for i in range(z) for side in SIDES]
     contact_colors = [ball_rgb(i, z, k) for i in range(z) for k in range(2)]
     for leaf, _title in CONTACT_SERIES:
         s.log(f"{root}/contacts/{leaf}", rr.SeriesLines(names=contact_names, colors=contact_colors), static=True)
-    s.log(f"{root}/electrical/discharge_risk",
-          rr.StateConfiguration(values=list(RISK_VALUES), labels=["no discharge risk", "discharge possible",
-                                                                  "discharge likely"],
-                                colors=np.array(RISK_RGBA, dtype=np.uint32)), static=True)
+    s.log(
+        f"{root}/electrical/discharge_risk",
+        rr.StateConfiguration(
+            values=list(RISK_VALUES),
+            labels=["no discharge risk", "discharge possible", "discharge likely"],
+            colors=np.array(RISK_RGBA, dtype=np.uint32),
+        ),
+        static=True,
+    )
     if tw.vibration:
         for leaf, (names, colors) in VIBRATION_SERIES.items():
             # a waveform drawn at min-max per pixel keeps its peaks (an average per pixel halves them)
             policy: Literal["MinMax"] | None = "MinMax" if leaf == WAVEFORM_LEAF else None
-            s.log(f"{root}/{leaf}", rr.SeriesLines(names=list(names), colors=list(colors), aggregation_policy=policy),
-                  static=True)
+            s.log(
+                f"{root}/{leaf}",
+                rr.SeriesLines(names=list(names), colors=list(colors), aggregation_policy=policy),
+                static=True,
+            )
         for leaf, rgb in (("peaks", (80, 160, 255)), ("defect_lines", (230, 60, 60))):
-            s.log(f"{root}/vibration/envelope/{leaf}", [
-                rr.components.ColorBatch([rgb]).described(rr.BarChart.descriptor_color()),
-                rr.components.LengthBatch(np.full(len(VIB_LINES), ENVELOPE_BAR_HZ, dtype=np.float32)).described(
-                    rr.BarChart.descriptor_widths())], static=True)
+            s.log(
+                f"{root}/vibration/envelope/{leaf}",
+                [
+                    rr.components.ColorBatch([rgb]).described(rr.BarChart.descriptor_color()),
+                    rr.components.LengthBatch(np.full(len(VIB_LINES), ENVELOPE_BAR_HZ, dtype=np.float32)).described(
+                        rr.BarChart.descriptor_widths()
+                    ),
+                ],
+                static=True,
+            )
         for leaf in ("vibration/envelope/spectrum", "vibration/spectrum"):
-            s.log(f"{root}/{leaf}", [rr.components.ColorBatch([SPECTRUM_RGB]).described(rr.BarChart.descriptor_color())],
-                  static=True)
+            s.log(
+                f"{root}/{leaf}",
+                [rr.components.ColorBatch([SPECTRUM_RGB]).described(rr.BarChart.descriptor_color())],
+                static=True,
+            )
         for name, rgb in zip(CURSOR_NAMES, VIB_LINE_RGB, strict=True):
-            s.log(f"{root}/vibration/envelope/cursor/{name}",
-                  [rr.components.ColorBatch([(*rgb, CURSOR_ALPHA)]).described(rr.BarChart.descriptor_color())],
-                  static=True)
-        s.log(f"{root}/vibration/spectrum_envelope_band",
-              [rr.components.ColorBatch([ENVELOPE_BAND_RGBA]).described(rr.BarChart.descriptor_color())], static=True)
+            s.log(
+                f"{root}/vibration/envelope/cursor/{name}",
+                [rr.components.ColorBatch([(*rgb, CURSOR_ALPHA)]).described(rr.BarChart.descriptor_color())],
+                static=True,
+            )
+        s.log(
+            f"{root}/vibration/spectrum_envelope_band",
+            [rr.components.ColorBatch([ENVELOPE_BAND_RGBA]).described(rr.BarChart.descriptor_color())],
+            static=True,
+        )
     for alarm_id in ALARM_IDS:
-        s.log(f"{root}/alarm_states/{alarm_id}",
-              rr.StateConfiguration(values=list(ALARM_STATES), labels=[f"{alarm_id} {v}" for v in ALARM_STATES],
-                                    colors=np.array(ALARM_STATE_RGBA, dtype=np.uint32)), static=True)
+        s.log(
+            f"{root}/alarm_states/{alarm_id}",
+            rr.StateConfiguration(
+                values=list(ALARM_STATES),
+                labels=[f"{alarm_id} {v}" for v in ALARM_STATES],
+                colors=np.array(ALARM_STATE_RGBA, dtype=np.uint32),
+            ),
+            static=True,
+        )
 
 
 # ---- blueprint --------------------------------------------------------------------------------
@@ -325,10 +411,14 @@ def _window(seconds: float | None):
     """The span a trend view shows: the last `seconds` before the time cursor, or (None) the
     whole recording whatever the cursor."""
     if not seconds:
-        return rrb.VisibleTimeRange(SIM_TIME, start=rrb.TimeRangeBoundary.infinite(),
-                                    end=rrb.TimeRangeBoundary.infinite())
-    return rrb.VisibleTimeRange(SIM_TIME, start=rrb.TimeRangeBoundary.cursor_relative(seconds=-float(seconds)),
-                                end=rrb.TimeRangeBoundary.cursor_relative())
+        return rrb.VisibleTimeRange(
+            SIM_TIME, start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.infinite()
+        )
+    return rrb.VisibleTimeRange(
+        SIM_TIME,
+        start=rrb.TimeRangeBoundary.cursor_relative(seconds=-float(seconds)),
+        end=rrb.TimeRangeBoundary.cursor_relative(),
+    )
 
 
 def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = True) -> rrb.Container:
@@ -339,47 +429,68 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = T
     tag = tw.bearing_id
     window = _window(series_window_s)
     # the x axis shows the whole recording too (else the viewer opens it on a span at the cursor)
-    axis_x = rrb.TimeAxis(view_range=TimeRange(start=rrb.TimeRangeBoundary.infinite(),
-                                               end=rrb.TimeRangeBoundary.infinite())) if not series_window_s else None
+    axis_x = (
+        rrb.TimeAxis(view_range=TimeRange(start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.infinite()))
+        if not series_window_s
+        else None
+    )
 
     def ts(title: str, leaf: str, legend: bool | None = None) -> rrb.TimeSeriesView:
         # a key where a view has several quantities; one quantity: its title names it and its unit
         if legend is None:
             legend = len(SERIES.get(leaf, VIBRATION_SERIES.get(leaf, ((), ())))[0]) > 1
         # the trend, its change markers (and for the capacitance its off-scale markers)
-        return rrb.TimeSeriesView(name=title, origin=root, contents=[f"+ {root}/{leaf}/**"], time_ranges=window,
-                                  axis_x=axis_x, plot_legend=rrb.PlotLegend(visible=legend, corner="LeftTop"))
+        return rrb.TimeSeriesView(
+            name=title,
+            origin=root,
+            contents=[f"+ {root}/{leaf}/**"],
+            time_ranges=window,
+            axis_x=axis_x,
+            plot_legend=rrb.PlotLegend(visible=legend, corner="LeftTop"),
+        )
 
     def bars(field_: str, title: str) -> rrb.BarChartView:
-        return rrb.BarChartView(name=f"{title} vs azimuth [deg]: inner blue, outer violet", origin=root,
-                                contents=[f"+ {root}/load_zone/{field_}/**"],
-                                plot_legend=rrb.PlotLegend(visible=False))
+        return rrb.BarChartView(
+            name=f"{title} vs azimuth [deg]: inner blue, outer violet",
+            origin=root,
+            contents=[f"+ {root}/load_zone/{field_}/**"],
+            plot_legend=rrb.PlotLegend(visible=False),
+        )
 
     top: list = []
     shares: list = []
     outer = tw.outer_raceway_radius_m
-    if outer is not None:   # tw.has_geometry
+    if outer is not None:  # tw.has_geometry
         distance = 3.4 * outer
-        top.append(rrb.Spatial3DView(
-            name=f"{tag} ({tw.designation}): balls by regime (colours as in 'balls per regime')", origin=root,
-            contents=[f"+ {root}/geometry/**", f"+ {root}/balls", f"+ {root}/loads"],
-            # look along the axis (-z) with the radial load line (+x, azimuth 0) pointing down
-            eye_controls=rrb.EyeControls3D(position=[0.0, 0.0, distance], look_target=[0.0, 0.0, 0.0],
-                                           eye_up=[-1.0, 0.0, 0.0]),
-            line_grid=False))
+        top.append(
+            rrb.Spatial3DView(
+                name=f"{tag} ({tw.designation}): balls by regime (colours as in 'balls per regime')",
+                origin=root,
+                contents=[f"+ {root}/geometry/**", f"+ {root}/balls", f"+ {root}/loads"],
+                # look along the axis (-z) with the radial load line (+x, azimuth 0) pointing down
+                eye_controls=rrb.EyeControls3D(
+                    position=[0.0, 0.0, distance], look_target=[0.0, 0.0, 0.0], eye_up=[-1.0, 0.0, 0.0]
+                ),
+                line_grid=False,
+            )
+        )
         shares.append(1.0)
     top.append(rrb.Vertical(*(bars(f, t) for f, t in LOAD_ZONE), name="load zone now (inner blue, outer violet)"))
     shares.append(1.0)
-    top.append(rrb.Grid(
-        ts("loads [N]", "loads_n"),
-        ts("speeds [rad/s]", "speeds_rad_s"),
-        ts("friction torque [N m]", "friction_torque_n_m"),
-        ts("min Lambda [-]", "min_lambda"),
-        ts("balls per regime (mean)", "regime_counts"),
-        ts("temperatures [degC]", "temperatures_c"),
-        ts("thermal network [degC]", "thermal/nodes_c"),
-        ts("friction heat by source [W]", "thermal/heat_w"),
-        grid_columns=3, name="trends"))
+    top.append(
+        rrb.Grid(
+            ts("loads [N]", "loads_n"),
+            ts("speeds [rad/s]", "speeds_rad_s"),
+            ts("friction torque [N m]", "friction_torque_n_m"),
+            ts("min Lambda [-]", "min_lambda"),
+            ts("balls per regime (mean)", "regime_counts"),
+            ts("temperatures [degC]", "temperatures_c"),
+            ts("thermal network [degC]", "thermal/nodes_c"),
+            ts("friction heat by source [W]", "thermal/heat_w"),
+            grid_columns=3,
+            name="trends",
+        )
+    )
     shares.append(2.4)
     electrical = rrb.Vertical(
         rrb.Grid(
@@ -389,55 +500,94 @@ def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = T
             ts("shaft voltage [V]", "electrical/shaft_voltage_v"),
             ts("shaft current [mA]", "electrical/shaft_current_ma"),
             ts("current density [A/mm2]", "electrical/current_density_a_per_mm2"),
-            grid_columns=3),
-        rrb.StateTimelineView(name="discharge risk", origin=root, contents=[f"+ {root}/electrical/discharge_risk"],
-                              time_ranges=window),
-        row_shares=[4.0, 1.0], name="electrical")
+            grid_columns=3,
+        ),
+        rrb.StateTimelineView(
+            name="discharge risk", origin=root, contents=[f"+ {root}/electrical/discharge_risk"], time_ranges=window
+        ),
+        row_shares=[4.0, 1.0],
+        name="electrical",
+    )
     events = rrb.TextLogView(
-        name=f"{tag}: events (setpoints, scenarios, restarts, fallbacks)", origin=root, contents=[f"+ {root}/events"],
+        name=f"{tag}: events (setpoints, scenarios, restarts, fallbacks)",
+        origin=root,
+        contents=[f"+ {root}/events"],
         columns=rrb.archetypes.TextLogColumns(
             timeline_columns=[rrb.encodings.TimelineColumn(SIM_TIME), rrb.encodings.TimelineColumn(SEQ, visible=False)],
-            text_log_columns=[rrb.encodings.TextLogColumn("LogLevel"), rrb.encodings.TextLogColumn("Body"),
-                              rrb.encodings.TextLogColumn("EntityPath", visible=False)]))
+            text_log_columns=[
+                rrb.encodings.TextLogColumn("LogLevel"),
+                rrb.encodings.TextLogColumn("Body"),
+                rrb.encodings.TextLogColumn("EntityPath", visible=False),
+            ],
+        ),
+    )
     alarms = rrb.Vertical(
-        rrb.StateTimelineView(name=f"{tag}: alarm states", origin=root, contents=[f"+ {root}/alarm_states/**"],
-                              time_ranges=window),
+        rrb.StateTimelineView(
+            name=f"{tag}: alarm states", origin=root, contents=[f"+ {root}/alarm_states/**"], time_ranges=window
+        ),
         rrb.TextLogView(
-            name=f"{tag}: alarm events", origin=root, contents=[f"+ {root}/alarms/**"],
+            name=f"{tag}: alarm events",
+            origin=root,
+            contents=[f"+ {root}/alarms/**"],
             columns=rrb.archetypes.TextLogColumns(
-                timeline_columns=[rrb.encodings.TimelineColumn(SIM_TIME),
-                                  rrb.encodings.TimelineColumn(SEQ, visible=False)],
-                text_log_columns=[rrb.encodings.TextLogColumn("LogLevel"), rrb.encodings.TextLogColumn("Body"),
-                                  rrb.encodings.TextLogColumn("EntityPath", visible=False)])),
-        row_shares=[1.0, 1.0], name="alarms")
-    rows = [rrb.Horizontal(*top, column_shares=shares),
-            rrb.Horizontal(events, alarms, electrical, column_shares=[1.0, 1.0, 1.6])]
+                timeline_columns=[
+                    rrb.encodings.TimelineColumn(SIM_TIME),
+                    rrb.encodings.TimelineColumn(SEQ, visible=False),
+                ],
+                text_log_columns=[
+                    rrb.encodings.TextLogColumn("LogLevel"),
+                    rrb.encodings.TextLogColumn("Body"),
+                    rrb.encodings.TextLogColumn("EntityPath", visible=False),
+                ],
+            ),
+        ),
+        row_shares=[1.0, 1.0],
+        name="alarms",
+    )
+    rows = [
+        rrb.Horizontal(*top, column_shares=shares),
+        rrb.Horizontal(events, alarms, electrical, column_shares=[1.0, 1.0, 1.6]),
+    ]
     if tw.vibration:
-        rows.append(rrb.Horizontal(
-            rrb.Vertical(
-                # live: the last 0.1 s at full rate; a file keeps bursts (service.recording.archive):
-                # the whole run, each burst drawn min-max
-                rrb.TimeSeriesView(name="housing acceleration [m/s^2] " + ("(last 0.1 s)" if live else "(bursts)"),
-                                   origin=root, contents=[f"+ {root}/{WAVEFORM_LEAF}"],
-                                   time_ranges=_window(0.1 if live else None),
-                                   plot_legend=rrb.PlotLegend(visible=False)),
-                rrb.BarChartView(name="acceleration spectrum [m/s^2] vs [Hz]; envelope band orange",
-                                 origin=root, contents=[f"+ {root}/vibration/spectrum",
-                                                        f"+ {root}/vibration/spectrum_envelope_band"],
-                                 plot_legend=rrb.PlotLegend(visible=False))),
-            # no legend: it would show the cursors' full entity paths over the spectrum
-            rrb.BarChartView(name="envelope spectrum [m/s^2] vs [Hz]; 1-3x BPFO red, BPFI blue, 2xBSF orange, "
-                                  "BSF green, FTF grey",
-                             origin=root, contents=[f"+ {root}/vibration/envelope/spectrum",
-                                                    f"+ {root}/vibration/envelope/cursor/**"],
-                             plot_legend=rrb.PlotLegend(visible=False)),
-            rrb.Grid(ts("RMS, peak [m/s^2]", "vibration/acceleration_rms_peak_m_s2"),
-                     ts("velocity RMS [mm/s]", "vibration/velocity_rms_mm_s"),
-                     ts("kurtosis, crest [-]", "vibration/kurtosis"),
-                     ts("envelope lines [m/s^2]", "vibration/envelope_lines_m_s2"),
-                     grid_columns=2),
-            column_shares=[1.1, 1.9, 1.0], name="vibration"))
-    return rrb.Vertical(*rows, row_shares=[1.5, 1.0, 1.3][:len(rows)], name=tag)
+        rows.append(
+            rrb.Horizontal(
+                rrb.Vertical(
+                    # live: the last 0.1 s at full rate; a file keeps bursts (service.recording.archive):
+                    # the whole run, each burst drawn min-max
+                    rrb.TimeSeriesView(
+                        name="housing acceleration [m/s^2] " + ("(last 0.1 s)" if live else "(bursts)"),
+                        origin=root,
+                        contents=[f"+ {root}/{WAVEFORM_LEAF}"],
+                        time_ranges=_window(0.1 if live else None),
+                        plot_legend=rrb.PlotLegend(visible=False),
+                    ),
+                    rrb.BarChartView(
+                        name="acceleration spectrum [m/s^2] vs [Hz]; envelope band orange",
+                        origin=root,
+                        contents=[f"+ {root}/vibration/spectrum", f"+ {root}/vibration/spectrum_envelope_band"],
+                        plot_legend=rrb.PlotLegend(visible=False),
+                    ),
+                ),
+                # no legend: it would show the cursors' full entity paths over the spectrum
+                rrb.BarChartView(
+                    name="envelope spectrum [m/s^2] vs [Hz]; 1-3x BPFO red, BPFI blue, 2xBSF orange, "
+                    "BSF green, FTF grey",
+                    origin=root,
+                    contents=[f"+ {root}/vibration/envelope/spectrum", f"+ {root}/vibration/envelope/cursor/**"],
+                    plot_legend=rrb.PlotLegend(visible=False),
+                ),
+                rrb.Grid(
+                    ts("RMS, peak [m/s^2]", "vibration/acceleration_rms_peak_m_s2"),
+                    ts("velocity RMS [mm/s]", "vibration/velocity_rms_mm_s"),
+                    ts("kurtosis, crest [-]", "vibration/kurtosis"),
+                    ts("envelope lines [m/s^2]", "vibration/envelope_lines_m_s2"),
+                    grid_columns=2,
+                ),
+                column_shares=[1.1, 1.9, 1.0],
+                name="vibration",
+            )
+        )
+    return rrb.Vertical(*rows, row_shares=[1.5, 1.0, 1.3][: len(rows)], name=tag)
 
 
 def blueprint(twins: list[TwinLayout], series_window_s: float | None, live: bool = False) -> rrb.Blueprint:
@@ -452,7 +602,10 @@ def blueprint(twins: list[TwinLayout], series_window_s: float | None, live: bool
         body = layouts[0]
     else:
         body = rrb.Tabs(*layouts)
-    return rrb.Blueprint(body, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
-                         rrb.TimePanel(timeline=SIM_TIME, play_state="following" if live else "paused",
-                                       state="collapsed"),
-                         collapse_panels=True)
+    return rrb.Blueprint(
+        body,
+        rrb.BlueprintPanel(state="collapsed"),
+        rrb.SelectionPanel(state="collapsed"),
+        rrb.TimePanel(timeline=SIM_TIME, play_state="following" if live else "paused", state="collapsed"),
+        collapse_panels=True,
+    )

@@ -36,7 +36,7 @@ from typing import IO, Self
 
 log = logging.getLogger("service.recording")
 
-START_TIMEOUT_S = 30.0      # the rerun process must listen within this [s]
+START_TIMEOUT_S = 30.0  # the rerun process must listen within this [s]
 
 
 class LiveViewerError(RuntimeError):
@@ -57,7 +57,8 @@ def check_bind(host: str, token_set: bool) -> None:
         raise LiveViewerError(
             f"rerun_web_bind = {host!r}: rerun's web viewer and gRPC server check no token, so with "
             "BEARING_TWIN_TOKEN set they bind to loopback only (127.0.0.1); watch from another "
-            "machine through an SSH tunnel")
+            "machine through an SSH tunnel"
+        )
 
 
 def rerun_command() -> str:
@@ -82,8 +83,9 @@ def _listening(host: str, port: int) -> bool:
 class LiveWebViewer:
     """A `rerun --serve-web` process (see module doc); `start()`, then `url`, `grpc_url`; `close()`."""
 
-    def __init__(self, web_port: int, *, grpc_port: int | None = None, host: str = "127.0.0.1",
-                 memory_limit_mb: float = 500.0):
+    def __init__(
+        self, web_port: int, *, grpc_port: int | None = None, host: str = "127.0.0.1", memory_limit_mb: float = 500.0
+    ):
         """`web_port`: HTTP port of the web viewer; `grpc_port`: the gRPC proxy's (default
         `web_port + 1`); `host`: the address both bind to; `memory_limit_mb` [MB]: what the proxy
         keeps for late viewers."""
@@ -115,12 +117,27 @@ class LiveWebViewer:
         for port in (self.web_port, self.grpc_port):
             if _listening(self._connect_host, port):
                 raise LiveViewerError(f"rerun_web_port: port {port} on {self.host} is taken")
-        cmd = [rerun_command(), "--bind", self.host, "--serve-web", "--port", str(self.grpc_port),
-               "--web-viewer-port", str(self.web_port), "--server-memory-limit", f"{self.memory_limit_mb:.0f}MB"]
+        cmd = [
+            rerun_command(),
+            "--bind",
+            self.host,
+            "--serve-web",
+            "--port",
+            str(self.grpc_port),
+            "--web-viewer-port",
+            str(self.web_port),
+            "--server-memory-limit",
+            f"{self.memory_limit_mb:.0f}MB",
+        ]
         err_file = self._err = tempfile.TemporaryFile()
-        self._proc = subprocess.Popen(cmd, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
-                                      stderr=err_file, start_new_session=True,
-                                      env={**os.environ, "RERUN_ANALYTICS": "0"})
+        self._proc = subprocess.Popen(
+            cmd,
+            stdin=subprocess.DEVNULL,
+            stdout=subprocess.DEVNULL,
+            stderr=err_file,
+            start_new_session=True,
+            env={**os.environ, "RERUN_ANALYTICS": "0"},
+        )
         deadline = time.monotonic() + START_TIMEOUT_S
         while time.monotonic() < deadline:
             if self._proc.poll() is not None:
@@ -133,8 +150,9 @@ class LiveWebViewer:
                 return self
             time.sleep(0.1)
         self.close()
-        raise LiveViewerError(f"rerun --serve-web did not listen on {self.web_port}/{self.grpc_port} "
-                              f"within {START_TIMEOUT_S:.0f} s")
+        raise LiveViewerError(
+            f"rerun --serve-web did not listen on {self.web_port}/{self.grpc_port} within {START_TIMEOUT_S:.0f} s"
+        )
 
     @property
     def running(self) -> bool:

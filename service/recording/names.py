@@ -38,8 +38,10 @@ def is_segment_of(main: str | Path, candidate: str | Path) -> bool:
     main, candidate = Path(main).absolute(), Path(candidate).absolute()
     if candidate == main:
         return True
-    return candidate.parent == main.parent and re.fullmatch(
-        re.escape(main.stem) + r"-\d{4,}" + re.escape(main.suffix), candidate.name) is not None
+    return (
+        candidate.parent == main.parent
+        and re.fullmatch(re.escape(main.stem) + r"-\d{4,}" + re.escape(main.suffix), candidate.name) is not None
+    )
 
 
 def recording_segments(path: str | Path) -> list[Path]:

@@ -31,9 +31,9 @@ from pathlib import Path, PurePosixPath
 
 from service.recording.names import numbered_segments
 
-MAX_DEPTH = 8                 # components of a per-twin path (7 folders and the file)
-MAX_PATH_CHARS = 255          # characters of a per-twin path
-MAX_NAME_CHARS = 100          # characters of one component
+MAX_DEPTH = 8  # components of a per-twin path (7 folders and the file)
+MAX_PATH_CHARS = 255  # characters of a per-twin path
+MAX_NAME_CHARS = 100  # characters of one component
 SUFFIX = ".rrd"
 
 _COMPONENT_RE = re.compile(r"^[A-Za-z0-9_][A-Za-z0-9_.-]*$")
@@ -64,16 +64,16 @@ def check_relative_path(path: str) -> PurePosixPath:
     if any(p == ".." for p in parts):
         raise RecordingPathError(f"{path!r}: '..' is not allowed (the recording stays inside the recordings folder)")
     if len(parts) > MAX_DEPTH:
-        raise RecordingPathError(f"{path!r} has {len(parts)} levels: at most {MAX_DEPTH} "
-                                 f"({MAX_DEPTH - 1} folders and the file)")
+        raise RecordingPathError(
+            f"{path!r} has {len(parts)} levels: at most {MAX_DEPTH} ({MAX_DEPTH - 1} folders and the file)"
+        )
     for p in parts:
         if not p:
             raise RecordingPathError(f"{path!r}: empty folder name ('//' or a trailing '/')")
         if len(p) > MAX_NAME_CHARS:
             raise RecordingPathError(f"{p[:20]!r}...: a name has at most {MAX_NAME_CHARS} characters")
         if not _COMPONENT_RE.match(p):
-            raise RecordingPathError(f"{p!r}: names are letters, digits and '_', '.', '-' and do not "
-                                     "start with '.'")
+            raise RecordingPathError(f"{p!r}: names are letters, digits and '_', '.', '-' and do not start with '.'")
     if not parts[-1].endswith(SUFFIX) or parts[-1] == SUFFIX:
         raise RecordingPathError(f"{path!r}: a rerun recording ends in {SUFFIX}")
     return PurePosixPath(path)
@@ -85,8 +85,8 @@ class CreatedFile:
 
     path: Path
     fd: int
-    created_dirs: list[Path] = field(default_factory=list)   # folders made for it, outermost first
-    ident: tuple[int, int] | None = None                     # (st_dev, st_ino) of the file made
+    created_dirs: list[Path] = field(default_factory=list)  # folders made for it, outermost first
+    ident: tuple[int, int] | None = None  # (st_dev, st_ino) of the file made
 
     def __post_init__(self) -> None:
         if self.ident is None and self.fd >= 0:
@@ -134,8 +134,9 @@ def _why_not(name: str, dir_fd: int | None, display: str, exc: OSError) -> Recor
     return RecordingPathError(f"cannot create {display!r}: {exc.strerror or exc}")
 
 
-def create_exclusive(folder: str | Path, relative: str | PurePosixPath, *, make_dirs: bool = True,
-                     mode: int = 0o644) -> CreatedFile:
+def create_exclusive(
+    folder: str | Path, relative: str | PurePosixPath, *, make_dirs: bool = True, mode: int = 0o644
+) -> CreatedFile:
     """Create `folder / relative` exclusively and open it for writing. `folder` (the recordings
     folder, chosen by the operator) is made if missing; below it, every folder component is
     opened without following links (missing ones are made when `make_dirs`), and the file is
@@ -149,14 +150,18 @@ def create_exclusive(folder: str | Path, relative: str | PurePosixPath, *, make_
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:
-        raise RecordingPathError(f"cannot create the recordings folder {str(folder)!r}: {exc.strerror or exc}") from None
+        raise RecordingPathError(
+            f"cannot create the recordings folder {str(folder)!r}: {exc.strerror or exc}"
+        ) from None
     created: list[Path] = []
     fds: list[int] = []
     try:
         try:
             cur = os.open(str(folder), os.O_RDONLY | _O_DIRECTORY | _O_CLOEXEC)
         except OSError as exc:
-            raise RecordingPathError(f"cannot open the recordings folder {str(folder)!r}: {exc.strerror or exc}") from None
+            raise RecordingPathError(
+                f"cannot open the recordings folder {str(folder)!r}: {exc.strerror or exc}"
+            ) from None
         fds.append(cur)
         where = folder
         shown = PurePosixPath()
@@ -172,7 +177,9 @@ def create_exclusive(folder: str | Path, relative: str | PurePosixPath, *, make_
                 try:
                     os.mkdir(part, 0o755, dir_fd=at) if at is not None else os.mkdir(where, 0o755)
                 except OSError as exc:
-                    raise RecordingPathError(f"cannot create the folder {str(shown)!r}: {exc.strerror or exc}") from None
+                    raise RecordingPathError(
+                        f"cannot create the folder {str(shown)!r}: {exc.strerror or exc}"
+                    ) from None
                 created.append(where)
                 try:
                     nxt = _open_dir(part if at is not None else str(where), at)
@@ -237,7 +244,7 @@ def create_recording(path: str | Path, *, rename: bool = True) -> CreatedFile:
         try:
             return create_exclusive(target.parent, target.name)
         except RecordingPathError:
-            if rename and os.path.lexists(target):      # taken meanwhile: try the next name
+            if rename and os.path.lexists(target):  # taken meanwhile: try the next name
                 continue
             raise
     raise RecordingPathError(f"{str(path)!r}: could not find a free name")

@@ -75,8 +75,9 @@ def describe_recording(path: PathOrPaths) -> dict:
             raise ValueError(f"{p} holds recording {ids}, not {(info['application_id'], info['recording_id'])}")
         for chunk in reader.stream(store=recordings[0]):
             entity = chunk.entity_path.lstrip("/")
-            e = entities.setdefault(entity, {"rows": 0, "static_rows": 0, "breaks": 0, "chunks": 0,
-                                             "components": set(), "timelines": set()})
+            e = entities.setdefault(
+                entity, {"rows": 0, "static_rows": 0, "breaks": 0, "chunks": 0, "components": set(), "timelines": set()}
+            )
             if chunk.is_static:
                 e["static_rows"] += chunk.num_rows
             else:
@@ -104,8 +105,7 @@ def read_recording(path: PathOrPaths) -> dict[str, int]:
     rows} of the first recording in an .rrd, or summed over the segments of one recording given
     as a list (`read_recording(recording_segments(path))`); entities with static data only map to
     0; rerun's own `__properties` entity is left out."""
-    return {k: v["rows"] for k, v in describe_recording(path)["entities"].items()
-            if not k.startswith("__")}
+    return {k: v["rows"] for k, v in describe_recording(path)["entities"].items() if not k.startswith("__")}
 
 
 def read_column(path: PathOrPaths, entity: str, column: str) -> list:

@@ -82,19 +82,40 @@ class RerunRecorder:
     # 50 Hz), the bearing now (3D, load zone) every 0.5 s, the per-contact series every 1 s, the
     # accelerometer's samples in bursts and around events and the spectra every 30 s
     # (`service.recording.archive`), each closed file compacted
-    SERVICE_OPTIONS: dict[str, Any] = {"trend_window_s": 0.2, "now_interval_s": 0.5, "contacts_interval_s": 1.0,
-                       "waveform_archive": WaveformArchive(), "compact_segments": True}
+    SERVICE_OPTIONS: dict[str, Any] = {
+        "trend_window_s": 0.2,
+        "now_interval_s": 0.5,
+        "contacts_interval_s": 1.0,
+        "waveform_archive": WaveformArchive(),
+        "compact_segments": True,
+    }
 
-    def __init__(self, path: str | Path | CreatedFile | None = None, *, spawn_viewer: bool = False,
-                 application_id: str = "bearing-twin", flush_interval_s: float = 1.0,
-                 slow_interval_s: float = 5.0, queue_size: int = 512, viewer_port: int = 9876,
-                 series_window_s: float | None = None, min_interval_s: float = 0.0,
-                 segment_s: float | None = None, segment_bytes: int | None = None,
-                 write_footer: bool = False, streams: RerunStreams | None = None,
-                 rename_existing: bool = True, retention: Retention | None = None,
-                 retry_s: float = 2.0, write_timeout_s: float = 30.0, trend_window_s: float | None = None,
-                 now_interval_s: float = 0.0, waveform_archive: WaveformArchive | None = None,
-                 compact_segments: bool = False, contacts_interval_s: float = 0.0):
+    def __init__(
+        self,
+        path: str | Path | CreatedFile | None = None,
+        *,
+        spawn_viewer: bool = False,
+        application_id: str = "bearing-twin",
+        flush_interval_s: float = 1.0,
+        slow_interval_s: float = 5.0,
+        queue_size: int = 512,
+        viewer_port: int = 9876,
+        series_window_s: float | None = None,
+        min_interval_s: float = 0.0,
+        segment_s: float | None = None,
+        segment_bytes: int | None = None,
+        write_footer: bool = False,
+        streams: RerunStreams | None = None,
+        rename_existing: bool = True,
+        retention: Retention | None = None,
+        retry_s: float = 2.0,
+        write_timeout_s: float = 30.0,
+        trend_window_s: float | None = None,
+        now_interval_s: float = 0.0,
+        waveform_archive: WaveformArchive | None = None,
+        compact_segments: bool = False,
+        contacts_interval_s: float = 0.0,
+    ):
         """`path`: the main file (None: none); taken -> `<stem>.runN.rrd` with `rename_existing`,
         else RecordingPathError; or a `CreatedFile` made by the caller (`create_exclusive`), which
         the recorder then owns (removed again if the start fails). `flush_interval_s` [s]: send
@@ -145,18 +166,30 @@ class RerunRecorder:
         self._blueprint_dirty = False
         self._thread: threading.Thread | None = None
         self._blueprints = BlueprintSender(application_id, self._streams)
-        self._rows = RowBatcher(queue_size=self.queue_size,
-                                slow_interval_s=max(float(slow_interval_s), self.flush_interval_s),
-                                min_interval_s=float(min_interval_s), wake=self._wake,
-                                trend_window_s=trend_window_s, now_interval_s=float(now_interval_s),
-                                waveform_archive=waveform_archive, contacts_interval_s=float(contacts_interval_s))
+        self._rows = RowBatcher(
+            queue_size=self.queue_size,
+            slow_interval_s=max(float(slow_interval_s), self.flush_interval_s),
+            min_interval_s=float(min_interval_s),
+            wake=self._wake,
+            trend_window_s=trend_window_s,
+            now_interval_s=float(now_interval_s),
+            waveform_archive=waveform_archive,
+            contacts_interval_s=float(contacts_interval_s),
+        )
         self._out = SegmentWriter(
-            application_id=application_id, recording_id=self.recording_id, streams=self._streams,
-            on_start=self._start_output, on_resume=self._rows.note_all,
+            application_id=application_id,
+            recording_id=self.recording_id,
+            streams=self._streams,
+            on_start=self._start_output,
+            on_resume=self._rows.note_all,
             segment_s=float(segment_s) if segment_s else None,
             segment_bytes=int(segment_bytes) if segment_bytes else None,
-            write_footer=bool(write_footer), retention=retention, retry_s=float(retry_s),
-            write_timeout_s=float(write_timeout_s), compact_segments=bool(compact_segments))
+            write_footer=bool(write_footer),
+            retention=retention,
+            retry_s=float(retry_s),
+            write_timeout_s=float(write_timeout_s),
+            compact_segments=bool(compact_segments),
+        )
         try:
             if spawn_viewer:
                 self._out.open_viewer(self.viewer_port)
@@ -249,7 +282,7 @@ class RerunRecorder:
             raise RecordingPathError(f"{path} is the recorder's main file (or one of its segments)")
         with self._io_lock:
             self._drain_locked()
-            self._send_locked(force_slow=True)   # rows published before start_file go to the old outputs only
+            self._send_locked(force_slow=True)  # rows published before start_file go to the old outputs only
             replaced = self._out.extra is not None
             if replaced:
                 self._out.stop_extra()
@@ -272,7 +305,7 @@ class RerunRecorder:
             self._drain_locked()
             self._send_locked(force_slow=True)
             path = self._out.stop_extra()
-        self._streams.reclaim()             # outside the lock: it flushes every stream
+        self._streams.reclaim()  # outside the lock: it flushes every stream
         return path
 
     @property
@@ -304,7 +337,7 @@ class RerunRecorder:
                 return None
             self._drain_locked()
             self._send_locked(force_slow=True)
-            if primary.file is None:        # the send just failed
+            if primary.file is None:  # the send just failed
                 return None
             return self._out.rotate()
 
@@ -407,10 +440,17 @@ class RerunRecorder:
         return self._out.rows_lost
 
     def health(self) -> dict:
-        return {"status": self.status, "error": self.fault, "path": str(self.path) if self.path else None,
-                "current": str(self.current_path) if self.current_path else None,
-                "rows": self._rows_logged, "rows_lost": self.rows_lost, "write_errors": self.write_errors,
-                "dropped": self.dropped, "segments": len(self._out.segments)}
+        return {
+            "status": self.status,
+            "error": self.fault,
+            "path": str(self.path) if self.path else None,
+            "current": str(self.current_path) if self.current_path else None,
+            "rows": self._rows_logged,
+            "rows_lost": self.rows_lost,
+            "write_errors": self.write_errors,
+            "dropped": self.dropped,
+            "segments": len(self._out.segments),
+        }
 
     # ---- flushing and closing ---------------------------------------------------------------
     def flush(self, timeout_s: float = 30.0) -> None:
@@ -441,7 +481,7 @@ class RerunRecorder:
             self._blueprints.close()
             self._rows.twins.clear()
             self._rows.context.clear()
-        self._streams.reclaim()             # free this recorder's streams (service.recording.streams)
+        self._streams.reclaim()  # free this recorder's streams (service.recording.streams)
 
     def __enter__(self) -> Self:
         return self
@@ -487,21 +527,36 @@ class RerunRecorder:
             self._rows_logged += sent
 
     # ---- twins ------------------------------------------------------------------------------
-    def add_twin(self, bearing_id: str, *, designation: str, pitch_radius_m: float,
-                 ball_radius_m: float, inner_raceway_radius_m: float,
-                 outer_raceway_radius_m: float, ball_count: int,
-                 load_scale_m_per_n: float | None = None, context: Callable[[], Any] | None = None,
-                 vibration: bool = False) -> None:
+    def add_twin(
+        self,
+        bearing_id: str,
+        *,
+        designation: str,
+        pitch_radius_m: float,
+        ball_radius_m: float,
+        inner_raceway_radius_m: float,
+        outer_raceway_radius_m: float,
+        ball_count: int,
+        load_scale_m_per_n: float | None = None,
+        context: Callable[[], Any] | None = None,
+        vibration: bool = False,
+    ) -> None:
         """Register a twin: its static geometry goes out now, the blueprint with the next send.
         `load_scale_m_per_n`: arrow length per newton of contact load; by default the largest load
         of the first loaded snapshot is drawn one ball diameter long. `context`: called with each
         `publish` (on the publishing thread) for the twin's scenario handle (name, state, phase),
         whose changes are logged as events."""
-        tw = TwinRows(bearing_id=str(bearing_id), designation=str(designation), ball_count=int(ball_count),
-                      pitch_radius_m=float(pitch_radius_m), ball_radius_m=float(ball_radius_m),
-                      inner_raceway_radius_m=float(inner_raceway_radius_m),
-                      outer_raceway_radius_m=float(outer_raceway_radius_m),
-                      load_scale_m_per_n=load_scale_m_per_n, vibration=bool(vibration))
+        tw = TwinRows(
+            bearing_id=str(bearing_id),
+            designation=str(designation),
+            ball_count=int(ball_count),
+            pitch_radius_m=float(pitch_radius_m),
+            ball_radius_m=float(ball_radius_m),
+            inner_raceway_radius_m=float(inner_raceway_radius_m),
+            outer_raceway_radius_m=float(outer_raceway_radius_m),
+            load_scale_m_per_n=load_scale_m_per_n,
+            vibration=bool(vibration),
+        )
         with self._io_lock:
             self._rows.register(tw, context, self._out.outputs())
             self._blueprint_dirty = True
@@ -510,11 +565,17 @@ class RerunRecorder:
         """`add_twin` with the geometry of a `twin.engine.Twin`."""
         m = twin.model
         g = m.spec.geometry
-        self.add_twin(bearing_id or twin.bearing_id, designation=m.spec.designation,
-                      pitch_radius_m=m.pitch_radius_m, ball_radius_m=m.ball_radius_m,
-                      inner_raceway_radius_m=g.inner_raceway_radius_m,
-                      outer_raceway_radius_m=g.outer_raceway_radius_m, ball_count=m.ball_count,
-                      context=context, vibration=bool(getattr(m, "housing_on", False)))
+        self.add_twin(
+            bearing_id or twin.bearing_id,
+            designation=m.spec.designation,
+            pitch_radius_m=m.pitch_radius_m,
+            ball_radius_m=m.ball_radius_m,
+            inner_raceway_radius_m=g.inner_raceway_radius_m,
+            outer_raceway_radius_m=g.outer_raceway_radius_m,
+            ball_count=m.ball_count,
+            context=context,
+            vibration=bool(getattr(m, "housing_on", False)),
+        )
 
     def remove_twin(self, bearing_id: str) -> bool:
         """Forget a twin (its runner has stopped): what it published is sent and written first,
@@ -551,7 +612,7 @@ class RerunRecorder:
             return
         layouts: dict[bool, Any] = {}
         for out in outs:
-            if out.stream is None:      # a closed output
+            if out.stream is None:  # a closed output
                 continue
             if out.viewer not in layouts:
                 layouts[out.viewer] = self.blueprint(live=out.viewer)

@@ -43,9 +43,9 @@ class Retention:
 
     folder: Path
     family: re.Pattern
-    keep_bytes: int = 0           # total size kept [bytes]; 0 = no size limit
-    keep_age_s: float = 0.0       # files older than this are deleted [s]; 0 = no age limit
-    deleted: int = 0              # files deleted so far
+    keep_bytes: int = 0  # total size kept [bytes]; 0 = no size limit
+    keep_age_s: float = 0.0  # files older than this are deleted [s]; 0 = no age limit
+    deleted: int = 0  # files deleted so far
     deleted_bytes: int = 0
     _protected: set = field(default_factory=set)
     _lock: threading.Lock = field(default_factory=threading.Lock)
@@ -94,7 +94,7 @@ class Retention:
         with self._lock:
             protected = set(self._protected)
         candidates = self.candidates()
-        kept = sum(size for _, size, path in candidates if os.path.abspath(path) in protected)   # open: always kept
+        kept = sum(size for _, size, path in candidates if os.path.abspath(path) in protected)  # open: always kept
         deleted: list[Path] = []
         for mtime, size, path in candidates:
             if os.path.abspath(path) in protected:
@@ -113,8 +113,12 @@ class Retention:
                 deleted.append(path)
                 self.deleted += 1
                 self.deleted_bytes += size
-                log.info("retention: deleted %s (%.1f MB, %s)", path, size / 1e6,
-                         "older than the age limit" if too_old else "beyond the size limit")
+                log.info(
+                    "retention: deleted %s (%.1f MB, %s)",
+                    path,
+                    size / 1e6,
+                    "older than the age limit" if too_old else "beyond the size limit",
+                )
             else:
                 kept += size
         return deleted

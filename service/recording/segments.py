@@ -35,8 +35,15 @@ import warnings
 from service.recording.names import is_segment_of, numbered_segments, recording_segments, segment_path
 from service.recording.paths import CreatedFile
 
-__all__ = ["DirectFile", "RecordingWriteError", "RerunFile", "is_segment_of", "numbered_segments",
-           "recording_segments", "segment_path"]
+__all__ = [
+    "DirectFile",
+    "RecordingWriteError",
+    "RerunFile",
+    "is_segment_of",
+    "numbered_segments",
+    "recording_segments",
+    "segment_path",
+]
 
 log = logging.getLogger("service.recording")
 
@@ -47,8 +54,8 @@ class RecordingWriteError(OSError):
 
 # ---- RRD framing (rerun-sdk 0.41, re_log_encoding rrd::frames) ----------------------------------
 _FOURCC = b"RRF2"
-_STREAM_HEADER = 12              # fourcc, version, encoding options
-_MESSAGE_HEADER = struct.Struct("<QQ")   # kind, payload length
+_STREAM_HEADER = 12  # fourcc, version, encoding options
+_MESSAGE_HEADER = struct.Struct("<QQ")  # kind, payload length
 _KIND_END = 0
 
 
@@ -80,8 +87,11 @@ class _RrdFraming:
     def _raw(self, view: memoryview, why: str) -> memoryview:
         if not _RrdFraming._warned:
             _RrdFraming._warned = True
-            log.warning("rerun: unexpected RRD framing (%s): writing complete streams one after "
-                        "the other (readable by the viewer, not by RrdReader)", why)
+            log.warning(
+                "rerun: unexpected RRD framing (%s): writing complete streams one after "
+                "the other (readable by the viewer, not by RrdReader)",
+                why,
+            )
         return view
 
 
@@ -101,7 +111,7 @@ class DirectFile:
         self.path = created.path
         self.bytes = 0
         self._framing = _RrdFraming()
-        self._storage = stream.binary_stream()     # the stream's sink from now on
+        self._storage = stream.binary_stream()  # the stream's sink from now on
 
     def write(self, timeout_s: float) -> int:
         """Write what the stream sent since the last call; returns bytes written. Raises
@@ -154,7 +164,7 @@ class RerunFile:
     """One segment written by rerun's own file sink, with the RRD footer (module doc)."""
 
     footer = True
-    rebind = None           # rerun's file sink cannot continue a file from another stream
+    rebind = None  # rerun's file sink cannot continue a file from another stream
 
     def __init__(self, created: CreatedFile, stream) -> None:
         self.created = created

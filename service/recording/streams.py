@@ -39,8 +39,8 @@ class RerunStreams:
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self.created = 0           # streams made (recordings and blueprints)
-        self.reclaims = 0          # successful cleanups
+        self.created = 0  # streams made (recordings and blueprints)
+        self.reclaims = 0  # successful cleanups
         self.reclaim_errors = 0
         self._warned = False
 
@@ -54,9 +54,11 @@ class RerunStreams:
 
         with self._lock:
             self.created += 1
-            return rr.RecordingStream._from_native(rerun_bindings.new_blueprint(
-                application_id=application_id, make_default=False, make_thread_default=False,
-                default_enabled=True))
+            return rr.RecordingStream._from_native(
+                rerun_bindings.new_blueprint(
+                    application_id=application_id, make_default=False, make_thread_default=False, default_enabled=True
+                )
+            )
 
     def send_blueprint(self, blueprint: rrb.Blueprint, recording: rr.RecordingStream) -> None:
         """rerun's own `send_blueprint` (it makes a blueprint stream per call) under the lock."""

@@ -41,16 +41,16 @@ from service.recording.layout import (
     TwinLayout,
 )
 
-OFF_SCALE_DECADES = 1.0     # a capacitance more than this many decades from the running median is off scale
-NOTE_EVERY_NS = 60_000_000_000   # [ns of simulated time] at most one film-broken / -healed event per minute
-_MEDIAN_MEMORY = 0.9        # running median of the capacitance: weight of the old value per window
+OFF_SCALE_DECADES = 1.0  # a capacitance more than this many decades from the running median is off scale
+NOTE_EVERY_NS = 60_000_000_000  # [ns of simulated time] at most one film-broken / -healed event per minute
+_MEDIAN_MEMORY = 0.9  # running median of the capacitance: weight of the old value per window
 
 
 def trend_values(tw: TwinLayout, rows: list) -> dict[str, np.ndarray]:
     """{trend leaf: (n, k) values per snapshot} in the units of `layout.SERIES` (setpoints beside
     the measured values; NaN where a snapshot has no value)."""
     n = len(rows)
-    c = np.stack([r.contacts for r in rows])                    # (n, z, 2, K)
+    c = np.stack([r.contacts for r in rows])  # (n, z, 2, K)
     reg = np.stack([r.regimes for r in rows])
     load, lam = c[..., F_LOAD], c[..., F_LAMBDA]
     sp = np.array([r.setpoint if r.setpoint is not None else (math.nan,) * 6 for r in rows]).reshape(n, 6)
@@ -58,7 +58,7 @@ def trend_values(tw: TwinLayout, rows: list) -> dict[str, np.ndarray]:
         qmax = np.nanmax(np.where(np.isfinite(load), load, -math.inf).reshape(n, -1), axis=1)
         loaded = np.isfinite(lam) & (load > 0)
     qmax[~np.isfinite(qmax)] = math.nan
-    min_lam = np.where(loaded, lam, math.inf).min(axis=1)                          # (n, 2)
+    min_lam = np.where(loaded, lam, math.inf).min(axis=1)  # (n, 2)
     min_lam[~np.isfinite(min_lam)] = math.nan
     ball_reg = ball_regime(reg)
     counts = np.stack([(ball_reg == code).sum(axis=1) for code in REGIME_ORDER], axis=1).astype(np.float64)
@@ -66,25 +66,30 @@ def trend_values(tw: TwinLayout, rows: list) -> dict[str, np.ndarray]:
     out = {
         "friction_torque_n_m": np.array([[r.friction_torque_n_m] for r in rows], dtype=np.float64),
         "loads_n": np.column_stack([qmax, sp[:, 1], sp[:, 2]]),
-        "speeds_rad_s": np.column_stack([sp[:, 0], [r.shaft_speed_rad_s for r in rows],
-                                         [r.cage_speed_rad_s for r in rows]]),
+        "speeds_rad_s": np.column_stack(
+            [sp[:, 0], [r.shaft_speed_rad_s for r in rows], [r.cage_speed_rad_s for r in rows]]
+        ),
         "min_lambda": min_lam,
         "regime_counts": counts,
         "temperatures_c": np.column_stack([sp[:, 3], sp[:, 3] + np.nan_to_num(rise)]),
     }
     if any(r.thermal is not None for r in rows):
         nt = len(THERMAL_NODES)
-        th = np.array([r.thermal if r.thermal is not None else (math.nan,) * (nt + len(THERMAL_SOURCES))
-                       for r in rows], dtype=np.float64)
+        th = np.array(
+            [r.thermal if r.thermal is not None else (math.nan,) * (nt + len(THERMAL_SOURCES)) for r in rows],
+            dtype=np.float64,
+        )
         out["thermal/nodes_c"] = th[:, :nt]
         out["thermal/heat_w"] = th[:, nt:]
     if any(r.electrical for r in rows):
+
         def el(key: str, scale: float = 1.0) -> np.ndarray:
             return np.array([r.electrical.get(key, math.nan) for r in rows], dtype=np.float64) * scale
 
         out[CAPACITANCE_LEAF] = el("capacitance_f", 1e12)[:, None]
         out["electrical/resistance_log10_kohm"] = np.column_stack(
-            [log10_kohm(el("resistance_ohm")), log10_kohm(el("impedance_ohm"))])
+            [log10_kohm(el("resistance_ohm")), log10_kohm(el("impedance_ohm"))]
+        )
         out["electrical/shaft_voltage_v"] = np.column_stack([el("shaft_voltage_v"), sp[:, 5]])
         out["electrical/shaft_current_ma"] = np.column_stack([el("shaft_current_a", 1e3), sp[:, 4] * 1e3])
         out["electrical/film_field_v_per_um"] = el("max_film_field_v_m", 1e-6)[:, None]
@@ -123,7 +128,7 @@ def _scalars(v: np.ndarray) -> rr.ComponentColumnList:
 def _stats(values: np.ndarray, bounds: list[tuple[int, int]], band: tuple[int, ...]) -> np.ndarray:
     """Per window: the mean of every series, then the min and max of the series in `band`."""
     with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)        # an all-NaN window stays NaN
+        warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN window stays NaN
         mean = np.array([np.nanmean(values[a:b], axis=0) for a, b in bounds])
         if not band:
             return mean
@@ -168,12 +173,22 @@ def trend_columns(tw: TwinLayout, windows: list[list], offset_s: float, bands: b
             first = v[sel, 0]
             ok = np.isfinite(first)
             if ok.any():
-                out.append((f"{root}/{leaf}/changes", _index(t_ns[sel][ok], seq[sel][ok]),
-                            rr.Scalars.columns(scalars=first[ok])))
+                out.append(
+                    (
+                        f"{root}/{leaf}/changes",
+                        _index(t_ns[sel][ok], seq[sel][ok]),
+                        rr.Scalars.columns(scalars=first[ok]),
+                    )
+                )
     if notes:
         sel = np.array([j for j, _ in notes])
-        out.append((f"{root}/events", _index(t_ns[sel], seq[sel]),
-                    rr.TextLog.columns(text=[t for _, t in notes], level=["WARN"] * len(notes))))
+        out.append(
+            (
+                f"{root}/events",
+                _index(t_ns[sel], seq[sel]),
+                rr.TextLog.columns(text=[t for _, t in notes], level=["WARN"] * len(notes)),
+            )
+        )
     return out
 
 
@@ -190,8 +205,9 @@ def _changes(tw: TwinLayout, rows: list) -> list[int]:
     return changed
 
 
-def _capacitance_scale(tw: TwinLayout, c_pf: np.ndarray, has_el: np.ndarray, t_ns: np.ndarray, seq: np.ndarray,
-                       out: list) -> list[tuple[int, str]]:
+def _capacitance_scale(
+    tw: TwinLayout, c_pf: np.ndarray, has_el: np.ndarray, t_ns: np.ndarray, seq: np.ndarray, out: list
+) -> list[tuple[int, str]]:
     """Leaves off-scale and undefined capacitances out of `c_pf` (set NaN, in place), marks them,
     and returns the event texts (at a change of state only). `has_el`: the rows with electrical
     fields (only there is a missing capacitance a broken film)."""
@@ -212,22 +228,32 @@ def _capacitance_scale(tw: TwinLayout, c_pf: np.ndarray, has_el: np.ndarray, t_n
         last["c_median_pf"] = ref
     broken = ~np.isfinite(c_pf) & has_el
     state = last.get("c_state", "ok")
-    starts = np.zeros(c_pf.size, dtype=bool)        # the first snapshot of each run of broken ones
+    starts = np.zeros(c_pf.size, dtype=bool)  # the first snapshot of each run of broken ones
     for j in range(c_pf.size):
         now = "broken" if broken[j] else "off" if off[j] else "ok"
         if now != state:
             starts[j] = now == "broken"
             quiet = t_ns[j] < last.get("c_note_ns", -NOTE_EVERY_NS) + NOTE_EVERY_NS
             if quiet and now != "off":
-                state = now                          # the film breaks and heals often: one note a minute
+                state = now  # the film breaks and heals often: one note a minute
                 continue
             last["c_note_ns"] = int(t_ns[j])
             if now == "broken":
-                notes.append((j, "film broken (metal contact): the bearing capacitance is undefined, its plot is "
-                                 "empty and marked x until the film carries the load again"))
+                notes.append(
+                    (
+                        j,
+                        "film broken (metal contact): the bearing capacitance is undefined, its plot is "
+                        "empty and marked x until the film carries the load again",
+                    )
+                )
             elif now == "off":
-                notes.append((j, f"bearing capacitance {c_pf[j]:.3g} pF is off scale (more than "
-                                 f"{OFF_SCALE_DECADES:g} decade from the running median {ref:.3g} pF): marked ^"))
+                notes.append(
+                    (
+                        j,
+                        f"bearing capacitance {c_pf[j]:.3g} pF is off scale (more than "
+                        f"{OFF_SCALE_DECADES:g} decade from the running median {ref:.3g} pF): marked ^",
+                    )
+                )
             elif state == "broken":
                 notes.append((j, "film carries the load again: bearing capacitance defined"))
             state = now
@@ -235,11 +261,21 @@ def _capacitance_scale(tw: TwinLayout, c_pf: np.ndarray, has_el: np.ndarray, t_n
     good = finite & ~off
     edge = float(np.max(c_pf[good])) if good.any() else (ref if ref is not None else 0.0)
     if off.any():
-        out.append((f"{root}/{OFF_SCALE_LEAF}", _index(t_ns[off], seq[off]),
-                    rr.Scalars.columns(scalars=np.full(int(off.sum()), edge))))
+        out.append(
+            (
+                f"{root}/{OFF_SCALE_LEAF}",
+                _index(t_ns[off], seq[off]),
+                rr.Scalars.columns(scalars=np.full(int(off.sum()), edge)),
+            )
+        )
     if starts.any():
         base = float(np.min(c_pf[good])) if good.any() else edge
-        out.append((f"{root}/{FILM_BROKEN_LEAF}", _index(t_ns[starts], seq[starts]),
-                    rr.Scalars.columns(scalars=np.full(int(starts.sum()), base))))
+        out.append(
+            (
+                f"{root}/{FILM_BROKEN_LEAF}",
+                _index(t_ns[starts], seq[starts]),
+                rr.Scalars.columns(scalars=np.full(int(starts.sum()), base)),
+            )
+        )
     c_pf[off | broken] = math.nan
     return notes

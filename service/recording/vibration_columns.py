@@ -44,8 +44,13 @@ def vibration_columns(tw: TwinLayout, batch: Batch) -> None:
 
     def scalars(leaf: str, values) -> None:
         v = np.asarray(values, dtype=np.float64).reshape(n, -1)
-        batch.out.append((f"{root}/vibration/{leaf}", batch.index(idx),
-                          rr.Scalars.columns(scalars=v.reshape(-1)).partition(np.full(n, v.shape[1]))))
+        batch.out.append(
+            (
+                f"{root}/vibration/{leaf}",
+                batch.index(idx),
+                rr.Scalars.columns(scalars=v.reshape(-1)).partition(np.full(n, v.shape[1])),
+            )
+        )
 
     scalars("acceleration_rms_peak_m_s2", [[b.rms_m_s2, b.peak_m_s2] for b in blocks])
     scalars("velocity_rms_mm_s", [[b.velocity_rms_mm_s] for b in blocks])
@@ -63,8 +68,9 @@ def vibration_columns(tw: TwinLayout, batch: Batch) -> None:
         for m, p in enumerate(b.envelope_peaks_hz):
             peak_f[i, m], peak_a[i, m] = p.frequency_hz, p.amplitude
     batch.out.append((f"{root}/vibration/envelope/peaks", batch.index(idx), bar_columns(peak_a, peak_f)))
-    batch.out.append((f"{root}/vibration/envelope/defect_lines", batch.index(idx),
-                      bar_columns(np.nan_to_num(amps), freqs)))
+    batch.out.append(
+        (f"{root}/vibration/envelope/defect_lines", batch.index(idx), bar_columns(np.nan_to_num(amps), freqs))
+    )
     _spectrum_columns(tw, batch, idx, blocks)
 
 
@@ -81,9 +87,17 @@ def _spectrum_columns(tw: TwinLayout, batch: Batch, idx: np.ndarray, blocks: lis
         sel = idx[[j for j, _ in env]]
         amps = [np.asarray(e.amplitude_m_s2) for _, e in env]
         tops = [float(a.max()) if a.size else 0.0 for a in amps]
-        batch.out.append((f"{root}/vibration/envelope/spectrum", batch.index(sel),
-                          bar_columns(amps, [e.frequencies_hz for _, e in env],
-                                       [np.full(a.size, _bar_width(e)) for a, (_, e) in zip(amps, env, strict=True)])))
+        batch.out.append(
+            (
+                f"{root}/vibration/envelope/spectrum",
+                batch.index(sel),
+                bar_columns(
+                    amps,
+                    [e.frequencies_hz for _, e in env],
+                    [np.full(a.size, _bar_width(e)) for a, (_, e) in zip(amps, env, strict=True)],
+                ),
+            )
+        )
         for name, label in zip(VIB_LINES, CURSOR_NAMES, strict=True):
             fs, hs, ws = [], [], []
             for (j, e), top in zip(env, tops, strict=True):
@@ -93,18 +107,35 @@ def _spectrum_columns(tw: TwinLayout, batch: Batch, idx: np.ndarray, blocks: lis
                 hs.append(np.full(f.size, top))
                 ws.append(np.full(f.size, max(2.0 * e.step_hz, e.max_hz / CURSOR_WIDTH_FRACTION)))
             batch.out.append((f"{root}/vibration/envelope/cursor/{label}", batch.index(sel), bar_columns(hs, fs, ws)))
-    acc = [(j, b.amplitude_spectrum) for j, b in enumerate(blocks) if getattr(b, "amplitude_spectrum", None) is not None]
+    acc = [
+        (j, b.amplitude_spectrum) for j, b in enumerate(blocks) if getattr(b, "amplitude_spectrum", None) is not None
+    ]
     if acc:
         sel = idx[[j for j, _ in acc]]
         amps = [np.asarray(a.amplitude_m_s2) for _, a in acc]
-        batch.out.append((f"{root}/vibration/spectrum", batch.index(sel),
-                          bar_columns(amps, [a.frequencies_hz for _, a in acc],
-                                       [np.full(x.size, _bar_width(a)) for x, (_, a) in zip(amps, acc, strict=True)])))
+        batch.out.append(
+            (
+                f"{root}/vibration/spectrum",
+                batch.index(sel),
+                bar_columns(
+                    amps,
+                    [a.frequencies_hz for _, a in acc],
+                    [np.full(x.size, _bar_width(a)) for x, (_, a) in zip(amps, acc, strict=True)],
+                ),
+            )
+        )
         band = [blocks[j].envelope_band_hz for j, _ in acc]
-        batch.out.append((f"{root}/vibration/spectrum_envelope_band", batch.index(sel),
-                          bar_columns([np.array([float(a.max()) if a.size else 0.0]) for a in amps],
-                                       [np.array([0.5 * (lo + hi)]) for lo, hi in band],
-                                       [np.array([hi - lo]) for lo, hi in band])))
+        batch.out.append(
+            (
+                f"{root}/vibration/spectrum_envelope_band",
+                batch.index(sel),
+                bar_columns(
+                    [np.array([float(a.max()) if a.size else 0.0]) for a in amps],
+                    [np.array([0.5 * (lo + hi)]) for lo, hi in band],
+                    [np.array([hi - lo]) for lo, hi in band],
+                ),
+            )
+        )
 
 
 def _bar_width(spectrum) -> float:
@@ -124,7 +155,7 @@ class WaveRow:
     seq: int
     t0_s: float
     sample_rate_hz: float
-    samples: np.ndarray              # float32 [m/s^2]
+    samples: np.ndarray  # float32 [m/s^2]
 
 
 def waveform_columns(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> list:
@@ -133,8 +164,9 @@ def waveform_columns(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> li
     rows = [r for r in rows if r.samples.size]
     if not rows:
         return []
-    t = np.concatenate([np.round((r.t0_s + offset_s + np.arange(r.samples.size) / r.sample_rate_hz) * 1e9)
-                        for r in rows]).astype(np.int64)
+    t = np.concatenate(
+        [np.round((r.t0_s + offset_s + np.arange(r.samples.size) / r.sample_rate_hz) * 1e9) for r in rows]
+    ).astype(np.int64)
     seq = np.concatenate([np.full(r.samples.size, r.seq, dtype=np.int64) for r in rows])
     x = np.concatenate([r.samples for r in rows]).astype(np.float64)
     index = [rr.TimeColumn(SIM_TIME, duration=t.astype("timedelta64[ns]")), rr.TimeColumn(SEQ, sequence=seq)]
@@ -146,5 +178,10 @@ def waveform_breaks(tw: TwinLayout, rows: list[WaveRow], offset_s: float) -> lis
     `service.recording.archive`: no line drawn across the samples not kept), on sim_time only."""
     at = np.array([round((r.t0_s + offset_s - 0.5 / r.sample_rate_hz) * 1e9) for r in rows], dtype=np.int64)
     index = [rr.TimeColumn(SIM_TIME, duration=at.astype("timedelta64[ns]"))]
-    return [(f"{tw.root}/vibration/acceleration_m_s2", index,
-             rr.Scalars.columns(scalars=np.zeros(0)).partition(np.zeros(at.size, np.int32)))]
+    return [
+        (
+            f"{tw.root}/vibration/acceleration_m_s2",
+            index,
+            rr.Scalars.columns(scalars=np.zeros(0)).partition(np.zeros(at.size, np.int32)),
+        )
+    ]

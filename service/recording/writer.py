@@ -43,7 +43,7 @@ from service.recording.streams import RerunStreams
 
 log = logging.getLogger("service.recorder")
 
-_ROTATION_RETRY_S = 10.0     # a failed rotation is retried this often [s], not at every write
+_ROTATION_RETRY_S = 10.0  # a failed rotation is retried this often [s], not at every write
 
 
 def _display_available() -> bool:
@@ -65,12 +65,12 @@ class Output:
     """One rerun stream and where it goes (a file, a spawned viewer, a live server)."""
 
     stream: rr.RecordingStream | None
-    file: DirectFile | RerunFile | None = None        # None: viewer, or a file that failed
+    file: DirectFile | RerunFile | None = None  # None: viewer, or a file that failed
     viewer: bool = False
-    viewer_url: str | None = None                     # a viewer's gRPC address (reconnected on renew)
-    opened_at: float = field(default_factory=time.monotonic)   # monotonic [s]
-    rows: int = 0                # snapshots written to this output (to this segment for the main file)
-    null_sink: Any = None        # while the main file is degraded: an in-memory sink emptied after each send
+    viewer_url: str | None = None  # a viewer's gRPC address (reconnected on renew)
+    opened_at: float = field(default_factory=time.monotonic)  # monotonic [s]
+    rows: int = 0  # snapshots written to this output (to this segment for the main file)
+    null_sink: Any = None  # while the main file is degraded: an in-memory sink emptied after each send
 
     @property
     def path(self) -> Path | None:
@@ -80,11 +80,22 @@ class Output:
 class SegmentWriter:
     """The outputs of one recording (see module doc): main file in segments, extra file, viewers."""
 
-    def __init__(self, *, application_id: str, recording_id: str, streams: RerunStreams,
-                 on_start: Callable[[Output], None], on_resume: Callable[[str], None],
-                 segment_s: float | None = None, segment_bytes: int | None = None, write_footer: bool = False,
-                 retention: Retention | None = None, retry_s: float = 2.0, write_timeout_s: float = 30.0,
-                 compact_segments: bool = False):
+    def __init__(
+        self,
+        *,
+        application_id: str,
+        recording_id: str,
+        streams: RerunStreams,
+        on_start: Callable[[Output], None],
+        on_resume: Callable[[str], None],
+        segment_s: float | None = None,
+        segment_bytes: int | None = None,
+        write_footer: bool = False,
+        retention: Retention | None = None,
+        retry_s: float = 2.0,
+        write_timeout_s: float = 30.0,
+        compact_segments: bool = False,
+    ):
         self.application_id = application_id
         self.recording_id = recording_id
         self.streams = streams
@@ -98,9 +109,9 @@ class SegmentWriter:
         self.write_timeout_s = write_timeout_s
         self.compact_segments = compact_segments  # rewrite each closed file compacted (service.recording.compaction)
         self._compactions: list[threading.Thread] = []
-        self.path: Path | None = None             # the main file's first segment
-        self.viewers: list[Output] = []           # spawned viewer, live server
-        self.primary: Output | None = None        # the main file's stream (its open segment in .file)
+        self.path: Path | None = None  # the main file's first segment
+        self.viewers: list[Output] = []  # spawned viewer, live server
+        self.primary: Output | None = None  # the main file's stream (its open segment in .file)
         self.extra: Output | None = None
         self.segments: list[Path] = []
         self.errors = 0
@@ -132,8 +143,10 @@ class SegmentWriter:
                 log.warning("rerun: the spawned viewer does not listen on port %d: continuing without it", port)
                 return None
         except Exception as exc:  # noqa: BLE001 - no viewer on PATH, headless, ...: warn, go on
-            log.warning("rerun: could not spawn a viewer (%s): continuing without a viewer",
-                        str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__)
+            log.warning(
+                "rerun: could not spawn a viewer (%s): continuing without a viewer",
+                str(exc).strip().splitlines()[0] if str(exc).strip() else type(exc).__name__,
+            )
             return None
         url = f"rerun+http://127.0.0.1:{port}/proxy"
         stream.connect_grpc(url)
@@ -264,7 +277,7 @@ class SegmentWriter:
             except RecordingWriteError as exc:
                 if out is self.primary:
                     self._on_write_error(out, exc, rows)
-                else:                       # a start_file clip: closed where it stands
+                else:  # a start_file clip: closed where it stands
                     self.write_errors += 1
                     f, out.file = out.file, None
                     log.error("rerun: %s; the file %s is closed", exc, f.path)
@@ -311,14 +324,14 @@ class SegmentWriter:
         self._rotation_failed_at = None
         old = out.file
         try:
-            old.write(self.write_timeout_s)     # nothing left, normally: the send wrote it
+            old.write(self.write_timeout_s)  # nothing left, normally: the send wrote it
         except RecordingWriteError as exc:
             created.discard()
             self._on_write_error(out, exc, 0)
             return None
         old_rows = out.rows
         try:
-            out.file = self._file_writer(created, out.stream)     # the stream's sink moves to the new file
+            out.file = self._file_writer(created, out.stream)  # the stream's sink moves to the new file
         except BaseException:
             created.discard()
             raise
@@ -358,14 +371,15 @@ class SegmentWriter:
             self._lost_since_fault = 0
         self._lost_since_fault += rows
         self.fault = f"recording write failed: {exc}"
-        log.error("rerun: %s; %d snapshots lost so far, retrying every %.0f s", self.fault, self.rows_lost,
-                  self.retry_s)
+        log.error(
+            "rerun: %s; %d snapshots lost so far, retrying every %.0f s", self.fault, self.rows_lost, self.retry_s
+        )
         f = out.file
         out.file = None
         if f is not None and not discarded:
             try:
                 if f.size() == 0:
-                    f.discard()              # this writer's own empty file
+                    f.discard()  # this writer's own empty file
                 else:
                     f.close()
             except OSError:
@@ -378,11 +392,11 @@ class SegmentWriter:
     def _sink_to_nowhere(self, out: Output) -> None:
         """While degraded the stream still gets every send: an in-memory sink that is emptied
         after each send (`_discard`) keeps its memory flat."""
-        if out.stream is None:     # a closed output has no sink to replace
+        if out.stream is None:  # a closed output has no sink to replace
             out.null_sink = None
             return
         try:
-            out.null_sink = rr.binary_stream(out.stream)     # replaces (and so ends) the failed sink
+            out.null_sink = rr.binary_stream(out.stream)  # replaces (and so ends) the failed sink
         except Exception:  # noqa: BLE001
             out.null_sink = None
 
@@ -417,12 +431,11 @@ class SegmentWriter:
             self.fault = f"recording write failed, retry failed: {exc}"
             return
         if self._segment_opened(out, created) is None:
-            return                                    # still failing: _on_write_error ran again
+            return  # still failing: _on_write_error ran again
         lost, since = self._lost_since_fault, self._fault_since
         assert since is not None  # set with the fault (_on_write_error)
         log.warning("rerun: recording again into %s after %s (%d snapshots lost)", created.path, self.fault, lost)
-        self.on_resume(f"recording resumed after {time.monotonic() - since:.0f} s: {lost} snapshots were "
-                       "not written")
+        self.on_resume(f"recording resumed after {time.monotonic() - since:.0f} s: {lost} snapshots were not written")
         self.fault = None
         self._fault_since = None
 
@@ -449,10 +462,10 @@ class SegmentWriter:
                 out.file.rebind(stream)
             elif out.viewer:
                 stream.connect_grpc(out.viewer_url)
-            else:                     # degraded main file: a sink emptied after each send
+            else:  # degraded main file: a sink emptied after each send
                 out.stream = stream
                 self._sink_to_nowhere(out)
-            out.stream = stream                  # (the file and the viewer have the static data)
+            out.stream = stream  # (the file and the viewer have the static data)
             try:
                 old.disconnect()
             except Exception as exc:  # noqa: BLE001 - only keeps the old stream alive

@@ -28,8 +28,7 @@ SEED_004_EPS = 2.46
 def _case(designation: str, radial: float, axial: float, settle_s: float, window_s: float) -> dict:
     """Run the DEM, sample the inner-ring displacement every 0.1 ms over the window, and solve
     Jones at the DEM's final ball azimuths."""
-    twin = Twin(designation, setpoint=Setpoint(shaft_speed_rad_s=SPEED_RAD_S, radial_load_n=radial,
-                                               axial_load_n=axial))
+    twin = Twin(designation, setpoint=Setpoint(shaft_speed_rad_s=SPEED_RAD_S, radial_load_n=radial, axial_load_n=axial))
     twin.advance(settle_s)
     samples = []
     for _ in range(max(1, int(round(window_s / 1e-4)))):
@@ -47,13 +46,19 @@ def _case(designation: str, radial: float, axial: float, settle_s: float, window
     delta_r = math.hypot(dx, dy)
     tan_a = math.tan(twin.model.contact_angle_rad)
     return {
-        "designation": designation, "radial": radial, "axial": axial, "psi": psi,
+        "designation": designation,
+        "radial": radial,
+        "axial": axial,
+        "psi": psi,
         "qi": np.array([b.inner.load_n for b in snap.balls]),
         "ai": np.degrees(np.abs([b.inner.contact_angle_rad for b in snap.balls])),
         "ao": np.degrees(np.abs([b.outer.contact_angle_rad for b in snap.balls])),
-        "jones": jones, "status": snap.status,
-        "disp_mean_m": float(mag.mean()), "jones_disp_m": float(np.linalg.norm(jones.ring_displacement_m)),
-        "drift": float(abs(means[-1] - means[0]) / mag.mean()), "ptp": float(np.ptp(mag) / mag.mean()),
+        "jones": jones,
+        "status": snap.status,
+        "disp_mean_m": float(mag.mean()),
+        "jones_disp_m": float(np.linalg.norm(jones.ring_displacement_m)),
+        "drift": float(abs(means[-1] - means[0]) / mag.mean()),
+        "ptp": float(np.ptp(mag) / mag.mean()),
         "eps": 0.5 * (1.0 + dz * tan_a / delta_r) if delta_r > 1e-9 else math.inf,
     }
 
@@ -77,17 +82,18 @@ def angular_contact_section(out_dir: Path, quick: bool) -> list[str]:
             psi = np.degrees(c["psi"][order])
             j = c["jones"]
             color = f"C{k}"
-            axes[0, col].plot(psi, j.inner_load_n[order], "-", color=color, lw=1,
-                              label=f"{name} ({angle:g} deg): Jones")
+            axes[0, col].plot(
+                psi, j.inner_load_n[order], "-", color=color, lw=1, label=f"{name} ({angle:g} deg): Jones"
+            )
             axes[0, col].plot(psi, c["qi"][order], "o", color=color, mfc="none", label=f"{name}: DEM")
             axes[1, col].plot(psi, np.degrees(j.inner_angle_rad[order]), "-", color=color, lw=1)
             axes[1, col].plot(psi, c["ai"][order], "o", color=color, mfc="none")
             axes[1, col].plot(psi, np.degrees(j.outer_angle_rad[order]), "--", color=color, lw=1)
             axes[1, col].plot(psi, c["ao"][order], "s", color=color, mfc="none", ms=4)
-        axes[0, col].set(title=f"Fr = {fr:g} N, Fa = {fa:g} N, {SPEED_RAD_S:g} rad/s",
-                         ylabel="inner contact load [N]")
-        axes[1, col].set(xlabel="ball azimuth from the radial load [deg]",
-                         ylabel="contact angle [deg] (inner o, outer s)")
+        axes[0, col].set(title=f"Fr = {fr:g} N, Fa = {fa:g} N, {SPEED_RAD_S:g} rad/s", ylabel="inner contact load [N]")
+        axes[1, col].set(
+            xlabel="ball azimuth from the radial load [deg]", ylabel="contact angle [deg] (inner o, outer s)"
+        )
     axes[0, 0].legend(fontsize=7)
     fig.suptitle("7208 family: DEM (markers) against Jones' quasi-static solution (lines)")
     save(fig, out / "angular_contact_jones.png")
@@ -114,7 +120,8 @@ def angular_contact_section(out_dir: Path, quick: bool) -> list[str]:
             f"| {c['designation']} | {c['radial']:g} / {c['axial']:g} | {c['qi'].max():.0f} / {j.qmax_n:.0f} "
             f"| {np.max(np.abs(c['qi'] - j.inner_load_n)) / j.qmax_n * 100:.1f} % | {dai:.2f} / {dao:.2f} "
             f"| {_fmt_eps(c['eps'])} / {_fmt_eps(j.epsilon)} | {c['disp_mean_m'] * 1e6:.1f} / "
-            f"{c['jones_disp_m'] * 1e6:.1f} | {c['drift'] * 100:.2f} % | {c['ptp'] * 100:.1f} % | {c['status']} |")
+            f"{c['jones_disp_m'] * 1e6:.1f} | {c['drift'] * 100:.2f} % | {c['ptp'] * 100:.1f} % | {c['status']} |"
+        )
     lines += [
         "",
         f"Seed 004 section 3.1 prints eps = {SEED_004_EPS} for this geometry under Fr = Fa = 3000 N. No "

@@ -34,9 +34,14 @@ def comparison(duration_s: float = 1.0) -> list[dict[str, Any]]:
     for rec in cwru.RECORDS:
         m, xm = cwru.measured(rec, duration_s)
         s, xs = cwru.simulated(rec, duration_s)
-        rows.append({"record": rec, "measured": (m, xm), "twin": (s, xs),
-                     "row": {"record": rec.number, "condition": rec.condition,
-                             "measured": asdict(m), "twin": asdict(s)}})
+        rows.append(
+            {
+                "record": rec,
+                "measured": (m, xm),
+                "twin": (s, xs),
+                "row": {"record": rec.number, "condition": rec.condition, "measured": asdict(m), "twin": asdict(s)},
+            }
+        )
     healthy = next(r for r in rows if r["record"].defect is None)
     for r in rows:
         for side in ("measured", "twin"):
@@ -63,8 +68,11 @@ def plot_comparison(rows: list[dict[str, Any]], path: str | Path) -> None:
         for k, (x, who) in enumerate(((xm, "measured"), (xs, "twin"))):
             a = r[who][0]
             ax[k].plot(np.arange(n) / fs * 1e3, x[:n], lw=0.5, color="k" if who == "measured" else "tab:blue")
-            ax[k].set(ylim=(-lim, lim), ylabel="acceleration [g]",
-                      title=f"{rec.number} {rec.condition}, {who}: RMS {a.rms_g:.3f} g, kurtosis {a.kurtosis:.2f}")
+            ax[k].set(
+                ylim=(-lim, lim),
+                ylabel="acceleration [g]",
+                title=f"{rec.number} {rec.condition}, {who}: RMS {a.rms_g:.3f} g, kurtosis {a.kurtosis:.2f}",
+            )
         ax[0].set_xlabel("time [ms]")
         ax[1].set_xlabel("time [ms]")
         for x, who, color in ((xm, "measured", "k"), (xs, "twin", "tab:blue")):
@@ -75,10 +83,19 @@ def plot_comparison(rows: list[dict[str, Any]], path: str | Path) -> None:
             line = cwru.PUBLISHED_MULTIPLES[rec.expected] * shaft
             for h in (1, 2, 3):
                 if h * line <= cwru.LINE_SEARCH_SHAFT[1] * shaft:
-                    ax[2].axvline(h * line, color="tab:red", ls="--" if h == 1 else ":", lw=0.9,
-                                  label=f"{rec.expected} {line:.1f} Hz" if h == 1 else None)
-        ax[2].set(xlabel="frequency [Hz]", ylabel="envelope [g]", yscale="log",
-                  title=f"envelope spectrum {cwru.ENVELOPE_BAND_HZ[0]:.0f}-{cwru.ENVELOPE_BAND_HZ[1]:.0f} Hz")
+                    ax[2].axvline(
+                        h * line,
+                        color="tab:red",
+                        ls="--" if h == 1 else ":",
+                        lw=0.9,
+                        label=f"{rec.expected} {line:.1f} Hz" if h == 1 else None,
+                    )
+        ax[2].set(
+            xlabel="frequency [Hz]",
+            ylabel="envelope [g]",
+            yscale="log",
+            title=f"envelope spectrum {cwru.ENVELOPE_BAND_HZ[0]:.0f}-{cwru.ENVELOPE_BAND_HZ[1]:.0f} Hz",
+        )
         ax[2].legend(loc="upper right", fontsize=7)
     save(fig, str(path), dpi=80)
 
@@ -91,11 +108,15 @@ def cwru_section(out_dir: str | Path, duration_s: float = 1.0) -> list[str]:
     out.mkdir(parents=True, exist_ok=True)
     rows = comparison(duration_s)
     plot_comparison(rows, out / FIGURE)
-    return ["## Vibration against the CWRU records (`python -m service.reports.cwru`)\n",
-            f"`CWRU-DE` at each record's speed against the measured drive-end acceleration, first "
-            f"{duration_s:g} s of each; measured / twin in every cell (docs/validation.md says what is "
-            "calibrated and why the fault levels are short).\n",
-            cwru.markdown([r["row"] for r in rows]), "", f"![CWRU records beside the twin]({FIGURE})\n"]
+    return [
+        "## Vibration against the CWRU records (`python -m service.reports.cwru`)\n",
+        f"`CWRU-DE` at each record's speed against the measured drive-end acceleration, first "
+        f"{duration_s:g} s of each; measured / twin in every cell (docs/validation.md says what is "
+        "calibrated and why the fault levels are short).\n",
+        cwru.markdown([r["row"] for r in rows]),
+        "",
+        f"![CWRU records beside the twin]({FIGURE})\n",
+    ]
 
 
 def main(argv=None) -> int:

@@ -19,15 +19,16 @@ BEARINGS_MM = {"6205": (25.0, 52.0, 15.0), "6208": (40.0, 80.0, 18.0), "6210": (
 SPEEDS_RAD_S = (100.0, 500.0, 1500.0)
 LOAD_SHARES_OF_C0 = (0.02, 0.06, 0.2)
 OIL_TEMPERATURE_C = 40.0
-ISO_HEAT_FLOW_DENSITY_W_MM2 = 0.016   # ISO 15312 reference heat flow density, radial bearings, A_r <= 50 000 mm^2
+ISO_HEAT_FLOW_DENSITY_W_MM2 = 0.016  # ISO 15312 reference heat flow density, radial bearings, A_r <= 50 000 mm^2
 ISO_OUTER_RING_C = 70.0
 ISO_LOAD_SHARE_OF_C0 = 0.05
 
 
 def _contact_torque_n_m(speed: float, load: float, designation: str, **kwargs) -> tuple[float, float]:
     """(contact friction torque, drag + seal torque) [N m] of the twin, oil bath, inlet heating on."""
-    total, twin = studies.mean_friction_torque_n_m(speed, load, designation=designation, shear_heating=True,
-                                                   lubrication=Lubrication(method="oil_bath"), **kwargs)
+    total, twin = studies.mean_friction_torque_n_m(
+        speed, load, designation=designation, shear_heating=True, lubrication=Lubrication(method="oil_bath"), **kwargs
+    )
     contact = twin.contact_friction_torque_n_m
     return contact, total - contact
 
@@ -35,8 +36,12 @@ def _contact_torque_n_m(speed: float, load: float, designation: str, **kwargs) -
 def skf_rows(quick: bool = False) -> list[dict]:
     """One row per (bearing, speed, load): twin contact torque, SKF M_rr + M_sl, their ratio."""
     lub = catalog.lubricant()
-    nu = viscosity.kinematic_viscosity_m2_s(lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s,
-                                            OIL_TEMPERATURE_C) * 1e6
+    nu = (
+        viscosity.kinematic_viscosity_m2_s(
+            lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s, OIL_TEMPERATURE_C
+        )
+        * 1e6
+    )
     rows = []
     designations = ("6208",) if quick else tuple(BEARINGS_MM)
     for d in designations:
@@ -47,19 +52,36 @@ def skf_rows(quick: bool = False) -> list[dict]:
                 load = share * c0
                 twin_nm, drag_nm = _contact_torque_n_m(speed, load, d)
                 skf = skf_friction.frictional_moment(d, bore, od, load, speed, nu)
-                rows.append({"bearing": d, "speed": speed, "load": load, "twin": twin_nm, "drag": drag_nm,
-                             "skf": skf.total_n_m, "phi": skf.phi_ish * skf.phi_rs})
+                rows.append(
+                    {
+                        "bearing": d,
+                        "speed": speed,
+                        "load": load,
+                        "twin": twin_nm,
+                        "drag": drag_nm,
+                        "skf": skf.total_n_m,
+                        "phi": skf.phi_ish * skf.phi_rs,
+                    }
+                )
     return rows
 
 
 def skf_markdown(rows: list[dict]) -> list[str]:
-    md = ["| bearing | speed [rad/s] | Fr [N] | twin contacts [mN m] | SKF M_rr + M_sl [mN m] | twin / SKF | "
-          "SKF phi_ish phi_rs | twin drag [mN m] |", "|---|---|---|---|---|---|---|---|"]
+    md = [
+        "| bearing | speed [rad/s] | Fr [N] | twin contacts [mN m] | SKF M_rr + M_sl [mN m] | twin / SKF | "
+        "SKF phi_ish phi_rs | twin drag [mN m] |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        md.append(f"| {r['bearing']} | {r['speed']:g} | {r['load']:.0f} | {1e3 * r['twin']:.1f} | "
-                  f"{1e3 * r['skf']:.1f} | {r['twin'] / r['skf']:.2f} | {r['phi']:.2f} | {1e3 * r['drag']:.2f} |")
-    md += ["", "| bearing | speed [rad/s] | load slope twin | load slope SKF | twin / SKF range |",
-           "|---|---|---|---|---|"]
+        md.append(
+            f"| {r['bearing']} | {r['speed']:g} | {r['load']:.0f} | {1e3 * r['twin']:.1f} | "
+            f"{1e3 * r['skf']:.1f} | {r['twin'] / r['skf']:.2f} | {r['phi']:.2f} | {1e3 * r['drag']:.2f} |"
+        )
+    md += [
+        "",
+        "| bearing | speed [rad/s] | load slope twin | load slope SKF | twin / SKF range |",
+        "|---|---|---|---|---|",
+    ]
     for d in sorted({r["bearing"] for r in rows}):
         for speed in SPEEDS_RAD_S:
             sel = [r for r in rows if r["bearing"] == d and r["speed"] == speed]
@@ -78,28 +100,48 @@ def iso15312_rows() -> list[dict]:
     centre of the lowest ball; twin.physics.drag), which the reference heat flow cannot hold."""
     rows = []
     lub = catalog.lubricant("ISO VG 32")
-    nu = viscosity.kinematic_viscosity_m2_s(lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s,
-                                            ISO_OUTER_RING_C)
+    nu = viscosity.kinematic_viscosity_m2_s(
+        lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s, ISO_OUTER_RING_C
+    )
     for d, (bore, od, width) in BEARINGS_MM.items():
         speed = catalog.thermal_reference_speed_rad_s(d)
         load = ISO_LOAD_SHARE_OF_C0 * catalog.load_ratings(d).static_load_rating_n
         total, twin = studies.mean_friction_torque_n_m(
-            speed, load, designation=d, shear_heating=True, lubricant=lub, oil_temperature_c=ISO_OUTER_RING_C,
-            limiting_speed_rad_s=1.1 * speed)
+            speed,
+            load,
+            designation=d,
+            shear_heating=True,
+            lubricant=lub,
+            oil_temperature_c=ISO_OUTER_RING_C,
+            limiting_speed_rad_s=1.1 * speed,
+        )
         reference = ISO_HEAT_FLOW_DENSITY_W_MM2 * math.pi * width * (od + bore)
         bath = catalog.bearing(d, lubrication=Lubrication(method="oil_bath"))
         drag_w = oil_bath_drag_power_w(bath, speed, nu)
-        rows.append({"bearing": d, "speed": speed, "load": load, "power": total * speed, "reference": reference,
-                     "drag_w": drag_w})
+        rows.append(
+            {
+                "bearing": d,
+                "speed": speed,
+                "load": load,
+                "power": total * speed,
+                "reference": reference,
+                "drag_w": drag_w,
+            }
+        )
     return rows
 
 
 def iso15312_markdown(rows: list[dict]) -> list[str]:
-    md = ["| bearing | n_theta_r [r/min] | P = 0.05 C0 [N] | twin contact friction power [W] | "
-          "ISO 15312 reference [W] | ratio | SKF drag at the standard's oil level [W] |", "|---|---|---|---|---|---|---|"]
+    md = [
+        "| bearing | n_theta_r [r/min] | P = 0.05 C0 [N] | twin contact friction power [W] | "
+        "ISO 15312 reference [W] | ratio | SKF drag at the standard's oil level [W] |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
-        md.append(f"| {r['bearing']} | {r['speed'] * 30 / math.pi:.0f} | {r['load']:.0f} | {r['power']:.1f} | "
-                  f"{r['reference']:.1f} | {r['power'] / r['reference']:.2f} | {r['drag_w']:.1f} |")
+        md.append(
+            f"| {r['bearing']} | {r['speed'] * 30 / math.pi:.0f} | {r['load']:.0f} | {r['power']:.1f} | "
+            f"{r['reference']:.1f} | {r['power'] / r['reference']:.2f} | {r['drag_w']:.1f} |"
+        )
     return md
 
 

@@ -48,12 +48,14 @@ def thermal_section(out: Path, quick: bool) -> list[str]:
     coupled = ", ".join(f"{t:.0f}" for t in tau_coupled[:3])
     ends = ", ".join(f"{n} {end[k]:.1f}" for k, n in enumerate(NODE_NAMES))
     steadies = ", ".join(f"{n} {v:.1f}" for n, v in steady["temperatures_c"].items())
-    return ["## Thermal network: start-up from cold (6208, 1000 rad/s, 3000 N, ambient 20 degC)\n",
-            f"![thermal start-up]({png.name})\n",
-            f"Network time constants (real heat capacities): {taus} s; with the friction's feedback (heat "
-            f"falling as the oil thins) {coupled} s. The outer ring's approach to its end value decays with "
-            f"{fitted:.0f} s.\n",
-            f"After {duration / 60:.0f} min: {ends} degC; fixed-point steady state: {steadies} degC (largest "
-            f"difference {diff:.2f} K). Friction {tr.friction_torque_n_m[1]:.3f} -> {tr.friction_torque_n_m[-1]:.3f} "
-            f"N m, viscosity {tr.viscosity_pa_s[0] * 1e3:.1f} -> {tr.viscosity_pa_s[-1] * 1e3:.1f} mPa s, smallest "
-            f"Lambda {tr.min_lambda[0]:.2f} -> {tr.min_lambda[-1]:.2f}.\n"]
+    return [
+        "## Thermal network: start-up from cold (6208, 1000 rad/s, 3000 N, ambient 20 degC)\n",
+        f"![thermal start-up]({png.name})\n",
+        f"Network time constants (real heat capacities): {taus} s; with the friction's feedback (heat "
+        f"falling as the oil thins) {coupled} s. The outer ring's approach to its end value decays with "
+        f"{fitted:.0f} s.\n",
+        f"After {duration / 60:.0f} min: {ends} degC; fixed-point steady state: {steadies} degC (largest "
+        f"difference {diff:.2f} K). Friction {tr.friction_torque_n_m[1]:.3f} -> {tr.friction_torque_n_m[-1]:.3f} "
+        f"N m, viscosity {tr.viscosity_pa_s[0] * 1e3:.1f} -> {tr.viscosity_pa_s[-1] * 1e3:.1f} mPa s, smallest "
+        f"Lambda {tr.min_lambda[0]:.2f} -> {tr.min_lambda[-1]:.2f}.\n",
+    ]

@@ -17,78 +17,130 @@ class AlarmSettings(BaseModel):
     model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
 
     machine_group: Literal[1, 2] = Field(
-        default=2, description="ISO 20816-3 machine group [1 | 2]: 1 = large machines (300 kW to "
-        "50 MW, Table A.1), 2 = medium machines (15 kW to 300 kW, Table A.2).")
+        default=2,
+        description="ISO 20816-3 machine group [1 | 2]: 1 = large machines (300 kW to "
+        "50 MW, Table A.1), 2 = medium machines (15 kW to 300 kW, Table A.2).",
+    )
     support: Literal["rigid", "flexible"] = Field(
-        default="rigid", description="ISO 20816-3 support class [rigid | flexible] (clause 4.4).")
+        default="rigid", description="ISO 20816-3 support class [rigid | flexible] (clause 4.4)."
+    )
     clear_ratio: float = Field(
-        default=0.9, gt=0.0, lt=1.0,
+        default=0.9,
+        gt=0.0,
+        lt=1.0,
         description="Hysteresis of the 'above' alarms: an alarm raised at threshold T clears below "
-        "clear_ratio x T (the 'below' alarms clear above T / clear_ratio) [-].")
+        "clear_ratio x T (the 'below' alarms clear above T / clear_ratio) [-].",
+    )
     clear_hold_s: float = Field(
-        default=1.0, ge=0.0, le=3600.0,
+        default=1.0,
+        ge=0.0,
+        le=3600.0,
         description="The value must stay on the clear side of the clear threshold this long before "
-        "an alarm clears or steps down [s of simulated time].")
+        "an alarm clears or steps down [s of simulated time].",
+    )
     vibration_delay_s: float = Field(
-        default=0.0, ge=0.0, le=3600.0,
-        description="A vibration zone alarm rises after the velocity RMS stays in zone C or D this long [s].")
+        default=0.0,
+        ge=0.0,
+        le=3600.0,
+        description="A vibration zone alarm rises after the velocity RMS stays in zone C or D this long [s].",
+    )
     lubrication_delay_s: float = Field(
-        default=1.0, ge=0.0, le=3600.0,
+        default=1.0,
+        ge=0.0,
+        le=3600.0,
         description="A lubrication alarm rises after kappa < kappa_threshold, or a loaded contact in "
-        "the boundary regime, lasts this long [s of simulated time].")
+        "the boundary regime, lasts this long [s of simulated time].",
+    )
     kappa_threshold: float = Field(
-        default=1.0, gt=0.0, le=10.0,
+        default=1.0,
+        gt=0.0,
+        le=10.0,
         description="Viscosity ratio kappa = nu / nu1 (ISO 281:2007 clause 9.3) below which the "
-        "lubrication alarm rises [-].")
+        "lubrication alarm rises [-].",
+    )
     boundary_lambda: float = Field(
-        default=1.0, gt=0.0, le=10.0,
+        default=1.0,
+        gt=0.0,
+        le=10.0,
         description="Film parameter at or below which a contact is in the boundary regime (seed "
-        "000 Table 2: Lambda <= 1) [-].")
+        "000 Table 2: Lambda <= 1) [-].",
+    )
     loaded_contact_fraction: float = Field(
-        default=0.1, ge=0.0, le=1.0,
+        default=0.1,
+        ge=0.0,
+        le=1.0,
         description="A contact counts as loaded when it carries at least this fraction of the "
-        "largest contact load of the snapshot [-].")
+        "largest contact load of the snapshot [-].",
+    )
     discharge_delay_s: float = Field(
-        default=0.0, ge=0.0, le=3600.0,
+        default=0.0,
+        ge=0.0,
+        le=3600.0,
         description="The electrical alarm rises after the discharge risk stays 'possible' or "
-        "'likely' this long [s of simulated time].")
+        "'likely' this long [s of simulated time].",
+    )
     defect_amplitude_m_s2: float = Field(
-        default=0.5, gt=0.0, le=1e4,
+        default=0.5,
+        gt=0.0,
+        le=1e4,
         description="Envelope amplitude of a defect line (FTF, BPFO, BPFI, BSF) above which its "
         "alarm rises [m/s^2]; a line must also stand defect_significance x the envelope noise "
-        "floor above it when the floor is known.")
+        "floor above it when the floor is known.",
+    )
     defect_significance: float = Field(
-        default=4.0, ge=1.0, le=100.0,
+        default=4.0,
+        ge=1.0,
+        le=100.0,
         description="Times the envelope noise floor (median) a defect line must exceed [-] "
-        "(twin.vibration.indicators.SIGNIFICANCE).")
+        "(twin.vibration.indicators.SIGNIFICANCE).",
+    )
     defect_delay_s: float = Field(
-        default=0.0, ge=0.0, le=3600.0, description="A defect alarm rises after its line stays above "
-        "the threshold this long [s of simulated time].")
+        default=0.0,
+        ge=0.0,
+        le=3600.0,
+        description="A defect alarm rises after its line stays above the threshold this long [s of simulated time].",
+    )
     life_used_warning: float = Field(
-        default=0.5, gt=0.0, le=10.0,
-        description="Palmgren-Miner damage fraction above which the life alarm is a warning [-].")
+        default=0.5,
+        gt=0.0,
+        le=10.0,
+        description="Palmgren-Miner damage fraction above which the life alarm is a warning [-].",
+    )
     life_used_critical: float = Field(
-        default=0.9, gt=0.0, le=10.0,
-        description="Damage fraction above which the life alarm is critical [-].")
+        default=0.9, gt=0.0, le=10.0, description="Damage fraction above which the life alarm is critical [-]."
+    )
     temperature_warning_c: float = Field(
-        default=82.0, gt=-30.0, le=300.0,
+        default=82.0,
+        gt=-30.0,
+        le=300.0,
         description="Outer-ring temperature above which the temperature alarm is a warning [degC] (82 degC: the oil "
-        "sump limit of ISO 13709 / API 610 for ring-oil and splash lubricated bearings).")
+        "sump limit of ISO 13709 / API 610 for ring-oil and splash lubricated bearings).",
+    )
     temperature_critical_c: float = Field(
-        default=95.0, gt=-30.0, le=300.0,
-        description="Outer-ring temperature above which the temperature alarm is critical [degC].")
+        default=95.0,
+        gt=-30.0,
+        le=300.0,
+        description="Outer-ring temperature above which the temperature alarm is critical [degC].",
+    )
     temperature_rate_warning_k_per_min: float = Field(
-        default=5.0, gt=0.0, le=1000.0,
+        default=5.0,
+        gt=0.0,
+        le=1000.0,
         description="Rate of rise of the outer ring (over a minute of thermal time) above which the rate alarm is a "
-        "warning [K/min].")
+        "warning [K/min].",
+    )
     temperature_rate_critical_k_per_min: float = Field(
-        default=10.0, gt=0.0, le=1000.0,
-        description="Rate of rise above which the rate alarm is critical [K/min].")
+        default=10.0, gt=0.0, le=1000.0, description="Rate of rise above which the rate alarm is critical [K/min]."
+    )
     temperature_delay_s: float = Field(
-        default=0.0, ge=0.0, le=3600.0,
-        description="A temperature alarm rises after its value stays beyond the threshold this long [s of simulated time].")
-    history: int = Field(default=200, ge=1, le=100000,
-                         description="Alarm events kept per twin for GET .../alarms [count].")
+        default=0.0,
+        ge=0.0,
+        le=3600.0,
+        description="A temperature alarm rises after its value stays beyond the threshold this long [s of simulated time].",
+    )
+    history: int = Field(
+        default=200, ge=1, le=100000, description="Alarm events kept per twin for GET .../alarms [count]."
+    )
 
     @field_validator("machine_group", mode="before")
     @classmethod
@@ -99,6 +151,8 @@ class AlarmSettings(BaseModel):
     @model_validator(mode="after")
     def _ordered(self) -> AlarmSettings:
         if self.life_used_critical < self.life_used_warning:
-            raise ValueError(f"life_used_critical = {self.life_used_critical:g} must be >= "
-                             f"life_used_warning = {self.life_used_warning:g}")
+            raise ValueError(
+                f"life_used_critical = {self.life_used_critical:g} must be >= "
+                f"life_used_warning = {self.life_used_warning:g}"
+            )
         return self

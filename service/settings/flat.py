@@ -19,8 +19,13 @@ from typing import Any, cast
 
 from pydantic import BaseModel
 from pydantic.fields import FieldInfo
-from pydantic_settings import (BaseSettings, EnvSettingsSource, InitSettingsSource, PydanticBaseSettingsSource,
-                               SettingsConfigDict)
+from pydantic_settings import (
+    BaseSettings,
+    EnvSettingsSource,
+    InitSettingsSource,
+    PydanticBaseSettingsSource,
+    SettingsConfigDict,
+)
 
 ENV_PREFIX = "BEARING_TWIN_"
 NESTED_DELIMITER = "__"
@@ -42,11 +47,11 @@ def flat(name: str, *flags: str, metavar: str | None = None) -> dict[str, Any]:
 class FlatSetting:
     """One field of a settings group and its flat name."""
 
-    flat: str                   # e.g. "port"
-    group: str                  # e.g. "http"
-    field: str                  # e.g. "port"
+    flat: str  # e.g. "port"
+    group: str  # e.g. "http"
+    field: str  # e.g. "port"
     info: FieldInfo
-    flags: tuple[str, ...]      # e.g. ("--port",)
+    flags: tuple[str, ...]  # e.g. ("--port",)
     metavar: str | None
 
     @property
@@ -109,12 +114,11 @@ def flat_settings(root: type[BaseModel]) -> tuple[FlatSetting, ...]:
             if not isinstance(extra, dict) or "flat" not in extra:
                 continue
             flat_name = str(extra["flat"])
-            negated = info.default is True              # a switch that turns a default-on setting off
+            negated = info.default is True  # a switch that turns a default-on setting off
             option = f"--{'no-' if negated else ''}{flat_name.replace('_', '-')}"
             flags = tuple(str(f) for f in cast(list, extra.get("flags", [option])))
             metavar = extra.get("metavar")
-            found.append(FlatSetting(flat_name, group, name, info, flags,
-                                     None if metavar is None else str(metavar)))
+            found.append(FlatSetting(flat_name, group, name, info, flags, None if metavar is None else str(metavar)))
     names = [s.flat for s in found]
     if len(set(names)) != len(names):
         raise TypeError(f"{root.__name__}: a flat settings name is used twice")
@@ -159,7 +163,7 @@ class FlatEnvSettingsSource(EnvSettingsSource):
                 continue
             value = env[key]
             if setting.flat in settings_cls.model_fields and (value or "").lstrip().startswith("{"):
-                continue                    # the group itself, as JSON
+                continue  # the group itself, as JSON
             self.flat_values.append((setting, env.pop(key)))
         self.env_vars = env
 
@@ -176,16 +180,27 @@ class NestedSettings(BaseSettings):
     """A settings root: groups read from `BEARING_TWIN_<GROUP>__<FIELD>` or the flat names,
     keyword arguments nested or flat; an unknown keyword is an error."""
 
-    model_config = SettingsConfigDict(env_prefix=ENV_PREFIX, env_nested_delimiter=NESTED_DELIMITER,
-                                      extra="forbid", validate_default=True, hide_input_in_errors=True)
+    model_config = SettingsConfigDict(
+        env_prefix=ENV_PREFIX,
+        env_nested_delimiter=NESTED_DELIMITER,
+        extra="forbid",
+        validate_default=True,
+        hide_input_in_errors=True,
+    )
 
     @classmethod
-    def settings_customise_sources(cls, settings_cls: type[BaseSettings],
-                                   init_settings: PydanticBaseSettingsSource,
-                                   env_settings: PydanticBaseSettingsSource,
-                                   dotenv_settings: PydanticBaseSettingsSource,
-                                   file_secret_settings: PydanticBaseSettingsSource,
-                                   ) -> tuple[PydanticBaseSettingsSource, ...]:
+    def settings_customise_sources(
+        cls,
+        settings_cls: type[BaseSettings],
+        init_settings: PydanticBaseSettingsSource,
+        env_settings: PydanticBaseSettingsSource,
+        dotenv_settings: PydanticBaseSettingsSource,
+        file_secret_settings: PydanticBaseSettingsSource,
+    ) -> tuple[PydanticBaseSettingsSource, ...]:
         given = cast(InitSettingsSource, init_settings).init_kwargs
-        return (InitSettingsSource(settings_cls, init_kwargs=nest_flat(settings_cls, given)),
-                FlatEnvSettingsSource(settings_cls), dotenv_settings, file_secret_settings)
+        return (
+            InitSettingsSource(settings_cls, init_kwargs=nest_flat(settings_cls, given)),
+            FlatEnvSettingsSource(settings_cls),
+            dotenv_settings,
+            file_secret_settings,
+        )

@@ -15,28 +15,51 @@ class HttpSettings(BaseModel):
 
     model_config = ConfigDict(extra="forbid", hide_input_in_errors=True)
 
-    host: str = Field(default="127.0.0.1", json_schema_extra=flat("host"),
-                      description="HTTP bind address [IP or host name]; loopback only unless set "
-                      "(0.0.0.0 exposes the API on every interface).")
-    port: int = Field(default=8000, ge=0, le=65535, json_schema_extra=flat("port"),
-                      description="HTTP port [TCP port number, 0 = any free port].")
+    host: str = Field(
+        default="127.0.0.1",
+        json_schema_extra=flat("host"),
+        description="HTTP bind address [IP or host name]; loopback only unless set "
+        "(0.0.0.0 exposes the API on every interface).",
+    )
+    port: int = Field(
+        default=8000,
+        ge=0,
+        le=65535,
+        json_schema_extra=flat("port"),
+        description="HTTP port [TCP port number, 0 = any free port].",
+    )
     header_timeout_s: float = Field(
-        default=10.0, gt=0.0, le=600.0, json_schema_extra=flat("http_header_timeout_s"),
+        default=10.0,
+        gt=0.0,
+        le=600.0,
+        json_schema_extra=flat("http_header_timeout_s"),
         description="A request's line and headers must be complete this long after the connection "
         "opened (or the next request's first byte arrived); else 408 and the connection is closed "
-        "(slow clients) [s].")
+        "(slow clients) [s].",
+    )
     body_timeout_s: float = Field(
-        default=30.0, gt=0.0, le=3600.0, json_schema_extra=flat("http_body_timeout_s"),
+        default=30.0,
+        gt=0.0,
+        le=3600.0,
+        json_schema_extra=flat("http_body_timeout_s"),
         description="A request body must be complete this long after its headers; else 408 and the "
-        "connection is closed [s].")
+        "connection is closed [s].",
+    )
     keep_alive_s: int = Field(
-        default=5, ge=1, le=3600, json_schema_extra=flat("http_keep_alive_s"),
-        description="An idle kept-alive HTTP connection is closed after this long (uvicorn "
-        "timeout_keep_alive) [s].")
+        default=5,
+        ge=1,
+        le=3600,
+        json_schema_extra=flat("http_keep_alive_s"),
+        description="An idle kept-alive HTTP connection is closed after this long (uvicorn timeout_keep_alive) [s].",
+    )
     max_connections: int = Field(
-        default=256, ge=8, le=100_000, json_schema_extra=flat("http_max_connections"),
+        default=256,
+        ge=8,
+        le=100_000,
+        json_schema_extra=flat("http_max_connections"),
         description="Open HTTP connections (or running requests) beyond which a new request gets 503 "
-        "(uvicorn limit_concurrency) [count].")
+        "(uvicorn limit_concurrency) [count].",
+    )
 
 
 class SecuritySettings(BaseModel):
@@ -45,48 +68,87 @@ class SecuritySettings(BaseModel):
     model_config = ConfigDict(extra="forbid", hide_input_in_errors=True)
 
     token: SecretStr | None = Field(
-        default=None, json_schema_extra=flat("token"),
+        default=None,
+        json_schema_extra=flat("token"),
         description="Bearer token of every mutating HTTP request (and of reads with read_requires_token) and OPC UA "
-        "password [text]; unset = no authentication; never on zenoh; environment only (docs/operations.md).")
+        "password [text]; unset = no authentication; never on zenoh; environment only (docs/operations.md).",
+    )
     read_requires_token: bool = Field(
-        default=False, json_schema_extra=flat("read_requires_token"),
-        description="Also require the token for reads (GET), except GET /health [bool].")
+        default=False,
+        json_schema_extra=flat("read_requires_token"),
+        description="Also require the token for reads (GET), except GET /health [bool].",
+    )
     setpoint_rate_hz: float = Field(
-        default=50.0, ge=0.0, le=1e6, json_schema_extra=flat("setpoint_rate_hz"),
+        default=50.0,
+        ge=0.0,
+        le=1e6,
+        json_schema_extra=flat("setpoint_rate_hz"),
         description="Sustained setpoint rate per twin, HTTP and zenoh together [1/s]; 0 = no limit. "
-        "Beyond it: HTTP 429 with Retry-After, zenoh refusal on the result key.")
+        "Beyond it: HTTP 429 with Retry-After, zenoh refusal on the result key.",
+    )
     setpoint_burst: int = Field(
-        default=100, ge=1, le=1_000_000, json_schema_extra=flat("setpoint_burst"),
-        description="Setpoints a twin accepts in a burst before the rate applies [count].")
+        default=100,
+        ge=1,
+        le=1_000_000,
+        json_schema_extra=flat("setpoint_burst"),
+        description="Setpoints a twin accepts in a burst before the rate applies [count].",
+    )
     max_body_bytes: int = Field(
-        default=64 * 1024, ge=256, le=64 * 1024 * 1024, json_schema_extra=flat("max_body_bytes"),
-        description="Largest HTTP request body (and zenoh setpoint payload) accepted [bytes]; "
-        "larger: 413.")
+        default=64 * 1024,
+        ge=256,
+        le=64 * 1024 * 1024,
+        json_schema_extra=flat("max_body_bytes"),
+        description="Largest HTTP request body (and zenoh setpoint payload) accepted [bytes]; larger: 413.",
+    )
     read_rate_hz: float = Field(
-        default=100.0, ge=0.0, le=1e6, json_schema_extra=flat("read_rate_hz"),
+        default=100.0,
+        ge=0.0,
+        le=1e6,
+        json_schema_extra=flat("read_rate_hz"),
         description="Sustained rate of API reads (GET/HEAD under /v1/) per client address [1/s]; 0 = no "
-        "limit. Beyond it: 429 with Retry-After naming the limit. /health and the docs are not counted.")
+        "limit. Beyond it: 429 with Retry-After naming the limit. /health and the docs are not counted.",
+    )
     read_burst: int = Field(
-        default=200, ge=1, le=1_000_000, json_schema_extra=flat("read_burst"),
-        description="Reads a client may make in a burst before read_rate_hz applies [count].")
+        default=200,
+        ge=1,
+        le=1_000_000,
+        json_schema_extra=flat("read_burst"),
+        description="Reads a client may make in a burst before read_rate_hz applies [count].",
+    )
     client_error_rate_hz: float = Field(
-        default=5.0, ge=0.0, le=1e6, json_schema_extra=flat("client_error_rate_hz"),
+        default=5.0,
+        ge=0.0,
+        le=1e6,
+        json_schema_extra=flat("client_error_rate_hz"),
         description="Sustained rate of refused HTTP requests (any 4xx answer: wrong or missing token, over a rate "
         "limit, invalid, unknown) a client address may cause before its refusals are held in the tarpit "
-        "(tarpit_delay_s) [1/s]; 0 = no tarpit. /health is never counted nor held.")
+        "(tarpit_delay_s) [1/s]; 0 = no tarpit. /health is never counted nor held.",
+    )
     client_error_burst: int = Field(
-        default=20, ge=1, le=1_000_000, json_schema_extra=flat("client_error_burst"),
-        description="Refused requests a client may cause in a burst before client_error_rate_hz applies [count].")
+        default=20,
+        ge=1,
+        le=1_000_000,
+        json_schema_extra=flat("client_error_burst"),
+        description="Refused requests a client may cause in a burst before client_error_rate_hz applies [count].",
+    )
     tarpit_delay_s: float = Field(
-        default=2.0, ge=0.0, le=60.0, json_schema_extra=flat("tarpit_delay_s"),
+        default=2.0,
+        ge=0.0,
+        le=60.0,
+        json_schema_extra=flat("tarpit_delay_s"),
         description="A client over its error budget (client_error_rate_hz) gets each refusal this long after it "
         "was decided, with Retry-After; the wait is an asyncio timer (no thread, no CPU), so a client that waits "
-        "for its answers before sending more (a closed-loop flood) slows itself down [s]; 0 = no tarpit.")
+        "for its answers before sending more (a closed-loop flood) slows itself down [s]; 0 = no tarpit.",
+    )
     tarpit_max_held: int = Field(
-        default=64, ge=1, le=100_000, json_schema_extra=flat("tarpit_max_held"),
+        default=64,
+        ge=1,
+        le=100_000,
+        json_schema_extra=flat("tarpit_max_held"),
         description="Refusals held in the tarpit at one time, at most [count]; beyond it a refusal is answered at "
         "once (counted in /health http_tarpit). Below http_max_connections: the held connections count "
-        "against it.")
+        "against it.",
+    )
 
     @field_validator("token", mode="before")
     @classmethod
@@ -97,7 +159,7 @@ class SecuritySettings(BaseModel):
             return None
         if isinstance(value, str):
             if not value.strip():
-                return None   # BEARING_TWIN_TOKEN="" means no token
+                return None  # BEARING_TWIN_TOKEN="" means no token
             if any(c.isspace() or not c.isprintable() for c in value):
                 raise ValueError("the token must be printable characters without spaces")
         return value

@@ -78,8 +78,7 @@ def read_usersfile(path: Path) -> list[str]:
             continue
         user, sep, password = line.partition(":")
         if not sep or not user.strip() or not password.strip():
-            raise ValueError(f"{str(path)!r} line {number}: expected `user:password` "
-                             "(both non-empty)")
+            raise ValueError(f"{str(path)!r} line {number}: expected `user:password` (both non-empty)")
         users.append(user.strip())
     if not users:
         raise ValueError(f"{str(path)!r} holds no `user:password` line")

@@ -32,47 +32,65 @@ class ZenohAccessConfig(BaseModel):
     model_config = ConfigDict(extra="forbid", hide_input_in_errors=True)
 
     prefix: str = Field(
-        default=DEFAULT_PREFIX, json_schema_extra=flat("zenoh_prefix", metavar="PREFIX"),
+        default=DEFAULT_PREFIX,
+        json_schema_extra=flat("zenoh_prefix", metavar="PREFIX"),
         description="Key prefix of the twins on zenoh [key expression chunks, e.g. plant1/line2/motor7]: "
         "a twin publishes under {prefix}/{id}/...; site / line / asset, up to 8 chunks of letters, "
         "digits, '_', '.', '-'. The router and the monitor also take patterns with '*' and '**' "
-        "(e.g. plant1/**).")
+        "(e.g. plant1/**).",
+    )
     user: str | None = Field(
-        default=None, json_schema_extra=flat("zenoh_user", metavar="USER"),
+        default=None,
+        json_schema_extra=flat("zenoh_user", metavar="USER"),
         description="User name this process presents when it connects to a zenoh router or peer "
-        "[text]; with zenoh_password (zenoh user-password authentication).")
+        "[text]; with zenoh_password (zenoh user-password authentication).",
+    )
     password: SecretStr | None = Field(
-        default=None, json_schema_extra=flat("zenoh_password"),
+        default=None,
+        json_schema_extra=flat("zenoh_password"),
         description="Password of zenoh_user [text]; give it in the environment "
-        "(BEARING_TWIN_ZENOH_PASSWORD), never on a command line.")
+        "(BEARING_TWIN_ZENOH_PASSWORD), never on a command line.",
+    )
     usersfile: Path | None = Field(
-        default=None, json_schema_extra=flat("zenoh_usersfile", metavar="FILE"),
+        default=None,
+        json_schema_extra=flat("zenoh_usersfile", metavar="FILE"),
         description="Users allowed to connect to this process's zenoh endpoints [path to a file of "
-        "`user:password` lines, zenoh's usrpwd dictionary]; keep it readable by the service only.")
+        "`user:password` lines, zenoh's usrpwd dictionary]; keep it readable by the service only.",
+    )
     writers: Annotated[list[str], NoDecode] = Field(
-        default_factory=list, json_schema_extra=flat("zenoh_writers", metavar="NAME"),
-        description="Users (or TLS certificate common names) that may put setpoints, and read "
-        "[comma-separated names].")
+        default_factory=list,
+        json_schema_extra=flat("zenoh_writers", metavar="NAME"),
+        description="Users (or TLS certificate common names) that may put setpoints, and read [comma-separated names].",
+    )
     readers: Annotated[list[str], NoDecode] = Field(
-        default_factory=list, json_schema_extra=flat("zenoh_readers", metavar="NAME"),
+        default_factory=list,
+        json_schema_extra=flat("zenoh_readers", metavar="NAME"),
         description="Users (or certificate common names) that may only read: state, balls, "
-        "setpoint results, snapshots, liveliness [comma-separated names].")
+        "setpoint results, snapshots, liveliness [comma-separated names].",
+    )
     services: Annotated[list[str], NoDecode] = Field(
-        default_factory=list, json_schema_extra=flat("zenoh_services", metavar="NAME"),
+        default_factory=list,
+        json_schema_extra=flat("zenoh_services", metavar="NAME"),
         description="Users (or certificate common names) of twin services joining a router: they "
         "publish state, answer queries and declare liveliness tokens [comma-separated names]; "
-        "the service's own zenoh_user is always one.")
+        "the service's own zenoh_user is always one.",
+    )
     tls_root_ca: Path | None = Field(
-        default=None, json_schema_extra=flat("zenoh_tls_root_ca", metavar="CA.pem"),
+        default=None,
+        json_schema_extra=flat("zenoh_tls_root_ca", metavar="CA.pem"),
         description="CA certificate that signed every node's certificate [path, PEM]; "
-        "with zenoh_tls_certificate and zenoh_tls_private_key: mutual TLS on tls/ endpoints.")
+        "with zenoh_tls_certificate and zenoh_tls_private_key: mutual TLS on tls/ endpoints.",
+    )
     tls_certificate: Path | None = Field(
-        default=None, json_schema_extra=flat("zenoh_tls_certificate", metavar="CERT.pem"),
-        description="This process's TLS certificate [path, PEM]; its common name is "
-        "the name the roles match.")
+        default=None,
+        json_schema_extra=flat("zenoh_tls_certificate", metavar="CERT.pem"),
+        description="This process's TLS certificate [path, PEM]; its common name is the name the roles match.",
+    )
     tls_private_key: Path | None = Field(
-        default=None, json_schema_extra=flat("zenoh_tls_private_key", metavar="KEY.pem"),
-        description="Private key of zenoh_tls_certificate [path, PEM].")
+        default=None,
+        json_schema_extra=flat("zenoh_tls_private_key", metavar="KEY.pem"),
+        description="Private key of zenoh_tls_certificate [path, PEM].",
+    )
 
     @field_validator("writers", "readers", "services", mode="before")
     @classmethod
@@ -80,8 +98,10 @@ class ZenohAccessConfig(BaseModel):
         names = split_list(value)
         for name in names:
             if not isinstance(name, str) or not NAME_RE.match(name):
-                raise ValueError("role members are user names or certificate common names: 1-128 "
-                                 "letters, digits, '_', '.', '@', '+', '-'")
+                raise ValueError(
+                    "role members are user names or certificate common names: 1-128 "
+                    "letters, digits, '_', '.', '@', '+', '-'"
+                )
         return list(dict.fromkeys(names))
 
     @field_validator("user", mode="before")
@@ -114,24 +134,31 @@ class ZenohAccessConfig(BaseModel):
     def _prefix(cls, value: str) -> str:
         value = value.strip().strip("/")
         if len(value) > 200 or not PREFIX_WILDCARD_RE.match(value):
-            raise ValueError("a key prefix is 1-8 chunks of letters, digits, '_', '.', '-' separated "
-                             "by '/' (patterns may use '*' and '**'), e.g. plant1/line2/motor7")
+            raise ValueError(
+                "a key prefix is 1-8 chunks of letters, digits, '_', '.', '-' separated "
+                "by '/' (patterns may use '*' and '**'), e.g. plant1/line2/motor7"
+            )
         return value
 
     @model_validator(mode="after")
     def _access(self) -> ZenohAccessConfig:
         if (self.user is None) != (self.password is None):
             missing = "zenoh_password" if self.password is None else "zenoh_user"
-            raise ValueError(f"{missing}: zenoh credentials are a user and a password together "
-                             "(BEARING_TWIN_ZENOH_USER, BEARING_TWIN_ZENOH_PASSWORD)")
+            raise ValueError(
+                f"{missing}: zenoh credentials are a user and a password together "
+                "(BEARING_TWIN_ZENOH_USER, BEARING_TWIN_ZENOH_PASSWORD)"
+            )
         if self.usersfile is not None:
-            read_usersfile(self.usersfile)            # ValueError naming the line
+            read_usersfile(self.usersfile)  # ValueError naming the line
         tls = (self.tls_root_ca, self.tls_certificate, self.tls_private_key)
         if any(t is not None for t in tls) and not all(t is not None for t in tls):
-            raise ValueError("zenoh_tls_certificate: mutual TLS needs the CA certificate, this "
-                             "process's certificate and its private key together")
-        for name, path in zip(("zenoh_tls_root_ca", "zenoh_tls_certificate", "zenoh_tls_private_key"),
-                              tls, strict=True):
+            raise ValueError(
+                "zenoh_tls_certificate: mutual TLS needs the CA certificate, this "
+                "process's certificate and its private key together"
+            )
+        for name, path in zip(
+            ("zenoh_tls_root_ca", "zenoh_tls_certificate", "zenoh_tls_private_key"), tls, strict=True
+        ):
             if path is not None and not Path(path).is_file():
                 raise ValueError(f"{name}: {str(path)!r} is not a file")
         return self
@@ -163,16 +190,20 @@ def check_tls_endpoints(zenoh: ZenohAccessConfig, listen: list[str]) -> None:
     if zenoh.tls and zenoh.usersfile is None:
         plain = [e for e in listen if not e.startswith(("tls/", "quic/"))]
         if plain:
-            raise ValueError(f"zenoh_listen: {plain[0]!r} would accept peers without a client "
-                             "certificate; with TLS (and no users file) listen on tls/HOST:PORT only")
+            raise ValueError(
+                f"zenoh_listen: {plain[0]!r} would accept peers without a client "
+                "certificate; with TLS (and no users file) listen on tls/HOST:PORT only"
+            )
 
 
 class RouterZenohSettings(ZenohAccessConfig):
     """The zenoh group of `bearing-twin router`: access, and the endpoints it listens on."""
 
     listen: Annotated[list[str], NoDecode] = Field(
-        default_factory=lambda: list(DEFAULT_ZENOH_LISTEN), json_schema_extra=flat("zenoh_listen", "--listen", "--zenoh-listen", metavar="ENDPOINT"),
-        description="zenoh endpoints the router listens on [zenoh locator, e.g. tcp/0.0.0.0:7447].")
+        default_factory=lambda: list(DEFAULT_ZENOH_LISTEN),
+        json_schema_extra=flat("zenoh_listen", "--listen", "--zenoh-listen", metavar="ENDPOINT"),
+        description="zenoh endpoints the router listens on [zenoh locator, e.g. tcp/0.0.0.0:7447].",
+    )
 
     @field_validator("listen", mode="before")
     @classmethod
@@ -190,19 +221,28 @@ class RouterZenohSettings(ZenohAccessConfig):
 class ZenohSettings(ZenohAccessConfig):
     """The zenoh group of `bearing-twin serve`: access, the session's endpoints and mode."""
 
-    enabled: bool = Field(default=True, json_schema_extra=flat("enable_zenoh", "--no-zenoh"),
-                          description="Start the zenoh bus [bool].")
+    enabled: bool = Field(
+        default=True, json_schema_extra=flat("enable_zenoh", "--no-zenoh"), description="Start the zenoh bus [bool]."
+    )
     connect: Annotated[list[str], NoDecode] = Field(
-        default_factory=list, json_schema_extra=flat("zenoh_connect", metavar="ENDPOINT"),
-        description="zenoh endpoints (routers or peers) to connect to [zenoh locator].")
+        default_factory=list,
+        json_schema_extra=flat("zenoh_connect", metavar="ENDPOINT"),
+        description="zenoh endpoints (routers or peers) to connect to [zenoh locator].",
+    )
     listen: Annotated[list[str], NoDecode] = Field(
-        default=None, validate_default=True, json_schema_extra=flat("zenoh_listen", metavar="ENDPOINT"),
+        default=None,
+        validate_default=True,
+        json_schema_extra=flat("zenoh_listen", metavar="ENDPOINT"),
         description="zenoh endpoints to listen on [zenoh locator, e.g. tcp/127.0.0.1:7447]; default "
-        "tcp/127.0.0.1:7447, or none when zenoh_connect is given (the service joins a router).")
+        "tcp/127.0.0.1:7447, or none when zenoh_connect is given (the service joins a router).",
+    )
     mode: Literal["peer", "client", "router"] = Field(
-        default=None, validate_default=True, json_schema_extra=flat("zenoh_mode"),
+        default=None,
+        validate_default=True,
+        json_schema_extra=flat("zenoh_mode"),
         description="zenoh session mode [peer | client | router]; default client when "
-        "the service only connects (joins a router: every message goes through it), else peer.")
+        "the service only connects (joins a router: every message goes through it), else peer.",
+    )
 
     @field_validator("connect", mode="before")
     @classmethod
@@ -228,8 +268,10 @@ class ZenohSettings(ZenohAccessConfig):
         """Refuse what zenoh's access control cannot guard (docs/operations.md "zenoh access
         control")."""
         if self.prefix_is_pattern:
-            raise ValueError("zenoh_prefix: a service publishes under a concrete prefix: no '*' "
-                             "or '**' (those are for the router and the monitor)")
+            raise ValueError(
+                "zenoh_prefix: a service publishes under a concrete prefix: no '*' "
+                "or '**' (those are for the router and the monitor)"
+            )
         if not self.enabled or not self.access_control:
             return self
         if self.listen and self.connect:
@@ -237,15 +279,18 @@ class ZenohSettings(ZenohAccessConfig):
                 "zenoh_connect: with zenoh access control a service either listens (its own access "
                 "rules guard who connects) or joins a router (the router's rules guard everyone), "
                 "not both: zenoh authenticates only the side that connects, so the links this "
-                "service opens would match none of its own rules")
+                "service opens would match none of its own rules"
+            )
         if self.listen and self.usersfile is None and not self.tls:
             raise ValueError(
                 "zenoh_usersfile: a service that listens with zenoh access control needs the users "
                 "allowed to connect (BEARING_TWIN_ZENOH_USERSFILE) or TLS client certificates; "
-                "to join a router instead give --zenoh-connect")
+                "to join a router instead give --zenoh-connect"
+            )
         if self.connect and self.user is None and not self.tls:
             raise ValueError(
                 "zenoh_user: joining a router with access control needs this service's credentials "
-                "(BEARING_TWIN_ZENOH_USER and BEARING_TWIN_ZENOH_PASSWORD) or a TLS certificate")
+                "(BEARING_TWIN_ZENOH_USER and BEARING_TWIN_ZENOH_PASSWORD) or a TLS certificate"
+            )
         check_tls_endpoints(self, self.listen)
         return self

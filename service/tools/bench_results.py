@@ -46,8 +46,13 @@ def git_commit(cwd: Path | None = None) -> str | None:
         head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=here, capture_output=True, text=True, timeout=10)
         if head.returncode != 0:
             return None
-        dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"], cwd=here,
-                               capture_output=True, text=True, timeout=10).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            cwd=here,
+            capture_output=True,
+            text=True,
+            timeout=10,
+        ).stdout.strip()
     except (OSError, subprocess.SubprocessError):
         return None
     return head.stdout.strip() + ("-dirty" if dirty else "")
@@ -66,9 +71,15 @@ def versions() -> dict[str, str | None]:
 
 def environment(command: str) -> dict:
     """Where and with what a result was measured: UTC time, command, CPU, cores, OS, versions, commit."""
-    return {"measured_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), "command": command,
-            "cpu_model": cpu_model(), "cpu_count": os.cpu_count(), "platform": platform.platform(),
-            "versions": versions(), "git_commit": git_commit()}
+    return {
+        "measured_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+        "command": command,
+        "cpu_model": cpu_model(),
+        "cpu_count": os.cpu_count(),
+        "platform": platform.platform(),
+        "versions": versions(),
+        "git_commit": git_commit(),
+    }
 
 
 def save(result: dict, kind: str, command: str, directory: Path = DEFAULT_DIRECTORY) -> Path:
@@ -97,18 +108,42 @@ def bench_table(saved: dict) -> str:
     """The Markdown table of a saved `bearing-twin bench` result (docs/performance.md): per case the
     auto step, the real-time factor best / median at it and at 1 us, and ns per step (best)."""
     r = saved["result"]
-    rows = [("serve-default", r["designation"], r["time_step_s"], r["real_time_factor"],
-             r["real_time_factor_median"], r["ns_per_step"], r["real_time_factor_1us"],
-             r["real_time_factor_1us_median"], r["ns_per_step_1us"])]
+    rows = [
+        (
+            "serve-default",
+            r["designation"],
+            r["time_step_s"],
+            r["real_time_factor"],
+            r["real_time_factor_median"],
+            r["ns_per_step"],
+            r["real_time_factor_1us"],
+            r["real_time_factor_1us_median"],
+            r["ns_per_step_1us"],
+        )
+    ]
     for c in r.get("cases", []):
         a, one = c["default_step"], c["step_1us"]
-        rows.append((c["id"], c["designation"], a["time_step_s"], a["real_time_factor"],
-                     a["real_time_factor_median"], a["ns_per_step"], one["real_time_factor"],
-                     one["real_time_factor_median"], one["ns_per_step"]))
-    lines = ["| case | bearing | auto step [us] | real-time factor at auto, best / median | ns per step at auto "
-             "| real-time factor at 1 us, best / median | ns per step at 1 us |",
-             "|---|---|---|---|---|---|---|"]
+        rows.append(
+            (
+                c["id"],
+                c["designation"],
+                a["time_step_s"],
+                a["real_time_factor"],
+                a["real_time_factor_median"],
+                a["ns_per_step"],
+                one["real_time_factor"],
+                one["real_time_factor_median"],
+                one["ns_per_step"],
+            )
+        )
+    lines = [
+        "| case | bearing | auto step [us] | real-time factor at auto, best / median | ns per step at auto "
+        "| real-time factor at 1 us, best / median | ns per step at 1 us |",
+        "|---|---|---|---|---|---|---|",
+    ]
     for case, des, dt, rtf, rtf_med, ns, rtf1, rtf1_med, ns1 in rows:
-        lines.append(f"| {case} | {des} | {dt * 1e6:.3f} | {rtf:.2f} / {rtf_med:.2f} | {ns:.0f} "
-                     f"| {rtf1:.2f} / {rtf1_med:.2f} | {ns1:.0f} |")
+        lines.append(
+            f"| {case} | {des} | {dt * 1e6:.3f} | {rtf:.2f} / {rtf_med:.2f} | {ns:.0f} "
+            f"| {rtf1:.2f} / {rtf1_med:.2f} | {ns1:.0f} |"
+        )
     return "\n".join(lines)

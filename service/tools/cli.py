@@ -70,12 +70,17 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
     try:
         options = ModelOptions(time_step_s=args.dt, film_formula=args.film_formula)
-        update = SetpointUpdate(shaft_speed_rad_s=args.speed, radial_load_n=args.radial_load,
-                                axial_load_n=args.axial_load, oil_temperature_c=args.oil_temperature)
-        twin = Twin(catalog.bearing_or_file(args.bearing), options=options, diametral_clearance_m=args.clearance,
-                    warm=False)
-        twin.set_setpoint(update)           # checked once, against this bearing's limits
-        twin.reset()                        # warm start at it
+        update = SetpointUpdate(
+            shaft_speed_rad_s=args.speed,
+            radial_load_n=args.radial_load,
+            axial_load_n=args.axial_load,
+            oil_temperature_c=args.oil_temperature,
+        )
+        twin = Twin(
+            catalog.bearing_or_file(args.bearing), options=options, diametral_clearance_m=args.clearance, warm=False
+        )
+        twin.set_setpoint(update)  # checked once, against this bearing's limits
+        twin.reset()  # warm start at it
         twin.advance(args.duration)
     except (ValidationError, SetpointError, ValueError) as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
@@ -97,18 +102,34 @@ def _print_table(snap) -> None:
     from rich.table import Table
 
     table = Table(title=f"{snap.designation} at t = {snap.time_s:.4f} s, status {snap.status}")
-    for col in ("ball", "azimuth deg", "spin rad/s", "Q in N", "Q out N", "Lambda in", "Lambda out",
-                "regime in", "regime out"):
+    for col in (
+        "ball",
+        "azimuth deg",
+        "spin rad/s",
+        "Q in N",
+        "Q out N",
+        "Lambda in",
+        "Lambda out",
+        "regime in",
+        "regime out",
+    ):
         table.add_column(col, justify="right")
     for b in snap.balls:
         lam = lambda c: "-" if c.lambda_ is None else f"{c.lambda_:.2f}"  # noqa: E731
-        table.add_row(str(b.index), f"{b.azimuth_rad * 57.29578:.1f}", f"{b.spin_rad_s:.1f}",
-                      f"{b.inner.load_n:.0f}", f"{b.outer.load_n:.0f}", lam(b.inner), lam(b.outer),
-                      b.inner.regime, b.outer.regime)
+        table.add_row(
+            str(b.index),
+            f"{b.azimuth_rad * 57.29578:.1f}",
+            f"{b.spin_rad_s:.1f}",
+            f"{b.inner.load_n:.0f}",
+            f"{b.outer.load_n:.0f}",
+            lam(b.inner),
+            lam(b.outer),
+            b.inner.regime,
+            b.outer.regime,
+        )
     console = Console()
     console.print(table)
-    console.print(f"cage {snap.cage_speed_rad_s:.2f} rad/s, friction torque "
-                  f"{snap.friction_torque_n_m * 1e3:.2f} mN m")
+    console.print(f"cage {snap.cage_speed_rad_s:.2f} rad/s, friction torque {snap.friction_torque_n_m * 1e3:.2f} mN m")
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
@@ -131,8 +152,11 @@ def _cmd_timestep_study(args: argparse.Namespace) -> int:
 
     study = subrate_study if args.subrates else timestep_study
     options = {"against_1us": True} if args.subrates else {}
-    result = study.run_all(quick=args.quick, progress=lambda case, step: print(
-        f"{case.id}: {step}", file=sys.stderr, flush=True), **options)
+    result = study.run_all(
+        quick=args.quick,
+        progress=lambda case, step: print(f"{case.id}: {step}", file=sys.stderr, flush=True),
+        **options,
+    )
     print(study.as_json(result) if args.json else study.markdown(result))
     return 0
 
@@ -150,14 +174,23 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
         return 2
     try:
         result, samples = simulate_vibration(
-            catalog.bearing_or_file(args.bearing), args.speed, args.radial_load, args.axial_load,
-            defect=args.defect, defect_size_m=args.defect_size, defect_length_m=args.defect_length,
-            defect_depth_m=args.defect_depth, defect_angle_deg=args.defect_angle,
-            duration_s=args.duration, noise_density_m_s2_rthz=args.noise_density, sample_rate_hz=args.sample_rate)
+            catalog.bearing_or_file(args.bearing),
+            args.speed,
+            args.radial_load,
+            args.axial_load,
+            defect=args.defect,
+            defect_size_m=args.defect_size,
+            defect_length_m=args.defect_length,
+            defect_depth_m=args.defect_depth,
+            defect_angle_deg=args.defect_angle,
+            duration_s=args.duration,
+            noise_density_m_s2_rthz=args.noise_density,
+            sample_rate_hz=args.sample_rate,
+        )
     except (ValidationError, SetpointError, ValueError) as exc:
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return 2
-    except RuntimeError as exc:   # the twin halted: the setpoint cannot be held (its status says why)
+    except RuntimeError as exc:  # the twin halted: the setpoint cannot be held (its status says why)
         print(f"error: {_one_line(exc)}", file=sys.stderr)
         return 1
     if args.waveform:
@@ -173,16 +206,24 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
         print(json.dumps(result, allow_nan=False))
         return 0
     f = result["defect_frequencies_hz"]
-    print(f"{result['bearing']} at {result['shaft_speed_rad_s']:g} rad/s, Fr = {result['radial_load_n']:g} N, "
-          f"Fa = {result['axial_load_n']:g} N, defect: {(result['defect'] or {}).get('kind', 'none')}, "
-          f"{result['duration_s']:g} s at {result['sample_rate_hz']:g} Hz (dt = {result['time_step_s'] * 1e6:.3f} us)")
-    print(f"  FTF {f['ftf']:.2f}, BPFO {f['bpfo']:.2f}, BPFI {f['bpfi']:.2f}, BSF {f['bsf']:.2f} Hz "
-          f"(contact angle {result['contact_angle_deg']:.2f} deg)")
-    print(f"  RMS {result['rms_m_s2']:.4g} m/s2, peak {result['peak_m_s2']:.4g} m/s2, crest {result['crest_factor']:.2f}, "
-          f"kurtosis {result['kurtosis']:.2f} (band {result['band_kurtosis']:.2f}), "
-          f"velocity RMS {result['velocity_rms_mm_s']:.4g} mm/s")
+    print(
+        f"{result['bearing']} at {result['shaft_speed_rad_s']:g} rad/s, Fr = {result['radial_load_n']:g} N, "
+        f"Fa = {result['axial_load_n']:g} N, defect: {(result['defect'] or {}).get('kind', 'none')}, "
+        f"{result['duration_s']:g} s at {result['sample_rate_hz']:g} Hz (dt = {result['time_step_s'] * 1e6:.3f} us)"
+    )
+    print(
+        f"  FTF {f['ftf']:.2f}, BPFO {f['bpfo']:.2f}, BPFI {f['bpfi']:.2f}, BSF {f['bsf']:.2f} Hz "
+        f"(contact angle {result['contact_angle_deg']:.2f} deg)"
+    )
+    print(
+        f"  RMS {result['rms_m_s2']:.4g} m/s2, peak {result['peak_m_s2']:.4g} m/s2, crest {result['crest_factor']:.2f}, "
+        f"kurtosis {result['kurtosis']:.2f} (band {result['band_kurtosis']:.2f}), "
+        f"velocity RMS {result['velocity_rms_mm_s']:.4g} mm/s"
+    )
     peaks = ", ".join(f"{p['frequency_hz']:.1f} Hz ({p['amplitude']:.3g})" for p in result["envelope_peaks_hz"])
-    print(f"  envelope peaks ({result['envelope_band_hz'][0]:.0f}-{result['envelope_band_hz'][1]:.0f} Hz band): {peaks}")
+    print(
+        f"  envelope peaks ({result['envelope_band_hz'][0]:.0f}-{result['envelope_band_hz'][1]:.0f} Hz band): {peaks}"
+    )
     if args.plot:
         print(f"  figure: {args.plot}")
     return 0
@@ -194,33 +235,50 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
 
     sim = sub.add_parser("simulate", help="run one twin for a duration, print the final snapshot")
-    sim.add_argument("--bearing", default=DEFAULT_DESIGNATION,
-                     help=f"catalog designation (default {DEFAULT_DESIGNATION}) or a bearing spec file (.yaml, .json)")
+    sim.add_argument(
+        "--bearing",
+        default=DEFAULT_DESIGNATION,
+        help=f"catalog designation (default {DEFAULT_DESIGNATION}) or a bearing spec file (.yaml, .json)",
+    )
     sim.add_argument("--radial-load", type=float, default=3000.0, help="radial load [N]")
     sim.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     sim.add_argument("--speed", type=float, default=500.0, help="shaft speed [rad/s]")
     sim.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC]")
     sim.add_argument("--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload")
     sim.add_argument("--duration", type=float, default=0.05, help="simulated time [s]")
-    sim.add_argument("--dt", type=_time_step, default="auto",
-                     help="time step [s] or 'auto' (default: from the critical step, twin.timestep)")
+    sim.add_argument(
+        "--dt",
+        type=_time_step,
+        default="auto",
+        help="time step [s] or 'auto' (default: from the critical step, twin.timestep)",
+    )
     sim.add_argument("--film-formula", choices=["hamrock_dowson", "masjedi_khonsari"], default="hamrock_dowson")
     sim.add_argument("--json", action="store_true", help="print the snapshot as JSON")
     sim.set_defaults(func=_cmd_simulate)
 
-    bench = sub.add_parser("bench", help="engine speed: real-time factor at the default step and at 1 us, "
-                           "further cases, per-pass timing")
+    bench = sub.add_parser(
+        "bench", help="engine speed: real-time factor at the default step and at 1 us, further cases, per-pass timing"
+    )
     bench.add_argument("--seconds", type=_positive_float, default=0.2, help="simulated seconds per repeat")
     bench.add_argument("--repeats", type=int, default=5, help="repeats, at least 5 (best and median reported)")
     bench.add_argument("--json", action="store_true")
-    bench.add_argument("--save", nargs="?", const="benchmarks/results", default=None, metavar="DIR",
-                       help="also write the result with the CPU model, versions and git commit as "
-                       "DIR/<UTC date>-<cpu>-bench.json (default DIR: benchmarks/results)")
+    bench.add_argument(
+        "--save",
+        nargs="?",
+        const="benchmarks/results",
+        default=None,
+        metavar="DIR",
+        help="also write the result with the CPU model, versions and git commit as "
+        "DIR/<UTC date>-<cpu>-bench.json (default DIR: benchmarks/results)",
+    )
     bench.set_defaults(func=_cmd_bench)
     study = sub.add_parser("timestep-study", help="the auto time step against 1 us over the operating envelope")
     study.add_argument("--quick", action="store_true", help="a subset of the cases (the test suite's)")
-    study.add_argument("--subrates", action="store_true",
-                       help="the tribology and traction sub-rates (periods) at the auto step instead of the step")
+    study.add_argument(
+        "--subrates",
+        action="store_true",
+        help="the tribology and traction sub-rates (periods) at the auto step instead of the step",
+    )
     study.add_argument("--json", action="store_true")
     study.set_defaults(func=_cmd_timestep_study)
     report = sub.add_parser("report", help="validation report against the seeds (Markdown + PNG plots)")
@@ -229,10 +287,12 @@ def build_parser() -> argparse.ArgumentParser:
     report.set_defaults(func=_cmd_report)
 
     serve = sub.add_parser(
-        "serve", help="run the service: HTTP API, zenoh bus, rerun recording, the `default` twin",
+        "serve",
+        help="run the service: HTTP API, zenoh bus, rerun recording, the `default` twin",
         description="Run the service (one uvicorn worker). Each flag overrides its BEARING_TWIN_* "
         "environment variable, which overrides the built-in default (docs/configuration.md). Secrets "
-        "(BEARING_TWIN_TOKEN, BEARING_TWIN_ZENOH_PASSWORD) come from the environment only.")
+        "(BEARING_TWIN_TOKEN, BEARING_TWIN_ZENOH_PASSWORD) come from the environment only.",
+    )
     add_settings_flags(serve, ServiceSettings)
     serve.add_argument("--log-level", default="info", choices=["critical", "error", "warning", "info", "debug"])
     serve.set_defaults(func=_cmd_serve)
@@ -240,36 +300,69 @@ def build_parser() -> argparse.ArgumentParser:
     add_scenario_command(sub)
 
     vib = sub.add_parser(
-        "vibration", help="housing acceleration with a local defect: indicators, defect frequencies, envelope peaks",
+        "vibration",
+        help="housing acceleration with a local defect: indicators, defect frequencies, envelope peaks",
         description="Run the twin with its outer ring on the housing (Sawalhi & Randall 2008 support, accelerometer "
         "sampled in the kernel) and an optional local defect, discard 0.05 s, analyse `--duration` of the signal "
-        "(twin.validation.vibration_simulation.simulate_vibration).")
-    vib.add_argument("--bearing", default=DEFAULT_DESIGNATION,
-                     help=f"catalog designation (default {DEFAULT_DESIGNATION}; CWRU-DE: the CWRU rig's drive end) "
-                     "or a BearingSpec file (.yaml, .yml, .json)")
+        "(twin.validation.vibration_simulation.simulate_vibration).",
+    )
+    vib.add_argument(
+        "--bearing",
+        default=DEFAULT_DESIGNATION,
+        help=f"catalog designation (default {DEFAULT_DESIGNATION}; CWRU-DE: the CWRU rig's drive end) "
+        "or a BearingSpec file (.yaml, .yml, .json)",
+    )
     vib.add_argument("--speed", type=float, default=None, help="shaft speed [rad/s] (required)")
-    vib.add_argument("--radial-load", type=float, default=None,
-                     help="radial load [N] (default: the rig's, for CWRU-DE; required otherwise)")
+    vib.add_argument(
+        "--radial-load",
+        type=float,
+        default=None,
+        help="radial load [N] (default: the rig's, for CWRU-DE; required otherwise)",
+    )
     vib.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
     vib.add_argument("--defect", choices=["outer", "inner", "ball"], help="local defect (default: none, healthy)")
-    vib.add_argument("--defect-size", type=float, default=0.5e-3,
-                     help="defect width along the rolling direction, width_m [m] (default 0.5e-3)")
-    vib.add_argument("--defect-length", type=float, default=None,
-                     help="defect length across the rolling direction, length_m [m] (default 0.6 x ball radius)")
+    vib.add_argument(
+        "--defect-size",
+        type=float,
+        default=0.5e-3,
+        help="defect width along the rolling direction, width_m [m] (default 0.5e-3)",
+    )
+    vib.add_argument(
+        "--defect-length",
+        type=float,
+        default=None,
+        help="defect length across the rolling direction, length_m [m] (default 0.6 x ball radius)",
+    )
     vib.add_argument("--defect-depth", type=float, default=50e-6, help="defect depth, depth_m [m] (default 50e-6)")
-    vib.add_argument("--defect-angle", type=float, default=0.0,
-                     help="defect position [deg]: outer race from the centre of the load zone (CWRU 6:00, 3:00, "
-                     "12:00 = 0, 90, 180), inner race from the ring's mark (default 0)")
+    vib.add_argument(
+        "--defect-angle",
+        type=float,
+        default=0.0,
+        help="defect position [deg]: outer race from the centre of the load zone (CWRU 6:00, 3:00, "
+        "12:00 = 0, 90, 180), inner race from the ring's mark (default 0)",
+    )
     vib.add_argument("--duration", type=_positive_float, default=1.0, help="analysed simulated time [s] (default 1)")
-    vib.add_argument("--noise-density", type=float, default=None,
-                     help="sensor noise density [m/s2/sqrt(Hz)] (default: the spec's, 0)")
-    vib.add_argument("--sample-rate", type=float, default=None,
-                     help="accelerometer rate [Hz] (default: the spec's; 51200, 12000 for CWRU-DE)")
+    vib.add_argument(
+        "--noise-density",
+        type=float,
+        default=None,
+        help="sensor noise density [m/s2/sqrt(Hz)] (default: the spec's, 0)",
+    )
+    vib.add_argument(
+        "--sample-rate",
+        type=float,
+        default=None,
+        help="accelerometer rate [Hz] (default: the spec's; 51200, 12000 for CWRU-DE)",
+    )
     vib.add_argument("--json", action="store_true", help="print the result as JSON")
-    vib.add_argument("--waveform", metavar="FILE.npy",
-                     help="write the analysed accelerometer signal [m/s2] at the sample rate (float64 .npy)")
-    vib.add_argument("--plot", metavar="FILE.png", help="waveform, spectrum and envelope spectrum with the defect "
-                     "frequencies marked")
+    vib.add_argument(
+        "--waveform",
+        metavar="FILE.npy",
+        help="write the analysed accelerometer signal [m/s2] at the sample rate (float64 .npy)",
+    )
+    vib.add_argument(
+        "--plot", metavar="FILE.png", help="waveform, spectrum and envelope spectrum with the defect frequencies marked"
+    )
     vib.set_defaults(func=_cmd_vibration)
     add_analyse_command(vib)
 
@@ -301,8 +394,11 @@ def _add_moved_load_tools(sub) -> None:
 
 
 def _moved_load_tool(name: str) -> int:
-    print(f"error: `{name}` is a load tool: run `bearing-twin-loadtest {name} ...` "
-          "(install it with pip install '.[loadtest]')", file=sys.stderr)
+    print(
+        f"error: `{name}` is a load tool: run `bearing-twin-loadtest {name} ...` "
+        "(install it with pip install '.[loadtest]')",
+        file=sys.stderr,
+    )
     return 2
 
 
@@ -356,7 +452,7 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     except ValidationError as exc:
         print(f"error: {settings_error_text(exc, ServiceSettings)}", file=sys.stderr)
         return 2
-    except SettingsError as exc:                # an environment value that is not JSON where JSON is due
+    except SettingsError as exc:  # an environment value that is not JSON where JSON is due
         print(f"error: {exc}", file=sys.stderr)
         return 2
     given = vars(args)
@@ -372,32 +468,44 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 
-
     from service.api.app import create_app
     from service.settings import is_loopback_host
 
-    logging.basicConfig(level=getattr(logging, args.log_level.upper()),
-                        format="%(asctime)s %(levelname)s %(name)s: %(message)s")
+    logging.basicConfig(
+        level=getattr(logging, args.log_level.upper()), format="%(asctime)s %(levelname)s %(name)s: %(message)s"
+    )
     host = settings.http.host
-    where = ("loopback only; --host 0.0.0.0 to expose it" if is_loopback_host(host)
-             else "reachable from other machines")
+    where = "loopback only; --host 0.0.0.0 to expose it" if is_loopback_host(host) else "reachable from other machines"
     port = settings.http.port if settings.http.port else "<a free port, see uvicorn's line below>"
-    print(f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
-          f"twin `{settings.twin.id}` = {default_spec.designation}, {'fast' if settings.runner.fast else 'real-time'} mode",
-          flush=True)
+    print(
+        f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
+        f"twin `{settings.twin.id}` = {default_spec.designation}, {'fast' if settings.runner.fast else 'real-time'} mode",
+        flush=True,
+    )
     from service.api.app import access_summary
 
-    print(f"bearing-twin: access: {access_summary(settings)}; setpoints limited to "
-          + (f"{settings.security.setpoint_rate_hz:g}/s per twin (bursts of {settings.security.setpoint_burst})"
-             if settings.security.setpoint_rate_hz else "no rate")
-          + f"; request bodies up to {settings.security.max_body_bytes} bytes", flush=True)
+    print(
+        f"bearing-twin: access: {access_summary(settings)}; setpoints limited to "
+        + (
+            f"{settings.security.setpoint_rate_hz:g}/s per twin (bursts of {settings.security.setpoint_burst})"
+            if settings.security.setpoint_rate_hz
+            else "no rate"
+        )
+        + f"; request bodies up to {settings.security.max_body_bytes} bytes",
+        flush=True,
+    )
     if settings.zenoh.enabled:
         from service.bus.access import ZenohAccess
 
-        print(f"bearing-twin: zenoh {settings.zenoh.mode} listening on {', '.join(settings.zenoh.listen) or 'nothing'}"
-              + (f", connecting to {', '.join(settings.zenoh.connect)}" if settings.zenoh.connect else "")
-              + f", keys {settings.zenoh.prefix}/<id>/...", flush=True)
-        zenoh_access = ZenohAccess.from_settings(settings.zenoh, enforce=True).describe(listening=bool(settings.zenoh.listen))
+        print(
+            f"bearing-twin: zenoh {settings.zenoh.mode} listening on {', '.join(settings.zenoh.listen) or 'nothing'}"
+            + (f", connecting to {', '.join(settings.zenoh.connect)}" if settings.zenoh.connect else "")
+            + f", keys {settings.zenoh.prefix}/<id>/...",
+            flush=True,
+        )
+        zenoh_access = ZenohAccess.from_settings(settings.zenoh, enforce=True).describe(
+            listening=bool(settings.zenoh.listen)
+        )
         if not settings.zenoh.access_control and settings.security.token is not None:
             zenoh_access += "; zenoh setpoints refused (the HTTP API needs a token)"
         print(f"bearing-twin: {zenoh_access}", flush=True)
@@ -405,16 +513,26 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         print("bearing-twin: zenoh off", flush=True)
     if settings.opcua.endpoint:
         security = settings.opcua_security_mode
-        print(f"bearing-twin: OPC UA on {settings.opcua.endpoint} (namespace urn:bearing-twin:opcua; "
-              + ("user name + the token as password to write" if settings.security.token else "anonymous writes allowed")
-              + "; security " + {"none": "None only" + (": the password crosses in clear" if settings.security.token else ""),
-                                  "sign": "Sign", "sign_and_encrypt": "SignAndEncrypt",
-                                  "both": "Sign and SignAndEncrypt",
-                                  "all": "Sign, SignAndEncrypt and None (anonymous reads)"}[security]
-              + (" with Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss" if security != "none" else "")
-              + (f"; clients trusted: the certificates in {settings.opcua.trusted_dir}"
-                 if settings.opcua.trusted_dir is not None else "")
-              + ")", flush=True)
+        print(
+            f"bearing-twin: OPC UA on {settings.opcua.endpoint} (namespace urn:bearing-twin:opcua; "
+            + ("user name + the token as password to write" if settings.security.token else "anonymous writes allowed")
+            + "; security "
+            + {
+                "none": "None only" + (": the password crosses in clear" if settings.security.token else ""),
+                "sign": "Sign",
+                "sign_and_encrypt": "SignAndEncrypt",
+                "both": "Sign and SignAndEncrypt",
+                "all": "Sign, SignAndEncrypt and None (anonymous reads)",
+            }[security]
+            + (" with Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss" if security != "none" else "")
+            + (
+                f"; clients trusted: the certificates in {settings.opcua.trusted_dir}"
+                if settings.opcua.trusted_dir is not None
+                else ""
+            )
+            + ")",
+            flush=True,
+        )
     from service.core.errors import InputError
     from service.wiring import TwinService, WiringError
 
@@ -429,19 +547,31 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         return 130
     pki = getattr(getattr(service, "opcua", None), "pki", None)
     if pki is not None:
-        print(f"bearing-twin: OPC UA server certificate {pki.certificate} (SHA-1 thumbprint "
-              f"{pki.thumbprint_sha1}, valid until {pki.not_after:%Y-%m-%d}): trust it in the clients", flush=True)
+        print(
+            f"bearing-twin: OPC UA server certificate {pki.certificate} (SHA-1 thumbprint "
+            f"{pki.thumbprint_sha1}, valid until {pki.not_after:%Y-%m-%d}): trust it in the clients",
+            flush=True,
+        )
     recorder = getattr(service, "recorder", None)
     written = getattr(recorder, "path", None) if recorder is not None else None
-    if written is not None:     # the file actually written: <stem>.run2.rrd when the name was taken
+    if written is not None:  # the file actually written: <stem>.run2.rrd when the name was taken
         print(f"bearing-twin: recording to {written}", flush=True)
     else:
-        print("bearing-twin: not recording" if settings.recording.active_path is None
-              else f"bearing-twin: recording to {settings.recording.active_path}", flush=True)
+        print(
+            "bearing-twin: not recording"
+            if settings.recording.active_path is None
+            else f"bearing-twin: recording to {settings.recording.active_path}",
+            flush=True,
+        )
     from service.api.server import uvicorn_config
 
-    config = uvicorn_config(create_app(settings, service=service), settings, host=host,
-                            log_level=args.log_level, timeout_graceful_shutdown=3)
+    config = uvicorn_config(
+        create_app(settings, service=service),
+        settings,
+        host=host,
+        log_level=args.log_level,
+        timeout_graceful_shutdown=3,
+    )
     server = _InterruptibleServer(config)
     try:
         server.run()
@@ -449,7 +579,7 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         # uvicorn re-raises a captured SIGINT (Ctrl-C) once its graceful shutdown - our lifespan
         # `finally`: runners stopped, zenoh closed, recordings flushed - is complete
         return 130
-    if server.interrupted:   # the re-raise can be absorbed by asyncio's own SIGINT handling
+    if server.interrupted:  # the re-raise can be absorbed by asyncio's own SIGINT handling
         return 130
     return 0 if server.started else 1
 

@@ -41,9 +41,12 @@ def _group_tables(root: type[BaseModel], flags: bool = True) -> list[str]:
         settings = [s for s in flat_settings(root) if s.group == group]
         if not settings:
             continue
-        lines += [f"### `{group}`: {_cell(info.description)}", "",
-                  "| Environment variable | Default | Nested variable | " + ("Flag | " if flags else "") + "Meaning |",
-                  "|---|---|---|" + ("---|" if flags else "") + "---|"]
+        lines += [
+            f"### `{group}`: {_cell(info.description)}",
+            "",
+            "| Environment variable | Default | Nested variable | " + ("Flag | " if flags else "") + "Meaning |",
+            "|---|---|---|" + ("---|" if flags else "") + "---|",
+        ]
         for s in settings:
             flag = f" {_flag(root, s)} |" if flags else ""
             lines.append(f"| `{s.env}` | {_default(s)} | `{s.nested_env}` |{flag} {_cell(s.info.description)} |")
@@ -75,7 +78,7 @@ def configuration_markdown() -> str:
         "(`opc.tcp://HOST:PORT`), or a JSON object of the whole `opcua` group.",
         "",
         "In Python the groups are attributes (`ServiceSettings().http.port`); the constructor takes "
-        "the flat names or the groups (`ServiceSettings(port=8080)`, `ServiceSettings(http={\"port\": 8080})`).",
+        'the flat names or the groups (`ServiceSettings(port=8080)`, `ServiceSettings(http={"port": 8080})`).',
         "",
         "## Service (`bearing-twin serve`)",
         "",
@@ -84,8 +87,10 @@ def configuration_markdown() -> str:
         "",
         "| Environment variable | Default | Nested variable | Flag | Meaning |",
         "|---|---|---|---|---|",
-        *[f"| `{s.env}` | {_default(s)} | `{s.nested_env}` | `{s.flags[0]}` | {_cell(s.info.description)} |"
-          for s in router_only],
+        *[
+            f"| `{s.env}` | {_default(s)} | `{s.nested_env}` | `{s.flags[0]}` | {_cell(s.info.description)} |"
+            for s in router_only
+        ],
         "",
         f"## Alarms (`{ENV_PREFIX}ALARMS`, a JSON object of these fields, or `{ENV_PREFIX}ALARMS__<FIELD>`)",
         "",

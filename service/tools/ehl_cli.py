@@ -49,27 +49,50 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
     `func(args) -> exit code`."""
     from twin.ehl_solver import params as prm
 
-    ehl = subparsers.add_parser("ehl", help="thermal EHL point-contact solver with current heating (seed 003)",
-                                description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ehl = subparsers.add_parser(
+        "ehl",
+        help="thermal EHL point-contact solver with current heating (seed 003)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     sub = ehl.add_subparsers(dest="ehl_command", required=True)
 
     solve = sub.add_parser("solve", help="solve one contact (defaults: seed 003 Appendix 2)")
-    solve.add_argument("--load", type=_positive_float, default=prm.LOAD_N,
-                       help=f"load on the ball [N] (default {prm.LOAD_N})")
-    solve.add_argument("--entrainment-speed", type=_positive_float, default=prm.DEFAULT_ENTRAINMENT_SPEED_M_S,
-                       help=f"mean entrainment speed [m/s] (default {prm.DEFAULT_ENTRAINMENT_SPEED_M_S}; "
-                            "seed 003 Fig. 1 spans 0.832-4.16)")
-    solve.add_argument("--current", type=_non_negative_float, default=0.0,
-                       help="current through the contact [A] (default 0: isothermal unless --thermal)")
+    solve.add_argument(
+        "--load", type=_positive_float, default=prm.LOAD_N, help=f"load on the ball [N] (default {prm.LOAD_N})"
+    )
+    solve.add_argument(
+        "--entrainment-speed",
+        type=_positive_float,
+        default=prm.DEFAULT_ENTRAINMENT_SPEED_M_S,
+        help=f"mean entrainment speed [m/s] (default {prm.DEFAULT_ENTRAINMENT_SPEED_M_S}; "
+        "seed 003 Fig. 1 spans 0.832-4.16)",
+    )
+    solve.add_argument(
+        "--current",
+        type=_non_negative_float,
+        default=0.0,
+        help="current through the contact [A] (default 0: isothermal unless --thermal)",
+    )
     solve.add_argument("--grid", type=_grid, default=129, help="nodes per direction, 2^k + 1 (default 129)")
-    solve.add_argument("--thermal", action="store_true",
-                       help="include shear heating (eq. 6) also at 0 A (with current it is always on)")
-    solve.add_argument("--base-temperature", type=float, default=prm.BASE_TEMPERATURE_C,
-                       help=f"oil (boundary) temperature [degC] (default {prm.BASE_TEMPERATURE_C})")
-    solve.add_argument("--bearing-resistance", type=_non_negative_float,
-                       default=prm.DEFAULT_BEARING_RESISTANCE_OHM,
-                       help=f"equivalent bearing resistance R_b of eq. 10 [ohm] "
-                            f"(default {prm.DEFAULT_BEARING_RESISTANCE_OHM:g}, anchored on seed 003 Fig. 2)")
+    solve.add_argument(
+        "--thermal",
+        action="store_true",
+        help="include shear heating (eq. 6) also at 0 A (with current it is always on)",
+    )
+    solve.add_argument(
+        "--base-temperature",
+        type=float,
+        default=prm.BASE_TEMPERATURE_C,
+        help=f"oil (boundary) temperature [degC] (default {prm.BASE_TEMPERATURE_C})",
+    )
+    solve.add_argument(
+        "--bearing-resistance",
+        type=_non_negative_float,
+        default=prm.DEFAULT_BEARING_RESISTANCE_OHM,
+        help=f"equivalent bearing resistance R_b of eq. 10 [ohm] "
+        f"(default {prm.DEFAULT_BEARING_RESISTANCE_OHM:g}, anchored on seed 003 Fig. 2)",
+    )
     solve.add_argument("--max-iter", type=int, default=200, help="multigrid cycle cap (default 200)")
     solve.add_argument("--json", action="store_true", help="print JSON instead of a table")
     solve.set_defaults(func=_cmd_solve)
@@ -77,8 +100,9 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
     cal = sub.add_parser("calibrate", help="regenerate the film-reduction table (current x speed) for the twin")
     cal.add_argument("--out", default=None, help="output JSON (default: the table shipped in twin/ehl_solver)")
     cal.add_argument("--grid", type=_grid, default=None, help="nodes per direction (default 257)")
-    cal.add_argument("--anchor", action="store_true",
-                     help="re-anchor the bearing resistance on 84.8 %% reduction at 30 A first")
+    cal.add_argument(
+        "--anchor", action="store_true", help="re-anchor the bearing resistance on 84.8 %% reduction at 30 A first"
+    )
     cal.set_defaults(func=_cmd_calibrate)
 
     bench = sub.add_parser("bench", help="time the isothermal solve at the default speed (after a warm-up)")
@@ -104,9 +128,15 @@ def benchmark_solve(grid: int = 129, repeats: int = 3) -> dict:
         t0 = time.perf_counter()
         res = solve_point_contact(grid=grid, thermal=False)
         times.append(time.perf_counter() - t0)
-    return {"grid": grid, "median_s": statistics.median(times), "times_s": times,
-            "iterations": res.iterations, "converged": res.converged, "h_min_m": res.h_min_m,
-            "h_c_m": res.h_c_m}
+    return {
+        "grid": grid,
+        "median_s": statistics.median(times),
+        "times_s": times,
+        "iterations": res.iterations,
+        "converged": res.converged,
+        "h_min_m": res.h_min_m,
+        "h_c_m": res.h_c_m,
+    }
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
@@ -114,8 +144,10 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(doc, indent=1))
     else:
-        print(f"isothermal solve, {doc['grid']} x {doc['grid']}, default speed: median {doc['median_s']:.2f} s "
-              f"over {len(doc['times_s'])} solves ({doc['iterations']} cycles, converged {doc['converged']})")
+        print(
+            f"isothermal solve, {doc['grid']} x {doc['grid']}, default speed: median {doc['median_s']:.2f} s "
+            f"over {len(doc['times_s'])} solves ({doc['iterations']} cycles, converged {doc['converged']})"
+        )
     return 0 if doc["converged"] else 1
 
 
@@ -124,9 +156,16 @@ def solve_to_dict(args: argparse.Namespace) -> dict:
     from twin.ehl_solver import solve_point_contact
 
     thermal = bool(args.thermal or args.current > 0)
-    res = solve_point_contact(args.load, args.entrainment_speed, current_a=args.current, grid=args.grid,
-                              thermal=thermal, base_temperature_c=args.base_temperature,
-                              bearing_resistance_ohm=args.bearing_resistance, max_iter=args.max_iter)
+    res = solve_point_contact(
+        args.load,
+        args.entrainment_speed,
+        current_a=args.current,
+        grid=args.grid,
+        thermal=thermal,
+        base_temperature_c=args.base_temperature,
+        bearing_resistance_ohm=args.bearing_resistance,
+        max_iter=args.max_iter,
+    )
     doc = {
         "schema": "bearing-twin/ehl-solve/1",
         "h_min_m": res.h_min_m,
@@ -166,10 +205,12 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         print(json.dumps(doc, indent=1))
     else:
         inp = doc["inputs"]
-        print(f"point contact (seed 003): w = {inp['load_n']:g} N, u = {inp['entrainment_speed_m_s']:g} m/s, "
-              f"I = {inp['current_a']:g} A, grid {inp['grid']} x {inp['grid']}, "
-              f"{'thermal' if inp['thermal'] else 'isothermal'}, eta0 = {inp['eta0_pa_s']:g} Pa s at "
-              f"{inp['base_temperature_c']:g} degC")
+        print(
+            f"point contact (seed 003): w = {inp['load_n']:g} N, u = {inp['entrainment_speed_m_s']:g} m/s, "
+            f"I = {inp['current_a']:g} A, grid {inp['grid']} x {inp['grid']}, "
+            f"{'thermal' if inp['thermal'] else 'isothermal'}, eta0 = {inp['eta0_pa_s']:g} Pa s at "
+            f"{inp['base_temperature_c']:g} degC"
+        )
 
         def nm(v):
             return "-" if v is None else f"{v * 1e9:.1f} nm"
@@ -179,10 +220,14 @@ def _cmd_solve(args: argparse.Namespace) -> int:
         if doc["max_pressure_pa"] is not None:
             print(f"  p_max {doc['max_pressure_pa'] / 1e9:.3f} GPa (Hertz {doc['hertz_pressure_pa'] / 1e9:.3f} GPa)")
         rise = doc["temperature_rise_k"]
-        print(f"  temperature rise {'-' if rise is None else f'{rise:.1f} K'} (current, eq. 10: "
-              f"{doc['current_temperature_rise_k']:.1f} K)")
-        print(f"  converged {doc['converged']} after {doc['iterations']} cycles in {doc['wall_time_s']:.1f} s"
-              + (f": {doc['message']}" if doc["message"] else ""))
+        print(
+            f"  temperature rise {'-' if rise is None else f'{rise:.1f} K'} (current, eq. 10: "
+            f"{doc['current_temperature_rise_k']:.1f} K)"
+        )
+        print(
+            f"  converged {doc['converged']} after {doc['iterations']} cycles in {doc['wall_time_s']:.1f} s"
+            + (f": {doc['message']}" if doc["message"] else "")
+        )
     return 0 if doc["converged"] else 1
 
 
@@ -192,8 +237,12 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     out = args.out or str(calibration.TABLE_PATH)
     grid = args.grid or calibration.CALIBRATION_GRID
     prog = "python -m service.tools.ehl_cli" if sys.argv and sys.argv[0].endswith("ehl_cli.py") else "bearing-twin"
-    command = f"{prog} ehl calibrate" + (f" --out {args.out}" if args.out else "") + \
-        (f" --grid {args.grid}" if args.grid else "") + (" --anchor" if args.anchor else "")
+    command = (
+        f"{prog} ehl calibrate"
+        + (f" --out {args.out}" if args.out else "")
+        + (f" --grid {args.grid}" if args.grid else "")
+        + (" --anchor" if args.anchor else "")
+    )
 
     def log(msg: str) -> None:
         print(msg, file=sys.stderr, flush=True)

@@ -10,6 +10,10 @@ def error_text(exc: Exception) -> str:
     field at the start of its message, "zenoh_user: ...", and is printed without pydantic's
     "Value error, " prefix); any other exception as its text."""
     if isinstance(exc, ValidationError):
-        return "; ".join(f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}" if e["loc"]
-                         else str(e["msg"]).removeprefix("Value error, ") for e in exc.errors())
+        return "; ".join(
+            f"{'.'.join(str(p) for p in e['loc'])}: {e['msg']}"
+            if e["loc"]
+            else str(e["msg"]).removeprefix("Value error, ")
+            for e in exc.errors()
+        )
     return str(exc)

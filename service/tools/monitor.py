@@ -37,8 +37,12 @@ def twin_keys(prefix: str) -> tuple[str, str]:
     """(state, liveliness) key expressions of the twins under `prefix` (canonical form)."""
     import zenoh
 
-    return (str(zenoh.KeyExpr.autocanonize(all_twins(prefix, STATE))),
-            str(zenoh.KeyExpr.autocanonize(all_twins(prefix, ALIVE))))
+    return (
+        str(zenoh.KeyExpr.autocanonize(all_twins(prefix, STATE))),
+        str(zenoh.KeyExpr.autocanonize(all_twins(prefix, ALIVE))),
+    )
+
+
 _REFRESH_S = 0.25
 _ONCE_SETTLE_S = 0.5
 
@@ -49,8 +53,8 @@ def twin_name(key: str, prefix: str = DEFAULT_PREFIX) -> str | None:
     head, sep, _last = key.rpartition("/")
     if not sep or not head:
         return None
-    if "*" not in prefix and head.startswith(prefix + "/") and "/" not in head[len(prefix) + 1:]:
-        return head[len(prefix) + 1:]
+    if "*" not in prefix and head.startswith(prefix + "/") and "/" not in head[len(prefix) + 1 :]:
+        return head[len(prefix) + 1 :]
     return head
 
 
@@ -59,19 +63,31 @@ class TwinTable:
 
     def __init__(self, prefix: str = DEFAULT_PREFIX, forget_gone_s: float | None = None) -> None:
         self.prefix = prefix
-        self.forget_gone_s = forget_gone_s   # drop a gone twin's row after this long [s]
+        self.forget_gone_s = forget_gone_s  # drop a gone twin's row after this long [s]
         self.rows: dict[str, dict[str, Any]] = {}
         self.invalid = 0  # messages that were not contract JSON objects
-        self.departed: dict[str, float] = {}   # forgotten twins: late messages do not revive them
+        self.departed: dict[str, float] = {}  # forgotten twins: late messages do not revive them
 
     def _row(self, bearing_id: str) -> dict[str, Any]:
         row = self.rows.get(bearing_id)
         if row is None:
             row = self.rows[bearing_id] = {
-                "bearing_id": bearing_id, "designation": None, "time_s": None, "status": None,
-                "shaft_speed_rad_s": None, "min_lambda": None, "regimes": {},
-                "friction_torque_n_m": None, "discharge_risk": None, "seq": None, "gaps": 0,
-                "missing": 0, "messages": 0, "alive": None, "last_seen": None, "key": None,
+                "bearing_id": bearing_id,
+                "designation": None,
+                "time_s": None,
+                "status": None,
+                "shaft_speed_rad_s": None,
+                "min_lambda": None,
+                "regimes": {},
+                "friction_torque_n_m": None,
+                "discharge_risk": None,
+                "seq": None,
+                "gaps": 0,
+                "missing": 0,
+                "messages": 0,
+                "alive": None,
+                "last_seen": None,
+                "key": None,
                 "gone_at": None,
                 "alarms": {},
             }
@@ -91,7 +107,7 @@ class TwinTable:
         bearing_id = twin_name(key, self.prefix) or str(data.get("bearing_id") or key)
         row = self.rows.get(bearing_id)
         if bearing_id in self.departed or (row is not None and row["alive"] is False):
-            return      # a late message of a twin that is gone (its last snapshots follow its token)
+            return  # a late message of a twin that is gone (its last snapshots follow its token)
         row = self._row(bearing_id)
         row["messages"] += 1
         row["key"] = key
@@ -163,26 +179,42 @@ class TwinTable:
         if self.forget_gone_s is None:
             return []
         now = time.monotonic() if now is None else now
-        gone = [k for k, r in self.rows.items()
-                if r["alive"] is False and r["gone_at"] is not None and now - r["gone_at"] >= self.forget_gone_s]
+        gone = [
+            k
+            for k, r in self.rows.items()
+            if r["alive"] is False and r["gone_at"] is not None and now - r["gone_at"] >= self.forget_gone_s
+        ]
         for k in gone:
             self.departed[k] = self.rows.pop(k)["gone_at"]
         return gone
 
     def snapshot(self) -> dict[str, dict[str, Any]]:
-        return {k: {**v, "regimes": dict(v["regimes"]), "alarms": dict(v["alarms"])}
-                for k, v in sorted(self.rows.items())}
+        return {
+            k: {**v, "regimes": dict(v["regimes"]), "alarms": dict(v["alarms"])} for k, v in sorted(self.rows.items())
+        }
 
     def render(self, title: str = "bearing-twin monitor"):
         from rich.table import Table
 
-        table = Table(title=title, caption=f"{len(self.rows)} twin(s)"
-                      + (f", {self.invalid} invalid message(s)" if self.invalid else ""))
+        table = Table(
+            title=title,
+            caption=f"{len(self.rows)} twin(s)" + (f", {self.invalid} invalid message(s)" if self.invalid else ""),
+        )
         columns: tuple[tuple[str, Literal["left", "right"]], ...] = (
-            ("bearing", "left"), ("designation", "left"), ("alive", "left"), ("time s", "right"),
-            ("status", "left"), ("shaft rad/s", "right"), ("min Lambda", "right"), ("regimes", "left"),
-            ("torque mN m", "right"), ("discharge", "right"), ("alarms", "left"), ("seq", "right"),
-            ("gaps", "right"))
+            ("bearing", "left"),
+            ("designation", "left"),
+            ("alive", "left"),
+            ("time s", "right"),
+            ("status", "left"),
+            ("shaft rad/s", "right"),
+            ("min Lambda", "right"),
+            ("regimes", "left"),
+            ("torque mN m", "right"),
+            ("discharge", "right"),
+            ("alarms", "left"),
+            ("seq", "right"),
+            ("gaps", "right"),
+        )
         for col, justify in columns:
             table.add_column(col, justify=justify)
         for bearing_id, r in sorted(self.rows.items()):
@@ -191,12 +223,18 @@ class TwinTable:
             risk_text = "-" if risk is None else (f"{risk:.3g}" if isinstance(risk, (int, float)) else str(risk))
             status = r["status"] or "-"
             table.add_row(
-                bearing_id, r["designation"] or "-", alive,
-                _fmt(r["time_s"], "{:.3f}"), status if status == "ok" else f"[yellow]{status}[/]",
-                _fmt(r["shaft_speed_rad_s"], "{:.1f}"), _fmt(r["min_lambda"], "{:.2f}"),
+                bearing_id,
+                r["designation"] or "-",
+                alive,
+                _fmt(r["time_s"], "{:.3f}"),
+                status if status == "ok" else f"[yellow]{status}[/]",
+                _fmt(r["shaft_speed_rad_s"], "{:.1f}"),
+                _fmt(r["min_lambda"], "{:.2f}"),
                 " ".join(f"{name}:{n}" for name, n in sorted(r["regimes"].items())) or "-",
                 _fmt(None if r["friction_torque_n_m"] is None else r["friction_torque_n_m"] * 1e3, "{:.2f}"),
-                risk_text, _alarms_text(r["alarms"]), "-" if r["seq"] is None else str(r["seq"]),
+                risk_text,
+                _alarms_text(r["alarms"]),
+                "-" if r["seq"] is None else str(r["seq"]),
                 str(r["gaps"]) if not r["gaps"] else f"[red]{r['gaps']}[/] ({r['missing']} lost)",
             )
         return table
@@ -204,19 +242,29 @@ class TwinTable:
 
 def _alarms_text(alarms: dict[str, str]) -> str:
     colour = {"critical": "red", "warning": "yellow"}
-    return " ".join(f"[{colour.get(sev, 'white')}]{alarm_id}:{sev}[/]"
-                    for alarm_id, sev in sorted(alarms.items())) or "-"
+    return (
+        " ".join(f"[{colour.get(sev, 'white')}]{alarm_id}:{sev}[/]" for alarm_id, sev in sorted(alarms.items())) or "-"
+    )
 
 
 def _fmt(value: float | None, spec: str) -> str:
     return "-" if value is None else spec.format(value)
 
 
-def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
-                keyexpr: str | None = None, duration_s: float | None = None,
-                once: bool = False, out: Any = None, *, prefix: str = DEFAULT_PREFIX,
-                forget_gone_s: float | None = None, access: Any = None,
-                on_update: Any = None, stop: Any = None) -> dict[str, dict[str, Any]]:
+def run_monitor(
+    connect: list[str] | None,
+    listen: list[str] | None = None,
+    keyexpr: str | None = None,
+    duration_s: float | None = None,
+    once: bool = False,
+    out: Any = None,
+    *,
+    prefix: str = DEFAULT_PREFIX,
+    forget_gone_s: float | None = None,
+    access: Any = None,
+    on_update: Any = None,
+    stop: Any = None,
+) -> dict[str, dict[str, Any]]:
     """Watch the bus and render a live table; return the final rows {twin: {...}}.
 
     connect: endpoints to connect to (None or [] -> tcp/127.0.0.1:7447 unless `listen` is given);
@@ -303,8 +351,7 @@ def run_monitor(connect: list[str] | None, listen: list[str] | None = None,
             console.print(table.render(title))
         else:
             try:
-                with Live(table.render(title), console=console, auto_refresh=False,
-                          transient=False) as live:
+                with Live(table.render(title), console=console, auto_refresh=False, transient=False) as live:
                     next_refresh = 0.0
                     while (deadline is None or time.monotonic() < deadline) and not (stop and stop.is_set()):
                         now = time.monotonic()
@@ -336,15 +383,24 @@ def _cmd_monitor(args: argparse.Namespace) -> int:
         given: dict[str, Any] = {"zenoh": {"prefix": args.prefix}} if args.prefix else {}
         env = ZenohAccessSettings(**given)
     except ValidationError as exc:
-        print("error: monitor: " + "; ".join(str(e["msg"]).removeprefix("Value error, ") for e in exc.errors()),
-              file=sys.stderr)
+        print(
+            "error: monitor: " + "; ".join(str(e["msg"]).removeprefix("Value error, ") for e in exc.errors()),
+            file=sys.stderr,
+        )
         return 2
     try:
         from service.bus.access import ZenohAccess
 
-        run_monitor(args.connect, args.listen, args.keyexpr, duration_s=args.duration, once=args.once,
-                    prefix=env.zenoh.prefix, forget_gone_s=args.forget_after,
-                    access=ZenohAccess.from_settings(env.zenoh))
+        run_monitor(
+            args.connect,
+            args.listen,
+            args.keyexpr,
+            duration_s=args.duration,
+            once=args.once,
+            prefix=env.zenoh.prefix,
+            forget_gone_s=args.forget_after,
+            access=ZenohAccess.from_settings(env.zenoh),
+        )
     except KeyboardInterrupt:
         return 0
     except Exception as exc:  # noqa: BLE001 - bad endpoint, port in use, ...
@@ -362,21 +418,49 @@ def _positive(text: str) -> float:
 
 def add_monitor_command(subparsers: Any) -> argparse.ArgumentParser:
     """Register `monitor` on an argparse subparsers object; its `func(args)` returns an exit code."""
-    p = subparsers.add_parser("monitor", help="live table of the twins on the zenoh bus",
-                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("keyexpr", nargs="?", default=None,
-                   help="state key expression to subscribe to (default {prefix}/*/state)")
-    p.add_argument("--prefix", default=None,
-                   help="key prefix of the twins, or a pattern for a fleet: plant1/** (default "
-                   "$BEARING_TWIN_ZENOH_PREFIX, else bearing)")
-    p.add_argument("--forget-after", type=_positive, default=10.0, metavar="SECONDS",
-                   help="drop a gone twin's row after this long (default 10)")
-    p.add_argument("--connect", metavar="ENDPOINT", action="append", default=None,
-                   help="zenoh endpoint to connect to (repeatable; default tcp/127.0.0.1:7447)")
-    p.add_argument("--listen", metavar="ENDPOINT", action="append", default=None,
-                   help="zenoh endpoint to listen on (repeatable; default: none)")
-    p.add_argument("--duration", type=_positive, default=None, metavar="SECONDS",
-                   help="stop after this many seconds (default: until Ctrl-C)")
+    p = subparsers.add_parser(
+        "monitor",
+        help="live table of the twins on the zenoh bus",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument(
+        "keyexpr", nargs="?", default=None, help="state key expression to subscribe to (default {prefix}/*/state)"
+    )
+    p.add_argument(
+        "--prefix",
+        default=None,
+        help="key prefix of the twins, or a pattern for a fleet: plant1/** (default "
+        "$BEARING_TWIN_ZENOH_PREFIX, else bearing)",
+    )
+    p.add_argument(
+        "--forget-after",
+        type=_positive,
+        default=10.0,
+        metavar="SECONDS",
+        help="drop a gone twin's row after this long (default 10)",
+    )
+    p.add_argument(
+        "--connect",
+        metavar="ENDPOINT",
+        action="append",
+        default=None,
+        help="zenoh endpoint to connect to (repeatable; default tcp/127.0.0.1:7447)",
+    )
+    p.add_argument(
+        "--listen",
+        metavar="ENDPOINT",
+        action="append",
+        default=None,
+        help="zenoh endpoint to listen on (repeatable; default: none)",
+    )
+    p.add_argument(
+        "--duration",
+        type=_positive,
+        default=None,
+        metavar="SECONDS",
+        help="stop after this many seconds (default: until Ctrl-C)",
+    )
     p.add_argument("--once", action="store_true", help="print one table once a twin is seen, then exit")
     p.set_defaults(func=_cmd_monitor)
     return p

@@ -46,8 +46,10 @@ def flatten_snapshot(snapshot: Snapshot) -> dict[str, Any]:
                 if k == "balls" and isinstance(v, (list, tuple)):
                     for i, ball in enumerate(v):
                         index = ball.get("index", i) if isinstance(ball, dict) else i
-                        walk(f"{prefix}ball{index}_",
-                             {bk: bv for bk, bv in ball.items() if bk != "index"} if isinstance(ball, dict) else ball)
+                        walk(
+                            f"{prefix}ball{index}_",
+                            {bk: bv for bk, bv in ball.items() if bk != "index"} if isinstance(ball, dict) else ball,
+                        )
                 elif isinstance(v, (list, tuple)) and len(v) == 3 and k.endswith("_m"):
                     for axis, x in zip(_XYZ, v):
                         out[f"{prefix}{k[:-2]}_{axis}_m"] = x
@@ -71,7 +73,7 @@ class RunResult:
     final: Snapshot | None
     state: str
     error: str | None
-    alarms: list[AlarmEvent] = field(default_factory=list)   # the run's alarm events, in order
+    alarms: list[AlarmEvent] = field(default_factory=list)  # the run's alarm events, in order
 
 
 class TableSink:
@@ -92,8 +94,13 @@ class TableSink:
 
     def begin(self, run: ResolvedRun, runner: TwinRunner, lubricant: str) -> None:
         """A new run on `runner`, whose scenario handle gives each row its phase at publish time."""
-        self._context = {"run": run.id, "run_label": run.label, "bearing": run.designation,
-                         "diametral_clearance_m": run.spec().mounting.diametral_clearance_m, "lubricant": lubricant}
+        self._context = {
+            "run": run.id,
+            "run_label": run.label,
+            "bearing": run.designation,
+            "diametral_clearance_m": run.spec().mounting.diametral_clearance_m,
+            "lubricant": lubricant,
+        }
         self._runner, self._t0 = runner, None
 
     def publish(self, snapshot: Snapshot) -> None:
@@ -105,8 +112,9 @@ class TableSink:
         row["time_s"] = flat.pop("time_s", None)
         if self._t0 is None and row["time_s"] is not None:
             self._t0 = row["time_s"]
-        row["scenario_time_s"] = (round(row["time_s"] - self._t0, 9)
-                                  if row["time_s"] is not None and self._t0 is not None else None)
+        row["scenario_time_s"] = (
+            round(row["time_s"] - self._t0, 9) if row["time_s"] is not None and self._t0 is not None else None
+        )
         row.update(flat)
         self.rows.append(row)
 
@@ -136,12 +144,18 @@ def write_table(rows: list[dict[str, Any]], path: str | Path) -> Path:
     return path
 
 
-def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
-                 table: TableSink | None = None, frame_s: float = 0.001,
-                 progress: Callable[[float], None] | None = None,
-                 timeout_factor: float = 200.0, min_timeout_s: float = 120.0,
-                 on_recording: Callable[[Path], None] | None = None,
-                 alarms: AlarmSettings | None = None) -> list[RunResult]:
+def run_scenario(
+    scenario: Scenario,
+    *,
+    record: str | Path | None = None,
+    table: TableSink | None = None,
+    frame_s: float = 0.001,
+    progress: Callable[[float], None] | None = None,
+    timeout_factor: float = 200.0,
+    min_timeout_s: float = 120.0,
+    on_recording: Callable[[Path], None] | None = None,
+    alarms: AlarmSettings | None = None,
+) -> list[RunResult]:
     """Run every run of a scenario in fast mode, each on a fresh warm-started twin.
 
     `progress(simulated seconds done over all runs)` is called about 10 times a second.
@@ -158,10 +172,10 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
         if on_recording is not None and recorder.path is not None:
             on_recording(recorder.path)
     settings = alarms or AlarmSettings()
-    hub = AlarmHub(settings, queue_size=1_000_000)     # lossless: every sample is judged
+    hub = AlarmHub(settings, queue_size=1_000_000)  # lossless: every sample is judged
     if recorder is not None:
         hub.subscribe(recorder.log_alarm)
-    scenario.check_bearing_limits()        # every run, before any runs (as `scenario check`)
+    scenario.check_bearing_limits()  # every run, before any runs (as `scenario check`)
     runs = scenario.resolved_runs()
     results: list[RunResult] = []
     done_s = 0.0
@@ -170,8 +184,13 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
             bearing_id = scenario.name if len(runs) == 1 else run.id
             spec = run.spec()
             twin = Twin(spec, setpoint=run.initial_setpoint(), bearing_id=bearing_id)
-            runner = TwinRunner(twin, fast=True, publish_rate_hz=1.0 / run.sample_every_s,
-                                frame_s=min(frame_s, run.sample_every_s), idle_without_scenario=True)
+            runner = TwinRunner(
+                twin,
+                fast=True,
+                publish_rate_hz=1.0 / run.sample_every_s,
+                frame_s=min(frame_s, run.sample_every_s),
+                idle_without_scenario=True,
+            )
             runner.add_sink(table)
             hub.add_twin(bearing_id)
             runner.add_sink(hub)
@@ -201,13 +220,20 @@ def run_scenario(scenario: Scenario, *, record: str | Path | None = None,
                 progress(done_s)
             error = handle.error or (runner.last_error if runner.failed else None)
             state = handle.state if not runner.failed else "failed"
-            results.append(RunResult(run=run, rows=len(table.rows) - rows_before,
-                                     wall_s=time.perf_counter() - t_wall, final=runner.latest,
-                                     state=state, error=error, alarms=hub.events(bearing_id)))
+            results.append(
+                RunResult(
+                    run=run,
+                    rows=len(table.rows) - rows_before,
+                    wall_s=time.perf_counter() - t_wall,
+                    final=runner.latest,
+                    state=state,
+                    error=error,
+                    alarms=hub.events(bearing_id),
+                )
+            )
             hub.forget(bearing_id)
     finally:
         hub.close()
         if recorder is not None:
             recorder.close()
     return results
-

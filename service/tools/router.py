@@ -53,9 +53,12 @@ def run_router(settings: Any, stop: threading.Event, out: Any = None) -> int:
     out = out if out is not None else sys.stdout
     session, access = open_router(settings)
     try:
-        print(f"bearing-twin router: zenoh router {session.info.zid()} listening on "
-              f"{', '.join(settings.zenoh.listen)}, key prefix {settings.zenoh.prefix}; {access}",
-              file=out, flush=True)
+        print(
+            f"bearing-twin router: zenoh router {session.info.zid()} listening on "
+            f"{', '.join(settings.zenoh.listen)}, key prefix {settings.zenoh.prefix}; {access}",
+            file=out,
+            flush=True,
+        )
         stop.wait()
     finally:
         session.close()
@@ -82,9 +85,12 @@ def _cmd_router(args: argparse.Namespace) -> int:
 
 
 def add_router_command(subparsers: Any) -> argparse.ArgumentParser:
-    p = subparsers.add_parser("router", help="a zenoh router for a fleet of services (optionally "
-                              "with authentication and access control)",
-                              description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p = subparsers.add_parser(
+        "router",
+        help="a zenoh router for a fleet of services (optionally with authentication and access control)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     add_settings_flags(p, RouterSettings, aliases={"zenoh.prefix": ("--prefix",)})
     p.set_defaults(func=_cmd_router)
     return p

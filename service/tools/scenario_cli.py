@@ -35,14 +35,16 @@ def _cmd_scenario_check(args: argparse.Namespace) -> int:
     for file in args.files:
         try:
             scenario = load_scenario(file)
-            scenario.check_bearing_limits()     # what `scenario run` checks before it runs
+            scenario.check_bearing_limits()  # what `scenario run` checks before it runs
         except ScenarioError as exc:
             print(f"{file}: error: {exc}", file=sys.stderr)
             status = 2
             continue
         runs = scenario.resolved_runs()
-        print(f"{file}: ok: {scenario.name}, {len(runs)} run(s), {scenario.total_duration_s:g} s simulated, "
-              f"sample every {scenario.sample_every_s:g} s")
+        print(
+            f"{file}: ok: {scenario.name}, {len(runs)} run(s), {scenario.total_duration_s:g} s simulated, "
+            f"sample every {scenario.sample_every_s:g} s"
+        )
         for w in scenario.warnings:
             print(f"  warning: {w}")
     return status
@@ -69,7 +71,7 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
         print(f"warning: {w}", file=sys.stderr)
     try:
         alarm_settings = _alarm_settings_from_env()
-    except ValueError as exc:                   # pydantic's ValidationError is a ValueError
+    except ValueError as exc:  # pydantic's ValidationError is a ValueError
         print(f"error: BEARING_TWIN_ALARMS: {error_text(exc)[:300]}", file=sys.stderr)
         return 2
     for path, suffixes in ((args.record, (".rrd",)), (args.table, (".parquet", ".pq", ".csv"))):
@@ -84,9 +86,13 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
     if not args.no_progress:
         from tqdm import tqdm
 
-        bar = tqdm(total=round(total * 1000), unit="ms", desc=scenario.name, file=sys.stderr,
-                   bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} ms simulated "
-                   "[{elapsed}<{remaining}]")
+        bar = tqdm(
+            total=round(total * 1000),
+            unit="ms",
+            desc=scenario.name,
+            file=sys.stderr,
+            bar_format="{desc}: {percentage:3.0f}%|{bar}| {n_fmt}/{total_fmt} ms simulated [{elapsed}<{remaining}]",
+        )
 
     def progress(done_s: float) -> None:
         if bar is not None:
@@ -95,8 +101,14 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
 
     try:
         written: list = []
-        results = run_scenario(scenario, record=args.record, table=table, progress=progress,
-                               on_recording=written.append, alarms=alarm_settings)
+        results = run_scenario(
+            scenario,
+            record=args.record,
+            table=table,
+            progress=progress,
+            on_recording=written.append,
+            alarms=alarm_settings,
+        )
     except ScenarioError as exc:
         if bar is not None:
             bar.close()
@@ -108,10 +120,18 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
     for r in results:
         snap = r.final
         lam = [c.lambda_ for b in (snap.balls if snap else ()) for c in (b.inner, b.outer) if c.lambda_ is not None]
-        summary = (f"min Lambda {min(lam):.2f}, friction torque {snap.friction_torque_n_m * 1e3:.2f} mN m, "
-                   f"status {snap.status}") if snap is not None and lam else (f"status {snap.status}" if snap else "")
-        print(f"  {r.run.id} ({r.run.label}): {r.state}, {r.rows} samples, {r.wall_s:.1f} s wall; {summary}"
-              + (f"; error: {r.error}" if r.error else ""))
+        summary = (
+            (
+                f"min Lambda {min(lam):.2f}, friction torque {snap.friction_torque_n_m * 1e3:.2f} mN m, "
+                f"status {snap.status}"
+            )
+            if snap is not None and lam
+            else (f"status {snap.status}" if snap else "")
+        )
+        print(
+            f"  {r.run.id} ({r.run.label}): {r.state}, {r.rows} samples, {r.wall_s:.1f} s wall; {summary}"
+            + (f"; error: {r.error}" if r.error else "")
+        )
         for e in r.alarms:
             print(f"    alarm at {e.time_s:.3f} s: {e.message}")
         if r.state != "done":
@@ -119,6 +139,6 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
     if args.table:
         path = write_table(table.rows, args.table)
         print(f"table: {path} ({len(table.rows)} rows)")
-    if args.record:      # the file written: <stem>.run2.rrd when the name was taken
+    if args.record:  # the file written: <stem>.run2.rrd when the name was taken
         print(f"recording: {written[0] if written else args.record}")
     return status

@@ -33,8 +33,11 @@ def _flag_options(setting: FlatSetting) -> dict[str, Any] | None:
     kind = members[0] if len(members) == 1 else str
     origin = typing.get_origin(kind)
     help_text = " ".join((setting.info.description or "").split()).replace("%", "%%")
-    options: dict[str, Any] = {"dest": setting.path, "default": argparse.SUPPRESS,
-                               "help": f"{help_text} (default {setting.default_text}) [{setting.env}]"}
+    options: dict[str, Any] = {
+        "dest": setting.path,
+        "default": argparse.SUPPRESS,
+        "help": f"{help_text} (default {setting.default_text}) [{setting.env}]",
+    }
     if kind is SecretStr:
         return None
     if kind is bool:
@@ -56,8 +59,9 @@ def _flag_options(setting: FlatSetting) -> dict[str, Any] | None:
     return options
 
 
-def add_settings_flags(parser: argparse.ArgumentParser, root: type[BaseModel],
-                       aliases: dict[str, tuple[str, ...]] | None = None) -> None:
+def add_settings_flags(
+    parser: argparse.ArgumentParser, root: type[BaseModel], aliases: dict[str, tuple[str, ...]] | None = None
+) -> None:
     """A flag for every field of `root`'s groups that has a flat name and is no secret, in one
     help section per group; `aliases`: further option strings of a setting of this command
     (`{"zenoh.prefix": ("--prefix",)}`), shown first."""
@@ -68,7 +72,8 @@ def add_settings_flags(parser: argparse.ArgumentParser, root: type[BaseModel],
             continue
         if setting.group not in sections:
             sections[setting.group] = parser.add_argument_group(
-                f"{setting.group} settings", root.model_fields[setting.group].description)
+                f"{setting.group} settings", root.model_fields[setting.group].description
+            )
         flags = (*(aliases or {}).get(setting.path, ()), *setting.flags)
         sections[setting.group].add_argument(*flags, **options)
 
@@ -102,7 +107,7 @@ def settings_error_text(exc: ValidationError, root: type[BaseModel]) -> str:
         setting = names.get((loc[0], loc[1])) if len(loc) >= 2 else None
         if setting is None:
             whole_model = not loc or (len(loc) == 1 and loc[0] in root.model_fields)
-            parts.append(message if whole_model else f"{'.'.join(loc)}: {message}")   # a check names its field
+            parts.append(message if whole_model else f"{'.'.join(loc)}: {message}")  # a check names its field
             continue
         flag = flag_of(root, setting.path)
         where = setting.env + (f", {flag}" if flag is not None else "")

@@ -45,8 +45,9 @@ def _pick_column(data: np.ndarray, column: int, what: str) -> np.ndarray:
     if data.ndim != 2:
         raise RecordError("FILE", f"the {what} has {data.ndim} dimensions; need 1 (or 2 with --column)")
     if not 0 <= column < data.shape[1]:
-        raise RecordError("--column",
-                          f"{column}: the {what} has {data.shape[1]} columns; allowed 0-{data.shape[1] - 1}")
+        raise RecordError(
+            "--column", f"{column}: the {what} has {data.shape[1]} columns; allowed 0-{data.shape[1] - 1}"
+        )
     return data[:, column]
 
 
@@ -101,8 +102,7 @@ def _parse_line(text: str) -> tuple[str, float]:
 def analyse_file(args: argparse.Namespace) -> dict:
     """The JSON of `vibration analyse` (module docstring). Raises RecordError / ValueError naming
     the option."""
-    from twin.vibration.analysis import (MAX_SAMPLE_RATE_HZ, AnalysisInputError, analyse_signal,
-                                         defect_multiples_of)
+    from twin.vibration.analysis import MAX_SAMPLE_RATE_HZ, AnalysisInputError, analyse_signal, defect_multiples_of
 
     path = Path(args.file)
     x, file_rate = read_record(path, args.column, args.full_scale)
@@ -110,8 +110,9 @@ def analyse_file(args: argparse.Namespace) -> dict:
         raise RecordError("--sample-rate", f"{args.sample_rate:g} Hz disagrees with the file's {file_rate:g} Hz")
     rate = file_rate if file_rate is not None else args.sample_rate
     if rate is None:
-        raise RecordError("--sample-rate",
-                          f"required for {path.suffix} records; allowed (0, {MAX_SAMPLE_RATE_HZ:g}] Hz")
+        raise RecordError(
+            "--sample-rate", f"required for {path.suffix} records; allowed (0, {MAX_SAMPLE_RATE_HZ:g}] Hz"
+        )
     if not (math.isfinite(rate) and 0.0 < rate <= MAX_SAMPLE_RATE_HZ):
         raise RecordError("--sample-rate", f"{rate:g} is out of range; allowed (0, {MAX_SAMPLE_RATE_HZ:g}] Hz")
     if not (math.isfinite(args.rpm) and 0.0 < args.rpm <= 3.0 * rate):
@@ -135,12 +136,25 @@ def analyse_file(args: argparse.Namespace) -> dict:
     try:
         analysis = analyse_signal(x * UNITS[args.units], rate, shaft_hz, multiples, band)
     except AnalysisInputError as exc:
-        option = {"signal_m_s2": "FILE", "sample_rate_hz": "--sample-rate", "shaft_hz": "--rpm",
-                  "band_hz": "--band"}.get(exc.field, exc.field)
+        option = {
+            "signal_m_s2": "FILE",
+            "sample_rate_hz": "--sample-rate",
+            "shaft_hz": "--rpm",
+            "band_hz": "--band",
+        }.get(exc.field, exc.field)
         raise RecordError(option, str(exc).split(": ", 1)[1]) from None
-    return {"input": {"file": str(path), "format": path.suffix.lower().lstrip("."), "units": args.units,
-                      "sample_rate_hz": rate, "rpm": args.rpm, "bearing": bearing, "line_multiples": multiples},
-            **analysis.to_dict(spectrum=args.spectrum)}
+    return {
+        "input": {
+            "file": str(path),
+            "format": path.suffix.lower().lstrip("."),
+            "units": args.units,
+            "sample_rate_hz": rate,
+            "rpm": args.rpm,
+            "bearing": bearing,
+            "line_multiples": multiples,
+        },
+        **analysis.to_dict(spectrum=args.spectrum),
+    }
 
 
 def _cmd_analyse(args: argparse.Namespace) -> int:
@@ -153,17 +167,24 @@ def _cmd_analyse(args: argparse.Namespace) -> int:
         print(json.dumps(result, allow_nan=False))
         return 0
     g = STANDARD_GRAVITY_M_S2
-    print(f"{result['input']['file']}: {result['n_samples']} samples at {result['sample_rate_hz']:g} Hz "
-          f"({result['duration_s']:.3g} s), shaft {result['shaft_hz']:.3f} Hz")
-    print(f"  RMS {result['rms_m_s2']:.4g} m/s2 ({result['rms_m_s2'] / g:.4g} g), kurtosis {result['kurtosis']:.2f}, "
-          f"crest factor {result['crest_factor']:.2f}")
+    print(
+        f"{result['input']['file']}: {result['n_samples']} samples at {result['sample_rate_hz']:g} Hz "
+        f"({result['duration_s']:.3g} s), shaft {result['shaft_hz']:.3f} Hz"
+    )
+    print(
+        f"  RMS {result['rms_m_s2']:.4g} m/s2 ({result['rms_m_s2'] / g:.4g} g), kurtosis {result['kurtosis']:.2f}, "
+        f"crest factor {result['crest_factor']:.2f}"
+    )
     lo, hi = result["envelope_band_hz"]
     print(f"  envelope band {lo:.0f}-{hi:.0f} Hz ({result['envelope_band_source']})")
     for d in result["defect_lines"]:
-        print(f"  {d['name']:>8}: expected {d['expected_hz']:8.2f} Hz, peak {d['peak_hz']:8.2f} Hz "
-              f"({100 * d['relative_error']:+.2f} %), {d['height_db']:5.1f} dB over +-20 Hz")
-    tops = ", ".join(f"{p['frequency_hz']:.1f} Hz {p['label'] or '?'} ({p['height_db']:.1f} dB)"
-                     for p in result["largest_lines"])
+        print(
+            f"  {d['name']:>8}: expected {d['expected_hz']:8.2f} Hz, peak {d['peak_hz']:8.2f} Hz "
+            f"({100 * d['relative_error']:+.2f} %), {d['height_db']:5.1f} dB over +-20 Hz"
+        )
+    tops = ", ".join(
+        f"{p['frequency_hz']:.1f} Hz {p['label'] or '?'} ({p['height_db']:.1f} dB)" for p in result["largest_lines"]
+    )
     print(f"  largest envelope lines: {tops}")
     return 0
 
@@ -171,21 +192,40 @@ def _cmd_analyse(args: argparse.Namespace) -> int:
 def add_analyse_command(vibration_parser: argparse.ArgumentParser) -> None:
     """`vibration analyse FILE ...` under the `vibration` command's parser."""
     sub = vibration_parser.add_subparsers(dest="vibration_command")
-    an = sub.add_parser("analyse", help="analyse a measured accelerometer record (.npy, .csv, .wav)",
-                        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    an = sub.add_parser(
+        "analyse",
+        help="analyse a measured accelerometer record (.npy, .csv, .wav)",
+        description=__doc__,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
     an.add_argument("file", metavar="FILE", help="record: .npy, .csv or .wav")
     an.add_argument("--sample-rate", type=float, default=None, help="sample rate [Hz] (.wav: from the file)")
     an.add_argument("--rpm", type=float, required=True, help="shaft speed [rev/min]")
-    an.add_argument("--bearing", default=None, help="catalog designation or bearing spec file (.yaml, .json): the defect lines from its geometry")
-    an.add_argument("--line", type=_parse_line, action="append", metavar="NAME=MULTIPLE",
-                    help="a defect line as a multiple of the shaft frequency (repeatable; replaces the "
-                         "bearing's lines), e.g. --line BPFI=5.4152")
-    an.add_argument("--band", type=float, nargs=2, metavar=("LO", "HI"),
-                    help="envelope band [Hz] (default: Antoni's fast kurtogram)")
+    an.add_argument(
+        "--bearing",
+        default=None,
+        help="catalog designation or bearing spec file (.yaml, .json): the defect lines from its geometry",
+    )
+    an.add_argument(
+        "--line",
+        type=_parse_line,
+        action="append",
+        metavar="NAME=MULTIPLE",
+        help="a defect line as a multiple of the shaft frequency (repeatable; replaces the "
+        "bearing's lines), e.g. --line BPFI=5.4152",
+    )
+    an.add_argument(
+        "--band",
+        type=float,
+        nargs=2,
+        metavar=("LO", "HI"),
+        help="envelope band [Hz] (default: Antoni's fast kurtogram)",
+    )
     an.add_argument("--units", choices=sorted(UNITS), default="m/s2", help="units of the samples (default m/s2)")
     an.add_argument("--column", type=int, default=0, help="column of a 2-D .npy or .csv (default 0)")
-    an.add_argument("--full-scale", type=float, default=1.0,
-                    help="value, in --units, of an integer .wav's full scale (default 1)")
+    an.add_argument(
+        "--full-scale", type=float, default=1.0, help="value, in --units, of an integer .wav's full scale (default 1)"
+    )
     an.add_argument("--spectrum", action="store_true", help="include the envelope spectrum in the JSON")
     an.add_argument("--json", action="store_true", help="print the result as JSON")
     an.set_defaults(func=_cmd_analyse)

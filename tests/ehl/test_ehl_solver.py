@@ -57,7 +57,7 @@ def _spike_excess(res) -> tuple[float, float]:
     x, p, _ = res.centre_line()
     xs = x / res.hertz["ax_m"]
     ps = p / res.hertz["p_hertz_pa"]
-    hertz = np.sqrt(np.clip(1.0 - xs ** 2, 0.0, None))
+    hertz = np.sqrt(np.clip(1.0 - xs**2, 0.0, None))
     down = xs > 0.0
     k = int(np.argmax(np.where(down, ps - hertz, -np.inf)))
     return float(ps[k] - hertz[k]), float(xs[k])
@@ -67,8 +67,11 @@ def _exit_local_maxima(res) -> list[float]:
     """X of the local pressure maxima along y = 0 in 0.5 < X < 1.1 (the exit region)."""
     x, p, _ = res.centre_line()
     xs = x / res.hertz["ax_m"]
-    return [float(xs[k]) for k in range(1, len(p) - 1)
-            if 0.5 < xs[k] < 1.1 and p[k] >= p[k - 1] and p[k] > p[k + 1] and p[k] > 0.0]
+    return [
+        float(xs[k])
+        for k in range(1, len(p) - 1)
+        if 0.5 < xs[k] < 1.1 and p[k] >= p[k - 1] and p[k] > p[k + 1] and p[k] > 0.0
+    ]
 
 
 @pytest.fixture(scope="module")
@@ -104,17 +107,29 @@ CURRENTS = (0.0, 10.0, 20.0, 30.0)
 @pytest.fixture(scope="module")
 def with_current(iso257):
     """Thermal solves at the default speed on the calibration grid (257), eqs. 6 + 10."""
-    return {i: solve_point_contact(entrainment_speed_m_s=DEFAULT_SPEED, grid=257, current_a=i, thermal=True)
-            for i in CURRENTS}
+    return {
+        i: solve_point_contact(entrainment_speed_m_s=DEFAULT_SPEED, grid=257, current_a=i, thermal=True)
+        for i in CURRENTS
+    }
 
 
 # --- elasticity (seed 003 eq. 4, term d_e) -----------------------------------------------------
 
+
 def test_fft_deflection_equals_the_direct_influence_sum():
     """eq. 4 d_e: the zero-padded FFT convolution is the influence-coefficient sum (to 1e-12)."""
     hz = prm.hertz_scales(prm.LOAD_N, prm.RX_M, prm.RY_M, prm.E_PRIME_PA)
-    d = Deflection(17, 17, 0.375, 0.375, ax_m=hz.ax_m, ay_m=hz.ay_m, rx_m=prm.RX_M,
-                   p_hertz_pa=hz.p_hertz_pa, e_prime_pa=prm.E_PRIME_PA)
+    d = Deflection(
+        17,
+        17,
+        0.375,
+        0.375,
+        ax_m=hz.ax_m,
+        ay_m=hz.ay_m,
+        rx_m=prm.RX_M,
+        p_hertz_pa=hz.p_hertz_pa,
+        e_prime_pa=prm.E_PRIME_PA,
+    )
     rng = np.random.default_rng(3)
     p = rng.random((17, 17))
     assert np.max(np.abs(d(p) - d.direct(p))) < 1e-12 * np.max(np.abs(d.direct(p)))
@@ -133,6 +148,7 @@ def test_hertz_pressure_gives_the_hertz_approach():
 
 
 # --- isothermal validation (seed 003 Fig. 1) ----------------------------------------------------
+
 
 def test_isothermal_solves_converge_to_the_seed_tolerances(iso129, iso257):
     """eqs. 13-14: pressure change < 1e-5, load error < 1e-2, every speed, 129 and 257 grids."""
@@ -153,19 +169,26 @@ def test_513_solves_converge_to_the_seed_tolerances(iso513):
         assert res.iterations <= 60
 
 
-_HD_FAILS = ("not achieved, and not a numerical artefact: the grid-converged minimum film (side lobes) lies "
-             "25-27 % (0.832 m/s, M = 435), ~16 % (1.664 m/s) and 8-9 % (2.496 m/s, M = 191) below "
-             "Hamrock-Dowson; bracketed by first- and second-order upwind solutions on 129-513 nodes "
-             "(0.832 m/s: 56.6 / 55.2 nm on 513 against HD 75.7 nm). HD's nearly fixed h_c/h_min = 1.76 "
-             "does not hold at high Moes M (solver: 1.9-2.3); h_c agrees with HD within 4 %. Seed 003 notes "
-             "the analytical model's accuracy diminishes below 2.5 m/s")
+_HD_FAILS = (
+    "not achieved, and not a numerical artefact: the grid-converged minimum film (side lobes) lies "
+    "25-27 % (0.832 m/s, M = 435), ~16 % (1.664 m/s) and 8-9 % (2.496 m/s, M = 191) below "
+    "Hamrock-Dowson; bracketed by first- and second-order upwind solutions on 129-513 nodes "
+    "(0.832 m/s: 56.6 / 55.2 nm on 513 against HD 75.7 nm). HD's nearly fixed h_c/h_min = 1.76 "
+    "does not hold at high Moes M (solver: 1.9-2.3); h_c agrees with HD within 4 %. Seed 003 notes "
+    "the analytical model's accuracy diminishes below 2.5 m/s"
+)
 
 
-@pytest.mark.parametrize("speed", [
-    pytest.param(0.832, marks=pytest.mark.xfail(strict=True, reason=_HD_FAILS)),
-    pytest.param(1.664, marks=pytest.mark.xfail(strict=True, reason=_HD_FAILS)),
-    pytest.param(2.496, marks=pytest.mark.xfail(strict=True, reason=_HD_FAILS)),
-    3.328, 4.16])
+@pytest.mark.parametrize(
+    "speed",
+    [
+        pytest.param(0.832, marks=pytest.mark.xfail(strict=True, reason=_HD_FAILS)),
+        pytest.param(1.664, marks=pytest.mark.xfail(strict=True, reason=_HD_FAILS)),
+        pytest.param(2.496, marks=pytest.mark.xfail(strict=True, reason=_HD_FAILS)),
+        3.328,
+        4.16,
+    ],
+)
 def test_minimum_film_within_8_percent_of_hamrock_dowson(iso257, speed):
     """Seed 003 Fig. 1: isothermal h_min within 8 % of Hamrock-Dowson (257 x 257 grid).
     Holds at 3.33 and 4.16 m/s; at the lower speeds it does not (strict xfail, see reason).
@@ -204,31 +227,39 @@ def test_isothermal_pressure_has_the_exit_spike(iso257, speed):
 def _nijenbanning_central_film(m_load: float, l_material: float) -> float:
     """Moes-Nijenbanning central film H_c = h_c/Rx (2U)^-1/2, circular contact (Nijenbanning,
     Venner, Moes, Wear 176 (1994) 217), fitted to Barus/incompressible numerical solutions."""
-    h_ri = 145.0 * (1.0 + 0.796) ** (-15.0 / 7.0) * m_load ** -2
+    h_ri = 145.0 * (1.0 + 0.796) ** (-15.0 / 7.0) * m_load**-2
     h_ei = 3.18 * 1.63 ** (-14.0 / 25.0) * m_load ** (-2.0 / 15.0)
     h_rp = 1.29 * 1.691 ** (-2.0 / 3.0) * l_material ** (2.0 / 3.0)
-    h_ep = 1.48 * 1.63 ** (-7.0 / 20.0) * m_load ** (-1.0 / 12.0) * l_material ** 0.75
+    h_ep = 1.48 * 1.63 ** (-7.0 / 20.0) * m_load ** (-1.0 / 12.0) * l_material**0.75
     s = 1.5 * (1.0 + math.exp(-1.2 * h_ei / h_ri))
-    return ((h_ri ** 1.5 + (h_ei ** -4 + 1.8 ** -4) ** (-3.0 / 8.0)) ** (2.0 * s / 3.0)
-            + (h_rp ** -8 + h_ep ** -8) ** (-s / 8.0)) ** (1.0 / s)
+    return (
+        (h_ri**1.5 + (h_ei**-4 + 1.8**-4) ** (-3.0 / 8.0)) ** (2.0 * s / 3.0) + (h_rp**-8 + h_ep**-8) ** (-s / 8.0)
+    ) ** (1.0 / s)
 
 
 def test_solver_reproduces_the_moes_nijenbanning_central_film():
     """Solver check beyond the seed: with Barus viscosity and constant density (the rheology of
     the Moes-Nijenbanning formula) at M = 20, L = 10 the central film is within 5 % of the
     formula (measured +2 %, the same on 129 and 257 nodes)."""
-    w = prm.LOAD_N / (prm.E_PRIME_PA * prm.RX_M ** 2)
+    w = prm.LOAD_N / (prm.E_PRIME_PA * prm.RX_M**2)
     two_u = (w / 20.0) ** (4.0 / 3.0)
     speed = 0.5 * two_u * prm.E_PRIME_PA * prm.RX_M / 0.04
-    alpha = 10.0 / two_u ** 0.25 / prm.E_PRIME_PA
-    res = solve_point_contact(entrainment_speed_m_s=speed, alpha_pa_inv=alpha, eta0_pa_s=0.04, grid=129,
-                              thermal=False, rheology="barus_incompressible")
+    alpha = 10.0 / two_u**0.25 / prm.E_PRIME_PA
+    res = solve_point_contact(
+        entrainment_speed_m_s=speed,
+        alpha_pa_inv=alpha,
+        eta0_pa_s=0.04,
+        grid=129,
+        thermal=False,
+        rheology="barus_incompressible",
+    )
     assert res.converged, res.message
     h_moes = res.h_c_m / (prm.RX_M * math.sqrt(two_u))
     assert h_moes == pytest.approx(_nijenbanning_central_film(20.0, 10.0), rel=0.05)
 
 
 # --- grid refinement -------------------------------------------------------------------------
+
 
 @pytest.mark.parametrize("speed", SPEEDS)
 def test_grid_refinement_minimum_film(iso129, iso257, iso513, speed):
@@ -252,6 +283,7 @@ def test_central_film_is_grid_converged_at_every_speed(iso129, iso257, iso513):
 
 
 # --- current discharge (seed 003 eqs. 6-10, Figs. 2-5) ----------------------------------------
+
 
 def test_current_heating_eq_10_scales_with_current_squared_over_speed():
     """eq. 10: T_obn proportional to I^2 R_b / f_s (to round-off)."""
@@ -305,6 +337,7 @@ def test_exit_spike_fades_as_current_rises(with_current):
 
 # --- failure is reported, not hidden -----------------------------------------------------------
 
+
 def test_non_convergence_is_reported_with_the_history():
     """A cycle cap far below what eqs. 13-14 need returns converged=False and the history."""
     res = solve_point_contact(grid=65, thermal=False, max_iter=2)
@@ -321,6 +354,7 @@ def test_bad_grid_is_refused():
 
 
 # --- the calibration table shipped for the real-time loop -------------------------------------
+
 
 def test_shipped_film_reduction_table_has_provenance_and_consistent_factors():
     """The table (generated by `bearing-twin ehl calibrate`) carries its inputs, grid, date and
@@ -355,6 +389,7 @@ def test_film_reduction_factor_interpolates_the_table():
 
 # --- command line --------------------------------------------------------------------------------
 
+
 def test_cli_solve_json_carries_the_required_fields():
     """Issue 7 CLI contract: `bearing-twin ehl solve --json` (service/tools/ehl_cli.py, Appendix 2
     defaults, 65 x 65 grid) carries the required fields and inputs (exact keys, eta0 = 0.04)."""
@@ -365,8 +400,15 @@ def test_cli_solve_json_carries_the_required_fields():
         code = main(["ehl", "solve", "--grid", "65", "--json"])
     doc = json.loads(buf.getvalue())
     assert code == 0 and doc["converged"] is True
-    for key in ("h_min_m", "h_c_m", "max_pressure_pa", "temperature_rise_k", "converged", "iterations",
-                "hamrock_dowson_h_min_m"):
+    for key in (
+        "h_min_m",
+        "h_c_m",
+        "max_pressure_pa",
+        "temperature_rise_k",
+        "converged",
+        "iterations",
+        "hamrock_dowson_h_min_m",
+    ):
         assert key in doc
     for key in ("eta0_pa_s", "alpha_pa_inv", "rx_m", "ry_m", "e_prime_pa", "load_n", "entrainment_speed_m_s"):
         assert key in doc["inputs"]
@@ -374,6 +416,7 @@ def test_cli_solve_json_carries_the_required_fields():
 
 
 # --- report section (seed 003 Figs. 1 and 5) ------------------------------------------------------
+
 
 def test_report_section_writes_the_figures_and_the_table(tmp_path):
     """service/reports/ehl.py write_ehl_section on a small grid (33 x 33, for speed): the three PNGs

@@ -26,20 +26,24 @@ SETTLE_S = 0.03
 WINDOW_S = 0.05
 SAMPLE_S = 1e-4
 LOADED = 0.2  # contact angles are compared for balls carrying >= 20 % of Qmax (see below)
-HEAVY = 0.6   # ... and held to 0.5 deg for balls carrying >= 60 % of Qmax
+HEAVY = 0.6  # ... and held to 0.5 deg for balls carrying >= 60 % of Qmax
 
 
 def _run(designation, radial, time_step):
-    twin = Twin(designation, options=ModelOptions(time_step_s=time_step),
-                setpoint=Setpoint(shaft_speed_rad_s=SPEED, radial_load_n=radial, axial_load_n=3000.0))
+    twin = Twin(
+        designation,
+        options=ModelOptions(time_step_s=time_step),
+        setpoint=Setpoint(shaft_speed_rad_s=SPEED, radial_load_n=radial, axial_load_n=3000.0),
+    )
     twin.advance(SETTLE_S)
     disp = []
     for _ in range(int(round(WINDOW_S / SAMPLE_S))):
         twin.advance(SAMPLE_S, frame_steps=100)
         disp.append(np.linalg.norm(twin.state.inner_ring_offset_m))
     snap = twin.snapshot()
-    jones = analytic.jones_equilibrium(twin.model, radial, 3000.0, snap.shaft_speed_rad_s,
-                                       azimuths_rad=twin.ball_azimuths_rad())
+    jones = analytic.jones_equilibrium(
+        twin.model, radial, 3000.0, snap.shaft_speed_rad_s, azimuths_rad=twin.ball_azimuths_rad()
+    )
     return twin, snap, jones, np.array(disp)
 
 
@@ -90,8 +94,7 @@ def test_ball_loads_and_contact_angles_match_jones(settled, time_step):
     rows = twin.state.contacts
     for c in range(2 * twin.model.ball_count):
         if rows[L.C_LOAD, c] > 0.0:
-            assert rows[L.M_STIFFNESS, c] == pytest.approx(
-                twin.model.stiffness_at(c % 2, rows[L.G_NZ, c]), rel=2e-3)
+            assert rows[L.M_STIFFNESS, c] == pytest.approx(twin.model.stiffness_at(c % 2, rows[L.G_NZ, c]), rel=2e-3)
 
 
 def _angle_departure_by_azimuth(time_step, bins_deg, limiting_shear_coefficient=None):
@@ -99,10 +102,17 @@ def _angle_departure_by_azimuth(time_step, bins_deg, limiting_shear_coefficient=
     3000 N in azimuth bins, over 30 snapshots 0.1 ms apart (more than one ball pass)."""
     spec = catalog.bearing("7208")
     if limiting_shear_coefficient is not None:
-        spec = BearingSpec.model_validate({**spec.model_dump(), "lubricant": {
-            **spec.lubricant.model_dump(), "limiting_shear_coefficient": limiting_shear_coefficient}})
-    twin = Twin(spec, options=ModelOptions(time_step_s=time_step),
-                setpoint=Setpoint(shaft_speed_rad_s=SPEED, radial_load_n=3000.0, axial_load_n=3000.0))
+        spec = BearingSpec.model_validate(
+            {
+                **spec.model_dump(),
+                "lubricant": {**spec.lubricant.model_dump(), "limiting_shear_coefficient": limiting_shear_coefficient},
+            }
+        )
+    twin = Twin(
+        spec,
+        options=ModelOptions(time_step_s=time_step),
+        setpoint=Setpoint(shaft_speed_rad_s=SPEED, radial_load_n=3000.0, axial_load_n=3000.0),
+    )
     twin.advance(SETTLE_S + WINDOW_S)
     rows = []
     for _ in range(30):
@@ -114,7 +124,9 @@ def _angle_departure_by_azimuth(time_step, bins_deg, limiting_shear_coefficient=
         ao = np.degrees(np.abs([b.outer.contact_angle_rad for b in snap.balls]))
         for j, a in enumerate(np.degrees(np.angle(np.exp(1j * np.asarray(az))))):
             if jones.inner_load_n[j] >= LOADED * jones.qmax_n:
-                rows.append((a, ai[j] - np.degrees(jones.inner_angle_rad[j]), ao[j] - np.degrees(jones.outer_angle_rad[j])))
+                rows.append(
+                    (a, ai[j] - np.degrees(jones.inner_angle_rad[j]), ao[j] - np.degrees(jones.outer_angle_rad[j]))
+                )
     rows = np.array(rows)
     idx = np.digitize(rows[:, 0], bins_deg)
     return np.array([rows[idx == k, 1:].mean(axis=0) for k in range(1, len(bins_deg))])
@@ -210,8 +222,9 @@ def test_jones_pure_thrust_equals_harris_closed_form():
         s = math.sin(a)
         kn = analytic.series_stiffness_n_m15(
             contact_constants(model.spec, True, s, e_prime)["stiffness_n_m15"],
-            contact_constants(model.spec, False, s, e_prime)["stiffness_n_m15"])
-        return 13 * kn * bd ** 1.5 * s * (math.cos(a0) / math.cos(a) - 1) ** 1.5 - 3000.0
+            contact_constants(model.spec, False, s, e_prime)["stiffness_n_m15"],
+        )
+        return 13 * kn * bd**1.5 * s * (math.cos(a0) / math.cos(a) - 1) ** 1.5 - 3000.0
 
     a = optimize.brentq(thrust, a0 + 1e-6, math.radians(60.0), xtol=1e-14)
     assert np.degrees(jones.inner_angle_rad) == pytest.approx(math.degrees(a), abs=1e-6)

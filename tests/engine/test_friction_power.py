@@ -1,7 +1,6 @@
 """The friction power by source (twin.friction_power, Twin.friction_power_w) and the friction
 torque's definition (twin.friction_power.frame_friction_torque_n_m)."""
 
-
 import numpy as np
 import pytest
 
@@ -52,11 +51,16 @@ def test_friction_torque_is_not_negative_from_start_to_rest():
             s = twin.state.scalars
             before = float(s[L.X_SHAFT_SPEED])
             twin.advance(1e-3)
-            rows.append((0.5 * (before + float(s[L.X_SHAFT_SPEED])), twin.snapshot().friction_torque_n_m,
-                         s[L.X_TORQUE_SUM] / s[L.X_TORQUE_COUNT]))
-    speed, friction, drive = np.array(rows).T   # speed: the frame's mean shaft speed
+            rows.append(
+                (
+                    0.5 * (before + float(s[L.X_SHAFT_SPEED])),
+                    twin.snapshot().friction_torque_n_m,
+                    s[L.X_TORQUE_SUM] / s[L.X_TORQUE_COUNT],
+                )
+            )
+    speed, friction, drive = np.array(rows).T  # speed: the frame's mean shaft speed
     turning = speed > 0.0
-    assert drive.min() < -0.02                      # the inertia the drive torque carries
+    assert drive.min() < -0.02  # the inertia the drive torque carries
     assert friction[turning].min() > 0.0
     # at rest: the torque the tangential springs still hold (elastic, not dissipative), within
     # +-3 mN m, 2 % of the running torque

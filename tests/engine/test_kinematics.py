@@ -16,8 +16,11 @@ TOL = 0.01  # the issue's 1 %
 
 @pytest.fixture(scope="module")
 def steady(time_step):
-    twin = Twin("6208", options=ModelOptions(time_step_s=time_step),
-                setpoint=Setpoint(shaft_speed_rad_s=500.0, radial_load_n=3000.0))
+    twin = Twin(
+        "6208",
+        options=ModelOptions(time_step_s=time_step),
+        setpoint=Setpoint(shaft_speed_rad_s=500.0, radial_load_n=3000.0),
+    )
     twin.advance(0.02)
     return twin, twin.snapshot()
 
@@ -36,15 +39,22 @@ def test_cage_speed_and_defect_frequencies(steady):
     g = 6.3 / 30.3  # D cos(alpha) / dm
     fs = 500.0 / (2 * math.pi)
     ftf = 0.5 * fs * (1 - g)
-    expected = {"ftf_hz": ftf, "bpfo_hz": 9 * ftf, "bpfi_hz": 4.5 * fs * (1 + g),
-                "bsf_hz": fs * 30.3 / 12.6 * (1 - g * g)}
+    expected = {
+        "ftf_hz": ftf,
+        "bpfo_hz": 9 * ftf,
+        "bpfi_hz": 4.5 * fs * (1 + g),
+        "bsf_hz": fs * 30.3 / 12.6 * (1 - g * g),
+    }
     assert twin.model.defect_frequencies_hz(500.0) == pytest.approx(expected, rel=1e-12)
     cage = snap.cage_speed_rad_s
     orbit = np.mean([b.orbital_speed_rad_s for b in snap.balls])
     spin_rel_cage = np.mean(np.abs(twin.state.ball_angular_velocity_rad_s[:, 2] - cage))
-    simulated = {"ftf_hz": cage / (2 * math.pi), "bpfo_hz": 9 * orbit / (2 * math.pi),
-                 "bpfi_hz": 9 * (snap.shaft_speed_rad_s - orbit) / (2 * math.pi),
-                 "bsf_hz": spin_rel_cage / (2 * math.pi)}
+    simulated = {
+        "ftf_hz": cage / (2 * math.pi),
+        "bpfo_hz": 9 * orbit / (2 * math.pi),
+        "bpfi_hz": 9 * (snap.shaft_speed_rad_s - orbit) / (2 * math.pi),
+        "bsf_hz": spin_rel_cage / (2 * math.pi),
+    }
     for key, value in simulated.items():
         assert value == pytest.approx(expected[key], rel=TOL), key
 

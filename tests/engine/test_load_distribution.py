@@ -25,8 +25,12 @@ TOL = 0.03  # the issue's 3 % agreement
 @pytest.fixture(scope="module", params=[-12.6e-6, 0.0, 12.6e-6], ids=["preload", "zero", "clearance"])
 def settled(request, time_step):
     pd = request.param
-    twin = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=1.0, radial_load_n=1500.0),
-                diametral_clearance_m=pd, options=ModelOptions(time_step_s=time_step))
+    twin = Twin(
+        "6208",
+        setpoint=Setpoint(shaft_speed_rad_s=1.0, radial_load_n=1500.0),
+        diametral_clearance_m=pd,
+        options=ModelOptions(time_step_s=time_step),
+    )
     twin.set_setpoint(radial_load_n=3000.0)
     twin.advance(0.08)
     snap = twin.snapshot()

@@ -41,8 +41,7 @@ def test_table_3_regimes_against_speed(speed_sweep):
 
 def test_speed_slope_is_0_68(speed_sweep):
     # seed 000 section 3.2: fit of ln Lambda_inner against ln omega, slope 0.6797 (eq. 6: U^0.68)
-    slope = studies.log_slope([s.shaft_speed_rad_s for s in speed_sweep],
-                              [s.lambda_inner for s in speed_sweep])
+    slope = studies.log_slope([s.shaft_speed_rad_s for s in speed_sweep], [s.lambda_inner for s in speed_sweep])
     assert slope == pytest.approx(0.68, abs=0.03)
 
 
@@ -53,7 +52,9 @@ def test_load_slope_is_minus_0_073(time_step):
     slope = studies.log_slope([s.load_outer_n for s in samples], [s.lambda_outer for s in samples])
     assert slope == pytest.approx(-0.073, abs=0.01)
     # and Fr against Qmax has a slope close to 1 (eq. A3)
-    assert studies.log_slope([s.load_inner_n for s in samples], [s.radial_load_n for s in samples]) == pytest.approx(1.0, abs=0.05)
+    assert studies.log_slope([s.load_inner_n for s in samples], [s.radial_load_n for s in samples]) == pytest.approx(
+        1.0, abs=0.05
+    )
 
 
 def test_fig_8_outer_lambda_over_a_cage_revolution(time_step):
@@ -77,4 +78,4 @@ def test_masjedi_khonsari_option_speed_slope(time_step):
     samples = [studies.sample_at_azimuth_zero(w, options=opts) for w in (300, 700, 1100, 1500)]
     slope = studies.log_slope([s.shaft_speed_rad_s for s in samples], [s.lambda_inner for s in samples])
     k_inner = (163.8 / 4.990) ** (2 / math.pi)
-    assert slope == pytest.approx(0.711 * k_inner ** -0.023, abs=0.02)
+    assert slope == pytest.approx(0.711 * k_inner**-0.023, abs=0.02)

@@ -12,8 +12,11 @@ from twin.spec import BearingSpec, Geometry, ModelOptions
 
 
 def test_one_second_at_1700_rad_s_and_7500_n(time_step):
-    twin = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=1700.0, radial_load_n=7500.0),
-                options=ModelOptions(time_step_s=time_step))
+    twin = Twin(
+        "6208",
+        setpoint=Setpoint(shaft_speed_rad_s=1700.0, radial_load_n=7500.0),
+        options=ModelOptions(time_step_s=time_step),
+    )
     worst = 0.0
     for _ in range(20):
         twin.advance(0.05)
@@ -30,9 +33,16 @@ def test_one_second_at_1700_rad_s_and_7500_n(time_step):
     snap.to_json()  # serialises without NaN
 
 
-@pytest.mark.parametrize("field, value", [
-    ("shaft_speed_rad_s", -1.0), ("shaft_speed_rad_s", float("nan")), ("radial_load_n", -5.0),
-    ("radial_load_n", float("inf")), ("oil_temperature_c", 400.0)])
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("shaft_speed_rad_s", -1.0),
+        ("shaft_speed_rad_s", float("nan")),
+        ("radial_load_n", -5.0),
+        ("radial_load_n", float("inf")),
+        ("oil_temperature_c", 400.0),
+    ],
+)
 def test_setpoint_refused_with_the_field_name(field, value):
     twin = Twin("6208")
     # a non-finite number is a type error (ValidationError), a finite one out of range a
@@ -62,8 +72,9 @@ def test_ball_that_does_not_fit_its_groove_is_refused():
         Geometry(**g)
 
 
-@pytest.mark.parametrize("field, value", [("ball_radius_m", -1.0), ("ball_count", 2),
-                                          ("cage_element_radius_m", float("nan"))])
+@pytest.mark.parametrize(
+    "field, value", [("ball_radius_m", -1.0), ("ball_count", 2), ("cage_element_radius_m", float("nan"))]
+)
 def test_bad_geometry_fields_named(field, value):
     g = catalog.bearing("6208").geometry.model_dump()
     g[field] = value
@@ -84,15 +95,25 @@ def test_every_catalog_bearing_builds_and_runs(time_step):
         assert isinstance(spec, BearingSpec)
         # an angular-contact bearing needs an axial load to seat its balls (a single row cannot
         # carry a pure radial load without an axial reaction)
-        twin = Twin(name, setpoint=Setpoint(shaft_speed_rad_s=300.0, radial_load_n=1000.0,
-                                            axial_load_n=500.0 if name.startswith("7208") else 0.0),
-                    options=ModelOptions(time_step_s=time_step))
+        twin = Twin(
+            name,
+            setpoint=Setpoint(
+                shaft_speed_rad_s=300.0, radial_load_n=1000.0, axial_load_n=500.0 if name.startswith("7208") else 0.0
+            ),
+            options=ModelOptions(time_step_s=time_step),
+        )
         twin.advance(0.002)
         assert twin.snapshot().status == "ok", name
 
 
 def test_6208_catalog_is_seed_000_table_1():
     g = catalog.bearing("6208").geometry
-    assert (g.ball_radius_m, g.inner_raceway_radius_m, g.outer_raceway_radius_m,
-            g.inner_groove_radius_m, g.outer_groove_radius_m, g.ball_count,
-            g.cage_element_radius_m) == (6.3e-3, 24.0e-3, 36.6e-3, 6.552e-3, 6.552e-3, 9, 4.19e-3)
+    assert (
+        g.ball_radius_m,
+        g.inner_raceway_radius_m,
+        g.outer_raceway_radius_m,
+        g.inner_groove_radius_m,
+        g.outer_groove_radius_m,
+        g.ball_count,
+        g.cage_element_radius_m,
+    ) == (6.3e-3, 24.0e-3, 36.6e-3, 6.552e-3, 6.552e-3, 9, 4.19e-3)

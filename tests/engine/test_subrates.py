@@ -32,9 +32,16 @@ def test_traction_period_is_a_whole_number_of_refreshes(dt):
     assert fast.params[L.P_TRACTION_EVERY] == 1
 
 
-@pytest.mark.parametrize("field, value", [("traction_period_s", 0.0), ("traction_period_s", 2e-3),
-                                          ("traction_period_s", math.nan), ("tribology_period_s", 1e-3),
-                                          ("tribology_period_s", -1e-5)])
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("traction_period_s", 0.0),
+        ("traction_period_s", 2e-3),
+        ("traction_period_s", math.nan),
+        ("tribology_period_s", 1e-3),
+        ("tribology_period_s", -1e-5),
+    ],
+)
 def test_bad_sub_rate_refused_with_field_and_range(field, value):
     with pytest.raises(ValidationError) as err:
         ModelOptions(**{field: value})

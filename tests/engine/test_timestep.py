@@ -22,6 +22,7 @@ def _leapfrog_stability_limit(zeta: float) -> float:
     """omega dt at which the engine's scheme (leapfrog kicks, the damping force on the half-step
     velocity) stops being stable for x'' = -x - 2 zeta x', by bisection on its amplification
     matrix: an independent check of the formula."""
+
     def stable(h):
         m = np.zeros((3, 3))
         for i in range(3):
@@ -30,6 +31,7 @@ def _leapfrog_stability_limit(zeta: float) -> float:
             x2 = x + h * vh2
             m[:, i] = [x2, vh2, -x2 - 2.0 * zeta * vh2]
         return np.max(np.abs(np.linalg.eigvals(m))) <= 1.0 + 1e-12
+
     lo, hi = 0.0, 4.0
     for _ in range(60):
         mid = 0.5 * (lo + hi)
@@ -48,7 +50,7 @@ def test_critical_step_is_the_schemes_stability_limit(zeta):
 def test_hertz_tangent_stiffness_is_dq_ddelta():
     # seed 000 eq. 2: Q = K delta^1.5 -> dQ/d(delta) = 1.5 K^(2/3) Q^(1/3)
     big_k, delta = 4.3e10, 30e-6
-    q = big_k * delta ** 1.5
+    q = big_k * delta**1.5
     h = 1e-10
     slope = (big_k * (delta + h) ** 1.5 - big_k * (delta - h) ** 1.5) / (2 * h)
     assert timestep.hertz_tangent_stiffness_n_m(big_k, q) == pytest.approx(slope, rel=1e-6)
@@ -66,7 +68,8 @@ def test_elements_read_from_the_compiled_model(designation):
     assert normal.omega_rad_s == pytest.approx(math.sqrt(k / p[L.P_BALL_MASS]), rel=0.02)
     # its damping: C_hyst = 1.5 alpha_e Q per contact (seed 000 eq. 4), both contacts
     assert normal.damping_ratio == pytest.approx(
-        2 * 1.5 * p[L.P_ALPHA_E] * est.static_load_n / (2 * math.sqrt(k * p[L.P_BALL_MASS])), rel=0.03)
+        2 * 1.5 * p[L.P_ALPHA_E] * est.static_load_n / (2 * math.sqrt(k * p[L.P_BALL_MASS])), rel=0.03
+    )
     # the static capacity: the ball load at which the model's Hertz pressure reaches 4.2 GPa
     a = race[:, L.R_SEMI_MAJOR_COEF] * est.static_load_n ** (1 / 3)
     b = race[:, L.R_SEMI_MINOR_COEF] * est.static_load_n ** (1 / 3)
@@ -117,8 +120,7 @@ def test_auto_step_is_a_stability_bound_not_a_loose_one():
 
 
 def _run_cli(*args, timeout=900):
-    return subprocess.run([sys.executable, "-m", "service.cli", *args], capture_output=True, text=True,
-                          timeout=timeout)
+    return subprocess.run([sys.executable, "-m", "service.cli", *args], capture_output=True, text=True, timeout=timeout)
 
 
 def test_quick_timestep_study_within_tolerances_at_auto():
@@ -164,14 +166,29 @@ def test_bench_json_keys_positive_and_finite():
     res = _run_cli("bench", "--json", "--seconds", "0.01")
     assert res.returncode == 0, res.stderr
     r = json.loads(res.stdout, parse_constant=lambda c: pytest.fail(f"non-finite {c}"))
-    for key in ("real_time_factor", "real_time_factor_median", "time_step_s", "ns_per_step",
-                "real_time_factor_1us", "real_time_factor_1us_median", "ns_per_step_1us",
-                "cpu_real_time_factor", "cpu_real_time_factor_1us"):
+    for key in (
+        "real_time_factor",
+        "real_time_factor_median",
+        "time_step_s",
+        "ns_per_step",
+        "real_time_factor_1us",
+        "real_time_factor_1us_median",
+        "ns_per_step_1us",
+        "cpu_real_time_factor",
+        "cpu_real_time_factor_1us",
+    ):
         assert math.isfinite(r[key]) and r[key] > 0, key
     assert r["repeats"] >= 5 and r["time_step_s"] > 1e-6
-    assert {c["id"] for c in r["cases"]} == {"ev-5A-heating", "7208-combined", "6208-1700rad-7.5kN",
-                                             "vibration-healthy", "vibration-outer-spall", "vibration-healthy-profile",
-                                             "vibration-cwru-de", "ev-6200-20krpm"}
+    assert {c["id"] for c in r["cases"]} == {
+        "ev-5A-heating",
+        "7208-combined",
+        "6208-1700rad-7.5kN",
+        "vibration-healthy",
+        "vibration-outer-spall",
+        "vibration-healthy-profile",
+        "vibration-cwru-de",
+        "ev-6200-20krpm",
+    }
     # seed 003's EV case: the 6200 at 20 000 rpm; the auto step (twin.timestep) is about 1.3 us there
     ev = next(c for c in r["cases"] if c["id"] == "ev-6200-20krpm")
     assert ev["designation"] == "6200" and ev["shaft_speed_rad_s"] == pytest.approx(20000.0 * math.pi / 30.0)

@@ -33,18 +33,42 @@ def free_port() -> int:
 class ServeProcess:
     """`bearing-twin serve` (python -m service.cli serve) as a subprocess on loopback ports."""
 
-    def __init__(self, tmp_path: Path, *extra: str, port: int | None = None,
-                 zenoh_port: int | None = None, record: Path | None = None, env: dict | None = None):
+    def __init__(
+        self,
+        tmp_path: Path,
+        *extra: str,
+        port: int | None = None,
+        zenoh_port: int | None = None,
+        record: Path | None = None,
+        env: dict | None = None,
+    ):
         self.port = port or free_port()
         self.zenoh_endpoint = f"tcp/127.0.0.1:{zenoh_port or free_port()}"
         self.rrd = record
-        cmd = [sys.executable, "-m", "service.cli", "serve", "--port", str(self.port),
-               "--zenoh-listen", self.zenoh_endpoint, "--log-level", "info", *extra]
+        cmd = [
+            sys.executable,
+            "-m",
+            "service.cli",
+            "serve",
+            "--port",
+            str(self.port),
+            "--zenoh-listen",
+            self.zenoh_endpoint,
+            "--log-level",
+            "info",
+            *extra,
+        ]
         cmd += ["--record", str(record)] if record is not None else ["--no-record"]
         full_env = {k: v for k, v in os.environ.items() if not k.startswith("BEARING_TWIN_")}
         full_env.update({"PYTHONUNBUFFERED": "1", "BEARING_TWIN_ADMISSION": "off", **(env or {})})
-        self.proc = subprocess.Popen(cmd, cwd=tmp_path, env={**full_env, "PYTHONPATH": str(REPO)},
-                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.proc = subprocess.Popen(
+            cmd,
+            cwd=tmp_path,
+            env={**full_env, "PYTHONPATH": str(REPO)},
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
         self.lines: queue.Queue = queue.Queue()
         self.log: list[str] = []
         threading.Thread(target=self._read, daemon=True).start()
@@ -80,7 +104,7 @@ class ServeProcess:
         except subprocess.TimeoutExpired:
             self.kill()
             raise AssertionError(f"service did not stop on signal {sig}:\n" + self.text) from None
-        time.sleep(0.1)   # let the reader thread take the last lines
+        time.sleep(0.1)  # let the reader thread take the last lines
         return time.monotonic() - t0
 
     def kill(self) -> None:
@@ -93,8 +117,10 @@ class ServeProcess:
 def hostile(support):
     """The helpers as one namespace (fixtures cannot be imported across test modules here);
     `ThreadServer`, `Peer`, `strict_loads` and `wait_for` are the shared ones of tests/support.py."""
+
     class H:
         pass
+
     h = H()
     h.REPO, h.SCENARIOS, h.WAIT_S = REPO, SCENARIOS, WAIT_S
     h.free_port, h.strict_loads = free_port, support.strict_loads

@@ -18,15 +18,23 @@ AUTH = {"Authorization": f"Bearer {TOKEN}"}
 
 
 def _settings(hostile, tmp_path, **kw):
-    return ServiceSettings(enable_zenoh=False, enable_recording=False, scenario_dir=hostile.SCENARIOS,
-                           record=tmp_path / "service.rrd", max_twins=3, **kw)
+    return ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        scenario_dir=hostile.SCENARIOS,
+        record=tmp_path / "service.rrd",
+        max_twins=3,
+        **kw,
+    )
 
 
 @pytest.fixture(scope="module")
 def guarded(hostile, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("access")
-    with hostile.ThreadServer(_settings(hostile, tmp, token=TOKEN)) as srv, \
-            httpx.Client(base_url=srv.url, timeout=30.0) as client:
+    with (
+        hostile.ThreadServer(_settings(hostile, tmp, token=TOKEN)) as srv,
+        httpx.Client(base_url=srv.url, timeout=30.0) as client,
+    ):
         yield client
 
 
@@ -40,11 +48,17 @@ MUTATIONS = [
 ]
 
 
-@pytest.mark.parametrize("headers", [{}, {"Authorization": "Bearer wrong"},
-                                     {"Authorization": f"Basic {TOKEN}"},
-                                     {"Authorization": f"Bearer {TOKEN}x"},
-                                     {"Authorization": "Bearer"}],
-                         ids=["none", "wrong", "other-scheme", "longer", "empty"])
+@pytest.mark.parametrize(
+    "headers",
+    [
+        {},
+        {"Authorization": "Bearer wrong"},
+        {"Authorization": f"Basic {TOKEN}"},
+        {"Authorization": f"Bearer {TOKEN}x"},
+        {"Authorization": "Bearer"},
+    ],
+    ids=["none", "wrong", "other-scheme", "longer", "empty"],
+)
 def test_mutations_without_the_token_are_401(guarded, headers):
     before = guarded.get("/v1/bearings/default").json()["setpoint"]
     twins = [b["id"] for b in guarded.get("/v1/bearings").json()]
@@ -73,8 +87,14 @@ def test_mutations_with_the_token_succeed(guarded):
 
 
 def test_reads_stay_open(guarded):
-    for path in ("/health", "/v1/bearings", "/v1/bearings/default", "/v1/bearings/default/state",
-                 "/v1/scenarios", "/openapi.json"):
+    for path in (
+        "/health",
+        "/v1/bearings",
+        "/v1/bearings/default",
+        "/v1/bearings/default/state",
+        "/v1/scenarios",
+        "/openapi.json",
+    ):
         assert guarded.get(path).status_code == 200, path
 
 
@@ -94,13 +114,12 @@ def test_reads_need_the_token_when_configured(hostile, tmp_path):
             assert c.get(path).status_code == 401, path
             assert c.get(path, headers={"Authorization": "Bearer nope"}).status_code == 401, path
             assert c.get(path, headers=AUTH).status_code == 200, path
-        assert c.get("/health").status_code == 200          # the liveness probe stays open
+        assert c.get("/health").status_code == 200  # the liveness probe stays open
         assert c.put("/v1/bearings/default/setpoint", json={}).status_code == 401
 
 
 def test_no_token_configured_means_open(hostile, tmp_path):
-    with hostile.ThreadServer(_settings(hostile, tmp_path)) as srv, \
-            httpx.Client(base_url=srv.url, timeout=30.0) as c:
+    with hostile.ThreadServer(_settings(hostile, tmp_path)) as srv, httpx.Client(base_url=srv.url, timeout=30.0) as c:
         assert c.put("/v1/bearings/default/setpoint", json={"radial_load_n": 3200.0}).status_code == 200
         assert c.get("/v1/bearings/default/state").status_code == 200
 
@@ -112,10 +131,11 @@ def test_token_comparison_is_constant_time(monkeypatch):
     def spy(a, b):
         calls.append((a, b))
         return real(a, b)
+
     monkeypatch.setattr(hmac, "compare_digest", spy)
     assert token_matches(TOKEN, TOKEN) and not token_matches("x", TOKEN) and not token_matches(None, TOKEN)
     assert len(calls) == 2 and all(isinstance(a, bytes) and isinstance(b, bytes) for a, b in calls)
-    assert token_matches("anything", None)        # no token configured
+    assert token_matches("anything", None)  # no token configured
     assert bearer_token(b"Bearer  abc ") == b"abc" and bearer_token(b"Basic abc") is None
     assert bearer_token(None) is None and bearer_token(b"Bearer") is None
 
@@ -129,7 +149,7 @@ def test_settings_token_from_environment(monkeypatch):
     monkeypatch.setenv("BEARING_TWIN_TOKEN", "has space")
     with pytest.raises(ValueError) as err:
         ServiceSettings()
-    assert "has space" not in str(err.value)           # never echoed
+    assert "has space" not in str(err.value)  # never echoed
 
 
 # zenoh setpoints no longer carry the token: tests/hostile/test_zenoh_access.py (issue 16)

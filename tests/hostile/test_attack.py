@@ -34,8 +34,13 @@ def test_attack_short_run_with_its_own_service():
         f = r[phase]
         assert f["probes"] > 0 and f["failed"] == 0
         assert f["health_p99_ms"] is not None and f["real_time_factor_median"] is not None
-    assert set(r["targets"]) == {"real_time_factor_median_min", "health_p99_ms_max", "real_time_factor_median",
-                                 "health_p99_ms", "met"}
+    assert set(r["targets"]) == {
+        "real_time_factor_median_min",
+        "health_p99_ms_max",
+        "real_time_factor_median",
+        "health_p99_ms",
+        "met",
+    }
     assert r["shutdown"]["clean"]
     # the floods on what watchers use (loadtest.attack_watchers): the squatter (refused a link by
     # zenoh access control) blocks no create and no answer repeats it; no guessed password opens a
@@ -45,7 +50,7 @@ def test_attack_short_run_with_its_own_service():
     assert logins["tried"] >= 1 and logins["accepted"] == 0
     assert 1 <= sessions["opened"] <= 16
     assert subs["subscriptions"] == 8 and subs["refused"]["BadTooManySubscriptions"] == 42
-    assert subs["publishing_interval_ms"] == [50.0] and subs["items"] == 50     # 1000/s at 20/s per item
+    assert subs["publishing_interval_ms"] == [50.0] and subs["items"] == 50  # 1000/s at 20/s per item
     assert subs["notifications_per_s"] <= 1000.0 * 1.2
     # the attackers' own CPU and the service's tarpit (on by default in a served process) are reported
     cpu = r["attacker_cpu_cores"]
@@ -54,8 +59,10 @@ def test_attack_short_run_with_its_own_service():
     assert tarpit["active"] and tarpit["held_now"] >= 0 and tarpit["max_held"] == 64
 
 
-@pytest.mark.parametrize("url, zenoh", [("http://10.0.0.8:8000", None), ("http://example.org", None),
-                                        ("http://127.0.0.1:8000", "tcp/192.168.1.4:7447")])
+@pytest.mark.parametrize(
+    "url, zenoh",
+    [("http://10.0.0.8:8000", None), ("http://example.org", None), ("http://127.0.0.1:8000", "tcp/192.168.1.4:7447")],
+)
 def test_attack_is_loopback_only(url, zenoh):
     with pytest.raises(ValueError, match="loopback"):
         check_loopback(url, zenoh)
@@ -63,8 +70,10 @@ def test_attack_is_loopback_only(url, zenoh):
         run_attack(AttackConfig(seconds=1.0, url=url, zenoh_connect=zenoh))
 
 
-@pytest.mark.parametrize("field, value", [("seconds", 601.0), ("seconds", float("inf")), ("seconds", 0.0),
-                                          ("concurrency", 65), ("concurrency", 0)])
+@pytest.mark.parametrize(
+    "field, value",
+    [("seconds", 601.0), ("seconds", float("inf")), ("seconds", 0.0), ("concurrency", 65), ("concurrency", 0)],
+)
 def test_attack_is_bounded(field, value):
     cfg = AttackConfig(seconds=1.0)
     setattr(cfg, field, value)

@@ -91,11 +91,11 @@ def twin():
 def test_restart_storm_is_bounded_by_max_restarts(twin):
     """A setpoint vector the kernel cannot hold fails again after every warm restart; without a
     bound a 1 ms frame would cost ~1000 warm starts. With max_restarts the call stops early."""
-    twin._setpoint_vector[L.S_RADIAL_LOAD] = 1e7          # bypasses validation
+    twin._setpoint_vector[L.S_RADIAL_LOAD] = 1e7  # bypasses validation
     left = twin.advance(0.001, max_restarts=2)
     assert twin.restarts == 2 and 0 < left < 1000
     assert "overloaded" in twin.status
-    twin.set_setpoint(radial_load_n=3000.0)                # rewrites the vector: holdable again
+    twin.set_setpoint(radial_load_n=3000.0)  # rewrites the vector: holdable again
     twin.reset(keep_time=True)
     assert twin.advance(0.002, max_restarts=2) == 0 and twin.restarts == 2
     finite_json(twin.snapshot().to_json())
@@ -104,12 +104,12 @@ def test_restart_storm_is_bounded_by_max_restarts(twin):
 def test_advance_stops_when_the_twin_halts_without_max_restarts(twin):
     """Without max_restarts a long advance at a setpoint the kernel cannot hold stops at the halt
     (restart, then a second failure within RESTART_WINDOW_S) instead of a warm start per step."""
-    twin._setpoint_vector[L.S_RADIAL_LOAD] = 1e7          # bypasses validation
+    twin._setpoint_vector[L.S_RADIAL_LOAD] = 1e7  # bypasses validation
     before = twin.restarts
     left = twin.advance(0.3)
     assert twin.halted and twin.restarts - before == 2 and left > 0
     assert twin.status.startswith("halted: overloaded")
-    twin.set_setpoint(radial_load_n=3000.0)                # a new setpoint: runs again
+    twin.set_setpoint(radial_load_n=3000.0)  # a new setpoint: runs again
     assert not twin.halted and twin.advance(0.002) == 0
 
 
@@ -123,10 +123,10 @@ def test_nan_in_the_state_is_detected_and_restarted(twin):
         wait_until(lambda: runner.latest.restarts >= 1)
         snap = runner.latest
         assert snap.status.startswith("restarted: diverged: non-finite state"), snap.status
-        assert runner.fallbacks == 0                     # the setpoint was fine: same setpoint
+        assert runner.fallbacks == 0  # the setpoint was fine: same setpoint
         assert snap.setpoint.radial_load_n == 3000.0
         n = runner.frames
-        wait_until(lambda: runner.frames > n + 20)       # and it keeps running
+        wait_until(lambda: runner.frames > n + 20)  # and it keeps running
         assert runner.running and runner.errors == 0
     finally:
         runner.stop()
@@ -140,14 +140,14 @@ def test_unholdable_setpoint_falls_back_to_the_last_safe_one(twin):
     try:
         runner.submit(radial_load_n=6000.0)
         wait_until(lambda: runner.last_safe_setpoint.radial_load_n == 6000.0)
-        FaultHook.of(twin).inject("overload", 1e7)       # a corrupted setpoint in force
+        FaultHook.of(twin).inject("overload", 1e7)  # a corrupted setpoint in force
         wait_until(lambda: runner.fallbacks == 1)
         wait_until(lambda: "setpoint not held" in runner.latest.status)
         status = runner.latest.status
         assert "radial_load_n = 1e+07 N" in status and "last safe setpoint (radial_load_n = 6000 N)" in status
         assert "overloaded" in status
         assert twin.setpoint.radial_load_n == 6000.0 and runner.target_setpoint.radial_load_n == 6000.0
-        assert runner.latest.restarts >= 2               # engine restart(s) + the fallback restart
+        assert runner.latest.restarts >= 2  # engine restart(s) + the fallback restart
         assert runner.stats()["fallbacks"] == 1
         n = runner.frames
         wait_until(lambda: runner.frames > n + 20)
@@ -159,8 +159,9 @@ def test_unholdable_setpoint_falls_back_to_the_last_safe_one(twin):
 @pytest.fixture(scope="module")
 def server(hostile, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("faults")
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, record=tmp / "s.rrd",
-                               scenario_dir=hostile.SCENARIOS, max_twins=3)
+    settings = ServiceSettings(
+        enable_zenoh=False, enable_recording=False, record=tmp / "s.rrd", scenario_dir=hostile.SCENARIOS, max_twins=3
+    )
     with hostile.ThreadServer(settings) as srv, httpx.Client(base_url=srv.url, timeout=30.0) as client:
         yield srv, client
 
@@ -197,7 +198,7 @@ def test_http_setpoint_at_the_edge_of_the_limits(server, hostile, field):
     srv, client = server
     high = client.get("/v1/bearings/default").json()["limits"][field][1]
     r = client.put("/v1/bearings/default/setpoint", json={field: high})
-    if r.status_code == 422:       # learned earlier in this module: refused by name
+    if r.status_code == 422:  # learned earlier in this module: refused by name
         assert r.json()["detail"][0]["field"] == field
         return
     assert r.status_code == 200, r.text
@@ -208,8 +209,13 @@ def test_http_setpoint_at_the_edge_of_the_limits(server, hostile, field):
         again = client.put("/v1/bearings/default/setpoint", json={field: high})
         assert again.status_code == 422 and again.json()["detail"][0]["field"] == field
     # back to the usual setpoint for the next tests
-    assert client.put("/v1/bearings/default/setpoint",
-                      json={"radial_load_n": 3000.0, "axial_load_n": 0.0, "shaft_speed_rad_s": 500.0}).status_code == 200
+    assert (
+        client.put(
+            "/v1/bearings/default/setpoint",
+            json={"radial_load_n": 3000.0, "axial_load_n": 0.0, "shaft_speed_rad_s": 500.0},
+        ).status_code
+        == 200
+    )
     hostile.wait_for(lambda: _state(client), lambda x: x["setpoint"]["radial_load_n"] == 3000.0)
 
 
@@ -232,8 +238,14 @@ def test_scenario_into_a_value_not_held_fails_cleanly(twin):
     runner = TwinRunner(twin)
     high = runner.limits["radial_load_n"][1]
     runner.faults.not_held["radial_load_n"] = (0.9 * high, "overloaded: excessive contact penetration")
-    scenario = scenario_from_dict({"name": "overload", "duration_s": 0.05, "initial": {"radial_load_n": 3000.0},
-                                   "steps": [{"at_s": 0.01, "set": {"radial_load_n": 0.95 * high}}]})
+    scenario = scenario_from_dict(
+        {
+            "name": "overload",
+            "duration_s": 0.05,
+            "initial": {"radial_load_n": 3000.0},
+            "steps": [{"at_s": 0.01, "set": {"radial_load_n": 0.95 * high}}],
+        }
+    )
     runner.start()
     try:
         handle, _ = runner.start_scenario(scenario.resolved_runs()[0])
@@ -255,6 +267,6 @@ def test_learned_refusal_only_for_the_twin_that_failed(twin):
     e = err.value.errors[0]
     assert e.field == "radial_load_n" and e.allowed == [0.0, 0.8 * high] and "could not hold" in e.message
     runner.submit(radial_load_n=0.5 * high, oil_temperature_c=60.0)  # below: accepted
-    runner.submit(oil_temperature_c=61.0)                             # other fields unaffected
+    runner.submit(oil_temperature_c=61.0)  # other fields unaffected
     other = TwinRunner(Twin("6208"))
-    other.submit(radial_load_n=0.9 * high)                            # another twin: its own history
+    other.submit(radial_load_n=0.9 * high)  # another twin: its own history

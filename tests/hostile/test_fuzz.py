@@ -23,10 +23,20 @@ from service.core.runner import TwinRunner
 from service.settings import ServiceSettings
 
 CAP = 4096
-FIELDS = ["shaft_speed_rad_s", "radial_load_n", "axial_load_n", "oil_temperature_c",
-          "shaft_current_a", "shaft_voltage_v"]
-FUZZ = settings(max_examples=120, deadline=None, derandomize=True,
-                suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow])
+FIELDS = [
+    "shaft_speed_rad_s",
+    "radial_load_n",
+    "axial_load_n",
+    "oil_temperature_c",
+    "shaft_current_a",
+    "shaft_voltage_v",
+]
+FUZZ = settings(
+    max_examples=120,
+    deadline=None,
+    derandomize=True,
+    suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
+)
 
 # ---- strategies ---------------------------------------------------------------------------------
 nasty_numbers = st.one_of(
@@ -35,11 +45,16 @@ nasty_numbers = st.one_of(
     st.sampled_from([0, -0.0, 1e308, -1e308, 5e-324, 2**63, -(2**63), 10**400, 72596.0, 2073.0, 1e7]),
 )
 scalars = st.one_of(st.none(), st.booleans(), nasty_numbers, st.text(max_size=40))
-json_values = st.recursive(scalars, lambda children: st.one_of(
-    st.lists(children, max_size=4), st.dictionaries(st.text(max_size=12), children, max_size=4)),
-    max_leaves=12)
-setpoint_like = st.dictionaries(st.one_of(st.sampled_from(FIELDS + ["token", "seq", ""]), st.text(max_size=12)),
-                                json_values, max_size=7)
+json_values = st.recursive(
+    scalars,
+    lambda children: st.one_of(
+        st.lists(children, max_size=4), st.dictionaries(st.text(max_size=12), children, max_size=4)
+    ),
+    max_leaves=12,
+)
+setpoint_like = st.dictionaries(
+    st.one_of(st.sampled_from(FIELDS + ["token", "seq", ""]), st.text(max_size=12)), json_values, max_size=7
+)
 
 
 def _dumps(value) -> bytes:
@@ -50,16 +65,34 @@ def _dumps(value) -> bytes:
         return b"{}"
 
 
-raw_text = st.sampled_from([
-    b"", b"{", b"}", b"null", b"[]", b"NaN", b"Infinity", b'{"radial_load_n": NaN}',
-    b'{"radial_load_n": Infinity}', b'{"radial_load_n": -Infinity}', b'{"radial_load_n": 1e999}',
-    b'{"shaft_speed_rad_s": 1' + b"0" * 400 + b"}", b'{"radial_load_n": "3000"}',
-    b'{"radial_load_n": 3000, "radial_load_n": NaN}', b"\xff\xfe\x00garbage", b'{"a":' * 200,
-    b'[' * 5000, b'{"action": "start", "path": "a\\u0000.rrd"}', b'{"action": "start", "path": "../../x.rrd"}',
-    b'{"id": "x\\ny"}', b'{"designation": "6208", "setpoint": {"radial_load_n": NaN}}',
-    b'{"scenario": {"name": "x", "duration_s": 1e308, "steps": []}}',
-    b'{"scenario": {"name": "x", "duration_s": NaN}}', b'{"scenario": []}',
-])
+raw_text = st.sampled_from(
+    [
+        b"",
+        b"{",
+        b"}",
+        b"null",
+        b"[]",
+        b"NaN",
+        b"Infinity",
+        b'{"radial_load_n": NaN}',
+        b'{"radial_load_n": Infinity}',
+        b'{"radial_load_n": -Infinity}',
+        b'{"radial_load_n": 1e999}',
+        b'{"shaft_speed_rad_s": 1' + b"0" * 400 + b"}",
+        b'{"radial_load_n": "3000"}',
+        b'{"radial_load_n": 3000, "radial_load_n": NaN}',
+        b"\xff\xfe\x00garbage",
+        b'{"a":' * 200,
+        b"[" * 5000,
+        b'{"action": "start", "path": "a\\u0000.rrd"}',
+        b'{"action": "start", "path": "../../x.rrd"}',
+        b'{"id": "x\\ny"}',
+        b'{"designation": "6208", "setpoint": {"radial_load_n": NaN}}',
+        b'{"scenario": {"name": "x", "duration_s": 1e308, "steps": []}}',
+        b'{"scenario": {"name": "x", "duration_s": NaN}}',
+        b'{"scenario": []}',
+    ]
+)
 
 
 def bodies(shaped):
@@ -72,23 +105,53 @@ def bodies(shaped):
     )
 
 
-scenario_like = st.fixed_dictionaries({}, optional={
-    "name": st.one_of(st.text(max_size=20), st.sampled_from(["seed000_load_sweep", "nope", "../etc"]), json_values),
-    "scenario": st.one_of(json_values, st.fixed_dictionaries({
-        "name": st.text(max_size=10), "duration_s": nasty_numbers,
-        "steps": st.lists(st.dictionaries(st.sampled_from(["at_s", "set", "ramp", "over_s", "phase"]),
-                                          json_values, max_size=4), max_size=3)})),
-    "run": json_values, "restart": json_values, "extra": json_values})
-bearing_like = st.fixed_dictionaries({}, optional={
-    "id": st.one_of(st.text(max_size=70), st.sampled_from(["default", "a/b", "*", "x" * 64])),
-    "designation": st.one_of(st.sampled_from(["6208", "7208", "6205", "9999", ""]), json_values),
-    "diametral_clearance_m": nasty_numbers, "lubricant": st.one_of(st.text(max_size=20), json_values),
-    "setpoint": setpoint_like, "extra": json_values})
-recording_like = st.fixed_dictionaries({}, optional={
-    "action": st.one_of(st.sampled_from(["start", "stop", "pause"]), json_values),
-    "path": st.one_of(st.text(max_size=40), st.sampled_from(["ok.rrd", "d/ok.rrd", "../x.rrd", "/tmp/x.rrd",
-                                                           "x.txt", "a\x00.rrd", ".hidden.rrd"]), json_values),
-    "extra": json_values})
+scenario_like = st.fixed_dictionaries(
+    {},
+    optional={
+        "name": st.one_of(st.text(max_size=20), st.sampled_from(["seed000_load_sweep", "nope", "../etc"]), json_values),
+        "scenario": st.one_of(
+            json_values,
+            st.fixed_dictionaries(
+                {
+                    "name": st.text(max_size=10),
+                    "duration_s": nasty_numbers,
+                    "steps": st.lists(
+                        st.dictionaries(
+                            st.sampled_from(["at_s", "set", "ramp", "over_s", "phase"]), json_values, max_size=4
+                        ),
+                        max_size=3,
+                    ),
+                }
+            ),
+        ),
+        "run": json_values,
+        "restart": json_values,
+        "extra": json_values,
+    },
+)
+bearing_like = st.fixed_dictionaries(
+    {},
+    optional={
+        "id": st.one_of(st.text(max_size=70), st.sampled_from(["default", "a/b", "*", "x" * 64])),
+        "designation": st.one_of(st.sampled_from(["6208", "7208", "6205", "9999", ""]), json_values),
+        "diametral_clearance_m": nasty_numbers,
+        "lubricant": st.one_of(st.text(max_size=20), json_values),
+        "setpoint": setpoint_like,
+        "extra": json_values,
+    },
+)
+recording_like = st.fixed_dictionaries(
+    {},
+    optional={
+        "action": st.one_of(st.sampled_from(["start", "stop", "pause"]), json_values),
+        "path": st.one_of(
+            st.text(max_size=40),
+            st.sampled_from(["ok.rrd", "d/ok.rrd", "../x.rrd", "/tmp/x.rrd", "x.txt", "a\x00.rrd", ".hidden.rrd"]),
+            json_values,
+        ),
+        "extra": json_values,
+    },
+)
 ids = st.one_of(st.sampled_from(["default", "nobody", "x" * 200, "%", "..", "a.b"]), st.text(min_size=1, max_size=30))
 
 
@@ -96,9 +159,15 @@ ids = st.one_of(st.sampled_from(["default", "nobody", "x" * 200, "%", "..", "a.b
 @pytest.fixture(scope="module")
 def fuzz_server(hostile, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("fuzz")
-    settings_ = ServiceSettings(enable_zenoh=False, enable_recording=True, record=tmp / "rec" / "service.rrd",
-                                scenario_dir=hostile.SCENARIOS, max_twins=3, setpoint_rate_hz=0.0,
-                                max_body_bytes=CAP)
+    settings_ = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=True,
+        record=tmp / "rec" / "service.rrd",
+        scenario_dir=hostile.SCENARIOS,
+        max_twins=3,
+        setpoint_rate_hz=0.0,
+        max_body_bytes=CAP,
+    )
     with hostile.ThreadServer(settings_) as srv, httpx.Client(base_url=srv.url, timeout=60.0) as client:
         yield srv, client
 
@@ -107,7 +176,7 @@ def _send(client, method, path, body: bytes):
     r = client.request(method, path, content=body, headers={"content-type": "application/json"})
     assert r.status_code < 500, (method, path, body[:200], r.status_code, r.text[:500])
     if r.status_code >= 400:
-        detail = r.json()["detail"]           # the service's error body, JSON without NaN
+        detail = r.json()["detail"]  # the service's error body, JSON without NaN
         assert isinstance(detail, list) and detail, r.text
     json.loads(r.content or b"null", parse_constant=lambda c: pytest.fail(f"response carries {c}"))
     return r
@@ -129,7 +198,7 @@ def test_fuzz_put_setpoint(fuzz_server, bearing_id, body):
 def test_fuzz_post_bearings(fuzz_server, body):
     _srv, client = fuzz_server
     r = _send(client, "POST", "/v1/bearings", body)
-    if r.status_code == 201:    # keep room for the next ones
+    if r.status_code == 201:  # keep room for the next ones
         assert client.delete(f"/v1/bearings/{_quote(r.json()['id'])}").status_code == 200
 
 
@@ -148,15 +217,29 @@ def test_fuzz_post_recording(fuzz_server, bearing_id, body):
 
 
 @FUZZ
-@given(bearing_id=ids.filter(lambda i: i != "default"), body=st.one_of(st.just(b""), bodies(json_values)),
-       what=st.sampled_from(["", "/scenario"]))
+@given(
+    bearing_id=ids.filter(lambda i: i != "default"),
+    body=st.one_of(st.just(b""), bodies(json_values)),
+    what=st.sampled_from(["", "/scenario"]),
+)
 def test_fuzz_delete(fuzz_server, bearing_id, body, what):
     _srv, client = fuzz_server
     _send(client, "DELETE", f"/v1/bearings/{_quote(bearing_id)}{what}", body)
 
 
-@pytest.mark.parametrize("path", ["a\x00.rrd", "x" * 300 + ".rrd", "service.rrd/x.rrd", "sub.rrd", "a b.rrd",
-                                  ".hidden.rrd", "d/../x.rrd", "C:\\x.rrd"])
+@pytest.mark.parametrize(
+    "path",
+    [
+        "a\x00.rrd",
+        "x" * 300 + ".rrd",
+        "service.rrd/x.rrd",
+        "sub.rrd",
+        "a b.rrd",
+        ".hidden.rrd",
+        "d/../x.rrd",
+        "C:\\x.rrd",
+    ],
+)
 def test_recording_paths_that_reached_the_file_system_are_422(fuzz_server, path):
     """A NUL byte, a name longer than the file system allows, a folder that is a file and a
     target that is a folder gave 500s before the paths were restricted."""
@@ -187,10 +270,18 @@ def test_after_the_fuzzing_the_service_is_alive_and_finite(fuzz_server):
         for value in s["setpoint"].values():
             assert math.isfinite(value)
     # and it still follows a good setpoint
-    r = client.put("/v1/bearings/default/setpoint", json={"radial_load_n": 3000.0, "shaft_speed_rad_s": 500.0,
-                                                          "axial_load_n": 0.0, "oil_temperature_c": 40.0,
-                                                          "shaft_current_a": 0.0, "shaft_voltage_v": 0.0})
-    assert r.status_code in (200, 422), r.text   # 422 only if a value was learned as not held
+    r = client.put(
+        "/v1/bearings/default/setpoint",
+        json={
+            "radial_load_n": 3000.0,
+            "shaft_speed_rad_s": 500.0,
+            "axial_load_n": 0.0,
+            "oil_temperature_c": 40.0,
+            "shaft_current_a": 0.0,
+            "shaft_voltage_v": 0.0,
+        },
+    )
+    assert r.status_code in (200, 422), r.text  # 422 only if a value was learned as not held
     seq = client.get("/v1/bearings/default/state").json()["seq"]
     client_state = lambda: client.get("/v1/bearings/default/state").json()  # noqa: E731
     deadline = time.monotonic() + 30
@@ -227,8 +318,9 @@ def running_runner():
     assert runner.stop(10.0)
 
 
-zenoh_payloads = st.one_of(bodies(setpoint_like), setpoint_like.map(lambda d: json.dumps(d, allow_nan=True)
-                                                                    if _dumpable(d) else "{}"))
+zenoh_payloads = st.one_of(
+    bodies(setpoint_like), setpoint_like.map(lambda d: json.dumps(d, allow_nan=True) if _dumpable(d) else "{}")
+)
 
 
 def _dumpable(value) -> bool:
@@ -239,14 +331,15 @@ def _dumpable(value) -> bool:
         return False
 
 
-@settings(max_examples=300, deadline=None, derandomize=True,
-          suppress_health_check=[HealthCheck.function_scoped_fixture])
+@settings(
+    max_examples=300, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture]
+)
 @given(payload=zenoh_payloads)
 def test_fuzz_zenoh_setpoint_handler(running_runner, payload):
     runner, _sink = running_runner
     result = runner.intake(payload)
     assert isinstance(result, dict) and isinstance(result["accepted"], bool)
-    json.dumps(result, allow_nan=False)          # what the bus publishes: never NaN
+    json.dumps(result, allow_nan=False)  # what the bus publishes: never NaN
     if not result["accepted"]:
         assert result["status"] in (401, 413, 422, 429) and result["error"]
 
@@ -270,11 +363,25 @@ def test_nasty_payloads_through_a_real_zenoh_session(hostile):
     the state stream stays finite and the twin keeps running."""
     pytest.importorskip("zenoh")
     endpoint = f"tcp/127.0.0.1:{hostile.free_port()}"
-    settings_ = ServiceSettings(enable_zenoh=True, zenoh_listen=[endpoint], enable_recording=False,
-                                scenario_dir=hostile.SCENARIOS, max_body_bytes=CAP)
-    payloads = [b'{"radial_load_n": NaN}', b'{"shaft_speed_rad_s": Infinity}', b'{"radial_load_n": 1e999}',
-                b'{"axial_load_n": 1' + b"0" * 300 + b"}", b"\xff\x00garbage", b"[" * 3000, b"null",
-                b'{"radial_load_n": "lots"}', b'{"unknown": 1}', b'{"radial_load_n": 1}' + b" " * (CAP + 1)]
+    settings_ = ServiceSettings(
+        enable_zenoh=True,
+        zenoh_listen=[endpoint],
+        enable_recording=False,
+        scenario_dir=hostile.SCENARIOS,
+        max_body_bytes=CAP,
+    )
+    payloads = [
+        b'{"radial_load_n": NaN}',
+        b'{"shaft_speed_rad_s": Infinity}',
+        b'{"radial_load_n": 1e999}',
+        b'{"axial_load_n": 1' + b"0" * 300 + b"}",
+        b"\xff\x00garbage",
+        b"[" * 3000,
+        b"null",
+        b'{"radial_load_n": "lots"}',
+        b'{"unknown": 1}',
+        b'{"radial_load_n": 1}' + b" " * (CAP + 1),
+    ]
     with hostile.ThreadServer(settings_):
         peer = hostile.Peer(endpoint)
         try:

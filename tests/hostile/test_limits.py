@@ -22,9 +22,16 @@ RATE, BURST, CAP = 5.0, 10, 2048
 @pytest.fixture(scope="module")
 def limited(hostile, tmp_path_factory):
     tmp = tmp_path_factory.mktemp("limits")
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, scenario_dir=hostile.SCENARIOS,
-                               record=tmp / "service.rrd", max_twins=3, setpoint_rate_hz=RATE,
-                               setpoint_burst=BURST, max_body_bytes=CAP)
+    settings = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        scenario_dir=hostile.SCENARIOS,
+        record=tmp / "service.rrd",
+        max_twins=3,
+        setpoint_rate_hz=RATE,
+        setpoint_burst=BURST,
+        max_body_bytes=CAP,
+    )
     with hostile.ThreadServer(settings) as srv, httpx.Client(base_url=srv.url, timeout=30.0) as client:
         yield client
 
@@ -42,7 +49,7 @@ def _exhaust(client, bearing_id="default"):
 
 
 def test_setpoint_burst_gets_429_with_retry_after(limited):
-    time.sleep(BURST / RATE + 0.2)   # a full bucket, whatever this module's other tests spent
+    time.sleep(BURST / RATE + 0.2)  # a full bucket, whatever this module's other tests spent
     t0 = time.monotonic()
     r, accepted = _exhaust(limited)
     elapsed = time.monotonic() - t0
@@ -102,9 +109,15 @@ def test_rate_limit_is_per_twin(limited):
     assert limited.put("/v1/bearings/nobody/setpoint", json={}).status_code == 404
 
 
-@pytest.mark.parametrize("method, path", [
-    ("PUT", "/v1/bearings/default/setpoint"), ("POST", "/v1/bearings"),
-    ("POST", "/v1/bearings/default/scenario"), ("POST", "/v1/bearings/default/recording")])
+@pytest.mark.parametrize(
+    "method, path",
+    [
+        ("PUT", "/v1/bearings/default/setpoint"),
+        ("POST", "/v1/bearings"),
+        ("POST", "/v1/bearings/default/scenario"),
+        ("POST", "/v1/bearings/default/recording"),
+    ],
+)
 def test_body_over_the_cap_is_413(limited, method, path):
     body = b'{"name": "' + b"x" * (CAP + 10) + b'"}'
     r = limited.request(method, path, content=body, headers={"content-type": "application/json"})
@@ -135,7 +148,7 @@ def test_body_at_the_cap_passes(limited):
     body = body[:-1] + b" " * (CAP - len(body)) + b"}"
     assert len(body) == CAP
     r = limited.post("/v1/bearings/default/scenario", content=body, headers={"content-type": "application/json"})
-    assert r.status_code == 422       # read and validated: an unknown scenario name
+    assert r.status_code == 422  # read and validated: an unknown scenario name
 
 
 @pytest.fixture(scope="module")
@@ -149,7 +162,7 @@ def twin():
 
 def test_zenoh_handler_rate_and_size(twin):
     gate = AdmissionGate(setpoint_rate_hz=RATE, setpoint_burst=BURST, max_payload_bytes=CAP)
-    intake = SetpointIntake(twin.bearing_id, gate, TwinRunner(twin))   # the same gate as HTTP's
+    intake = SetpointIntake(twin.bearing_id, gate, TwinRunner(twin))  # the same gate as HTTP's
     results = [intake(b'{"oil_temperature_c": 44}') for _ in range(BURST + 5)]
     accepted = [r for r in results if r["accepted"]]
     limited = [r for r in results if not r["accepted"]]
@@ -169,7 +182,7 @@ def test_token_bucket_refills_on_its_clock():
     assert not ok and retry == pytest.approx(0.5)
     now[0] += 0.5
     assert bucket.take() == (True, 0.0)
-    now[0] += 100.0                  # never more than the burst
+    now[0] += 100.0  # never more than the burst
     assert [bucket.take()[0] for _ in range(4)] == [True, True, True, False]
     with pytest.raises(ValueError):
         TokenBucket(0.0, 1)

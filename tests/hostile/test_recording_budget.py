@@ -49,7 +49,7 @@ def test_30_s_serve_stays_within_the_recording_budget(hostile, tmp_path):
     try:
         t0 = time.monotonic()
         with httpx.Client(base_url=svc.url, timeout=30.0) as c:
-            time.sleep(RUN_S)                                     # the run being measured, not a bound
+            time.sleep(RUN_S)  # the run being measured, not a bound
             published = c.get("/health").json()["twins"][0]["published"]
         svc.signal(signal.SIGTERM, timeout=30.0)
         wall_s = time.monotonic() - t0
@@ -65,13 +65,16 @@ def test_30_s_serve_stays_within_the_recording_budget(hostile, tmp_path):
         assert out.returncode == 0, out.stderr
         chunks += _stat(out.stdout, "num_chunks")
     seqs = read_index(segs, TORQUE)
-    print(f"\n{wall_s:.1f} s of serve: {size / 1e6:.2f} MB ({size / 1e6 / wall_s:.3f} MB/s), {chunks} chunks "
-          f"({chunks / wall_s:.1f} per s), {len(seqs)} snapshots recorded of {published}+ published")
+    print(
+        f"\n{wall_s:.1f} s of serve: {size / 1e6:.2f} MB ({size / 1e6 / wall_s:.3f} MB/s), {chunks} chunks "
+        f"({chunks / wall_s:.1f} per s), {len(seqs)} snapshots recorded of {published}+ published"
+    )
     assert size <= 7.5e6 and size <= 0.25e6 * wall_s
     assert chunks <= 30 * wall_s
     # trends are window means (RerunRecorder.SERVICE_OPTIONS): a row per window of `per_window`
     # snapshots carrying its last seq; every published snapshot is in a recorded window
-    per_window = snapshots_per_trend_window(ServiceSettings().runner.publish_rate_hz,
-                                            RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
+    per_window = snapshots_per_trend_window(
+        ServiceSettings().runner.publish_rate_hz, RerunRecorder.SERVICE_OPTIONS["trend_window_s"]
+    )
     assert seqs[-1] >= published and len(seqs) * per_window >= published - per_window
     assert len(set(seqs.tolist())) == len(seqs) and window_seq_gaps(seqs, per_window) == 0

@@ -21,8 +21,9 @@ def _settings(tmp=None, scenarios=None) -> ServiceSettings:
     kw = {"record": tmp / "rec" / "service.rrd"} if tmp is not None else {}
     if scenarios is not None:
         kw["scenario_dir"] = scenarios
-    return ServiceSettings(enable_zenoh=False, enable_recording=True, max_twins=3, setpoint_rate_hz=0.0,
-                           max_body_bytes=16 * 1024, **kw)
+    return ServiceSettings(
+        enable_zenoh=False, enable_recording=True, max_twins=3, setpoint_rate_hz=0.0, max_body_bytes=16 * 1024, **kw
+    )
 
 
 # the spec comes from the app factory itself (no server needed to collect the tests)
@@ -47,7 +48,6 @@ def base_url(hostile, tmp_path_factory):
 
 
 @schema.parametrize()
-@settings(max_examples=EXAMPLES, deadline=None, derandomize=True,
-          suppress_health_check=list(HealthCheck))
+@settings(max_examples=EXAMPLES, deadline=None, derandomize=True, suppress_health_check=list(HealthCheck))
 def test_no_server_errors(case, base_url):
     case.call_and_validate(base_url=base_url, checks=[not_a_server_error], timeout=30)

@@ -30,14 +30,15 @@ from service.settings import ServiceSettings  # noqa: E402
 
 TOKEN = "shutdown-test-token"
 AUTH = {"Authorization": f"Bearer {TOKEN}"}
-EXIT_BOUND_S = 20.0     # a liveness bound, not a performance figure
+EXIT_BOUND_S = 20.0  # a liveness bound, not a performance figure
 TORQUE = "bearing/default/friction_torque_n_m"
 
 
 # the service's trends are window means (RerunRecorder.SERVICE_OPTIONS): a row per window of
 # PER_WINDOW snapshots, carrying the seq of the window's last snapshot
-PER_WINDOW = snapshots_per_trend_window(ServiceSettings().runner.publish_rate_hz,
-                                        RerunRecorder.SERVICE_OPTIONS["trend_window_s"])
+PER_WINDOW = snapshots_per_trend_window(
+    ServiceSettings().runner.publish_rate_hz, RerunRecorder.SERVICE_OPTIONS["trend_window_s"]
+)
 
 
 def _windows(snapshots: int) -> range:
@@ -65,9 +66,15 @@ def test_signal_flushes_recordings_and_closes_zenoh(hostile, tmp_path, sig):
         peer = hostile.Peer(svc.zenoh_endpoint)
         peer.subscribe("bearing/*/alive", liveliness=True)
         with httpx.Client(base_url=svc.url, timeout=30.0) as c:
-            assert c.post("/v1/bearings/default/recording", json={"action": "start", "path": "clip.rrd"},
-                          headers=AUTH).status_code == 200
-            assert c.put("/v1/bearings/default/setpoint", json={"radial_load_n": 4000.0}, headers=AUTH).status_code == 200
+            assert (
+                c.post(
+                    "/v1/bearings/default/recording", json={"action": "start", "path": "clip.rrd"}, headers=AUTH
+                ).status_code
+                == 200
+            )
+            assert (
+                c.put("/v1/bearings/default/setpoint", json={"radial_load_n": 4000.0}, headers=AUTH).status_code == 200
+            )
             hostile.wait_for(lambda: c.get("/health").json(), lambda h: h["recording_rows"] >= 20, timeout=60)
             rows_before = c.get("/health").json()["recording_rows"]
         peer.wait_for(lambda item: item.key == "bearing/default/alive")
@@ -79,8 +86,9 @@ def test_signal_flushes_recordings_and_closes_zenoh(hostile, tmp_path, sig):
         log = svc.text
         assert "Application shutdown complete" in log and "Traceback" not in log, log
         # zenoh was closed properly: the twin's liveliness token was withdrawn
-        peer.wait_for(lambda item: item.key == "bearing/default/alive" and item.kind == zenoh.SampleKind.DELETE,
-                      timeout_s=10)
+        peer.wait_for(
+            lambda item: item.key == "bearing/default/alive" and item.kind == zenoh.SampleKind.DELETE, timeout_s=10
+        )
     finally:
         if peer is not None:
             peer.close()
@@ -118,8 +126,10 @@ def test_kill_9_keeps_every_file_and_restarts_beside_them_on_the_same_ports(host
             rows_logged = stop.json()["rows_logged"]
             assert rows_logged > 0
             # an open one at the moment of the kill
-            assert c.post("/v1/bearings/default/recording",
-                          json={"action": "start", "path": "open.rrd"}).status_code == 200
+            assert (
+                c.post("/v1/bearings/default/recording", json={"action": "start", "path": "open.rrd"}).status_code
+                == 200
+            )
             hostile.wait_for(lambda: len(recording_segments(rec / "first.rrd")), lambda n: n >= 3, timeout=60)
     finally:
         first.proc.send_signal(signal.SIGKILL)
@@ -128,7 +138,7 @@ def test_kill_9_keeps_every_file_and_restarts_beside_them_on_the_same_ports(host
     killed = _digests(rec)
     assert {"first.rrd", "first-0001.rrd", "closed.rrd", "open.rrd"} <= set(killed)
 
-    closed = recording_segments(rec / "closed.rrd")          # it rotated too (1 s segments)
+    closed = recording_segments(rec / "closed.rrd")  # it rotated too (1 s segments)
     rows = read_recording(closed)
     assert rows[TORQUE] in _windows(rows_logged)
     assert _seq_gaps(closed) == (rows[TORQUE], 0)
@@ -139,8 +149,9 @@ def test_kill_9_keeps_every_file_and_restarts_beside_them_on_the_same_ports(host
     assert read_recording(rec / "open.rrd").get(TORQUE, 0) >= 0
 
     # the same ports and the same --record, at once: HTTP answers, zenoh streams, no stale state
-    second = hostile.ServeProcess(tmp_path, port=port, zenoh_port=int(endpoint.rsplit(":", 1)[1]),
-                                  record=rec / "first.rrd")
+    second = hostile.ServeProcess(
+        tmp_path, port=port, zenoh_port=int(endpoint.rsplit(":", 1)[1]), record=rec / "first.rrd"
+    )
     try:
         assert second.url.endswith(f":{port}") and second.zenoh_endpoint == endpoint
         assert "first.run2.rrd" in second.text, second.text
@@ -166,7 +177,7 @@ def test_kill_9_keeps_every_file_and_restarts_beside_them_on_the_same_ports(host
     finally:
         second.kill()
     after = _digests(rec)
-    assert {k: after[k] for k in killed} == killed            # every file of the killed run untouched
+    assert {k: after[k] for k in killed} == killed  # every file of the killed run untouched
     assert read_recording(rec / "first.run2.rrd")[TORQUE] > 0
     json.dumps(rows)
 
@@ -176,8 +187,9 @@ def test_sigterm_closes_the_open_segment_of_a_rotating_recording(hostile, tmp_pa
     the open segment; the segments together hold every row the service counted, each once, and
     each is a complete recording of its own (same recording id, static geometry, blueprint)."""
     rrd = tmp_path / "rot.rrd"
-    svc = hostile.ServeProcess(tmp_path, record=rrd, env={"BEARING_TWIN_RECORD_SEGMENT_S": "1",
-                                                          "BEARING_TWIN_RECORD_FOOTER": "true"})
+    svc = hostile.ServeProcess(
+        tmp_path, record=rrd, env={"BEARING_TWIN_RECORD_SEGMENT_S": "1", "BEARING_TWIN_RECORD_FOOTER": "true"}
+    )
     try:
         with httpx.Client(base_url=svc.url, timeout=30.0) as c:
             hostile.wait_for(lambda: len(recording_segments(rrd)), lambda n: n >= 3, timeout=60)
@@ -197,8 +209,8 @@ def test_sigterm_closes_the_open_segment_of_a_rotating_recording(hostile, tmp_pa
         info = describe_recording(seg)
         ids.add(info["recording_id"])
         assert info["blueprints"] >= 1 and "bearing/default/geometry/inner_raceway" in info["entities"], seg
-        assert "bearing/default/events" in info["entities"], seg   # each segment logs the state again
-        _reader(seg).store()        # footer on: every segment, the last one too, was closed properly
+        assert "bearing/default/events" in info["entities"], seg  # each segment logs the state again
+        _reader(seg).store()  # footer on: every segment, the last one too, was closed properly
     assert len(ids) == 1
     rows = read_recording(segs)
     seqs = read_index(segs, TORQUE)

@@ -35,7 +35,7 @@ def test_state_json_is_serialised_once_per_snapshot():
     tw = Twin("6208", bearing_id="j1")
     pub = Publisher("j1")
     assert pub.latest_json() is None
-    pub.capture(tw, 1.0)                      # no worker: built and delivered at once
+    pub.capture(tw, 1.0)  # no worker: built and delivered at once
     first = pub.latest_json()
     got: list[bytes] = []
     threads = [threading.Thread(target=lambda: got.append(pub.latest_json())) for _ in range(8)]
@@ -43,7 +43,7 @@ def test_state_json_is_serialised_once_per_snapshot():
         t.start()
     for t in threads:
         t.join(10)
-    assert all(b is first for b in got)       # one serialisation, shared by every reader
+    assert all(b is first for b in got)  # one serialisation, shared by every reader
     assert json.loads(first) == pub.latest.to_dict()
     tw.advance(0.001)
     pub.capture(tw, 1.0)
@@ -53,20 +53,26 @@ def test_state_json_is_serialised_once_per_snapshot():
 
 @pytest.fixture(scope="module")
 def guarded(hostile, tmp_path_factory):
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, scenario_dir=hostile.SCENARIOS,
-                               http_header_timeout_s=HEADER_S, http_body_timeout_s=BODY_S,
-                               read_rate_hz=5.0, read_burst=10)
+    settings = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        scenario_dir=hostile.SCENARIOS,
+        http_header_timeout_s=HEADER_S,
+        http_body_timeout_s=BODY_S,
+        read_rate_hz=5.0,
+        read_burst=10,
+    )
     with hostile.ThreadServer(settings) as srv, httpx.Client(base_url=srv.url, timeout=30.0) as client:
         yield srv, client
 
 
 def test_reads_are_rate_limited_per_client(guarded):
     _, client = guarded
-    time.sleep(2.5)                           # a full bucket (10 reads at 5/s refill)
+    time.sleep(2.5)  # a full bucket (10 reads at 5/s refill)
     t0 = time.monotonic()
     codes, refused = [], None
     bodies = set()
-    for i in range(40):                       # every API read shares the client's budget
+    for i in range(40):  # every API read shares the client's budget
         r = client.get("/v1/bearings/default/state" if i % 2 else "/v1/bearings")
         codes.append(r.status_code)
         if r.status_code == 200 and i % 2:
@@ -76,7 +82,7 @@ def test_reads_are_rate_limited_per_client(guarded):
     elapsed = time.monotonic() - t0
     ok = codes.count(200)
     assert set(codes) <= {200, 429} and refused is not None
-    assert 10 <= ok <= 10 + 5.0 * elapsed + 1          # the burst, plus what refilled meanwhile
+    assert 10 <= ok <= 10 + 5.0 * elapsed + 1  # the burst, plus what refilled meanwhile
     assert bodies == {"bearing-twin/state/1"}
     assert int(refused.headers["retry-after"]) >= 1
     (err,) = refused.json()["detail"]
@@ -99,8 +105,10 @@ def _slow_sockets(port: int) -> list[tuple[socket.socket, str, bytes]]:
             s.sendall(b"GET /health HTTP/1.1\r\nHost: x\r\n")
             out.append((s, "headers", b"X"))
         elif kind == 1:
-            s.sendall(b"PUT /v1/bearings/default/setpoint HTTP/1.1\r\nHost: x\r\n"
-                      b"Content-Type: application/json\r\nContent-Length: 4096\r\n\r\n{")
+            s.sendall(
+                b"PUT /v1/bearings/default/setpoint HTTP/1.1\r\nHost: x\r\n"
+                b"Content-Type: application/json\r\nContent-Length: 4096\r\n\r\n{"
+            )
             out.append((s, "body", b" "))
         else:
             out.append((s, "headers", b""))
@@ -120,7 +128,7 @@ def test_slowloris_connections_are_closed_and_health_answers(guarded):
         assert client.get("/health").status_code == 200
     data = {s: b"" for s, _, _ in socks}
     closed: dict[socket.socket, float] = {}
-    deadline = t0 + 60.0                       # liveness bound only
+    deadline = t0 + 60.0  # liveness bound only
     while len(closed) < SLOW and time.monotonic() < deadline:
         open_ = [s for s in data if s not in closed]
         readable, _, _ = select.select(open_, [], [], 0.2)
@@ -133,15 +141,17 @@ def test_slowloris_connections_are_closed_and_health_answers(guarded):
                 data[s] += chunk
             else:
                 closed[s] = time.monotonic() - t0
-        for s, _, drip in socks:                # one more byte to each open one: no deadline moves
+        for s, _, drip in socks:  # one more byte to each open one: no deadline moves
             if s not in closed and drip:
                 try:
                     s.send(drip)
                 except (BlockingIOError, OSError):
                     pass
     assert len(closed) == SLOW, f"{SLOW - len(closed)} slow connections still open after 60 s"
-    print(f"\n{peak - baseline} slow connections open at once; {SLOW} closed after {min(closed.values()):.2f}-{max(closed.values()):.2f} s "
-          f"(deadlines: headers {HEADER_S:g} s, body {BODY_S:g} s)")
+    print(
+        f"\n{peak - baseline} slow connections open at once; {SLOW} closed after {min(closed.values()):.2f}-{max(closed.values()):.2f} s "
+        f"(deadlines: headers {HEADER_S:g} s, body {BODY_S:g} s)"
+    )
     for s, field, _ in socks:
         head, _, body = data[s].partition(b"\r\n\r\n")
         assert head.startswith(b"HTTP/1.1 408"), data[s][:200]
@@ -151,7 +161,7 @@ def test_slowloris_connections_are_closed_and_health_answers(guarded):
     deadline = time.monotonic() + 30.0
     while len(state.connections) > baseline + 1 and time.monotonic() < deadline:
         time.sleep(0.05)
-    assert len(state.connections) <= baseline + 1      # + the test's own kept-alive client
+    assert len(state.connections) <= baseline + 1  # + the test's own kept-alive client
     h = client.get("/health").json()
     assert h["status"] == "ok" and h["http_slow_closed"] >= SLOW
 

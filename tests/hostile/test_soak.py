@@ -25,8 +25,22 @@ def test_soak_short_run_with_its_own_service(hostile, tmp_path):
     pytest.importorskip("zenoh")
     pytest.importorskip("rerun")
     # the service's recording rotates every 4 s: the check reads every segment back
-    cmd = [sys.executable, "-m", "loadtest", "soak", "--minutes", "0.3", "--start", "--json",
-           "--seed", "7", "--rate", "12", "--record-segment-s", "4"]
+    cmd = [
+        sys.executable,
+        "-m",
+        "loadtest",
+        "soak",
+        "--minutes",
+        "0.3",
+        "--start",
+        "--json",
+        "--seed",
+        "7",
+        "--rate",
+        "12",
+        "--record-segment-s",
+        "4",
+    ]
     proc = subprocess.run(cmd, cwd=tmp_path, capture_output=True, text=True, timeout=300, env=LOADTEST_ENV)
     assert proc.stdout.strip(), proc.stderr
     r = json.loads(proc.stdout)
@@ -37,7 +51,9 @@ def test_soak_short_run_with_its_own_service(hostile, tmp_path):
     assert r["http"]["server_errors"] == 0 and r["http"]["transport_errors"] == 0, detail
     assert r["unexpected_count"] == 0, detail
     z = r["zenoh_results"]
-    assert z["unexpected"] == 0 and z["missing"] == 0 and z["received"] == sp["zenoh_valid"] + sp["zenoh_invalid"], detail
+    assert z["unexpected"] == 0 and z["missing"] == 0 and z["received"] == sp["zenoh_valid"] + sp["zenoh_invalid"], (
+        detail
+    )
     s = r["stream"]
     assert s["messages"] > 0 and s["non_finite"] == 0 and s["out_of_order"] == 0, detail
     # gaps would mean dropped snapshots; loopback at 50 Hz should lose none, but a stalled
@@ -62,22 +78,29 @@ def test_soak_short_run_with_its_own_service(hostile, tmp_path):
 
 def test_soak_against_a_running_service_http_only(hostile, tmp_path):
     """Without --start: drives an existing service (here an in-process one, no zenoh)."""
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, scenario_dir=hostile.SCENARIOS,
-                               token="tok-123")
+    settings = ServiceSettings(
+        enable_zenoh=False, enable_recording=False, scenario_dir=hostile.SCENARIOS, token="tok-123"
+    )
     with hostile.ThreadServer(settings) as srv:
-        r = run_soak(SoakConfig(minutes=0.08, url=srv.url, token="tok-123", seed=3, rate_hz=20.0,
-                                sample_s=0.5))
+        r = run_soak(SoakConfig(minutes=0.08, url=srv.url, token="tok-123", seed=3, rate_hz=20.0, sample_s=0.5))
     assert r["stream"] is None and r["zenoh"] is None
     assert r["setpoints"]["http_valid"] > 0 and r["setpoints"]["http_invalid"] > 0
     assert r["http"]["server_errors"] == 0 and r["unexpected_count"] == 0, r["unexpected"]
     assert r["memory"]["samples"] > 0 and r["memory"]["source"] in ("psutil", "proc")
-    assert "401" in r["http"]["status_counts"] or "413" in r["http"]["status_counts"] or "422" in r["http"]["status_counts"]
+    assert (
+        "401" in r["http"]["status_counts"]
+        or "413" in r["http"]["status_counts"]
+        or "422" in r["http"]["status_counts"]
+    )
 
 
 def test_memory_growth_uses_the_first_sample_after_the_warm_up():
     mib = 2**20
-    m = _memory([(0.0, 50 * mib), (5.0, 100 * mib), (10.0, 101 * mib), (15.0, 104 * mib), (20.0, 102 * mib)],
-                warmup=5.0, source="proc")
+    m = _memory(
+        [(0.0, 50 * mib), (5.0, 100 * mib), (10.0, 101 * mib), (15.0, 104 * mib), (20.0, 102 * mib)],
+        warmup=5.0,
+        source="proc",
+    )
     assert m["baseline_mb"] == 100.0 and m["final_mb"] == 102.0 and m["growth_pct"] == pytest.approx(2.0)
     assert _memory([], 5.0, None)["growth_pct"] is None
 
@@ -85,8 +108,13 @@ def test_memory_growth_uses_the_first_sample_after_the_warm_up():
 def test_soak_refuses_unbounded_runs():
     with pytest.raises(ValueError):
         run_soak(SoakConfig(minutes=float("inf")))
-    proc = subprocess.run([sys.executable, "-m", "loadtest", "soak", "--minutes", "0"],
-                          capture_output=True, text=True, timeout=60, env=LOADTEST_ENV)
+    proc = subprocess.run(
+        [sys.executable, "-m", "loadtest", "soak", "--minutes", "0"],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env=LOADTEST_ENV,
+    )
     assert proc.returncode == 2 and "--minutes" in proc.stderr
 
 
@@ -113,15 +141,13 @@ def test_recording_check_reads_every_segment(tmp_path):
     from loadtest.soak import _check_recording
 
     rec = _segmented_recording(tmp_path, (4, 6, 5))
-    r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None,
-                          snapshots_per_row=1)
+    r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None, snapshots_per_row=1)
     assert r["error"] is None and r["complete"], r
     assert r["segments"] == 3 and [f["rows"] for f in r["segment_files"]] == [4, 6, 5]
     assert r["rows_read"] == 15 and r["seq_gaps"] == 0 and r["duplicates"] == 0 and r["recording_ids"] == 1
     # a lost segment in the middle: a gap, incomplete
     rec.segments[1].rename(tmp_path / "soak-0001.rrd.bak")
-    r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None,
-                          snapshots_per_row=1)
+    r = _check_recording(tmp_path / "soak.rrd", "default", rows_reported=15, last_stream_seq=None, snapshots_per_row=1)
     assert r["segments"] == 1 and not r["complete"]
 
 

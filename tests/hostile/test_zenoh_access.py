@@ -49,8 +49,7 @@ def users(tmp_path):
 class Spy:
     """A zenoh session that records every sample of the key expressions it subscribes to."""
 
-    def __init__(self, endpoint: str, *, mode: str = "client", user: str | None = None,
-                 password: str | None = None):
+    def __init__(self, endpoint: str, *, mode: str = "client", user: str | None = None, password: str | None = None):
         access = ZenohAccess(user=user, password=password)
         self.session = zenoh.open(make_config([], [endpoint], mode, access=access))
         self.samples: queue.Queue = queue.Queue()
@@ -62,6 +61,7 @@ class Spy:
             item = (str(sample.key_expr), sample.payload.to_bytes(), sample.kind)
             self.seen.append(item[:2])
             self.samples.put(item)
+
         for key in keys:
             if liveliness:
                 self._keep.append(self.session.liveliness().declare_subscriber(key, cb, history=True))
@@ -76,8 +76,9 @@ class Spy:
 
     def get(self, key: str, timeout_s: float = 3.0) -> list[bytes]:
         out = []
-        for reply in self.session.get(key, target=zenoh.QueryTarget.ALL,
-                                      consolidation=zenoh.ConsolidationMode.NONE, timeout=timeout_s):
+        for reply in self.session.get(
+            key, target=zenoh.QueryTarget.ALL, consolidation=zenoh.ConsolidationMode.NONE, timeout=timeout_s
+        ):
             if reply.ok is not None:
                 payload = reply.ok.payload.to_bytes()
                 self.seen.append((str(reply.ok.key_expr), payload))
@@ -85,8 +86,9 @@ class Spy:
         return out
 
     def alive(self, key: str, timeout_s: float = 3.0) -> list[str]:
-        return sorted(str(r.ok.key_expr) for r in self.session.liveliness().get(key, timeout=timeout_s)
-                      if r.ok is not None)
+        return sorted(
+            str(r.ok.key_expr) for r in self.session.liveliness().get(key, timeout=timeout_s) if r.ok is not None
+        )
 
     def close(self) -> None:
         for entity in self._keep:
@@ -126,8 +128,9 @@ def _no_token(*spies: Spy) -> int:
 
 
 def _service_settings(hostile, **kw) -> ServiceSettings:
-    return ServiceSettings(enable_recording=False, scenario_dir=hostile.SCENARIOS, token=TOKEN,
-                           publish_rate_hz=25.0, **kw)
+    return ServiceSettings(
+        enable_recording=False, scenario_dir=hostile.SCENARIOS, token=TOKEN, publish_rate_hz=25.0, **kw
+    )
 
 
 # ---- the rules themselves ---------------------------------------------------------------------
@@ -139,23 +142,34 @@ def test_acl_rules_are_default_deny_and_per_role():
 
     def allowed(role, message, flow):
         return {k for r in by_role[role] if message in r["messages"] and flow in r["flows"] for k in r["key_exprs"]}
+
     # canonical keys: `**/*` is written `*/**`
     assert allowed("writers", "put", "ingress") == {"plant1/*/**/setpoint", "plant1/*/**/defects"}
-    assert allowed("readers", "put", "ingress") == set()                # a reader never writes
+    assert allowed("readers", "put", "ingress") == set()  # a reader never writes
     assert "plant1/*/**/setpoint" not in allowed("readers", "put", "egress")  # nor sees setpoints
-    assert allowed("readers", "liveliness_token", "ingress") == set()   # nor declares a twin
-    assert allowed("readers", "reply", "ingress") == set()              # nor answers a query
+    assert allowed("readers", "liveliness_token", "ingress") == set()  # nor declares a twin
+    assert allowed("readers", "reply", "ingress") == set()  # nor answers a query
     assert allowed("services", "liveliness_token", "ingress") == {"plant1/*/**/alive"}
     assert allowed("services", "put", "ingress") == {
-        "plant1/*/**/state", "plant1/*/**/ball/*", "plant1/*/**/setpoint/result", "plant1/*/**/defects/result",
-        "plant1/*/**/alarm", "plant1/*/**/vibration", "plant1/*/**/vibration/waveform"}
-    assert "plant1/*/**/defects" not in allowed("readers", "put", "egress")   # nor sees defect writes
+        "plant1/*/**/state",
+        "plant1/*/**/ball/*",
+        "plant1/*/**/setpoint/result",
+        "plant1/*/**/defects/result",
+        "plant1/*/**/alarm",
+        "plant1/*/**/vibration",
+        "plant1/*/**/vibration/waveform",
+    }
+    assert "plant1/*/**/defects" not in allowed("readers", "put", "egress")  # nor sees defect writes
     assert {s["id"] for s in acl["subjects"]} >= {"writers-users", "writers-certs"}
     assert set(ROLE_RULES) == {"services", "writers", "readers"}
     # an empty role grants nothing (no rule, no subject)
     assert acl_config("bearing", Roles(writers=("op",)))["policies"] == [
-        {"id": "writers", "rules": [f"writers-{i}" for i in range(len(ROLE_RULES["writers"]))],
-         "subjects": ["writers-users"]}]
+        {
+            "id": "writers",
+            "rules": [f"writers-{i}" for i in range(len(ROLE_RULES["writers"]))],
+            "subjects": ["writers-users"],
+        }
+    ]
 
 
 def test_settings_refuse_what_zenoh_cannot_guard(tmp_path, users, monkeypatch):
@@ -164,7 +178,7 @@ def test_settings_refuse_what_zenoh_cannot_guard(tmp_path, users, monkeypatch):
         monkeypatch.delenv(f"BEARING_TWIN_{var}", raising=False)
     with pytest.raises(ValueError, match="zenoh_password"):
         ServiceSettings(zenoh_user="twin")
-    with pytest.raises(ValueError, match="zenoh_usersfile"):      # listens, but no users to check
+    with pytest.raises(ValueError, match="zenoh_usersfile"):  # listens, but no users to check
         ServiceSettings(zenoh_user="twin", zenoh_password=pw["twin"])
     with pytest.raises(ValueError, match="either listens .* or joins a router"):
         ServiceSettings(zenoh_usersfile=path, zenoh_listen=["tcp/127.0.0.1:1"], zenoh_connect=["tcp/127.0.0.1:2"])
@@ -195,7 +209,7 @@ def twin():
 
 
 def test_intake_refuses_token_fields_and_closed_bus(twin):
-    runner = TwinRunner(twin)                    # not started: submissions only hit the mailbox
+    runner = TwinRunner(twin)  # not started: submissions only hit the mailbox
     open_gate = SetpointIntake(twin.bearing_id, AdmissionGate(bus_writes="authorized"), runner)
     refused = open_gate(json.dumps({"radial_load_n": 3300.0, "token": TOKEN}))
     assert refused["accepted"] is False and refused["status"] == 422
@@ -216,25 +230,33 @@ def test_http_token_without_zenoh_access_control(hostile):
     (403 on the result key) and nothing on the bus carries the token, while HTTP PUTs with the
     token go on."""
     endpoint = f"tcp/127.0.0.1:{hostile.free_port()}"
-    with hostile.ThreadServer(_service_settings(hostile, zenoh_listen=[endpoint])) as srv, \
-            httpx.Client(base_url=srv.url, timeout=30.0) as http:
+    with (
+        hostile.ThreadServer(_service_settings(hostile, zenoh_listen=[endpoint])) as srv,
+        httpx.Client(base_url=srv.url, timeout=30.0) as http,
+    ):
         spy = Spy(endpoint)
         try:
             spy.subscribe("**")
             spy.subscribe("**", liveliness=True)
             _wait(lambda: spy.count(_states("bearing/default")) >= 5, what="state samples")
             for load in (3100.0, 3200.0):
-                assert http.put("/v1/bearings/default/setpoint", json={"radial_load_n": load},
-                                headers=AUTH).status_code == 200
+                assert (
+                    http.put("/v1/bearings/default/setpoint", json={"radial_load_n": load}, headers=AUTH).status_code
+                    == 200
+                )
             spy.session.put("bearing/default/setpoint", json.dumps({"radial_load_n": 3300.0}))
             _wait(lambda: spy.count(lambda k, p: k == "bearing/default/setpoint/result") >= 1, what="result")
             result = next(json.loads(p) for k, p in spy.seen if k == "bearing/default/setpoint/result")
             assert result["accepted"] is False and result["status"] == 403
             assert spy.get("bearing/default/snapshot")
-            hostile.wait_for(lambda: http.get("/v1/bearings/default/state").json(),
-                             lambda st: st["setpoint"]["radial_load_n"] == 3200.0)
-            _wait(lambda: spy.count(lambda k, p: k == "bearing/default/state" and b'"radial_load_n":3200.0' in p) >= 1,
-                  what="a state carrying the HTTP setpoint")
+            hostile.wait_for(
+                lambda: http.get("/v1/bearings/default/state").json(),
+                lambda st: st["setpoint"]["radial_load_n"] == 3200.0,
+            )
+            _wait(
+                lambda: spy.count(lambda k, p: k == "bearing/default/state" and b'"radial_load_n":3200.0' in p) >= 1,
+                what="a state carrying the HTTP setpoint",
+            )
             assert _no_token(spy) >= 5
         finally:
             spy.close()
@@ -244,11 +266,12 @@ def test_http_token_without_zenoh_access_control(hostile):
 def test_secured_service_anonymous_gets_nothing_reader_cannot_write(hostile, users):
     path, pw = users
     endpoint = f"tcp/127.0.0.1:{hostile.free_port()}"
-    settings = _service_settings(hostile, zenoh_listen=[endpoint], zenoh_usersfile=path,
-                                 zenoh_writers=["op"], zenoh_readers=["viewer"])
+    settings = _service_settings(
+        hostile, zenoh_listen=[endpoint], zenoh_usersfile=path, zenoh_writers=["op"], zenoh_readers=["viewer"]
+    )
     with hostile.ThreadServer(settings) as srv, httpx.Client(base_url=srv.url, timeout=30.0) as http:
         channel = srv.service.find("default").channel
-        anon = Spy(endpoint, mode="peer")                         # no credentials
+        anon = Spy(endpoint, mode="peer")  # no credentials
         wrong = Spy(endpoint, mode="peer", user="op", password="not-" + pw["op"])
         viewer = Spy(endpoint, user="viewer", password=pw["viewer"])
         op = Spy(endpoint, user="op", password=pw["op"])
@@ -268,15 +291,17 @@ def test_secured_service_anonymous_gets_nothing_reader_cannot_write(hostile, use
             _wait(lambda: op.count(lambda k, p: k.endswith("/setpoint/result")) >= 1, what="the writer's result")
             results = [json.loads(p) for k, p in op.seen if k.endswith("/setpoint/result")]
             assert [r["accepted"] for r in results] == [True] and results[0]["setpoint"]["radial_load_n"] == 3500.0
-            hostile.wait_for(lambda: http.get("/v1/bearings/default/state").json(),
-                             lambda s: s["setpoint"]["radial_load_n"] == 3500.0)
+            hostile.wait_for(
+                lambda: http.get("/v1/bearings/default/state").json(),
+                lambda s: s["setpoint"]["radial_load_n"] == 3500.0,
+            )
             time.sleep(0.5)
             # only the writer's one setpoint reached the service's subscriber
             assert channel.setpoints_received - before == 1
             own = "bearing/default/setpoint"
-            assert _foreign(anon, own) == [] and _foreign(wrong, own) == []   # not one sample, any key
+            assert _foreign(anon, own) == [] and _foreign(wrong, own) == []  # not one sample, any key
             assert anon.get("bearing/default/snapshot", timeout_s=1.0) == []
-            assert viewer.get("bearing/default/snapshot")           # the reader may query
+            assert viewer.get("bearing/default/snapshot")  # the reader may query
             assert _no_token(*spies) >= CONTROL_N
         finally:
             for spy in spies:
@@ -292,13 +317,21 @@ def test_secured_router_fleet(hostile, users):
 
     path, pw = users
     endpoint = f"tcp/127.0.0.1:{hostile.free_port()}"
-    router, described = open_router(RouterSettings(
-        zenoh_listen=[endpoint], zenoh_prefix="plant1/**", zenoh_usersfile=path,
-        zenoh_services=["twin"], zenoh_writers=["op"], zenoh_readers=["viewer"]))
+    router, described = open_router(
+        RouterSettings(
+            zenoh_listen=[endpoint],
+            zenoh_prefix="plant1/**",
+            zenoh_usersfile=path,
+            zenoh_services=["twin"],
+            zenoh_writers=["op"],
+            zenoh_readers=["viewer"],
+        )
+    )
     assert "rules: services twin; writers op; readers viewer" in described
     key = "plant1/line2/default"
-    settings = _service_settings(hostile, zenoh_connect=[endpoint], zenoh_prefix="plant1/line2",
-                                 zenoh_user="twin", zenoh_password=pw["twin"])
+    settings = _service_settings(
+        hostile, zenoh_connect=[endpoint], zenoh_prefix="plant1/line2", zenoh_user="twin", zenoh_password=pw["twin"]
+    )
     spies: list[Spy] = []
     try:
         with hostile.ThreadServer(settings) as srv, httpx.Client(base_url=srv.url, timeout=30.0) as http:
@@ -314,7 +347,7 @@ def test_secured_router_fleet(hostile, users):
                 spy.subscribe("**")
                 spy.subscribe("**", liveliness=True)
             viewer.subscribe("plant1/line2/*/state", "plant1/line2/*/setpoint/result")
-            viewer.subscribe("plant1/line2/*/setpoint")           # the leak of issue 16: refused
+            viewer.subscribe("plant1/line2/*/setpoint")  # the leak of issue 16: refused
             viewer.subscribe("plant1/line2/*/alive", liveliness=True)
             op.subscribe("plant1/line2/*/setpoint/result")
             op.subscribe("plant1/line2/*/alive", liveliness=True)
@@ -323,8 +356,11 @@ def test_secured_router_fleet(hostile, users):
             # and by the (authenticated) reader
             for spy, name in ((anon, "ghost-anon"), (viewer, "ghost-viewer"), (wrong, "ghost-wrong")):
                 spy.keep(spy.session.liveliness().declare_token(f"plant1/line2/{name}/alive"))
-                spy.keep(spy.session.declare_queryable(
-                    f"{key}/snapshot", lambda q, n=name: q.reply(f"{key}/snapshot", json.dumps({"forged": n}))))
+                spy.keep(
+                    spy.session.declare_queryable(
+                        f"{key}/snapshot", lambda q, n=name: q.reply(f"{key}/snapshot", json.dumps({"forged": n}))
+                    )
+                )
             before = channel.setpoints_received
             for spy, load in ((anon, 3300.0), (wrong, 3350.0), (viewer, 3400.0)):
                 for _ in range(3):
@@ -332,8 +368,10 @@ def test_secured_router_fleet(hostile, users):
             time.sleep(1.0)
             op.session.put(f"{key}/setpoint", json.dumps({"radial_load_n": 3500.0}))
             _wait(lambda: op.count(lambda k, p: k.endswith("/setpoint/result")) >= 1, what="the writer's result")
-            hostile.wait_for(lambda: http.get("/v1/bearings/default/state").json(),
-                             lambda s: s["setpoint"]["radial_load_n"] == 3500.0)
+            hostile.wait_for(
+                lambda: http.get("/v1/bearings/default/state").json(),
+                lambda s: s["setpoint"]["radial_load_n"] == 3500.0,
+            )
             # the writer's query: only the service answers; liveliness: only the real twin
             replies = [json.loads(p) for p in op.get(f"{key}/snapshot")]
             assert len(replies) == 1 and replies[0]["bearing_id"] == "default" and "balls" in replies[0]
@@ -341,8 +379,10 @@ def test_secured_router_fleet(hostile, users):
             # router has the service's token in its tables: ask until the real twin answers, then
             # require that it is the only one (no forged token among the answers)
             alive: list[str] = []
-            _wait(lambda: bool(alive.extend(op.alive("plant1/line2/*/alive")) or alive),
-                  what="the twin's liveliness token through the router")
+            _wait(
+                lambda: bool(alive.extend(op.alive("plant1/line2/*/alive")) or alive),
+                what="the twin's liveliness token through the router",
+            )
             assert sorted(set(alive)) == [f"{key}/alive"], alive
             time.sleep(0.5)
             # a liveliness subscriber with history can get the same token twice (once from the
@@ -359,10 +399,14 @@ def test_secured_router_fleet(hostile, users):
                 assert _foreign(spy, f"{key}/setpoint", f"plant1/line2/{name}/alive") == [], name
                 assert [json.loads(p) for p in spy.get(f"{key}/snapshot", timeout_s=1.0)] == [{"forged": name}]
             # the HTTP token, used meanwhile, is in no payload
-            assert http.put("/v1/bearings/default/setpoint", json={"radial_load_n": 3600.0},
-                            headers=AUTH).status_code == 200
-            _wait(lambda: viewer.count(lambda k, p: k == f"{key}/state" and b'"radial_load_n":3600.0' in p) >= 1,
-                  what="a state carrying the HTTP setpoint")
+            assert (
+                http.put("/v1/bearings/default/setpoint", json={"radial_load_n": 3600.0}, headers=AUTH).status_code
+                == 200
+            )
+            _wait(
+                lambda: viewer.count(lambda k, p: k == f"{key}/state" and b'"radial_load_n":3600.0' in p) >= 1,
+                what="a state carrying the HTTP setpoint",
+            )
             assert _no_token(*spies) >= CONTROL_N
     finally:
         for spy in spies:
@@ -394,8 +438,10 @@ def test_router_command_runs_until_stopped(hostile, users, capsys):
     endpoint = f"tcp/127.0.0.1:{hostile.free_port()}"
     stop = threading.Event()
     done: dict = {}
-    th = threading.Thread(target=lambda: done.update(rc=run_router(
-        RouterSettings(zenoh_listen=[endpoint], zenoh_usersfile=path), stop)), daemon=True)
+    th = threading.Thread(
+        target=lambda: done.update(rc=run_router(RouterSettings(zenoh_listen=[endpoint], zenoh_usersfile=path), stop)),
+        daemon=True,
+    )
     th.start()
     _wait(lambda: "listening on" in capsys.readouterr().out or done, what="router start")
     stop.set()
@@ -419,28 +465,59 @@ def _certificates(out, names):
     ca_name = x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, "bearing-twin test CA")])
 
     def builder(subject, key):
-        return (x509.CertificateBuilder().subject_name(subject).issuer_name(ca_name).public_key(key.public_key())
-                .serial_number(x509.random_serial_number()).not_valid_before(now - datetime.timedelta(minutes=5))
-                .not_valid_after(now + datetime.timedelta(hours=2)))
-    ca = (builder(ca_name, ca_key).add_extension(x509.BasicConstraints(ca=True, path_length=None), critical=True)
-          .add_extension(x509.KeyUsage(digital_signature=True, key_cert_sign=True, crl_sign=True,
-                                       content_commitment=False, key_encipherment=False, data_encipherment=False,
-                                       key_agreement=False, encipher_only=False, decipher_only=False), critical=True)
-          .sign(ca_key, hashes.SHA256()))
+        return (
+            x509.CertificateBuilder()
+            .subject_name(subject)
+            .issuer_name(ca_name)
+            .public_key(key.public_key())
+            .serial_number(x509.random_serial_number())
+            .not_valid_before(now - datetime.timedelta(minutes=5))
+            .not_valid_after(now + datetime.timedelta(hours=2))
+        )
+
+    ca = (
+        builder(ca_name, ca_key)
+        .add_extension(x509.BasicConstraints(ca=True, path_length=None), critical=True)
+        .add_extension(
+            x509.KeyUsage(
+                digital_signature=True,
+                key_cert_sign=True,
+                crl_sign=True,
+                content_commitment=False,
+                key_encipherment=False,
+                data_encipherment=False,
+                key_agreement=False,
+                encipher_only=False,
+                decipher_only=False,
+            ),
+            critical=True,
+        )
+        .sign(ca_key, hashes.SHA256())
+    )
     (out / "ca.pem").write_bytes(ca.public_bytes(serialization.Encoding.PEM))
     for name in names:
         key = ec.generate_private_key(ec.SECP256R1())
-        cert = (builder(x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, name)]), key)
-                .add_extension(x509.SubjectAlternativeName([x509.DNSName("localhost"),
-                                                            x509.IPAddress(ipaddress.ip_address("127.0.0.1"))]),
-                               critical=False)
-                .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
-                .add_extension(x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH, ExtendedKeyUsageOID.CLIENT_AUTH]),
-                               critical=False)
-                .sign(ca_key, hashes.SHA256()))
+        cert = (
+            builder(x509.Name([x509.NameAttribute(NameOID.COMMON_NAME, name)]), key)
+            .add_extension(
+                x509.SubjectAlternativeName(
+                    [x509.DNSName("localhost"), x509.IPAddress(ipaddress.ip_address("127.0.0.1"))]
+                ),
+                critical=False,
+            )
+            .add_extension(x509.BasicConstraints(ca=False, path_length=None), critical=True)
+            .add_extension(
+                x509.ExtendedKeyUsage([ExtendedKeyUsageOID.SERVER_AUTH, ExtendedKeyUsageOID.CLIENT_AUTH]),
+                critical=False,
+            )
+            .sign(ca_key, hashes.SHA256())
+        )
         (out / f"{name}.pem").write_bytes(cert.public_bytes(serialization.Encoding.PEM))
-        (out / f"{name}.key").write_bytes(key.private_bytes(serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8,
-                                                            serialization.NoEncryption()))
+        (out / f"{name}.key").write_bytes(
+            key.private_bytes(
+                serialization.Encoding.PEM, serialization.PrivateFormat.PKCS8, serialization.NoEncryption()
+            )
+        )
 
 
 def test_mutual_tls_roles_by_certificate_common_name(hostile, tmp_path):
@@ -453,24 +530,45 @@ def test_mutual_tls_roles_by_certificate_common_name(hostile, tmp_path):
     _certificates(tmp_path, ["router", "twin", "op", "viewer", "stranger"])
 
     def tls(name):
-        return dict(zenoh_tls_root_ca=tmp_path / "ca.pem", zenoh_tls_certificate=tmp_path / f"{name}.pem",
-                    zenoh_tls_private_key=tmp_path / f"{name}.key")
+        return dict(
+            zenoh_tls_root_ca=tmp_path / "ca.pem",
+            zenoh_tls_certificate=tmp_path / f"{name}.pem",
+            zenoh_tls_private_key=tmp_path / f"{name}.key",
+        )
 
     def client(name):
-        return zenoh.open(make_config([], [endpoint], "client", access=ZenohAccess(
-            tls_root_ca=tmp_path / "ca.pem", tls_certificate=tmp_path / f"{name}.pem",
-            tls_private_key=tmp_path / f"{name}.key")))
+        return zenoh.open(
+            make_config(
+                [],
+                [endpoint],
+                "client",
+                access=ZenohAccess(
+                    tls_root_ca=tmp_path / "ca.pem",
+                    tls_certificate=tmp_path / f"{name}.pem",
+                    tls_private_key=tmp_path / f"{name}.key",
+                ),
+            )
+        )
 
     endpoint = f"tls/127.0.0.1:{hostile.free_port()}"
-    with pytest.raises(ValueError, match="tls/HOST:PORT only"):        # a tcp/ endpoint would be open
+    with pytest.raises(ValueError, match="tls/HOST:PORT only"):  # a tcp/ endpoint would be open
         RouterSettings(zenoh_listen=[f"tcp/127.0.0.1:{hostile.free_port()}"], **tls("router"))
-    router, described = open_router(RouterSettings(zenoh_listen=[endpoint], zenoh_services=["twin"],
-                                                   zenoh_writers=["op"], zenoh_readers=["viewer"], **tls("router")))
+    router, described = open_router(
+        RouterSettings(
+            zenoh_listen=[endpoint],
+            zenoh_services=["twin"],
+            zenoh_writers=["op"],
+            zenoh_readers=["viewer"],
+            **tls("router"),
+        )
+    )
     assert "mutual TLS" in described
     sessions: dict = {}
     try:
-        with hostile.ThreadServer(_service_settings(hostile, zenoh_connect=[endpoint], **tls("twin"))) as srv, \
-                httpx.Client(base_url=srv.url, timeout=30.0) as http:
+        with (
+            hostile.ThreadServer(_service_settings(hostile, zenoh_connect=[endpoint], **tls("twin"))) as srv,
+            httpx.Client(base_url=srv.url, timeout=30.0) as http,
+        ):
             channel = srv.service.find("default").channel
             seen: dict = {name: [] for name in ("op", "viewer", "stranger")}
             subs = []
@@ -478,15 +576,17 @@ def test_mutual_tls_roles_by_certificate_common_name(hostile, tmp_path):
                 sessions[name] = client(name)
                 subs.append(sessions[name].declare_subscriber("bearing/*/state", lambda smp, n=name: seen[n].append(1)))
             with pytest.raises(Exception):  # noqa: B017
-                zenoh.open(make_config([], [endpoint], "client"))            # no certificate
+                zenoh.open(make_config([], [endpoint], "client"))  # no certificate
             _wait(lambda: len(seen["viewer"]) >= CONTROL_N and len(seen["op"]) >= CONTROL_N, what="states")
             before = channel.setpoints_received
             for name, load in (("stranger", 3300.0), ("viewer", 3400.0)):
                 sessions[name].put("bearing/default/setpoint", json.dumps({"radial_load_n": load}))
             time.sleep(1.0)
             sessions["op"].put("bearing/default/setpoint", json.dumps({"radial_load_n": 3500.0}))
-            hostile.wait_for(lambda: http.get("/v1/bearings/default/state").json(),
-                             lambda st: st["setpoint"]["radial_load_n"] == 3500.0)
+            hostile.wait_for(
+                lambda: http.get("/v1/bearings/default/state").json(),
+                lambda st: st["setpoint"]["radial_load_n"] == 3500.0,
+            )
             time.sleep(0.5)
             assert channel.setpoints_received - before == 1
             assert seen["stranger"] == []

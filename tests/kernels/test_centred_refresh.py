@@ -12,7 +12,7 @@ from twin.kernels.step import centred_inputs
 
 C = 3  # the contact lane used
 DT = 1e-6
-K = 1e10          # Hertz constant [N/m^1.5]
+K = 1e10  # Hertz constant [N/m^1.5]
 CLEARANCE = 2e-4  # groove radius - ball radius [m]
 
 
@@ -39,7 +39,7 @@ def _refresh(p, w, delta, rate, stamp, u=5.0, nz=0.5, vz=0.0):
     w[L.O_NORMAL_RATE * L.CW + C] = rate
     w[L.G_NZ * L.CW + C] = nz
     w[L.K_VZ * L.CW + C] = vz
-    return centred_inputs(p, w, C, K * delta ** 1.5, u, min(abs(nz), L.ANGLE_MAX_SIN), stamp)
+    return centred_inputs(p, w, C, K * delta**1.5, u, min(abs(nz), L.ANGLE_MAX_SIN), stamp)
 
 
 def test_linear_inputs_are_taken_at_the_middle_of_the_period():
@@ -57,12 +57,12 @@ def test_linear_inputs_are_taken_at_the_middle_of_the_period():
         return delta, nz, u0 + udot * step * DT
 
     delta, nz, u = at(0)
-    assert _refresh(p, w, delta, ddot, 1.0, u, nz, vz) == (K * delta ** 1.5, u, nz)  # first: as they are
+    assert _refresh(p, w, delta, ddot, 1.0, u, nz, vz) == (K * delta**1.5, u, nz)  # first: as they are
     delta, nz, u = at(n)
     q, um, sm = _refresh(p, w, delta, ddot, 1.0 + n, u, nz, vz)
     ahead = 0.5 * (n - 1)
     q_mid = K * (d0 + ddot * (n + ahead) * DT) ** 1.5
-    q0, qn = K * d0 ** 1.5, K * delta ** 1.5
+    q0, qn = K * d0**1.5, K * delta**1.5
     # q = K delta^1.5 rises convexly: the secant over the last period is the smaller slope (minmod)
     assert q == pytest.approx(qn + ahead * (qn - q0) / n, rel=1e-12)
     assert q == pytest.approx(q_mid, rel=3e-4)  # measured 1.4e-4 below: the curvature of delta^1.5
@@ -117,12 +117,12 @@ def _held_error(n, centred):
     steps = np.arange(8000)
     delta = d0 * (1.0 + amp * np.sin(omega * steps * DT))
     rate = d0 * amp * omega * np.cos(omega * steps * DT)
-    q = K * delta ** 1.5
+    q = K * delta**1.5
     worst = 0.0
     for k in range(0, len(steps) - n, n):
         held, _, _ = _refresh(p, w, delta[k], rate[k], k + 1.0)
         if k >= 2 * n:  # past the first refresh (no history)
-            worst = max(worst, abs(np.mean(held - q[k:k + n])))
+            worst = max(worst, abs(np.mean(held - q[k : k + n])))
     return worst / (q.max() - q.min())
 
 

@@ -23,8 +23,11 @@ def f(x):
 
 
 def test_docstrings_and_comments_do_not_change_the_digest():
-    edited = SOURCE.replace("Docstring.", "Another, longer docstring\n    on two lines.").replace(
-        "# a comment", "# another comment\n    # and one more").replace("Module docstring.", "Other.")
+    edited = (
+        SOURCE.replace("Docstring.", "Another, longer docstring\n    on two lines.")
+        .replace("# a comment", "# another comment\n    # and one more")
+        .replace("Module docstring.", "Other.")
+    )
     assert code_digest(edited) == code_digest(SOURCE)
 
 
@@ -99,7 +102,7 @@ def test_a_docstring_edit_loads_the_compiled_kernel_from_the_cache(tmp_path, mon
     monkeypatch.setattr(jit, "ENGINE_ROOT", package.resolve())
     monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "cache"))
     law.write_text(KERNEL)
-    assert _compile_and_call(tmp_path, "law_first") == (0, 1)      # compiled and saved
+    assert _compile_and_call(tmp_path, "law_first") == (0, 1)  # compiled and saved
     law.write_text(KERNEL_DOCS_EDITED)
     assert KERNEL_DOCS_EDITED.count("\n") >= KERNEL.count("\n") + 5
     assert _compile_and_call(tmp_path, "law_docs_edited") == (1, 0)  # loaded, not compiled

@@ -22,9 +22,16 @@ DT = 1e-6
 
 def _one_contact(decay, slip, k=3e10, sqrt_delta=3e-3):
     w = np.zeros(L.N_ROWS * L.CW)
-    for row, value in ((L.G_DELTA, sqrt_delta ** 2), (L.G_SQRT_DELTA, sqrt_delta), (L.G_NX, 1.0),
-                       (L.G_LOAD, k * sqrt_delta ** 3), (L.M_STIFFNESS, k), (L.C_MU, 10.0),
-                       (L.K_VY, slip), (L.C_XI_DECAY, decay)):
+    for row, value in (
+        (L.G_DELTA, sqrt_delta**2),
+        (L.G_SQRT_DELTA, sqrt_delta),
+        (L.G_NX, 1.0),
+        (L.G_LOAD, k * sqrt_delta**3),
+        (L.M_STIFFNESS, k),
+        (L.C_MU, 10.0),
+        (L.K_VY, slip),
+        (L.C_XI_DECAY, decay),
+    ):
         w[row * L.CW] = value
     return w
 
@@ -78,8 +85,9 @@ def test_refresh_rate_is_rolling_plus_spin_sliding():
         assert c[L.C_MU, k] == pytest.approx(mu, rel=1e-12)
         ab = math.sqrt(c[L.C_SEMI_MAJOR, k] * c[L.C_SEMI_MINOR, k])
         kt = m.options.tangential_stiffness_ratio * 1.5 * c[L.M_STIFFNESS, k] * c[L.G_SQRT_DELTA, k]
-        spin = abs(c[L.K_WX, k] * c[L.G_NX, k] + c[L.K_WY, k] * c[L.G_NY, k]
-                   + (c[L.K_WZ, k] - c[L.K_SPIN, k]) * c[L.G_NZ, k])
+        spin = abs(
+            c[L.K_WX, k] * c[L.G_NX, k] + c[L.K_WY, k] * c[L.G_NY, k] + (c[L.K_WZ, k] - c[L.K_SPIN, k]) * c[L.G_NZ, k]
+        )
         rate = c[L.C_ENTRAINMENT, k] / ab + kt * spin * ab / (SPIN_CREEP_FACTOR * mu * q)
         assert c[L.C_XI_DECAY, k] == pytest.approx(1.0 / (1.0 + rate * m.dt_s), rel=1e-12)
         spins.append(spin)

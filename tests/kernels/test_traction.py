@@ -20,8 +20,9 @@ SEMI_MAJOR_COEF = 1.514e-4  # 6208 inner contact: a = coef Q^(1/3), a / b = 9.23
 
 
 def _model(n_strips=12, s_a=1e-3):
-    return make_model(catalog.bearing("6208"), ModelOptions(traction_strips=n_strips,
-                                                            asperity_regularisation_slip_m_s=s_a))
+    return make_model(
+        catalog.bearing("6208"), ModelOptions(traction_strips=n_strips, asperity_regularisation_slip_m_s=s_a)
+    )
 
 
 def _solve(model, q, h, lam, spin, roll, force, eta=0.04):
@@ -31,10 +32,21 @@ def _solve(model, q, h, lam, spin, roll, force, eta=0.04):
     p = model.params
     a = SEMI_MAJOR_COEF * q ** (1 / 3)
     w = np.zeros(L.N_ROWS * L.CW)
-    rows = {L.G_DELTA: 1e-6, L.C_LOAD: q, L.C_SEMI_MAJOR: a, L.C_SEMI_MINOR: a / 9.23, L.C_H_C: h,
-            L.C_LAMBDA: lam, L.G_NX: 1.0, L.O_EY: 1.0, L.K_WX: spin, L.K_WZ: roll,
-            L.M_STIFFNESS: 1.0 / (1.5 * p[L.P_KT_RATIO]), L.G_SQRT_DELTA: 1.0,  # kt = 1 N/m
-            L.T_XI1: -force}
+    rows = {
+        L.G_DELTA: 1e-6,
+        L.C_LOAD: q,
+        L.C_SEMI_MAJOR: a,
+        L.C_SEMI_MINOR: a / 9.23,
+        L.C_H_C: h,
+        L.C_LAMBDA: lam,
+        L.G_NX: 1.0,
+        L.O_EY: 1.0,
+        L.K_WX: spin,
+        L.K_WZ: roll,
+        L.M_STIFFNESS: 1.0 / (1.5 * p[L.P_KT_RATIO]),
+        L.G_SQRT_DELTA: 1.0,  # kt = 1 N/m
+        L.T_XI1: -force,
+    }
     for row, v in rows.items():
         w[row * L.CW] = v
     ellipse_traction(w, 1, p, eta, p[L.P_KT_RATIO], 1.0, 1e-6)
@@ -47,7 +59,7 @@ def _solve(model, q, h, lam, spin, roll, force, eta=0.04):
 def _heathcote_line():
     """No-slip lines of a sliding (Coulomb) contact in pure rolling under a Hertz pressure: the
     load inside |t| < t* equals the load outside, (3/4)(2 t* - 2 t*^3/3) = 1/2."""
-    return brentq(lambda t: t - t ** 3 / 3 - 1 / 3, 0.0, 1.0)
+    return brentq(lambda t: t - t**3 / 3 - 1 / 3, 0.0, 1.0)
 
 
 def test_heathcote_no_slip_lines_and_moment_closed_form():
@@ -56,7 +68,7 @@ def test_heathcote_no_slip_lines_and_moment_closed_form():
     # moment is mu Q a^2 / (2 R_d) (3/4) [int_in - int_out] t^2 (1 - t^2) dt = -0.1612 mu Q a^2 / (2 R_d).
     t_star = _heathcote_line()
     assert t_star == pytest.approx(0.347, abs=5e-4)
-    inner = 2 * (t_star ** 3 / 3 - t_star ** 5 / 5)
+    inner = 2 * (t_star**3 / 3 - t_star**5 / 5)
     moment_coef = 0.75 * (inner - (4 / 15 - inner))
     assert moment_coef == pytest.approx(-0.1612, abs=2e-4)
     # boundary lubrication (Lambda = 0: all load on asperities, mu = 0.1 of seed 000), a sharp
@@ -67,7 +79,7 @@ def test_heathcote_no_slip_lines_and_moment_closed_form():
         assert r["E_MOMENT_T2"] / scale == pytest.approx(moment_coef, rel=0.005)
         # the centre slides at s0 = curvature slip at t*: s(t*) = s0 - roll a^2 t*^2 / (2 R_d) = 0
         curv = 1452.0 * r["a"] ** 2 / (2 * r["r_d"])
-        assert r["E_SLIP"] / curv == pytest.approx(t_star ** 2, rel=0.05 if n < 16 else 0.01)
+        assert r["E_SLIP"] / curv == pytest.approx(t_star**2, rel=0.05 if n < 16 else 0.01)
 
 
 def test_pure_spin_moment_is_seed001_eq10():
@@ -92,8 +104,8 @@ def _reference_2d(q, h, lam, spin, roll, force, r_d, lub, s_a, ny=1600, nx=240):
     t = (np.arange(ny) + 0.5) / ny * 2 - 1
     u = (np.arange(nx) + 0.5) / nx * 2 - 1
     tt, uu = np.meshgrid(t, u, indexing="ij")
-    inside = tt ** 2 + uu ** 2 < 1
-    p = np.where(inside, p_h * np.sqrt(np.clip(1 - tt ** 2 - uu ** 2, 0, None)), 0.0)
+    inside = tt**2 + uu**2 < 1
+    p = np.where(inside, p_h * np.sqrt(np.clip(1 - tt**2 - uu**2, 0, None)), 0.0)
     area = (2 * a / ny) * (2 * b / nx)
     load_scale = q / (p.sum() * area)  # the discrete pressure carries exactly Q
     share, mu = asperity_load_share(lam), stribeck_line_mu(lam)
@@ -120,9 +132,13 @@ class _Lub:
 # (Q [N], h_c [m], Lambda, spin [rad/s], roll [rad/s], net force on the ball [N]): 6208 contacts
 # at 500 rad/s (1452 rad/s relative rolling at the inner race) from the heaviest to the edge of
 # the load zone, mixed film, and an angular-contact-like spin
-CASES = [(1300.0, 0.6e-6, 3.0, -0.5, 1452.0, 3.0), (1300.0, 0.6e-6, 3.0, 30.0, 1452.0, 3.0),
-         (400.0, 1.0e-6, 3.0, 0.0, 1800.0, 0.0), (200.0, 0.5e-6, 3.0, 0.0, 1452.0, 0.5),
-         (1300.0, 0.4e-6, 1.5, 0.0, 400.0, 1.0)]
+CASES = [
+    (1300.0, 0.6e-6, 3.0, -0.5, 1452.0, 3.0),
+    (1300.0, 0.6e-6, 3.0, 30.0, 1452.0, 3.0),
+    (400.0, 1.0e-6, 3.0, 0.0, 1800.0, 0.0),
+    (200.0, 0.5e-6, 3.0, 0.0, 1452.0, 0.5),
+    (1300.0, 0.4e-6, 1.5, 0.0, 400.0, 1.0),
+]
 
 
 @pytest.mark.parametrize("case", CASES)
@@ -134,7 +150,7 @@ def test_strips_against_a_2d_quadrature_of_the_same_law(case):
     q, h, lam, spin, roll, force = case
     r = _solve(_model(12), q, h, lam, spin, roll, force)
     s0, m2, mn = _reference_2d(q, h, lam, spin, roll, force, r["r_d"], _Lub, 1e-3)
-    assert m2 < 0.0 and r["E_MOMENT_T2"] < 0.0           # both resist the rolling
+    assert m2 < 0.0 and r["E_MOMENT_T2"] < 0.0  # both resist the rolling
     assert r["E_MOMENT_T2"] / m2 == pytest.approx(1.0, abs=0.05)
     # the spin moment: within 2 % where the spin matters (30 rad/s: measured 0.4 %); near zero
     # spin it is a small difference of large strip forces: within 5 % of the moment along t2
@@ -177,7 +193,7 @@ def test_laws_by_hand():
     # Johnson-Tevaarwerk Eyring, Bair-Winer limit, Barus, Harris' deformed radius
     assert tr.eyring_shear_stress_pa(0.1, 1e-6, 10.0, 5e6) == pytest.approx(5e6 * math.asinh(10 * 0.1 / (1e-6 * 5e6)))
     assert tr.limiting_shear_stress_pa(1e9, 0.06) == pytest.approx(6e7)
-    assert tr.fluid_shear_stress_pa(-0.1, 1e-6, 1e9, 1e9, 5e6, 0.06) == pytest.approx(-6e7)   # limited
+    assert tr.fluid_shear_stress_pa(-0.1, 1e-6, 1e9, 1e9, 5e6, 0.06) == pytest.approx(-6e7)  # limited
     assert tr.fluid_shear_stress_pa(-0.1, 1e-6, 1e6, 1e9, 5e6, 0.06) == pytest.approx(-5e6 * math.asinh(2e4))
     assert tr.barus_viscosity_pa_s(0.04, 2e-8, 1e9) == pytest.approx(0.04 * math.exp(20.0))
     s_l = tr.eyring_saturation_slip_m_s(1e-6, 100.0, 1e9, 5e6, 0.06)

@@ -24,8 +24,8 @@ def test_fast_path_equals_laws(formula):
     p = model.params
     for _ in range(200):
         r = int(rng.integers(0, 2))
-        q = float(10 ** rng.uniform(0, 4))       # 1 N .. 10 kN
-        u = float(10 ** rng.uniform(-2, 1.5))    # 1 cm/s .. 30 m/s
+        q = float(10 ** rng.uniform(0, 4))  # 1 N .. 10 kN
+        u = float(10 ** rng.uniform(-2, 1.5))  # 1 cm/s .. 30 m/s
         eta = float(10 ** rng.uniform(-3, -0.5))
         tr = model.race_tribology[r]
         out = contact_tribology(q, u, eta, p[L.P_ROUGHNESS], *tr[:15], 0, True)
@@ -41,8 +41,10 @@ def test_fast_path_equals_laws(formula):
         assert a == pytest.approx(model.race_params[r, L.R_SEMI_MAJOR_COEF] * q ** (1 / 3), rel=1e-12)
         assert out[7] == pytest.approx(damping.fluid_damping_n_s_m(eta, a, 6.3e-3, h), rel=1e-10)
         ratio = ry / rx
-        fr = (rolling.rolling_force_transition_n(e, rx, ratio, q, eta, u)
-              + rolling.hysteresis_moment_n_m(12.6e-3, q, ratio) / 6.3e-3)
+        fr = (
+            rolling.rolling_force_transition_n(e, rx, ratio, q, eta, u)
+            + rolling.hysteresis_moment_n_m(12.6e-3, q, ratio) / 6.3e-3
+        )
         assert out[8] == pytest.approx(fr, rel=1e-10)
         assert out[9] == pytest.approx(rolling.pivoting_moment_n_m(out[4], q, a, ratio), rel=1e-10)
 
@@ -76,7 +78,8 @@ def test_asperity_share_from_the_film_logarithm():
             share = asperity_load_share_ln(lam, ln_lam)
             assert share == pytest.approx(asperity_load_share(lam), rel=1e-13, abs=1e-15)
             assert limiting_traction_coefficient_share(lam, share, 0.06) == pytest.approx(
-                limiting_traction_coefficient(lam, 0.06), rel=1e-13)
+                limiting_traction_coefficient(lam, 0.06), rel=1e-13
+            )
     lams = [float(x) for x in np.linspace(0.1, 3.0, 30)]
     assert any(0.0 < asperity_load_share(x) < 1.0 for x in lams)
     for x in lams:

@@ -23,7 +23,7 @@ def test_raceway_load_rating_by_hand():
     (Harris & Kotzalas; b_m = 1.3 of ISO 281 Table 1), 6208: f = 0.52, g = 12.6/60.6, D = 12.6 mm,
     Z = 9: Q_ci = 8982 N, Q_ce = 18588 N."""
     g = 12.6 / 60.6
-    common = 93.2 * 1.3 * (1.04 / 0.04) ** 0.41 * g ** 0.3 * 12.6 ** 1.8 * 9 ** (-1 / 3)
+    common = 93.2 * 1.3 * (1.04 / 0.04) ** 0.41 * g**0.3 * 12.6**1.8 * 9 ** (-1 / 3)
     qci = life.raceway_load_rating_n(0.0126, 0.0606, 0.006552, 0.0, 9, True)
     qce = life.raceway_load_rating_n(0.0126, 0.0606, 0.006552, 0.0, 9, False)
     assert qci == pytest.approx(common * (1 - g) ** 1.39 / (1 + g) ** (1 / 3), rel=1e-3)
@@ -44,7 +44,7 @@ def test_equivalent_raceway_loads():
     # one loaded ball: the rotating ring averages its cube over Z, the stationary ring its 10/3 power
     one = [q] + [0.0] * 8
     got = life.contact_load_life_mrev(geom, one, one, [0.0] * 9, [0.0] * 9)
-    li, le = 9 * (qci / q) ** 3, 9 ** 0.9 * (qce / q) ** 3
+    li, le = 9 * (qci / q) ** 3, 9**0.9 * (qce / q) ** 3
     assert got == pytest.approx((li ** (-10 / 9) + le ** (-10 / 9)) ** -0.9, rel=1e-12)
     assert math.isinf(life.contact_load_life_mrev(geom, [0.0] * 9, [0.0] * 9, [0.0] * 9, [0.0] * 9))
 

@@ -28,13 +28,13 @@ def test_basic_rating_life_worked_numbers():
 def _a_iso_standard(kappa, x):
     """The three radial-ball-bearing equations of ISO 281:2007 clause 9.3, written out again."""
     if kappa < 0.4:
-        inner = 2.5671 - 2.2649 / kappa ** 0.054381
+        inner = 2.5671 - 2.2649 / kappa**0.054381
     elif kappa < 1.0:
-        inner = 2.5671 - 1.9987 / kappa ** 0.19087
+        inner = 2.5671 - 1.9987 / kappa**0.19087
     else:
-        inner = 2.5671 - 1.9987 / kappa ** 0.071739
-    base = 1.0 - inner ** 0.83 * x ** (1.0 / 3.0)
-    return 50.0 if base <= 0 else min(50.0, 0.1 * base ** -9.3)
+        inner = 2.5671 - 1.9987 / kappa**0.071739
+    base = 1.0 - inner**0.83 * x ** (1.0 / 3.0)
+    return 50.0 if base <= 0 else min(50.0, 0.1 * base**-9.3)
 
 
 @pytest.mark.parametrize("kappa", [0.4, 1.0, 4.0])
@@ -74,10 +74,10 @@ def test_rated_viscosity_both_speed_ranges():
     45000 n^-0.83 Dpw^-0.5 (n < 1000 r/min), mm^2/s. 6208, Dpw = 60.6 mm: 8.37 mm^2/s at 500
     rad/s; at 50 rad/s (477.5 r/min)."""
     n = 500.0 * 60 / TWO_PI
-    assert life.rated_viscosity_m2_s(500.0, 0.0606) * 1e6 == pytest.approx(4500 * n ** -0.5 * 60.6 ** -0.5, rel=1e-12)
+    assert life.rated_viscosity_m2_s(500.0, 0.0606) * 1e6 == pytest.approx(4500 * n**-0.5 * 60.6**-0.5, rel=1e-12)
     assert life.rated_viscosity_m2_s(500.0, 0.0606) * 1e6 == pytest.approx(8.366, abs=0.001)
     n = 50.0 * 60 / TWO_PI
-    assert life.rated_viscosity_m2_s(50.0, 0.0606) * 1e6 == pytest.approx(45000 * n ** -0.83 * 60.6 ** -0.5, rel=1e-12)
+    assert life.rated_viscosity_m2_s(50.0, 0.0606) * 1e6 == pytest.approx(45000 * n**-0.83 * 60.6**-0.5, rel=1e-12)
     assert math.isinf(life.rated_viscosity_m2_s(0.0, 0.0606))
 
 
@@ -85,8 +85,9 @@ def test_kappa_from_the_twins_oil():
     """nu of the seed-000 oil at 40 degC (eta 0.04 Pa s / rho 855.9 kg/m^3 = 46.7 mm^2/s) over nu1:
     kappa = 5.59 for the 6208 at 500 rad/s."""
     spec = catalog.bearing("6208")
-    iso = life.iso_life(spec, life.ratings_for(spec), life.LifeSettings(), 3000.0, 0.0, 500.0,
-                        0.04 / (870.0 * (1 - 6.5e-4 * 25.0)))
+    iso = life.iso_life(
+        spec, life.ratings_for(spec), life.LifeSettings(), 3000.0, 0.0, 500.0, 0.04 / (870.0 * (1 - 6.5e-4 * 25.0))
+    )
     assert iso.kappa == pytest.approx(46.736 / 8.3658, rel=1e-3)
 
 
@@ -97,14 +98,24 @@ def test_contamination_factor_formula():
     0.7095 at kappa = 4 (a capped at 1), 0.291 at kappa = 1; cleaner levels give more, 'extreme
     cleanliness' 1 (Table 13); grease 'slight to typical' uses (0.0177, 1.887)."""
     d = 60.6
-    assert life.contamination_factor("normal_cleanliness", 0.0606, 4.0) == pytest.approx(1 - 1.141 / d ** (1 / 3), rel=1e-12)
+    assert life.contamination_factor("normal_cleanliness", 0.0606, 4.0) == pytest.approx(
+        1 - 1.141 / d ** (1 / 3), rel=1e-12
+    )
     assert life.contamination_factor("normal_cleanliness", 0.0606, 4.0) == pytest.approx(0.7095, abs=1e-4)
     assert life.contamination_factor("normal_cleanliness", 0.0606, 1.0) == pytest.approx(
-        0.0432 * d ** 0.55 * (1 - 1.141 / d ** (1 / 3)), rel=1e-12)
+        0.0432 * d**0.55 * (1 - 1.141 / d ** (1 / 3)), rel=1e-12
+    )
     assert life.contamination_factor("slight_to_typical_contamination", 0.0606, 1.0, "grease") == pytest.approx(
-        0.0177 * d ** 0.55 * (1 - 1.887 / d ** (1 / 3)), rel=1e-12)
-    levels = ["extreme_cleanliness", "high_cleanliness", "normal_cleanliness", "slight_to_typical_contamination",
-              "severe_contamination", "very_severe_contamination"]
+        0.0177 * d**0.55 * (1 - 1.887 / d ** (1 / 3)), rel=1e-12
+    )
+    levels = [
+        "extreme_cleanliness",
+        "high_cleanliness",
+        "normal_cleanliness",
+        "slight_to_typical_contamination",
+        "severe_contamination",
+        "very_severe_contamination",
+    ]
     values = [life.contamination_factor(lv, 0.0606, 2.0) for lv in levels]
     assert values[0] == 1.0 and values == sorted(values, reverse=True) and values[-1] >= 0.0
     with pytest.raises(ValueError, match="contamination"):
@@ -200,6 +211,6 @@ def test_iso_c_of_the_6208_by_hand():
     """ISO 281:2007 clause 5.1 for the seed 6208 (Z = 9, Dw = 12.6 mm, Dpw = 60.6 mm): f_c at
     0.2079 = 59.9 - 0.395 x 0.3 = 59.78 (Table 2), C = 1.3 x 59.78 x 9^(2/3) x 12.6^1.8 = 32.16 kN."""
     fc = 59.9 + (0.2079208 - 0.20) / 0.02 * (59.6 - 59.9)
-    expected = 1.3 * fc * 9 ** (2 / 3) * 12.6 ** 1.8
+    expected = 1.3 * fc * 9 ** (2 / 3) * 12.6**1.8
     assert life.basic_dynamic_load_rating_n(0.0126, 0.0606, 0.0, 9) == pytest.approx(expected, rel=1e-6)
     assert expected == pytest.approx(32160, abs=10)

@@ -23,7 +23,7 @@ def test_accumulator_is_miner_sum():
     assert acc.damage_at(10.0) == pytest.approx(0.1 + 1e-2)
     acc.set_rate(10.0, 4e-3)
     assert acc.damage_at(15.0) == pytest.approx(0.1 + 1e-2 + 2e-2)
-    assert acc.damage_at(10.0) == pytest.approx(0.11)   # reading changed nothing
+    assert acc.damage_at(10.0) == pytest.approx(0.11)  # reading changed nothing
     acc.set_rate(2.0, 1e-3)  # restarted clock (a scenario restart): the old interval ends at 10 s
     assert acc.damage_at(2.0) == pytest.approx(0.11)
     assert acc.damage_at(3.0) == pytest.approx(0.11 + 1e-3)
@@ -36,8 +36,12 @@ def runs():
     """6208 twins at 500 rad/s: 3000 N and 6000 N, damage against ISO 281's L10m, and 3000 N
     against the contact-load life; damage read every 20 ms over 100 ms."""
     out = {}
-    for name, load, basis in (("iso_3000", 3000.0, "iso_281"), ("iso_6000", 6000.0, "iso_281"),
-                              ("contact_3000", 3000.0, "contact_loads"), ("contact_6000", 6000.0, "contact_loads")):
+    for name, load, basis in (
+        ("iso_3000", 3000.0, "iso_281"),
+        ("iso_6000", 6000.0, "iso_281"),
+        ("contact_3000", 3000.0, "contact_loads"),
+        ("contact_6000", 6000.0, "contact_loads"),
+    ):
         twin = Twin("6208", life=life.LifeSettings(damage_basis=basis))
         twin.set_setpoint(radial_load_n=load)
         twin.reset()  # warm start at this load
@@ -85,7 +89,7 @@ def test_snapshot_life_block(runs):
     block = json.loads(snap.to_json(), parse_constant=lambda c: pytest.fail(f"non-finite {c}"))["life"]
     for key in ("kappa", "a_iso", "l10_h", "l10m_h", "l10_contact_loads_h", "damage_fraction", "remaining_life_h"):
         assert block[key] is not None, key
-    assert block["l10_h"] == pytest.approx(4438.07, abs=0.05)            # (32.5/3)^3 at 500 rad/s
+    assert block["l10_h"] == pytest.approx(4438.07, abs=0.05)  # (32.5/3)^3 at 500 rad/s
     # kappa = nu / nu1 (ISO 281) of the film inlet: 5.587 for the seed oil at 40 degC unheated; the default
     # twin's inlet is shear-heated (Thermal.shear_heating, Murch-Wilson) by the published rise dT, so nu
     # falls by Roelands' eta(T0 + dT) / eta(T0) (seed 003 eq. 3) over rho(T0 + dT) / rho(T0) (4.41 at 500 rad/s)
@@ -93,8 +97,12 @@ def test_snapshot_life_block(runs):
     rise = snap.electrical.shear_temperature_rise_k
     assert rise > 0.0
     eta0 = dynamic_viscosity_pa_s(lub, t0)
-    eta_ratio = roelands_temperature_viscosity_pa_s(eta0, t0 + 273.15, t0 + 273.15 + rise,
-                                                    temperature_viscosity_coefficient_k_inv(lub, t0)) / eta0
+    eta_ratio = (
+        roelands_temperature_viscosity_pa_s(
+            eta0, t0 + 273.15, t0 + 273.15 + rise, temperature_viscosity_coefficient_k_inv(lub, t0)
+        )
+        / eta0
+    )
     rho_ratio = density_kg_m3(lub.density_15c_kg_m3, t0 + rise) / density_kg_m3(lub.density_15c_kg_m3, t0)
     assert block["kappa"] == pytest.approx(5.587 * eta_ratio / rho_ratio, abs=0.01)
     assert block["dynamic_load_rating_n"] == 32500.0 and block["equivalent_load_n"] == 3000.0

@@ -17,8 +17,7 @@ from twin.physics import hertz
 from twin.spec import ModelOptions
 
 # columns compared in log form (their value is a logarithm: an absolute error is a relative one)
-_LOG_COLUMNS = [L.A_TRIBOLOGY + c for c in (T_LN_HMIN, T_LN_HC, T_LN_IVR, T_LN_IVR + 1, T_LN_IVR + 2,
-                                           T_LN_IVR + 3)]
+_LOG_COLUMNS = [L.A_TRIBOLOGY + c for c in (T_LN_HMIN, T_LN_HC, T_LN_IVR, T_LN_IVR + 1, T_LN_IVR + 2, T_LN_IVR + 3)]
 
 
 def _worst_error(designation, points):
@@ -29,8 +28,12 @@ def _worst_error(designation, points):
     model = make_model(spec, opt)
     e_prime, g_param = model.params[L.P_E_PRIME], model.params[L.P_G_PARAM]
     grid = np.linspace(0.0, L.ANGLE_MAX_SIN, points)
-    table = np.array([[np.r_[k, tri] for k, tri in (_tribology_row(spec, opt, r == 0, s, e_prime, g_param)
-                                                     for s in grid)] for r in (0, 1)])
+    table = np.array(
+        [
+            [np.r_[k, tri] for k, tri in (_tribology_row(spec, opt, r == 0, s, e_prime, g_param) for s in grid)]
+            for r in (0, 1)
+        ]
+    )
     worst = 0.0
     for s in np.linspace(1e-3, L.ANGLE_MAX_SIN - 1e-3, 157):
         x = s / grid[1]
@@ -62,10 +65,12 @@ def test_model_table_is_the_exact_constants_on_the_grid():
             s = i * L.ANGLE_STEP
             rx, ry = raceway_radii_m(spec, r == 0, s)
             assert model.angle_table[r, i, L.A_STIFFNESS] == pytest.approx(
-                hertz.raceway_stiffness_n_m15(rx, ry, e_prime), rel=1e-12)
+                hertz.raceway_stiffness_n_m15(rx, ry, e_prime), rel=1e-12
+            )
             assert model.angle_table[r, i, L.A_TRIBOLOGY + T_RX] == pytest.approx(rx, rel=1e-12)
             assert model.angle_table[r, i, L.A_TRIBOLOGY + T_SEMI_MAJOR] == pytest.approx(
-                hertz.semi_major_axis_m(1.0, rx, ry, e_prime), rel=1e-12)
+                hertz.semi_major_axis_m(1.0, rx, ry, e_prime), rel=1e-12
+            )
     # the nominal rows (race_params, race_tribology) are the table at the nominal angle
     s40 = math.sin(math.radians(40.0))
     for r in (0, 1):

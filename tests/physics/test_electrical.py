@@ -36,7 +36,9 @@ def test_laws_by_hand():
     # outer zone: eps0 eps 2 pi sqrt(Rx Ry) ln((h + g) / h)
     hand = EPS0 * 2.2 * 2 * math.pi * math.sqrt(RX * RY) * math.log(51.0)
     assert el.outer_zone_capacitance_f(2.2, RX, RY, 1e-6, 50e-6) == pytest.approx(hand, rel=1e-12)
-    assert el.oil_film_resistance_ohm(1e10, 1e-6, 1.7e-3, 0.19e-3) == pytest.approx(1e4 / (math.pi * 3.23e-7), rel=1e-12)
+    assert el.oil_film_resistance_ohm(1e10, 1e-6, 1.7e-3, 0.19e-3) == pytest.approx(
+        1e4 / (math.pi * 3.23e-7), rel=1e-12
+    )
     assert el.parallel_resistance_ohm(2.0, 2.0) == 1.0
     assert el.parallel_resistance_ohm(math.inf, 3.0) == 3.0
     assert math.isinf(el.asperity_resistance_ohm(0.1, 0.0))
@@ -50,9 +52,9 @@ def _contact_rc(load, lam, h_c, rx=RX, ry=RY):
 
 def test_regime_consistency_resistive_in_boundary_capacitive_in_full_film():
     omega = 2 * math.pi * Electrical().frequency_hz
-    r, c = _contact_rc(1000.0, 0.5, 0.2e-6)      # boundary: asperities carry most of the load
+    r, c = _contact_rc(1000.0, 0.5, 0.2e-6)  # boundary: asperities carry most of the load
     assert omega * r * c < 1e-3
-    r, c = _contact_rc(1000.0, 4.0, 1.5e-6)      # full film: leakage only
+    r, c = _contact_rc(1000.0, 4.0, 1.5e-6)  # full film: leakage only
     assert omega * r * c > 1e3
 
 
@@ -65,8 +67,8 @@ def test_no_asperity_contact_means_leakage_only():
 
 def test_capacitance_grows_with_load_and_falls_with_film():
     _, c1 = _contact_rc(500.0, 2.0, 1.0e-6)
-    _, c2 = _contact_rc(2000.0, 2.0, 0.9e-6)   # more load: bigger ellipse, slightly thinner film
-    _, c3 = _contact_rc(2000.0, 3.0, 1.4e-6)   # more speed: thicker film
+    _, c2 = _contact_rc(2000.0, 2.0, 0.9e-6)  # more load: bigger ellipse, slightly thinner film
+    _, c3 = _contact_rc(2000.0, 3.0, 1.4e-6)  # more speed: thicker film
     assert c2 > c1 and c3 < c2
 
 
@@ -190,7 +192,8 @@ def test_geometry_capacitances():
     # the rest of the bearing: the rings' lands as coaxial cylinders across the oil-filled
     # annulus, 2 pi eps0 eps_r L / ln(r_out / r_in)
     assert el.coaxial_capacitance_f(2.2, 8e-3, 26e-3, 34e-3) == pytest.approx(
-        2 * math.pi * EPS0 * 2.2 * 8e-3 / math.log(34 / 26), rel=1e-12)
+        2 * math.pi * EPS0 * 2.2 * 8e-3 / math.log(34 / 26), rel=1e-12
+    )
     assert 2e-12 < model.rest_capacitance_f < 6e-12
 
 
@@ -200,8 +203,8 @@ def test_boundary_bearing_is_resistive_full_film_bearing_capacitive(time_step):
     slow.advance(0.003)
     fast = Twin("6208", setpoint=Setpoint(shaft_speed_rad_s=1700.0, radial_load_n=1000.0), options=options)
     fast.advance(0.003)
-    assert abs(slow.snapshot().electrical.phase_rad) < 0.1          # resistive
-    assert fast.snapshot().electrical.phase_rad < -1.4              # capacitive
+    assert abs(slow.snapshot().electrical.phase_rad) < 0.1  # resistive
+    assert fast.snapshot().electrical.phase_rad < -1.4  # capacitive
 
 
 def test_discharge_risk_indicators():
@@ -217,9 +220,17 @@ def test_discharge_risk_indicators():
     assert e.discharge_risk in ("none", "possible") and e.max_film_field_v_m > 0
 
 
-@pytest.mark.parametrize("field, value", [("oil_relative_permittivity", 0.0), ("oil_relative_permittivity", 1.0),
-                                          ("oil_resistivity_ohm_m", -1.0), ("metallic_contact_resistance_ohm", -0.1),
-                                          ("frequency_hz", 0.0), ("breakdown_field_v_m", float("nan"))])
+@pytest.mark.parametrize(
+    "field, value",
+    [
+        ("oil_relative_permittivity", 0.0),
+        ("oil_relative_permittivity", 1.0),
+        ("oil_resistivity_ohm_m", -1.0),
+        ("metallic_contact_resistance_ohm", -0.1),
+        ("frequency_hz", 0.0),
+        ("breakdown_field_v_m", float("nan")),
+    ],
+)
 def test_non_physical_electrical_inputs_refused_by_name(field, value):
     with pytest.raises(ValidationError, match=field):
         Electrical(**{field: value})
@@ -228,7 +239,7 @@ def test_non_physical_electrical_inputs_refused_by_name(field, value):
 def test_bad_electrical_setpoints_refused():
     twin = Twin("6208")
     for field, value in (("shaft_current_a", -1.0), ("shaft_voltage_v", float("inf")), ("shaft_current_a", 1e4)):
-        with pytest.raises((ValidationError, SetpointError), match=field):   # type / the bearing's range
+        with pytest.raises((ValidationError, SetpointError), match=field):  # type / the bearing's range
             twin.set_setpoint(**{field: value})
 
 

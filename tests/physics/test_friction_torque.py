@@ -16,8 +16,12 @@ LOADS_N = (750.0, 1500.0, 3000.0, 7500.0)
 
 def _nu_mm2_s(temperature_c=40.0):
     lub = catalog.lubricant()
-    return viscosity.kinematic_viscosity_m2_s(lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s,
-                                              temperature_c) * 1e6
+    return (
+        viscosity.kinematic_viscosity_m2_s(
+            lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s, temperature_c
+        )
+        * 1e6
+    )
 
 
 @pytest.fixture(scope="module")
@@ -30,8 +34,10 @@ def test_torque_rises_with_load_like_published_models(sweep):
     # M_sl ~ Fr^(5/3); its slope over 750-7500 N here is 0.78); the centre-point friction gave
     # 0.40. The differential (Heathcote) slip over the ellipse supplies the missing sliding part.
     slope = studies.log_slope(list(sweep), list(sweep.values()))
-    skf = [skf_friction.frictional_moment("6208", 40.0, 80.0, f, 500.0, _nu_mm2_s(), inlet_shear=False).total_n_m
-           for f in LOADS_N]
+    skf = [
+        skf_friction.frictional_moment("6208", 40.0, 80.0, f, 500.0, _nu_mm2_s(), inlet_shear=False).total_n_m
+        for f in LOADS_N
+    ]
     skf_slope = studies.log_slope(LOADS_N, skf)
     assert 0.6 <= slope <= 1.0, (slope, sweep)
     assert 0.7 <= skf_slope <= 0.9
@@ -56,8 +62,9 @@ def _spin_moments(twin):
     c = twin.state.contacts
     loaded = c[L.C_LOAD] > 100.0
     spin = c[L.K_WX] * c[L.G_NX] + c[L.K_WY] * c[L.G_NY] + (c[L.K_WZ] - c[L.K_SPIN]) * c[L.G_NZ]
-    applied = np.clip(c[L.E_SPIN_MOMENT] + c[L.E_SPIN_SLOPE] * (spin - c[L.E_SPIN_RATE]),
-                      -c[L.E_SPIN_CAP], c[L.E_SPIN_CAP])[loaded]
+    applied = np.clip(
+        c[L.E_SPIN_MOMENT] + c[L.E_SPIN_SLOPE] * (spin - c[L.E_SPIN_RATE]), -c[L.E_SPIN_CAP], c[L.E_SPIN_CAP]
+    )[loaded]
     evaluate(*twin._kernel_args())
     return applied, twin.state.contacts[L.E_SPIN_MOMENT][loaded].copy()
 
@@ -93,9 +100,9 @@ def test_traction_sub_rate_is_converged():
     assert default == pytest.approx(fast, rel=0.005)
     runs = []
     for period in (1e-6, ModelOptions().traction_period_s):  # every refresh, the default
-        torque, twin = studies.mean_friction_torque_n_m(500.0, 3000.0, designation="7208",
-                                                        options=ModelOptions(traction_period_s=period),
-                                                        axial_load_n=3000.0)
+        torque, twin = studies.mean_friction_torque_n_m(
+            500.0, 3000.0, designation="7208", options=ModelOptions(traction_period_s=period), axial_load_n=3000.0
+        )
         runs.append((torque, *_spin_moments(twin)))
     (torque1, applied1, solved1), (torque20, applied20, solved20) = runs
     largest = np.max(np.abs(solved1))
@@ -110,9 +117,9 @@ def test_skf_model_by_hand():
     # nu 46.7 mm^2/s; hand evaluation of each factor
     n = 500.0 * 30 / np.pi
     dm, nu = 60.0, 46.736
-    g_rr = 3.9e-7 * dm ** 1.96 * 3000.0 ** 0.54
-    g_sl = 3.23e-3 * dm ** -0.26 * 3000.0 ** (5 / 3)
-    phi_ish = 1 / (1 + 1.84e-9 * (n * dm) ** 1.28 * nu ** 0.64)
+    g_rr = 3.9e-7 * dm**1.96 * 3000.0**0.54
+    g_sl = 3.23e-3 * dm**-0.26 * 3000.0 ** (5 / 3)
+    phi_ish = 1 / (1 + 1.84e-9 * (n * dm) ** 1.28 * nu**0.64)
     phi_rs = np.exp(-3e-8 * nu * n * 120.0 * np.sqrt(3.1 / 80.0))
     phi_bl = np.exp(-2.6e-8 * (n * nu) ** 1.4 * dm)
     mu_sl = phi_bl * 0.15 + (1 - phi_bl) * 0.05

@@ -17,7 +17,7 @@ from twin.kernels import layout as L
 from twin.model import make_model, raceway_radii_m
 from twin.physics import hertz
 
-E_PRIME = 210e9 / (1 - 0.3 ** 2)
+E_PRIME = 210e9 / (1 - 0.3**2)
 RX_INNER_6208 = 6.3 * 24.0 / (24.0 + 6.3) * 1e-3  # seed 000 Table 1
 RX_OUTER_6208 = 6.3 * 36.6 / (36.6 - 6.3) * 1e-3
 RY_6208 = 6.3 * 6.552 / (6.552 - 6.3) * 1e-3
@@ -27,11 +27,12 @@ RY_6208 = 6.3 * 6.552 / (6.552 - 6.3) * 1e-3
 def test_exact_constants_solve_the_hertz_equation(ratio):
     # Johnson eq. 4.39 / Hamrock & Brewe 1983 eq. 6: Ry/Rx = (k^2 E - K) / (K - E), m = 1 - 1/k^2
     c = hertz.elliptic_constants_of_ratio(ratio)
-    m = 1.0 - 1.0 / c.ellipticity ** 2
+    m = 1.0 - 1.0 / c.ellipticity**2
     from scipy import special
+
     assert c.first_kind == pytest.approx(special.ellipk(m), rel=1e-9)
     assert c.second_kind == pytest.approx(special.ellipe(m), rel=1e-12)
-    back = (c.ellipticity ** 2 * c.second_kind - c.first_kind) / (c.first_kind - c.second_kind)
+    back = (c.ellipticity**2 * c.second_kind - c.first_kind) / (c.first_kind - c.second_kind)
     assert back == pytest.approx(ratio, rel=1e-8)
     assert 1.0 <= c.ellipticity < ratio + 1e-9
 
@@ -73,15 +74,20 @@ def test_brewe_hamrock_approximations_are_bounded():
         e = hertz.brewe_hamrock_second_kind(rx, ry)
         k_approx = hertz.stiffness_from_constants(k, f, e, 1.0, 1.0)
         k_exact = hertz.stiffness_from_constants(c.ellipticity, c.first_kind, c.second_kind, 1.0, 1.0)
-        worst = np.maximum(worst, np.abs([k / c.ellipticity - 1, f / c.first_kind - 1,
-                                          e / c.second_kind - 1, k_approx / k_exact - 1]))
+        worst = np.maximum(
+            worst, np.abs([k / c.ellipticity - 1, f / c.first_kind - 1, e / c.second_kind - 1, k_approx / k_exact - 1])
+        )
     assert worst[0] < 0.04 and worst[1] < 0.022 and worst[2] < 0.01 and worst[3] < 0.07
     assert worst[0] > 0.03 and worst[3] > 0.05  # the bounds are tight, not loose guesses
     # at the 6208's contacts the approximated K is within 1.3 % (inner) and 0.3 % (outer)
     for rx, tol in ((RX_INNER_6208, 0.014), (RX_OUTER_6208, 0.004)):
         k_bh = hertz.stiffness_from_constants(
-            hertz.brewe_hamrock_ellipticity(rx, RY_6208), hertz.brewe_hamrock_first_kind(rx, RY_6208),
-            hertz.brewe_hamrock_second_kind(rx, RY_6208), hertz.curvature_sum_radius_m(rx, RY_6208), E_PRIME)
+            hertz.brewe_hamrock_ellipticity(rx, RY_6208),
+            hertz.brewe_hamrock_first_kind(rx, RY_6208),
+            hertz.brewe_hamrock_second_kind(rx, RY_6208),
+            hertz.curvature_sum_radius_m(rx, RY_6208),
+            E_PRIME,
+        )
         assert k_bh == pytest.approx(hertz.raceway_stiffness_n_m15(rx, RY_6208, E_PRIME), rel=tol)
 
 
@@ -97,7 +103,7 @@ def _dry_contact(rx, ry, load, nx, ny, span=1.25):
     x = (np.arange(nx) - (nx - 1) / 2) * hx
     y = (np.arange(ny) - (ny - 1) / 2) * hy
     xx, yy = np.meshgrid(x, y, indexing="ij")
-    gap0 = xx ** 2 / (2 * rx) + yy ** 2 / (2 * ry)
+    gap0 = xx**2 / (2 * rx) + yy**2 / (2 * ry)
     deflect = Deflection(nx, ny, hx, hy, ax_m=1.0, ay_m=1.0, rx_m=1.0, p_hertz_pa=1.0, e_prime_pa=E_PRIME)
     cell = hx * hy
     p = np.full((nx, ny), load / (nx * ny * cell))
@@ -123,8 +129,12 @@ def _dry_contact(rx, ry, load, nx, ny, span=1.25):
             break
     gap = deflect(p) + gap0
     w = p / p.sum()
-    return (float(gap[p > 0].mean()), float(p.max()), math.sqrt(5 * (w * yy ** 2).sum()),
-            math.sqrt(5 * (w * xx ** 2).sum()))
+    return (
+        float(gap[p > 0].mean()),
+        float(p.max()),
+        math.sqrt(5 * (w * yy**2).sum()),
+        math.sqrt(5 * (w * xx**2).sum()),
+    )
 
 
 @pytest.mark.parametrize("case", ["6208_inner", "7208_outer_40deg"])
@@ -146,8 +156,12 @@ def test_exact_hertz_against_a_numerical_contact_solution(case):
     assert p_max == pytest.approx(hertz.max_pressure_pa(load, a_exact, b_exact), rel=2e-3)
     # the old reading Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) is refuted by the numerical solution
     k_old = hertz.stiffness_from_constants(
-        hertz.brewe_hamrock_ellipticity(rx, ry), 1 + (math.pi / 2 - 1) * math.log(ry / rx),
-        hertz.brewe_hamrock_second_kind(rx, ry), hertz.curvature_sum_radius_m(rx, ry), E_PRIME)
+        hertz.brewe_hamrock_ellipticity(rx, ry),
+        1 + (math.pi / 2 - 1) * math.log(ry / rx),
+        hertz.brewe_hamrock_second_kind(rx, ry),
+        hertz.curvature_sum_radius_m(rx, ry),
+        E_PRIME,
+    )
     assert abs(approach / (load / k_old) ** (2 / 3) - 1) > 0.1
 
 
@@ -177,8 +191,9 @@ def test_contact_ellipse_and_pressure_at_the_stribeck_load():
     c = hertz.elliptic_constants(rx, ry)
     assert a / b == pytest.approx(c.ellipticity, rel=1e-9)
     r = rx * ry / (rx + ry)
-    assert a == pytest.approx((6 * c.ellipticity ** 2 * c.second_kind * 1457.0 * r / (math.pi * E_PRIME)) ** (1 / 3),
-                              rel=1e-12)
+    assert a == pytest.approx(
+        (6 * c.ellipticity**2 * c.second_kind * 1457.0 * r / (math.pi * E_PRIME)) ** (1 / 3), rel=1e-12
+    )
     assert a == pytest.approx(1.734e-3, rel=1e-3)
     assert b == pytest.approx(0.185e-3, rel=3e-3)
     p = hertz.max_pressure_pa(1457.0, a, b)

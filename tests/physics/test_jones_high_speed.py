@@ -37,10 +37,14 @@ def _compare(speed_rad_s):
         snap = twin.snapshot()
         az = twin.ball_azimuths_rad()
         dem.append([b.inner.load_n for b in snap.balls])
-        jones.append(analytic.jones_equilibrium(twin.model, LOAD_N, LOAD_N, snap.shaft_speed_rad_s,
-                                                azimuths_rad=az).inner_load_n)
-        static.append(analytic.jones_equilibrium(twin.model, LOAD_N, LOAD_N, snap.shaft_speed_rad_s, azimuths_rad=az,
-                                                 centrifugal=False).inner_load_n)
+        jones.append(
+            analytic.jones_equilibrium(twin.model, LOAD_N, LOAD_N, snap.shaft_speed_rad_s, azimuths_rad=az).inner_load_n
+        )
+        static.append(
+            analytic.jones_equilibrium(
+                twin.model, LOAD_N, LOAD_N, snap.shaft_speed_rad_s, azimuths_rad=az, centrifugal=False
+            ).inner_load_n
+        )
     return np.array(dem), np.array(jones), np.array(static)
 
 

@@ -49,6 +49,7 @@ def _case(d_m, rpm):
 
 # ---------------------------------------------------------------- dimensionless groups (eqs. 6-7)
 
+
 def test_speed_and_load_parameters_eq6_eq7():
     # U = eta0 u / (E* Rx), W = Q / (E* Rx^2): 0.05 * 0.5 / 3.45e8 and 0.633 / 517500
     assert speed_parameter_u(0.05, 0.5, 2.3e11, 1.5e-3) == pytest.approx(7.246376811594203e-11, rel=1e-12)
@@ -57,10 +58,11 @@ def test_speed_and_load_parameters_eq6_eq7():
 
 # ---------------------------------------------------------------- rolling forces (eqs. 1-5)
 
+
 def test_ivr_force_eq1_reduced_form():
     # Eq. 1 with W, U substituted: E* Rx^2 W^(1/3) U^(2/3) = Q^(1/3) (eta u Rx)^(2/3) (E* cancels)
     rx, k, u = _case(6.35e-3, 60)
-    hand = 2.9766 * k ** 0.3316 * 0.125 ** (1.0 / 3.0) * (ETA * u * rx) ** (2.0 / 3.0)
+    hand = 2.9766 * k**0.3316 * 0.125 ** (1.0 / 3.0) * (ETA * u * rx) ** (2.0 / 3.0)
     got = rolling_force_ivr_n(E_STAR, rx, k, 0.125, ETA, u)
     assert got == pytest.approx(hand, rel=1e-9)
     assert got == pytest.approx(1.0365e-3, rel=1e-3)  # pencil value, N
@@ -69,8 +71,7 @@ def test_ivr_force_eq1_reduced_form():
 def test_ehl_force_eq2_reduced_form():
     # Eq. 2: E* Rx^2 W^(1/3) U^(3/4) = Q^(1/3) (eta u)^(3/4) E*^(-1/12) Rx^(7/12)
     rx, k, u = _case(3e-3, 150)
-    hand = (7.5826 * k ** 0.4055 * 0.633 ** (1.0 / 3.0) * (ETA * u) ** 0.75
-            * E_STAR ** (-1.0 / 12.0) * rx ** (7.0 / 12.0))
+    hand = 7.5826 * k**0.4055 * 0.633 ** (1.0 / 3.0) * (ETA * u) ** 0.75 * E_STAR ** (-1.0 / 12.0) * rx ** (7.0 / 12.0)
     assert rolling_force_ehl_n(E_STAR, rx, k, 0.633, ETA, u) == pytest.approx(hand, rel=1e-9)
 
 
@@ -78,7 +79,7 @@ def test_ehl_parameter_eq4_negative_speed_exponent():
     # Eq. 4 (README reading): M = 0.5549 k^-0.6029 W U^-0.75 = 0.5549 k^-0.6029 Q E*^(-1/4)
     # Rx^(-5/4) (eta u)^(-3/4); M falls with speed.
     rx, k, u = _case(6.35e-3, 120)
-    hand = 0.5549 * k ** -0.6029 * 0.125 * E_STAR ** -0.25 * rx ** -1.25 * (ETA * u) ** -0.75
+    hand = 0.5549 * k**-0.6029 * 0.125 * E_STAR**-0.25 * rx**-1.25 * (ETA * u) ** -0.75
     assert ehl_parameter_m(E_STAR, rx, k, 0.125, ETA, u) == pytest.approx(hand, rel=1e-9)
     assert ehl_parameter_m(E_STAR, rx, k, 0.125, ETA, 2 * u) < ehl_parameter_m(E_STAR, rx, k, 0.125, ETA, u)
 
@@ -95,28 +96,30 @@ def test_transition_force_eq3_as_printed():
     # Eq. 3 written as in the seed, [FR_IVR + (M/6.6) FR_EHL] / (1 + M/6.6), all by hand.
     d, q = 3e-3, 0.633
     rx, k, u = _case(d, 90)
-    f_ivr = 2.9766 * k ** 0.3316 * q ** (1 / 3) * (ETA * u * rx) ** (2 / 3)
-    f_ehl = 7.5826 * k ** 0.4055 * q ** (1 / 3) * (ETA * u) ** 0.75 * E_STAR ** (-1 / 12) * rx ** (7 / 12)
-    m = 0.5549 * k ** -0.6029 * q * E_STAR ** -0.25 * rx ** -1.25 * (ETA * u) ** -0.75
+    f_ivr = 2.9766 * k**0.3316 * q ** (1 / 3) * (ETA * u * rx) ** (2 / 3)
+    f_ehl = 7.5826 * k**0.4055 * q ** (1 / 3) * (ETA * u) ** 0.75 * E_STAR ** (-1 / 12) * rx ** (7 / 12)
+    m = 0.5549 * k**-0.6029 * q * E_STAR**-0.25 * rx**-1.25 * (ETA * u) ** -0.75
     hand = (f_ivr + m / 6.6 * f_ehl) / (1 + m / 6.6)
     assert rolling_force_transition_n(E_STAR, rx, k, q, ETA, u) == pytest.approx(hand, rel=1e-9)
 
 
 # ---------------------------------------------------------------- hysteresis moment (eq. 9)
 
+
 def test_hysteresis_moment_eq9_si():
     # Eq. 9 in SI (d in m, Q in N, MER in N m): d = 3 mm, Q = 0.633 N, k = 4.16/2.66
     k = 4.16 / 2.66
-    hand = 7.48e-7 * 0.0015 ** 0.33 * 0.633 ** 1.33 * (1 - 3.519e-3 * (k - 1) ** 0.8063)
+    hand = 7.48e-7 * 0.0015**0.33 * 0.633**1.33 * (1 - 3.519e-3 * (k - 1) ** 0.8063)
     got = hysteresis_moment_n_m(3e-3, 0.633, k)
     assert got == pytest.approx(hand, rel=1e-12)
     assert got == pytest.approx(4.752e-8, rel=1e-3)  # pencil value, N m
     # k = 1: bracket is exactly 1; k < 1 is treated as 1
-    assert hysteresis_moment_n_m(3e-3, 0.633, 1.0) == pytest.approx(7.48e-7 * 0.0015 ** 0.33 * 0.633 ** 1.33, rel=1e-12)
+    assert hysteresis_moment_n_m(3e-3, 0.633, 1.0) == pytest.approx(7.48e-7 * 0.0015**0.33 * 0.633**1.33, rel=1e-12)
     assert hysteresis_moment_n_m(3e-3, 0.633, 0.5) == hysteresis_moment_n_m(3e-3, 0.633, 1.0)
 
 
 # ---------------------------------------------------------------- pivoting moment (eqs. 10-11)
+
 
 def _elliptic_ke(m):
     """Complete elliptic integrals K(m), E(m) by the arithmetic-geometric mean."""
@@ -162,9 +165,10 @@ def test_pivoting_moment_eq11_exponent_reading_matches_exact_spin(k):
 
 # ---------------------------------------------------------------- asperity share, mu_s (A1-A2)
 
+
 def test_asperity_load_share_eq_a2_values():
     assert asperity_load_share(1.0) == pytest.approx(1 - 1.21 / 1.37, rel=1e-12)  # 0.11679
-    hand = 1 - 1.21 * 0.5 ** 0.64 / (1 + 0.37 * 0.5 ** 1.26)
+    hand = 1 - 1.21 * 0.5**0.64 / (1 + 0.37 * 0.5**1.26)
     assert asperity_load_share(0.5) == pytest.approx(hand, rel=1e-12)
     assert asperity_load_share(0.5) == pytest.approx(0.3274, rel=1e-3)
     assert asperity_load_share(0.0) == 1.0  # no film
@@ -176,7 +180,7 @@ def test_asperity_load_share_eq_a2_not_used_past_minimum():
     # Raw fit minimum at L* = (0.64 / (0.37 * 0.62))^(1/1.26) = 2.258, value -0.003; the raw fit
     # rises again (0.013 at 3, 0.059 at 4): the function must return 0 there.
     l_star = (0.64 / (0.37 * 0.62)) ** (1 / 1.26)
-    raw = lambda lam: 1 - 1.21 * lam ** 0.64 / (1 + 0.37 * lam ** 1.26)  # noqa: E731
+    raw = lambda lam: 1 - 1.21 * lam**0.64 / (1 + 0.37 * lam**1.26)  # noqa: E731
     assert raw(3.0) > 0.01 and raw(4.0) > 0.05
     assert raw(l_star) < 0.0
     for lam in (l_star, 2.5, 3.0, 4.0, 10.0, 1e6):
@@ -199,6 +203,7 @@ def test_sliding_friction_coefficient_eq_a1():
 
 # ---------------------------------------------------------------- geometry of the seed's bearing
 
+
 def test_geometry_k_of_seed_section_4_5():
     # Seed 001 Section 4.5: d = 7.938 mm in the 4.16 mm groove, conformity 0.524, k = 21.78
     _rx, _ry, k = ball_race_geometry(7.938e-3)
@@ -215,7 +220,7 @@ def test_hertz_pressure_range_of_seed_section_3_1(d, q, p_seed):
     ke = (ry / rx) ** (2 / math.pi)
     ebar = 1 + (math.pi / 2 - 1) * rx / ry
     r = rx * ry / (rx + ry)
-    a = (6 * ke ** 2 * ebar * q * r / (math.pi * E_STAR)) ** (1 / 3)
+    a = (6 * ke**2 * ebar * q * r / (math.pi * E_STAR)) ** (1 / 3)
     b = (6 * ebar * q * r / (math.pi * ke * E_STAR)) ** (1 / 3)
     assert 3 * q / (2 * math.pi * a * b) == pytest.approx(p_seed, rel=0.05)
 
@@ -234,6 +239,7 @@ def test_entrainment_speed_and_torque_lever():
 
 
 # ---------------------------------------------------------------- acceptance (seed Tables 1-2)
+
 
 def test_acceptance_ivr_law_table2_d635_q0125():
     # Seed 001 Section 4.4 / Fig. 14: at Q = 0.125 N IVR dominates and eq. 1 matches best.
@@ -258,8 +264,10 @@ def test_acceptance_transition_law_table1_d3_q0633():
         res = thrust_torque_seed001(3e-3, 0.633, rpm, law="transition")
         meas = measured_torque_n_m(TABLE_1_D3MM_Q0633N, rpm)
         dev = res.torque_n_m / meas - 1
-        print(f"  {rpm:3d}  {res.torque_n_m:.3e}  {meas:.3e}  {dev:+.1%}  {res.ehl_share:.1%}"
-              + ("" if rpm >= 120 else "  (not asserted)"))
+        print(
+            f"  {rpm:3d}  {res.torque_n_m:.3e}  {meas:.3e}  {dev:+.1%}  {res.ehl_share:.1%}"
+            + ("" if rpm >= 120 else "  (not asserted)")
+        )
         if rpm >= 120:
             assert abs(dev) <= 0.30, (rpm, dev)
 
@@ -288,18 +296,21 @@ def test_appendix_a_secondary_torques_pin_eq9_units():
     mu_s = sliding_friction_coefficient_asperity_share(asperity_load_share(0.5))
     tz_mer, tz_mp = secondary_torques_seed001(3e-3, 0.633, mu_s)
     k = 4.16 / 2.66
-    mer_hand = 7.48e-7 * 0.0015 ** 0.33 * 0.633 ** 1.33 * (1 - 3.519e-3 * (k - 1) ** 0.8063)
+    mer_hand = 7.48e-7 * 0.0015**0.33 * 0.633**1.33 * (1 - 3.519e-3 * (k - 1) ** 0.8063)
     assert tz_mer == pytest.approx(6 * 0.018 * mer_hand / 3e-3, rel=1e-9)
     meas_60 = measured_torque_n_m(TABLE_1_D3MM_Q0633N, 60)
     meas_210 = measured_torque_n_m(TABLE_1_D3MM_Q0633N, 210)
-    print(f"\nAppendix A: Tz_MER {tz_mer:.2e}, Tz_MP {tz_mp:.2e} N m; share of measured "
-          f"{(tz_mer + tz_mp) / meas_60:.1%} at 60 rpm, {(tz_mer + tz_mp) / meas_210:.1%} at 210 rpm")
+    print(
+        f"\nAppendix A: Tz_MER {tz_mer:.2e}, Tz_MP {tz_mp:.2e} N m; share of measured "
+        f"{(tz_mer + tz_mp) / meas_60:.1%} at 60 rpm, {(tz_mer + tz_mp) / meas_210:.1%} at 210 rpm"
+    )
     assert 0.01 < tz_mer / meas_60 < 0.10
     assert 0.03 < (tz_mer + tz_mp) / meas_60 < 0.09
     assert 0.015 < (tz_mer + tz_mp) / meas_210 < 0.05
 
 
 # ---------------------------------------------------------------- guards
+
 
 @pytest.mark.parametrize("bad", [0.0, -1.0, math.nan])
 def test_zero_negative_nan_speed_or_load_gives_zero(bad):

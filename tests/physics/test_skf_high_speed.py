@@ -39,8 +39,13 @@ def runs(request):
     c0 = catalog.load_ratings(designation).static_load_rating_n
     out = {}
     for share in LOAD_SHARES_OF_C0:
-        _, twin = studies.mean_friction_torque_n_m(SPEED_RAD_S, share * c0, designation=designation,
-                                                   shear_heating=True, lubrication=Lubrication(method="oil_bath"))
+        _, twin = studies.mean_friction_torque_n_m(
+            SPEED_RAD_S,
+            share * c0,
+            designation=designation,
+            shear_heating=True,
+            lubrication=Lubrication(method="oil_bath"),
+        )
         out[share * c0] = twin
     return out
 
@@ -53,8 +58,10 @@ def _skf(twin, load_n, nu_mm2_s):
 
 def _nu_mm2_s():
     lub = catalog.lubricant()
-    return viscosity.kinematic_viscosity_m2_s(lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s,
-                                              40.0) * 1e6
+    return (
+        viscosity.kinematic_viscosity_m2_s(lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s, 40.0)
+        * 1e6
+    )
 
 
 def _unloaded_outer(twin):
@@ -72,7 +79,7 @@ def test_balls_outside_the_loaded_zone_carry_their_centrifugal_force(runs):
     for twin in runs.values():
         m = twin.model
         omega_c = float(twin.state.scalars[L.X_CAGE_SPEED])
-        f_c = m.params[L.P_BALL_MASS] * m.pitch_radius_m * omega_c ** 2
+        f_c = m.params[L.P_BALL_MASS] * m.pitch_radius_m * omega_c**2
         loads, _ = _unloaded_outer(twin)
         assert len(loads) >= 4
         assert float(np.mean(loads)) == pytest.approx(f_c, rel=0.02)
@@ -100,7 +107,7 @@ def test_the_centrifugal_floor_accounts_for_the_departure_from_skf(runs):
     bare = [t - torque for t, (_, torque) in zip(twin, floors)]
     assert abs(studies.log_slope(loads, bare) - slope_skf) < 0.15, (bare, skf)
     assert all(1 / 1.4 < b / s < 1.4 for b, s in zip(bare, skf)), (bare, skf)
-    assert floors[0][1] > 0.25 * twin[0]   # a quarter or more of the torque at 0.02 C0 (5.5 / 17.4 / 24.4 mN m)
+    assert floors[0][1] > 0.25 * twin[0]  # a quarter or more of the torque at 0.02 C0 (5.5 / 17.4 / 24.4 mN m)
 
 
 def test_the_other_candidates_agree_with_skf(runs):

@@ -23,7 +23,9 @@ def _tensor(k):
             tangent = (-y / r, x / r)
             # d(v/|v|)/dv at v = w x r: (I - t t^T) / (w r), Hertz pressure weight 3/(2 pi) sqrt(1 - s^2)
             return 1.5 / math.pi * math.sqrt(1.0 - s * s) * (1.0 - tangent[i] ** 2) / r * s
+
         return integrate.dblquad(f, 0.0, 2.0 * math.pi, 0.0, 1.0)[0]
+
     return term(0), term(1)
 
 

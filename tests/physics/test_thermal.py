@@ -23,20 +23,39 @@ def test_roelands_temperature_law_by_hand():
     assert thermal.roelands_temperature_viscosity_pa_s(eta0, t0, t0, beta) == pytest.approx(eta0, rel=1e-12)
     # its slope at T0 is -beta by construction of S0
     h = 1e-3
-    slope = (math.log(thermal.roelands_temperature_viscosity_pa_s(eta0, t0, t0 + h, beta))
-             - math.log(thermal.roelands_temperature_viscosity_pa_s(eta0, t0, t0 - h, beta))) / (2 * h)
+    slope = (
+        math.log(thermal.roelands_temperature_viscosity_pa_s(eta0, t0, t0 + h, beta))
+        - math.log(thermal.roelands_temperature_viscosity_pa_s(eta0, t0, t0 - h, beta))
+    ) / (2 * h)
     assert slope == pytest.approx(-beta, rel=1e-5)
 
 
 def test_current_heating_eq10_by_hand():
     # seed 003 eq. 10: 1.45 I^2 R K (D + 2d) / (f_s Hc rho c alpha d^2 (D + d))
-    i, r, k, big_d, d, fs, hc, rho, c, alpha = 10.0, 1.0, 3, 28.9e-3, 4.78e-3, 500.0, 3e-3, 7700.0, 460.0, math.radians(15)
+    i, r, k, big_d, d, fs, hc, rho, c, alpha = (
+        10.0,
+        1.0,
+        3,
+        28.9e-3,
+        4.78e-3,
+        500.0,
+        3e-3,
+        7700.0,
+        460.0,
+        math.radians(15),
+    )
     hand = 1.45 * i * i * r * k * (big_d + 2 * d) / (fs * hc * rho * c * alpha * d * d * (big_d + d))
-    assert thermal.current_heating_temperature_rise_k(i, r, big_d, d, k, fs, hc, rho, c, alpha) == pytest.approx(hand, rel=1e-12)
+    assert thermal.current_heating_temperature_rise_k(i, r, big_d, d, k, fs, hc, rho, c, alpha) == pytest.approx(
+        hand, rel=1e-12
+    )
     assert 1.0 < hand < 100.0  # tens of kelvin at 10 A, as seed 003 Fig. 3
     # rises with I^2 and R, falls with shaft frequency
-    assert thermal.current_heating_temperature_rise_k(2 * i, r, big_d, d, k, fs, hc, rho, c, alpha) == pytest.approx(4 * hand)
-    assert thermal.current_heating_temperature_rise_k(i, 2 * r, big_d, d, k, fs, hc, rho, c, alpha) == pytest.approx(2 * hand)
+    assert thermal.current_heating_temperature_rise_k(2 * i, r, big_d, d, k, fs, hc, rho, c, alpha) == pytest.approx(
+        4 * hand
+    )
+    assert thermal.current_heating_temperature_rise_k(i, 2 * r, big_d, d, k, fs, hc, rho, c, alpha) == pytest.approx(
+        2 * hand
+    )
     assert thermal.current_heating_temperature_rise_k(0.0, r, big_d, d, k, fs, hc, rho, c, alpha) == 0.0
 
 
@@ -49,9 +68,14 @@ def test_shear_heating_eq6_by_hand():
 
 def _ev_twin(current_a, temperature_c=40.0, resistance_ohm=None, rpm=20000.0, shear_heating=True, time_step="auto"):
     """The 6200 EV twin of seed 003 (shear and current heating on), settled for 20 ms."""
-    sample, snap = studies.ev_operating_point(current_a, rpm, oil_temperature_c=temperature_c,
-                                              equivalent_resistance_ohm=resistance_ohm, shear_heating=shear_heating,
-                                              options=ModelOptions(time_step_s=time_step))
+    sample, snap = studies.ev_operating_point(
+        current_a,
+        rpm,
+        oil_temperature_c=temperature_c,
+        equivalent_resistance_ohm=resistance_ohm,
+        shear_heating=shear_heating,
+        options=ModelOptions(time_step_s=time_step),
+    )
     return sample.h_min_inner_m, snap
 
 
@@ -61,8 +85,9 @@ def test_film_falls_with_current_base_temperature_and_resistance(time_step):
     assert h[0] > h[1] > h[2]
     dt = time_step
     assert _ev_twin(10.0, temperature_c=80.0, time_step=dt)[0] < _ev_twin(10.0, temperature_c=40.0, time_step=dt)[0]
-    assert (_ev_twin(10.0, resistance_ohm=5.6e-4, time_step=dt)[0]
-            < _ev_twin(10.0, resistance_ohm=2.92e-4, time_step=dt)[0])
+    assert (
+        _ev_twin(10.0, resistance_ohm=5.6e-4, time_step=dt)[0] < _ev_twin(10.0, resistance_ohm=2.92e-4, time_step=dt)[0]
+    )
     _, snap = _ev_twin(10.0, time_step=time_step)
     e = snap.electrical
     assert e.current_temperature_rise_k > 0 and e.shear_temperature_rise_k > 0
@@ -80,13 +105,17 @@ def test_loop_film_is_the_isothermal_film_times_the_thermal_factor():
     theta0 = 40.0 + 273.15
     eta0 = viscosity.dynamic_viscosity_pa_s(catalog.lubricant(), 40.0)
     beta = viscosity.temperature_viscosity_coefficient_k_inv(catalog.lubricant(), 40.0)
-    current = thermal.thermal_film_factor(e.current_temperature_rise_k, eta0, theta0, beta,
-                                          Thermal().film_temperature_exponent)
+    current = thermal.thermal_film_factor(
+        e.current_temperature_rise_k, eta0, theta0, beta, Thermal().film_temperature_exponent
+    )
     theta_c = theta0 + e.current_temperature_rise_k
     u = np.mean([b.inner.entrainment_speed_m_s for b in snap_hot.balls if b.inner.load_n > 0.0])
     loading = thermal.thermal_loading_parameter(
         thermal.roelands_temperature_viscosity_coefficient_k_inv(eta0, theta0, theta_c, beta),
-        thermal.roelands_temperature_viscosity_pa_s(eta0, theta0, theta_c, beta), u, Thermal().oil_thermal_conductivity_w_m_k)
+        thermal.roelands_temperature_viscosity_pa_s(eta0, theta0, theta_c, beta),
+        u,
+        Thermal().oil_thermal_conductivity_w_m_k,
+    )
     # the loop's speed is the one of its last coupling (<= 10 ms before the snapshot): 1 %
     assert e.film_thermal_factor == pytest.approx(current * thermal.murch_wilson_thermal_factor(loading), rel=0.01)
     assert snap_iso.electrical.film_thermal_factor == 1.0
@@ -128,9 +157,14 @@ def test_shear_heating_is_on_by_default_and_off_in_the_isothermal_seed000_studie
     twin.advance(0.005)
     e = twin.snapshot().electrical
     lub = twin.model.spec.lubricant
-    law = thermal.murch_wilson_thermal_factor(thermal.thermal_loading_parameter(
-        viscosity.temperature_viscosity_coefficient_k_inv(lub, 40.0), viscosity.dynamic_viscosity_pa_s(lub, 40.0),
-        twin.mean_entrainment_speed_m_s(), Thermal().oil_thermal_conductivity_w_m_k))
+    law = thermal.murch_wilson_thermal_factor(
+        thermal.thermal_loading_parameter(
+            viscosity.temperature_viscosity_coefficient_k_inv(lub, 40.0),
+            viscosity.dynamic_viscosity_pa_s(lub, 40.0),
+            twin.mean_entrainment_speed_m_s(),
+            Thermal().oil_thermal_conductivity_w_m_k,
+        )
+    )
     assert law < 0.9
     assert e.film_thermal_factor == pytest.approx(law, rel=0.05) and e.shear_temperature_rise_k > 0.0
     seed = Twin(studies.isothermal_spec("6208"))
@@ -143,10 +177,11 @@ def test_inlet_shear_heating_laws_by_hand_and_cross_check():
     # Murch and Wilson 1975: phi_T = 3.94 / (3.94 + L^0.62); Gupta et al. 1992:
     # [1 - 13.2 (p_h/E') L^0.42] / [1 + 0.213 (1 + 2.23 SRR^0.83) L^0.64]; L = beta eta0 u^2 / k_f
     lam = thermal.thermal_loading_parameter(0.047, 0.04, 7.25, 0.145)
-    assert lam == pytest.approx(0.047 * 0.04 * 7.25 ** 2 / 0.145, rel=1e-12)
-    assert thermal.murch_wilson_thermal_factor(lam) == pytest.approx(3.94 / (3.94 + lam ** 0.62), rel=1e-12)
+    assert lam == pytest.approx(0.047 * 0.04 * 7.25**2 / 0.145, rel=1e-12)
+    assert thermal.murch_wilson_thermal_factor(lam) == pytest.approx(3.94 / (3.94 + lam**0.62), rel=1e-12)
     assert thermal.gupta_thermal_factor(lam, 0.01, 0.2) == pytest.approx(
-        (1 - 13.2 * 0.01 * lam ** 0.42) / (1 + 0.213 * (1 + 2.23 * 0.2 ** 0.83) * lam ** 0.64), rel=1e-12)
+        (1 - 13.2 * 0.01 * lam**0.42) / (1 + 0.213 * (1 + 2.23 * 0.2**0.83) * lam**0.64), rel=1e-12
+    )
     assert thermal.murch_wilson_thermal_factor(0.0) == 1.0 and thermal.gupta_thermal_factor(0.0, 0.01) == 1.0
     # the two published laws agree within 0.12 for the 6208's rolling speeds (1.45-24.6 m/s,
     # p_h = 2 GPa, pure rolling); Gupta's is the lower (measured 0.02 at 1.45 m/s, 0.12 at 24.6 m/s)
@@ -163,8 +198,9 @@ def test_inlet_shear_heating_laws_by_hand_and_cross_check():
     assert thermal.roelands_temperature_viscosity_coefficient_k_inv(0.04, 313.15, 353.15, 0.047) < 0.047
 
 
-@pytest.mark.parametrize("speed, band", [(100.0, (0.95, 1.0)), (500.0, (0.8, 0.95)), (1000.0, (0.6, 0.85)),
-                                         (1700.0, (0.5, 0.8))])
+@pytest.mark.parametrize(
+    "speed, band", [(100.0, (0.95, 1.0)), (500.0, (0.8, 0.95)), (1000.0, (0.6, 0.85)), (1700.0, (0.5, 0.8))]
+)
 def test_6208_film_factor_follows_murch_wilson(speed, band):
     # issue 11: with inlet heating on, the loop's film factor within the cited law's value +-5 %
     # across 100-1700 rad/s (6208, 3000 N, seed oil at 40 degC), and in the range established
@@ -180,9 +216,14 @@ def test_6208_film_factor_follows_murch_wilson(speed, band):
         ball = min(snap.balls, key=lambda b: abs(b.azimuth_rad))
         films.append(ball.inner.h_min_m)
     lub = base.lubricant
-    law = thermal.murch_wilson_thermal_factor(thermal.thermal_loading_parameter(
-        viscosity.temperature_viscosity_coefficient_k_inv(lub, 40.0), viscosity.dynamic_viscosity_pa_s(lub, 40.0),
-        twin.mean_entrainment_speed_m_s(), Thermal().oil_thermal_conductivity_w_m_k))
+    law = thermal.murch_wilson_thermal_factor(
+        thermal.thermal_loading_parameter(
+            viscosity.temperature_viscosity_coefficient_k_inv(lub, 40.0),
+            viscosity.dynamic_viscosity_pa_s(lub, 40.0),
+            twin.mean_entrainment_speed_m_s(),
+            Thermal().oil_thermal_conductivity_w_m_k,
+        )
+    )
     factor = snap.electrical.film_thermal_factor
     assert factor == pytest.approx(law, rel=0.05)
     assert films[1] / films[0] == pytest.approx(law, rel=0.05)

@@ -39,13 +39,27 @@ HOUSING = {"enabled": True, "accelerometer": {"window_s": WINDOW_S, "noise_densi
 @pytest.fixture(scope="module")
 def service(support):
     endpoint = support.free_endpoint()
-    settings = ServiceSettings(enable_recording=False, zenoh_listen=[endpoint], fast=True, publish_rate_hz=100.0,
-                               opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
-                               alarms=AlarmSettings(defect_delay_s=0.0, clear_hold_s=0.1))
-    with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=60.0) as srv, \
-            httpx.Client(base_url=srv.url, timeout=60.0) as http:
-        created = http.post("/v1/bearings", json={"id": "vib", "designation": "6208", "housing": HOUSING,
-                                                  "setpoint": {"shaft_speed_rad_s": 523.0, "radial_load_n": 3000.0}})
+    settings = ServiceSettings(
+        enable_recording=False,
+        zenoh_listen=[endpoint],
+        fast=True,
+        publish_rate_hz=100.0,
+        opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
+        alarms=AlarmSettings(defect_delay_s=0.0, clear_hold_s=0.1),
+    )
+    with (
+        support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=60.0) as srv,
+        httpx.Client(base_url=srv.url, timeout=60.0) as http,
+    ):
+        created = http.post(
+            "/v1/bearings",
+            json={
+                "id": "vib",
+                "designation": "6208",
+                "housing": HOUSING,
+                "setpoint": {"shaft_speed_rad_s": 523.0, "radial_load_n": 3000.0},
+            },
+        )
         assert created.status_code == 201, created.text
         yield srv, http, endpoint
 
@@ -70,14 +84,23 @@ def test_bad_defects_are_refused_with_the_field_and_the_bearings_range(service):
     g = catalog.bearing("6208").geometry
     outer = race_limits(g, outer=True)
     cases = {
-        "wider than the ball spacing": ({**SPALL, "width_m": 1.1 * outer["width_m"]}, "defects[0].width_m",
-                                        f"{outer['width_m']:g}] m for this bearing"),
-        "longer than the groove arc": ({**SPALL, "length_m": 1.1 * outer["length_m"]}, "defects[0].length_m",
-                                       f"{outer['length_m']:g}] m for this bearing"),
+        "wider than the ball spacing": (
+            {**SPALL, "width_m": 1.1 * outer["width_m"]},
+            "defects[0].width_m",
+            f"{outer['width_m']:g}] m for this bearing",
+        ),
+        "longer than the groove arc": (
+            {**SPALL, "length_m": 1.1 * outer["length_m"]},
+            "defects[0].length_m",
+            f"{outer['length_m']:g}] m for this bearing",
+        ),
         "negative depth": ({**SPALL, "depth_m": -1e-5}, "defects[0].depth_m", "greater than 0"),
         "deeper than Rb / 2": ({**SPALL, "depth_m": 0.6 * RB}, "defects[0].depth_m", f"{0.5 * RB:g}] m"),
-        "a ball the bearing has not": ({"kind": "ball", "width_m": 0.2e-3, "length_m": 0.2e-3, "depth_m": 20e-6,
-                                        "ball_index": 9}, "defects[0].ball_index", "[0, 8]"),
+        "a ball the bearing has not": (
+            {"kind": "ball", "width_m": 0.2e-3, "length_m": 0.2e-3, "depth_m": 20e-6, "ball_index": 9},
+            "defects[0].ball_index",
+            "[0, 8]",
+        ),
     }
     for name, (defect, field, words) in cases.items():
         r = http.put("/v1/bearings/vib/defects", json={"defects": [defect]})
@@ -116,7 +139,9 @@ def test_an_outer_spall_raises_the_defect_alarm_and_bpfo_leads_the_envelope(serv
         for key in ("vibration", "vibration/waveform", "alarm", "defects/result"):
             peer.subscribe(f"bearing/vib/{key}")
         # healthy windows first: no defect alarm
-        support.wait_for(lambda: http.get("/v1/bearings/vib/state").json()["vibration"], lambda v: v is not None, WAIT_S)
+        support.wait_for(
+            lambda: http.get("/v1/bearings/vib/state").json()["vibration"], lambda v: v is not None, WAIT_S
+        )
         put = http.put("/v1/bearings/vib/defects", json={"defects": [SPALL]})
         assert put.status_code == 200, put.text
         assert put.json()["defects"] == [{**SPALL, "edge_radius_m": 0.0}]
@@ -127,8 +152,13 @@ def test_an_outer_spall_raises_the_defect_alarm_and_bpfo_leads_the_envelope(serv
             v = json.loads(payload)
             return v if v["defects"] and v["window_end_s"] - v["window_s"] >= t_applied else None
 
-        got = _collect(peer, lambda g: sum(1 for p in g.get("bearing/vib/vibration", []) if faulty(p)) >= 2
-                       and any(json.loads(p)["alarm_id"] == "defect_bpfo" for p in g.get("bearing/vib/alarm", [])))
+        got = _collect(
+            peer,
+            lambda g: (
+                sum(1 for p in g.get("bearing/vib/vibration", []) if faulty(p)) >= 2
+                and any(json.loads(p)["alarm_id"] == "defect_bpfo" for p in g.get("bearing/vib/alarm", []))
+            ),
+        )
         # DELETE clears them again (through the runner too)
         cleared = http.delete("/v1/bearings/vib/defects")
         assert cleared.status_code == 200 and cleared.json()["defects"] == []
@@ -142,17 +172,17 @@ def test_an_outer_spall_raises_the_defect_alarm_and_bpfo_leads_the_envelope(serv
     assert v["defects"][0]["kind"] == "outer" and v["window_s"] == pytest.approx(WINDOW_S)
     bpfo = v["defect_frequencies_hz"]["bpfo"]
     top = v["envelope_peaks_hz"][0]["frequency_hz"]
-    assert top == pytest.approx(bpfo, rel=0.01)            # the largest envelope peak is BPFO (1 %)
+    assert top == pytest.approx(bpfo, rel=0.01)  # the largest envelope peak is BPFO (1 %)
     line = v["envelope_lines"]["bpfo"]["harmonics"][0]
-    assert line > 4.0 * v["envelope_noise_floor_m_s2"]      # twin.vibration.indicators.SIGNIFICANCE
+    assert line > 4.0 * v["envelope_noise_floor_m_s2"]  # twin.vibration.indicators.SIGNIFICANCE
     # the window's full spectra ride on .../vibration (not on the state): arrays with their axis
     env, acc = v["envelope_spectrum"], v["amplitude_spectrum"]
     for spectrum in (env, acc):
         assert spectrum["units"] == "m/s^2" and len(spectrum["amplitude_m_s2"]) == spectrum["bins"]
-    assert env["start_hz"] == 0.0 and env["step_hz"] == pytest.approx(1.0 / WINDOW_S)   # 4 Hz
+    assert env["start_hz"] == 0.0 and env["step_hz"] == pytest.approx(1.0 / WINDOW_S)  # 4 Hz
     amp = np.array(env["amplitude_m_s2"])
     assert abs(env["start_hz"] + env["step_hz"] * np.argmax(amp) - bpfo) <= env["step_hz"]
-    assert amp.max() <= v["envelope_peaks_hz"][0]["amplitude"] * (1.0 + 1e-5)   # the peak is refined from these bins
+    assert amp.max() <= v["envelope_peaks_hz"][0]["amplitude"] * (1.0 + 1e-5)  # the peak is refined from these bins
     # 0.25 s at 51.2 kHz: 6401 FFT bins summed 4 by 4 (16 Hz) up to 25.6 kHz; Parseval to the 6 digits sent
     assert (acc["bins"], acc["step_hz"]) == (1601, 16.0)
     assert np.sum(np.square(acc["amplitude_m_s2"])) / 2.0 == pytest.approx(v["rms_m_s2"] ** 2, rel=1e-5)
@@ -192,8 +222,13 @@ def test_the_spectra_are_on_vibration_and_not_in_the_state(service, support):
     try:
         for key in ("state", "vibration"):
             peer.subscribe(f"bearing/vib/{key}")
-        got = _collect(peer, lambda g: g.get("bearing/vib/vibration") and any(
-            json.loads(p)["vibration"] for p in g.get("bearing/vib/state", [])))
+        got = _collect(
+            peer,
+            lambda g: (
+                g.get("bearing/vib/vibration")
+                and any(json.loads(p)["vibration"] for p in g.get("bearing/vib/state", []))
+            ),
+        )
     finally:
         peer.close()
     states = [p for p in got["bearing/vib/state"] if json.loads(p)["vibration"]]
@@ -201,8 +236,15 @@ def test_the_spectra_are_on_vibration_and_not_in_the_state(service, support):
     assert all(b"spectrum" not in p for p in got["bearing/vib/state"])
     assert set(json.loads(vibration)) >= {"envelope_spectrum", "amplitude_spectrum"}
     block = json.loads(states[-1])["vibration"]
-    assert set(block) == set(json.loads(vibration)) - {"schema", "bearing_id", "seq", "time_s", "defects",
-                                                      "envelope_spectrum", "amplitude_spectrum"}
+    assert set(block) == set(json.loads(vibration)) - {
+        "schema",
+        "bearing_id",
+        "seq",
+        "time_s",
+        "defects",
+        "envelope_spectrum",
+        "amplitude_spectrum",
+    }
     # the spectra alone would more than double the state message (with its vibration block)
     spectra = json.loads(vibration)
     text = len(json.dumps({k: spectra[k] for k in ("envelope_spectrum", "amplitude_spectrum")}, separators=(",", ":")))
@@ -215,17 +257,23 @@ def test_defects_over_zenoh_are_validated_and_answered(service, support):
     peer = support.Peer(endpoint)
     try:
         peer.subscribe("bearing/vib/defects/result")
-        time.sleep(0.5)                                     # the subscription reaches the service
+        time.sleep(0.5)  # the subscription reaches the service
         bad = json.dumps({"defects": [{**SPALL, "depth_m": -1e-5}]})
-        sample = peer.wait_for(lambda s: s.key == "bearing/vib/defects/result",
-                               poke=lambda: peer.session.put("bearing/vib/defects", bad), poke_every_s=2.0)
+        sample = peer.wait_for(
+            lambda s: s.key == "bearing/vib/defects/result",
+            poke=lambda: peer.session.put("bearing/vib/defects", bad),
+            poke_every_s=2.0,
+        )
         result = support.strict_loads(sample.payload)
         assert result["accepted"] is False and result["status"] == 422 and result["bearing_id"] == "vib"
         assert result["detail"][0]["field"] == "defects[0].depth_m"
         peer.drain()
         good = json.dumps([SPALL])
-        sample = peer.wait_for(lambda s: s.key == "bearing/vib/defects/result",
-                               poke=lambda: peer.session.put("bearing/vib/defects", good), poke_every_s=2.0)
+        sample = peer.wait_for(
+            lambda s: s.key == "bearing/vib/defects/result",
+            poke=lambda: peer.session.put("bearing/vib/defects", good),
+            poke_every_s=2.0,
+        )
         result = support.strict_loads(sample.payload)
         assert result["accepted"] is True and result["defects"][0]["kind"] == "outer"
         assert http.get("/v1/bearings/vib/defects").json()["defects"][0]["width_m"] == SPALL["width_m"]
@@ -253,6 +301,7 @@ def test_a_severe_outer_spall_raises_the_iso_20816_zone_alarm_and_opc_ua_shows_t
     def zone_event():
         events = http.get("/v1/bearings/vib/alarms", params={"events": 1000}).json()["events"]
         return [e for e in events if e["alarm_id"] == "vibration_zone" and e["transition"] == "raised"]
+
     def critical(events):
         return [e for e in events if e["severity"] == "critical"]
 
@@ -279,11 +328,12 @@ def test_a_severe_outer_spall_raises_the_iso_20816_zone_alarm_and_opc_ua_shows_t
                     return values, v
                 await asyncio.sleep(0.05)
             raise AssertionError("the OPC UA window never matched the HTTP one")
+
     values, v = asyncio.run(asyncio.wait_for(read_window(), WAIT_S))
     assert values["velocity_rms_mm_s"] == v["velocity_rms_mm_s"]
     assert values["bpfo_hz"] == v["defect_frequencies_hz"]["bpfo"]
     assert values["bpfo_m_s2"] == v["envelope_lines"]["bpfo"]["harmonics"][0]
-    vel = v["velocity_rms_mm_s"]   # ISO 20816-3 Table A.2, group 2, rigid: zone boundaries 1.4, 2.8, 4.5 mm/s
+    vel = v["velocity_rms_mm_s"]  # ISO 20816-3 Table A.2, group 2, rigid: zone boundaries 1.4, 2.8, 4.5 mm/s
     assert values["zone"] == ("D" if vel >= 4.5 else "C" if vel >= 2.8 else "B" if vel >= 1.4 else "A")
     http.delete("/v1/bearings/vib/defects").raise_for_status()
     http.put("/v1/bearings/vib/setpoint", json={"radial_load_n": 3000.0}).raise_for_status()
@@ -295,22 +345,34 @@ def test_a_scenario_step_injects_and_clears_defects(service, support):
     r = http.post("/v1/bearings/vib/scenario", json={"scenario": bad})
     assert r.status_code == 422, r.text
     assert r.json()["detail"][0]["field"] == "scenario.steps[0].defects[0].depth_m"
-    timeline = {"name": "spall_on_off", "duration_s": 0.3, "steps": [
-        {"at_s": 0.0, "phase": "spall", "defects": [SPALL]},
-        {"at_s": 0.1, "phase": "two spalls, heavier", "set": {"radial_load_n": 4000.0},
-         "defects": [SPALL, {**SPALL, "azimuth_deg": 90.0}]},
-        {"at_s": 0.2, "phase": "healthy", "defects": []}]}
+    timeline = {
+        "name": "spall_on_off",
+        "duration_s": 0.3,
+        "steps": [
+            {"at_s": 0.0, "phase": "spall", "defects": [SPALL]},
+            {
+                "at_s": 0.1,
+                "phase": "two spalls, heavier",
+                "set": {"radial_load_n": 4000.0},
+                "defects": [SPALL, {**SPALL, "azimuth_deg": 90.0}],
+            },
+            {"at_s": 0.2, "phase": "healthy", "defects": []},
+        ],
+    }
     peer = support.Peer(endpoint)
     try:
         peer.subscribe("bearing/vib/state")
-        support.wait_for(lambda: peer.inbox.qsize(), lambda n: n > 0, WAIT_S)   # the subscription is routed
+        support.wait_for(lambda: peer.inbox.qsize(), lambda n: n > 0, WAIT_S)  # the subscription is routed
         r = http.post("/v1/bearings/vib/scenario", json={"scenario": timeline})
         assert r.status_code == 202, r.text
-        support.wait_for(lambda: http.get("/v1/bearings/vib/scenario").json()["state"],
-                         lambda st: st in ("done", "failed", "cancelled"), WAIT_S)
+        support.wait_for(
+            lambda: http.get("/v1/bearings/vib/scenario").json()["state"],
+            lambda st: st in ("done", "failed", "cancelled"),
+            WAIT_S,
+        )
         assert http.get("/v1/bearings/vib/scenario").json()["state"] == "done"
         support.wait_for(lambda: http.get("/v1/bearings/vib/state").json()["defects"], lambda d: d == [], WAIT_S)
-        time.sleep(0.5)                                      # the last states reach the peer
+        time.sleep(0.5)  # the last states reach the peer
         states = []
         while not peer.inbox.empty():
             states.append(json.loads(peer.inbox.get_nowait().payload))
@@ -318,10 +380,10 @@ def test_a_scenario_step_injects_and_clears_defects(service, support):
         peer.close()
     counts = [len(x["defects"]) for x in states]
     changes = [c for k, c in enumerate(counts) if k == 0 or c != counts[k - 1]]
-    assert changes[-3:] == [1, 2, 0], changes                # in order, each published
+    assert changes[-3:] == [1, 2, 0], changes  # in order, each published
     two = [x for x in states if len(x["defects"]) == 2]
     assert {d["azimuth_deg"] for d in two[0]["defects"]} == {0.0, 90.0}
-    assert all(x["setpoint"]["radial_load_n"] == 4000.0 for x in two[1:])   # the set of the same step
+    assert all(x["setpoint"]["radial_load_n"] == 4000.0 for x in two[1:])  # the set of the same step
     assert http.get("/v1/bearings/vib/defects").json()["defects"] == []
     http.put("/v1/bearings/vib/setpoint", json={"radial_load_n": 3000.0}).raise_for_status()
 

@@ -39,6 +39,7 @@ def free_port() -> int:
 def strict_loads(payload: bytes) -> dict:
     def reject(name):
         raise AssertionError(f"JSON carries {name}")
+
     return json.loads(payload, parse_constant=reject)
 
 
@@ -46,14 +47,26 @@ class Service:
     def __init__(self, tmp_path: Path, *extra: str, record: bool = True):
         self.zenoh_endpoint = f"tcp/127.0.0.1:{free_port()}"
         self.rrd = tmp_path / "x.rrd"
-        cmd = [sys.executable, "-m", "service.cli", "serve", "--port", "0",
-               "--zenoh-listen", self.zenoh_endpoint, "--log-level", "info", *extra]
+        cmd = [
+            sys.executable,
+            "-m",
+            "service.cli",
+            "serve",
+            "--port",
+            "0",
+            "--zenoh-listen",
+            self.zenoh_endpoint,
+            "--log-level",
+            "info",
+            *extra,
+        ]
         cmd += ["--record", str(self.rrd)] if record else ["--no-record"]
         env = {**os.environ, "PYTHONUNBUFFERED": "1"}
         env = {k: v for k, v in env.items() if not k.startswith("BEARING_TWIN_")}
-        env["BEARING_TWIN_ADMISSION"] = "off"     # twins whatever this machine's speed (tests/conftest.py)
-        self.proc = subprocess.Popen(cmd, cwd=REPO, env=env, stdout=subprocess.PIPE,
-                                     stderr=subprocess.STDOUT, text=True)
+        env["BEARING_TWIN_ADMISSION"] = "off"  # twins whatever this machine's speed (tests/conftest.py)
+        self.proc = subprocess.Popen(
+            cmd, cwd=REPO, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+        )
         self.lines: queue.Queue = queue.Queue()
         self.log: list[str] = []
         threading.Thread(target=self._read, daemon=True).start()
@@ -111,6 +124,7 @@ def state_where(peer, predicate, bearing_id="default"):
     def match(item):
         k, _, payload = item
         return k == key and predicate(strict_loads(payload))
+
     return strict_loads(peer.wait_for(match)[2])
 
 
@@ -140,14 +154,17 @@ def test_serve_http_zenoh_rerun_sigterm(service, support):
         _, _, result = peer.wait_for(lambda item: item[0] == "bearing/default/setpoint/result")
         result = strict_loads(result)
         assert result["accepted"] is True and result["setpoint"]["shaft_speed_rad_s"] == 600.0
-        state_where(peer, lambda s: s["setpoint"]["shaft_speed_rad_s"] == 600.0
-                    and s["setpoint"]["radial_load_n"] == 4321.0)
+        state_where(
+            peer, lambda s: s["setpoint"]["shaft_speed_rad_s"] == 600.0 and s["setpoint"]["radial_load_n"] == 4321.0
+        )
         assert http.get("/v1/bearings/default/state").json()["setpoint"]["shaft_speed_rad_s"] == 600.0
 
         # malformed setpoints are refused with the field named; the twin keeps running
-        for payload, field in ((b'{"radial_load_n": -5}', "radial_load_n"),
-                               (b'{"shaft_speed_rad_s": NaN}', "shaft_speed_rad_s"),
-                               (b"garbage", None)):
+        for payload, field in (
+            (b'{"radial_load_n": -5}', "radial_load_n"),
+            (b'{"shaft_speed_rad_s": NaN}', "shaft_speed_rad_s"),
+            (b"garbage", None),
+        ):
             peer.session.put("bearing/default/setpoint", payload)
             _, _, result = peer.wait_for(lambda item: item[0] == "bearing/default/setpoint/result")
             result = strict_loads(result)
@@ -183,8 +200,9 @@ def test_serve_http_zenoh_rerun_sigterm(service, support):
     # SIGTERM: graceful stop within a few seconds; the token goes, the recording is complete
     took = service.terminate(timeout=15.0)
     try:
-        peer.wait_for(lambda item: item[0] == "bearing/default/alive" and item[1] == zenoh.SampleKind.DELETE,
-                      timeout_s=5.0)
+        peer.wait_for(
+            lambda item: item[0] == "bearing/default/alive" and item[1] == zenoh.SampleKind.DELETE, timeout_s=5.0
+        )
     finally:
         peer.close()
     # uvicorn re-raises the captured SIGTERM once its graceful shutdown (our lifespan `finally`)
@@ -217,8 +235,16 @@ def test_two_services_on_one_zenoh_network_seen_by_one_monitor(tmp_path):
     a = Service(tmp_path / "a", "--twin-id", "pump-a", "--publish-rate", "20", record=False)
     b = None
     try:
-        b = Service(tmp_path / "b", "--twin-id", "pump-b", "--publish-rate", "20",
-                    "--zenoh-connect", a.zenoh_endpoint, record=False)
+        b = Service(
+            tmp_path / "b",
+            "--twin-id",
+            "pump-b",
+            "--publish-rate",
+            "20",
+            "--zenoh-connect",
+            a.zenoh_endpoint,
+            record=False,
+        )
         with httpx.Client(base_url=a.url, timeout=30.0) as http:
             assert http.post("/v1/bearings", json={"id": "pump-a2", "designation": "6204"}).status_code == 201
         seen: dict = {}

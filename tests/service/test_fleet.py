@@ -37,10 +37,17 @@ class Proc:
         full_env = {k: v for k, v in os.environ.items() if not k.startswith("BEARING_TWIN_")}
         # the capacity admission is not what this test is about (a loaded CI host may refuse a
         # third twin): tests/service/core/test_pool.py and test_capacity cover it
-        full_env.update({"PYTHONUNBUFFERED": "1", "PYTHONPATH": str(REPO), "BEARING_TWIN_ADMISSION": "off",
-                         **(env or {})})
-        self.proc = subprocess.Popen([sys.executable, "-m", "service.cli", *args], cwd=tmp_path,
-                                     env=full_env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        full_env.update(
+            {"PYTHONUNBUFFERED": "1", "PYTHONPATH": str(REPO), "BEARING_TWIN_ADMISSION": "off", **(env or {})}
+        )
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "service.cli", *args],
+            cwd=tmp_path,
+            env=full_env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
         self.lines: list[str] = []
         threading.Thread(target=self._read, daemon=True).start()
         if ready:
@@ -80,9 +87,24 @@ class Proc:
 
 
 def _serve(tmp_path: Path, router: str, http_port: int, twin_id: str) -> Proc:
-    return Proc(tmp_path, "serve", "--port", str(http_port), "--zenoh-connect", router,
-                "--zenoh-prefix", PREFIX, "--twin-id", twin_id, "--no-record", "--publish-rate", "10",
-                "--log-level", "info", ready="Application startup complete")
+    return Proc(
+        tmp_path,
+        "serve",
+        "--port",
+        str(http_port),
+        "--zenoh-connect",
+        router,
+        "--zenoh-prefix",
+        PREFIX,
+        "--twin-id",
+        twin_id,
+        "--no-record",
+        "--publish-rate",
+        "10",
+        "--log-level",
+        "info",
+        ready="Application startup complete",
+    )
 
 
 def _wait(fetch, predicate, timeout_s: float = WAIT_S, what: str = "condition"):
@@ -128,21 +150,35 @@ def test_fleet_router_two_services_three_twins(tmp_path, support):
             latest.update(snapshot)
             rows.put(snapshot)
 
-        th = threading.Thread(target=lambda: run_monitor(
-            [router_ep], prefix="plant1/**", duration_s=240.0, forget_gone_s=1.0, on_update=on_update,
-            stop=monitor_stop, access=ZenohAccess(), out=io.StringIO()), daemon=True)
+        th = threading.Thread(
+            target=lambda: run_monitor(
+                [router_ep],
+                prefix="plant1/**",
+                duration_s=240.0,
+                forget_gone_s=1.0,
+                on_update=on_update,
+                stop=monitor_stop,
+                access=ZenohAccess(),
+                out=io.StringIO(),
+            ),
+            daemon=True,
+        )
         th.start()
         names = {f"{PREFIX}/{i}" for i in ("motor7", "pump3", "fan1")}
-        seen = _wait(lambda: dict(latest), lambda s: names <= set(s) and all(
-            s[n]["alive"] and s[n]["messages"] >= 3 for n in names), what="the monitor lists the three twins")
+        seen = _wait(
+            lambda: dict(latest),
+            lambda s: names <= set(s) and all(s[n]["alive"] and s[n]["messages"] >= 3 for n in names),
+            what="the monitor lists the three twins",
+        )
         assert seen[f"{PREFIX}/pump3"]["designation"] == "6205"
         assert seen[f"{PREFIX}/fan1"]["designation"] == "6208"
 
         # a zenoh setpoint to each twin lands on that twin only
         writer = zenoh.open(make_config([], [router_ep], "client"))
         results: queue.Queue = queue.Queue()
-        sub = writer.declare_subscriber(f"{PREFIX}/*/setpoint/result",
-                                        lambda s: results.put((str(s.key_expr), json.loads(s.payload.to_bytes()))))
+        sub = writer.declare_subscriber(
+            f"{PREFIX}/*/setpoint/result", lambda s: results.put((str(s.key_expr), json.loads(s.payload.to_bytes())))
+        )
         loads = {"motor7": 3100.0, "pump3": 1100.0, "fan1": 3300.0}
         where = {"motor7": http_a, "pump3": http_a, "fan1": http_b}
         time.sleep(0.5)
@@ -160,8 +196,11 @@ def test_fleet_router_two_services_three_twins(tmp_path, support):
         for twin_id, (key, msg) in got.items():
             assert key == f"{PREFIX}/{twin_id}/setpoint/result" and msg["accepted"] is True, msg
             assert msg["setpoint"]["radial_load_n"] == loads[twin_id]
-            state = _wait(lambda t=twin_id: where[t].get(f"/v1/bearings/{t}/state").json(),
-                          lambda s, t=twin_id: s["setpoint"]["radial_load_n"] == loads[t], what=twin_id)
+            state = _wait(
+                lambda t=twin_id: where[t].get(f"/v1/bearings/{t}/state").json(),
+                lambda s, t=twin_id: s["setpoint"]["radial_load_n"] == loads[t],
+                what=twin_id,
+            )
             assert state["bearing_id"] == twin_id
         sub.undeclare()
 
@@ -174,8 +213,20 @@ def test_fleet_router_two_services_three_twins(tmp_path, support):
         a.wait_text(f"in process '{b.proc.pid}'", WAIT_S)
         assert f"(HTTP 'http://127.0.0.1:{port_b}')" in a.text
         assert [t["id"] for t in http_a.get("/v1/bearings").json()] == ["motor7", "pump3"]
-        third = Proc(tmp_path, "serve", "--port", str(support.free_port()), "--zenoh-connect", router_ep,
-                     "--zenoh-prefix", PREFIX, "--twin-id", "motor7", "--no-record", ready="")
+        third = Proc(
+            tmp_path,
+            "serve",
+            "--port",
+            str(support.free_port()),
+            "--zenoh-connect",
+            router_ep,
+            "--zenoh-prefix",
+            PREFIX,
+            "--twin-id",
+            "motor7",
+            "--no-record",
+            ready="",
+        )
         procs.append(third)
         assert third.wait_exit(START_S) == 2
         assert f"twin 'motor7' already runs under '{PREFIX}' in process '{a.proc.pid}'" in third.text, third.text

@@ -43,9 +43,9 @@ def test_prefixes_refused_by_the_settings_and_the_bus(bad):
     with pytest.raises(ValueError):
         keys.check_prefix(bad)
     if bad.strip("/") != bad.strip("/").strip() or bad in ("/a", "a/"):
-        return                      # the settings strip the outer '/' of a prefix read from the environment
+        return  # the settings strip the outer '/' of a prefix read from the environment
     with pytest.raises(ValueError):
-        ServiceSettings(zenoh_prefix=bad)     # a service publishes under a concrete prefix
+        ServiceSettings(zenoh_prefix=bad)  # a service publishes under a concrete prefix
     if "*" not in bad:
         with pytest.raises(ValueError):
             ZenohAccessSettings(zenoh_prefix=bad)
@@ -56,11 +56,18 @@ def test_one_definition():
     regex, a prefix regex or the default prefix as a literal."""
     assert ZenohAccessConfig.model_fields["prefix"].default == keys.DEFAULT_PREFIX
     assert registry.ID_PATTERN is keys.TWIN_ID_PATTERN and scenarios._NAME_RE is keys.TWIN_ID_PATTERN
-    literals = re.compile(r"\[A-Za-z0-9\]\[A-Za-z0-9_\.-\]|\[A-Za-z0-9_\.:\+=|prefix[^=\n]*=\s*\"bearing\"|"
-                          r"default=\"bearing\"")
-    offenders = [f"{p.relative_to(ROOT)}:{i}" for base in ("service", "loadtest") for p in (ROOT / base).rglob("*.py")
-                 if p.name != "keys.py"
-                 for i, line in enumerate(p.read_text().splitlines(), 1) if literals.search(line)]
+    literals = re.compile(
+        r"\[A-Za-z0-9\]\[A-Za-z0-9_\.-\]|\[A-Za-z0-9_\.:\+=|prefix[^=\n]*=\s*\"bearing\"|"
+        r"default=\"bearing\""
+    )
+    offenders = [
+        f"{p.relative_to(ROOT)}:{i}"
+        for base in ("service", "loadtest")
+        for p in (ROOT / base).rglob("*.py")
+        if p.name != "keys.py"
+        for i, line in enumerate(p.read_text().splitlines(), 1)
+        if literals.search(line)
+    ]
     assert not offenders, offenders
 
 
@@ -73,6 +80,10 @@ def test_version_from_package_metadata():
 
     declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
     assert service.__version__ == importlib.metadata.version("bearing-twin") == declared
-    offenders = [str(p.relative_to(ROOT)) for base in ("service", "twin", "loadtest") for p in (ROOT / base).rglob("*.py")
-                 if f'version="{declared}"' in p.read_text() or f"__version__ = \"{declared}\"" in p.read_text()]
+    offenders = [
+        str(p.relative_to(ROOT))
+        for base in ("service", "twin", "loadtest")
+        for p in (ROOT / base).rglob("*.py")
+        if f'version="{declared}"' in p.read_text() or f'__version__ = "{declared}"' in p.read_text()
+    ]
     assert not offenders, offenders

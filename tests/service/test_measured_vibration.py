@@ -34,40 +34,60 @@ RPM = 1797.0
 SPEED_RAD_S = RPM * 2.0 * math.pi / 60.0
 RB = catalog.bearing("6205").geometry.ball_radius_m
 INNER = {"kind": "inner", "width_m": 0.178e-3, "length_m": 0.178e-3, "depth_m": 0.279e-3}
-INNER_WINDOW = np.load(DATA / "105_DE_5s.npy")[:12000]        # [g]
+INNER_WINDOW = np.load(DATA / "105_DE_5s.npy")[:12000]  # [g]
 HEALTHY_WINDOW = np.load(DATA / "97_DE_12k_5s.npy")[:12000]  # [g]
 
 
 @pytest.fixture(scope="module")
 def service(support):
     endpoint = support.free_endpoint()
-    settings = ServiceSettings(enable_recording=False, zenoh_listen=[endpoint], fast=True, publish_rate_hz=50.0,
-                               opcua=f"opc.tcp://127.0.0.1:{support.free_port()}", opcua_security="none")
-    with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=60.0) as srv, \
-            httpx.Client(base_url=srv.url, timeout=60.0) as http:
+    settings = ServiceSettings(
+        enable_recording=False,
+        zenoh_listen=[endpoint],
+        fast=True,
+        publish_rate_hz=50.0,
+        opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
+        opcua_security="none",
+    )
+    with (
+        support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=60.0) as srv,
+        httpx.Client(base_url=srv.url, timeout=60.0) as http,
+    ):
         for name in ("healthy", "inner"):
-            created = http.post("/v1/bearings", json={"id": name, "designation": "6205", "setpoint": {
-                "shaft_speed_rad_s": SPEED_RAD_S, "radial_load_n": 1000.0}})
+            created = http.post(
+                "/v1/bearings",
+                json={
+                    "id": name,
+                    "designation": "6205",
+                    "setpoint": {"shaft_speed_rad_s": SPEED_RAD_S, "radial_load_n": 1000.0},
+                },
+            )
             assert created.status_code == 201, created.text
         put = http.put("/v1/bearings/inner/defects", json={"defects": [INNER]})
         assert put.status_code == 200, put.text
-        for name in ("healthy", "inner"):     # both twins at the record's speed
-            support.wait_for(lambda n=name: http.get(f"/v1/bearings/{n}/state").json()["shaft_speed_rad_s"],
-                             lambda w: abs(w - SPEED_RAD_S) < 1e-6 * SPEED_RAD_S, 120.0)
+        for name in ("healthy", "inner"):  # both twins at the record's speed
+            support.wait_for(
+                lambda n=name: http.get(f"/v1/bearings/{n}/state").json()["shaft_speed_rad_s"],
+                lambda w: abs(w - SPEED_RAD_S) < 1e-6 * SPEED_RAD_S,
+                120.0,
+            )
         yield srv, http, endpoint
 
 
 def _post(http, name, samples_g):
-    return http.post(f"/v1/bearings/{name}/vibration/measured", params={"sample_rate_hz": FS, "units": "g"},
-                     content=np.asarray(samples_g, dtype="<f4").tobytes(),
-                     headers={"content-type": "application/octet-stream"})
+    return http.post(
+        f"/v1/bearings/{name}/vibration/measured",
+        params={"sample_rate_hz": FS, "units": "g"},
+        content=np.asarray(samples_g, dtype="<f4").tobytes(),
+        headers={"content-type": "application/octet-stream"},
+    )
 
 
 def test_inner_race_window_alarms_on_the_healthy_twin_only(service, support):
     """An inner-race window: the healthy twin raises `unexplained_line` BPFI (and `kurtosis_above_twin`);
     the twin with the inner-race defect raises nothing; the GET returns the same comparison."""
     _srv, http, _ep = service
-    last = http.get("/v1/bearings/healthy/vibration/comparison")   # other tests of the module may have posted
+    last = http.get("/v1/bearings/healthy/vibration/comparison")  # other tests of the module may have posted
     windows = last.json()["window"] if last.status_code == 200 else 0
     r = _post(http, "healthy", INNER_WINDOW)
     assert r.status_code == 200, r.text
@@ -98,7 +118,7 @@ def _active_alarm_ids(http, name, timeout_s=10.0):
         ids = {a["alarm_id"] for a in body["active"]}
         if "measured_line" in ids or time.monotonic() > deadline:
             return ids, body
-        time.sleep(0.25)   # a few reads a second: within the service's read rate
+        time.sleep(0.25)  # a few reads a second: within the service's read rate
 
 
 def test_measured_window_raises_the_stateful_alarm_on_the_healthy_twin_only(service):
@@ -123,24 +143,32 @@ def test_healthy_window_on_the_healthy_twin_is_quiet(service):
     service's 64 KiB limit): no alarm on the healthy twin."""
     _srv, http, _ep = service
     samples = [float(f"{v:.5g}") for v in HEALTHY_WINDOW[:4800]]
-    r = http.post("/v1/bearings/healthy/vibration/measured",
-                  json={"sample_rate_hz": FS, "units": "g", "samples": samples})
+    r = http.post(
+        "/v1/bearings/healthy/vibration/measured", json={"sample_rate_hz": FS, "units": "g", "samples": samples}
+    )
     assert r.status_code == 200, r.text
     assert r.json()["alarm"] is False
 
 
-@pytest.mark.parametrize("params, body, field", [
-    ({"sample_rate_hz": FS, "units": "g"}, np.zeros(100, "<f4").tobytes(), "samples"),
-    ({"sample_rate_hz": FS, "units": "g"}, np.r_[np.zeros(5000), np.nan].astype("<f4").tobytes(), "samples"),
-    ({"sample_rate_hz": 1e9, "units": "g"}, np.zeros(4096, "<f4").tobytes(), "sample_rate_hz"),
-    ({"sample_rate_hz": FS, "units": "furlongs"}, np.zeros(4096, "<f4").tobytes(), "units"),
-    ({"units": "g"}, np.zeros(4096, "<f4").tobytes(), "sample_rate_hz"),
-    ({"sample_rate_hz": FS, "shaft_hz": 5000.0}, np.zeros(4096, "<f4").tobytes(), "shaft_hz"),
-])
+@pytest.mark.parametrize(
+    "params, body, field",
+    [
+        ({"sample_rate_hz": FS, "units": "g"}, np.zeros(100, "<f4").tobytes(), "samples"),
+        ({"sample_rate_hz": FS, "units": "g"}, np.r_[np.zeros(5000), np.nan].astype("<f4").tobytes(), "samples"),
+        ({"sample_rate_hz": 1e9, "units": "g"}, np.zeros(4096, "<f4").tobytes(), "sample_rate_hz"),
+        ({"sample_rate_hz": FS, "units": "furlongs"}, np.zeros(4096, "<f4").tobytes(), "units"),
+        ({"units": "g"}, np.zeros(4096, "<f4").tobytes(), "sample_rate_hz"),
+        ({"sample_rate_hz": FS, "shaft_hz": 5000.0}, np.zeros(4096, "<f4").tobytes(), "shaft_hz"),
+    ],
+)
 def test_bad_windows_get_422_naming_the_field(service, params, body, field):
     _srv, http, _ep = service
-    r = http.post("/v1/bearings/healthy/vibration/measured", params=params, content=body,
-                  headers={"content-type": "application/octet-stream"})
+    r = http.post(
+        "/v1/bearings/healthy/vibration/measured",
+        params=params,
+        content=body,
+        headers={"content-type": "application/octet-stream"},
+    )
     assert r.status_code == 422, r.text
     detail = r.json()["detail"]
     assert detail[0]["field"] == field and detail[0]["message"]
@@ -167,15 +195,19 @@ def test_zenoh_frame_gives_the_comparison(service, support):
         frame = encode_frame(INNER_WINDOW, FS, "g")
         for name, alarmed in (("healthy", True), ("inner", False)):
             key = f"bearing/{name}/vibration/comparison"
-            sample = peer.wait_for(lambda s, k=key: s.key == k,
-                                   poke=lambda n=name: peer.session.put(f"bearing/{n}/vibration/measured", frame),
-                                   poke_every_s=5.0)
+            sample = peer.wait_for(
+                lambda s, k=key: s.key == k,
+                poke=lambda n=name: peer.session.put(f"bearing/{n}/vibration/measured", frame),
+                poke_every_s=5.0,
+            )
             result = support.strict_loads(sample.payload)
             assert result["accepted"] is True and result["alarm"] is alarmed, json.dumps(result)[:400]
             peer.drain()
-        sample = peer.wait_for(lambda s: s.key == "bearing/healthy/vibration/comparison",
-                               poke=lambda: peer.session.put("bearing/healthy/vibration/measured", frame[:-8]),
-                               poke_every_s=5.0)
+        sample = peer.wait_for(
+            lambda s: s.key == "bearing/healthy/vibration/comparison",
+            poke=lambda: peer.session.put("bearing/healthy/vibration/measured", frame[:-8]),
+            poke_every_s=5.0,
+        )
         result = support.strict_loads(sample.payload)
         assert result["accepted"] is False and result["status"] == 422 and result["detail"][0]["field"] == "n"
     finally:
@@ -200,8 +232,9 @@ def test_opcua_shows_the_comparison(service, support):
         c = Client(srv.service.opcua.url, timeout=20, watchdog_intervall=10.0)
         async with c:
             idx = await c.get_namespace_index(NAMESPACE_URI)
-            folder = await c.nodes.objects.get_child([f"{idx}:{ROOT_FOLDER}", f"{idx}:healthy",
-                                                      f"{idx}:MeasuredVibration"])
+            folder = await c.nodes.objects.get_child(
+                [f"{idx}:{ROOT_FOLDER}", f"{idx}:healthy", f"{idx}:MeasuredVibration"]
+            )
             out = {}
             for name in ("window", "alarm", "alarm_codes", "bpfi_height_db", "kurtosis"):
                 out[name] = await (await folder.get_child(f"{idx}:{name}")).read_value()
@@ -228,8 +261,9 @@ def test_rerun_recording_holds_measured_beside_predicted(tmp_path):
     from twin.engine import Twin
     from twin.setpoint import Setpoint
 
-    twin = Twin(catalog.bearing("6205"), bearing_id="m",
-                setpoint=Setpoint(shaft_speed_rad_s=SPEED_RAD_S, radial_load_n=1000.0))
+    twin = Twin(
+        catalog.bearing("6205"), bearing_id="m", setpoint=Setpoint(shaft_speed_rad_s=SPEED_RAD_S, radial_load_n=1000.0)
+    )
     twin.advance(0.01)
     path = tmp_path / "m.rrd"
     rec = RerunRecorder(path)
@@ -242,8 +276,9 @@ def test_rerun_recording_holds_measured_beside_predicted(tmp_path):
     rec.close()
     assert rec.errors == 0 and comparator.listener_errors == 0
     base = "bearing/m/vibration/measured"
-    assert [v[0] for v in read_column(path, f"{base}/kurtosis/measured", "Scalars:scalars")] == \
-        pytest.approx([out["measured"]["kurtosis"]])
+    assert [v[0] for v in read_column(path, f"{base}/kurtosis/measured", "Scalars:scalars")] == pytest.approx(
+        [out["measured"]["kurtosis"]]
+    )
     assert [v[0] for v in read_column(path, f"{base}/kurtosis/predicted", "Scalars:scalars")] == [3.0]
     bpfi = next(d["height_db"] for d in out["measured"]["defect_lines"] if d["name"] == "BPFI")
     assert [v[0] for v in read_column(path, f"{base}/line_height_db/BPFI", "Scalars:scalars")] == pytest.approx([bpfi])

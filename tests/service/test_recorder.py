@@ -27,8 +27,8 @@ from service.recording.layout import REGIME_CODE
 from service.recording.reader import open_reader as _reader
 from twin.engine import Twin
 
-N = 40            # snapshots per twin
-FRAME_S = 0.002   # 2 ms frames
+N = 40  # snapshots per twin
+FRAME_S = 0.002  # 2 ms frames
 
 
 def _run(twin: Twin, n: int = N) -> list:
@@ -55,9 +55,14 @@ def twin_b():
 def _geometry(twin: Twin) -> dict:
     m = twin.model
     g = m.spec.geometry
-    return {"designation": m.spec.designation, "pitch_radius_m": m.pitch_radius_m,
-            "ball_radius_m": m.ball_radius_m, "inner_raceway_radius_m": g.inner_raceway_radius_m,
-            "outer_raceway_radius_m": g.outer_raceway_radius_m, "ball_count": m.ball_count}
+    return {
+        "designation": m.spec.designation,
+        "pitch_radius_m": m.pitch_radius_m,
+        "ball_radius_m": m.ball_radius_m,
+        "inner_raceway_radius_m": g.inner_raceway_radius_m,
+        "outer_raceway_radius_m": g.outer_raceway_radius_m,
+        "ball_count": m.ball_count,
+    }
 
 
 def _recorder(path, *twins, **kw) -> RerunRecorder:
@@ -71,8 +76,16 @@ def _defined(snaps, i: int, side: str, attr: str = "lambda_") -> int:
     return sum(getattr(getattr(s.balls[i], side), attr) is not None for s in snaps)
 
 
-FAST = ("balls", "loads", "friction_torque_n_m", "loads_n", "speeds_rad_s", "min_lambda", "regime_counts",
-        "temperatures_c") + tuple(f"load_zone/{f}/{side}" for f in ("load_n", "lambda", "mu") for side in ("inner", "outer"))
+FAST = (
+    "balls",
+    "loads",
+    "friction_torque_n_m",
+    "loads_n",
+    "speeds_rad_s",
+    "min_lambda",
+    "regime_counts",
+    "temperatures_c",
+) + tuple(f"load_zone/{f}/{side}" for f in ("load_n", "lambda", "mu") for side in ("inner", "outer"))
 SLOW = ("contacts/load_n", "contacts/lambda", "contacts/mu")
 
 
@@ -82,7 +95,7 @@ def _assert_tree(rows: dict, bearing_id: str, snaps: list, geometry: bool = True
     n = len(snaps)
     if geometry:
         for name in ("inner_raceway", "outer_raceway", "pitch_circle", "load_line"):
-            assert f"{root}/geometry/{name}" in rows            # static geometry
+            assert f"{root}/geometry/{name}" in rows  # static geometry
     for leaf in FAST + SLOW:
         if not geometry and leaf in ("balls", "loads"):
             assert f"{root}/{leaf}" not in rows or rows[f"{root}/{leaf}"] == 0
@@ -123,8 +136,7 @@ def test_one_twin_round_trip(tmp_path, twin_a):
 
     # timelines: seq = snapshot.seq, sim_time = snapshot.time_s (integer ns, rounded)
     assert list(read_index(path, "bearing/a/friction_torque_n_m")) == [s.seq for s in snaps]
-    assert read_column(path, "bearing/a/friction_torque_n_m", "sim_time") == \
-        [round(s.time_s * 1e9) for s in snaps]
+    assert read_column(path, "bearing/a/friction_torque_n_m", "sim_time") == [round(s.time_s * 1e9) for s in snaps]
     torque = [v[0] for v in read_column(path, "bearing/a/friction_torque_n_m", "Scalars:scalars")]
     assert torque == pytest.approx([s.friction_torque_n_m for s in snaps])
 
@@ -189,7 +201,7 @@ def test_two_twins_in_one_recording(tmp_path, twin_a, twin_b):
     rows = read_recording(path)
     _assert_tree(rows, "a", sa)
     _assert_tree(rows, "b", sb)
-    assert describe_recording(path)["blueprints"] >= 1   # each send_blueprint adds a blueprint store
+    assert describe_recording(path)["blueprints"] >= 1  # each send_blueprint adds a blueprint store
 
 
 def test_publish_never_blocks_and_drops_oldest(tmp_path, twin_a):
@@ -220,11 +232,11 @@ def test_close_is_idempotent(tmp_path, twin_a):
         rec.publish(s)
     rec.close()
     rec.close()
-    rec.publish(snaps[5])              # after close: ignored (counted as dropped), no exception
+    rec.publish(snaps[5])  # after close: ignored (counted as dropped), no exception
     rec.close()
     assert rec.closed and rec.rows_logged == 5 and rec.dropped == 1
     assert read_recording(path)["bearing/a/friction_torque_n_m"] == 5
-    with _recorder(tmp_path / "ctx.rrd", twin) as ctx:   # context manager closes too
+    with _recorder(tmp_path / "ctx.rrd", twin) as ctx:  # context manager closes too
         ctx.publish(snaps[0])
     assert ctx.closed and read_recording(tmp_path / "ctx.rrd")["bearing/a/balls"] == 1
 
@@ -241,7 +253,7 @@ def test_start_and_stop_file_while_running(tmp_path, twin_a):
     assert rec.recording_file == extra
     for s in snaps[10:30]:
         rec.publish(s)
-    time.sleep(0.12)                   # let the worker flush a batch on its own
+    time.sleep(0.12)  # let the worker flush a batch on its own
     assert rec.stop_file() == extra
     assert rec.stop_file() is None and rec.recording_file is None
     for s in snaps[30:]:
@@ -249,7 +261,7 @@ def test_start_and_stop_file_while_running(tmp_path, twin_a):
     rec.close()
 
     second = snaps[10:30]
-    rows = read_recording(extra)       # complete on its own: geometry, blueprint, its 20 rows
+    rows = read_recording(extra)  # complete on its own: geometry, blueprint, its 20 rows
     _assert_tree(rows, "a", second)
     assert list(read_index(extra, "bearing/a/balls")) == [s.seq for s in second]
     assert describe_recording(extra)["blueprints"] == 1
@@ -258,7 +270,7 @@ def test_start_and_stop_file_while_running(tmp_path, twin_a):
 
 def test_no_main_file_then_start_file(tmp_path, twin_a):
     twin, snaps = twin_a
-    rec = _recorder(None, twin)        # nothing is written until a file is started
+    rec = _recorder(None, twin)  # nothing is written until a file is started
     for s in snaps[:5]:
         rec.publish(s)
     rec.flush()
@@ -291,7 +303,7 @@ def test_positions_override_and_unregistered_twin(tmp_path, twin_a):
     z = len(snaps[0].balls)
     given = np.arange(3 * z, dtype=float).reshape(z, 3) * 1e-3
     rec.publish(snaps[0], positions_m=given)
-    stranger = snaps[1].model_copy(update={"bearing_id": "c"})   # never added: series only
+    stranger = snaps[1].model_copy(update={"bearing_id": "c"})  # never added: series only
     rec.publish(stranger)
     rec.close()
     np.testing.assert_allclose(read_column(path, "bearing/a/balls", "Points3D:positions")[0], given, rtol=1e-6)
@@ -305,9 +317,11 @@ def test_positions_override_and_unregistered_twin(tmp_path, twin_a):
 def _without_electrical(s):
     """A duck-typed copy of a snapshot without the electrical fields (the schema before they were
     added): the recorder must record it all the same."""
+
     def strip(obj, **repl):
         d = {k: v for k, v in obj.__dict__.items() if k not in ("resistance_ohm", "capacitance_f", "electrical")}
         return SimpleNamespace(**{**d, **repl})
+
     balls = tuple(strip(b, inner=strip(b.inner), outer=strip(b.outer)) for b in s.balls)
     return strip(s, balls=balls)
 
@@ -323,25 +337,39 @@ def test_electrical_series_follow_the_snapshot(tmp_path, twin_a):
     rec.close()
     assert rec.errors == 0
     rows = read_recording(path)
-    for leaf in ("capacitance_pf", "resistance_log10_kohm", "shaft_voltage_v", "shaft_current_ma",
-                 "film_field_v_per_um", "current_density_a_per_mm2"):
+    for leaf in (
+        "capacitance_pf",
+        "resistance_log10_kohm",
+        "shaft_voltage_v",
+        "shaft_current_ma",
+        "film_field_v_per_um",
+        "current_density_a_per_mm2",
+    ):
         assert rows[f"bearing/a/electrical/{leaf}"] == N, leaf
     c = _scalars(path, "bearing/a/electrical/capacitance_pf")[:, 0]
-    np.testing.assert_allclose(c, [s.electrical.capacitance_f * 1e12 if s.electrical.capacitance_f is not None else math.nan
-                                   for s in snaps], rtol=1e-12)   # NaN (a line break) where C is null
+    np.testing.assert_allclose(
+        c,
+        [s.electrical.capacitance_f * 1e12 if s.electrical.capacitance_f is not None else math.nan for s in snaps],
+        rtol=1e-12,
+    )  # NaN (a line break) where C is null
     r = _scalars(path, "bearing/a/electrical/resistance_log10_kohm")
     want_r = [math.log10(s.electrical.resistance_ohm / 1e3) if s.electrical.resistance_ohm else math.nan for s in snaps]
-    np.testing.assert_allclose(r[:, 0], want_r, rtol=1e-12)          # NaN where R is null
+    np.testing.assert_allclose(r[:, 0], want_r, rtol=1e-12)  # NaN where R is null
     np.testing.assert_allclose(r[:, 1], [math.log10(s.electrical.impedance_ohm / 1e3) for s in snaps], rtol=1e-12)
-    np.testing.assert_allclose(_scalars(path, "bearing/a/electrical/shaft_current_ma")[:, 0],
-                               [s.electrical.shaft_current_a * 1e3 for s in snaps], rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(
+        _scalars(path, "bearing/a/electrical/shaft_current_ma")[:, 0],
+        [s.electrical.shaft_current_a * 1e3 for s in snaps],
+        rtol=1e-12,
+        atol=1e-15,
+    )
     # per contact: C [pF] for all 2 Z contacts
     cc = np.array(read_column(path, "bearing/a/contacts/capacitance_pf", "Scalars:scalars")[-1])
-    np.testing.assert_allclose(cc, [x * 1e12 for b in snaps[-1].balls
-                                    for x in (b.inner.capacitance_f, b.outer.capacitance_f)], rtol=1e-12)
+    np.testing.assert_allclose(
+        cc, [x * 1e12 for b in snaps[-1].balls for x in (b.inner.capacitance_f, b.outer.capacitance_f)], rtol=1e-12
+    )
     risks = [s.electrical.discharge_risk for s in snaps]
     changes = 1 + sum(a != b for a, b in zip(risks, risks[1:]))
-    assert rows["bearing/a/electrical/discharge_risk"] == changes      # StateChange on change
+    assert rows["bearing/a/electrical/discharge_risk"] == changes  # StateChange on change
     assert read_column(path, "bearing/a/electrical/discharge_risk", "StateChange:state")[0] == [risks[0]]
 
 
@@ -356,8 +384,11 @@ def test_snapshots_without_electrical_fields(tmp_path, twin_a):
     rows = read_recording(path)
     _assert_tree(rows, "a", snaps[:10])
     # (the alarm states are logged from the first row on, the electrical-discharge alarm's too)
-    assert not [k for k, v in rows.items() if v and ("resistance" in k or "capacitance" in k or "electrical" in k)
-                and "/alarm_states/" not in k]
+    assert not [
+        k
+        for k, v in rows.items()
+        if v and ("resistance" in k or "capacitance" in k or "electrical" in k) and "/alarm_states/" not in k
+    ]
 
 
 def test_spawn_viewer_headless_falls_back_to_file(tmp_path, twin_a, monkeypatch, caplog):
@@ -387,7 +418,7 @@ def test_spawn_viewer_headless_falls_back_to_file(tmp_path, twin_a, monkeypatch,
 # The rotation is checked after each send; `flush()` sends, waits until the file holds it, then
 # rotates if due, so with tiny thresholds every flush that wrote rows closes a segment: the number
 # of segments does not depend on timing (the worker never sends: flush_interval_s is huge).
-GROUPS = (7, 13, 1, 19)     # snapshots per segment (sum = N)
+GROUPS = (7, 13, 1, 19)  # snapshots per segment (sum = N)
 
 
 def _segmented(path, twin, **kw) -> RerunRecorder:
@@ -398,7 +429,7 @@ def _publish_in_groups(rec, snaps, groups=GROUPS) -> None:
     assert sum(groups) == len(snaps)
     i = 0
     for g in groups:
-        for s in snaps[i:i + g]:
+        for s in snaps[i : i + g]:
             rec.publish(s)
         i += g
         rec.flush()
@@ -417,9 +448,9 @@ def _assert_segments_complete(segs, snaps, groups=GROUPS) -> None:
         assert info["blueprints"] >= 1, seg
         ent = info["entities"]
         assert ent["bearing/a/geometry/inner_raceway"]["static_rows"] == 1, seg
-        assert ent["bearing/a/friction_torque_n_m"]["static_rows"] >= 1, seg       # series style
-        assert list(read_index(seg, "bearing/a/balls")) == [s.seq for s in snaps[start:start + g]], seg
-        _assert_tree(read_recording(seg), "a", snaps[start:start + g])
+        assert ent["bearing/a/friction_torque_n_m"]["static_rows"] >= 1, seg  # series style
+        assert list(read_index(seg, "bearing/a/balls")) == [s.seq for s in snaps[start : start + g]], seg
+        _assert_tree(read_recording(seg), "a", snaps[start : start + g])
         start += g
     assert len(ids) == 1
     # across the boundaries: per entity, the rows of all segments = the snapshots published
@@ -435,19 +466,19 @@ def test_rotation_by_size_loses_no_row(tmp_path, twin_a, footer):
     twin, snaps = twin_a
     path = tmp_path / "run.rrd"
     rec = _segmented(path, twin, segment_bytes=1, write_footer=footer)
-    _publish_in_groups(rec, snaps[:sum(GROUPS[:-1])], GROUPS[:-1])   # three segments closed by flush
+    _publish_in_groups(rec, snaps[: sum(GROUPS[:-1])], GROUPS[:-1])  # three segments closed by flush
     assert rec.segments == [segment_path(path, i) for i in range(4)]
     assert rec.current_path == segment_path(path, 3)
-    for s in snaps[sum(GROUPS[:-1]):]:
+    for s in snaps[sum(GROUPS[:-1]) :]:
         rec.publish(s)
-    rec.close()              # the shutdown path: drains, sends and closes the open segment
+    rec.close()  # the shutdown path: drains, sends and closes the open segment
     assert rec.current_path is None and rec.segments == recording_segments(path)
     assert rec.rows_logged == N and rec.dropped == 0 and rec.errors == 0
     segs = recording_segments(path)
     assert len(segs) == 4
     _assert_segments_complete(segs, snaps)
     for seg in segs:
-        if footer:      # the footer (manifest) is written when a segment is closed: it is, each one
+        if footer:  # the footer (manifest) is written when a segment is closed: it is, each one
             _reader(seg).store()
         else:
             with pytest.raises(RuntimeError, match="footer"):
@@ -457,29 +488,32 @@ def test_rotation_by_size_loses_no_row(tmp_path, twin_a, footer):
 def test_rotation_by_age_and_explicit(tmp_path, twin_a):
     twin, snaps = twin_a
     path = tmp_path / "run.rrd"
-    rec = _segmented(path, twin, segment_s=1e-9)       # due as soon as a segment holds a row
+    rec = _segmented(path, twin, segment_s=1e-9)  # due as soon as a segment holds a row
     _publish_in_groups(rec, snaps[:20], (7, 13))
     assert len(rec.segments) == 3
-    rec.flush()                                     # no row since the rotation: no empty segment
+    rec.flush()  # no row since the rotation: no empty segment
     assert len(rec.segments) == 3
     rec.close()
     segs = recording_segments(path)
     assert len(segs) == 3 and read_recording(segs[-1]).get("bearing/a/balls", 0) == 0
     _assert_segments_complete(segs[:2], snaps[:20], (7, 13))
 
-    rec = _segmented(tmp_path / "x.rrd", twin)             # no thresholds: rotates on request only
+    rec = _segmented(tmp_path / "x.rrd", twin)  # no thresholds: rotates on request only
     for s in snaps[:5]:
         rec.publish(s)
     rec.flush()
     assert rec.segments == [tmp_path / "x.rrd"]
     assert rec.rotate() == tmp_path / "x-0001.rrd"
     with pytest.raises(ValueError):
-        rec.start_file(tmp_path / "x-0001.rrd")       # a segment is not a free file
+        rec.start_file(tmp_path / "x-0001.rrd")  # a segment is not a free file
     for s in snaps[5:9]:
         rec.publish(s)
     rec.close()
     assert rec.rotate() is None
-    assert [read_recording(p)["bearing/a/friction_torque_n_m"] for p in recording_segments(tmp_path / "x.rrd")] == [5, 4]
+    assert [read_recording(p)["bearing/a/friction_torque_n_m"] for p in recording_segments(tmp_path / "x.rrd")] == [
+        5,
+        4,
+    ]
 
 
 def test_rotation_happens_in_the_worker(tmp_path, twin_a):
@@ -489,7 +523,7 @@ def test_rotation_happens_in_the_worker(tmp_path, twin_a):
     rec = _recorder(path, twin, flush_interval_s=0.01, segment_bytes=1)
     for s in snaps[:10]:
         rec.publish(s)
-    deadline = time.monotonic() + 30.0        # a liveness bound, not a performance figure
+    deadline = time.monotonic() + 30.0  # a liveness bound, not a performance figure
     while len(rec.segments) < 2 and time.monotonic() < deadline:
         time.sleep(0.01)
     for s in snaps[10:]:
@@ -509,19 +543,34 @@ def test_segment_names_and_earlier_runs_are_kept(tmp_path, twin_a):
     path = tmp_path / "run.rrd"
     assert segment_path(path, 0) == path and segment_path(path, 12) == tmp_path / "run-0012.rrd"
     assert recording_segments(path) == []
-    old = {name: f"old {name}".encode() for name in ("run.rrd", "run-0001.rrd", "run-0002.rrd", "run-0003.rrd",
-                                                     "run-x.rrd", "run-0001.txt", "other-0001.rrd", "run.run2-0001.rrd")}
+    old = {
+        name: f"old {name}".encode()
+        for name in (
+            "run.rrd",
+            "run-0001.rrd",
+            "run-0002.rrd",
+            "run-0003.rrd",
+            "run-x.rrd",
+            "run-0001.txt",
+            "other-0001.rrd",
+            "run.run2-0001.rrd",
+        )
+    }
     for name, data in old.items():
         (tmp_path / name).write_bytes(data)
     rec = _segmented(path, twin, segment_bytes=1)
-    assert rec.path == tmp_path / "run.run3.rrd"          # run.run2 is taken by a stray segment
+    assert rec.path == tmp_path / "run.run3.rrd"  # run.run2 is taken by a stray segment
     _publish_in_groups(rec, snaps[:10], (10,))
     rec.close()
     assert all((tmp_path / name).read_bytes() == data for name, data in old.items())
     assert recording_segments(rec.path) == [rec.path, tmp_path / "run.run3-0001.rrd"]
     assert read_recording(recording_segments(rec.path))["bearing/a/balls"] == 10
-    assert recording_segments(path) == [path, tmp_path / "run-0001.rrd", tmp_path / "run-0002.rrd",
-                                        tmp_path / "run-0003.rrd"]
+    assert recording_segments(path) == [
+        path,
+        tmp_path / "run-0001.rrd",
+        tmp_path / "run-0002.rrd",
+        tmp_path / "run-0003.rrd",
+    ]
     # a missing number ends the list
     (tmp_path / "run-0005.rrd").write_bytes(b"x")
     assert len(recording_segments(path)) == 4
@@ -577,12 +626,12 @@ def test_rotation_keeps_one_stream_and_closes_the_old_segment_at_once(tmp_path, 
     path = tmp_path / "run.rrd"
     rec = _segmented(path, twin, segment_bytes=1, write_footer=True)
     rec.publish(snaps[0])
-    rec.flush()                                   # first rotation: blueprint stream created
+    rec.flush()  # first rotation: blueprint stream created
     before = _threads()
     for i in range(1, 31):
         rec.publish(snaps[i % N])
         rec.flush()
-        _reader(rec.segments[-2]).store()         # the segment just left is complete (footer)
+        _reader(rec.segments[-2]).store()  # the segment just left is complete (footer)
     assert len(rec.segments) == 32
     assert _threads() - before <= 1
     rec.close()
@@ -593,7 +642,7 @@ def test_a_failed_rotation_keeps_writing_the_open_segment(tmp_path, twin_a):
     twin, snaps = twin_a
     path = tmp_path / "run.rrd"
     rec = _segmented(path, twin)
-    (tmp_path / "run-0001.rrd").mkdir()           # the next segment cannot be created
+    (tmp_path / "run-0001.rrd").mkdir()  # the next segment cannot be created
     for s in snaps[:5]:
         rec.publish(s)
     assert rec.rotate() is None and rec.errors == 1

@@ -39,10 +39,15 @@ def run():
 
 def _alarm_rows(path, alarm_id: str, bearing_id: str = "a"):
     base = f"bearing/{bearing_id}"
-    return list(zip(read_column(path, f"{base}/alarms/{alarm_id}", "seq"),
-                    read_column(path, f"{base}/alarms/{alarm_id}", "sim_time"),
-                    [t[0] for t in read_column(path, f"{base}/alarms/{alarm_id}", "TextLog:text")],
-                    [lv[0] for lv in read_column(path, f"{base}/alarms/{alarm_id}", "TextLog:level")], strict=True))
+    return list(
+        zip(
+            read_column(path, f"{base}/alarms/{alarm_id}", "seq"),
+            read_column(path, f"{base}/alarms/{alarm_id}", "sim_time"),
+            [t[0] for t in read_column(path, f"{base}/alarms/{alarm_id}", "TextLog:text")],
+            [lv[0] for lv in read_column(path, f"{base}/alarms/{alarm_id}", "TextLog:level")],
+            strict=True,
+        )
+    )
 
 
 def test_every_alarm_event_is_a_log_row_and_a_state_at_its_snapshot(tmp_path, run):
@@ -59,27 +64,32 @@ def test_every_alarm_event_is_a_log_row_and_a_state_at_its_snapshot(tmp_path, ru
 
     rows = _alarm_rows(path, "electrical_discharge")
     assert [(seq, lv) for seq, _t, _text, lv in rows] == [
-        (snaps[10].seq, "WARN"), (snaps[20].seq, "CRITICAL"), (snaps[31].seq, "INFO")]
+        (snaps[10].seq, "WARN"),
+        (snaps[20].seq, "CRITICAL"),
+        (snaps[31].seq, "INFO"),
+    ]
     assert [t for _seq, t, _text, _lv in rows] == [round(snaps[k].time_s * 1e9) for k in (10, 20, 31)]
     raised, escalated, cleared = (text for _s, _t, text, _l in rows)
     assert raised.startswith("electrical_discharge raised warning: discharge risk possible: test")
     assert "[value 1, raise at 1, clear at 0.5]" in raised
-    assert escalated.startswith("electrical_discharge escalated to critical") and "raise at 2, clear at 1.5" in escalated
+    assert (
+        escalated.startswith("electrical_discharge escalated to critical") and "raise at 2, clear at 1.5" in escalated
+    )
     assert cleared.startswith("electrical_discharge cleared") and "[value 0," in cleared
     states = read_column(path, "bearing/a/alarm_states/electrical_discharge", "StateChange:state")
     # the state from the first row on ("inactive"), then one row per event
     assert [s[0] for s in states] == ["inactive", "warning", "critical", "inactive"]
     assert read_column(path, "bearing/a/alarm_states/electrical_discharge", "seq") == [
-        snaps[k].seq for k in (0, 10, 20, 31)]
+        snaps[k].seq for k in (0, 10, 20, 31)
+    ]
 
     info = describe_recording(path)["entities"]
     # every alarm has its state configuration (values and colours) and its state from the start
     for alarm_id in ALARM_IDS:
         e = info[f"bearing/a/alarm_states/{alarm_id}"]
         assert "StateConfiguration:values" in e["components"]
-        assert e["rows"] == 1 + (3 if alarm_id == "electrical_discharge" else 0)    # the first row's state too
-    assert not any(k.startswith("bearing/a/alarms/") and k != "bearing/a/alarms/electrical_discharge"
-                   for k in info)
+        assert e["rows"] == 1 + (3 if alarm_id == "electrical_discharge" else 0)  # the first row's state too
+    assert not any(k.startswith("bearing/a/alarms/") and k != "bearing/a/alarms/electrical_discharge" for k in info)
 
 
 def test_events_of_a_twin_not_recorded_are_left_out_and_dicts_are_taken(tmp_path, run):
@@ -90,8 +100,8 @@ def test_events_of_a_twin_not_recorded_are_left_out_and_dicts_are_taken(tmp_path
     for s in snaps:
         rec.publish(s)
     rec.log_alarm(events[0].model_copy(update={"bearing_id": "somebody-else"}))
-    rec.log_alarm(events[0].to_dict())          # the zenoh JSON form
-    rec.log_alarm({"bearing_id": "a"})           # not an event: skipped, counted, never raised
+    rec.log_alarm(events[0].to_dict())  # the zenoh JSON form
+    rec.log_alarm({"bearing_id": "a"})  # not an event: skipped, counted, never raised
     rec.close()
     assert rec.alarms_logged == 1 and rec.errors == 1
     assert [seq for seq, *_ in _alarm_rows(path, "electrical_discharge")] == [snaps[10].seq]
@@ -107,7 +117,7 @@ def test_a_new_segment_starts_with_the_alarms_in_force(tmp_path, run):
     rec.add_twin_from(twin)
     for s in snaps[:15]:
         rec.publish(s)
-    rec.log_alarm(events[0])                     # raised at snapshot 10
+    rec.log_alarm(events[0])  # raised at snapshot 10
     rec.flush()
     second = rec.rotate()
     assert second is not None
@@ -117,10 +127,13 @@ def test_a_new_segment_starts_with_the_alarms_in_force(tmp_path, run):
     states = read_column(second, "bearing/a/alarm_states/electrical_discharge", "StateChange:state")
     seqs = read_column(second, "bearing/a/alarm_states/electrical_discharge", "seq")
     assert [s[0] for s in states] == ["warning"] and seqs == [snaps[15].seq]
-    assert read_column(second, "bearing/a/alarms/electrical_discharge", "seq") == []   # the event is in the first
+    assert read_column(second, "bearing/a/alarms/electrical_discharge", "seq") == []  # the event is in the first
     both = recording_segments(path)
     assert [s[0] for s in read_column(both, "bearing/a/alarm_states/electrical_discharge", "StateChange:state")] == [
-        "inactive", "warning", "warning"]                                     # from the first row on
+        "inactive",
+        "warning",
+        "warning",
+    ]  # from the first row on
 
 
 def test_the_blueprint_has_the_alarm_views():
@@ -136,6 +149,7 @@ def test_the_blueprint_has_the_alarm_views():
                 views.append(child)
             else:
                 walk(child)
+
     walk(twin_blueprint(TwinLayout("a", "6208", 9), 10.0))
     by_name = {v.name: v for v in views}
     assert isinstance(by_name["a: alarm states"], rrb.StateTimelineView)

@@ -58,9 +58,27 @@ def test_non_loopback_bind_is_refused_with_a_token():
 def test_serve_refuses_a_public_rerun_web_with_a_token(tmp_path):
     env = {k: v for k, v in os.environ.items() if not k.startswith("BEARING_TWIN_")}
     env["BEARING_TWIN_TOKEN"] = "s3cret-token-for-the-test"
-    r = subprocess.run([sys.executable, "-m", "service.cli", "serve", "--port", "0", "--no-zenoh", "--no-record",
-                        "--rerun-web", str(free_port()), "--rerun-web-bind", "0.0.0.0"],
-                       cwd=REPO, env=env, capture_output=True, text=True, timeout=120)
+    r = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "service.cli",
+            "serve",
+            "--port",
+            "0",
+            "--no-zenoh",
+            "--no-record",
+            "--rerun-web",
+            str(free_port()),
+            "--rerun-web-bind",
+            "0.0.0.0",
+        ],
+        cwd=REPO,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
     assert r.returncode != 0
     assert "rerun_web_bind" in r.stderr + r.stdout and "Traceback" not in r.stderr
 
@@ -72,7 +90,7 @@ def _regime_pixels(png: bytes) -> int:
     img = np.asarray(Image.open(io.BytesIO(png)).convert("RGB")).astype(np.int16)
     hits = np.zeros(img.shape[:2], dtype=bool)
     for rgb in REGIME_RGB[1:]:
-        hits |= (np.abs(img - rgb.astype(np.int16)).max(axis=2) <= 12)
+        hits |= np.abs(img - rgb.astype(np.int16)).max(axis=2) <= 12
     return int(hits.sum())
 
 
@@ -104,7 +122,7 @@ def test_live_web_viewer_shows_the_running_twin(tmp_path):
             time.sleep(3.0)
             png = browser.screenshot()
             pixels = _regime_pixels(png)
-            if pixels > 2000:            # the balls (each ~60 px across at 1600 x 1000) are drawn
+            if pixels > 2000:  # the balls (each ~60 px across at 1600 x 1000) are drawn
                 break
         else:
             (tmp_path / "live.png").write_bytes(png)

@@ -58,7 +58,7 @@ def _assert_clip(path, seqs: list[int], footer: bool) -> str:
         import rerun_bindings
 
         assert rerun_bindings.check_for_rrd_footer(str(path))
-        _reader(path).store()            # random access through the footer works
+        _reader(path).store()  # random access through the footer works
     return info["recording_id"]
 
 
@@ -73,20 +73,20 @@ def test_recorder_clips_free_their_streams(tmp_path, twin_and_snaps, footer):
     def clip(i: int, n: int) -> list[int]:
         rec = RerunRecorder(tmp_path / f"clip-{i}.rrd", streams=streams, write_footer=footer)
         rec.add_twin_from(twin)
-        part = snaps[i % 10: i % 10 + n]
+        part = snaps[i % 10 : i % 10 + n]
         for s in part:
             rec.publish(s)
         rec.close()
         assert rec.rows_logged == n
         return [s.seq for s in part]
 
-    clip(0, 3)                                   # warm-up (rerun's own runtime threads)
+    clip(0, 3)  # warm-up (rerun's own runtime threads)
     before = _threads()
     seqs = {i: clip(i, 1 + i % 7) for i in range(1, 41)}
-    assert _threads() - before <= 1              # was +4 per clip (data + blueprint stream)
+    assert _threads() - before <= 1  # was +4 per clip (data + blueprint stream)
     assert streams.reclaim_errors == 0 and streams.reclaims >= 40
     ids = {_assert_clip(tmp_path / f"clip-{i}.rrd", s, footer) for i, s in seqs.items()}
-    assert len(ids) == 40                        # every clip is its own recording
+    assert len(ids) == 40  # every clip is its own recording
 
 
 @needs_proc
@@ -113,13 +113,13 @@ def test_start_file_clips_free_their_streams(tmp_path, twin_and_snaps):
             expected[open_clip].append(s.seq)
 
     for i in range(30):
-        publish()                                  # between clips: main file (and a clip left open)
-        rec.start_file(tmp_path / f"f-{i}.rrd")    # replaces (completes) a clip left open
+        publish()  # between clips: main file (and a clip left open)
+        rec.start_file(tmp_path / f"f-{i}.rrd")  # replaces (completes) a clip left open
         open_clip = i
         expected[i] = []
         for _ in range(1 + i % 4):
             publish()
-        if i % 3 != 2:                             # every third clip is left open
+        if i % 3 != 2:  # every third clip is left open
             assert rec.stop_file() == tmp_path / f"f-{i}.rrd"
             open_clip = None
     rec.stop_file()
@@ -128,7 +128,7 @@ def test_start_file_clips_free_their_streams(tmp_path, twin_and_snaps):
     ids = set()
     for i, seqs in expected.items():
         ids.add(_assert_clip(tmp_path / f"f-{i}.rrd", seqs, footer=True))
-    assert ids == {rec.recording_id}              # start_file clips share the recorder's id (doc)
+    assert ids == {rec.recording_id}  # start_file clips share the recorder's id (doc)
     assert read_recording(main)["bearing/a/balls"] == k
 
 
@@ -140,12 +140,18 @@ def test_service_clips_free_their_streams(tmp_path):
     from service.settings import ServiceSettings
     from service.wiring import TwinService
 
-    s = ServiceSettings(enable_zenoh=False, enable_recording=True, record=tmp_path / "svc.rrd",
-                        record_footer=True, fast=True, publish_rate_hz=200.0)
+    s = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=True,
+        record=tmp_path / "svc.rrd",
+        record_footer=True,
+        fast=True,
+        publish_rate_hz=200.0,
+    )
     svc = TwinService(s).open()
     try:
         entry = svc.get("default")
-        for i in range(3):                       # warm-up: rerun starts some pools lazily
+        for i in range(3):  # warm-up: rerun starts some pools lazily
             svc.start_recording(entry, f"warm-{i}.rrd")
             svc.stop_recording(entry)
         before = _threads()

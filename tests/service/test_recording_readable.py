@@ -21,8 +21,8 @@ from service.recording.layout import SERIES, TREND_BANDS, TwinLayout, blueprint
 from service.recording.trends import OFF_SCALE_DECADES, _capacitance_scale, split_windows
 from twin.engine import Twin
 
-FRAME_S = 0.02      # 50 Hz snapshots
-WINDOW_S = 0.2      # 10 snapshots per trend window
+FRAME_S = 0.02  # 50 Hz snapshots
+WINDOW_S = 0.2  # 10 snapshots per trend window
 
 
 @pytest.fixture(scope="module")
@@ -60,7 +60,7 @@ def test_trends_are_window_means_with_min_and_max(tmp_path, run):
     keys = np.floor(t / WINDOW_S).astype(int)
     torque = np.array([s.friction_torque_n_m for s in snaps])
     rows = read_column(path, "bearing/a/friction_torque_n_m", "Scalars:scalars")
-    assert len(rows) == len(set(keys.tolist()))                 # a row per window, not per snapshot
+    assert len(rows) == len(set(keys.tolist()))  # a row per window, not per snapshot
     for row, k in zip(rows, sorted(set(keys.tolist())), strict=True):
         sel = torque[keys == k]
         assert row == pytest.approx([sel.mean(), sel.min(), sel.max()], rel=1e-12)
@@ -130,7 +130,7 @@ def test_an_off_scale_capacitance_and_a_broken_film_are_marked_not_plotted():
     c = np.array([200.0, 210.0, 2.5e9, 205.0, math.nan, math.nan, 202.0])
     has_el = np.ones(c.size, dtype=bool)
     out: list = []
-    notes = _capacitance_scale(tw, c, has_el, np.arange(c.size) * 30_000_000_000, np.arange(c.size), out)   # 30 s apart
+    notes = _capacitance_scale(tw, c, has_el, np.arange(c.size) * 30_000_000_000, np.arange(c.size), out)  # 30 s apart
     assert np.isnan(c[[2, 4, 5]]).all() and np.isfinite(c[[0, 1, 3, 6]]).all()
     paths = [p for p, _i, _c in out]
     assert paths == ["bearing/a/electrical/capacitance_pf/off_scale", "bearing/a/electrical/capacitance_pf/film_broken"]
@@ -141,14 +141,15 @@ def test_an_off_scale_capacitance_and_a_broken_film_are_marked_not_plotted():
     # a film that breaks and heals every snapshot: a marker at each break, one note a minute
     c = np.array([200.0, math.nan] * 10)
     out = []
-    notes = _capacitance_scale(tw, c, np.ones(c.size, dtype=bool), 300_000_000_000 + np.arange(c.size) * 20_000_000,
-                               np.arange(c.size), out)
+    notes = _capacitance_scale(
+        tw, c, np.ones(c.size, dtype=bool), 300_000_000_000 + np.arange(c.size) * 20_000_000, np.arange(c.size), out
+    )
     assert len(notes) == 1 and [len(idx[1].as_arrow_array()) for _p, idx, _cols in out] == [10]
 
 
 def test_the_waveform_archive_keeps_bursts_and_the_second_after_an_event():
     fs = 51_200.0
-    row = WaveRow(seq=1, t0_s=9.95, sample_rate_hz=fs, samples=np.arange(int(fs), dtype=np.float32))   # 9.95..10.95 s
+    row = WaveRow(seq=1, t0_s=9.95, sample_rate_hz=fs, samples=np.arange(int(fs), dtype=np.float32))  # 9.95..10.95 s
     arch = WaveformArchive(burst_s=0.1, every_s=10.0, after_event_s=0.2)
     kept = arch.keep([row], events_s=[])
     assert len(kept) == 1 and kept[0].t0_s == pytest.approx(10.0, abs=1 / fs)
@@ -174,7 +175,7 @@ def test_the_blueprint_shows_whole_runs_with_short_titles_opens_files_paused_and
     file_bp, live_bp = blueprint([tw], None), blueprint([tw], None, live=True)
     assert str(file_bp.time_panel.play_state) == "paused" and str(live_bp.time_panel.play_state) == "following"
     live_names = [str(v.name) for v in _views(live_bp.root_container)]
-    assert "housing acceleration [m/s^2] (last 0.1 s)" in live_names      # live: the newest samples
+    assert "housing acceleration [m/s^2] (last 0.1 s)" in live_names  # live: the newest samples
     series = [v for v in _views(file_bp.root_container) if type(v).__name__ == "TimeSeriesView"]
     assert len(series) >= 16
     for view in series:
@@ -182,14 +183,14 @@ def test_the_blueprint_shows_whole_runs_with_short_titles_opens_files_paused_and
         # the whole recording: both boundaries infinite, whatever the time cursor
         assert "'start': None" in ranges and "'end': None" in ranges, (view.name, ranges)
         # a short title with its unit: readable at 1600 x 1000 (a third of the width is ~250 px)
-        assert len(str(view.name)) <= (40 if str(view.name).startswith("housing") else 28), view.name   # a wide one
+        assert len(str(view.name)) <= (40 if str(view.name).startswith("housing") else 28), view.name  # a wide one
         leaf = next((k for k in SERIES if f"{k}/**" in repr(view.contents)), None)
-        if leaf is not None:                        # a key where there are several quantities
+        if leaf is not None:  # a key where there are several quantities
             keyed = "True" in repr(view.properties["PlotLegend"])
             assert keyed == (len(SERIES[leaf][0]) > 1), view.name
     for leaf, (names, _colors) in SERIES.items():
         if leaf != "regime_counts":
-            assert all("[" in n for n in names), leaf            # every series says its unit
+            assert all("[" in n for n in names), leaf  # every series says its unit
 
 
 def test_the_waveform_is_drawn_min_max(tmp_path):
@@ -215,8 +216,8 @@ def test_closed_files_are_compacted_in_rerun_s_current_format(tmp_path, run):
     for path, compact in ((plain, False), (packed, True)):
         rec = RerunRecorder(path, trend_window_s=WINDOW_S, flush_interval_s=1e6, compact_segments=compact)
         rec.add_twin_from(twin)
-        for k in range(0, len(snaps), 5):          # 12 sends: 12 chunks per entity before compaction
-            for s in snaps[k:k + 5]:
+        for k in range(0, len(snaps), 5):  # 12 sends: 12 chunks per entity before compaction
+            for s in snaps[k : k + 5]:
                 rec.publish(s)
             rec.flush()
         rec.close()
@@ -230,7 +231,7 @@ def test_closed_files_are_compacted_in_rerun_s_current_format(tmp_path, run):
         warnings.simplefilter("always")
         RrdReader(str(packed))
     assert not [w for w in caught if "footer" in str(w.message) or "legacy" in str(w.message)]
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["packed.rrd", "plain.rrd"]     # no temporary left
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["packed.rrd", "plain.rrd"]  # no temporary left
 
 
 def test_a_file_keeps_waveform_bursts_with_line_breaks_between(tmp_path):
@@ -239,15 +240,23 @@ def test_a_file_keeps_waveform_bursts_with_line_breaks_between(tmp_path):
 
     path = tmp_path / "v.rrd"
     rec = RerunRecorder(path, waveform_archive=WaveformArchive(burst_s=0.01, every_s=0.05, after_event_s=0.0))
-    rec.add_twin("v", designation="6208", pitch_radius_m=0.02, ball_radius_m=0.006, inner_raceway_radius_m=0.014,
-        outer_raceway_radius_m=0.026, ball_count=9, vibration=True)
+    rec.add_twin(
+        "v",
+        designation="6208",
+        pitch_radius_m=0.02,
+        ball_radius_m=0.006,
+        inner_raceway_radius_m=0.014,
+        outer_raceway_radius_m=0.026,
+        ball_count=9,
+        vibration=True,
+    )
     fs = 10_000.0
     block = SimpleNamespace(t0_s=0.0, sample_rate_hz=fs, samples=np.ones(int(0.2 * fs), dtype=np.float32))
     rec.publish_waveform("v", [block], seq=1)
     rec.close()
     rows = read_column(path, "bearing/v/vibration/acceleration_m_s2", "Scalars:scalars")
     kept = [r for r in rows if r]
-    assert len(kept) == pytest.approx(4 * 0.01 * fs, abs=4)    # bursts at 0, 0.05, 0.1, 0.15 s, 0.01 s each
+    assert len(kept) == pytest.approx(4 * 0.01 * fs, abs=4)  # bursts at 0, 0.05, 0.1, 0.15 s, 0.01 s each
     from service.recording import describe_recording as _d
 
     assert _d(path)["entities"]["bearing/v/vibration/acceleration_m_s2"]["breaks"] == 4

@@ -73,14 +73,17 @@ def _tree(root: Path) -> dict:
             p = Path(dirpath) / name
             st = os.lstat(p)
             is_dir = stat.S_ISDIR(st.st_mode)
-            out[str(p.relative_to(root))] = (st.st_mode, None if is_dir else st.st_size,
-                                             None if is_dir else st.st_mtime_ns,
-                                             os.readlink(p) if p.is_symlink() else None)
+            out[str(p.relative_to(root))] = (
+                st.st_mode,
+                None if is_dir else st.st_size,
+                None if is_dir else st.st_mtime_ns,
+                os.readlink(p) if p.is_symlink() else None,
+            )
     return out
 
 
 def _wait(fetch, predicate, timeout=60.0, step=0.05):
-    deadline = time.monotonic() + timeout       # a liveness bound, not a performance figure
+    deadline = time.monotonic() + timeout  # a liveness bound, not a performance figure
     value = fetch()
     while not predicate(value):
         if time.monotonic() > deadline:
@@ -91,11 +94,22 @@ def _wait(fetch, predicate, timeout=60.0, step=0.05):
 
 
 # ---- path rules -----------------------------------------------------------------------------------
-@pytest.mark.parametrize("path, why", [
-    ("../x.rrd", "'..'"), ("a/../../x.rrd", "'..'"), ("/etc/x.rrd", "absolute"), ("C:/x.rrd", "absolute"),
-    ("/".join(["d"] * 99) + "/x.rrd", "levels"), ("x" * 300 + ".rrd", "characters"), (".hidden.rrd", "start with"),
-    ("a b.rrd", "letters"), ("a\x00.rrd", "letters"), ("x.txt", "ends in .rrd"), ("a//b.rrd", "empty"),
-])
+@pytest.mark.parametrize(
+    "path, why",
+    [
+        ("../x.rrd", "'..'"),
+        ("a/../../x.rrd", "'..'"),
+        ("/etc/x.rrd", "absolute"),
+        ("C:/x.rrd", "absolute"),
+        ("/".join(["d"] * 99) + "/x.rrd", "levels"),
+        ("x" * 300 + ".rrd", "characters"),
+        (".hidden.rrd", "start with"),
+        ("a b.rrd", "letters"),
+        ("a\x00.rrd", "letters"),
+        ("x.txt", "ends in .rrd"),
+        ("a//b.rrd", "empty"),
+    ],
+)
 def test_relative_path_rules(path, why):
     with pytest.raises(RecordingPathError, match=why):
         check_relative_path(path)
@@ -112,15 +126,20 @@ def test_exclusive_create_refuses_links_and_existing_files(tmp_path):
     (base / "linkdir").symlink_to(outside, target_is_directory=True)
     (base / "old.rrd").write_bytes(b"old")
     before = _tree(tmp_path)
-    for rel, why in (("victim.rrd", "symbolic link"), ("dangling.rrd", "symbolic link"),
-                     ("linkdir/x.rrd", "symbolic link"), ("linkdir/new/x.rrd", "symbolic link"),
-                     ("old.rrd", "exists"), ("old.rrd/x.rrd", "not a folder")):
+    for rel, why in (
+        ("victim.rrd", "symbolic link"),
+        ("dangling.rrd", "symbolic link"),
+        ("linkdir/x.rrd", "symbolic link"),
+        ("linkdir/new/x.rrd", "symbolic link"),
+        ("old.rrd", "exists"),
+        ("old.rrd/x.rrd", "not a folder"),
+    ):
         with pytest.raises(RecordingPathError, match=why):
             create_exclusive(base, rel)
     assert _tree(tmp_path) == before
     made = create_exclusive(base, "a/b/c.rrd")
     assert made.path == base / "a/b/c.rrd" and made.created_dirs == [base / "a", base / "a/b"]
-    made.discard()                             # a failed start: the file and its folders go again
+    made.discard()  # a failed start: the file and its folders go again
     assert _tree(tmp_path) == before
 
 
@@ -128,8 +147,7 @@ def test_exclusive_create_refuses_links_and_existing_files(tmp_path):
 def server(tmp_path, support):
     rec = tmp_path / "rec"
     settings = ServiceSettings(enable_zenoh=False, enable_recording=True, record=rec / "service.rrd", max_twins=4)
-    with support.ThreadServer(settings, start_timeout_s=90.0) as srv, \
-            httpx.Client(base_url=srv.url, timeout=60.0) as c:
+    with support.ThreadServer(settings, start_timeout_s=90.0) as srv, httpx.Client(base_url=srv.url, timeout=60.0) as c:
         yield srv, c, rec
 
 
@@ -146,9 +164,14 @@ def test_http_refuses_unsafe_paths_and_leaves_the_file_system_unchanged(server, 
     (rec / "linkdir").symlink_to(outside, target_is_directory=True)
     (rec / "old.rrd").write_bytes(b"an earlier recording")
     before = _tree(tmp_path)
-    cases = {"victim.rrd": "symbolic link", "linkdir/x.rrd": "symbolic link", "../escape.rrd": "'..'",
-             str(tmp_path / "abs.rrd"): "absolute", "old.rrd": "exists",
-             "/".join(["d"] * 100) + "/deep.rrd": "levels"}
+    cases = {
+        "victim.rrd": "symbolic link",
+        "linkdir/x.rrd": "symbolic link",
+        "../escape.rrd": "'..'",
+        str(tmp_path / "abs.rrd"): "absolute",
+        "old.rrd": "exists",
+        "/".join(["d"] * 100) + "/deep.rrd": "levels",
+    }
     for path, why in cases.items():
         r = _start(c, path)
         assert r.status_code == 422, (path, r.text)
@@ -209,17 +232,17 @@ def test_full_disk_degrades_health_keeps_the_twin_and_recovers(full_tmpfs, suppo
     monkeypatch.setattr(RerunRecorder, "SERVICE_OPTIONS", {"trend_window_s": None, "now_interval_s": 0.0})
     mnt, fill, free = full_tmpfs
     rec_dir = mnt / "rec"
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=True, record=rec_dir / "service.rrd",
-                               record_keep_mb=0)
-    with support.ThreadServer(settings, start_timeout_s=90.0) as srv, \
-            httpx.Client(base_url=srv.url, timeout=60.0) as c:
+    settings = ServiceSettings(
+        enable_zenoh=False, enable_recording=True, record=rec_dir / "service.rrd", record_keep_mb=0
+    )
+    with support.ThreadServer(settings, start_timeout_s=90.0) as srv, httpx.Client(base_url=srv.url, timeout=60.0) as c:
         h = _wait(lambda: c.get("/health").json(), lambda h: h["recording_rows"] >= 50)
         assert h["status"] == "ok" and h["recording_status"] == "ok"
         fill()
         t_full = time.monotonic()
         h = _wait(lambda: c.get("/health").json(), lambda h: h["recording_status"] == "degraded", step=0.02)
         took = time.monotonic() - t_full
-        print(f"\n/health degraded {took:.2f} s after the disk filled up")   # reported, not asserted
+        print(f"\n/health degraded {took:.2f} s after the disk filled up")  # reported, not asserted
         assert h["status"] == "degraded" and "No space left on device" in h["recording_error"]
         assert h["recording_write_errors"] >= 1
         rows_at_fault = h["recording_rows"]
@@ -236,22 +259,26 @@ def test_full_disk_degrades_health_keeps_the_twin_and_recovers(full_tmpfs, suppo
         assert _threads() <= threads and _fds() <= fds, (threads, _threads(), fds, _fds())
         assert sorted(os.listdir(rec_dir)) == listing
         # the twin keeps running; rows that were not written are counted as lost, not logged
-        h = _wait(lambda: c.get("/health").json(),
-                  lambda h: h["twins"][0]["frames"] > frames + 500 and h["recording_rows_lost"] > 0)
+        h = _wait(
+            lambda: c.get("/health").json(),
+            lambda h: h["twins"][0]["frames"] > frames + 500 and h["recording_rows_lost"] > 0,
+        )
         assert h["twins"][0]["running"] and h["twins"][0]["errors"] == 0
         assert h["recording_rows"] == rows_at_fault
         # room again: the recorder opens a new segment and counts again
         free()
-        h = _wait(lambda: c.get("/health").json(),
-                  lambda h: h["recording_status"] == "ok" and h["recording_rows"] > rows_at_fault + 20)
+        h = _wait(
+            lambda: c.get("/health").json(),
+            lambda h: h["recording_status"] == "ok" and h["recording_rows"] > rows_at_fault + 20,
+        )
         assert h["status"] == "ok" and h["recording_error"] is None
         lost = h["recording_rows_lost"]
         service = srv.service
     segs = recording_segments(service.recorder.path)
     assert len(segs) >= 2
     seqs = read_index(segs, TORQUE)
-    assert len(set(seqs.tolist())) == len(seqs)                       # nothing twice
-    assert seqs[-1] - seqs[0] + 1 == len(seqs) + lost                 # the rest: the rows counted lost
+    assert len(set(seqs.tolist())) == len(seqs)  # nothing twice
+    assert seqs[-1] - seqs[0] + 1 == len(seqs) + lost  # the rest: the rows counted lost
 
 
 # ---- resources follow the twins ------------------------------------------------------------------
@@ -263,11 +290,11 @@ def test_create_delete_cycles_free_the_recorder_entries(server):
         r = c.post("/v1/bearings", json={"id": f"tmp-{i}", "designation": "6205"})
         assert r.status_code == 201, r.text
         _wait(lambda: srv.service.recorder.bearing_ids, lambda ids: f"tmp-{i}" in ids)
-        time.sleep(0.2)                     # let it publish a few snapshots into the recording
+        time.sleep(0.2)  # let it publish a few snapshots into the recording
         assert c.delete(f"/v1/bearings/tmp-{i}").status_code == 200
 
-    for i in range(20):                     # warm-up: numba, rerun, arrow and allocator pools fill up
-        cycle(i)                            # (about 5 MB, then flat; before: +0.3 MB every cycle)
+    for i in range(20):  # warm-up: numba, rerun, arrow and allocator pools fill up
+        cycle(i)  # (about 5 MB, then flat; before: +0.3 MB every cycle)
     threads, rss = _threads(), _rss_bytes()
     for i in range(20, 50):
         cycle(i)

@@ -62,10 +62,12 @@ def test_samples_indicators_and_defects_are_recorded(tmp_path, run):
     entity = "bearing/v/vibration/acceleration_m_s2"
     values = np.array([v[0] for v in read_column(path, entity, "Scalars:scalars")])
     times = np.array(read_column(path, entity, "sim_time"))
-    assert values.size == samples.size > 0.1 * 51200.0           # every sample, one row each
+    assert values.size == samples.size > 0.1 * 51200.0  # every sample, one row each
     order = np.argsort(times, kind="stable")
     assert np.array_equal(values[order].astype(np.float32), samples)
-    expected_t = np.concatenate([np.round((b.t0_s + np.arange(b.samples.size) / b.sample_rate_hz) * 1e9) for b in blocks])
+    expected_t = np.concatenate(
+        [np.round((b.t0_s + np.arange(b.samples.size) / b.sample_rate_hz) * 1e9) for b in blocks]
+    )
     assert np.array_equal(times[order], expected_t.astype(np.int64))
 
     # one indicator row per window, at the first snapshot that carries it
@@ -80,7 +82,8 @@ def test_samples_indicators_and_defects_are_recorded(tmp_path, run):
     assert velocity == pytest.approx([s.vibration.velocity_rms_mm_s for s in windows.values()])
     lines = read_column(path, "bearing/v/vibration/envelope_lines_m_s2", "Scalars:scalars")
     assert [row[1] for row in lines] == pytest.approx(
-        [s.vibration.envelope_lines["bpfo"].harmonics[0] for s in windows.values()])   # BPFO second
+        [s.vibration.envelope_lines["bpfo"].harmonics[0] for s in windows.values()]
+    )  # BPFO second
     bars = read_column(path, "bearing/v/vibration/envelope/defect_lines", "BarChart:abscissa")
     assert len(bars) == len(windows)
     # the full spectra, a bar chart row per window: the window's own bins on their frequency axis
@@ -104,13 +107,23 @@ def test_samples_indicators_and_defects_are_recorded(tmp_path, run):
     assert (len(acc.amplitude_m_s2), acc.start_hz, acc.step_hz) == (1281, 0.0, 20.0)
     # the BPFO cursors of the first faulty window: 1x, 2x, 3x BPFO, as tall as its envelope spectrum
     faulty = next(s for s in windows.values() if s.defects)
-    rows = dict(zip(read_column(path, "bearing/v/vibration/envelope/cursor/BPFO", "seq"),
-                    read_column(path, "bearing/v/vibration/envelope/cursor/BPFO", "BarChart:abscissa"), strict=True))
+    rows = dict(
+        zip(
+            read_column(path, "bearing/v/vibration/envelope/cursor/BPFO", "seq"),
+            read_column(path, "bearing/v/vibration/envelope/cursor/BPFO", "BarChart:abscissa"),
+            strict=True,
+        )
+    )
     bpfo = faulty.vibration.defect_frequencies_hz.bpfo
     assert _tensor(rows[faulty.seq]) == pytest.approx([bpfo, 2 * bpfo, 3 * bpfo], rel=1e-6)
 
-    events = list(zip(read_column(path, "bearing/v/events", "seq"),
-                      [t[0] for t in read_column(path, "bearing/v/events", "TextLog:text")], strict=True))
+    events = list(
+        zip(
+            read_column(path, "bearing/v/events", "seq"),
+            [t[0] for t in read_column(path, "bearing/v/events", "TextLog:text")],
+            strict=True,
+        )
+    )
     defect_rows = [(seq, text) for seq, text in events if text.startswith("defects")]
     assert defect_rows[0][0] == frames[4][0].seq and defect_rows[0][1].startswith("defects: outer spall 0.5 x")
     assert defect_rows[1] == (frames[12][0].seq, "defects cleared")
@@ -139,8 +152,10 @@ def test_the_vibration_views_only_with_the_housing():
                     out.append(child.name)
                 else:
                     walk(child)
+
         walk(twin_blueprint(tw, 10.0))
         return out
+
     with_housing = names(TwinLayout("v", "6208", 9, vibration=True))
     assert "housing acceleration [m/s^2] (last 0.1 s)" in with_housing
     assert any(n.startswith("envelope spectrum [m/s^2] vs [Hz]") for n in with_housing)

@@ -14,7 +14,7 @@ pytest.importorskip("rerun")
 from service.recording import RerunRecorder, describe_recording, read_column, read_index
 from twin.engine import Twin
 
-FRAME_S = 0.02      # one snapshot per 20 ms of simulated time (50 Hz)
+FRAME_S = 0.02  # one snapshot per 20 ms of simulated time (50 Hz)
 
 
 @pytest.fixture(scope="module")
@@ -60,8 +60,11 @@ def test_one_chunk_per_entity_and_send_and_one_blueprint(tmp_path, run):
     # 9 balls, 2 contacts, many fields: still about two dozen entities, not hundreds (besides one
     # alarm_states entity per alarm, whose state is logged from the first row on, and the
     # setpoint-change markers beside each trend)
-    temporal = [k for k, v in info["entities"].items()
-                if v["chunks"] and "/alarm_states/" not in k and not k.endswith("/changes")]
+    temporal = [
+        k
+        for k, v in info["entities"].items()
+        if v["chunks"] and "/alarm_states/" not in k and not k.endswith("/changes")
+    ]
     assert len(temporal) <= 30, temporal
 
 
@@ -90,9 +93,13 @@ def test_a_log_row_for_every_setpoint_scenario_restart_and_fallback(tmp_path, ru
     scenario.state, scenario.phase = "done", None
     restarted = snaps[45].model_copy(update={"restarts": 1, "status": "restarted: penetration at t = 1 s"})
     rec.publish(restarted)
-    fallback = snaps[46].model_copy(update={
-        "restarts": 2, "status": "setpoint not held (penetration): radial_load_n = 9e4 N; restarted from the warm "
-        "start at the last safe setpoint (radial_load_n = 4000 N); fallbacks: 1"})
+    fallback = snaps[46].model_copy(
+        update={
+            "restarts": 2,
+            "status": "setpoint not held (penetration): radial_load_n = 9e4 N; restarted from the warm "
+            "start at the last safe setpoint (radial_load_n = 4000 N); fallbacks: 1",
+        }
+    )
     rec.publish(fallback)
     for s in snaps[47:]:
         rec.publish(s.model_copy(update={"restarts": 2}))
@@ -146,7 +153,7 @@ def test_a_recreated_twin_continues_after_the_previous_run(tmp_path, run):
         rec.publish(s)
     assert rec.remove_twin("a") and rec.bearing_ids == []
     rec.add_twin_from(twin)
-    for s in snaps[:20]:                         # time and seq start over
+    for s in snaps[:20]:  # time and seq start over
         rec.publish(s)
     rec.close()
     t = read_column(path, "bearing/a/friction_torque_n_m", "sim_time")

@@ -20,16 +20,23 @@ def heated_inlet_viscosity_pa_s(lub, inlet_c: float, shear_rise_k: float) -> flo
     """The oil's viscosity at the inlet temperature (ASTM D341), heated by the inlet's shear by Roelands
     (seed 003 eq. 3 with the oil's beta there): the viscosity the film reads with Thermal.shear_heating on."""
     t0 = inlet_c + 273.15
-    return roelands_temperature_viscosity_pa_s(dynamic_viscosity_pa_s(lub, inlet_c), t0, t0 + shear_rise_k,
-                                               temperature_viscosity_coefficient_k_inv(lub, inlet_c))
+    return roelands_temperature_viscosity_pa_s(
+        dynamic_viscosity_pa_s(lub, inlet_c),
+        t0,
+        t0 + shear_rise_k,
+        temperature_viscosity_coefficient_k_inv(lub, inlet_c),
+    )
 
 
 @pytest.fixture(scope="module")
 def warmed():
-    twin = Twin("6208", options=ACCELERATED,
-                setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0))
+    twin = Twin(
+        "6208",
+        options=ACCELERATED,
+        setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0),
+    )
     start = twin.snapshot()
-    twin.advance(0.3)     # 300 s of thermal time
+    twin.advance(0.3)  # 300 s of thermal time
     return twin, start, twin.snapshot()
 
 
@@ -41,8 +48,11 @@ def test_starts_at_the_set_temperature_with_its_viscosity(warmed):
     lub = catalog.bearing("6208").lubricant
     # the film starts at the set temperature's viscosity (ASTM D341), as with the fixed oil temperature,
     # heated at the inlet by its shear (Thermal.shear_heating, on by default: Murch-Wilson)
-    fixed = Twin("6208", options=ModelOptions(thermal="fixed"),
-                 setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0))
+    fixed = Twin(
+        "6208",
+        options=ModelOptions(thermal="fixed"),
+        setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0),
+    )
     assert start.viscosity_pa_s == pytest.approx(fixed.snapshot().viscosity_pa_s, rel=1e-12)
     rise = fixed.snapshot().electrical.shear_temperature_rise_k
     assert rise > 0.0
@@ -63,7 +73,8 @@ def test_friction_heats_the_bearing_and_thins_the_oil(warmed):
     lub = twin.model.spec.lubricant
     assert th.inlet_temperature_c > 25.0
     assert end.viscosity_pa_s == pytest.approx(
-        heated_inlet_viscosity_pa_s(lub, th.inlet_temperature_c, end.electrical.shear_temperature_rise_k), rel=1e-9)
+        heated_inlet_viscosity_pa_s(lub, th.inlet_temperature_c, end.electrical.shear_temperature_rise_k), rel=1e-9
+    )
     assert end.viscosity_pa_s < 0.7 * start.viscosity_pa_s
     # expansion: the hotter balls and inner ring close the clearance
     assert th.clearance_change_m < 0.0

@@ -11,7 +11,7 @@ from twin.thermal.network import NODE_NAMES, Operating, assemble, network_geomet
 from twin.thermal.settings import ThermalNetworkSettings
 
 OUTER = NODE_NAMES.index("outer_ring")
-HEAT_W = np.array([0.0, 60.0, 60.0, 60.0, 0.0, 0.0])   # 180 W: the 6208 at 1000 rad/s, 3 kN (tests/thermal)
+HEAT_W = np.array([0.0, 60.0, 60.0, 60.0, 0.0, 0.0])  # 180 W: the 6208 at 1000 rad/s, 3 kN (tests/thermal)
 
 
 def _net():
@@ -61,8 +61,8 @@ def test_follows_a_bearing_8_k_warmer_and_raises_on_an_unexplained_20_k_step():
     s_hat, sigma = at_conv
     assert abs(s_hat - s_true) < max(2.0 * sigma, 0.0) and abs(s_hat / s_true - 1.0) < 0.05, (s_hat, sigma, s_true)
     # and the residual has returned within the noise: RMS over the last quarter below 1.5 x sigma_sensor
-    late = np.array(residuals[-len(residuals) // 4:])
-    assert np.sqrt(np.mean(late ** 2)) < 1.5 * 0.3
+    late = np.array(residuals[-len(residuals) // 4 :])
+    assert np.sqrt(np.mean(late**2)) < 1.5 * 0.3
     assert not est.unexplained
     # a +20 K step the dissipation cannot explain: gated, not assimilated, flagged while it lasts
     before = est.dissipation_factor

@@ -46,8 +46,9 @@ def _reference_point(designation):
     base = catalog.bearing(designation, lubricant=catalog.lubricant("ISO VG 32"))
     spec = BearingSpec.model_validate({**base.model_dump(), "thermal": Thermal(shear_heating=True).model_dump()})
     settings = ThermalNetworkSettings(dissipation="iso_15312")
-    r = steady_operating_point(designation, _reference_speed_rad_s(designation), 0.05 * c0, 0.0, 20.0, settings,
-                               spec=spec)
+    r = steady_operating_point(
+        designation, _reference_speed_rad_s(designation), 0.05 * c0, 0.0, 20.0, settings, spec=spec
+    )
     phi_r = network_geometry(spec, settings).iso_15312_dissipation_w_k * 50.0
     return r, phi_r
 

@@ -20,7 +20,7 @@ def test_churchill_chu_against_the_formula_by_hand():
     # [1 + (0.559/0.71)^(9/16)]^(8/27) = 1.2045 and Nu = (0.60 + 0.387 * 14.678 / 1.2045)^2 = 28.3
     d, dt = 0.1, 20.0
     t_film = 30.0 + 273.15
-    ra = 9.80665 * dt / t_film * d ** 3 * AIR_PRANDTL / AIR_KINEMATIC_VISCOSITY_M2_S ** 2
+    ra = 9.80665 * dt / t_film * d**3 * AIR_PRANDTL / AIR_KINEMATIC_VISCOSITY_M2_S**2
     nu_hand = (0.60 + 0.387 * ra ** (1 / 6) / 1.2045) ** 2
     h = cr.churchill_chu_cylinder_w_m2_k(d, 40.0, 20.0)
     assert h * d / AIR_CONDUCTIVITY_W_M_K == pytest.approx(nu_hand, rel=2e-3)
@@ -36,18 +36,20 @@ def test_iso_15312_reference_heat_flow_of_the_6208():
     assert cr.iso_15312_reference_area_mm2(40.0, 80.0, 18.0) == pytest.approx(6785.8, rel=1e-4)
     assert cr.iso_15312_dissipation_w_k(40.0, 80.0, 18.0) == pytest.approx(108.57 / 50.0, rel=1e-3)
     # above 50 000 mm^2: q_r = 0.016 (A_r / 50 000)^-0.34
-    assert cr.iso_15312_reference_flux_w_mm2(100_000.0) == pytest.approx(0.016 * 2 ** -0.34, rel=1e-12)
+    assert cr.iso_15312_reference_flux_w_mm2(100_000.0) == pytest.approx(0.016 * 2**-0.34, rel=1e-12)
 
 
 def test_conduction_laws():
     # Fourier through a cylindrical shell and the Hertz spot's constriction 1/(2 k a), a = sqrt(a b)
     assert cr.cylindrical_shell_w_k(0.02, 0.03, 0.018, 46.6) == pytest.approx(
-        2 * math.pi * 46.6 * 0.018 / math.log(1.5), rel=1e-12)
+        2 * math.pi * 46.6 * 0.018 / math.log(1.5), rel=1e-12
+    )
     assert cr.hertz_constriction_w_k(1.6e-3, 0.25e-3, 46.6) == pytest.approx(2 * 46.6 * math.sqrt(4e-7), rel=1e-12)
     # Becker's rotating shaft: Nu = 0.133 Re^(2/3) Pr^(1/3)
-    re = 500.0 * 0.04 ** 2 / (2 * AIR_KINEMATIC_VISCOSITY_M2_S)
+    re = 500.0 * 0.04**2 / (2 * AIR_KINEMATIC_VISCOSITY_M2_S)
     assert cr.rotating_cylinder_w_m2_k(0.04, 500.0) * 0.04 / AIR_CONDUCTIVITY_W_M_K == pytest.approx(
-        0.133 * re ** (2 / 3) * AIR_PRANDTL ** (1 / 3), rel=1e-12)
+        0.133 * re ** (2 / 3) * AIR_PRANDTL ** (1 / 3), rel=1e-12
+    )
 
 
 def _network(settings=None, ambient=20.0):
@@ -77,7 +79,7 @@ def test_exponential_step_is_exact_and_unconditionally_stable():
     q = np.array([0.0, 40.0, 40.0, 20.0, 0.0, 0.0])
     t0 = np.full(6, 20.0)
     tau = net.time_constants_s()
-    assert tau[-1] < 10.0 < 300.0 < tau[0]     # balls in seconds, the housing in many minutes
+    assert tau[-1] < 10.0 < 300.0 < tau[0]  # balls in seconds, the housing in many minutes
     for h in (1.0, 100.0, 1e4):
         one = step_c(net, t0, 1.0, 20.0, 20.0, q, h)
         many = t0

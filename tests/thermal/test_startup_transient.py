@@ -52,9 +52,15 @@ def test_viscosity_lambda_and_friction_follow_the_temperature(transient):
     assert tr.friction_torque_n_m[-1] < 0.95 * tr.friction_torque_n_m[1]
     # the viscosity is the oil's at the network's inlet temperature (ASTM D341), heated by the inlet's
     # shear by Roelands (seed 003 eq. 3), at every sample
-    heated = [roelands_temperature_viscosity_pa_s(dynamic_viscosity_pa_s(lub, t), t + 273.15, t + 273.15 + rise,
-                                                  temperature_viscosity_coefficient_k_inv(lub, t))
-              for t, rise in zip(t_in, tr.shear_rise_k)]
+    heated = [
+        roelands_temperature_viscosity_pa_s(
+            dynamic_viscosity_pa_s(lub, t),
+            t + 273.15,
+            t + 273.15 + rise,
+            temperature_viscosity_coefficient_k_inv(lub, t),
+        )
+        for t, rise in zip(t_in, tr.shear_rise_k)
+    ]
     assert np.allclose(tr.viscosity_pa_s, heated, rtol=1e-9)
     # Lambda falls with it: correlation with the inlet temperature over the run
     assert np.corrcoef(t_in[1:], tr.min_lambda[1:])[0, 1] < -0.9

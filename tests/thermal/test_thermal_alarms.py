@@ -8,9 +8,17 @@ from service.settings import AlarmSettings
 
 
 def _thermal(t_outer, rate=0.0, unexplained=False, residual=None):
-    return {"time_s": 0.0, "seq": 1, "balls": [],
-            "thermal": {"temperatures_c": {"outer_ring": t_outer}, "outer_ring_rate_k_per_min": rate,
-                        "unexplained_heating": unexplained, "residual_k": residual}}
+    return {
+        "time_s": 0.0,
+        "seq": 1,
+        "balls": [],
+        "thermal": {
+            "temperatures_c": {"outer_ring": t_outer},
+            "outer_ring_rate_k_per_min": rate,
+            "unexplained_heating": unexplained,
+            "residual_k": residual,
+        },
+    }
 
 
 def test_inputs_from_the_thermal_block_and_none_without_it():
@@ -38,7 +46,10 @@ def test_zone_rate_and_unexplained_heating_raise_and_clear():
     assert "+20.0 K" in e["temperature_unexplained"].message
     e = feed(3.0, outer_ring_c=60.0, outer_ring_rate_k_per_min=0.0, unexplained_heating=False)
     assert {k: v.transition for k, v in e.items()} == {
-        "temperature_zone": "cleared", "temperature_rate": "cleared", "temperature_unexplained": "cleared"}
+        "temperature_zone": "cleared",
+        "temperature_rate": "cleared",
+        "temperature_unexplained": "cleared",
+    }
 
 
 @pytest.mark.parametrize("field", ["temperature_warning_c", "temperature_rate_warning_k_per_min"])

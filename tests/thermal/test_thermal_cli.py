@@ -14,8 +14,10 @@ def test_bad_ambient_names_the_field(capsys):
 
 @pytest.mark.slow
 def test_json_steady_state_balances_its_heat(capsys):
-    assert main(["thermal", "--bearing", "6208", "--speed", "1000", "--radial-load", "3000", "--ambient", "20",
-                 "--json"]) == 0
+    assert (
+        main(["thermal", "--bearing", "6208", "--speed", "1000", "--radial-load", "3000", "--ambient", "20", "--json"])
+        == 0
+    )
     r = json.loads(capsys.readouterr().out)
     assert r["converged"]
     t = r["temperatures_c"]

@@ -21,13 +21,23 @@ def test_shipped_thermal_scenario_carries_its_measurements_in_order():
         if ex.temperature is not None:
             seen.append((round(k * 0.01, 2), ex.temperature.node, ex.temperature.temperature_c))
             ex.temperature = None
-    assert seen == [(0.1, "outer_ring", 28.0), (0.3, "outer_ring", 28.0), (1.5, "outer_ring", 28.0),
-                    (2.2, "outer_ring", 48.0), (3.2, "outer_ring", 48.0)]
-    assert run.initial.fields["oil_temperature_c"] == 20.0   # the ambient
+    assert seen == [
+        (0.1, "outer_ring", 28.0),
+        (0.3, "outer_ring", 28.0),
+        (1.5, "outer_ring", 28.0),
+        (2.2, "outer_ring", 48.0),
+        (3.2, "outer_ring", 48.0),
+    ]
+    assert run.initial.fields["oil_temperature_c"] == 20.0  # the ambient
 
 
-@pytest.mark.parametrize("bad, field", [({"node": "cage", "temperature_c": 40.0}, "node"),
-                                        ({"node": "outer_ring", "temperature_c": 900.0}, "temperature_c")])
+@pytest.mark.parametrize(
+    "bad, field",
+    [
+        ({"node": "cage", "temperature_c": 40.0}, "node"),
+        ({"node": "outer_ring", "temperature_c": 900.0}, "temperature_c"),
+    ],
+)
 def test_bad_measurement_names_its_field(bad, field):
     with pytest.raises(ScenarioError, match=field):
         scenario_from_dict({"name": "t", "duration_s": 0.1, "steps": [{"at_s": 0.0, "temperature": bad}]})

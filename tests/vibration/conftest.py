@@ -4,9 +4,20 @@ import numpy as np
 import pytest
 
 
-def _fault_signal(sample_rate_hz, duration_s, rate_hz, resonance_hz, *, damping_ratio=0.05,
-                  amplitude=1.0, modulation_hz=None, modulation_depth=0.0, jitter=0.0, noise=0.0,
-                  seed=0):
+def _fault_signal(
+    sample_rate_hz,
+    duration_s,
+    rate_hz,
+    resonance_hz,
+    *,
+    damping_ratio=0.05,
+    amplitude=1.0,
+    modulation_hz=None,
+    modulation_depth=0.0,
+    jitter=0.0,
+    noise=0.0,
+    seed=0,
+):
     """Impulse train at rate_hz (period jitter: std as a fraction of the period, not cumulative,
     the 1-2 % random slip of real bearings, Randall & Antoni 2011 sec. 2.1), each impulse ringing
     a single-degree-of-freedom resonance (resonance_hz, damping_ratio), amplitudes modulated by
@@ -27,7 +38,7 @@ def _fault_signal(sample_rate_hz, duration_s, rate_hz, resonance_hz, *, damping_
     np.add.at(pulses, np.minimum((times * fs).round().astype(int), n - 1), amps)
     w = 2.0 * np.pi * resonance_hz
     t = np.arange(int(12.0 / (damping_ratio * w) * fs)) / fs
-    h = np.exp(-damping_ratio * w * t) * np.sin(w * np.sqrt(1.0 - damping_ratio ** 2) * t)
+    h = np.exp(-damping_ratio * w * t) * np.sin(w * np.sqrt(1.0 - damping_ratio**2) * t)
     x = scipy.signal.fftconvolve(pulses, h)[:n]
     return x + noise * rng.standard_normal(n)
 

@@ -112,8 +112,10 @@ def test_ball_fault_line_is_weak():
     assert a.largest_lines[0].label != "2xBSF"
 
 
-@pytest.mark.parametrize("file, line", [("105_DE_5s.npy", "BPFI"), ("130_DE_5s.npy", "BPFO"),
-                                        ("144_DE_5s.npy", "BPFO"), ("156_DE_5s.npy", "BPFO")])
+@pytest.mark.parametrize(
+    "file, line",
+    [("105_DE_5s.npy", "BPFI"), ("130_DE_5s.npy", "BPFO"), ("144_DE_5s.npy", "BPFO"), ("156_DE_5s.npy", "BPFO")],
+)
 def test_kurtogram_band_shows_the_fault_line_first(file, line):
     """With the band chosen by the fast kurtogram (no band given), the fault's line is the largest
     envelope line and stands over 25 dB above its neighbours (measured 31-38 dB on the excerpts)."""
@@ -133,23 +135,29 @@ def test_json_is_finite_and_carries_units():
     assert len(d["envelope_spectrum"]["amplitude_m_s2"]) > 100
 
 
-@pytest.mark.parametrize("kwargs, field", [
-    ({"signal_m_s2": np.zeros(100)}, "signal_m_s2"),
-    ({"signal_m_s2": np.r_[np.zeros(5000), np.nan]}, "signal_m_s2"),
-    ({"signal_m_s2": np.zeros((2, 4096))}, "signal_m_s2"),
-    ({"sample_rate_hz": -1.0}, "sample_rate_hz"),
-    ({"sample_rate_hz": float("inf")}, "sample_rate_hz"),
-    ({"shaft_hz": 0.0}, "shaft_hz"),
-    ({"shaft_hz": 5000.0}, "shaft_hz"),
-    ({"band_hz": (5000.0, 2000.0)}, "band_hz"),
-    ({"band_hz": (2000.0, 7000.0)}, "band_hz"),
-    ({"defect_multiples": {"BPFO": float("nan")}}, "defect_multiples"),
-])
+@pytest.mark.parametrize(
+    "kwargs, field",
+    [
+        ({"signal_m_s2": np.zeros(100)}, "signal_m_s2"),
+        ({"signal_m_s2": np.r_[np.zeros(5000), np.nan]}, "signal_m_s2"),
+        ({"signal_m_s2": np.zeros((2, 4096))}, "signal_m_s2"),
+        ({"sample_rate_hz": -1.0}, "sample_rate_hz"),
+        ({"sample_rate_hz": float("inf")}, "sample_rate_hz"),
+        ({"shaft_hz": 0.0}, "shaft_hz"),
+        ({"shaft_hz": 5000.0}, "shaft_hz"),
+        ({"band_hz": (5000.0, 2000.0)}, "band_hz"),
+        ({"band_hz": (2000.0, 7000.0)}, "band_hz"),
+        ({"defect_multiples": {"BPFO": float("nan")}}, "defect_multiples"),
+    ],
+)
 def test_bad_input_names_the_field(kwargs, field):
-    args = {"signal_m_s2": np.random.default_rng(0).standard_normal(12000), "sample_rate_hz": FS_HZ,
-            "shaft_hz": 30.0, **kwargs}
+    args = {
+        "signal_m_s2": np.random.default_rng(0).standard_normal(12000),
+        "sample_rate_hz": FS_HZ,
+        "shaft_hz": 30.0,
+        **kwargs,
+    }
     with pytest.raises(AnalysisInputError) as err:
         analyse_signal(**args)
     assert err.value.field.startswith(field)
     assert "allowed" in str(err.value) or "must" in str(err.value) or "need" in str(err.value)
-

@@ -77,8 +77,16 @@ def test_expected_line_is_the_largest_and_as_high_as_measured(results, number):
     assert s.kurtosis == pytest.approx(m.kurtosis, rel=0.4)
 
 
-@pytest.mark.parametrize("number", [pytest.param(105, marks=SHORT), 118, pytest.param(130, marks=SHORT),
-                                    pytest.param(144, marks=SHORT), pytest.param(156, marks=SHORT)])
+@pytest.mark.parametrize(
+    "number",
+    [
+        pytest.param(105, marks=SHORT),
+        118,
+        pytest.param(130, marks=SHORT),
+        pytest.param(144, marks=SHORT),
+        pytest.param(156, marks=SHORT),
+    ],
+)
 def test_rms_relative_to_healthy_within_a_factor_two(results, number):
     measured = _ratio(results, number, 0)
     twin = _ratio(results, number, 1)
@@ -108,14 +116,37 @@ def _upper_bound_peak_g(spec, ball_load_n: float) -> float:
     a = model.race_params[1, L.R_SEMI_MAJOR_COEF] * k ** (1.0 / 3.0) * math.sqrt(delta)
     speed = cwru.PUBLISHED_MULTIPLES["FTF"] * 1797.0 * math.pi / 30.0 * g.outer_raceway_radius_m
     t = np.arange(0.0, 0.004, 5e-7)
-    lost = np.array([pit_load_loss((ti - 5e-4) * speed, 0.0, cwru.FAULT_WIDTH_M / 2, cwru.FAULT_WIDTH_M / 2,
-                                   cwru.FAULT_DEPTH_M, 0.0, model.race_params[1, L.R_RX], delta, a) for ti in t])
+    lost = np.array(
+        [
+            pit_load_loss(
+                (ti - 5e-4) * speed,
+                0.0,
+                cwru.FAULT_WIDTH_M / 2,
+                cwru.FAULT_WIDTH_M / 2,
+                cwru.FAULT_DEPTH_M,
+                0.0,
+                model.race_params[1, L.R_RX],
+                delta,
+                a,
+            )
+            for ti in t
+        ]
+    )
     mp, kp, cp = h.pedestal_mass_kg, h.radial_stiffness_n_m, h.radial_damping_n_s_m
     mr, kr, cr = h.sprung_mass_kg, h.sprung_stiffness_n_m, h.sprung_damping_n_s_m
-    sys_ = (np.array([[0, 1, 0, 0], [-(kp + kr) / mp, -(cp + cr) / mp, kr / mp, cr / mp], [0, 0, 0, 1],
-                      [kr / mr, cr / mr, -kr / mr, -cr / mr]]),
-            np.array([[0.0], [1.0 / mp], [0.0], [0.0]]), np.array([[kr / mr, cr / mr, -kr / mr, -cr / mr]]),
-            np.zeros((1, 1)))
+    sys_ = (
+        np.array(
+            [
+                [0, 1, 0, 0],
+                [-(kp + kr) / mp, -(cp + cr) / mp, kr / mp, cr / mp],
+                [0, 0, 0, 1],
+                [kr / mr, cr / mr, -kr / mr, -cr / mr],
+            ]
+        ),
+        np.array([[0.0], [1.0 / mp], [0.0], [0.0]]),
+        np.array([[kr / mr, cr / mr, -kr / mr, -cr / mr]]),
+        np.zeros((1, 1)),
+    )
     _, y, _ = signal.lsim(sys_, -lost * ball_load_n, t)
     return float(np.abs(y).max() / cwru.G_M_S2)
 
@@ -135,9 +166,17 @@ def test_outer_pit_response_is_bounded_by_the_whole_lost_load():
     data["housing"]["accelerometer"]["noise_density_m_s2_rthz"] = 0.0
     spec = BearingSpec.model_validate(data)
     bound = max(_upper_bound_peak_g(spec, q) for q in (26.0, 37.0))
-    _, x = simulate_vibration(spec, 1797.0 * math.pi / 30.0, None, defect="outer",
-                              defect_size_m=cwru.FAULT_WIDTH_M, defect_length_m=cwru.FAULT_WIDTH_M,
-                              defect_depth_m=cwru.FAULT_DEPTH_M, duration_s=0.3, window_s=0.3)
+    _, x = simulate_vibration(
+        spec,
+        1797.0 * math.pi / 30.0,
+        None,
+        defect="outer",
+        defect_size_m=cwru.FAULT_WIDTH_M,
+        defect_length_m=cwru.FAULT_WIDTH_M,
+        defect_depth_m=cwru.FAULT_DEPTH_M,
+        duration_s=0.3,
+        window_s=0.3,
+    )
     peak = float(np.abs(x).max() / cwru.G_M_S2)
     assert 0.3 * bound <= peak <= bound
     _, measured = cwru.measured(BY_NUMBER[130], 1.0)

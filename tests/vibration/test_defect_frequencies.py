@@ -8,21 +8,36 @@ import pytest
 from twin import catalog
 from twin.model import make_model
 from twin.vibration.defect_frequencies import (
-    bearing_defect_frequencies, defect_frequencies, loaded_contact_angle_rad,
+    bearing_defect_frequencies,
+    defect_frequencies,
+    loaded_contact_angle_rad,
 )
 
 INCH = 0.0254
 
 
-@pytest.mark.parametrize("name, z, d_in, dm_in, published", [
-    # Case Western Reserve University Bearing Data Center, bearing information page: SKF deep-groove
-    # bearings of the test rig, defect frequencies as multiples of the running speed; its "rolling
-    # element" column is 2 x BSF.
-    ("6205-2RS JEM (drive end)", 9, 0.3126, 1.537,
-     {"bpfi": 5.4152, "bpfo": 3.5848, "ftf": 0.39828, "two_bsf": 4.7135}),
-    ("6203-2RS JEM (fan end)", 8, 0.2656, 1.122,
-     {"bpfi": 4.9469, "bpfo": 3.0530, "ftf": 0.3817, "two_bsf": 3.9874}),
-])
+@pytest.mark.parametrize(
+    "name, z, d_in, dm_in, published",
+    [
+        # Case Western Reserve University Bearing Data Center, bearing information page: SKF deep-groove
+        # bearings of the test rig, defect frequencies as multiples of the running speed; its "rolling
+        # element" column is 2 x BSF.
+        (
+            "6205-2RS JEM (drive end)",
+            9,
+            0.3126,
+            1.537,
+            {"bpfi": 5.4152, "bpfo": 3.5848, "ftf": 0.39828, "two_bsf": 4.7135},
+        ),
+        (
+            "6203-2RS JEM (fan end)",
+            8,
+            0.2656,
+            1.122,
+            {"bpfi": 4.9469, "bpfo": 3.0530, "ftf": 0.3817, "two_bsf": 3.9874},
+        ),
+    ],
+)
 def test_orders_match_the_published_cwru_table(name, z, d_in, dm_in, published):
     """Randall & Antoni 2011 eqs. 1-4 reproduce the published orders to their 5 digits (2e-4)."""
     f = defect_frequencies(d_in * INCH, dm_in * INCH, z, shaft_speed_rad_s=2 * math.pi * 29.95)
@@ -70,11 +85,11 @@ def test_loaded_contact_angle_is_the_mean_over_loaded_balls():
     load = np.zeros(2 * z)
     loaded = [0, 1, 2, 8]
     for j in loaded:
-        nz[2 * j] = -math.sin(math.radians(18.0 + j))    # inner normal points down
+        nz[2 * j] = -math.sin(math.radians(18.0 + j))  # inner normal points down
         nz[2 * j + 1] = math.sin(math.radians(20.0 + j))  # outer up
-        load[2 * j:2 * j + 2] = 100.0 + j
-    nz[2 * 4:2 * 4 + 2] = 0.9  # an unloaded ball's geometry must not count
-    load[2 * 5] = 50.0         # loaded at one raceway only: not a loaded ball
+        load[2 * j : 2 * j + 2] = 100.0 + j
+    nz[2 * 4 : 2 * 4 + 2] = 0.9  # an unloaded ball's geometry must not count
+    load[2 * 5] = 50.0  # loaded at one raceway only: not a loaded ball
     expected = np.mean([math.radians(19.0 + j) for j in loaded])
     assert loaded_contact_angle_rad(nz, load) == pytest.approx(expected, rel=1e-12)
     with pytest.raises(ValueError, match="no loaded contact"):

@@ -12,8 +12,17 @@ from twin.kernels import layout as L
 from twin.model import make_model
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.defects import (
-    OuterRaceSpall, contact_defect_drop_m, defect_row, edge_drop_m, pit_drop_m, pit_load_loss,
-    quat_integrate, quat_rotate, race_limits, validate_defect, validate_defects,
+    OuterRaceSpall,
+    contact_defect_drop_m,
+    defect_row,
+    edge_drop_m,
+    pit_drop_m,
+    pit_load_loss,
+    quat_integrate,
+    quat_rotate,
+    race_limits,
+    validate_defect,
+    validate_defects,
 )
 
 SPEC = catalog.bearing("6208")
@@ -31,19 +40,19 @@ DEEP, TINY = 1.0, 1e-6
 def test_flat_race_centre_drop_is_sawalhi_randall(width, depth):
     """Flat raceway (relative radius = ball radius), long across: at the spall centre
     h_eff = min(depth, Rb - sqrt(Rb^2 - (w/2)^2)) (Sawalhi & Randall 2008 Part I sec. 4.1), exactly."""
-    expected = min(depth, RB - math.sqrt(RB ** 2 - (width / 2) ** 2))
+    expected = min(depth, RB - math.sqrt(RB**2 - (width / 2) ** 2))
     assert pit_drop_m(0.0, 0.0, width / 2, 0.5, depth, 0.0, RB, DEEP, TINY) == pytest.approx(expected, rel=1e-10)
 
 
 def _exact_outer(w, ro):
     """Exact drop of a ball (Rb) inside a concave circle (Ro) over a pit with edges at +-w/2 of arc."""
     th = w / (2 * ro)
-    return ro * math.cos(th) - ro + RB - math.sqrt(RB ** 2 - (ro * math.sin(th)) ** 2)
+    return ro * math.cos(th) - ro + RB - math.sqrt(RB**2 - (ro * math.sin(th)) ** 2)
 
 
 def _exact_inner(w, ri):
     th = w / (2 * ri)
-    return ri + RB - ri * math.cos(th) - math.sqrt(RB ** 2 - (ri * math.sin(th)) ** 2)
+    return ri + RB - ri * math.cos(th) - math.sqrt(RB**2 - (ri * math.sin(th)) ** 2)
 
 
 @pytest.mark.parametrize("width, tol", [(0.5e-3, 5e-4), (1e-3, 2e-3), (2e-3, 7e-3), (4e-3, 0.03)])
@@ -59,7 +68,7 @@ def test_curved_races_follow_the_relative_radius(width, tol):
     inn = pit_drop_m(0.0, 0.0, width / 2, 0.5, 1.0, 0.0, RX_IN, DEEP, TINY)
     assert out == pytest.approx(_exact_outer(width, ro), rel=tol)
     assert inn == pytest.approx(_exact_inner(width, ri), rel=tol)
-    flat = RB - math.sqrt(RB ** 2 - (width / 2) ** 2)
+    flat = RB - math.sqrt(RB**2 - (width / 2) ** 2)
     assert out < flat < inn
 
 
@@ -88,7 +97,7 @@ def test_deep_pit_narrower_than_the_ellipse_removes_the_hertz_load_of_its_strip(
     assert lost == pytest.approx(expected, abs=2e-3)
     if offset == 0.0:
         r = half_length / a
-        assert lost == pytest.approx(1.5 * r - 0.5 * r ** 3, rel=1e-12)
+        assert lost == pytest.approx(1.5 * r - 0.5 * r**3, rel=1e-12)
 
 
 @pytest.mark.parametrize("ratio", [0.1, 0.5, 0.9, 1.5])
@@ -101,20 +110,20 @@ def test_pit_across_the_whole_ellipse_is_sawalhi_randall_drop(ratio):
     delta = h / ratio
     lost = pit_load_loss(0.0, 0.0, half_width, 5e-3, 1.0, 0.0, RX_OUT, delta, a)
     assert 1.0 - lost == pytest.approx(max(0.0, 1.0 - ratio) ** 1.5, abs=1e-12)
-    assert pit_drop_m(0.0, 0.0, half_width, 5e-3, 1.0, 0.0, RX_OUT, delta, a) == pytest.approx(
-        min(delta, h), rel=1e-12)
+    assert pit_drop_m(0.0, 0.0, half_width, 5e-3, 1.0, 0.0, RX_OUT, delta, a) == pytest.approx(min(delta, h), rel=1e-12)
 
 
 def test_load_loss_grows_with_the_pit_and_vanishes_beside_it():
     """Monotonic in the pit's length across and in its depth below the interference; zero once the
     pit's strip lies beyond the ellipse (|v| >= a + l) or the contact is open (delta <= 0)."""
     a, delta = 0.36e-3, 0.84e-6
-    lengths = [pit_load_loss(0.0, 0.0, 1e-3, hl, 1e-3, 0.0, RX_IN, delta, a)
-               for hl in (0.05e-3, 0.1e-3, 0.2e-3, 0.4e-3)]
+    lengths = [
+        pit_load_loss(0.0, 0.0, 1e-3, hl, 1e-3, 0.0, RX_IN, delta, a) for hl in (0.05e-3, 0.1e-3, 0.2e-3, 0.4e-3)
+    ]
     assert np.all(np.diff(lengths) > 0.0) and lengths[-1] == pytest.approx(1.0)
     depths = [pit_load_loss(0.0, 0.0, 1e-3, 0.089e-3, d, 0.0, RX_IN, delta, a) for d in (0.1e-6, 0.4e-6, 0.8e-6, 2e-6)]
     r = 0.089e-3 / a
-    assert np.all(np.diff(depths) > 0.0) and depths[3] == pytest.approx(1.5 * r - 0.5 * r ** 3, rel=1e-12)
+    assert np.all(np.diff(depths) > 0.0) and depths[3] == pytest.approx(1.5 * r - 0.5 * r**3, rel=1e-12)
     assert pit_load_loss(0.0, a + 0.089e-3, 1e-3, 0.089e-3, 1e-3, 0.0, RX_IN, delta, a) == 0.0
     assert pit_load_loss(0.0, 0.0, 1e-3, 0.089e-3, 1e-3, 0.0, RX_IN, 0.0, a) == 0.0
 
@@ -133,7 +142,8 @@ def test_profile_shape_unloads_entering_and_closes_at_the_exit_edge():
     assert sharp == pytest.approx(sharp[::-1], abs=1e-18)
     a = 0.1e-3
     assert pit_drop_m(hw - a, 0.0, hw, 0.5, depth, 0.0, RX_OUT, DEEP, TINY) == pytest.approx(
-        RX_OUT - math.sqrt(RX_OUT ** 2 - a * a), rel=1e-12)
+        RX_OUT - math.sqrt(RX_OUT**2 - a * a), rel=1e-12
+    )
     assert sharp[2000] == pytest.approx(depth, rel=1e-9)
     r_e = 0.5e-3
     rounded = np.array([pit_drop_m(x, 0.0, hw, 0.5, depth, r_e, RX_OUT, DEEP, TINY) for x in u])
@@ -147,23 +157,36 @@ def test_profile_shape_unloads_entering_and_closes_at_the_exit_edge():
 
 # ---- validation -------------------------------------------------------------------------------
 def test_spall_within_the_bearing_is_accepted_and_row_is_built():
-    d = validate_defect({"kind": "outer", "azimuth_deg": 30.0, "width_m": 1e-3, "length_m": 4e-3,
-                         "depth_m": 50e-6, "edge_radius_m": 0.1e-3}, G)
+    d = validate_defect(
+        {
+            "kind": "outer",
+            "azimuth_deg": 30.0,
+            "width_m": 1e-3,
+            "length_m": 4e-3,
+            "depth_m": 50e-6,
+            "edge_radius_m": 0.1e-3,
+        },
+        G,
+    )
     row = defect_row(d, G)
     assert row[1] == pytest.approx(math.radians(30.0))
     assert row[6:10] == pytest.approx([0.5e-3, 2e-3, 50e-6, 0.1e-3])
 
 
-@pytest.mark.parametrize("data, field, limit", [
-    ({"kind": "outer", "width_m": 0.03, "length_m": 1e-3, "depth_m": 1e-4}, "width_m",
-     2 * math.pi * 36.6e-3 / 9),
-    ({"kind": "inner", "width_m": 1e-3, "length_m": 0.02, "depth_m": 1e-4}, "length_m",
-     2 * 6.552e-3 * math.asin(6.3 / 6.552)),
-    ({"kind": "outer", "width_m": 1e-3, "length_m": 1e-3, "depth_m": 4e-3}, "depth_m", 3.15e-3),
-    ({"kind": "ball", "ball_index": 9, "width_m": 1e-3, "length_m": 1e-3, "depth_m": 1e-4},
-     "ball_index", 8),
-    ({"kind": "ball", "width_m": 7e-3, "length_m": 1e-3, "depth_m": 1e-4}, "width_m", 6.3e-3),
-])
+@pytest.mark.parametrize(
+    "data, field, limit",
+    [
+        ({"kind": "outer", "width_m": 0.03, "length_m": 1e-3, "depth_m": 1e-4}, "width_m", 2 * math.pi * 36.6e-3 / 9),
+        (
+            {"kind": "inner", "width_m": 1e-3, "length_m": 0.02, "depth_m": 1e-4},
+            "length_m",
+            2 * 6.552e-3 * math.asin(6.3 / 6.552),
+        ),
+        ({"kind": "outer", "width_m": 1e-3, "length_m": 1e-3, "depth_m": 4e-3}, "depth_m", 3.15e-3),
+        ({"kind": "ball", "ball_index": 9, "width_m": 1e-3, "length_m": 1e-3, "depth_m": 1e-4}, "ball_index", 8),
+        ({"kind": "ball", "width_m": 7e-3, "length_m": 1e-3, "depth_m": 1e-4}, "width_m", 6.3e-3),
+    ],
+)
 def test_defect_larger_than_the_bearing_is_refused_naming_field_and_range(data, field, limit):
     with pytest.raises(ValidationError) as err:
         validate_defect(data, G)
@@ -178,8 +201,10 @@ def test_negative_depth_and_oversized_edge_are_refused():
     with pytest.raises(ValidationError, match="edge_radius_m"):
         OuterRaceSpall(width_m=1e-3, length_m=2e-3, depth_m=1e-5, edge_radius_m=0.6e-3)
     with pytest.raises(ValidationError) as err:
-        validate_defects([{"kind": "outer", "width_m": 1e-3, "length_m": 1e-3, "depth_m": 1e-5},
-                          {"kind": "wear", "width_m": 1e-3}], G)
+        validate_defects(
+            [{"kind": "outer", "width_m": 1e-3, "length_m": 1e-3, "depth_m": 1e-5}, {"kind": "wear", "width_m": 1e-3}],
+            G,
+        )
     assert err.value.errors()[0]["loc"][0] == 1
 
 
@@ -190,15 +215,36 @@ def test_race_limits_of_the_6208():
 
 
 # ---- kernel-facing per-contact drop ----------------------------------------------------------------
-def _drop(row, race, ball, azimuth, shaft_angle=0.0, nz=0.0, q=(1.0, 0.0, 0.0, 0.0),
-          w=(0.0, 0.0, -950.0)):
+def _drop(row, race, ball, azimuth, shaft_angle=0.0, nz=0.0, q=(1.0, 0.0, 0.0, 0.0), w=(0.0, 0.0, -950.0)):
     r = G.outer_raceway_radius_m if race == 1 else G.inner_raceway_radius_m
     px, py = G.pitch_radius_m * math.cos(azimuth), G.pitch_radius_m * math.sin(azimuth)
     sign = 1.0 if race == 1 else -1.0
     nx, ny = sign * math.cos(azimuth), sign * math.sin(azimuth)
     rx = RX_OUT if race == 1 else RX_IN
-    return contact_defect_drop_m(row, race, ball, px, py, nx, ny, nz, w[0], w[1], w[2], shaft_angle,
-                                 q[0], q[1], q[2], q[3], RB, r, G.outer_groove_radius_m, rx, DEEP, TINY)
+    return contact_defect_drop_m(
+        row,
+        race,
+        ball,
+        px,
+        py,
+        nx,
+        ny,
+        nz,
+        w[0],
+        w[1],
+        w[2],
+        shaft_angle,
+        q[0],
+        q[1],
+        q[2],
+        q[3],
+        RB,
+        r,
+        G.outer_groove_radius_m,
+        rx,
+        DEEP,
+        TINY,
+    )
 
 
 def test_race_spall_is_seen_only_by_its_race_at_its_azimuth():
@@ -214,7 +260,8 @@ def test_race_spall_is_seen_only_by_its_race_at_its_azimuth():
     assert _drop(outer, 1, 3, math.radians(30.0) - 2 * math.pi) == pytest.approx(centre, rel=1e-9)
     inner = defect_row(validate_defect({"kind": "inner", "ring_angle_deg": 10.0, **spall}, G), G)
     assert _drop(inner, 0, 0, math.radians(30.0), shaft_angle=math.radians(20.0)) == pytest.approx(
-        pit_drop_m(0.0, 0.0, 1e-3, 3e-3, 20e-6, 0.0, RX_IN, DEEP, TINY), rel=1e-9)
+        pit_drop_m(0.0, 0.0, 1e-3, 3e-3, 20e-6, 0.0, RX_IN, DEEP, TINY), rel=1e-9
+    )
     assert _drop(inner, 0, 0, math.radians(30.0)) == 0.0  # shaft at 0: the spall is at 10 deg
 
 
@@ -222,9 +269,21 @@ def test_ball_defect_is_seen_where_it_faces_the_contact():
     """Ball defect at body +x with the identity orientation: at the outer contact of a ball at
     azimuth 0 (normal +x) it opens the pit's centre drop; at the inner contact (normal -x) nothing;
     another ball nothing."""
-    row = defect_row(validate_defect({"kind": "ball", "ball_index": 2, "colatitude_deg": 90.0,
-                                      "longitude_deg": 0.0, "width_m": 1.5e-3, "length_m": 3e-3,
-                                      "depth_m": 30e-6}, G), G)
+    row = defect_row(
+        validate_defect(
+            {
+                "kind": "ball",
+                "ball_index": 2,
+                "colatitude_deg": 90.0,
+                "longitude_deg": 0.0,
+                "width_m": 1.5e-3,
+                "length_m": 3e-3,
+                "depth_m": 30e-6,
+            },
+            G,
+        ),
+        G,
+    )
     centre = pit_drop_m(0.0, 0.0, 0.75e-3, 1.5e-3, 30e-6, 0.0, RX_OUT, DEEP, TINY)
     assert centre > 0.0
     assert _drop(row, 1, 2, 0.0) == pytest.approx(centre, rel=1e-12)
@@ -277,10 +336,12 @@ def _roll_ball(row, n, dt, w_cage, w_ball, pitch, rb, ro, ri, rg, rx_o, rx_i, hi
         phi = w_cage * (k * dt)
         c, s = math.cos(phi), math.sin(phi)
         px, py = pitch * c, pitch * s
-        hits[k, 1] = contact_defect_drop_m(row, 1, 0, px, py, c, s, 0.0, 0.0, 0.0, w_ball, 0.0,
-                                           q[0], q[1], q[2], q[3], rb, ro, rg, rx_o, 1.0, 1e-6)
-        hits[k, 0] = contact_defect_drop_m(row, 0, 0, px, py, -c, -s, 0.0, 0.0, 0.0, w_ball, 0.0,
-                                           q[0], q[1], q[2], q[3], rb, ri, rg, rx_i, 1.0, 1e-6)
+        hits[k, 1] = contact_defect_drop_m(
+            row, 1, 0, px, py, c, s, 0.0, 0.0, 0.0, w_ball, 0.0, q[0], q[1], q[2], q[3], rb, ro, rg, rx_o, 1.0, 1e-6
+        )
+        hits[k, 0] = contact_defect_drop_m(
+            row, 0, 0, px, py, -c, -s, 0.0, 0.0, 0.0, w_ball, 0.0, q[0], q[1], q[2], q[3], rb, ri, rg, rx_i, 1.0, 1e-6
+        )
         quat_integrate(q, 0.0, 0.0, w_ball, dt)
 
 
@@ -293,12 +354,37 @@ def test_ball_defect_meets_the_races_twice_per_ball_revolution():
     freq = bearing_defect_frequencies(G, shaft)
     w_cage = 2 * math.pi * freq.ftf_hz
     w_ball = -w_cage * G.pitch_radius_m / RB
-    row = defect_row(validate_defect({"kind": "ball", "colatitude_deg": 90.0, "longitude_deg": 0.0,
-                                      "width_m": 1e-3, "length_m": 2e-3, "depth_m": 20e-6}, G), G)
+    row = defect_row(
+        validate_defect(
+            {
+                "kind": "ball",
+                "colatitude_deg": 90.0,
+                "longitude_deg": 0.0,
+                "width_m": 1e-3,
+                "length_m": 2e-3,
+                "depth_m": 20e-6,
+            },
+            G,
+        ),
+        G,
+    )
     dt, n = 1e-6, 50_000
     hits = np.zeros((n, 2))
-    _roll_ball(row, n, dt, w_cage, w_ball, G.pitch_radius_m, RB, G.outer_raceway_radius_m,
-               G.inner_raceway_radius_m, G.outer_groove_radius_m, RX_OUT, RX_IN, hits)
+    _roll_ball(
+        row,
+        n,
+        dt,
+        w_cage,
+        w_ball,
+        G.pitch_radius_m,
+        RB,
+        G.outer_raceway_radius_m,
+        G.inner_raceway_radius_m,
+        G.outer_groove_radius_m,
+        RX_OUT,
+        RX_IN,
+        hits,
+    )
     events = []
     for race in (0, 1):
         on = hits[:, race] > 0.0
@@ -320,6 +406,12 @@ def test_ball_defect_meets_the_races_twice_per_ball_revolution():
 def test_wrap_angle():
     from twin.vibration.defects import wrap_angle
 
-    for a, w in [(0.0, 0.0), (math.pi, math.pi), (-math.pi, math.pi), (3 * math.pi / 2, -math.pi / 2),
-                 (-7.0, -7.0 + 2 * math.pi), (20.0, 20.0 - 6 * math.pi)]:
+    for a, w in [
+        (0.0, 0.0),
+        (math.pi, math.pi),
+        (-math.pi, math.pi),
+        (3 * math.pi / 2, -math.pi / 2),
+        (-7.0, -7.0 + 2 * math.pi),
+        (20.0, 20.0 - 6 * math.pi),
+    ]:
         assert wrap_angle(a) == pytest.approx(w, abs=1e-12)

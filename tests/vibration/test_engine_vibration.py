@@ -37,10 +37,10 @@ from twin.spec import BearingSpec, ModelOptions
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.indicators import SIGNIFICANCE
 
-NOISE = 0.01          # m/s^2/sqrt(Hz)
-SPEED = 523.0         # rad/s
-WINDOW = 0.5          # s
-WIDTH = 0.5e-3        # m
+NOISE = 0.01  # m/s^2/sqrt(Hz)
+SPEED = 523.0  # rad/s
+WINDOW = 0.5  # s
+WIDTH = 0.5e-3  # m
 
 
 def _spec(designation="6208", *, noise=NOISE, window=WINDOW, enabled=True):
@@ -57,8 +57,10 @@ def _pit(kind, width=WIDTH, designation="6208"):
 
 def _window(defects=(), designation="6208", radial=3000.0, axial=0.0, window=WINDOW):
     """One engine window after the start: (twin, snapshot vibration block)."""
-    twin = Twin(_spec(designation, window=window),
-                setpoint=Setpoint(shaft_speed_rad_s=SPEED, radial_load_n=radial, axial_load_n=axial))
+    twin = Twin(
+        _spec(designation, window=window),
+        setpoint=Setpoint(shaft_speed_rad_s=SPEED, radial_load_n=radial, axial_load_n=axial),
+    )
     twin.set_defects(list(defects))
     twin.advance(window + 0.003)  # + the decimator's start-up (K - 1 outputs, ~1 ms)
     assert twin.status == "ok"
@@ -74,8 +76,13 @@ def runs():
 
     def get(name):
         if name not in cache:
-            defects = {"healthy": (), "outer_small": (_pit("outer", 0.25e-3),), "outer": (_pit("outer"),),
-                       "inner": (_pit("inner"),), "ball": (_pit("ball"),)}[name]
+            defects = {
+                "healthy": (),
+                "outer_small": (_pit("outer", 0.25e-3),),
+                "outer": (_pit("outer"),),
+                "inner": (_pit("inner"),),
+                "ball": (_pit("ball"),),
+            }[name]
             cache[name] = _window(defects)
         return cache[name]
 
@@ -128,13 +135,15 @@ def test_outer_race_spall_full_spectra_of_the_window(runs):
     assert abs(freqs[np.argmax(amp)] - f.bpfo) <= env.step_hz
     for peak in v.envelope_peaks_hz:
         i = int(np.rint((peak.frequency_hz - env.start_hz) / env.step_hz))
-        i = max((i - 1, i, i + 1), key=lambda k: amp[k])        # the local maximum it was refined from
+        i = max((i - 1, i, i + 1), key=lambda k: amp[k])  # the local maximum it was refined from
         got_f, got_a = _refine(freqs, amp, i)
         assert (got_f, got_a) == pytest.approx((peak.frequency_hz, peak.amplitude), rel=1e-9)
     fs = v.sample_rate_hz
     assert acc.start_hz == pytest.approx(0.5 * (acc.step_hz * WINDOW - 1.0) / WINDOW, rel=1e-9)
-    assert len(acc.amplitude_m_s2) <= 2000 and acc.max_hz - 0.5 * acc.step_hz < 0.5 * fs <= acc.max_hz + 0.5 * acc.step_hz
-    assert np.sum(np.square(acc.amplitude_m_s2)) / 2.0 == pytest.approx(v.rms_m_s2 ** 2, rel=1e-9)
+    assert (
+        len(acc.amplitude_m_s2) <= 2000 and acc.max_hz - 0.5 * acc.step_hz < 0.5 * fs <= acc.max_hz + 0.5 * acc.step_hz
+    )
+    assert np.sum(np.square(acc.amplitude_m_s2)) / 2.0 == pytest.approx(v.rms_m_s2**2, rel=1e-9)
 
 
 def test_inner_race_spall_bpfi_with_shaft_sidebands(runs):
@@ -278,12 +287,13 @@ def test_a_frozen_copys_snapshot_leaves_the_live_waveform_intact():
     ending at 0.1695 s). Here the copy's snapshot runs after the live twin moved on and drained
     part of it (the race, made deterministic): the live samples are exactly those of the same run
     without the copy (noise off, so bit for bit), and the copy carries the window of its moment."""
+
     def run(with_copy: bool):
         twin = Twin(_spec(noise=0.0, window=0.05))
         twin.advance(0.06)
         (a,) = twin.drain_waveform()
         frozen = twin.frozen()
-        twin.advance(0.053)                 # ends between two drains of the reader (DRAIN_EVERY_S)
+        twin.advance(0.053)  # ends between two drains of the reader (DRAIN_EVERY_S)
         snap = frozen.snapshot() if with_copy else None
         (b,) = twin.drain_waveform()
         return twin, frozen, snap, a, b
@@ -313,12 +323,15 @@ def test_defects_set_and_cleared_without_recompiling():
     assert len(step_n.signatures) == compiled
 
 
-@pytest.mark.parametrize("defect, field, bound", [
-    ({"kind": "outer", "width_m": 0.04, "length_m": 3e-3, "depth_m": 5e-5}, "width_m", "0.0255"),
-    ({"kind": "inner", "width_m": 1e-3, "length_m": 3e-3, "depth_m": -5e-5}, "depth_m", "greater than 0"),
-    ({"kind": "ball", "width_m": 1e-3, "length_m": 3e-3, "depth_m": 5e-5, "ball_index": 9}, "ball_index", "[0, 8]"),
-    ({"kind": "ball", "width_m": 7e-3, "length_m": 3e-3, "depth_m": 5e-5}, "width_m", "0.0063"),
-])
+@pytest.mark.parametrize(
+    "defect, field, bound",
+    [
+        ({"kind": "outer", "width_m": 0.04, "length_m": 3e-3, "depth_m": 5e-5}, "width_m", "0.0255"),
+        ({"kind": "inner", "width_m": 1e-3, "length_m": 3e-3, "depth_m": -5e-5}, "depth_m", "greater than 0"),
+        ({"kind": "ball", "width_m": 1e-3, "length_m": 3e-3, "depth_m": 5e-5, "ball_index": 9}, "ball_index", "[0, 8]"),
+        ({"kind": "ball", "width_m": 7e-3, "length_m": 3e-3, "depth_m": 5e-5}, "width_m", "0.0063"),
+    ],
+)
 def test_bad_defects_name_the_field_and_the_bearings_range(defect, field, bound):
     twin = Twin(_spec(noise=0.0, enabled=False))
     with pytest.raises(ValidationError) as info:

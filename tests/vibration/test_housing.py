@@ -8,8 +8,18 @@ import scipy.linalg
 from pydantic import ValidationError
 
 from twin.vibration.housing import (
-    HR, HX, N_HOUSING_DOF, Accelerometer, Housing, housing_accelerations, housing_equilibrium,
-    housing_params, housing_verlet_step, matrices, modes, sensor_resonance,
+    HR,
+    HX,
+    N_HOUSING_DOF,
+    Accelerometer,
+    Housing,
+    housing_accelerations,
+    housing_equilibrium,
+    housing_params,
+    housing_verlet_step,
+    matrices,
+    modes,
+    sensor_resonance,
 )
 
 
@@ -28,8 +38,7 @@ def test_defaults_are_the_published_sprung_mass_resonance():
 def test_modes_match_the_closed_form_undamped_two_dof_system():
     """Undamped: the pedestal y and z modes are sqrt(k/m), the x-resonator pair the roots of
     m_p m_r w^4 - (m_p k_r + m_r (k_p + k_r)) w^2 + k_p k_r = 0 (1e-9)."""
-    h = Housing(radial_damping_n_s_m=0.0, axial_damping_n_s_m=0.0, sprung_damping_n_s_m=0.0,
-                axial_stiffness_n_m=3e7)
+    h = Housing(radial_damping_n_s_m=0.0, axial_damping_n_s_m=0.0, sprung_damping_n_s_m=0.0, axial_stiffness_n_m=3e7)
     mp, kp, mr, kr = h.pedestal_mass_kg, h.radial_stiffness_n_m, h.sprung_mass_kg, h.sprung_stiffness_n_m
     a, b, c = mp * mr, -(mp * kr + mr * (kp + kr)), kp * kr
     roots = sorted(math.sqrt(r) / (2 * math.pi) for r in np.roots([a, b, c]).real)
@@ -146,7 +155,10 @@ def test_bad_housing_is_refused_naming_the_field():
         Housing(enabled=True, accelerometer=Accelerometer(sample_rate_hz=25600.0))  # 16 kHz > 0.4 x 25.6 kHz
     Housing(enabled=False, accelerometer=Accelerometer(sample_rate_hz=25600.0))  # no signal: not checked
     with pytest.raises(ValidationError, match="window_s"):
-        Housing(enabled=True, sprung_stiffness_n_m=1e5,  # a 50 Hz sensed mode: inside 0.4 x 1 kHz
-                accelerometer=Accelerometer(sample_rate_hz=1000.0, window_s=0.5))  # 500 samples < 1024
+        Housing(
+            enabled=True,
+            sprung_stiffness_n_m=1e5,  # a 50 Hz sensed mode: inside 0.4 x 1 kHz
+            accelerometer=Accelerometer(sample_rate_hz=1000.0, window_s=0.5),
+        )  # 500 samples < 1024
     with pytest.raises(ValidationError, match="azimuth_deg"):
         Accelerometer(azimuth_deg=400.0)

@@ -35,12 +35,16 @@ def test_sine_time_indicators():
     assert r["kurtosis"] == pytest.approx(1.5, rel=1e-3)
 
 
-@pytest.mark.parametrize("f_hz, expected_mm_s", [
-    (100.0, 10.0 / (2 * math.pi * 100.0) / math.sqrt(2) * 1e3),   # 11.254 mm/s
-    (1000.0, 10.0 / (2 * math.pi * 1000.0) / math.sqrt(2) * 1e3),  # band edge, inside
-    (159.3, 10.0 / (2 * math.pi * 159.3) / math.sqrt(2) * 1e3),    # not a whole number of periods
-    (5.0, 0.0), (2000.0, 0.0),                                      # outside 10-1000 Hz
-])
+@pytest.mark.parametrize(
+    "f_hz, expected_mm_s",
+    [
+        (100.0, 10.0 / (2 * math.pi * 100.0) / math.sqrt(2) * 1e3),  # 11.254 mm/s
+        (1000.0, 10.0 / (2 * math.pi * 1000.0) / math.sqrt(2) * 1e3),  # band edge, inside
+        (159.3, 10.0 / (2 * math.pi * 159.3) / math.sqrt(2) * 1e3),  # not a whole number of periods
+        (5.0, 0.0),
+        (2000.0, 0.0),  # outside 10-1000 Hz
+    ],
+)
 def test_velocity_rms_of_a_sine(f_hz, expected_mm_s):
     """ISO 20816-1 velocity RMS (10-1000 Hz) of a 10 m/s^2 sine: A / (2 pi f sqrt 2) by hand,
     within 0.1 % (1 % when the window does not hold whole periods); below 1 % of the 100 Hz value
@@ -85,8 +89,9 @@ def test_inner_race_gives_bpfi_with_shaft_sidebands(fault_signal):
     """Impulses at BPFI whose amplitude follows the load zone, 1 + 0.8 cos(2 pi f_s t): the
     largest envelope peak within 1 % of BPFI, sidebands at BPFI -+ f_s 5x above the floor and
     above the spectrum midway between them and BPFI."""
-    x = fault_signal(FS, 2.0, FREQ.bpfi_hz, 6000.0, modulation_hz=FREQ.shaft_hz,
-                     modulation_depth=0.8, jitter=0.01, noise=0.3, seed=2)
+    x = fault_signal(
+        FS, 2.0, FREQ.bpfi_hz, 6000.0, modulation_hz=FREQ.shaft_hz, modulation_depth=0.8, jitter=0.01, noise=0.3, seed=2
+    )
     band = (3000.0, 9000.0)
     f, a = ind.envelope_spectrum(x, FS, band)
     top = ind.envelope_peaks(f, a, 5, max_hz=3000.0)
@@ -102,8 +107,17 @@ def test_ball_defect_gives_two_bsf_with_cage_sidebands(fault_signal):
     """Impulses at 2 x BSF modulated at FTF (the defective ball travels with the cage through the
     load zone): the largest envelope peak within 1 % of 2 x BSF, sidebands at 2 x BSF -+ FTF 5x
     above the floor."""
-    x = fault_signal(FS, 3.0, FREQ.two_bsf_hz, 6000.0, modulation_hz=FREQ.ftf_hz,
-                     modulation_depth=0.8, jitter=0.01, noise=0.3, seed=3)
+    x = fault_signal(
+        FS,
+        3.0,
+        FREQ.two_bsf_hz,
+        6000.0,
+        modulation_hz=FREQ.ftf_hz,
+        modulation_depth=0.8,
+        jitter=0.01,
+        noise=0.3,
+        seed=3,
+    )
     f, a = ind.envelope_spectrum(x, FS, (3000.0, 9000.0))
     top = ind.envelope_peaks(f, a, 5, max_hz=3000.0)
     assert top[0]["frequency_hz"] == pytest.approx(FREQ.two_bsf_hz, rel=0.01)
@@ -145,17 +159,17 @@ def test_amplitude_spectrum_parseval_and_a_line_reads_its_amplitude():
     start, step, a = ind.amplitude_spectrum(x, FS)
     assert (a.size, step, start) == (1970, 13.0, 6.0)
     ms = ind.time_indicators(x)["rms_m_s2"] ** 2
-    assert np.sum(a ** 2) / 2.0 == pytest.approx(ms, rel=1e-9)
+    assert np.sum(a**2) / 2.0 == pytest.approx(ms, rel=1e-9)
     j = int(np.argmax(a))
     assert abs(start + j * step - 1234.37) <= 0.5 * step
-    assert math.sqrt(np.sum(a[j - 1:j + 2] ** 2)) == pytest.approx(2.0, rel=0.01)
+    assert math.sqrt(np.sum(a[j - 1 : j + 2] ** 2)) == pytest.approx(2.0, rel=0.01)
     # no binning below max_bins: 2 |X_k| / N on the FFT grid, Parseval with the Nyquist bin's weight
     y = x[:4096]
     start, step, b = ind.amplitude_spectrum(y, FS, max_bins=5000)
     assert (start, step, b.size) == (0.0, FS / 4096, 2049)
     spec = np.fft.rfft(y - y.mean())
     assert b[1:-1] == pytest.approx(2.0 * np.abs(spec[1:-1]) / y.size, rel=1e-12)
-    assert np.sum(b ** 2) / 2.0 == pytest.approx(np.mean((y - y.mean()) ** 2), rel=1e-9)
+    assert np.sum(b**2) / 2.0 == pytest.approx(np.mean((y - y.mean()) ** 2), rel=1e-9)
 
 
 def test_envelope_spectrum_view_keeps_the_bins_up_to_the_limit_or_peak_holds():
@@ -163,7 +177,7 @@ def test_envelope_spectrum_view_keeps_the_bins_up_to_the_limit_or_peak_holds():
     bins are peak-held (a line keeps its height)."""
     f = np.arange(3001) * 0.5
     a = np.random.default_rng(1).random(f.size)
-    a[2001] = 7.0                                  # 1000.5 Hz
+    a[2001] = 7.0  # 1000.5 Hz
     start, step, v = ind.envelope_spectrum_view(f, a, 1200.0)
     assert (start, step, v.size) == (0.0, 0.5, 2401) and np.array_equal(v, a[:2401])
     start, step, v = ind.envelope_spectrum_view(f, a, 1200.0, max_bins=1000)

@@ -11,24 +11,26 @@ from twin.vibration import kurtogram as K
 FS = 12000.0
 
 
-@pytest.mark.parametrize("taps, factor, column", [(K._BINARY_TAPS, 2, 0), (K._BINARY_TAPS, 2, 1),
-                                                  (K._TERNARY_TAPS, 3, 0), (K._TERNARY_TAPS, 3, 2)])
+@pytest.mark.parametrize(
+    "taps, factor, column",
+    [(K._BINARY_TAPS, 2, 0), (K._BINARY_TAPS, 2, 1), (K._TERNARY_TAPS, 3, 0), (K._TERNARY_TAPS, 3, 2)],
+)
 def test_filter_bank_is_the_reference_filter_and_decimation(taps, factor, column):
     """Each split is the reference implementation's filter(h, 1, x) kept at x(factor:factor:N)
     (Fast_Kurtogram.m, DBFB / TBFB), to round-off (1e-12)."""
     x = np.random.default_rng(3).standard_normal((2, 1001)) + 0j
-    ref = scipy.signal.lfilter(taps[:, column], 1.0, x, axis=1)[:, factor - 1::factor][:, :1001 // factor]
+    ref = scipy.signal.lfilter(taps[:, column], 1.0, x, axis=1)[:, factor - 1 :: factor][:, : 1001 // factor]
     assert np.max(np.abs(K._filter_bank(x, taps, factor)[:, :, column] - ref)) < 1e-12
 
 
 def test_levels_and_bandwidths_of_the_tree():
     """Levels 0, 1, log2 3, 2, 1 + log2 3, ..., nlevel (Antoni 2007 fig. 4) with bands fs / 2^(k+1)
     wide; 2 nlevel rows of 3 x 2^nlevel columns."""
-    kg = K.fast_kurtogram(np.random.default_rng(0).standard_normal(2 ** 13), FS, nlevel=4)
+    kg = K.fast_kurtogram(np.random.default_rng(0).standard_normal(2**13), FS, nlevel=4)
     expected = [0, 1, math.log2(3), 2, 1 + math.log2(3), 3, 2 + math.log2(3), 4]
     assert kg.levels == pytest.approx(expected, abs=1e-12)
     assert kg.bandwidth_hz == pytest.approx(FS * 2.0 ** -(np.array(expected) + 1.0), rel=1e-12)
-    assert kg.kurtosis.shape == (8, 3 * 2 ** 4)
+    assert kg.kurtosis.shape == (8, 3 * 2**4)
 
 
 def test_gaussian_noise_is_not_impulsive():

@@ -19,8 +19,7 @@ def outer_signal(fault_signal):
     """3 s of a 6208 outer-race fault at 500 rad/s ringing the default housing's sensed resonance."""
     freq = bearing_defect_frequencies(catalog.bearing("6208").geometry, 500.0)
     f_r, zeta = sensor_resonance(Housing())
-    return freq, fault_signal(FS, 3.0, freq.bpfo_hz, f_r, damping_ratio=zeta, jitter=0.01,
-                              noise=0.3, seed=5)
+    return freq, fault_signal(FS, 3.0, freq.bpfo_hz, f_r, damping_ratio=zeta, jitter=0.01, noise=0.3, seed=5)
 
 
 @pytest.mark.parametrize("band", ["resonance", "kurtogram"])

@@ -7,7 +7,11 @@ import pytest
 import scipy.signal
 
 from twin.vibration.signal import (
-    add_sensor_noise, decimate_block, design_decimator, integer_ratio_time_step, noise_sigma,
+    add_sensor_noise,
+    decimate_block,
+    design_decimator,
+    integer_ratio_time_step,
+    noise_sigma,
     seed_sensor_noise,
 )
 
@@ -77,13 +81,13 @@ def _tone_gain(d, f_hz, seconds=0.05):
     x = np.sin(2 * np.pi * f_hz * t + 0.3)
     out = np.zeros(n // d.ratio + 1)
     k = decimate_block(d.phases, d.new_state(), x, out)
-    y = out[d.ring:k]
+    y = out[d.ring : k]
     f_alias = abs(((f_hz + 0.5 * F_OUT) % F_OUT) - 0.5 * F_OUT)
     tt = np.arange(y.size) / F_OUT
     basis = np.column_stack([np.sin(2 * np.pi * f_alias * tt), np.cos(2 * np.pi * f_alias * tt)])
     coef, *_ = np.linalg.lstsq(basis, y, rcond=None)
     residual = y - basis @ coef
-    return math.hypot(*coef), float(np.sqrt(np.mean(residual ** 2)))
+    return math.hypot(*coef), float(np.sqrt(np.mean(residual**2)))
 
 
 @pytest.mark.parametrize("ratio", [20, 4])
@@ -125,9 +129,9 @@ def test_sensor_noise_has_the_stated_density():
     sigma = noise_sigma(rho, F_OUT)
     assert sigma == pytest.approx(rho * math.sqrt(F_OUT / 2))
     seed_sensor_noise(7)
-    y = np.array([add_sensor_noise(0.0, sigma) for _ in range(2 ** 17)])
+    y = np.array([add_sensor_noise(0.0, sigma) for _ in range(2**17)])
     f, psd = scipy.signal.welch(y, fs=F_OUT, nperseg=4096)
-    assert np.mean(psd[1:-1]) == pytest.approx(rho ** 2, rel=0.02)
+    assert np.mean(psd[1:-1]) == pytest.approx(rho**2, rel=0.02)
     seed_sensor_noise(7)
     again = np.array([add_sensor_noise(0.0, sigma) for _ in range(100)])
     assert np.array_equal(again, y[:100])
@@ -157,4 +161,4 @@ def test_sensor_push_fills_a_ring_the_reader_drains():
     got.append(new)
     assert np.array_equal(np.concatenate(got), ref[:k]) and cursor == k == 700
     new, cursor, lost = read_ring(ring, ring_state, 0)  # a reader 700 behind a 256 ring
-    assert lost == 700 - 256 and np.array_equal(new, ref[700 - 256:700])
+    assert lost == 700 - 256 and np.array_equal(new, ref[700 - 256 : 700])

@@ -25,14 +25,14 @@ def test_race_profile_has_the_rms_and_the_orders_asked():
     a = np.abs(np.fft.rfft(h))
     n_max = int(2 * math.pi * radius / lam)
     assert np.all(a[:2] < 1e-9 * a.max())
-    assert np.all(a[n_max + 1:] < 1e-9 * a.max())
-    assert np.ptp(a[2:n_max + 1]) < 1e-9 * a.max()
+    assert np.all(a[n_max + 1 :] < 1e-9 * a.max())
+    assert np.ptp(a[2 : n_max + 1]) < 1e-9 * a.max()
 
 
 def test_profile_interpolation_is_periodic_and_exact_on_the_grid():
     p = np.zeros(L.N_PARAMS)
     h = race_profile_m(1e-7, 0.02, 0.3e-3, np.random.default_rng(2))
-    p[L.P_PROFILE_OUTER:L.P_PROFILE_OUTER + L.PROFILE_POINTS] = h
+    p[L.P_PROFILE_OUTER : L.P_PROFILE_OUTER + L.PROFILE_POINTS] = h
     step = 2 * math.pi / L.PROFILE_POINTS
     for i in (0, 1, 1000, L.PROFILE_POINTS - 1):
         assert profile_height_m(p, L.P_PROFILE_OUTER, i * step) == pytest.approx(h[i], abs=1e-20)
@@ -47,7 +47,7 @@ def test_profile_at_a_tiny_negative_angle_is_the_height_at_zero():
     CWRU-DE warm start at 1796 rpm read -110 um there and restarted at every step)."""
     p = np.zeros(L.N_PARAMS)
     h = race_profile_m(5e-8, 0.0156, 0.3e-3, np.random.default_rng(0))
-    p[L.P_PROFILE_INNER:L.P_PROFILE_INNER + L.PROFILE_POINTS] = h
+    p[L.P_PROFILE_INNER : L.P_PROFILE_INNER + L.PROFILE_POINTS] = h
     for angle in (-1e-17, -5e-17, -1e-300, -0.0, 0.0):
         assert profile_height_m(p, L.P_PROFILE_INNER, angle) == pytest.approx(h[0], abs=1e-18)
     assert profile_height_m(p, L.P_PROFILE_INNER, math.atan2(-1.05e-12, 19.5e-3)) == pytest.approx(h[0], abs=1e-14)
@@ -119,7 +119,6 @@ def test_defect_angle_places_the_outer_spall_from_the_load_zone():
         defect_for("outer", g, angle_deg=float("nan"))
 
 
-
 def test_cwru_de_noise_floor_is_the_healthy_records_floor():
     """`CWRU-DE`'s sensor noise density is record 97's 2.0-2.9 kHz floor (twin.validation.cwru.
     calibrate_background, within 1 %), and that floor alone fills the record's 2.9-3.6 kHz
@@ -141,7 +140,15 @@ def test_profile_azimuth_is_atan2_to_two_hundredths_of_a_microradian():
     from twin.kernels.profile import azimuth_rad
 
     rng = np.random.default_rng(5)
-    pts = list(rng.normal(size=(20000, 2)) * 0.02) + [(0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0),
-                                                       (1.0, 1.0), (-1.0, 1.0), (-1.0, -1.0), (1.0, -1.0)]
+    pts = list(rng.normal(size=(20000, 2)) * 0.02) + [
+        (0.0, 1.0),
+        (1.0, 0.0),
+        (0.0, -1.0),
+        (-1.0, 0.0),
+        (1.0, 1.0),
+        (-1.0, 1.0),
+        (-1.0, -1.0),
+        (1.0, -1.0),
+    ]
     err = max(abs(azimuth_rad(y, x) - math.atan2(y, x)) for y, x in pts)
     assert err <= 3e-8

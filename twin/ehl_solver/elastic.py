@@ -27,8 +27,12 @@ def _antiderivative(u: np.ndarray, v: np.ndarray) -> np.ndarray:
 
 def rectangle_influence(dx: np.ndarray, dy: np.ndarray, half_x: float, half_y: float) -> np.ndarray:
     """int int over [-half_x, half_x] x [-half_y, half_y] of 1 / r, seen from offset (dx, dy) [m]."""
-    return (_antiderivative(dx + half_x, dy + half_y) - _antiderivative(dx - half_x, dy + half_y)
-            - _antiderivative(dx + half_x, dy - half_y) + _antiderivative(dx - half_x, dy - half_y))
+    return (
+        _antiderivative(dx + half_x, dy + half_y)
+        - _antiderivative(dx - half_x, dy + half_y)
+        - _antiderivative(dx + half_x, dy - half_y)
+        + _antiderivative(dx - half_x, dy - half_y)
+    )
 
 
 class Deflection:
@@ -38,8 +42,19 @@ class Deflection:
     `coef[m, l]` is dD at node offset (m, l) per unit P on one patch (symmetric in sign of m, l).
     """
 
-    def __init__(self, nx: int, ny: int, hx: float, hy: float, *, ax_m: float, ay_m: float,
-                 rx_m: float, p_hertz_pa: float, e_prime_pa: float):
+    def __init__(
+        self,
+        nx: int,
+        ny: int,
+        hx: float,
+        hy: float,
+        *,
+        ax_m: float,
+        ay_m: float,
+        rx_m: float,
+        p_hertz_pa: float,
+        e_prime_pa: float,
+    ):
         self.nx, self.ny = nx, ny
         mx = np.arange(nx, dtype=float) * hx * ax_m
         my = np.arange(ny, dtype=float) * hy * ay_m
@@ -50,17 +65,17 @@ class Deflection:
         self.fy = sfft.next_fast_len(2 * ny - 1, real=True)
         wrap = np.zeros((self.fx, self.fy))
         wrap[:nx, :ny] = self.coef
-        wrap[self.fx - nx + 1:, :ny] = self.coef[:0:-1, :]
-        wrap[:nx, self.fy - ny + 1:] = self.coef[:, :0:-1]
-        wrap[self.fx - nx + 1:, self.fy - ny + 1:] = self.coef[:0:-1, :0:-1]
+        wrap[self.fx - nx + 1 :, :ny] = self.coef[:0:-1, :]
+        wrap[:nx, self.fy - ny + 1 :] = self.coef[:, :0:-1]
+        wrap[self.fx - nx + 1 :, self.fy - ny + 1 :] = self.coef[:0:-1, :0:-1]
         self._kernel_hat = sfft.rfft2(wrap)
         self._pad = np.zeros((self.fx, self.fy))
 
     def __call__(self, p: np.ndarray) -> np.ndarray:
         """D on the grid for pressure P (same shape)."""
-        self._pad[:self.nx, :self.ny] = p
+        self._pad[: self.nx, : self.ny] = p
         out = sfft.irfft2(sfft.rfft2(self._pad) * self._kernel_hat, s=(self.fx, self.fy))
-        return np.ascontiguousarray(out[:self.nx, :self.ny])
+        return np.ascontiguousarray(out[: self.nx, : self.ny])
 
     def direct(self, p: np.ndarray) -> np.ndarray:
         """The same sum by brute force (O(n^4)); for tests on small grids."""

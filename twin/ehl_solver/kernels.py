@@ -74,15 +74,15 @@ def shear_temperature_rise_k(h_m, p_pa, u_m_s, theta_i_k, alpha_t, b_m, eta0, k_
 
 
 @njit(**JIT)
-def temperature_field(p, h, dtheta, p_h, h_scale, u_m_s, theta_i_k, alpha_t, b_m, eta0, k_oil,
-                      current_rise_k, cap_k):
+def temperature_field(p, h, dtheta, p_h, h_scale, u_m_s, theta_i_k, alpha_t, b_m, eta0, k_oil, current_rise_k, cap_k):
     """dtheta[i, j] = eq. 6 (local h, p) + eq. 10 (uniform); returns the number of capped nodes."""
     nx, ny = p.shape
     capped = 0
     for i in range(nx):
         for j in range(ny):
-            t = shear_temperature_rise_k(h[i, j] * h_scale, p[i, j] * p_h, u_m_s, theta_i_k,
-                                         alpha_t, b_m, eta0, k_oil, cap_k)
+            t = shear_temperature_rise_k(
+                h[i, j] * h_scale, p[i, j] * p_h, u_m_s, theta_i_k, alpha_t, b_m, eta0, k_oil, cap_k
+            )
             if t >= cap_k:
                 capped += 1
             dtheta[i, j] = t + current_rise_k
@@ -90,8 +90,9 @@ def temperature_field(p, h, dtheta, p_h, h_scale, u_m_s, theta_i_k, alpha_t, b_m
 
 
 @njit(**JIT)
-def update_fields(p, h, dtheta, eta, rho, eps, p_h, lam, ln_eta0, z, s0, theta_i_k, dt_rel,
-                  barus_alpha, incompressible):
+def update_fields(
+    p, h, dtheta, eta, rho, eps, p_h, lam, ln_eta0, z, s0, theta_i_k, dt_rel, barus_alpha, incompressible
+):
     """eta_bar, rho_bar and eps = rho H^3 / (eta lambda) on every node; returns #non-finite.
     barus_alpha > 0 replaces Roelands by Barus exp(alpha p) and incompressible=True sets rho_bar = 1
     (the rheology of the Moes/Nijenbanning film formula, used to validate the solver)."""
@@ -162,9 +163,11 @@ def _faces(eps, i, j):
 def _operator(p, h, rho, i, j, exm, exp_, eym, eyp, rx2, ry2, rx1, w):
     """L(P) at node (i, j): the discrete Reynolds operator of seed 003 eq. 1 (Poiseuille terms
     with the face coefficients minus the wedge term)."""
-    return ((exm * (p[i - 1, j] - p[i, j]) + exp_ * (p[i + 1, j] - p[i, j])) * rx2
-            + (eym * (p[i, j - 1] - p[i, j]) + eyp * (p[i, j + 1] - p[i, j])) * ry2
-            - _wedge(rho, h, i, j, rx1, w))
+    return (
+        (exm * (p[i - 1, j] - p[i, j]) + exp_ * (p[i + 1, j] - p[i, j])) * rx2
+        + (eym * (p[i, j - 1] - p[i, j]) + eyp * (p[i, j + 1] - p[i, j])) * ry2
+        - _wedge(rho, h, i, j, rx1, w)
+    )
 
 
 @njit(**JIT)
@@ -234,8 +237,9 @@ def classify(p, eps, hx, xi_lim, kind):
         for j in range(1, ny - 1):
             e = min(eps[i - 1, j], eps[i, j], eps[i + 1, j])
             gs = 0.5 * (e + eps[i, j]) * rx2 >= xi_lim
-            if not gs and (p[i, j] <= 0.0 or p[i - 1, j] <= 0.0 or p[i + 1, j] <= 0.0
-                           or p[i, j - 1] <= 0.0 or p[i, j + 1] <= 0.0):
+            if not gs and (
+                p[i, j] <= 0.0 or p[i - 1, j] <= 0.0 or p[i + 1, j] <= 0.0 or p[i, j - 1] <= 0.0 or p[i, j + 1] <= 0.0
+            ):
                 gs = True
             kind[i, j] = 1 if gs else 2
 
@@ -264,9 +268,9 @@ def _wedge_jacobian_lumped(rho, i, j, rx1, w, kern, tail, o):
         a0 = (1.0 + 0.5 * w) * rho[i, j]
         a1 = -(1.0 + w) * rho[i - 1, j]
         a2 = 0.5 * w * rho[i - 2, j] if w != 0.0 else 0.0
-        if o == 2:   # offsets o >= 3: film at i, i-1, i-2 sees distances o, o+1, o+2
+        if o == 2:  # offsets o >= 3: film at i, i-1, i-2 sees distances o, o+1, o+2
             val += (a0 * tail[3] + a1 * tail[4] + a2 * tail[5]) * rx1
-        else:        # offsets o <= -3: distances -o, -o-1, -o-2
+        else:  # offsets o <= -3: distances -o, -o-1, -o-2
             val += (a0 * tail[3] + a1 * tail[2] + a2 * tail[1]) * rx1
     return val
 
@@ -334,8 +338,7 @@ def relax_gs(p, h, rho, eps, f, hx, hy, kappa2, kc, kind, xi0, omega, max_step, 
 
 
 @njit(**JIT)
-def relax_jd(p, h, rho, eps, f, hx, hy, kappa2, kc, kind, xi0, omega, max_step, band, rhs, x, delta,
-             parity):
+def relax_jd(p, h, rho, eps, f, hx, hy, kappa2, kc, kind, xi0, omega, max_step, band, rhs, x, delta, parity):
     """One Jacobi distributive line sweep over the nodes of kind 2: the change delta at (i, j) is
     applied as +delta there and -delta/4 at its four neighbours, which makes the film response
     local (the distributed influence kernel decays like 1/r^3): the smoother of Venner for the
@@ -454,9 +457,16 @@ def natural_residual(p, h, rho, eps, r, hx, hy, kappa2, kc, xi0):
         for j in range(1, ny - 1):
             exm, exp_, eym, eyp = _faces(eps, i, j)
             w = wedge_weight(eps[i, j], rx2, xi0, i)
-            d = (-(exm + exp_) * rx2 - (eym + eyp) * ry2
-                 - ((1.0 + 0.5 * w) * rho[i, j] * kc[0, 0] - (1.0 + w) * rho[i - 1, j] * kc[1, 0]
-                    + 0.5 * w * rho[i - 2, j] * kc[2, 0]) * rx1)
+            d = (
+                -(exm + exp_) * rx2
+                - (eym + eyp) * ry2
+                - (
+                    (1.0 + 0.5 * w) * rho[i, j] * kc[0, 0]
+                    - (1.0 + w) * rho[i - 1, j] * kc[1, 0]
+                    + 0.5 * w * rho[i - 2, j] * kc[2, 0]
+                )
+                * rx1
+            )
             if d == 0.0:
                 continue
             q = p[i, j] + r[i, j] / d

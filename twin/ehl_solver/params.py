@@ -60,7 +60,7 @@ BALL_RADIUS_M = 2.39e-3
 RACE_RADIUS_M = 11.28e-3
 YOUNGS_MODULUS_PA = 200e9
 POISSON_RATIO = 0.28
-E_PRIME_PA = YOUNGS_MODULUS_PA / (1.0 - POISSON_RATIO ** 2)
+E_PRIME_PA = YOUNGS_MODULUS_PA / (1.0 - POISSON_RATIO**2)
 CONTACT_RADIUS_M = BALL_RADIUS_M * RACE_RADIUS_M / (RACE_RADIUS_M - BALL_RADIUS_M)
 RX_M = CONTACT_RADIUS_M
 RY_M = CONTACT_RADIUS_M
@@ -108,15 +108,19 @@ def shaft_frequency_hz(entrainment_speed_m_s: float) -> float:
     return entrainment_speed_m_s * RPM_PER_M_S / 60.0
 
 
-def current_temperature_rise_k(current_a: float, entrainment_speed_m_s: float,
-                               bearing_resistance_ohm: float, *,
-                               balls_in_zone: float = BALLS_IN_LOADED_ZONE,
-                               pitch_diameter_m: float = PITCH_DIAMETER_M,
-                               ball_diameter_m: float = BALL_DIAMETER_M,
-                               slip_band_depth_m: float = SLIP_BAND_DEPTH_M,
-                               ball_density_kg_m3: float = BALL_DENSITY_KG_M3,
-                               specific_heat_j_kg_k: float = BALL_SPECIFIC_HEAT_J_KG_K,
-                               contact_angle_rad: float = CONTACT_ANGLE_RAD) -> float:
+def current_temperature_rise_k(
+    current_a: float,
+    entrainment_speed_m_s: float,
+    bearing_resistance_ohm: float,
+    *,
+    balls_in_zone: float = BALLS_IN_LOADED_ZONE,
+    pitch_diameter_m: float = PITCH_DIAMETER_M,
+    ball_diameter_m: float = BALL_DIAMETER_M,
+    slip_band_depth_m: float = SLIP_BAND_DEPTH_M,
+    ball_density_kg_m3: float = BALL_DENSITY_KG_M3,
+    specific_heat_j_kg_k: float = BALL_SPECIFIC_HEAT_J_KG_K,
+    contact_angle_rad: float = CONTACT_ANGLE_RAD,
+) -> float:
     """Instantaneous temperature rise of the outer-race contact per shaft rotation, seed 003
     eq. 10: T_obn = 1.45 I^2 R_b K (D + 2d) / (f_s H_c rho c alpha'' d^2 (D + d)) [K].
 
@@ -128,9 +132,8 @@ def current_temperature_rise_k(current_a: float, entrainment_speed_m_s: float,
         return 0.0
     f_s = shaft_frequency_hz(entrainment_speed_m_s)
     d, big_d = ball_diameter_m, pitch_diameter_m
-    num = 1.45 * current_a ** 2 * bearing_resistance_ohm * balls_in_zone * (big_d + 2.0 * d)
-    den = (f_s * slip_band_depth_m * ball_density_kg_m3 * specific_heat_j_kg_k * contact_angle_rad
-           * d * d * (big_d + d))
+    num = 1.45 * current_a**2 * bearing_resistance_ohm * balls_in_zone * (big_d + 2.0 * d)
+    den = f_s * slip_band_depth_m * ball_density_kg_m3 * specific_heat_j_kg_k * contact_angle_rad * d * d * (big_d + d)
     return num / den
 
 
@@ -138,8 +141,8 @@ def current_temperature_rise_k(current_a: float, entrainment_speed_m_s: float,
 class HertzScales:
     """Dry Hertz contact of the same load and curvatures: the solver's length/pressure scales."""
 
-    ax_m: float        # semi-axis along x (rolling direction)
-    ay_m: float        # semi-axis along y
+    ax_m: float  # semi-axis along x (rolling direction)
+    ay_m: float  # semi-axis along y
     p_hertz_pa: float  # maximum Hertz pressure
     approach_m: float  # rigid-body approach of the dry contact
 
@@ -172,23 +175,37 @@ def hertz_scales(load_n: float, rx_m: float, ry_m: float, e_prime_pa: float) -> 
     return HertzScales(a_major, b_minor, p0, approach)
 
 
-def hamrock_dowson_film_m(load_n: float, entrainment_speed_m_s: float, *, rx_m: float, ry_m: float,
-                          e_prime_pa: float, eta0_pa_s: float, alpha_pa_inv: float) -> tuple[float, float]:
+def hamrock_dowson_film_m(
+    load_n: float,
+    entrainment_speed_m_s: float,
+    *,
+    rx_m: float,
+    ry_m: float,
+    e_prime_pa: float,
+    eta0_pa_s: float,
+    alpha_pa_inv: float,
+) -> tuple[float, float]:
     """(h_min, h_c) of Hamrock-Dowson (seed 003 ref. [7], seed 000 eq. 6) via twin.physics.ehl."""
     k = (ry_m / rx_m) ** (2.0 / math.pi)
     u = ehl.speed_parameter(eta0_pa_s, entrainment_speed_m_s, e_prime_pa, rx_m)
     w = ehl.load_parameter(load_n, e_prime_pa, rx_m)
     g = alpha_pa_inv * e_prime_pa
-    return (float(ehl.hamrock_dowson_h_min_m(rx_m, u, g, w, k)),
-            float(ehl.hamrock_dowson_h_c_m(rx_m, u, g, w, k)))
+    return (float(ehl.hamrock_dowson_h_min_m(rx_m, u, g, w, k)), float(ehl.hamrock_dowson_h_c_m(rx_m, u, g, w, k)))
 
 
-def moes_parameters(load_n: float, entrainment_speed_m_s: float, *, rx_m: float, e_prime_pa: float,
-                    eta0_pa_s: float, alpha_pa_inv: float) -> tuple[float, float]:
+def moes_parameters(
+    load_n: float,
+    entrainment_speed_m_s: float,
+    *,
+    rx_m: float,
+    e_prime_pa: float,
+    eta0_pa_s: float,
+    alpha_pa_inv: float,
+) -> tuple[float, float]:
     """Moes dimensionless load M = W (2U)^-3/4 and material L = G (2U)^1/4 (circular contact,
     U on the mean speed): the two numbers that set how hard the EHL problem is."""
     u = eta0_pa_s * entrainment_speed_m_s / (e_prime_pa * rx_m)
-    w = load_n / (e_prime_pa * rx_m ** 2)
+    w = load_n / (e_prime_pa * rx_m**2)
     g = alpha_pa_inv * e_prime_pa
     return w * (2.0 * u) ** -0.75, g * (2.0 * u) ** 0.25
 

@@ -117,7 +117,7 @@ class EHLResult:
     h_c_m: float
     h_min_m: float
     max_pressure_pa: float
-    temperature_rise_k: float          # mean over the Hertzian contact area (eq. 6 + eq. 10)
+    temperature_rise_k: float  # mean over the Hertzian contact area (eq. 6 + eq. 10)
     current_temperature_rise_k: float  # eq. 10 part alone
     converged: bool
     iterations: int
@@ -137,13 +137,17 @@ class EHLResult:
     def summary(self) -> dict:
         """Scalars only (JSON-ready)."""
         return {
-            "h_min_m": self.h_min_m, "h_c_m": self.h_c_m, "max_pressure_pa": self.max_pressure_pa,
+            "h_min_m": self.h_min_m,
+            "h_c_m": self.h_c_m,
+            "max_pressure_pa": self.max_pressure_pa,
             "temperature_rise_k": self.temperature_rise_k,
             "current_temperature_rise_k": self.current_temperature_rise_k,
-            "converged": self.converged, "iterations": self.iterations,
+            "converged": self.converged,
+            "iterations": self.iterations,
             "hamrock_dowson_h_min_m": self.hamrock_dowson_h_min_m,
             "hamrock_dowson_h_c_m": self.hamrock_dowson_h_c_m,
-            "hertz_pressure_pa": self.hertz.get("p_hertz_pa"), "message": self.message,
+            "hertz_pressure_pa": self.hertz.get("p_hertz_pa"),
+            "message": self.message,
             "wall_time_s": self.wall_time_s,
         }
 
@@ -160,8 +164,17 @@ class _Level:
         self.y = y0 + self.hy * np.arange(n)
         b = (rx_m / ry_m) * (hz.ay_m / hz.ax_m) ** 2
         self.gap = 0.5 * self.x[:, None] ** 2 + 0.5 * b * self.y[None, :] ** 2
-        self.defl = Deflection(n, n, self.hx, self.hy, ax_m=hz.ax_m, ay_m=hz.ay_m, rx_m=rx_m,
-                               p_hertz_pa=hz.p_hertz_pa, e_prime_pa=e_prime_pa)
+        self.defl = Deflection(
+            n,
+            n,
+            self.hx,
+            self.hy,
+            ax_m=hz.ax_m,
+            ay_m=hz.ay_m,
+            rx_m=rx_m,
+            p_hertz_pa=hz.p_hertz_pa,
+            e_prime_pa=e_prime_pa,
+        )
         self.kc = self.defl.coef
         shape = (n, n)
         self.p = np.zeros(shape)
@@ -187,9 +200,14 @@ class _Level:
 def _restrict_full_weighting(r: np.ndarray, out: np.ndarray) -> None:
     out[:] = 0.0
     c = r[2:-2:2, 2:-2:2]
-    out[1:-1, 1:-1] = (4.0 * c
-                       + 2.0 * (r[1:-3:2, 2:-2:2] + r[3:-1:2, 2:-2:2] + r[2:-2:2, 1:-3:2] + r[2:-2:2, 3:-1:2])
-                       + r[1:-3:2, 1:-3:2] + r[3:-1:2, 1:-3:2] + r[1:-3:2, 3:-1:2] + r[3:-1:2, 3:-1:2]) / 16.0
+    out[1:-1, 1:-1] = (
+        4.0 * c
+        + 2.0 * (r[1:-3:2, 2:-2:2] + r[3:-1:2, 2:-2:2] + r[2:-2:2, 1:-3:2] + r[2:-2:2, 3:-1:2])
+        + r[1:-3:2, 1:-3:2]
+        + r[3:-1:2, 1:-3:2]
+        + r[1:-3:2, 3:-1:2]
+        + r[3:-1:2, 3:-1:2]
+    ) / 16.0
 
 
 def _prolong_bilinear(ec: np.ndarray, nf: int) -> np.ndarray:
@@ -204,24 +222,40 @@ def _prolong_bilinear(ec: np.ndarray, nf: int) -> np.ndarray:
 @dataclass
 class _Settings:
     xi_lim: float = 0.3
-    omega_gs: float = 0.5     # 0.7 stagnated on 513 nodes (see the module docstring)
+    omega_gs: float = 0.5  # 0.7 stagnated on 513 nodes (see the module docstring)
     omega_jd: float = 0.25
     nu1: int = 2
     nu2: int = 1
     coarse_sweeps: int = 8
-    gamma: int = 1            # 1: V-cycle, 2: W-cycle
-    h0_gain: float = 0.1      # nested iteration, coarsest grid: H0 += gain delta_H err per sweep
+    gamma: int = 1  # 1: V-cycle, 2: W-cycle
+    h0_gain: float = 0.1  # nested iteration, coarsest grid: H0 += gain delta_H err per sweep
     h0_gain_finest: float = 0.6  # after each cycle: fraction of the dry-contact Newton step
-    xi0: float = 1.0          # wedge blending, kernels.wedge_weight (-1: first-order upwind)
-    omega_t: float = 0.5      # under-relaxation of the temperature field (finest grid)
-    zebra: bool = True        # Jacobi distributive lines in two passes (even, odd)
-    max_step: float = 0.2     # largest pressure change per node and sweep (units of p_hertz)
-    cgc_margin: int = 2       # no coarse-grid correction within this many nodes of P = 0
+    xi0: float = 1.0  # wedge blending, kernels.wedge_weight (-1: first-order upwind)
+    omega_t: float = 0.5  # under-relaxation of the temperature field (finest grid)
+    zebra: bool = True  # Jacobi distributive lines in two passes (even, odd)
+    max_step: float = 0.2  # largest pressure change per node and sweep (units of p_hertz)
+    cgc_margin: int = 2  # no coarse-grid correction within this many nodes of P = 0
 
 
 class _Solver:
-    def __init__(self, n_fine: int, n_coarse: int, domain, hz, *, rx_m, ry_m, e_prime_pa, lam,
-                 ln_eta0, z, s0, theta_i_k, dt_rel, settings: _Settings):
+    def __init__(
+        self,
+        n_fine: int,
+        n_coarse: int,
+        domain,
+        hz,
+        *,
+        rx_m,
+        ry_m,
+        e_prime_pa,
+        lam,
+        ln_eta0,
+        z,
+        s0,
+        theta_i_k,
+        dt_rel,
+        settings: _Settings,
+    ):
         self.levels: list[_Level] = []
         n = n_fine
         while True:
@@ -236,7 +270,7 @@ class _Solver:
         self.barus_alpha = 0.0
         self.incompressible = False
         self.h0 = 0.0
-        self.h_approach = hz.approach_m * rx_m / hz.ax_m ** 2
+        self.h_approach = hz.approach_m * rx_m / hz.ax_m**2
         self.s = settings
         self.bad = 0
         self.zero_pivots = 0
@@ -246,9 +280,23 @@ class _Solver:
         lv.h[:] = self.h0 + lv.gap + lv.defl(lv.p)
 
     def fields(self, lv: _Level) -> None:
-        self.bad += K.update_fields(lv.p, lv.h, lv.dtheta, lv.eta, lv.rho, lv.eps, self.hz.p_hertz_pa,
-                                    self.lam, self.ln_eta0, self.z, self.s0, self.theta_i_k, self.dt_rel,
-                                    self.barus_alpha, self.incompressible)
+        self.bad += K.update_fields(
+            lv.p,
+            lv.h,
+            lv.dtheta,
+            lv.eta,
+            lv.rho,
+            lv.eps,
+            self.hz.p_hertz_pa,
+            self.lam,
+            self.ln_eta0,
+            self.z,
+            self.s0,
+            self.theta_i_k,
+            self.dt_rel,
+            self.barus_alpha,
+            self.incompressible,
+        )
 
     def operator(self, lv: _Level) -> float:
         """Film, fields and residual r = f - L(P); returns sum |r| over nodes with P > 0."""
@@ -262,15 +310,48 @@ class _Solver:
             self.film(lv)
             self.fields(lv)
             K.classify(lv.p, lv.eps, lv.hx, s.xi_lim, lv.kind)
-            self.zero_pivots += K.relax_gs(lv.p, lv.h, lv.rho, lv.eps, lv.f, lv.hx, lv.hy, self.kappa2,
-                                           lv.kc, lv.kind, s.xi0, s.omega_gs, s.max_step, lv.band, lv.rhs, lv.xw)
-            for parity in ((0, 1) if s.zebra else (-1,)):
+            self.zero_pivots += K.relax_gs(
+                lv.p,
+                lv.h,
+                lv.rho,
+                lv.eps,
+                lv.f,
+                lv.hx,
+                lv.hy,
+                self.kappa2,
+                lv.kc,
+                lv.kind,
+                s.xi0,
+                s.omega_gs,
+                s.max_step,
+                lv.band,
+                lv.rhs,
+                lv.xw,
+            )
+            for parity in (0, 1) if s.zebra else (-1,):
                 self.film(lv)
                 self.fields(lv)
                 K.classify(lv.p, lv.eps, lv.hx, s.xi_lim, lv.kind)
-                self.zero_pivots += K.relax_jd(lv.p, lv.h, lv.rho, lv.eps, lv.f, lv.hx, lv.hy, self.kappa2,
-                                               lv.kc, lv.kind, s.xi0, s.omega_jd, s.max_step, lv.band,
-                                               lv.rhs, lv.xw, lv.delta, parity)
+                self.zero_pivots += K.relax_jd(
+                    lv.p,
+                    lv.h,
+                    lv.rho,
+                    lv.eps,
+                    lv.f,
+                    lv.hx,
+                    lv.hy,
+                    self.kappa2,
+                    lv.kc,
+                    lv.kind,
+                    s.xi0,
+                    s.omega_jd,
+                    s.max_step,
+                    lv.band,
+                    lv.rhs,
+                    lv.xw,
+                    lv.delta,
+                    parity,
+                )
             if load_balance:
                 err = (lv.load() - lv.load_target) / lv.load_target
                 self.h0 += s.h0_gain * self.h_approach * err
@@ -326,17 +407,29 @@ def _validate_grid(n: int) -> None:
         raise ValueError(f"grid must be 2^k + 1 with k >= 3 (9, 17, 33, 65, 129, 257, ...), got {n}")
 
 
-def solve_point_contact(load_n: float = prm.LOAD_N,
-                        entrainment_speed_m_s: float = prm.DEFAULT_ENTRAINMENT_SPEED_M_S, *,
-                        rx_m: float = prm.RX_M, ry_m: float = prm.RY_M,
-                        e_prime_pa: float = prm.E_PRIME_PA, eta0_pa_s: float | None = None,
-                        alpha_pa_inv: float = prm.ALPHA_PA_INV, current_a: float = 0.0,
-                        base_temperature_c: float = prm.BASE_TEMPERATURE_C,
-                        bearing_resistance_ohm: float = prm.DEFAULT_BEARING_RESISTANCE_OHM,
-                        thermal: bool | None = None, beta_k_inv: float | None = None,
-                        grid: int = 129, domain=DEFAULT_DOMAIN, tol_p: float = 1e-5,
-                        tol_load: float = 1e-2, max_iter: int = 200, coarsest_grid: int = 17,
-                        rheology: str = "roelands", settings: dict | None = None) -> EHLResult:
+def solve_point_contact(
+    load_n: float = prm.LOAD_N,
+    entrainment_speed_m_s: float = prm.DEFAULT_ENTRAINMENT_SPEED_M_S,
+    *,
+    rx_m: float = prm.RX_M,
+    ry_m: float = prm.RY_M,
+    e_prime_pa: float = prm.E_PRIME_PA,
+    eta0_pa_s: float | None = None,
+    alpha_pa_inv: float = prm.ALPHA_PA_INV,
+    current_a: float = 0.0,
+    base_temperature_c: float = prm.BASE_TEMPERATURE_C,
+    bearing_resistance_ohm: float = prm.DEFAULT_BEARING_RESISTANCE_OHM,
+    thermal: bool | None = None,
+    beta_k_inv: float | None = None,
+    grid: int = 129,
+    domain=DEFAULT_DOMAIN,
+    tol_p: float = 1e-5,
+    tol_load: float = 1e-2,
+    max_iter: int = 200,
+    coarsest_grid: int = 17,
+    rheology: str = "roelands",
+    settings: dict | None = None,
+) -> EHLResult:
     """Steady point-contact EHL (seed 003): pressure and film maps, h_c, h_min, temperature rise.
 
     Defaults are seed 003 Appendix 2 (see params.py). eta0_pa_s=None takes the project's seed-000
@@ -348,8 +441,16 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
     t_start = time.perf_counter()
     _validate_grid(grid)
     _validate_grid(coarsest_grid)
-    if not (load_n > 0 and entrainment_speed_m_s > 0 and rx_m > 0 and ry_m > 0 and e_prime_pa > 0
-            and alpha_pa_inv > 0 and current_a >= 0 and math.isfinite(current_a)):
+    if not (
+        load_n > 0
+        and entrainment_speed_m_s > 0
+        and rx_m > 0
+        and ry_m > 0
+        and e_prime_pa > 0
+        and alpha_pa_inv > 0
+        and current_a >= 0
+        and math.isfinite(current_a)
+    ):
         raise ValueError("load, speed, radii, modulus and alpha must be > 0 and current >= 0")
     if thermal is None:
         thermal = current_a > 0.0
@@ -366,18 +467,38 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
         raise ValueError("Roelands needs eta0 > exp(-9.67) Pa s = 6.3e-5 Pa s")
     z = alpha_pa_inv / (5.1e-9 * (ln_eta0 + 9.67))
     s0 = beta_k_inv * (theta_i_k - 138.0) / (ln_eta0 + 9.67)
-    lam = 12.0 * eta0_pa_s * entrainment_speed_m_s * rx_m ** 2 / (hz.ax_m ** 3 * hz.p_hertz_pa)
+    lam = 12.0 * eta0_pa_s * entrainment_speed_m_s * rx_m**2 / (hz.ax_m**3 * hz.p_hertz_pa)
     dt_rel = prm.DENSITY_TEMPERATURE_KG_M3_K / prm.OIL_DENSITY_KG_M3
-    h_scale = hz.ax_m ** 2 / rx_m  # h [m] = H h_scale
-    current_rise = (prm.current_temperature_rise_k(current_a, entrainment_speed_m_s, bearing_resistance_ohm)
-                    if thermal else 0.0)
-    hd_min, hd_c = prm.hamrock_dowson_film_m(load_n, entrainment_speed_m_s, rx_m=rx_m, ry_m=ry_m,
-                                             e_prime_pa=e_prime_pa, eta0_pa_s=eta0_pa_s,
-                                             alpha_pa_inv=alpha_pa_inv)
+    h_scale = hz.ax_m**2 / rx_m  # h [m] = H h_scale
+    current_rise = (
+        prm.current_temperature_rise_k(current_a, entrainment_speed_m_s, bearing_resistance_ohm) if thermal else 0.0
+    )
+    hd_min, hd_c = prm.hamrock_dowson_film_m(
+        load_n,
+        entrainment_speed_m_s,
+        rx_m=rx_m,
+        ry_m=ry_m,
+        e_prime_pa=e_prime_pa,
+        eta0_pa_s=eta0_pa_s,
+        alpha_pa_inv=alpha_pa_inv,
+    )
     st = _Settings(**(settings or {}))
-    solver = _Solver(grid, coarsest_grid, domain, hz, rx_m=rx_m, ry_m=ry_m, e_prime_pa=e_prime_pa,
-                     lam=lam, ln_eta0=ln_eta0, z=z, s0=s0, theta_i_k=theta_i_k, dt_rel=dt_rel,
-                     settings=st)
+    solver = _Solver(
+        grid,
+        coarsest_grid,
+        domain,
+        hz,
+        rx_m=rx_m,
+        ry_m=ry_m,
+        e_prime_pa=e_prime_pa,
+        lam=lam,
+        ln_eta0=ln_eta0,
+        z=z,
+        s0=s0,
+        theta_i_k=theta_i_k,
+        dt_rel=dt_rel,
+        settings=st,
+    )
     if rheology == "barus_incompressible":
         solver.barus_alpha = alpha_pa_inv
         solver.incompressible = True
@@ -386,15 +507,29 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
     levels = solver.levels
     target = load_n / (hz.p_hertz_pa * hz.ax_m * hz.ay_m)
     inputs = {
-        "load_n": load_n, "entrainment_speed_m_s": entrainment_speed_m_s, "rx_m": rx_m, "ry_m": ry_m,
-        "e_prime_pa": e_prime_pa, "eta0_pa_s": eta0_pa_s, "alpha_pa_inv": alpha_pa_inv,
-        "current_a": current_a, "base_temperature_c": base_temperature_c,
-        "bearing_resistance_ohm": bearing_resistance_ohm, "thermal": bool(thermal),
-        "beta_k_inv": beta_k_inv, "grid": grid, "domain_hertz_radii": list(domain),
-        "rheology": rheology, "tol_p": tol_p, "tol_load": tol_load, "max_iter": max_iter, "coarsest_grid": levels[-1].n,
+        "load_n": load_n,
+        "entrainment_speed_m_s": entrainment_speed_m_s,
+        "rx_m": rx_m,
+        "ry_m": ry_m,
+        "e_prime_pa": e_prime_pa,
+        "eta0_pa_s": eta0_pa_s,
+        "alpha_pa_inv": alpha_pa_inv,
+        "current_a": current_a,
+        "base_temperature_c": base_temperature_c,
+        "bearing_resistance_ohm": bearing_resistance_ohm,
+        "thermal": bool(thermal),
+        "beta_k_inv": beta_k_inv,
+        "grid": grid,
+        "domain_hertz_radii": list(domain),
+        "rheology": rheology,
+        "tol_p": tol_p,
+        "tol_load": tol_load,
+        "max_iter": max_iter,
+        "coarsest_grid": levels[-1].n,
         "thermal_expansion_per_k": prm.THERMAL_EXPANSION_PER_K,
         "oil_conductivity_w_m_k": prm.OIL_CONDUCTIVITY_W_M_K,
-        "density_temperature_rel_per_k": dt_rel, "shaft_frequency_hz": prm.shaft_frequency_hz(entrainment_speed_m_s),
+        "density_temperature_rel_per_k": dt_rel,
+        "shaft_frequency_hz": prm.shaft_frequency_hz(entrainment_speed_m_s),
     }
     hertz = {"ax_m": hz.ax_m, "ay_m": hz.ay_m, "p_hertz_pa": hz.p_hertz_pa, "approach_m": hz.approach_m}
 
@@ -410,9 +545,21 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
         if lv is not levels[0]:
             lv.dtheta[:] = current_rise
             return 0, 0.0
-        capped = K.temperature_field(lv.p, lv.h, t_work, hz.p_hertz_pa, h_scale, entrainment_speed_m_s,
-                                     theta_i_k, prm.THERMAL_EXPANSION_PER_K, hz.ax_m, eta0_pa_s,
-                                     prm.OIL_CONDUCTIVITY_W_M_K, current_rise, TEMPERATURE_CAP_K)
+        capped = K.temperature_field(
+            lv.p,
+            lv.h,
+            t_work,
+            hz.p_hertz_pa,
+            h_scale,
+            entrainment_speed_m_s,
+            theta_i_k,
+            prm.THERMAL_EXPANSION_PER_K,
+            hz.ax_m,
+            eta0_pa_s,
+            prm.OIL_CONDUCTIVITY_W_M_K,
+            current_rise,
+            TEMPERATURE_CAP_K,
+        )
         change = t_work - lv.dtheta
         lv.dtheta += st.omega_t * change
         return capped, float(np.abs(change).max())
@@ -426,8 +573,16 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
     solver.h0 = hd_c / h_scale - coarse.h[ic, jc]
 
     history: dict[str, list[float]] = {
-        "dp": [], "load_error": [], "residual": [], "h0": [], "h_c_m": [], "h_min_m": [], "level_n": [],
-        "capped_temperature_nodes": [], "temperature_change_k": []}
+        "dp": [],
+        "load_error": [],
+        "residual": [],
+        "h0": [],
+        "h_c_m": [],
+        "h_min_m": [],
+        "level_n": [],
+        "capped_temperature_nodes": [],
+        "temperature_change_k": [],
+    }
     message = ""
     converged = False
     iterations = 0
@@ -461,8 +616,10 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
                 iterations = it + 1
                 solver.fields(lv)
                 K.residual(lv.p, lv.h, lv.rho, lv.eps, lv.f, lv.hx, lv.hy, solver.kappa2, st.xi0, lv.r)
-                res = K.natural_residual(lv.p, lv.h, lv.rho, lv.eps, lv.r, lv.hx, lv.hy, solver.kappa2,
-                                         lv.kc, st.xi0) / psum
+                res = (
+                    K.natural_residual(lv.p, lv.h, lv.rho, lv.eps, lv.r, lv.hx, lv.hy, solver.kappa2, lv.kc, st.xi0)
+                    / psum
+                )
                 history["dp"].append(dp)
                 history["load_error"].append(load_err)
                 history["residual"].append(res)
@@ -482,8 +639,10 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
                     converged = True
                     break
                 if _stagnated(history["dp"], tol_p):
-                    message = (f"stagnated: pressure change per cycle stays near {dp:.1e} "
-                               f"(tolerance {tol_p:.0e}) over the last {STAGNATION_WINDOW} cycles")
+                    message = (
+                        f"stagnated: pressure change per cycle stays near {dp:.1e} "
+                        f"(tolerance {tol_p:.0e}) over the last {STAGNATION_WINDOW} cycles"
+                    )
                     break
             if not math.isfinite(psum) or solver.bad:
                 message = "non-finite values (diverged)"
@@ -512,12 +671,26 @@ def solve_point_contact(load_n: float = prm.LOAD_N,
     if not converged:  # no number that looks like an answer; the maps stay for diagnosis
         h_c = h_min = p_max = mean_rise = float("nan")
     return EHLResult(
-        pressure_pa=p_pa, film_m=h_m, temperature_rise_map_k=fine.dtheta.copy(),
-        x_m=fine.x * hz.ax_m, y_m=fine.y * hz.ay_m, h_c_m=h_c, h_min_m=h_min, max_pressure_pa=p_max,
-        temperature_rise_k=mean_rise, current_temperature_rise_k=current_rise, converged=converged,
-        iterations=iterations, history=history, inputs=inputs, hertz=hertz,
-        hamrock_dowson_h_min_m=hd_min, hamrock_dowson_h_c_m=hd_c, message=message,
-        wall_time_s=time.perf_counter() - t_start)
+        pressure_pa=p_pa,
+        film_m=h_m,
+        temperature_rise_map_k=fine.dtheta.copy(),
+        x_m=fine.x * hz.ax_m,
+        y_m=fine.y * hz.ay_m,
+        h_c_m=h_c,
+        h_min_m=h_min,
+        max_pressure_pa=p_max,
+        temperature_rise_k=mean_rise,
+        current_temperature_rise_k=current_rise,
+        converged=converged,
+        iterations=iterations,
+        history=history,
+        inputs=inputs,
+        hertz=hertz,
+        hamrock_dowson_h_min_m=hd_min,
+        hamrock_dowson_h_c_m=hd_c,
+        message=message,
+        wall_time_s=time.perf_counter() - t_start,
+    )
 
 
 def _stagnated(dps: list, tol_p: float) -> bool:
@@ -540,5 +713,9 @@ def _centre_value(lv: _Level) -> float:
     j = min(max(j, 0), lv.n - 2)
     tx, ty = fx - i, fy - j
     h = lv.h
-    return float((1 - tx) * (1 - ty) * h[i, j] + tx * (1 - ty) * h[i + 1, j]
-                 + (1 - tx) * ty * h[i, j + 1] + tx * ty * h[i + 1, j + 1])
+    return float(
+        (1 - tx) * (1 - ty) * h[i, j]
+        + tx * (1 - ty) * h[i + 1, j]
+        + (1 - tx) * ty * h[i, j + 1]
+        + tx * ty * h[i + 1, j + 1]
+    )

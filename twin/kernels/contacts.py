@@ -13,11 +13,57 @@ from numba import njit
 
 from twin.jit import JIT, JIT_VECTOR
 from twin.kernels.layout import (
-    C_FLUID_DAMPING, C_LAMBDA, C_MU, C_ROLLING_PER_SPEED, C_SPIN_MOMENT, C_TANGENT_DAMPING, CW,
-    C_XI_DECAY, G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY, K_OVZ,
-    K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_GROOVE_CENTRE_RADIUS,
-    M_GROOVE_CENTRE_Z, M_GROOVE_CLEARANCE, M_STIFFNESS, O_EX, O_NORMAL_RATE, O_EY, O_EZ, O_FX, O_FY, O_FZ,
-    O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ, T_XI0, T_XI1, T_XI2,
+    C_FLUID_DAMPING,
+    C_LAMBDA,
+    C_MU,
+    C_ROLLING_PER_SPEED,
+    C_SPIN_MOMENT,
+    C_TANGENT_DAMPING,
+    CW,
+    C_XI_DECAY,
+    G_DELTA,
+    G_LOAD,
+    G_NX,
+    G_NY,
+    G_NZ,
+    G_SQRT_DELTA,
+    K_BX,
+    K_BY,
+    K_ORBIT,
+    K_OVX,
+    K_OVY,
+    K_OVZ,
+    K_PX,
+    K_PY,
+    K_PZ,
+    K_SPIN,
+    K_VX,
+    K_VY,
+    K_VZ,
+    K_WX,
+    K_WY,
+    K_WZ,
+    M_GROOVE_CENTRE_RADIUS,
+    M_GROOVE_CENTRE_Z,
+    M_GROOVE_CLEARANCE,
+    M_STIFFNESS,
+    O_EX,
+    O_NORMAL_RATE,
+    O_EY,
+    O_EZ,
+    O_FX,
+    O_FY,
+    O_FZ,
+    O_RING_TZ,
+    O_SX,
+    O_SY,
+    O_SZ,
+    O_TX,
+    O_TY,
+    O_TZ,
+    T_XI0,
+    T_XI1,
+    T_XI2,
 )
 
 
@@ -219,8 +265,7 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
 
 
 @njit(inline="always", **JIT)
-def cage_contact(bx, by, bz, bvx, bvy, bvz, ex, ey, cage_speed, contact_distance, k_cage,
-                 reduced_mass):
+def cage_contact(bx, by, bz, bvx, bvy, bvz, ex, ey, cage_speed, contact_distance, k_cage, reduced_mass):
     """Ball (centre b, velocity bv) against a cage element centred at (ex, ey, 0) on the cage
     turning at cage_speed: Q = K delta^1.5 (seed 000 eq. 3) with critical damping and no
     friction (seed 000 section 2.1). Returns (force on the ball [N], nx, ny, nz: unit vector

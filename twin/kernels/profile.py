@@ -13,7 +13,14 @@ from numba import njit
 
 from twin.jit import JIT
 from twin.kernels.layout import (
-    CW, G_DEFECT_DROP, K_PX, K_PY, P_BALL_SIZE, P_PROFILE_INNER, P_PROFILE_OUTER, PROFILE_POINTS,
+    CW,
+    G_DEFECT_DROP,
+    K_PX,
+    K_PY,
+    P_BALL_SIZE,
+    P_PROFILE_INNER,
+    P_PROFILE_OUTER,
+    PROFILE_POINTS,
 )
 from twin.vibration.surface import SurfaceProfile, ball_radius_offsets_m, race_profile_m
 
@@ -25,21 +32,31 @@ _INV_TWO_PI = 1.0 / (2.0 * math.pi)
 def write_profile_params(p: np.ndarray, profile: SurfaceProfile, geometry) -> None:
     """The profile tables and the ball radius offsets into the model vector p (P_PROFILE_*,
     P_BALL_SIZE); all zero when the profile is off."""
-    p[P_BALL_SIZE:P_PROFILE_OUTER + PROFILE_POINTS] = 0.0
+    p[P_BALL_SIZE : P_PROFILE_OUTER + PROFILE_POINTS] = 0.0
     if not profile.enabled:
         return
     rng = np.random.default_rng(profile.seed)
-    p[P_PROFILE_INNER:P_PROFILE_INNER + PROFILE_POINTS] = race_profile_m(
-        profile.race_profile_rms_m, geometry.inner_raceway_radius_m, profile.shortest_wavelength_m, rng)
-    p[P_PROFILE_OUTER:P_PROFILE_OUTER + PROFILE_POINTS] = race_profile_m(
-        profile.race_profile_rms_m, geometry.outer_raceway_radius_m, profile.shortest_wavelength_m, rng)
+    p[P_PROFILE_INNER : P_PROFILE_INNER + PROFILE_POINTS] = race_profile_m(
+        profile.race_profile_rms_m, geometry.inner_raceway_radius_m, profile.shortest_wavelength_m, rng
+    )
+    p[P_PROFILE_OUTER : P_PROFILE_OUTER + PROFILE_POINTS] = race_profile_m(
+        profile.race_profile_rms_m, geometry.outer_raceway_radius_m, profile.shortest_wavelength_m, rng
+    )
     z = geometry.ball_count
-    p[P_BALL_SIZE:P_BALL_SIZE + z] = ball_radius_offsets_m(profile.ball_diameter_spread_m, z, rng)
+    p[P_BALL_SIZE : P_BALL_SIZE + z] = ball_radius_offsets_m(profile.ball_diameter_spread_m, z, rng)
 
 
 # Abramowitz & Stegun 4.4.49: atan x = x (1 + sum a_2k x^2k), 0 <= x <= 1, |error| <= 2e-8 rad
-_ATAN_COEFFS = (-0.3333314528, 0.1999355085, -0.1420889944, 0.1065626393,
-                -0.0752896400, 0.0429096138, -0.0161657367, 0.0028662257)
+_ATAN_COEFFS = (
+    -0.3333314528,
+    0.1999355085,
+    -0.1420889944,
+    0.1065626393,
+    -0.0752896400,
+    0.0429096138,
+    -0.0161657367,
+    0.0028662257,
+)
 _A2, _A4, _A6, _A8, _A10, _A12, _A14, _A16 = _ATAN_COEFFS
 
 
@@ -55,8 +72,9 @@ def azimuth_rad(y, x):
     swap = ay > ax
     t = ax / ay if swap else ay / ax
     t2 = t * t
-    a = t * (1.0 + t2 * (_A2 + t2 * (_A4 + t2 * (_A6 + t2 * (_A8 + t2 * (_A10 + t2 * (_A12 + t2 * (
-        _A14 + t2 * _A16))))))))
+    a = t * (
+        1.0 + t2 * (_A2 + t2 * (_A4 + t2 * (_A6 + t2 * (_A8 + t2 * (_A10 + t2 * (_A12 + t2 * (_A14 + t2 * _A16)))))))
+    )
     if swap:
         a = 0.5 * math.pi - a
     if x < 0.0:

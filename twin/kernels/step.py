@@ -12,27 +12,138 @@ from numba import njit
 from twin.jit import JIT, JIT_STEP
 from twin.kernels.contacts import cage_contact, raceway_forces, raceway_geometry
 from twin.kernels.layout import (
-    A_STIFFNESS, A_TRIBOLOGY, ANGLE_INV_STEP, ANGLE_MAX_SIN, ANGLE_POINTS, G_NZ,
-    C_CAPACITANCE, C_ENTRAINMENT, C_XI_DECAY, C_FLUID_DAMPING, C_RESISTANCE, C_H_C, C_H_MIN, C_LAMBDA, C_LOAD, C_MU, C_REGIME,
-    C_ROLLING_FORCE, C_ROLLING_PER_SPEED, C_SEMI_MAJOR, C_SEMI_MINOR, C_SPIN_MOMENT, C_SRR,
-    C_TANGENT_DAMPING, CW, G_DELTA, M_GROOVE_CLEARANCE, O_NORMAL_RATE, H_LOAD, H_SIN_ANGLE, H_SPEED, H_STAMP, G_LOAD, G_SQRT_DELTA, K_BX, K_BY, K_ORBIT, K_OVX, K_OVY,
-    G_NX, G_NY, K_OVZ, K_PX, K_PY, K_PZ, K_SPIN, K_VX, K_VY, K_VZ, K_WX, K_WY, K_WZ, M_STIFFNESS, N_CACHED,
-    O_EX, O_EY, O_EZ, O_FX, O_FY, O_FZ, O_RING_TZ, O_SX, O_SY, O_SZ, O_TX, O_TY, O_TZ,
-    P_ALPHA_E, P_BALL_INERTIA, P_BALL_MASS, P_BALL_RADIUS, P_BALL_REDUCED_TANGENT_MASS,
-    P_CAGE_CONTACT_DISTANCE, P_CAGE_INERTIA, P_CAGE_STEP_COS, P_CAGE_STEP_SIN, P_CAGE_RADIUS, P_CAGE_REDUCED_MASS,
-    P_CAGE_STIFFNESS, P_CENTRED_REFRESH, P_CT_RATIO, P_DT, P_FRICTION_MODEL, P_KT_RATIO, P_MAX_PENETRATION, P_RAMP,
-    P_ASPERITY_RESISTANCE, P_GAP_LIMIT, P_GAP_LIMIT_OUTER, P_LIMITING_SHEAR, P_LN_ROUGHNESS, P_OIL_PERMITTIVITY, P_OIL_RESISTIVITY,
-    P_RING_MASS, P_ROLLING, LANE_BLOCK, P_ROUGHNESS, P_SUBSTEPS, P_TRACTION_EVERY, S_AXIAL_LOAD, S_RADIAL_LOAD, S_SHAFT_SPEED,
-    S_STOP, S_VISCOSITY, STATUS_NOT_FINITE, STATUS_OK, STATUS_PENETRATION, X_CAGE_ANGLE, X_CAGE_SPEED,
-    X_CAGE_TORQUE, X_DRIVE_TORQUE, X_MAX_PENETRATION, X_SHAFT_ANGLE, X_SHAFT_SPEED, X_STEP, X_TIME,
-    X_TORQUE_COUNT, X_TORQUE_SUM,
+    A_STIFFNESS,
+    A_TRIBOLOGY,
+    ANGLE_INV_STEP,
+    ANGLE_MAX_SIN,
+    ANGLE_POINTS,
+    G_NZ,
+    C_CAPACITANCE,
+    C_ENTRAINMENT,
+    C_XI_DECAY,
+    C_FLUID_DAMPING,
+    C_RESISTANCE,
+    C_H_C,
+    C_H_MIN,
+    C_LAMBDA,
+    C_LOAD,
+    C_MU,
+    C_REGIME,
+    C_ROLLING_FORCE,
+    C_ROLLING_PER_SPEED,
+    C_SEMI_MAJOR,
+    C_SEMI_MINOR,
+    C_SPIN_MOMENT,
+    C_SRR,
+    C_TANGENT_DAMPING,
+    CW,
+    G_DELTA,
+    M_GROOVE_CLEARANCE,
+    O_NORMAL_RATE,
+    H_LOAD,
+    H_SIN_ANGLE,
+    H_SPEED,
+    H_STAMP,
+    G_LOAD,
+    G_SQRT_DELTA,
+    K_BX,
+    K_BY,
+    K_ORBIT,
+    K_OVX,
+    K_OVY,
+    G_NX,
+    G_NY,
+    K_OVZ,
+    K_PX,
+    K_PY,
+    K_PZ,
+    K_SPIN,
+    K_VX,
+    K_VY,
+    K_VZ,
+    K_WX,
+    K_WY,
+    K_WZ,
+    M_STIFFNESS,
+    N_CACHED,
+    O_EX,
+    O_EY,
+    O_EZ,
+    O_FX,
+    O_FY,
+    O_FZ,
+    O_RING_TZ,
+    O_SX,
+    O_SY,
+    O_SZ,
+    O_TX,
+    O_TY,
+    O_TZ,
+    P_ALPHA_E,
+    P_BALL_INERTIA,
+    P_BALL_MASS,
+    P_BALL_RADIUS,
+    P_BALL_REDUCED_TANGENT_MASS,
+    P_CAGE_CONTACT_DISTANCE,
+    P_CAGE_INERTIA,
+    P_CAGE_STEP_COS,
+    P_CAGE_STEP_SIN,
+    P_CAGE_RADIUS,
+    P_CAGE_REDUCED_MASS,
+    P_CAGE_STIFFNESS,
+    P_CENTRED_REFRESH,
+    P_CT_RATIO,
+    P_DT,
+    P_FRICTION_MODEL,
+    P_KT_RATIO,
+    P_MAX_PENETRATION,
+    P_RAMP,
+    P_ASPERITY_RESISTANCE,
+    P_GAP_LIMIT,
+    P_GAP_LIMIT_OUTER,
+    P_LIMITING_SHEAR,
+    P_LN_ROUGHNESS,
+    P_OIL_PERMITTIVITY,
+    P_OIL_RESISTIVITY,
+    P_RING_MASS,
+    P_ROLLING,
+    LANE_BLOCK,
+    P_ROUGHNESS,
+    P_SUBSTEPS,
+    P_TRACTION_EVERY,
+    S_AXIAL_LOAD,
+    S_RADIAL_LOAD,
+    S_SHAFT_SPEED,
+    S_STOP,
+    S_VISCOSITY,
+    STATUS_NOT_FINITE,
+    STATUS_OK,
+    STATUS_PENETRATION,
+    X_CAGE_ANGLE,
+    X_CAGE_SPEED,
+    X_CAGE_TORQUE,
+    X_DRIVE_TORQUE,
+    X_MAX_PENETRATION,
+    X_SHAFT_ANGLE,
+    X_SHAFT_SPEED,
+    X_STEP,
+    X_TIME,
+    X_TORQUE_COUNT,
+    X_TORQUE_SUM,
 )
 from twin.kernels.traction import apply_traction_moments, ellipse_traction, limiting_traction_coefficient_share
 from twin.kernels.tribology import T_RX, T_RY, contact_electrical, contact_tribology
 from twin.physics.rolling import asperity_load_share_ln
 from twin.kernels.layout import P_PROFILE_ON, P_VIB, V_DECIMATION_RATIO, V_HOUSING_ON, X_DEFECT_COUNT
-from twin.kernels.vibration import (apply_clearances, defect_table, has_ball_defect, integrate_orientations,
-                                    orientations, outer_ring_force, shift_frame)
+from twin.kernels.vibration import (
+    apply_clearances,
+    defect_table,
+    has_ball_defect,
+    integrate_orientations,
+    orientations,
+    outer_ring_force,
+    shift_frame,
+)
 from twin.vibration.housing import housing_accelerations, housing_close, housing_kick_drift
 from twin.vibration.signal import sensor_push_direct
 
@@ -57,7 +168,9 @@ ELECTRICAL_EVERY = 5
 
 FRICTION_ELLIPSE = 2
 
-SMALL_ANGLE = 1e-2  # [rad] below it `_cos_sin` takes the series  # P_FRICTION_MODEL code of the friction over the contact ellipse
+SMALL_ANGLE = (
+    1e-2  # [rad] below it `_cos_sin` takes the series  # P_FRICTION_MODEL code of the friction over the contact ellipse
+)
 
 
 @njit(inline="always", **JIT)
@@ -173,8 +286,7 @@ def refresh_contact(p, tr, w, c, q_now, eta, electrical_now, stamp):
     ey = w[O_EY * CW + c]
     ez = w[O_EZ * CW + c]
     u2 = ex * ex + ey * ey + ez * ez
-    q_el, u, sin_a = centred_inputs(p, w, c, q_now, math.sqrt(u2), min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN),
-                                    stamp)
+    q_el, u, sin_a = centred_inputs(p, w, c, q_now, math.sqrt(u2), min(abs(w[G_NZ * CW + c]), ANGLE_MAX_SIN), stamp)
     # Hertz and film constants at the contact's (centred) angle (angle table row i, i + 1)
     xa = sin_a * ANGLE_INV_STEP
     ia = min(int(xa), ANGLE_POINTS - 2)
@@ -182,14 +294,28 @@ def refresh_contact(p, tr, w, c, q_now, eta, electrical_now, stamp):
     w[M_STIFFNESS * CW + c] = _at_angle(tr, r, ia, fa, A_STIFFNESS)
     t = A_TRIBOLOGY
     tri = contact_tribology(
-        q_el, u, eta, p[P_ROUGHNESS], _at_angle(tr, r, ia, fa, t), _at_angle(tr, r, ia, fa, t + 1),
-        _at_angle(tr, r, ia, fa, t + 2), _at_angle(tr, r, ia, fa, t + 3),
-        _at_angle(tr, r, ia, fa, t + 4), _at_angle(tr, r, ia, fa, t + 5),
-        _at_angle(tr, r, ia, fa, t + 6), _at_angle(tr, r, ia, fa, t + 7),
-        _at_angle(tr, r, ia, fa, t + 8), _at_angle(tr, r, ia, fa, t + 9),
-        _at_angle(tr, r, ia, fa, t + 10), _at_angle(tr, r, ia, fa, t + 11),
-        _at_angle(tr, r, ia, fa, t + 12), _at_angle(tr, r, ia, fa, t + 13),
-        _at_angle(tr, r, ia, fa, t + 14), friction_model, p[P_ROLLING] != 0.0)
+        q_el,
+        u,
+        eta,
+        p[P_ROUGHNESS],
+        _at_angle(tr, r, ia, fa, t),
+        _at_angle(tr, r, ia, fa, t + 1),
+        _at_angle(tr, r, ia, fa, t + 2),
+        _at_angle(tr, r, ia, fa, t + 3),
+        _at_angle(tr, r, ia, fa, t + 4),
+        _at_angle(tr, r, ia, fa, t + 5),
+        _at_angle(tr, r, ia, fa, t + 6),
+        _at_angle(tr, r, ia, fa, t + 7),
+        _at_angle(tr, r, ia, fa, t + 8),
+        _at_angle(tr, r, ia, fa, t + 9),
+        _at_angle(tr, r, ia, fa, t + 10),
+        _at_angle(tr, r, ia, fa, t + 11),
+        _at_angle(tr, r, ia, fa, t + 12),
+        _at_angle(tr, r, ia, fa, t + 13),
+        _at_angle(tr, r, ia, fa, t + 14),
+        friction_model,
+        p[P_ROLLING] != 0.0,
+    )
     w[C_H_MIN * CW + c] = tri[0]
     w[C_H_C * CW + c] = tri[1]
     w[C_LAMBDA * CW + c] = tri[2]
@@ -215,20 +341,32 @@ def refresh_contact(p, tr, w, c, q_now, eta, electrical_now, stamp):
     # and by the spin sliding of the contact, kt |w_spin| sqrt(a b) / (1.3 mu Q) with mu the
     # limiting coefficient of the fully sliding traction (mu_lim)
     ab = math.sqrt(tri[5] * tri[6])
-    spin_rel = abs(w[K_WX * CW + c] * w[G_NX * CW + c] + w[K_WY * CW + c] * w[G_NY * CW + c]
-                   + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c])
+    spin_rel = abs(
+        w[K_WX * CW + c] * w[G_NX * CW + c]
+        + w[K_WY * CW + c] * w[G_NY * CW + c]
+        + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * w[G_NZ * CW + c]
+    )
     relax = u / ab + kt * spin_rel * ab / max(SPIN_CREEP_FACTOR * mu_lim * q_el, 1e-12)
     w[C_XI_DECAY * CW + c] = 1.0 / (1.0 + relax * p[P_DT])
-    w[C_SRR * CW + c] = ((w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey
-                          + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0)
+    w[C_SRR * CW + c] = (
+        (w[O_SX * CW + c] * ex + w[O_SY * CW + c] * ey + w[O_SZ * CW + c] * ez) / u2 if u2 > 0.0 else 0.0
+    )
     if not (electrical_now or w[C_CAPACITANCE * CW + c] == 0.0):
         return  # the RC keeps its last value between electrical refreshes
     if tri[1] > 0.0:
         res_ohm, cap_f = contact_electrical(
-            q_el, tri[2], tri[1], tri[5], tri[6], _at_angle(tr, r, ia, fa, t + T_RX),
+            q_el,
+            tri[2],
+            tri[1],
+            tri[5],
+            tri[6],
+            _at_angle(tr, r, ia, fa, t + T_RX),
             _at_angle(tr, r, ia, fa, t + T_RY),
-            p[P_OIL_PERMITTIVITY], p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER], p[P_ASPERITY_RESISTANCE],
-            p[P_OIL_RESISTIVITY])
+            p[P_OIL_PERMITTIVITY],
+            p[P_GAP_LIMIT] if r == 0 else p[P_GAP_LIMIT_OUTER],
+            p[P_ASPERITY_RESISTANCE],
+            p[P_OIL_RESISTIVITY],
+        )
     else:  # no film (no entrainment): metallic contact, no dielectric
         res_ohm, cap_f = p[P_ASPERITY_RESISTANCE], 0.0
     w[C_RESISTANCE * CW + c] = res_ohm
@@ -369,8 +507,9 @@ def ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st):
         for slot in range(2):
             ex = rc * (next_c if slot == 0 else prev_c)
             ey = rc * (next_s if slot == 0 else prev_s)
-            f, nx, ny, nz = cage_contact(bx[j, 0], bx[j, 1], bx[j, 2], v0, v1,
-                                         bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage)
+            f, nx, ny, nz = cage_contact(
+                bx[j, 0], bx[j, 1], bx[j, 2], v0, v1, bv[j, 2], ex, ey, cage_speed, s_cage, k_cage, m_cage
+            )
             cage_load[j, slot] = f
             fx += f * nx
             fy += f * ny
@@ -385,8 +524,28 @@ def ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st):
 
 
 @njit(inline="always", **JIT_STEP)
-def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                          tribology_now, electrical_now, traction_now, ct, st, stamp):
+def compute_accelerations(
+    p,
+    tr,
+    sp,
+    scal,
+    bx,
+    bv,
+    bw,
+    ba,
+    balpha,
+    rx,
+    rv,
+    ra,
+    w,
+    cage_load,
+    tribology_now,
+    electrical_now,
+    traction_now,
+    ct,
+    st,
+    stamp,
+):
     """Forces and torques of every contact at the current positions -> accelerations of the
     balls (seed 000 eq. 9), the inner ring (translation) and the cage (rotation).
 
@@ -440,16 +599,20 @@ def compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w
         if traction_now:
             ellipse_traction(w, nc, p, eta, kt_ratio, inertia, p[P_DT])
         apply_traction_moments(w, nl)
-    ring_fx, ring_fy, ring_fz, ring_tz, cage_tz = ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w,
-                                                                      cage_load, ct, st)
+    ring_fx, ring_fy, ring_fz, ring_tz, cage_tz = ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st)
     inv_mr = 1.0 / p[P_RING_MASS]
     ra[0] = (ring_fx + sp[S_RADIAL_LOAD]) * inv_mr
     ra[1] = ring_fy * inv_mr
     ra[2] = (ring_fz + sp[S_AXIAL_LOAD]) * inv_mr
     scal[X_DRIVE_TORQUE] = -ring_tz
     scal[X_CAGE_TORQUE] = cage_tz
-    if not (math.isfinite(ra[0]) and math.isfinite(ra[1]) and math.isfinite(ra[2])
-            and math.isfinite(cage_tz) and math.isfinite(ring_tz)):
+    if not (
+        math.isfinite(ra[0])
+        and math.isfinite(ra[1])
+        and math.isfinite(ra[2])
+        and math.isfinite(cage_tz)
+        and math.isfinite(ring_tz)
+    ):
         return STATUS_NOT_FINITE
     if max_pen > p[P_MAX_PENETRATION]:
         return STATUS_PENETRATION
@@ -540,11 +703,28 @@ def step_n(model, state, setpoint, n):
         ct, st = _cos_sin(half * scal[X_CAGE_SPEED])
         if housing_on:  # forces in the outer ring's frame
             shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
-        status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w,
-                                       cage_load, step % substeps == 0,
-                                       step % (substeps * ELECTRICAL_EVERY) == 0,
-                                       step % (substeps * traction_every) == 0, ct, st,
-                                       step + 1.0)  # a tribology step
+        status = compute_accelerations(
+            p,
+            tr,
+            sp,
+            scal,
+            bx,
+            bv,
+            bw,
+            ba,
+            balpha,
+            rx,
+            rv,
+            ra,
+            w,
+            cage_load,
+            step % substeps == 0,
+            step % (substeps * ELECTRICAL_EVERY) == 0,
+            step % (substeps * traction_every) == 0,
+            ct,
+            st,
+            step + 1.0,
+        )  # a tribology step
         if housing_on:  # back to the world frame; the housing and the accelerometer
             shift_frame(bx, bv, rx, rv, hx, hv, 1.0)
             fx, fy, fz = outer_ring_force(w, z)
@@ -586,8 +766,9 @@ def evaluate(model, state, setpoint):
     housing_on = p[P_VIB + V_HOUSING_ON] != 0.0
     if housing_on:
         shift_frame(bx, bv, rx, rv, hx, hv, -1.0)
-    status = compute_accelerations(p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load,
-                                   True, True, True, 1.0, 0.0, 0.0)
+    status = compute_accelerations(
+        p, tr, sp, scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, True, True, True, 1.0, 0.0, 0.0
+    )
     if housing_on:
         shift_frame(bx, bv, rx, rv, hx, hv, 1.0)
         fx, fy, fz = outer_ring_force(w, bx.shape[0])

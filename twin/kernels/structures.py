@@ -16,10 +16,10 @@ import numpy as np
 class ModelArrays(NamedTuple):
     """The model's constants, as the kernels read them."""
 
-    params: np.ndarray           # layout.P_* vector of scalar constants (SI)
-    angle_table: np.ndarray      # (race, angle row, layout.A_*) contact constants per contact angle
-    housing_params: np.ndarray   # twin.vibration.housing H_* vector (housing, sprung mass, sensor path)
-    decimator_taps: np.ndarray   # anti-aliasing FIR taps of the accelerometer's decimator
+    params: np.ndarray  # layout.P_* vector of scalar constants (SI)
+    angle_table: np.ndarray  # (race, angle row, layout.A_*) contact constants per contact angle
+    housing_params: np.ndarray  # twin.vibration.housing H_* vector (housing, sprung mass, sensor path)
+    decimator_taps: np.ndarray  # anti-aliasing FIR taps of the accelerometer's decimator
 
 
 class StateArrays(NamedTuple):

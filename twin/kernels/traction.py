@@ -41,20 +41,65 @@ from numba import njit
 
 from twin.jit import JIT, JIT_VECTOR
 from twin.kernels.layout import (
-    C_H_C, C_LAMBDA, C_LOAD, C_MU, C_SEMI_MAJOR, C_SEMI_MINOR, CW, E_M2X, E_M2Y, E_M2Z, E_MOMENT_T2,
-    E_SCRATCH_EY, E_SCRATCH_O, E_SCRATCH_SE, E_SCRATCH_SIGNED_HALF, E_SCRATCH_SPREAD, E_SCRATCH_SSAT, E_SLIP, E_SPIN_CAP, E_SPIN_MOMENT,
-    E_SPIN_RATE, E_SPIN_SLOPE, G_DELTA, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_BX, K_BY, K_SPIN, K_WX,
-    K_WY, K_WZ, M_STIFFNESS, O_EX, O_EY, O_EZ, O_RING_TZ, O_TX, O_TY, O_TZ, P_ASPERITY_SLIP,
-    P_DEFORMED_RADIUS, P_EYRING_STRESS, P_LIMITING_SHEAR, P_PRESSURE_VISCOSITY, P_STRIP_TABLE,
-    P_TRACTION_STRIPS, T_XI0, T_XI1, T_XI2,
+    C_H_C,
+    C_LAMBDA,
+    C_LOAD,
+    C_MU,
+    C_SEMI_MAJOR,
+    C_SEMI_MINOR,
+    CW,
+    E_M2X,
+    E_M2Y,
+    E_M2Z,
+    E_MOMENT_T2,
+    E_SCRATCH_EY,
+    E_SCRATCH_O,
+    E_SCRATCH_SE,
+    E_SCRATCH_SIGNED_HALF,
+    E_SCRATCH_SPREAD,
+    E_SCRATCH_SSAT,
+    E_SLIP,
+    E_SPIN_CAP,
+    E_SPIN_MOMENT,
+    E_SPIN_RATE,
+    E_SPIN_SLOPE,
+    G_DELTA,
+    G_NX,
+    G_NY,
+    G_NZ,
+    G_SQRT_DELTA,
+    K_BX,
+    K_BY,
+    K_SPIN,
+    K_WX,
+    K_WY,
+    K_WZ,
+    M_STIFFNESS,
+    O_EX,
+    O_EY,
+    O_EZ,
+    O_RING_TZ,
+    O_TX,
+    O_TY,
+    O_TZ,
+    P_ASPERITY_SLIP,
+    P_DEFORMED_RADIUS,
+    P_EYRING_STRESS,
+    P_LIMITING_SHEAR,
+    P_PRESSURE_VISCOSITY,
+    P_STRIP_TABLE,
+    P_TRACTION_STRIPS,
+    T_XI0,
+    T_XI1,
+    T_XI2,
 )
 from twin.physics.friction import stribeck_line_mu
 from twin.physics.rolling import asperity_load_share
 from twin.physics.traction import barus_viscosity_pa_s, eyring_saturation_slip_m_s, traction_capacity
 
 NEWTON_MAX_ITERATIONS = 40
-NEWTON_FORCE_TOLERANCE = 1e-3   # of the capacity Q: |sum f_k - target| below this stops the solve
-TARGET_FRACTION = 0.999         # the net force is kept inside the capacity by this factor
+NEWTON_FORCE_TOLERANCE = 1e-3  # of the capacity Q: |sum f_k - target| below this stops the solve
+TARGET_FRACTION = 0.999  # the net force is kept inside the capacity by this factor
 
 
 @njit(**JIT)
@@ -65,8 +110,9 @@ def limiting_traction_coefficient(film_parameter, limiting_shear_coefficient):
     coefficient: the tangential spring's Coulomb limit (C_MU) and the mu of the fully sliding
     traction that the spin-creep relaxation linearises (twin.kernels.step). In full film
     (Lambda >= 2.26, no asperity share) it is gamma without evaluating a power."""
-    return limiting_traction_coefficient_share(film_parameter, asperity_load_share(film_parameter),
-                                               limiting_shear_coefficient)
+    return limiting_traction_coefficient_share(
+        film_parameter, asperity_load_share(film_parameter), limiting_shear_coefficient
+    )
 
 
 @njit(inline="always", **JIT)
@@ -131,9 +177,9 @@ def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
         spin = dwx * nx + dwy * ny + dwz * nz
         roll = dwx * t2x + dwy * t2y + dwz * t2z
         r_d = p[P_DEFORMED_RADIUS + (c & 1)]
-        spin_a = spin * a                        # slip offset per unit t from spin [m/s]
-        curv = roll * a * a / (2.0 * r_d)        # slip offset per unit t^2 from conformity [m/s]
-        target = -(fx * t1x + fy * t1y + fz * t1z)   # sum of strip forces opposing the slip
+        spin_a = spin * a  # slip offset per unit t from spin [m/s]
+        curv = roll * a * a / (2.0 * r_d)  # slip offset per unit t^2 from conformity [m/s]
+        target = -(fx * t1x + fy * t1y + fz * t1z)  # sum of strip forces opposing the slip
         limit = TARGET_FRACTION * capacity * q
         target = min(max(target, -limit), limit)
         # per-strip constants of this contact (pressure-dependent ones shared by mirror strips)
@@ -141,14 +187,14 @@ def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
         o_max = -math.inf
         s_big = 30.0 * s_a
         half_width = 1.0 / n_strips
-        fl_q = (1.0 - share) * gamma * q      # strip k's limiting fluid force is w_k fl_q
-        as_q = share * mu_a * q               # and its asperity force w_k as_q
+        fl_q = (1.0 - share) * gamma * q  # strip k's limiting fluid force is w_k fl_q
+        as_q = share * mu_a * q  # and its asperity force w_k as_q
         cap = 0.0
         for k in range(n_strips):
             row = P_STRIP_TABLE + 4 * k
             o = spin_a * p[row] + curv * p[row + 1]
             mid = -1.0 + (2 * k + 1) * half_width
-            gradient = spin_a + 2.0 * curv * mid      # -ds/dt across the strip
+            gradient = spin_a + 2.0 * curv * mid  # -ds/dt across the strip
             w[E_SCRATCH_O * CW + k] = o
             w[E_SCRATCH_SPREAD * CW + k] = abs(gradient) * half_width
             w[E_SCRATCH_SIGNED_HALF * CW + k] = -half_width if gradient > 0.0 else half_width
@@ -187,9 +233,17 @@ def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
             sum_dtt = 0.0
             for k in range(n_strips):
                 row = P_STRIP_TABLE + 4 * k
-                f, df, split, frac = _strip_force(s0 - w[E_SCRATCH_O * CW + k], p[row + 2], fl_q, as_q,
-                                                  w[E_SCRATCH_SE * CW + k], w[E_SCRATCH_SSAT * CW + k],
-                                                  w[E_SCRATCH_EY * CW + k], s_a, w[E_SCRATCH_SPREAD * CW + k])
+                f, df, split, frac = _strip_force(
+                    s0 - w[E_SCRATCH_O * CW + k],
+                    p[row + 2],
+                    fl_q,
+                    as_q,
+                    w[E_SCRATCH_SE * CW + k],
+                    w[E_SCRATCH_SSAT * CW + k],
+                    w[E_SCRATCH_EY * CW + k],
+                    s_a,
+                    w[E_SCRATCH_SPREAD * CW + k],
+                )
                 t = p[row]
                 # a no-slip line inside the strip: the forces on its two sides act on either side
                 # of it (first and second moments of a sign change at t_r = mid - F sh)
@@ -325,8 +379,7 @@ def apply_traction_moments(w, nc):
         nx = w[G_NX * CW + c]
         ny = w[G_NY * CW + c]
         nz = w[G_NZ * CW + c]
-        spin = (w[K_WX * CW + c] * nx + w[K_WY * CW + c] * ny
-                + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * nz)
+        spin = w[K_WX * CW + c] * nx + w[K_WY * CW + c] * ny + (w[K_WZ * CW + c] - w[K_SPIN * CW + c]) * nz
         mx, my, mz = traction_moment_lane(w, c, loaded, nx, ny, nz, spin)
         w[O_TX * CW + c] += mx
         w[O_TY * CW + c] += my

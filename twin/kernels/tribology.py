@@ -18,39 +18,51 @@ from numba import njit
 from twin.jit import JIT
 from twin.physics import ehl, rolling
 from twin.physics.electrical import (
-    asperity_resistance_ohm, clausius_mossotti_permittivity, dowson_higginson_density_ratio,
-    hertz_zone_capacitance_f, oil_film_resistance_ohm, outer_zone_capacitance_f,
+    asperity_resistance_ohm,
+    clausius_mossotti_permittivity,
+    dowson_higginson_density_ratio,
+    hertz_zone_capacitance_f,
+    oil_film_resistance_ohm,
+    outer_zone_capacitance_f,
     parallel_resistance_ohm,
 )
 from twin.physics.friction import regime_code, stribeck_line_mu
 from twin.physics.rolling import asperity_load_share, sliding_friction_coefficient_asperity_share
 
 # indices of race_tribology[r, :]
-T_LN_HMIN = 0      # ln A of h_min [m]
+T_LN_HMIN = 0  # ln A of h_min [m]
 T_HMIN_EXP_EU = 1  # exponent of eta u
-T_HMIN_EXP_Q = 2   # exponent of Q
-T_LN_HC = 3        # Hamrock-Dowson central film
+T_HMIN_EXP_Q = 2  # exponent of Q
+T_LN_HC = 3  # Hamrock-Dowson central film
 T_HC_EXP_EU = 4
 T_HC_EXP_Q = 5
-T_SEMI_MAJOR = 6   # a = coef Q^(1/3) [m]
+T_SEMI_MAJOR = 6  # a = coef Q^(1/3) [m]
 T_SEMI_MINOR = 7
 T_FLUID_DAMPING = 8  # C_fluid = coef eta a h^-1.5: 3 pi Rb^1.5 / sqrt(2)  (seed 000 eq. 5)
-T_LN_IVR = 9       # Biboulet IVR force ~ (eta u)^(2/3) Q^(1/3) (seed 001 eq. 1)
-T_LN_EHL = 10      # EHL force ~ (eta u)^(3/4) Q^(1/3) (seed 001 eq. 2)
-T_LN_M = 11        # M ~ Q (eta u)^-0.75 (seed 001 eq. 4)
-T_LN_HYST = 12     # hysteresis moment / Rb ~ Q^1.33 (seed 001 eq. 9) [N]
+T_LN_IVR = 9  # Biboulet IVR force ~ (eta u)^(2/3) Q^(1/3) (seed 001 eq. 1)
+T_LN_EHL = 10  # EHL force ~ (eta u)^(3/4) Q^(1/3) (seed 001 eq. 2)
+T_LN_M = 11  # M ~ Q (eta u)^-0.75 (seed 001 eq. 4)
+T_LN_HYST = 12  # hysteresis moment / Rb ~ Q^1.33 (seed 001 eq. 9) [N]
 T_HYST_EXP_Q = 13
-T_PIVOT = 14       # pivoting moment / (mu Q a) (seed 001 eq. 11)
-T_RX = 15          # Rx [m] (for the outer-zone capacitance)
-T_RY = 16          # Ry [m]
+T_PIVOT = 14  # pivoting moment / (mu Q a) (seed 001 eq. 11)
+T_RX = 15  # Rx [m] (for the outer-zone capacitance)
+T_RY = 16  # Ry [m]
 N_TRIBOLOGY = 17
 
 _ONE_EU = 1.0  # eta u = 1 N/m (eta = 1 Pa s, u = 1 m/s)
 
 
-def tribology_coefficients(rx_m: float, ry_m: float, k_ellipticity: float, e_prime_pa: float,
-                           g_param: float, ball_radius_m: float, semi_major_coef: float,
-                           semi_minor_coef: float, film_formula: str) -> np.ndarray:
+def tribology_coefficients(
+    rx_m: float,
+    ry_m: float,
+    k_ellipticity: float,
+    e_prime_pa: float,
+    g_param: float,
+    ball_radius_m: float,
+    semi_major_coef: float,
+    semi_minor_coef: float,
+    film_formula: str,
+) -> np.ndarray:
     """Prefactors and exponents of one race's in-loop laws, from the law functions."""
     t = np.zeros(N_TRIBOLOGY)
     u1 = ehl.speed_parameter(1.0, 1.0, e_prime_pa, rx_m)
@@ -66,7 +78,7 @@ def tribology_coefficients(rx_m: float, ry_m: float, k_ellipticity: float, e_pri
     t[T_HC_EXP_EU], t[T_HC_EXP_Q] = ehl.HD_HC_U_EXP, ehl.HD_HC_W_EXP
     t[T_SEMI_MAJOR] = semi_major_coef
     t[T_SEMI_MINOR] = semi_minor_coef
-    t[T_FLUID_DAMPING] = 3.0 * math.pi / math.sqrt(2.0) * ball_radius_m ** 1.5
+    t[T_FLUID_DAMPING] = 3.0 * math.pi / math.sqrt(2.0) * ball_radius_m**1.5
     ratio = ry_m / rx_m
     t[T_LN_IVR] = math.log(rolling.rolling_force_ivr_n(e_prime_pa, rx_m, ratio, 1.0, 1.0, 1.0))
     t[T_LN_EHL] = math.log(rolling.rolling_force_ehl_n(e_prime_pa, rx_m, ratio, 1.0, 1.0, 1.0))
@@ -79,8 +91,29 @@ def tribology_coefficients(rx_m: float, ry_m: float, k_ellipticity: float, e_pri
 
 
 @njit(**JIT)
-def contact_tribology(load_n, entrainment_m_s, viscosity_pa_s, roughness_m, t0, t1, t2, t3, t4,
-                      t5, t6, t7, t8, t9, t10, t11, t12, t13, t14, friction_model, rolling_on):
+def contact_tribology(
+    load_n,
+    entrainment_m_s,
+    viscosity_pa_s,
+    roughness_m,
+    t0,
+    t1,
+    t2,
+    t3,
+    t4,
+    t5,
+    t6,
+    t7,
+    t8,
+    t9,
+    t10,
+    t11,
+    t12,
+    t13,
+    t14,
+    friction_model,
+    rolling_on,
+):
     """Film, Lambda, regime, mu, fluid damping and rolling resistance of one contact (seed 000
     eqs. 5-7 and Table 2 with the film formula compiled into t0-t2, seed 001 eqs. 1-5, 9, 11,
     A1-A2); t0..t14 = race_tribology[r, :].
@@ -126,8 +159,19 @@ def _mu(film_parameter, friction_model):
 
 
 @njit(**JIT)
-def contact_electrical(load_n, film_parameter, h_c_m, semi_major_m, semi_minor_m, rx_m, ry_m,
-                       oil_permittivity, gap_limit_m, metallic_resistance_ohm, oil_resistivity_ohm_m):
+def contact_electrical(
+    load_n,
+    film_parameter,
+    h_c_m,
+    semi_major_m,
+    semi_minor_m,
+    rx_m,
+    ry_m,
+    oil_permittivity,
+    gap_limit_m,
+    metallic_resistance_ohm,
+    oil_resistivity_ohm_m,
+):
     """Parallel RC of one loaded contact (seed 000 end of section 2.2): capacitance of the
     Hertz zone on the central film, with the permittivity raised by the mean Hertz pressure
     (Dowson-Higginson density, seed 003 eq. 2, through Clausius-Mossotti), plus the oil-filled gap
@@ -135,10 +179,12 @@ def contact_electrical(load_n, film_parameter, h_c_m, semi_major_m, semi_minor_m
     seed 001 eq. A2) in parallel with the oil's leakage. Returns (R [ohm], C [F])."""
     mean_pressure = load_n / (math.pi * semi_major_m * semi_minor_m)
     eps = clausius_mossotti_permittivity(oil_permittivity, dowson_higginson_density_ratio(mean_pressure))
-    capacitance = (hertz_zone_capacitance_f(eps, semi_major_m, semi_minor_m, h_c_m)
-                   + outer_zone_capacitance_f(oil_permittivity, rx_m, ry_m, h_c_m, gap_limit_m))
+    capacitance = hertz_zone_capacitance_f(eps, semi_major_m, semi_minor_m, h_c_m) + outer_zone_capacitance_f(
+        oil_permittivity, rx_m, ry_m, h_c_m, gap_limit_m
+    )
     share = asperity_load_share(film_parameter)
     resistance = parallel_resistance_ohm(
         asperity_resistance_ohm(metallic_resistance_ohm, share),
-        oil_film_resistance_ohm(oil_resistivity_ohm_m, h_c_m, semi_major_m, semi_minor_m))
+        oil_film_resistance_ohm(oil_resistivity_ohm_m, h_c_m, semi_major_m, semi_minor_m),
+    )
     return resistance, capacitance

@@ -28,13 +28,49 @@ from numba import njit
 from twin.jit import JIT, JIT_VECTOR
 
 from twin.kernels.layout import (
-    CW, G_DEFECT_DROP, G_DELTA, G_LOAD, G_NX, G_NY, G_NZ, G_SQRT_DELTA, K_PX, K_PY, K_WX, K_WY,
-    K_WZ, M_STIFFNESS, N_VIB_PARAMS, O_FX, O_FY, O_FZ, P_PROFILE_ON, P_VIB, W_DEFECTS, W_ORIENTATION, V_INNER_GROOVE_RADIUS, V_INNER_RACEWAY_RADIUS, V_INNER_RX,
-    V_INNER_FOOTPRINT, V_OUTER_GROOVE_RADIUS, V_OUTER_RACEWAY_RADIUS, V_OUTER_RX, V_OUTER_FOOTPRINT,
+    CW,
+    G_DEFECT_DROP,
+    G_DELTA,
+    G_LOAD,
+    G_NX,
+    G_NY,
+    G_NZ,
+    G_SQRT_DELTA,
+    K_PX,
+    K_PY,
+    K_WX,
+    K_WY,
+    K_WZ,
+    M_STIFFNESS,
+    N_VIB_PARAMS,
+    O_FX,
+    O_FY,
+    O_FZ,
+    P_PROFILE_ON,
+    P_VIB,
+    W_DEFECTS,
+    W_ORIENTATION,
+    V_INNER_GROOVE_RADIUS,
+    V_INNER_RACEWAY_RADIUS,
+    V_INNER_RX,
+    V_INNER_FOOTPRINT,
+    V_OUTER_GROOVE_RADIUS,
+    V_OUTER_RACEWAY_RADIUS,
+    V_OUTER_RX,
+    V_OUTER_FOOTPRINT,
 )
 from twin.vibration.defects import (
-    N_DEFECT_PARAMS, D_BALL, D_CENTRE_COS, D_CENTRE_SIN, D_KIND, D_REACH_COS, KIND_BALL, KIND_INNER, KIND_OUTER,
-    contact_defect_drop_m, quat_integrate,
+    N_DEFECT_PARAMS,
+    D_BALL,
+    D_CENTRE_COS,
+    D_CENTRE_SIN,
+    D_KIND,
+    D_REACH_COS,
+    KIND_BALL,
+    KIND_INNER,
+    KIND_OUTER,
+    contact_defect_drop_m,
+    quat_integrate,
 )
 from twin.kernels.profile import profile_drops
 
@@ -55,12 +91,29 @@ def _lane_drop(defects, k, c, w, bq, shaft_angle, vp, rb):
         return 0.0
     semi_major = (vp[V_OUTER_FOOTPRINT] if outer else vp[V_INNER_FOOTPRINT]) * math.sqrt(delta)
     return contact_defect_drop_m(
-        defects[k], r, j, w[K_PX * CW + c], w[K_PY * CW + c], w[G_NX * CW + c], w[G_NY * CW + c],
-        w[G_NZ * CW + c], w[K_WX * CW + c], w[K_WY * CW + c], w[K_WZ * CW + c], shaft_angle,
-        bq[j, 0], bq[j, 1], bq[j, 2], bq[j, 3], rb,
+        defects[k],
+        r,
+        j,
+        w[K_PX * CW + c],
+        w[K_PY * CW + c],
+        w[G_NX * CW + c],
+        w[G_NY * CW + c],
+        w[G_NZ * CW + c],
+        w[K_WX * CW + c],
+        w[K_WY * CW + c],
+        w[K_WZ * CW + c],
+        shaft_angle,
+        bq[j, 0],
+        bq[j, 1],
+        bq[j, 2],
+        bq[j, 3],
+        rb,
         vp[V_OUTER_RACEWAY_RADIUS] if outer else vp[V_INNER_RACEWAY_RADIUS],
         vp[V_OUTER_GROOVE_RADIUS] if outer else vp[V_INNER_GROOVE_RADIUS],
-        vp[V_OUTER_RX] if outer else vp[V_INNER_RX], delta, semi_major)
+        vp[V_OUTER_RX] if outer else vp[V_INNER_RX],
+        delta,
+        semi_major,
+    )
 
 
 @njit(**JIT_INLINE)
@@ -120,12 +173,12 @@ def subtract_drops(w, nc):
 def defect_table(w, count):
     """The first `count` defect rows of the workspace (twin.kernels.layout.W_DEFECTS), a
     (count, N_DEFECT_PARAMS) view."""
-    return w[W_DEFECTS:W_DEFECTS + count * N_DEFECT_PARAMS].reshape((count, N_DEFECT_PARAMS))
+    return w[W_DEFECTS : W_DEFECTS + count * N_DEFECT_PARAMS].reshape((count, N_DEFECT_PARAMS))
 
 
 def orientations(w, z):
     """The balls' unit quaternions in the workspace (W_ORIENTATION), a (z, 4) view."""
-    return w[W_ORIENTATION:W_ORIENTATION + 4 * z].reshape((z, 4))
+    return w[W_ORIENTATION : W_ORIENTATION + 4 * z].reshape((z, 4))
 
 
 defect_table = njit(**JIT_INLINE)(defect_table)
@@ -140,7 +193,7 @@ def apply_clearances(w, nc, count, shaft_angle, p, rb):
     docstring). Called only while a defect is active (X_DEFECT_COUNT > 0) or the profile is on."""
     defects = defect_table(w, count)
     bq = orientations(w, nc // 2)
-    vp = p[P_VIB:P_VIB + N_VIB_PARAMS]
+    vp = p[P_VIB : P_VIB + N_VIB_PARAMS]
     found = defect_drops(w, nc, defects, bq, shaft_angle, vp, rb)
     if p[P_PROFILE_ON] != 0.0:
         profile_drops(w, nc, p, shaft_angle)

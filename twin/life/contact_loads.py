@@ -33,16 +33,22 @@ class RacewayGeometry:
     @classmethod
     def of(cls, geometry) -> RacewayGeometry:
         """From a `twin.spec.Geometry`."""
-        return cls(2.0 * geometry.ball_radius_m, 2.0 * geometry.pitch_radius_m, geometry.inner_groove_radius_m,
-                   geometry.outer_groove_radius_m, geometry.ball_count)
+        return cls(
+            2.0 * geometry.ball_radius_m,
+            2.0 * geometry.pitch_radius_m,
+            geometry.inner_groove_radius_m,
+            geometry.outer_groove_radius_m,
+            geometry.ball_count,
+        )
 
 
 def _floats(values) -> list[float]:
     return values.tolist() if isinstance(values, np.ndarray) else [float(v) for v in values]
 
 
-def contact_load_damage_per_mrev(geometry: RacewayGeometry, inner_loads_n, outer_loads_n,
-                                 inner_angles_rad, outer_angles_rad) -> float:
+def contact_load_damage_per_mrev(
+    geometry: RacewayGeometry, inner_loads_n, outer_loads_n, inner_angles_rad, outer_angles_rad
+) -> float:
     """1 / L [per 10^6 inner-ring revolutions] from the ball loads Q_j and contact angles of both
     raceways (Lundberg-Palmgren, Harris & Kotzalas ch. "Fatigue life"; ISO/TS 16281 spirit):
     rotating inner ring 1/L_i = (Q_ei / Q_ci)^3 with Q_ei = (1/Z sum Q_j^3)^(1/3), stationary
@@ -59,18 +65,19 @@ def contact_load_damage_per_mrev(geometry: RacewayGeometry, inner_loads_n, outer
     if si > 0.0:
         ai = sum(q * a for q, a in zip(qi, _floats(inner_angles_rad))) / si
         qci = raceway_load_rating_n(g.ball_diameter_m, g.pitch_diameter_m, g.inner_groove_radius_m, ai, z, True)
-        inv_li = sum(q * q * q for q in qi) / z / qci ** 3
+        inv_li = sum(q * q * q for q in qi) / z / qci**3
     if se > 0.0:
         ae = sum(q * a for q, a in zip(qe, _floats(outer_angles_rad))) / se
         qce = raceway_load_rating_n(g.ball_diameter_m, g.pitch_diameter_m, g.outer_groove_radius_m, ae, z, False)
-        inv_le = (sum(q ** (10.0 / 3.0) for q in qe) / z) ** 0.9 / qce ** 3
+        inv_le = (sum(q ** (10.0 / 3.0) for q in qe) / z) ** 0.9 / qce**3
     if inv_li <= 0.0 and inv_le <= 0.0:
         return 0.0
     return float((inv_li ** (10.0 / 9.0) + inv_le ** (10.0 / 9.0)) ** 0.9)
 
 
-def contact_load_life_mrev(geometry: RacewayGeometry, inner_loads_n, outer_loads_n, inner_angles_rad,
-                           outer_angles_rad) -> float:
+def contact_load_life_mrev(
+    geometry: RacewayGeometry, inner_loads_n, outer_loads_n, inner_angles_rad, outer_angles_rad
+) -> float:
     """L [10^6 inner-ring revolutions] = 1 / `contact_load_damage_per_mrev` (inf when unloaded)."""
     d = contact_load_damage_per_mrev(geometry, inner_loads_n, outer_loads_n, inner_angles_rad, outer_angles_rad)
     return math.inf if d <= 0.0 else 1.0 / d
@@ -85,16 +92,18 @@ def contact_loads_from_state(contacts: np.ndarray) -> tuple[list, list, list, li
     return q[0::2], q[1::2], ang[0::2], ang[1::2]
 
 
-def contact_loads_from_equilibrium(model, radial_load_n: float, axial_load_n: float, shaft_speed_rad_s: float,
-                                   cage_angle_rad: float = 0.0):
+def contact_loads_from_equilibrium(
+    model, radial_load_n: float, axial_load_n: float, shaft_speed_rad_s: float, cage_angle_rad: float = 0.0
+):
     """The same four arrays from the quasi-static equilibrium of the warm start
     (`twin.warmstart.solve_equilibrium`: Hertz contacts on the torus grooves, applied loads,
     centrifugal force of the orbit at the rolling cage speed) with ball 0 at `cage_angle_rad`."""
 
     z = model.ball_count
     azimuths = cage_angle_rad + 2.0 * math.pi * np.arange(z) / z
-    ring, d_rho, zb, ok = solve_equilibrium(model, azimuths, radial_load_n, axial_load_n,
-                                            model.cage_speed_rad_s(shaft_speed_rad_s))
+    ring, d_rho, zb, ok = solve_equilibrium(
+        model, azimuths, radial_load_n, axial_load_n, model.cage_speed_rad_s(shaft_speed_rad_s)
+    )
     if not ok:
         raise ValueError("the quasi-static equilibrium did not converge for these loads")
     race, rb = model.race_params, model.ball_radius_m
@@ -104,10 +113,17 @@ def contact_loads_from_equilibrium(model, radial_load_n: float, axial_load_n: fl
         ball = np.array([rho * math.cos(azimuths[j]), rho * math.sin(azimuths[j]), zb[j]])
         for r, centre in ((0, ring), (1, np.zeros(3))):
             rel = ball - centre
-            delta, _nx, _ny, nz = groove_penetration(rel[0], rel[1], rel[2], race[r, L.R_GROOVE_CENTRE_RADIUS],
-                                                     race[r, L.R_GROOVE_CENTRE_Z], race[r, L.R_GROOVE_RADIUS], rb)
+            delta, _nx, _ny, nz = groove_penetration(
+                rel[0],
+                rel[1],
+                rel[2],
+                race[r, L.R_GROOVE_CENTRE_RADIUS],
+                race[r, L.R_GROOVE_CENTRE_Z],
+                race[r, L.R_GROOVE_RADIUS],
+                rb,
+            )
             if delta > 0.0:
-                q[r, j] = race[r, L.R_STIFFNESS] * delta ** 1.5
+                q[r, j] = race[r, L.R_STIFFNESS] * delta**1.5
                 ang[r, j] = math.asin(min(1.0, abs(nz)))
     return q[0], q[1], ang[0], ang[1]
 
@@ -120,7 +136,12 @@ def equilibrium_contact_life_mrev(model, radial_load_n: float, axial_load_n: flo
     the four quarter-pitch positions give the same mean within 0.1 %.)"""
     geometry = RacewayGeometry.of(model.spec.geometry)
     z = model.ball_count
-    damage = [contact_load_damage_per_mrev(geometry, *contact_loads_from_equilibrium(
-        model, radial_load_n, axial_load_n, shaft_speed_rad_s, math.pi * k / z)) for k in range(2)]
+    damage = [
+        contact_load_damage_per_mrev(
+            geometry,
+            *contact_loads_from_equilibrium(model, radial_load_n, axial_load_n, shaft_speed_rad_s, math.pi * k / z),
+        )
+        for k in range(2)
+    ]
     mean = float(np.mean(damage))
     return math.inf if mean <= 0.0 else 1.0 / mean

@@ -28,17 +28,27 @@ def damage_rate_per_s(life_h: float) -> float:
 def life_block(iso: IsoLife, contact_life_h: float, settings: LifeSettings, damage_fraction: float) -> dict:
     """The published `life` block (twin.snapshot.LifeState fields): hours, fractions, nulls where
     undefined, one `reason` string for the nulls and caveats."""
-    basis_h = (iso.a_iso_for_damage * iso.l10_h if settings.damage_basis == "iso_281"
-               else iso.a_iso_for_damage * contact_life_h)
+    basis_h = (
+        iso.a_iso_for_damage * iso.l10_h
+        if settings.damage_basis == "iso_281"
+        else iso.a_iso_for_damage * contact_life_h
+    )
     rate = damage_rate_per_s(basis_h)
     remaining = max(0.0, 1.0 - damage_fraction) * basis_h if math.isfinite(basis_h) else None
     return {
-        "kappa": _finite(iso.kappa), "a_iso": _finite(iso.a_iso), "l10_h": _finite(iso.l10_h),
-        "l10m_h": _finite(iso.l10m_h), "l10_contact_loads_h": _finite(contact_life_h),
-        "damage_fraction": float(damage_fraction), "damage_rate_per_s": float(rate),
-        "remaining_life_h": _finite(remaining), "dynamic_load_rating_n": float(iso.dynamic_load_rating_n),
-        "equivalent_load_n": float(iso.equivalent_load_n), "contamination_factor": float(iso.contamination_factor),
-        "viscosity_m2_s": float(iso.viscosity_m2_s), "rated_viscosity_m2_s": _finite(iso.rated_viscosity_m2_s),
+        "kappa": _finite(iso.kappa),
+        "a_iso": _finite(iso.a_iso),
+        "l10_h": _finite(iso.l10_h),
+        "l10m_h": _finite(iso.l10m_h),
+        "l10_contact_loads_h": _finite(contact_life_h),
+        "damage_fraction": float(damage_fraction),
+        "damage_rate_per_s": float(rate),
+        "remaining_life_h": _finite(remaining),
+        "dynamic_load_rating_n": float(iso.dynamic_load_rating_n),
+        "equivalent_load_n": float(iso.equivalent_load_n),
+        "contamination_factor": float(iso.contamination_factor),
+        "viscosity_m2_s": float(iso.viscosity_m2_s),
+        "rated_viscosity_m2_s": _finite(iso.rated_viscosity_m2_s),
         "damage_basis": settings.damage_basis,
         "reason": "; ".join(iso.reasons) if iso.reasons else None,
     }
@@ -101,16 +111,31 @@ class LifeMonitor:
         last = self._last_eval_s
         return self.ratings is not None and (last is None or not last <= time_s < last + self.settings.refresh_s)
 
-    def update(self, time_s: float, shaft_speed_rad_s: float, radial_load_n: float, axial_load_n: float,
-               kinematic_viscosity_m2_s: float, contacts: np.ndarray, force: bool = False) -> None:
+    def update(
+        self,
+        time_s: float,
+        shaft_speed_rad_s: float,
+        radial_load_n: float,
+        axial_load_n: float,
+        kinematic_viscosity_m2_s: float,
+        contacts: np.ndarray,
+        force: bool = False,
+    ) -> None:
         """Re-evaluate if `refresh_s` has passed (or `force`), and restart the damage interval at
         the new rate."""
         if self.ratings is None or not (force or self.due(time_s)):
             return
         last = self._last_eval_s
         try:
-            self._iso = iso_life(self.spec, self.ratings, self.settings, radial_load_n, axial_load_n,
-                                 shaft_speed_rad_s, kinematic_viscosity_m2_s)
+            self._iso = iso_life(
+                self.spec,
+                self.ratings,
+                self.settings,
+                radial_load_n,
+                axial_load_n,
+                shaft_speed_rad_s,
+                kinematic_viscosity_m2_s,
+            )
             d = contact_load_damage_per_mrev(self.geometry, *contact_loads_from_state(contacts))
             prev = self._contact_damage_per_mrev
             if prev is None or last is None or time_s <= last:
@@ -126,8 +151,9 @@ class LifeMonitor:
         self._last_eval_s = time_s
         rate = 0.0
         if self._iso is not None:
-            basis_h = (self._iso.a_iso_for_damage * (self._iso.l10_h if self.settings.damage_basis == "iso_281"
-                                                     else self._contact_life_h))
+            basis_h = self._iso.a_iso_for_damage * (
+                self._iso.l10_h if self.settings.damage_basis == "iso_281" else self._contact_life_h
+            )
             rate = damage_rate_per_s(basis_h)
         self.accumulator.set_rate(time_s, rate)
 

@@ -36,14 +36,26 @@ from __future__ import annotations
 
 import math
 
-AIR_DENSITY_KG_M3 = 1.2      # at 20 degC, 1 atm
+AIR_DENSITY_KG_M3 = 1.2  # at 20 degC, 1 atm
 # (H / d_m, V_M) of ball bearings: the SKF catalogue's diagram 'Drag loss factor V_M' (2018,
 # 'Drag losses in oil bath lubrication') read at rounded H / d_m from its digitisation in
 # github.com/JRaposo-m/SKF-Bearing-Selection-Tool (Graficos/Friction Moments/Drag Moment/Drag Loss
 # Factor Vm/ball_bearing*.csv); linear between the points
-BALL_DRAG_LOSS_FACTOR = ((0.0, 0.0), (0.02, 6.1e-6), (0.05, 1.86e-5), (0.1, 7.3e-5), (0.15, 1.58e-4),
-                         (0.2, 2.46e-4), (0.3, 3.81e-4), (0.4, 4.78e-4), (0.5, 5.66e-4), (0.6, 6.39e-4),
-                         (0.8, 7.78e-4), (1.0, 9.48e-4), (1.2, 1.235e-3))
+BALL_DRAG_LOSS_FACTOR = (
+    (0.0, 0.0),
+    (0.02, 6.1e-6),
+    (0.05, 1.86e-5),
+    (0.1, 7.3e-5),
+    (0.15, 1.58e-4),
+    (0.2, 2.46e-4),
+    (0.3, 3.81e-4),
+    (0.4, 4.78e-4),
+    (0.5, 5.66e-4),
+    (0.6, 6.39e-4),
+    (0.8, 7.78e-4),
+    (1.0, 9.48e-4),
+    (1.2, 1.235e-3),
+)
 MAX_OIL_LEVEL_OVER_DM = 1.2  # the catalogue takes H = 1.2 d_m for any deeper bath
 AIR_VISCOSITY_PA_S = 1.8e-5  # at 20 degC
 
@@ -53,18 +65,19 @@ def sphere_drag_coefficient(reynolds: float) -> float:
     Stokes limit 24/Re is its first term. Re <= 0 gives 0 (no motion, no drag)."""
     if not (reynolds > 0.0):
         return 0.0
-    return 24.0 / reynolds * (1.0 + 0.15 * reynolds ** 0.687) + 0.42 / (1.0 + 4.25e4 * reynolds ** -1.16)
+    return 24.0 / reynolds * (1.0 + 0.15 * reynolds**0.687) + 0.42 / (1.0 + 4.25e4 * reynolds**-1.16)
 
 
-def ball_drag_force_n(ball_diameter_m: float, orbital_speed_m_s: float, density_kg_m3: float,
-                      viscosity_pa_s: float) -> float:
+def ball_drag_force_n(
+    ball_diameter_m: float, orbital_speed_m_s: float, density_kg_m3: float, viscosity_pa_s: float
+) -> float:
     """F_D = C_D(Re) rho pi D^2 v^2 / 8 [N] of a ball moving at v [m/s] through a fluid of the
     given density and dynamic viscosity (Harris and Kotzalas; module docstring)."""
     v = abs(orbital_speed_m_s)
     if v == 0.0:
         return 0.0
     re = density_kg_m3 * v * ball_diameter_m / viscosity_pa_s
-    return sphere_drag_coefficient(re) * density_kg_m3 * math.pi * ball_diameter_m ** 2 * v * v / 8.0
+    return sphere_drag_coefficient(re) * density_kg_m3 * math.pi * ball_diameter_m**2 * v * v / 8.0
 
 
 def immersed_area_fraction(depth_m: float, ball_diameter_m: float) -> float:
@@ -99,9 +112,15 @@ def drag_loss_factor(oil_level_over_dm: float) -> float:
     return pts[-1][1]
 
 
-def oil_bath_drag_moment_n_m(bore_m: float, outside_diameter_m: float, oil_level_m: float,
-                             shaft_speed_rad_s: float, kinematic_viscosity_m2_s: float, k_z: float,
-                             rows: int = 1) -> float:
+def oil_bath_drag_moment_n_m(
+    bore_m: float,
+    outside_diameter_m: float,
+    oil_level_m: float,
+    shaft_speed_rad_s: float,
+    kinematic_viscosity_m2_s: float,
+    k_z: float,
+    rows: int = 1,
+) -> float:
     """M_drag of the SKF model for a ball bearing in an oil bath [N m] (module docstring), SI in:
     bore d, outside diameter D, oil level H above the bottom of the outer raceway [m], shaft
     speed [rad/s], the oil's kinematic viscosity [m^2/s], K_z [-], ball rows i_rw. 0 without
@@ -122,6 +141,6 @@ def oil_bath_drag_moment_n_m(bore_m: float, outside_diameter_m: float, oil_level
     f_a = 0.05 * k_z * (big_d + d) / (big_d - d)
     r_s = 0.36 * dm * dm * (t - math.sin(t)) * f_a
     k_ball = rows * k_z * (d + big_d) / (big_d - d) * 1e-12
-    churning = 0.4 * drag_loss_factor(h / dm) * k_ball * dm ** 5 * n * n
-    viscous = 1.093e-7 * n * n * dm ** 3 * (n * dm * dm * f_t / nu) ** -1.379 * r_s
+    churning = 0.4 * drag_loss_factor(h / dm) * k_ball * dm**5 * n * n
+    viscous = 1.093e-7 * n * n * dm**3 * (n * dm * dm * f_t / nu) ** -1.379 * r_s
     return (churning + viscous) * 1e-3

@@ -25,9 +25,9 @@ def load_parameter(load_n, effective_modulus_pa, rx_m):
 
 # Exponents of the dimensionless speed U (proportional to eta u) and load W (to Q) of the
 # Hamrock-Dowson films; twin.kernels.tribology compiles the in-loop power laws from them.
-HD_HMIN_U_EXP = 0.68     # seed 000 eq. 6
+HD_HMIN_U_EXP = 0.68  # seed 000 eq. 6
 HD_HMIN_W_EXP = -0.073
-HD_HC_U_EXP = 0.67       # Hamrock-Dowson 1977 central film
+HD_HC_U_EXP = 0.67  # Hamrock-Dowson 1977 central film
 HD_HC_W_EXP = -0.067
 
 
@@ -35,7 +35,7 @@ HD_HC_W_EXP = -0.067
 def masjedi_khonsari_exponents(k_ellipticity):
     """(exponent of U, exponent of W) of Masjedi-Khonsari's h_min (seed 004 eq. 6): 0.711 k^-0.023,
     -0.09 k^-0.15."""
-    return 0.711 * k_ellipticity ** -0.023, -0.09 * k_ellipticity ** -0.15
+    return 0.711 * k_ellipticity**-0.023, -0.09 * k_ellipticity**-0.15
 
 
 @njit(**JIT)
@@ -43,8 +43,14 @@ def hamrock_dowson_h_min_m(rx_m, u_param, g_param, w_param, k_ellipticity):
     """h_min = 3.63 Rx U^0.68 G^0.49 W^-0.073 (1 - exp(-0.68 k)) [m] (seed 000 eq. 6)."""
     if u_param <= 0.0 or w_param <= 0.0:
         return 0.0
-    return (3.63 * rx_m * u_param ** HD_HMIN_U_EXP * g_param ** 0.49 * w_param ** HD_HMIN_W_EXP
-            * (1.0 - math.exp(-0.68 * k_ellipticity)))
+    return (
+        3.63
+        * rx_m
+        * u_param**HD_HMIN_U_EXP
+        * g_param**0.49
+        * w_param**HD_HMIN_W_EXP
+        * (1.0 - math.exp(-0.68 * k_ellipticity))
+    )
 
 
 @njit(**JIT)
@@ -53,8 +59,14 @@ def hamrock_dowson_h_c_m(rx_m, u_param, g_param, w_param, k_ellipticity):
     (Hamrock-Dowson 1977, the companion of seed 000 eq. 6, ref. [9])."""
     if u_param <= 0.0 or w_param <= 0.0:
         return 0.0
-    return (2.69 * rx_m * u_param ** HD_HC_U_EXP * g_param ** 0.53 * w_param ** HD_HC_W_EXP
-            * (1.0 - 0.61 * math.exp(-0.73 * k_ellipticity)))
+    return (
+        2.69
+        * rx_m
+        * u_param**HD_HC_U_EXP
+        * g_param**0.53
+        * w_param**HD_HC_W_EXP
+        * (1.0 - 0.61 * math.exp(-0.73 * k_ellipticity))
+    )
 
 
 @njit(**JIT)
@@ -65,10 +77,14 @@ def masjedi_khonsari_h_min_m(rx_m, u_param, g_param, w_param, k_ellipticity):
     if u_param <= 0.0 or w_param <= 0.0:
         return 0.0
     u_exp, w_exp = masjedi_khonsari_exponents(k_ellipticity)
-    return (1.637 * rx_m * u_param ** u_exp
-            * g_param ** (0.65 * k_ellipticity ** -0.045)
-            * w_param ** w_exp
-            * (1.0 - 0.974 * math.exp(-0.676 * k_ellipticity)))
+    return (
+        1.637
+        * rx_m
+        * u_param**u_exp
+        * g_param ** (0.65 * k_ellipticity**-0.045)
+        * w_param**w_exp
+        * (1.0 - 0.974 * math.exp(-0.676 * k_ellipticity))
+    )
 
 
 @njit(**JIT)

@@ -48,8 +48,14 @@ def outer_zone_capacitance_f(relative_permittivity_0, rx_m, ry_m, gap_m, gap_lim
     result insensitive to the exact limit."""
     if gap_m <= 0.0:
         return 0.0
-    return (VACUUM_PERMITTIVITY_F_M * relative_permittivity_0 * 2.0 * math.pi * math.sqrt(rx_m * ry_m)
-            * math.log((gap_m + gap_limit_m) / gap_m))
+    return (
+        VACUUM_PERMITTIVITY_F_M
+        * relative_permittivity_0
+        * 2.0
+        * math.pi
+        * math.sqrt(rx_m * ry_m)
+        * math.log((gap_m + gap_limit_m) / gap_m)
+    )
 
 
 @njit(**JIT)
@@ -82,10 +88,19 @@ def parallel_resistance_ohm(r1, r2):
 
 # ---- capacitance of the bearing's geometry (model build, numpy) ---------------------------
 
-def ball_raceway_gap_integral_m(ball_radius_m: float, groove_radius_m: float, groove_centre_radius_m: float,
-                                contact_angle_rad: float, inner: bool, land_radius_m: float,
-                                ring_width_m: float | None, central_gap_m: float,
-                                polar_steps: int = 300, azimuth_steps: int = 90) -> float:
+
+def ball_raceway_gap_integral_m(
+    ball_radius_m: float,
+    groove_radius_m: float,
+    groove_centre_radius_m: float,
+    contact_angle_rad: float,
+    inner: bool,
+    land_radius_m: float,
+    ring_width_m: float | None,
+    central_gap_m: float,
+    polar_steps: int = 300,
+    azimuth_steps: int = 90,
+) -> float:
     """Integral of dA / gap over the half of the ball that faces a raceway [m]: C = eps0 eps_r
     times it is the ball-raceway capacitance when the oil fills the gap (local parallel-plate
     reading, as in the bearing-capacitance models of the literature, e.g. Jablonka, Glovnea and
@@ -111,15 +126,18 @@ def ball_raceway_gap_integral_m(ball_radius_m: float, groove_radius_m: float, gr
     theta = 0.5 * (edges[1:] + edges[:-1])
     phi = (np.arange(azimuth_steps) + 0.5) * 2.0 * math.pi / azimuth_steps
     th, ph = np.meshgrid(theta, phi, indexing="ij")
-    ray = (np.cos(th)[..., None] * nrm + (np.sin(th) * np.cos(ph))[..., None] * e_roll
-           + (np.sin(th) * np.sin(ph))[..., None] * e_cross)
+    ray = (
+        np.cos(th)[..., None] * nrm
+        + (np.sin(th) * np.cos(ph))[..., None] * e_roll
+        + (np.sin(th) * np.sin(ph))[..., None] * e_cross
+    )
 
     def torus(t):
         x = centre + t[..., None] * ray
         return (np.hypot(x[..., 0], x[..., 1]) - groove_centre_radius_m) ** 2 + (x[..., 2] - z_g) ** 2 - rg * rg
 
     lo = np.zeros(th.shape)
-    hi = np.full(th.shape, 3.0 * rg)   # the ball centre lies inside the torus tube: one crossing
+    hi = np.full(th.shape, 3.0 * rg)  # the ball centre lies inside the torus tube: one crossing
     for _ in range(60):
         mid = 0.5 * (lo + hi)
         inside = torus(mid) < 0.0
@@ -132,7 +150,7 @@ def ball_raceway_gap_integral_m(ball_radius_m: float, groove_radius_m: float, gr
     # beyond the shoulder: the land cylinder |x_xy| = land radius along the same ray
     a2 = ray[..., 0] ** 2 + ray[..., 1] ** 2
     b2 = 2.0 * (centre[0] * ray[..., 0] + centre[1] * ray[..., 1])
-    c2 = centre[0] ** 2 + centre[1] ** 2 - land_radius_m ** 2
+    c2 = centre[0] ** 2 + centre[1] ** 2 - land_radius_m**2
     disc = b2 * b2 - 4.0 * a2 * c2
     root = np.sqrt(np.clip(disc, 0.0, None))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -157,11 +175,18 @@ def equivalent_gap_limit_m(gap_integral_m: float, rx_m: float, ry_m: float, cent
     return central_gap_m * math.expm1(gap_integral_m / (2.0 * math.pi * math.sqrt(rx_m * ry_m)))
 
 
-def coaxial_capacitance_f(relative_permittivity: float, length_m: float, inner_radius_m: float,
-                          outer_radius_m: float) -> float:
+def coaxial_capacitance_f(
+    relative_permittivity: float, length_m: float, inner_radius_m: float, outer_radius_m: float
+) -> float:
     """C = 2 pi eps0 eps_r L / ln(r_out / r_in) [F]: two coaxial cylinders (the rings' lands facing
     each other across the annulus)."""
     if length_m <= 0.0 or outer_radius_m <= inner_radius_m:
         return 0.0
-    return 2.0 * math.pi * VACUUM_PERMITTIVITY_F_M * relative_permittivity * length_m / math.log(
-        outer_radius_m / inner_radius_m)
+    return (
+        2.0
+        * math.pi
+        * VACUUM_PERMITTIVITY_F_M
+        * relative_permittivity
+        * length_m
+        / math.log(outer_radius_m / inner_radius_m)
+    )

@@ -64,6 +64,7 @@ def curvature_sum_radius_m(rx_m, ry_m):
 
 # ---- exact solution (compile time) --------------------------------------------------------------
 
+
 @dataclass(frozen=True)
 class EllipticConstants:
     """Exact Hertz constants of one contact geometry.
@@ -101,8 +102,9 @@ def elliptic_constants_of_ratio(curvature_ratio: float) -> EllipticConstants:
         return EllipticConstants(1.0, 0.5 * math.pi, 0.5 * math.pi)
     # Ry/Rx grows monotonically with k and k < Ry/Rx: the root lies in (1 + 1e-7, ratio + 1]
     # (at k = 1 + 1e-7 the K - E difference still carries 9 significant digits)
-    k = optimize.brentq(lambda kk: _curvature_ratio_of(kk) - ratio, 1.0 + 1e-7, ratio + 1.0,
-                        xtol=1e-14, rtol=1e-14, maxiter=200)
+    k = optimize.brentq(
+        lambda kk: _curvature_ratio_of(kk) - ratio, 1.0 + 1e-7, ratio + 1.0, xtol=1e-14, rtol=1e-14, maxiter=200
+    )
     big_k, big_e = _integrals(k)
     return EllipticConstants(float(k), big_k, big_e)
 
@@ -118,6 +120,7 @@ def elliptic_constants(rx_m: float, ry_m: float) -> EllipticConstants:
 
 
 # ---- Brewe-Hamrock approximations (documented, not used by the model) ---------------------------
+
 
 @njit(**JIT)
 def brewe_hamrock_ellipticity(rx_m, ry_m):
@@ -139,10 +142,11 @@ def brewe_hamrock_second_kind(rx_m, ry_m):
 
 # ---- contact laws in terms of the constants -----------------------------------------------------
 
+
 @njit(**JIT)
 def stiffness_from_constants(k, fbar, ebar, r_m, effective_modulus):
     """K = pi k E' sqrt(2 Ebar R / (9 Fbar^3)) [N/m^1.5] (seed 000 eq. 2, docs/physics.md)."""
-    return math.pi * k * effective_modulus * math.sqrt(2.0 * ebar * r_m / (9.0 * fbar ** 3))
+    return math.pi * k * effective_modulus * math.sqrt(2.0 * ebar * r_m / (9.0 * fbar**3))
 
 
 @njit(**JIT)
@@ -164,23 +168,26 @@ def semi_minor_from_constants(load_n, k, ebar, r_m, effective_modulus):
 def raceway_stiffness_n_m15(rx_m, ry_m, effective_modulus):
     """K [N/m^1.5] in Q = K delta^1.5 of a ball-raceway contact, exact constants (seed 000 eq. 2)."""
     c = elliptic_constants(rx_m, ry_m)
-    return stiffness_from_constants(c.ellipticity, c.first_kind, c.second_kind,
-                                    curvature_sum_radius_m(rx_m, ry_m), effective_modulus)
+    return stiffness_from_constants(
+        c.ellipticity, c.first_kind, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus
+    )
 
 
 def semi_major_axis_m(load_n, rx_m, ry_m, effective_modulus):
     """a [m], transverse semi-axis of the Hertz ellipse, exact constants (Hamrock & Brewe 1983,
     the ref. [9] that seed 000 eq. 5 uses)."""
     c = elliptic_constants(rx_m, ry_m)
-    return semi_major_from_constants(load_n, c.ellipticity, c.second_kind,
-                                     curvature_sum_radius_m(rx_m, ry_m), effective_modulus)
+    return semi_major_from_constants(
+        load_n, c.ellipticity, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus
+    )
 
 
 def semi_minor_axis_m(load_n, rx_m, ry_m, effective_modulus):
     """b [m], rolling-direction semi-axis of the Hertz ellipse, exact constants."""
     c = elliptic_constants(rx_m, ry_m)
-    return semi_minor_from_constants(load_n, c.ellipticity, c.second_kind,
-                                     curvature_sum_radius_m(rx_m, ry_m), effective_modulus)
+    return semi_minor_from_constants(
+        load_n, c.ellipticity, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus
+    )
 
 
 def approach_m(load_n, rx_m, ry_m, effective_modulus):

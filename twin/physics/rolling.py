@@ -66,8 +66,7 @@ def rolling_force_ivr_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrai
     w_dim = load_parameter_w(load_n, e_star_pa, rx_m)
     if u_dim <= 0.0 or w_dim <= 0.0 or not (k_radii_ratio > 0.0):
         return 0.0
-    return (2.9766 * e_star_pa * rx_m * rx_m * k_radii_ratio ** 0.3316
-            * w_dim ** (1.0 / 3.0) * u_dim ** (2.0 / 3.0))
+    return 2.9766 * e_star_pa * rx_m * rx_m * k_radii_ratio**0.3316 * w_dim ** (1.0 / 3.0) * u_dim ** (2.0 / 3.0)
 
 
 @njit(**JIT)
@@ -82,8 +81,7 @@ def rolling_force_ehl_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrai
     w_dim = load_parameter_w(load_n, e_star_pa, rx_m)
     if u_dim <= 0.0 or w_dim <= 0.0 or not (k_radii_ratio > 0.0):
         return 0.0
-    return (7.5826 * e_star_pa * rx_m * rx_m * k_radii_ratio ** 0.4055
-            * w_dim ** (1.0 / 3.0) * u_dim ** 0.75)
+    return 7.5826 * e_star_pa * rx_m * rx_m * k_radii_ratio**0.4055 * w_dim ** (1.0 / 3.0) * u_dim**0.75
 
 
 @njit(**JIT)
@@ -101,7 +99,7 @@ def ehl_parameter_m(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainmen
     w_dim = load_parameter_w(load_n, e_star_pa, rx_m)
     if u_dim <= 0.0 or w_dim <= 0.0 or not (k_radii_ratio > 0.0):
         return 0.0
-    return 0.5549 * k_radii_ratio ** -0.6029 * w_dim * u_dim ** -0.75
+    return 0.5549 * k_radii_ratio**-0.6029 * w_dim * u_dim**-0.75
 
 
 @njit(**JIT)
@@ -117,8 +115,7 @@ def ehl_share(m_parameter):
 
 
 @njit(**JIT)
-def rolling_force_transition_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s,
-                               entrainment_speed_m_s):
+def rolling_force_transition_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainment_speed_m_s):
     """Biboulet-Houpert transition rolling force of one contact [N]:
     FR = [FR_IVR + (M/6.6) FR_EHL] / (1 + M/6.6) = (1 - s) FR_IVR + s FR_EHL, s = EHL share
     (seed 001 eqs. 3 and 5 with eqs. 1, 2, 4; docs/physics.md seed 001 reading). k = Ry/Rx.
@@ -127,12 +124,9 @@ def rolling_force_transition_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s,
     IVR force (eq. 1) matched its measurements better (Sections 4.4-4.5, conclusion).
     Returns 0.0 for non-positive / NaN speed or load.
     """
-    f_ivr = rolling_force_ivr_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s,
-                                entrainment_speed_m_s)
-    f_ehl = rolling_force_ehl_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s,
-                                entrainment_speed_m_s)
-    s = ehl_share(ehl_parameter_m(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s,
-                                  entrainment_speed_m_s))
+    f_ivr = rolling_force_ivr_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainment_speed_m_s)
+    f_ehl = rolling_force_ehl_n(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainment_speed_m_s)
+    s = ehl_share(ehl_parameter_m(e_star_pa, rx_m, k_radii_ratio, load_n, eta_pa_s, entrainment_speed_m_s))
     return (1.0 - s) * f_ivr + s * f_ehl
 
 
@@ -160,8 +154,7 @@ def hysteresis_moment_n_m(ball_diameter_m, load_n, k_radii_ratio):
     km1 = k_radii_ratio - 1.0
     if not (km1 > 0.0):
         km1 = 0.0
-    return (7.48e-7 * (0.5 * ball_diameter_m) ** 0.33 * load_n ** HYSTERESIS_LOAD_EXP
-            * (1.0 - 3.519e-3 * km1 ** 0.8063))
+    return 7.48e-7 * (0.5 * ball_diameter_m) ** 0.33 * load_n**HYSTERESIS_LOAD_EXP * (1.0 - 3.519e-3 * km1**0.8063)
 
 
 @njit(**JIT)

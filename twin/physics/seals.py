@@ -18,8 +18,12 @@ from __future__ import annotations
 # constants', deep-groove ball bearings, RS1 seals: D <= 62, 62-80, 80-100, over 100 mm; the same
 # rows, beta = 2.25 in every one, in the transcription of github.com/JRaposo-m/SKF-Bearing-Selection-Tool,
 # skf_model/friction_model/seal_friction/seal_frictional_moment.csv)
-RS1_CONSTANTS = ((62.0, 2.25, 0.023, 2.0), (80.0, 2.25, 0.018, 20.0), (100.0, 2.25, 0.018, 15.0),
-                 (1e9, 2.25, 0.018, 0.0))
+RS1_CONSTANTS = (
+    (62.0, 2.25, 0.023, 2.0),
+    (80.0, 2.25, 0.018, 20.0),
+    (100.0, 2.25, 0.018, 15.0),
+    (1e9, 2.25, 0.018, 0.0),
+)
 
 
 def seal_constants(seal: str, outside_diameter_m: float) -> tuple[float, float, float]:

@@ -26,9 +26,14 @@ K_Z = {"deep_groove": 3.1, "angular_contact": 4.4}
 K_RS = {"oil_bath": 3e-8, "jet": 3e-8, "oil_air": 6e-8}
 
 
-def kinematic_replenishment_factor(shaft_speed_rad_s: float, kinematic_viscosity_m2_s: float,
-                                   bore_m: float, outside_diameter_m: float, k_rs: float,
-                                   k_z: float) -> float:
+def kinematic_replenishment_factor(
+    shaft_speed_rad_s: float,
+    kinematic_viscosity_m2_s: float,
+    bore_m: float,
+    outside_diameter_m: float,
+    k_rs: float,
+    k_z: float,
+) -> float:
     """phi_rs [-] of the SKF model (module docstring) in SI inputs: shaft speed [rad/s],
     kinematic viscosity [m^2/s], bore and outside diameter [m]. 1 at rest."""
     n_rpm = abs(shaft_speed_rad_s) * 30.0 / math.pi

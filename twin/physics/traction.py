@@ -67,18 +67,18 @@ def limiting_shear_stress_pa(pressure_pa, limiting_shear_coefficient):
 
 
 @njit(**JIT)
-def fluid_shear_stress_pa(slip_m_s, film_m, viscosity_pa_s, pressure_pa, eyring_stress_pa,
-                          limiting_shear_coefficient):
+def fluid_shear_stress_pa(slip_m_s, film_m, viscosity_pa_s, pressure_pa, eyring_stress_pa, limiting_shear_coefficient):
     """Signed shear stress of the fluid film on the faster surface, along the slip [Pa]:
     sgn(s) min(tau_E, tau_L) (Eyring bounded by the limiting shear stress)."""
-    tau = min(eyring_shear_stress_pa(slip_m_s, film_m, viscosity_pa_s, eyring_stress_pa),
-              limiting_shear_stress_pa(pressure_pa, limiting_shear_coefficient))
+    tau = min(
+        eyring_shear_stress_pa(slip_m_s, film_m, viscosity_pa_s, eyring_stress_pa),
+        limiting_shear_stress_pa(pressure_pa, limiting_shear_coefficient),
+    )
     return tau if slip_m_s > 0.0 else -tau
 
 
 @njit(**JIT)
-def eyring_saturation_slip_m_s(film_m, viscosity_pa_s, pressure_pa, eyring_stress_pa,
-                               limiting_shear_coefficient):
+def eyring_saturation_slip_m_s(film_m, viscosity_pa_s, pressure_pa, eyring_stress_pa, limiting_shear_coefficient):
     """Sliding speed at which the Eyring stress reaches the limiting shear stress,
     s_L = (h tau0 / eta) sinh(gamma p / tau0) [m/s]: above it the film transmits gamma p."""
     if film_m <= 0.0 or viscosity_pa_s <= 0.0:
@@ -114,14 +114,14 @@ def hertz_strip_table(n_strips: int) -> np.ndarray:
     edges = np.linspace(-1.0, 1.0, n_strips + 1)
     lo, hi = edges[:-1], edges[1:]
 
-    load = (hi - hi ** 3 / 3) - (lo - lo ** 3 / 3)                       # int (1 - t^2)
-    first = (hi ** 2 / 2 - hi ** 4 / 4) - (lo ** 2 / 2 - lo ** 4 / 4)    # int t (1 - t^2)
-    second = (hi ** 3 / 3 - hi ** 5 / 5) - (lo ** 3 / 3 - lo ** 5 / 5)   # int t^2 (1 - t^2)
+    load = (hi - hi**3 / 3) - (lo - lo**3 / 3)  # int (1 - t^2)
+    first = (hi**2 / 2 - hi**4 / 4) - (lo**2 / 2 - lo**4 / 4)  # int t (1 - t^2)
+    second = (hi**3 / 3 - hi**5 / 5) - (lo**3 / 3 - lo**5 / 5)  # int t^2 (1 - t^2)
 
     def half_disc(t):
         return 0.5 * (t * np.sqrt(np.clip(1.0 - t * t, 0.0, None)) + np.arcsin(np.clip(t, -1.0, 1.0)))
 
-    area = half_disc(hi) - half_disc(lo)                                 # int sqrt(1 - t^2)
+    area = half_disc(hi) - half_disc(lo)  # int sqrt(1 - t^2)
     share = 0.75 * load
     # mean pressure = share Q / (2 a b area), Q = (2 pi / 3) p_h a b
     mean_pressure = share * (2.0 * math.pi / 3.0) / (2.0 * area)

@@ -26,7 +26,7 @@ def kinematic_viscosity_m2_s(nu40_m2_s: float, nu100_m2_s: float, temperature_c:
         return nu40_m2_s
     a, b = walther_constants(nu40_m2_s, nu100_m2_s)
     y = a - b * math.log10(temperature_c + 273.15)
-    return (10.0 ** (10.0 ** y) - 0.7) * 1e-6
+    return (10.0 ** (10.0**y) - 0.7) * 1e-6
 
 
 def density_kg_m3(density_15c_kg_m3: float, temperature_c: float) -> float:
@@ -36,8 +36,9 @@ def density_kg_m3(density_15c_kg_m3: float, temperature_c: float) -> float:
 
 def dynamic_viscosity_pa_s(lubricant, temperature_c: float) -> float:
     """eta(T) = nu(T) rho(T) [Pa s] for a `twin.spec.Lubricant`."""
-    nu = kinematic_viscosity_m2_s(lubricant.kinematic_viscosity_40c_m2_s,
-                                  lubricant.kinematic_viscosity_100c_m2_s, temperature_c)
+    nu = kinematic_viscosity_m2_s(
+        lubricant.kinematic_viscosity_40c_m2_s, lubricant.kinematic_viscosity_100c_m2_s, temperature_c
+    )
     return nu * density_kg_m3(lubricant.density_15c_kg_m3, temperature_c)
 
 

@@ -8,12 +8,17 @@ from __future__ import annotations
 
 import math
 
-from twin.thermal.materials import (AIR_CONDUCTIVITY_W_M_K, AIR_KINEMATIC_VISCOSITY_M2_S, AIR_PRANDTL,
-                                    GRAVITY_M_S2, STEFAN_BOLTZMANN_W_M2_K4)
+from twin.thermal.materials import (
+    AIR_CONDUCTIVITY_W_M_K,
+    AIR_KINEMATIC_VISCOSITY_M2_S,
+    AIR_PRANDTL,
+    GRAVITY_M_S2,
+    STEFAN_BOLTZMANN_W_M2_K4,
+)
 
-ISO_15312_REFERENCE_FLUX_W_MM2 = 0.016   # q_r for A_r <= 50 000 mm^2 (ISO 15312:2018 clause 5)
+ISO_15312_REFERENCE_FLUX_W_MM2 = 0.016  # q_r for A_r <= 50 000 mm^2 (ISO 15312:2018 clause 5)
 ISO_15312_AREA_KNEE_MM2 = 50_000.0
-ISO_15312_REFERENCE_RISE_K = 50.0        # outer ring 70 degC over ambient 20 degC (ISO 15312 clause 4)
+ISO_15312_REFERENCE_RISE_K = 50.0  # outer ring 70 degC over ambient 20 degC (ISO 15312 clause 4)
 
 
 def churchill_chu_cylinder_w_m2_k(diameter_m: float, surface_c: float, ambient_c: float) -> float:
@@ -24,7 +29,7 @@ def churchill_chu_cylinder_w_m2_k(diameter_m: float, surface_c: float, ambient_c
     dt = abs(surface_c - ambient_c)
     t_film_k = 0.5 * (surface_c + ambient_c) + 273.15
     nu, pr = AIR_KINEMATIC_VISCOSITY_M2_S, AIR_PRANDTL
-    ra = GRAVITY_M_S2 * dt / t_film_k * diameter_m ** 3 / (nu * nu / pr)
+    ra = GRAVITY_M_S2 * dt / t_film_k * diameter_m**3 / (nu * nu / pr)
     nusselt = (0.60 + 0.387 * ra ** (1.0 / 6.0) / (1.0 + (0.559 / pr) ** (9.0 / 16.0)) ** (8.0 / 27.0)) ** 2
     return nusselt * AIR_CONDUCTIVITY_W_M_K / diameter_m
 
@@ -45,8 +50,9 @@ def radiation_w_m2_k(emissivity: float, surface_c: float, ambient_c: float) -> f
     return emissivity * STEFAN_BOLTZMANN_W_M2_K4 * (ts * ts + ta * ta) * (ts + ta)
 
 
-def flat_plate_laminar_w_m2_k(speed_m_s: float, length_m: float, conductivity_w_m_k: float,
-                              kinematic_viscosity_m2_s: float, prandtl: float) -> float:
+def flat_plate_laminar_w_m2_k(
+    speed_m_s: float, length_m: float, conductivity_w_m_k: float, kinematic_viscosity_m2_s: float, prandtl: float
+) -> float:
     """Mean coefficient of a laminar flat plate, Pohlhausen: Nu_L = 0.664 Re_L^(1/2) Pr^(1/3)
     (Incropera and DeWitt eq. 7.30). Harris and Kotzalas (Advanced Concepts, ch. 7) treat the
     bearing's surfaces sweeping the oil the same way, with the surface speed relative to the oil."""
@@ -64,8 +70,9 @@ def hertz_constriction_w_k(semi_major_m: float, semi_minor_m: float, conductivit
     return 2.0 * conductivity_w_m_k * math.sqrt(semi_major_m * semi_minor_m)
 
 
-def cylindrical_shell_w_k(inner_radius_m: float, outer_radius_m: float, length_m: float,
-                          conductivity_w_m_k: float) -> float:
+def cylindrical_shell_w_k(
+    inner_radius_m: float, outer_radius_m: float, length_m: float, conductivity_w_m_k: float
+) -> float:
     """Radial conduction through a cylindrical shell, G = 2 pi k L / ln(r2 / r1) (Fourier)."""
     return 2.0 * math.pi * conductivity_w_m_k * length_m / math.log(outer_radius_m / inner_radius_m)
 

@@ -42,7 +42,7 @@ import numpy as np
 from twin.thermal.integrator import steady_state_c, transition
 from twin.thermal.network import N_NODES, Network
 
-THETA_STEP = 1e-4            # central difference of dT'/dtheta [-]
+THETA_STEP = 1e-4  # central difference of dT'/dtheta [-]
 THETA_BOUND = math.log(50.0)  # |ln s| kept within a factor 50 of the correlations [-]
 
 
@@ -50,12 +50,12 @@ THETA_BOUND = math.log(50.0)  # |ln s| kept within a factor 50 of the correlatio
 class EstimatorSettings:
     """Noise model of the filter."""
 
-    measurement_sigma_k: float = 0.3         # sensor noise of a thermocouple / RTD reading [K]
+    measurement_sigma_k: float = 0.3  # sensor noise of a thermocouple / RTD reading [K]
     initial_temperature_sigma_k: float = 10.0  # the start temperatures, one offset common to every node [K]
-    initial_theta_sigma: float = 0.7         # prior on ln s: the correlations within a factor 2 [-]
-    theta_process_sigma_per_sqrt_s: float = 1e-3   # random walk of ln s [1/sqrt(s)]
+    initial_theta_sigma: float = 0.7  # prior on ln s: the correlations within a factor 2 [-]
+    theta_process_sigma_per_sqrt_s: float = 1e-3  # random walk of ln s [1/sqrt(s)]
     temperature_process_sigma_k_per_sqrt_s: float = 0.01  # model error of the node temperatures [K/sqrt(s)]
-    gate_sigma: float = 5.0                  # innovation gate [-]
+    gate_sigma: float = 5.0  # innovation gate [-]
 
 
 def convergence_time_s(net: Network, dissipation_factor: float = 1.0) -> float:
@@ -71,8 +71,8 @@ class DissipationEstimator:
         self.settings = settings or EstimatorSettings()
         self.x = np.concatenate([np.asarray(temperature_c, dtype=float), [0.0]])
         self.p = np.zeros((N_NODES + 1, N_NODES + 1))
-        self.p[:N_NODES, :N_NODES] = self.settings.initial_temperature_sigma_k ** 2
-        self.p[N_NODES, N_NODES] = self.settings.initial_theta_sigma ** 2
+        self.p[:N_NODES, :N_NODES] = self.settings.initial_temperature_sigma_k**2
+        self.p[N_NODES, N_NODES] = self.settings.initial_theta_sigma**2
         self.residual_k: float | None = None
         self.innovation_sigma_k: float | None = None
         self.unexplained = False
@@ -105,8 +105,15 @@ class DissipationEstimator:
         phi = transition(net, s, h)
         return t_inf + phi @ (temps - t_inf), phi
 
-    def predict(self, net: Network, ambient_c: float, supply_c: float, heat_w: np.ndarray, period_s: float,
-                capacity_scale: float = 1.0) -> None:
+    def predict(
+        self,
+        net: Network,
+        ambient_c: float,
+        supply_c: float,
+        heat_w: np.ndarray,
+        period_s: float,
+        capacity_scale: float = 1.0,
+    ) -> None:
         """Advance the state and covariance over one network period [s] of network time
         (`capacity_scale`: the heat-capacity factor, which speeds the network's time by its inverse;
         the noise densities are per second of network time)."""
@@ -120,8 +127,8 @@ class DissipationEstimator:
         f[:N_NODES, N_NODES] = (up - dn) / (2.0 * THETA_STEP)
         st = self.settings
         h_net = period_s / capacity_scale
-        q = np.full(N_NODES + 1, st.temperature_process_sigma_k_per_sqrt_s ** 2 * h_net)
-        q[N_NODES] = st.theta_process_sigma_per_sqrt_s ** 2 * h_net
+        q = np.full(N_NODES + 1, st.temperature_process_sigma_k_per_sqrt_s**2 * h_net)
+        q[N_NODES] = st.theta_process_sigma_per_sqrt_s**2 * h_net
         self.x[:N_NODES] = new_t
         self.p = f @ self.p @ f.T + np.diag(q)
 
@@ -129,7 +136,7 @@ class DissipationEstimator:
         """Assimilate a measured temperature of `node` [degC]; returns the residual measured -
         predicted before the update [K]."""
         st = self.settings
-        r = st.measurement_sigma_k ** 2
+        r = st.measurement_sigma_k**2
         y = float(measured_c - self.x[node])
         s = float(self.p[node, node] + r)
         self.residual_k = y

@@ -22,9 +22,9 @@ from twin.thermal.materials import STEEL_EXPANSION_K_INV
 class Expansion:
     """Growth of each body over its reference temperature [m]."""
 
-    inner_raceway_m: float     # radial growth of the inner raceway
-    outer_raceway_m: float     # radial growth of the outer raceway
-    ball_radius_m: float       # growth of a ball's radius
+    inner_raceway_m: float  # radial growth of the inner raceway
+    outer_raceway_m: float  # radial growth of the outer raceway
+    ball_radius_m: float  # growth of a ball's radius
 
     @property
     def diametral_clearance_change_m(self) -> float:
@@ -32,17 +32,26 @@ class Expansion:
         return 2.0 * (self.outer_raceway_m - self.inner_raceway_m - 2.0 * self.ball_radius_m)
 
 
-def expansion(inner_rise_k: float, outer_rise_k: float, ball_rise_k: float, inner_raceway_radius_m: float,
-              outer_raceway_radius_m: float, ball_radius_m: float,
-              alpha_k_inv: float = STEEL_EXPANSION_K_INV) -> Expansion:
+def expansion(
+    inner_rise_k: float,
+    outer_rise_k: float,
+    ball_rise_k: float,
+    inner_raceway_radius_m: float,
+    outer_raceway_radius_m: float,
+    ball_radius_m: float,
+    alpha_k_inv: float = STEEL_EXPANSION_K_INV,
+) -> Expansion:
     """The growths of the raceways and the balls for temperature rises over the reference [m]."""
-    return Expansion(alpha_k_inv * inner_rise_k * inner_raceway_radius_m,
-                     alpha_k_inv * outer_rise_k * outer_raceway_radius_m,
-                     alpha_k_inv * ball_rise_k * ball_radius_m)
+    return Expansion(
+        alpha_k_inv * inner_rise_k * inner_raceway_radius_m,
+        alpha_k_inv * outer_rise_k * outer_raceway_radius_m,
+        alpha_k_inv * ball_rise_k * ball_radius_m,
+    )
 
 
-def write_groove_lanes(contacts: np.ndarray, base: tuple[np.ndarray, np.ndarray], growth: Expansion,
-                       ball_count: int) -> None:
+def write_groove_lanes(
+    contacts: np.ndarray, base: tuple[np.ndarray, np.ndarray], growth: Expansion, ball_count: int
+) -> None:
     """Write the growths into the engine's contact lanes (twin.kernels.layout): the groove-centre
     radius of each inner contact (even lanes) grows with the inner raceway, of each outer contact
     (odd lanes, and the pad lanes, which copy the last outer contact) with the outer raceway; the

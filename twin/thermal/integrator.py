@@ -14,17 +14,20 @@ import numpy as np
 from twin.thermal.network import Network
 
 
-def forcing_w(net: Network, dissipation_factor: float, ambient_c: float, supply_c: float,
-              heat_w: np.ndarray) -> np.ndarray:
+def forcing_w(
+    net: Network, dissipation_factor: float, ambient_c: float, supply_c: float, heat_w: np.ndarray
+) -> np.ndarray:
     """b = G_amb s T_amb + G_sup T_sup + q [W] (temperatures in degC: the network is linear)."""
     return net.ambient_w_k * dissipation_factor * ambient_c + net.supply_w_k * supply_c + heat_w
 
 
-def steady_state_c(net: Network, dissipation_factor: float, ambient_c: float, supply_c: float,
-                   heat_w: np.ndarray) -> np.ndarray:
+def steady_state_c(
+    net: Network, dissipation_factor: float, ambient_c: float, supply_c: float, heat_w: np.ndarray
+) -> np.ndarray:
     """T_inf = K^-1 b [degC]: the temperatures the held heat and conductances lead to."""
-    return np.linalg.solve(net.stiffness(dissipation_factor),
-                           forcing_w(net, dissipation_factor, ambient_c, supply_c, heat_w))
+    return np.linalg.solve(
+        net.stiffness(dissipation_factor), forcing_w(net, dissipation_factor, ambient_c, supply_c, heat_w)
+    )
 
 
 def transition(net: Network, dissipation_factor: float, period_s: float) -> np.ndarray:
@@ -37,8 +40,15 @@ def transition(net: Network, dissipation_factor: float, period_s: float) -> np.n
     return (r[:, None] * v) @ (np.exp(-lam * period_s)[:, None] * (v.T / r[None, :]))
 
 
-def step_c(net: Network, temperature_c: np.ndarray, dissipation_factor: float, ambient_c: float,
-           supply_c: float, heat_w: np.ndarray, period_s: float) -> np.ndarray:
+def step_c(
+    net: Network,
+    temperature_c: np.ndarray,
+    dissipation_factor: float,
+    ambient_c: float,
+    supply_c: float,
+    heat_w: np.ndarray,
+    period_s: float,
+) -> np.ndarray:
     """T(t + h) by the exact exponential step [degC]."""
     t_inf = steady_state_c(net, dissipation_factor, ambient_c, supply_c, heat_w)
     return t_inf + transition(net, dissipation_factor, period_s) @ (temperature_c - t_inf)

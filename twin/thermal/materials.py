@@ -11,7 +11,7 @@ Table A.4).
 
 STEEL_SPECIFIC_HEAT_J_KG_K = 475.0
 STEEL_CONDUCTIVITY_W_M_K = 46.6
-STEEL_EXPANSION_K_INV = 11.5e-6   # linear thermal expansion of 52100 [1/K] (Harris and Kotzalas, Table 3.5)
+STEEL_EXPANSION_K_INV = 11.5e-6  # linear thermal expansion of 52100 [1/K] (Harris and Kotzalas, Table 3.5)
 OIL_SPECIFIC_HEAT_J_KG_K = 1900.0
 OIL_CONDUCTIVITY_W_M_K = 0.13
 AIR_CONDUCTIVITY_W_M_K = 0.0271

@@ -19,18 +19,28 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from twin.thermal.correlations import (churchill_chu_cylinder_w_m2_k, cylindrical_shell_w_k,
-                                       flat_plate_laminar_w_m2_k, hertz_constriction_w_k,
-                                       iso_15312_dissipation_w_k, radiation_w_m2_k, rotating_cylinder_w_m2_k)
-from twin.thermal.materials import (OIL_CONDUCTIVITY_W_M_K, OIL_SPECIFIC_HEAT_J_KG_K, STEEL_CONDUCTIVITY_W_M_K,
-                                    STEEL_SPECIFIC_HEAT_J_KG_K)
+from twin.thermal.correlations import (
+    churchill_chu_cylinder_w_m2_k,
+    cylindrical_shell_w_k,
+    flat_plate_laminar_w_m2_k,
+    hertz_constriction_w_k,
+    iso_15312_dissipation_w_k,
+    radiation_w_m2_k,
+    rotating_cylinder_w_m2_k,
+)
+from twin.thermal.materials import (
+    OIL_CONDUCTIVITY_W_M_K,
+    OIL_SPECIFIC_HEAT_J_KG_K,
+    STEEL_CONDUCTIVITY_W_M_K,
+    STEEL_SPECIFIC_HEAT_J_KG_K,
+)
 from twin.thermal.settings import ThermalNetworkSettings
 
 NODE_NAMES = ("shaft", "inner_ring", "balls", "outer_ring", "housing", "oil")
 SHAFT, INNER_RING, BALLS, OUTER_RING, HOUSING, OIL = range(6)
 N_NODES = 6
-RING_SPAN_OVER_BALL = 1.0 / 0.3       # (D - d) / D_w of series-02 deep-groove bearings [-]
-SHOULDER_OVER_BALL = 0.2              # shoulder height / ball diameter when the spec has none [-]
+RING_SPAN_OVER_BALL = 1.0 / 0.3  # (D - d) / D_w of series-02 deep-groove bearings [-]
+SHOULDER_OVER_BALL = 0.2  # shoulder height / ball diameter when the spec has none [-]
 CAST_IRON_DENSITY_KG_M3 = 7200.0
 CAST_IRON_SPECIFIC_HEAT_J_KG_K = 460.0  # grey cast iron (Incropera and DeWitt Table A.1)
 
@@ -58,7 +68,7 @@ class NetworkGeometry:
     housing_width_m: float
     oil_volume_m3: float
     oil_density_kg_m3: float
-    capacity_j_k: np.ndarray   # per node, times the settings' heat_capacity_scale
+    capacity_j_k: np.ndarray  # per node, times the settings' heat_capacity_scale
 
     @property
     def iso_15312_dissipation_w_k(self) -> float:
@@ -78,23 +88,47 @@ def network_geometry(spec, settings: ThermalNetworkSettings) -> NetworkGeometry:
     r_i, r_o = g.inner_raceway_radius_m, g.outer_raceway_radius_m
     r_is, r_os = min(r_i + shoulder, g.pitch_radius_m), max(r_o - shoulder, g.pitch_radius_m)
     rho = spec.material.density_kg_m3
-    v_inner = math.pi * width * (r_is ** 2 - (0.5 * bore) ** 2)
-    v_outer = math.pi * width * ((0.5 * od) ** 2 - r_os ** 2)
-    v_balls = g.ball_count * math.pi / 6.0 * dw ** 3
+    v_inner = math.pi * width * (r_is**2 - (0.5 * bore) ** 2)
+    v_outer = math.pi * width * ((0.5 * od) ** 2 - r_os**2)
+    v_balls = g.ball_count * math.pi / 6.0 * dw**3
     shaft_len = settings.shaft_length_m or 4.0 * width
     v_shaft = math.pi * (0.5 * bore) ** 2 * (width + 2.0 * shaft_len)
     h_d, h_w = 2.0 * od, 2.0 * width
-    m_housing = (settings.housing_mass_kg
-                 or CAST_IRON_DENSITY_KG_M3 * math.pi * h_w * ((0.5 * h_d) ** 2 - (0.5 * od) ** 2))
-    free = math.pi * width * (r_os ** 2 - r_is ** 2) - v_balls
+    m_housing = settings.housing_mass_kg or CAST_IRON_DENSITY_KG_M3 * math.pi * h_w * (
+        (0.5 * h_d) ** 2 - (0.5 * od) ** 2
+    )
+    free = math.pi * width * (r_os**2 - r_is**2) - v_balls
     oil_volume = settings.oil_volume_m3 or 3.0 * max(free, 0.0)
     oil_rho = spec.lubricant.density_15c_kg_m3
     scale = settings.heat_capacity_scale
-    cap = np.array([v_shaft * rho * STEEL_SPECIFIC_HEAT_J_KG_K, v_inner * rho * STEEL_SPECIFIC_HEAT_J_KG_K,
-                    v_balls * rho * STEEL_SPECIFIC_HEAT_J_KG_K, v_outer * rho * STEEL_SPECIFIC_HEAT_J_KG_K,
-                    m_housing * CAST_IRON_SPECIFIC_HEAT_J_KG_K, oil_volume * oil_rho * OIL_SPECIFIC_HEAT_J_KG_K])
-    return NetworkGeometry(bore, od, width, dm, dw, g.ball_count, r_i, r_o, r_is, r_os, shaft_len, h_d, h_w,
-                           oil_volume, oil_rho, cap * scale)
+    cap = np.array(
+        [
+            v_shaft * rho * STEEL_SPECIFIC_HEAT_J_KG_K,
+            v_inner * rho * STEEL_SPECIFIC_HEAT_J_KG_K,
+            v_balls * rho * STEEL_SPECIFIC_HEAT_J_KG_K,
+            v_outer * rho * STEEL_SPECIFIC_HEAT_J_KG_K,
+            m_housing * CAST_IRON_SPECIFIC_HEAT_J_KG_K,
+            oil_volume * oil_rho * OIL_SPECIFIC_HEAT_J_KG_K,
+        ]
+    )
+    return NetworkGeometry(
+        bore,
+        od,
+        width,
+        dm,
+        dw,
+        g.ball_count,
+        r_i,
+        r_o,
+        r_is,
+        r_os,
+        shaft_len,
+        h_d,
+        h_w,
+        oil_volume,
+        oil_rho,
+        cap * scale,
+    )
 
 
 @dataclass(frozen=True)
@@ -104,9 +138,9 @@ class Operating:
     shaft_speed_rad_s: float
     cage_speed_rad_s: float
     ball_spin_rad_s: float
-    inner_contact_semi_axes_m: np.ndarray   # (n, 2): a, b of the loaded inner contacts
+    inner_contact_semi_axes_m: np.ndarray  # (n, 2): a, b of the loaded inner contacts
     outer_contact_semi_axes_m: np.ndarray
-    temperature_c: np.ndarray               # node temperatures the film properties are taken at
+    temperature_c: np.ndarray  # node temperatures the film properties are taken at
     ambient_c: float
     oil_kinematic_viscosity_m2_s: float
 
@@ -116,16 +150,17 @@ class Network:
     """dC T/dt = -K T + G_amb s T_amb + G_sup T_sup + q, K = L + diag(G_amb s + G_sup), L the
     Laplacian of the node-to-node conductances, s the dissipation factor."""
 
-    capacity_j_k: np.ndarray          # (n,) [J/K]
-    coupling_w_k: np.ndarray          # (n, n) symmetric node-to-node conductances, zero diagonal [W/K]
-    ambient_w_k: np.ndarray           # (n,) to the surroundings, before the dissipation factor [W/K]
-    supply_w_k: np.ndarray            # (n,) to the circulating oil supply [W/K]
+    capacity_j_k: np.ndarray  # (n,) [J/K]
+    coupling_w_k: np.ndarray  # (n, n) symmetric node-to-node conductances, zero diagonal [W/K]
+    ambient_w_k: np.ndarray  # (n,) to the surroundings, before the dissipation factor [W/K]
+    supply_w_k: np.ndarray  # (n,) to the circulating oil supply [W/K]
 
     def stiffness(self, dissipation_factor: float) -> np.ndarray:
         """K [W/K] at a dissipation factor s."""
         k = -self.coupling_w_k.copy()
-        k[np.diag_indices_from(k)] = (self.coupling_w_k.sum(axis=1) + self.ambient_w_k * dissipation_factor
-                                      + self.supply_w_k)
+        k[np.diag_indices_from(k)] = (
+            self.coupling_w_k.sum(axis=1) + self.ambient_w_k * dissipation_factor + self.supply_w_k
+        )
         return k
 
     def time_constants_s(self, dissipation_factor: float = 1.0) -> np.ndarray:
@@ -134,8 +169,13 @@ class Network:
         return np.sort(1.0 / lam)[::-1]
 
 
-def coupled_time_constants_s(net: Network, heat_slope_w_k: float, heat_share: np.ndarray,
-                             inlet_weights: np.ndarray, dissipation_factor: float = 1.0) -> np.ndarray:
+def coupled_time_constants_s(
+    net: Network,
+    heat_slope_w_k: float,
+    heat_share: np.ndarray,
+    inlet_weights: np.ndarray,
+    dissipation_factor: float = 1.0,
+) -> np.ndarray:
     """Time constants of the network with the friction's feedback, slowest first [s]: the heat
     q = P(T_in) p, P the friction power, p its share per node, T_in = w . T the inlet
     temperature; linearised, C dT/dt = -(K - dP/dT_in p w^T) T + ... A heat falling with the
@@ -187,7 +227,7 @@ def assemble(geo: NetworkGeometry, op: Operating, spec, settings: ThermalNetwork
     dw = geo.ball_diameter_m
     _link(coupling, BALLS, OIL, oil_h(0.5 * op.ball_spin_rad_s * dw, math.pi * dw) * geo.ball_count * math.pi * dw * dw)
     # the sump's walls: the housing bore and sides, swept by the oil the cage drags
-    sump_area = 2.0 * math.pi * r_od * b + 2.0 * math.pi * (r_od ** 2 - geo.outer_shoulder_radius_m ** 2)
+    sump_area = 2.0 * math.pi * r_od * b + 2.0 * math.pi * (r_od**2 - geo.outer_shoulder_radius_m**2)
     _link(coupling, OIL, HOUSING, oil_h(0.5 * u_outer, circ) * sump_area)
     if settings.oil_supply == "circulating":
         supply[OIL] = geo.oil_density_kg_m3 * OIL_SPECIFIC_HEAT_J_KG_K * settings.oil_flow_m3_s
@@ -198,12 +238,15 @@ def assemble(geo: NetworkGeometry, op: Operating, spec, settings: ThermalNetwork
         ambient[INNER_RING] = g_iso * geo.bore_m / (geo.outside_diameter_m + geo.bore_m)
     else:
         h_d, h_w = geo.housing_diameter_m, geo.housing_width_m
-        h_area = math.pi * h_d * h_w + 2.0 * math.pi * 0.25 * (h_d ** 2 - geo.outside_diameter_m ** 2)
-        h_h = (churchill_chu_cylinder_w_m2_k(h_d, t[HOUSING], amb)
-               + radiation_w_m2_k(settings.housing_emissivity, t[HOUSING], amb))
+        h_area = math.pi * h_d * h_w + 2.0 * math.pi * 0.25 * (h_d**2 - geo.outside_diameter_m**2)
+        h_h = churchill_chu_cylinder_w_m2_k(h_d, t[HOUSING], amb) + radiation_w_m2_k(
+            settings.housing_emissivity, t[HOUSING], amb
+        )
         ambient[HOUSING] = h_h * h_area + settings.housing_frame_conductance_w_k
         s_area = 2.0 * math.pi * geo.bore_m * geo.shaft_length_m
-        s_h = max(rotating_cylinder_w_m2_k(geo.bore_m, op.shaft_speed_rad_s),
-                  churchill_chu_cylinder_w_m2_k(geo.bore_m, t[SHAFT], amb))
+        s_h = max(
+            rotating_cylinder_w_m2_k(geo.bore_m, op.shaft_speed_rad_s),
+            churchill_chu_cylinder_w_m2_k(geo.bore_m, t[SHAFT], amb),
+        )
         ambient[SHAFT] = s_h * s_area + settings.shaft_frame_conductance_w_k
     return Network(geo.capacity_j_k, coupling, ambient, supply)

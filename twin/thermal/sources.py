@@ -36,7 +36,7 @@ class HeatSources:
     """Friction heat [W]: per contact (rows: ball j inner 2j, outer 2j+1; columns SOURCE_NAMES
     rolling, sliding, spin) and per non-contact source."""
 
-    per_contact_w: np.ndarray   # (2Z, 3) [W]
+    per_contact_w: np.ndarray  # (2Z, 3) [W]
     drag_w: float = 0.0
     seal_w: float = 0.0
 
@@ -44,8 +44,13 @@ class HeatSources:
     def by_source_w(self) -> dict[str, float]:
         """Total heat of each source [W]."""
         s = self.per_contact_w.sum(axis=0)
-        return {"rolling": float(s[0]), "sliding": float(s[1]), "spin": float(s[2]),
-                "drag": float(self.drag_w), "seal": float(self.seal_w)}
+        return {
+            "rolling": float(s[0]),
+            "sliding": float(s[1]),
+            "spin": float(s[2]),
+            "drag": float(self.drag_w),
+            "seal": float(self.seal_w),
+        }
 
     @property
     def total_w(self) -> float:

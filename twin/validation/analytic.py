@@ -51,8 +51,9 @@ def stribeck_qmax_n(radial_load_n: float, ball_count: int, epsilon: float = 0.5)
     return radial_load_n / (ball_count * radial_integral(epsilon))
 
 
-def radial_equilibrium(model: BearingModel, radial_load_n: float, azimuths_rad,
-                       clearance_m: float | None = None) -> dict:
+def radial_equilibrium(
+    model: BearingModel, radial_load_n: float, azimuths_rad, clearance_m: float | None = None
+) -> dict:
     """Hertz equilibrium of the inner ring for balls at the given azimuths (rigid rings, no
     centrifugal force): solves sum_j Q_j (cos psi_j, sin psi_j) = (Fr, 0) for the ring shift.
 
@@ -79,8 +80,12 @@ def radial_equilibrium(model: BearingModel, radial_load_n: float, azimuths_rad,
     q, defl = loads(shift)
     delta_r = float(math.hypot(*shift))
     return {
-        "shift_m": shift, "radial_shift_m": delta_r, "ball_loads_n": q, "deflections_m": defl,
-        "epsilon": load_parameter_epsilon(delta_r, clearance_m), "qmax_n": float(q.max()),
+        "shift_m": shift,
+        "radial_shift_m": delta_r,
+        "ball_loads_n": q,
+        "deflections_m": defl,
+        "epsilon": load_parameter_epsilon(delta_r, clearance_m),
+        "qmax_n": float(q.max()),
         "converged": bool(sol.success),
     }
 
@@ -132,8 +137,9 @@ class _Geometry:
 
     def stiffness(self, race: int, sin_alpha: float) -> float:
         """Exact Hertz K [N/m^1.5] of race `race` at |sin(alpha)|."""
-        return model_lib.contact_constants(self.model.spec, race == 0, min(abs(sin_alpha), 0.999),
-                                           self.e_prime)["stiffness_n_m15"]
+        return model_lib.contact_constants(self.model.spec, race == 0, min(abs(sin_alpha), 0.999), self.e_prime)[
+            "stiffness_n_m15"
+        ]
 
 
 def _ball_forces(geo: _Geometry, ball: np.ndarray, inner_centre: np.ndarray, m_omega2: float):
@@ -141,14 +147,14 @@ def _ball_forces(geo: _Geometry, ball: np.ndarray, inner_centre: np.ndarray, m_o
     m_omega2 = m omega_c^2 [N/m] makes the centrifugal force m omega_c^2 rho."""
     to_inner = inner_centre - ball
     d_i = float(np.hypot(*to_inner))
-    n_i = to_inner / d_i                      # ball -> inner groove centre
+    n_i = to_inner / d_i  # ball -> inner groove centre
     from_outer = ball - geo.outer_centre
     d_o = float(np.hypot(*from_outer))
-    n_o = from_outer / d_o                    # outer groove centre -> ball
+    n_o = from_outer / d_o  # outer groove centre -> ball
     delta_i = d_i - geo.inner_free
     delta_o = d_o - geo.outer_free
-    q_i = geo.stiffness(0, n_i[0]) * delta_i ** 1.5 if delta_i > 0.0 else 0.0
-    q_o = geo.stiffness(1, n_o[0]) * delta_o ** 1.5 if delta_o > 0.0 else 0.0
+    q_i = geo.stiffness(0, n_i[0]) * delta_i**1.5 if delta_i > 0.0 else 0.0
+    q_o = geo.stiffness(1, n_o[0]) * delta_o**1.5 if delta_o > 0.0 else 0.0
     force = q_i * n_i - q_o * n_o + np.array([0.0, m_omega2 * ball[1]])
     return force, q_i, n_i, q_o, n_o
 
@@ -176,9 +182,15 @@ def _solve_ball(geo: _Geometry, inner_centre: np.ndarray, m_omega2: float, scale
     return sol.x * 1e-6
 
 
-def jones_equilibrium(model: BearingModel, radial_load_n: float, axial_load_n: float,
-                      shaft_speed_rad_s: float = 0.0, azimuths_rad=None,
-                      centrifugal: bool = True, initial_displacement_m=None) -> JonesSolution:
+def jones_equilibrium(
+    model: BearingModel,
+    radial_load_n: float,
+    axial_load_n: float,
+    shaft_speed_rad_s: float = 0.0,
+    azimuths_rad=None,
+    centrifugal: bool = True,
+    initial_displacement_m=None,
+) -> JonesSolution:
     """Jones' quasi-static solution (Jones 1960, "A general theory for elastically constrained
     ball and radial roller bearings under arbitrary load and speed conditions", J. Basic Eng. 82;
     Harris & Kotzalas vol. 2 ch. 3) for the model's bearing: rigid rings, the inner ring displaced
@@ -192,15 +204,14 @@ def jones_equilibrium(model: BearingModel, radial_load_n: float, axial_load_n: f
     azimuths_rad: the balls' azimuths (default evenly spaced from 0); radial load along +x,
     axial load along +z on the inner ring [N]."""
     z = model.ball_count
-    psi = (np.asarray(azimuths_rad, dtype=float) if azimuths_rad is not None
-           else 2.0 * math.pi * np.arange(z) / z)
+    psi = np.asarray(azimuths_rad, dtype=float) if azimuths_rad is not None else 2.0 * math.pi * np.arange(z) / z
     geo = _Geometry(model)
     mass = float(model.params[L.P_BALL_MASS])
     omega_c = model.cage_speed_rad_s(shaft_speed_rad_s) if centrifugal else 0.0
     scale = max(abs(radial_load_n), abs(axial_load_n), 1.0)
     c, s = np.cos(psi), np.sin(psi)
 
-    m_omega2 = mass * omega_c ** 2
+    m_omega2 = mass * omega_c**2
 
     def solve_balls(shift):
         out = []
@@ -220,8 +231,9 @@ def jones_equilibrium(model: BearingModel, radial_load_n: float, axial_load_n: f
         return force / scale
 
     if initial_displacement_m is None:
-        k_eff = series_stiffness_n_m15(geo.stiffness(0, math.sin(model.contact_angle_rad)),
-                                       geo.stiffness(1, math.sin(model.contact_angle_rad)))
+        k_eff = series_stiffness_n_m15(
+            geo.stiffness(0, math.sin(model.contact_angle_rad)), geo.stiffness(1, math.sin(model.contact_angle_rad))
+        )
         sa, ca = math.sin(model.contact_angle_rad), math.cos(model.contact_angle_rad)
         pd = model.spec.mounting.diametral_clearance_m
         dr = (max(radial_load_n, 1.0) / (z * 0.2288 * k_eff)) ** (2 / 3) / max(ca, 0.2) + 0.5 * max(pd, 0.0)
@@ -243,7 +255,16 @@ def jones_equilibrium(model: BearingModel, radial_load_n: float, axial_load_n: f
     delta_r = float(math.hypot(shift[0], shift[1]))
     tan_a = math.tan(model.contact_angle_rad)
     eps = 0.5 * (1.0 + shift[2] * tan_a / delta_r) if delta_r > 0.0 else math.inf
-    return JonesSolution(ring_displacement_m=shift, azimuths_rad=psi, inner_load_n=q_in,
-                         outer_load_n=q_out, inner_angle_rad=a_in, outer_angle_rad=a_out,
-                         ball_axial_m=zb, ball_radial_m=rho, centrifugal_force_n=float(m_omega2 * model.pitch_radius_m),
-                         epsilon=eps, converged=converged)
+    return JonesSolution(
+        ring_displacement_m=shift,
+        azimuths_rad=psi,
+        inner_load_n=q_in,
+        outer_load_n=q_out,
+        inner_angle_rad=a_in,
+        outer_angle_rad=a_out,
+        ball_axial_m=zb,
+        ball_radial_m=rho,
+        centrifugal_force_n=float(m_omega2 * model.pitch_radius_m),
+        epsilon=eps,
+        converged=converged,
+    )

@@ -64,9 +64,9 @@ class BenchCase:
     axial_load_n: float = 0.0
     shaft_current_a: float = 0.0
     shear_heating: bool | None = None  # inlet shear heating (None: the spec's default, on)
-    housing: bool | None = None       # outer ring on the housing (None: the spec's default, off)
-    defect: str | None = None         # local defect of twin.validation.vibration_simulation.defect_for (outer, inner, ball)
-    surface_profile: bool = False     # race profiles and ball sizes exciting the contacts (twin.vibration.surface)
+    housing: bool | None = None  # outer ring on the housing (None: the spec's default, off)
+    defect: str | None = None  # local defect of twin.validation.vibration_simulation.defect_for (outer, inner, ball)
+    surface_profile: bool = False  # race profiles and ball sizes exciting the contacts (twin.vibration.surface)
 
 
 SERVE_DEFAULT = BenchCase("serve-default")  # Twin("6208")'s default setpoint, what `serve` runs
@@ -78,35 +78,60 @@ CASES: tuple[BenchCase, ...] = (
     BenchCase("vibration-outer-spall", housing=True, defect="outer"),
     BenchCase("vibration-healthy-profile", housing=True, surface_profile=True),
     # the CWRU rig as `python -m twin.validation.cwru` runs it: housing, rotor, race profiles
-    BenchCase("vibration-cwru-de", designation="CWRU-DE", shaft_speed_rad_s=1797.0 * math.pi / 30.0,
-              radial_load_n=catalog.CWRU_RADIAL_LOAD_N, surface_profile=True),
+    BenchCase(
+        "vibration-cwru-de",
+        designation="CWRU-DE",
+        shaft_speed_rad_s=1797.0 * math.pi / 30.0,
+        radial_load_n=catalog.CWRU_RADIAL_LOAD_N,
+        surface_profile=True,
+    ),
 )
-EV_20K = BenchCase("ev-6200-20krpm", designation=EV_BEARING, shaft_speed_rad_s=20000.0 * math.pi / 30.0,
-                   radial_load_n=EV_RADIAL_LOAD_N, shaft_current_a=10.0, shear_heating=True)
+EV_20K = BenchCase(
+    "ev-6200-20krpm",
+    designation=EV_BEARING,
+    shaft_speed_rad_s=20000.0 * math.pi / 30.0,
+    radial_load_n=EV_RADIAL_LOAD_N,
+    shaft_current_a=10.0,
+    shear_heating=True,
+)
 CASES = (*CASES, EV_20K)
 
 
 def _twin(case: BenchCase, time_step_s: float | Literal["auto"]) -> Twin:
     spec = catalog.bearing(case.designation)
     if case.shear_heating is not None and case.shear_heating != spec.thermal.shear_heating:
-        spec = BearingSpec.model_validate({**spec.model_dump(), "thermal": {
-            **spec.thermal.model_dump(), "shear_heating": case.shear_heating}})
+        spec = BearingSpec.model_validate(
+            {**spec.model_dump(), "thermal": {**spec.thermal.model_dump(), "shear_heating": case.shear_heating}}
+        )
     if case.housing is not None and case.housing != spec.housing.enabled:
-        spec = BearingSpec.model_validate({**spec.model_dump(), "housing": {
-            **spec.housing.model_dump(), "enabled": case.housing}})
+        spec = BearingSpec.model_validate(
+            {**spec.model_dump(), "housing": {**spec.housing.model_dump(), "enabled": case.housing}}
+        )
     if case.surface_profile != spec.surface_profile.enabled:
-        spec = BearingSpec.model_validate({**spec.model_dump(), "surface_profile": {
-            **spec.surface_profile.model_dump(), "enabled": case.surface_profile}})
-    twin = Twin(spec, options=ModelOptions(time_step_s=time_step_s),
-                setpoint=Setpoint(shaft_speed_rad_s=case.shaft_speed_rad_s, radial_load_n=case.radial_load_n,
-                                  axial_load_n=case.axial_load_n, shaft_current_a=case.shaft_current_a))
+        spec = BearingSpec.model_validate(
+            {
+                **spec.model_dump(),
+                "surface_profile": {**spec.surface_profile.model_dump(), "enabled": case.surface_profile},
+            }
+        )
+    twin = Twin(
+        spec,
+        options=ModelOptions(time_step_s=time_step_s),
+        setpoint=Setpoint(
+            shaft_speed_rad_s=case.shaft_speed_rad_s,
+            radial_load_n=case.radial_load_n,
+            axial_load_n=case.axial_load_n,
+            shaft_current_a=case.shaft_current_a,
+        ),
+    )
     if case.defect is not None:
         twin.set_defects([defect_for(case.defect, spec.geometry)])
     return twin
 
 
-def measure(case: BenchCase, time_step_s: float | Literal["auto"] = "auto", seconds: float = 0.2,
-            repeats: int = MIN_REPEATS) -> dict:
+def measure(
+    case: BenchCase, time_step_s: float | Literal["auto"] = "auto", seconds: float = 0.2, repeats: int = MIN_REPEATS
+) -> dict:
     """Best and median real-time factor and ns per step of `repeats` runs of `seconds`; with the
     outer ring on the housing the indicators of one window are timed apart and their share per
     simulated second added (module docstring)."""
@@ -121,11 +146,18 @@ def measure(case: BenchCase, time_step_s: float | Literal["auto"] = "auto", seco
     dt = twin.model.dt_s
     best, median = max(factors), statistics.median(factors)
     out: dict[str, Any] = {
-        "time_step_s": dt, "real_time_factor": best, "real_time_factor_median": median,
-        "ns_per_step": dt / best * 1e9, "ns_per_step_median": dt / median * 1e9,
-        "cpu_real_time_factor": max(cpu_factors), "cpu_real_time_factor_median": statistics.median(cpu_factors),
-        "repeats": repeats, "housing": twin.model.housing_on, "defects": len(twin.defects),
-        "status": twin.status}
+        "time_step_s": dt,
+        "real_time_factor": best,
+        "real_time_factor_median": median,
+        "ns_per_step": dt / best * 1e9,
+        "ns_per_step_median": dt / median * 1e9,
+        "cpu_real_time_factor": max(cpu_factors),
+        "cpu_real_time_factor_median": statistics.median(cpu_factors),
+        "repeats": repeats,
+        "housing": twin.model.housing_on,
+        "defects": len(twin.defects),
+        "status": twin.status,
+    }
     if twin.model.housing_on:
         reader = twin._sensor
         assert reader is not None  # the housing's accelerometer
@@ -138,19 +170,26 @@ def measure(case: BenchCase, time_step_s: float | Literal["auto"] = "auto", seco
             cpu_costs.append(time.thread_time() - c0)
         share = min(costs) / reader.window_s  # wall s per simulated s
         cpu_share = min(cpu_costs) / reader.window_s
-        out.update({"indicator_window_s": min(costs), "window_s": reader.window_s,
-                    "real_time_factor_kernel": best, "real_time_factor_kernel_median": median,
-                    "real_time_factor": 1.0 / (1.0 / best + share),
-                    "real_time_factor_median": 1.0 / (1.0 / median + share),
-                    "cpu_real_time_factor": 1.0 / (1.0 / out["cpu_real_time_factor"] + cpu_share),
-                    "cpu_real_time_factor_median": 1.0 / (1.0 / out["cpu_real_time_factor_median"] + cpu_share)})
+        out.update(
+            {
+                "indicator_window_s": min(costs),
+                "window_s": reader.window_s,
+                "real_time_factor_kernel": best,
+                "real_time_factor_kernel_median": median,
+                "real_time_factor": 1.0 / (1.0 / best + share),
+                "real_time_factor_median": 1.0 / (1.0 / median + share),
+                "cpu_real_time_factor": 1.0 / (1.0 / out["cpu_real_time_factor"] + cpu_share),
+                "cpu_real_time_factor_median": 1.0 / (1.0 / out["cpu_real_time_factor_median"] + cpu_share),
+            }
+        )
         out["ns_per_step"] = dt / out["real_time_factor"] * 1e9
         out["ns_per_step_median"] = dt / out["real_time_factor_median"] * 1e9
     return out
 
 
-def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, cases: bool = True,
-                         passes: bool = True) -> dict:
+def run_engine_benchmark(
+    seconds: float = 0.2, repeats: int = MIN_REPEATS, *, cases: bool = True, passes: bool = True
+) -> dict:
     """The benchmark (module docstring). `cases` / `passes`: include those parts."""
     if repeats < MIN_REPEATS:
         raise ValueError(f"repeats = {repeats}: at least {MIN_REPEATS}")
@@ -158,13 +197,20 @@ def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, ca
     auto = measure(SERVE_DEFAULT, "auto", seconds, repeats)
     one = measure(SERVE_DEFAULT, 1e-6, seconds, repeats)
     result = {
-        **asdict(SERVE_DEFAULT), "bearing": SERVE_DEFAULT.designation,
-        "simulated_seconds_per_repeat": seconds, "repeats": repeats,
-        "time_step_s": auto["time_step_s"], "real_time_factor": auto["real_time_factor"],
-        "real_time_factor_median": auto["real_time_factor_median"], "ns_per_step": auto["ns_per_step"],
-        "ns_per_step_median": auto["ns_per_step_median"], "status": auto["status"],
-        "real_time_factor_1us": one["real_time_factor"], "real_time_factor_1us_median": one["real_time_factor_median"],
-        "ns_per_step_1us": one["ns_per_step"], "ns_per_step_1us_median": one["ns_per_step_median"],
+        **asdict(SERVE_DEFAULT),
+        "bearing": SERVE_DEFAULT.designation,
+        "simulated_seconds_per_repeat": seconds,
+        "repeats": repeats,
+        "time_step_s": auto["time_step_s"],
+        "real_time_factor": auto["real_time_factor"],
+        "real_time_factor_median": auto["real_time_factor_median"],
+        "ns_per_step": auto["ns_per_step"],
+        "ns_per_step_median": auto["ns_per_step_median"],
+        "status": auto["status"],
+        "real_time_factor_1us": one["real_time_factor"],
+        "real_time_factor_1us_median": one["real_time_factor_median"],
+        "ns_per_step_1us": one["ns_per_step"],
+        "ns_per_step_1us_median": one["ns_per_step_median"],
         "cpu_real_time_factor": auto["cpu_real_time_factor"],
         "cpu_real_time_factor_median": auto["cpu_real_time_factor_median"],
         "cpu_real_time_factor_1us": one["cpu_real_time_factor"],
@@ -172,9 +218,13 @@ def run_engine_benchmark(seconds: float = 0.2, repeats: int = MIN_REPEATS, *, ca
     }
     if cases:
         result["cases"] = [
-            {**asdict(c), "default_step": measure(c, "auto", seconds, repeats),
-             "step_1us": measure(c, 1e-6, seconds, repeats)}
-            for c in CASES]
+            {
+                **asdict(c),
+                "default_step": measure(c, "auto", seconds, repeats),
+                "step_1us": measure(c, 1e-6, seconds, repeats),
+            }
+            for c in CASES
+        ]
     if passes:
         twin = _twin(SERVE_DEFAULT, "auto")
         twin.advance(0.005)
@@ -190,34 +240,49 @@ def ev_passes(repeats: int = MIN_REPEATS) -> dict:
     that real time allows (its auto step) [ns]."""
     twin = _twin(EV_20K, "auto")
     twin.advance(0.005)
-    return {**time_passes(twin, repeats=repeats), "time_step_s": twin.model.dt_s,
-            "ns_per_step_for_real_time": twin.model.dt_s * 1e9}
+    return {
+        **time_passes(twin, repeats=repeats),
+        "time_step_s": twin.model.dt_s,
+        "ns_per_step_for_real_time": twin.model.dt_s * 1e9,
+    }
 
 
 def summary_text(result: dict) -> str:
     """The benchmark as a few lines of text (what `bearing-twin bench` prints without --json)."""
-    def fig(r: dict, key: str = "") -> str:
-        return (f"real-time factor {r[f'real_time_factor{key}']:.2f} best / {r[f'real_time_factor{key}_median']:.2f} "
-                f"median, {r[f'ns_per_step{key}']:.0f} ns per step")
 
-    lines = [f"{result['bearing']} at {result['radial_load_n']:.0f} N, {result['shaft_speed_rad_s']:.0f} rad/s, "
-             f"best and median of {result['repeats']} x {result['simulated_seconds_per_repeat']:g} s:",
-             f"  default step dt = {result['time_step_s'] * 1e6:.3f} us: {fig(result)}",
-             f"  dt = 1 us: {fig(result, '_1us')}",
-             f"  per CPU second of the stepping thread: {result['cpu_real_time_factor']:.2f} (default step), "
-             f"{result['cpu_real_time_factor_1us']:.2f} (1 us)"]
+    def fig(r: dict, key: str = "") -> str:
+        return (
+            f"real-time factor {r[f'real_time_factor{key}']:.2f} best / {r[f'real_time_factor{key}_median']:.2f} "
+            f"median, {r[f'ns_per_step{key}']:.0f} ns per step"
+        )
+
+    lines = [
+        f"{result['bearing']} at {result['radial_load_n']:.0f} N, {result['shaft_speed_rad_s']:.0f} rad/s, "
+        f"best and median of {result['repeats']} x {result['simulated_seconds_per_repeat']:g} s:",
+        f"  default step dt = {result['time_step_s'] * 1e6:.3f} us: {fig(result)}",
+        f"  dt = 1 us: {fig(result, '_1us')}",
+        f"  per CPU second of the stepping thread: {result['cpu_real_time_factor']:.2f} (default step), "
+        f"{result['cpu_real_time_factor_1us']:.2f} (1 us)",
+    ]
     for c in result.get("cases", []):
         d, o = c["default_step"], c["step_1us"]
         lines.append(f"  {c['id']}: dt = {d['time_step_s'] * 1e6:.3f} us: {fig(d)}; 1 us: {fig(o)}")
     for key, what in (("passes", ""), ("passes_ev", f" of {EV_20K.id}")):
         p = result.get(key)
         if p:
-            parts = ", ".join(f"{k} {p[k]['best_ns']:.0f}" for k in ("gather", "geometry", "forces", "tribology",
-                                                                      "traction", "cage", "integration"))
-            budget = (f"; real time needs <= {p['ns_per_step_for_real_time']:.0f}"
-                      if "ns_per_step_for_real_time" in p else "")
-            lines.append(f"  per pass{what}, ns per step (best): {parts}; sum {p['sum_of_passes']['best_ns']:.0f}, "
-                         f"step_n {p['total']['best_ns']:.0f}{budget}")
-    lines.append(f"  load average (1 min) before / after: {result['load_average_1min'][0]:.2f} / "
-                 f"{result['load_average_1min'][1]:.2f}")
+            parts = ", ".join(
+                f"{k} {p[k]['best_ns']:.0f}"
+                for k in ("gather", "geometry", "forces", "tribology", "traction", "cage", "integration")
+            )
+            budget = (
+                f"; real time needs <= {p['ns_per_step_for_real_time']:.0f}" if "ns_per_step_for_real_time" in p else ""
+            )
+            lines.append(
+                f"  per pass{what}, ns per step (best): {parts}; sum {p['sum_of_passes']['best_ns']:.0f}, "
+                f"step_n {p['total']['best_ns']:.0f}{budget}"
+            )
+    lines.append(
+        f"  load average (1 min) before / after: {result['load_average_1min'][0]:.2f} / "
+        f"{result['load_average_1min'][1]:.2f}"
+    )
     return "\n".join(lines)

@@ -34,9 +34,9 @@ from twin.vibration import indicators as ind
 G_M_S2 = 9.80665
 DATA_DIR = Path(__file__).resolve().parents[2] / "tests" / "data" / "cwru"
 ENVELOPE_BAND_HZ = (2000.0, 5000.0)
-LINE_SEARCH_SHAFT = (0.3, 12.0)   # largest envelope line searched between these multiples of shaft
-BACKGROUND_HALF_WIDTH_HZ = 20.0   # the line's background: median within +- this [Hz]
-SETTLE_S = 0.3                    # simulated start-up discarded before the analysed window [s]
+LINE_SEARCH_SHAFT = (0.3, 12.0)  # largest envelope line searched between these multiples of shaft
+BACKGROUND_HALF_WIDTH_HZ = 20.0  # the line's background: median within +- this [Hz]
+SETTLE_S = 0.3  # simulated start-up discarded before the analysed window [s]
 # published multiples of the shaft frequency (CWRU data center, 6205-2RS JEM)
 PUBLISHED_MULTIPLES = {"BPFI": 5.4152, "BPFO": 3.5848, "FTF": 0.39828, "2xBSF": 4.7135}
 
@@ -48,10 +48,10 @@ class Record:
     number: int
     file: str
     condition: str
-    defect: str | None      # 'inner', 'outer', 'ball' or None
-    angle_deg: float        # outer race: from the centre of the load zone [deg]
+    defect: str | None  # 'inner', 'outer', 'ball' or None
+    angle_deg: float  # outer race: from the centre of the load zone [deg]
     rpm: float
-    expected: str | None    # the defect line: 'BPFI', 'BPFO', '2xBSF'
+    expected: str | None  # the defect line: 'BPFI', 'BPFO', '2xBSF'
 
 
 RECORDS = (
@@ -62,8 +62,8 @@ RECORDS = (
     Record(144, "144_DE_5s.npy", "outer race 3:00", "outer", 90.0, 1797.0, "BPFO"),
     Record(156, "156_DE_5s.npy", "outer race 12:00", "outer", 180.0, 1797.0, "BPFO"),
 )
-FAULT_WIDTH_M = 0.007 * 0.0254   # 0.178 mm
-FAULT_DEPTH_M = 0.011 * 0.0254   # 0.279 mm
+FAULT_WIDTH_M = 0.007 * 0.0254  # 0.178 mm
+FAULT_DEPTH_M = 0.011 * 0.0254  # 0.279 mm
 SAMPLE_RATE_HZ = 12000.0
 
 
@@ -75,10 +75,10 @@ class Analysis:
     kurtosis: float
     crest_factor: float
     largest_line_hz: float
-    largest_line_shaft: float          # its frequency over the shaft frequency [-]
-    largest_line_name: str             # nearest defect line name within 1.5 %, else 'other'
+    largest_line_shaft: float  # its frequency over the shaft frequency [-]
+    largest_line_name: str  # nearest defect line name within 1.5 %, else 'other'
     expected_line_hz: float | None
-    expected_line_db: float | None     # height over the +-20 Hz median [dB]
+    expected_line_db: float | None  # height over the +-20 Hz median [dB]
 
 
 def line_height_db(freqs: np.ndarray, amp: np.ndarray, f_hz: float) -> tuple[float, float]:
@@ -110,9 +110,16 @@ def analyse(x_m_s2: np.ndarray, sample_rate_hz: float, rpm: float, expected: str
     f_exp = db = None
     if expected is not None:
         f_exp, db = line_height_db(freqs, amp, PUBLISHED_MULTIPLES[expected] * shaft_hz)
-    return Analysis(rms_g=t["rms_m_s2"] / G_M_S2, kurtosis=t["kurtosis"], crest_factor=t["crest_factor"],
-                    largest_line_hz=float(freqs[i]), largest_line_shaft=ratio, largest_line_name=name,
-                    expected_line_hz=f_exp, expected_line_db=db)
+    return Analysis(
+        rms_g=t["rms_m_s2"] / G_M_S2,
+        kurtosis=t["kurtosis"],
+        crest_factor=t["crest_factor"],
+        largest_line_hz=float(freqs[i]),
+        largest_line_shaft=ratio,
+        largest_line_name=name,
+        expected_line_hz=f_exp,
+        expected_line_db=db,
+    )
 
 
 def measured(record: Record, duration_s: float | None = None, data_dir: Path = DATA_DIR) -> tuple[Analysis, np.ndarray]:
@@ -121,17 +128,26 @@ def measured(record: Record, duration_s: float | None = None, data_dir: Path = D
     background grows with the record's length (the background per bin falls as 1 / sqrt(length))."""
     x = np.load(data_dir / record.file).astype(float) * G_M_S2
     if duration_s is not None:
-        x = x[:int(round(duration_s * SAMPLE_RATE_HZ))]
+        x = x[: int(round(duration_s * SAMPLE_RATE_HZ))]
     return analyse(x, SAMPLE_RATE_HZ, record.rpm, record.expected), x
 
 
 def simulated(record: Record, duration_s: float = 1.0, settle_s: float = SETTLE_S) -> tuple[Analysis, np.ndarray]:
     """The `CWRU-DE` twin in the conditions of `record`: its signal [m/s^2] and analysis."""
     _, x = simulate_vibration(
-        "CWRU-DE", record.rpm * 2.0 * math.pi / 60.0, None, defect=record.defect,
-        defect_size_m=FAULT_WIDTH_M, defect_length_m=FAULT_WIDTH_M, defect_depth_m=FAULT_DEPTH_M,
-        defect_angle_deg=record.angle_deg, duration_s=duration_s, settle_s=settle_s,
-        band=ENVELOPE_BAND_HZ, window_s=duration_s)
+        "CWRU-DE",
+        record.rpm * 2.0 * math.pi / 60.0,
+        None,
+        defect=record.defect,
+        defect_size_m=FAULT_WIDTH_M,
+        defect_length_m=FAULT_WIDTH_M,
+        defect_depth_m=FAULT_DEPTH_M,
+        defect_angle_deg=record.angle_deg,
+        duration_s=duration_s,
+        settle_s=settle_s,
+        band=ENVELOPE_BAND_HZ,
+        window_s=duration_s,
+    )
     return analyse(x, SAMPLE_RATE_HZ, record.rpm, record.expected), x
 
 
@@ -152,11 +168,15 @@ def compare(duration_s: float = 1.0, records=RECORDS) -> list[dict]:
 
 def markdown(rows: list[dict]) -> str:
     """The comparison as a Markdown table (measured / twin per column)."""
+
     def db(v):
         return "-" if v is None else f"{v:.1f}"
 
-    out = ["| record | condition | RMS [g] | RMS / healthy | kurtosis | crest | largest envelope line "
-           "[x shaft] | expected line [dB] |", "|---|---|---|---|---|---|---|---|"]
+    out = [
+        "| record | condition | RMS [g] | RMS / healthy | kurtosis | crest | largest envelope line "
+        "[x shaft] | expected line [dB] |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         m, t = r["measured"], r["twin"]
         out.append(
@@ -164,12 +184,14 @@ def markdown(rows: list[dict]) -> str:
             f"{m.get('rms_ratio', float('nan')):.2f} / {t.get('rms_ratio', float('nan')):.2f} | "
             f"{m['kurtosis']:.2f} / {t['kurtosis']:.2f} | {m['crest_factor']:.2f} / {t['crest_factor']:.2f} | "
             f"{m['largest_line_shaft']:.3f} {m['largest_line_name']} / {t['largest_line_shaft']:.3f} "
-            f"{t['largest_line_name']} | {db(m['expected_line_db'])} / {db(t['expected_line_db'])} |")
+            f"{t['largest_line_name']} | {db(m['expected_line_db'])} / {db(t['expected_line_db'])} |"
+        )
     return "\n".join(out)
 
 
-def calibrate_housing(x_m_s2: np.ndarray, sample_rate_hz: float = SAMPLE_RATE_HZ,
-                      search_hz: tuple[float, float] = (2950.0, 3600.0)) -> tuple[float, float]:
+def calibrate_housing(
+    x_m_s2: np.ndarray, sample_rate_hz: float = SAMPLE_RATE_HZ, search_hz: tuple[float, float] = (2950.0, 3600.0)
+) -> tuple[float, float]:
     """(frequency [Hz], damping ratio [-]) of the broadband housing resonance of a healthy record:
     the peak of its Welch power spectrum (512 points) in `search_hz` and its half-power bandwidth
     (linear interpolation of the crossings), zeta = bandwidth / (2 f). Run once on record 97 to
@@ -189,7 +211,7 @@ def calibrate_housing(x_m_s2: np.ndarray, sample_rate_hz: float = SAMPLE_RATE_HZ
     return float(f[i]), float((f_hi - f_lo) / (2.0 * f[i]))
 
 
-FLOOR_BAND_HZ = (2000.0, 2900.0)      # healthy record: between the motor's content and the resonance
+FLOOR_BAND_HZ = (2000.0, 2900.0)  # healthy record: between the motor's content and the resonance
 RESONANCE_BAND_HZ = (2900.0, 3600.0)  # healthy record: the housing resonance the impacts ring
 
 
@@ -209,9 +231,11 @@ def calibrate_background(x_m_s2: np.ndarray, sample_rate_hz: float = SAMPLE_RATE
     `CWRU_RACE_PROFILE_RMS_M`."""
     floor = band_rms(x_m_s2, FLOOR_BAND_HZ, sample_rate_hz)
     density = floor / math.sqrt(FLOOR_BAND_HZ[1] - FLOOR_BAND_HZ[0])
-    return {"noise_density_m_s2_rthz": density,
-            "resonance_band_rms_m_s2": band_rms(x_m_s2, RESONANCE_BAND_HZ, sample_rate_hz),
-            "floor_in_resonance_band_m_s2": density * math.sqrt(RESONANCE_BAND_HZ[1] - RESONANCE_BAND_HZ[0])}
+    return {
+        "noise_density_m_s2_rthz": density,
+        "resonance_band_rms_m_s2": band_rms(x_m_s2, RESONANCE_BAND_HZ, sample_rate_hz),
+        "floor_in_resonance_band_m_s2": density * math.sqrt(RESONANCE_BAND_HZ[1] - RESONANCE_BAND_HZ[0]),
+    }
 
 
 def main(argv=None) -> int:

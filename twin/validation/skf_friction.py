@@ -69,8 +69,9 @@ def series_of(designation: str) -> str:
     """'62' for '6208', '60' for '6010' (four-digit deep-groove designations)."""
     d = designation.strip()
     if len(d) != 4 or not d.isdigit() or d[0] != "6":
-        raise ValueError(f"designation = {designation!r}: the SKF constants here cover four-digit 60/62/63 "
-                         "deep-groove designations")
+        raise ValueError(
+            f"designation = {designation!r}: the SKF constants here cover four-digit 60/62/63 deep-groove designations"
+        )
     series = d[:2]
     if series not in SERIES_CONSTANTS:
         raise ValueError(f"designation = {designation!r}: series {series} not in {sorted(SERIES_CONSTANTS)}")
@@ -79,26 +80,42 @@ def series_of(designation: str) -> str:
 
 def inlet_shear_heating_factor(n_rpm: float, dm_mm: float, nu_mm2_s: float) -> float:
     """phi_ish = 1 / (1 + 1.84e-9 (n dm)^1.28 nu^0.64) [-] (SKF catalogue)."""
-    return 1.0 / (1.0 + 1.84e-9 * (n_rpm * dm_mm) ** 1.28 * nu_mm2_s ** 0.64)
+    return 1.0 / (1.0 + 1.84e-9 * (n_rpm * dm_mm) ** 1.28 * nu_mm2_s**0.64)
 
 
-def replenishment_factor(n_rpm: float, nu_mm2_s: float, bore_mm: float, od_mm: float,
-                         k_rs: float = K_RS_OIL_JET, k_z: float = K_Z_DEEP_GROOVE) -> float:
+def replenishment_factor(
+    n_rpm: float,
+    nu_mm2_s: float,
+    bore_mm: float,
+    od_mm: float,
+    k_rs: float = K_RS_OIL_JET,
+    k_z: float = K_Z_DEEP_GROOVE,
+) -> float:
     """phi_rs = exp(-K_rs nu n (d + D) sqrt(K_z / (2 (D - d)))) [-] (SKF catalogue)."""
     return math.exp(-k_rs * nu_mm2_s * n_rpm * (bore_mm + od_mm) * math.sqrt(k_z / (2.0 * (od_mm - bore_mm))))
 
 
-def sliding_friction_coefficient(n_rpm: float, nu_mm2_s: float, dm_mm: float, mu_bl: float = MU_BL,
-                                 mu_ehl: float = MU_EHL_MINERAL) -> tuple[float, float]:
+def sliding_friction_coefficient(
+    n_rpm: float, nu_mm2_s: float, dm_mm: float, mu_bl: float = MU_BL, mu_ehl: float = MU_EHL_MINERAL
+) -> tuple[float, float]:
     """(mu_sl, phi_bl): mu_sl = phi_bl mu_bl + (1 - phi_bl) mu_EHL, phi_bl = exp(-2.6e-8 (n nu)^1.4 dm)."""
     phi_bl = math.exp(-2.6e-8 * (n_rpm * nu_mm2_s) ** 1.4 * dm_mm)
     return phi_bl * mu_bl + (1.0 - phi_bl) * mu_ehl, phi_bl
 
 
-def frictional_moment(designation: str, bore_mm: float, od_mm: float, radial_load_n: float,
-                      shaft_speed_rad_s: float, kinematic_viscosity_mm2_s: float, *,
-                      axial_load_n: float = 0.0, static_load_rating_n: float | None = None,
-                      inlet_shear: bool = True, k_rs: float = K_RS_OIL_JET) -> SKFMoment:
+def frictional_moment(
+    designation: str,
+    bore_mm: float,
+    od_mm: float,
+    radial_load_n: float,
+    shaft_speed_rad_s: float,
+    kinematic_viscosity_mm2_s: float,
+    *,
+    axial_load_n: float = 0.0,
+    static_load_rating_n: float | None = None,
+    inlet_shear: bool = True,
+    k_rs: float = K_RS_OIL_JET,
+) -> SKFMoment:
     """SKF frictional moment of an open, oil-lubricated deep-groove ball bearing without oil
     bath (M_seal = M_drag = 0) [N m]. `inlet_shear=False` sets phi_ish = 1 (the isothermal
     comparison). Axial load needs the static load rating C0 [N] for alpha_F."""
@@ -112,15 +129,22 @@ def frictional_moment(designation: str, bore_mm: float, od_mm: float, radial_loa
         if static_load_rating_n is None:
             raise ValueError("axial_load_n > 0 needs static_load_rating_n (C0) for alpha_F")
         sin_af = math.sin(math.radians(24.6 * (axial_load_n / static_load_rating_n) ** 0.24))
-        g_rr = r1 * dm ** 1.96 * (radial_load_n + r2 / sin_af * axial_load_n) ** 0.54
-        g_sl = s1 * dm ** -0.145 * (radial_load_n ** 5 + s2 * dm ** 1.5 / sin_af * axial_load_n ** 4) ** (1.0 / 3.0)
+        g_rr = r1 * dm**1.96 * (radial_load_n + r2 / sin_af * axial_load_n) ** 0.54
+        g_sl = s1 * dm**-0.145 * (radial_load_n**5 + s2 * dm**1.5 / sin_af * axial_load_n**4) ** (1.0 / 3.0)
     else:
-        g_rr = r1 * dm ** 1.96 * radial_load_n ** 0.54
-        g_sl = s1 * dm ** -0.26 * radial_load_n ** (5.0 / 3.0)
+        g_rr = r1 * dm**1.96 * radial_load_n**0.54
+        g_sl = s1 * dm**-0.26 * radial_load_n ** (5.0 / 3.0)
     phi_ish = inlet_shear_heating_factor(n, dm, nu) if inlet_shear else 1.0
     phi_rs = replenishment_factor(n, nu, bore_mm, od_mm, k_rs)
     m_rr = phi_ish * phi_rs * g_rr * (nu * n) ** 0.6
     mu_sl, phi_bl = sliding_friction_coefficient(n, nu, dm)
     m_sl = g_sl * mu_sl
-    return SKFMoment(total_n_m=(m_rr + m_sl) * 1e-3, rolling_n_m=m_rr * 1e-3, sliding_n_m=m_sl * 1e-3,
-                     phi_ish=phi_ish, phi_rs=phi_rs, phi_bl=phi_bl, mu_sl=mu_sl)
+    return SKFMoment(
+        total_n_m=(m_rr + m_sl) * 1e-3,
+        rolling_n_m=m_rr * 1e-3,
+        sliding_n_m=m_sl * 1e-3,
+        phi_ish=phi_ish,
+        phi_rs=phi_rs,
+        phi_bl=phi_bl,
+        mu_sl=mu_sl,
+    )

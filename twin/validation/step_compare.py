@@ -41,40 +41,75 @@ CASES: dict[str, tuple[str, float | str, float, dict[str, Any]]] = {
     "6208-1us": ("6208", 1e-6, 0.05, {"shear_heating": False}),
     "7208-combined-auto": ("7208", "auto", 0.05, {"axial_load_n": 3000.0, "shear_heating": False}),
     "6208-stribeck-auto": ("6208", "auto", 0.05, {"friction_model": "stribeck_line", "shear_heating": False}),
-    "6208-asperity-1700rad-7.5kN": ("6208", "auto", 0.05, {"friction_model": "asperity_share", "shear_heating": False,
-                                                          "shaft_speed_rad_s": 1700.0, "radial_load_n": 7500.0}),
+    "6208-asperity-1700rad-7.5kN": (
+        "6208",
+        "auto",
+        0.05,
+        {
+            "friction_model": "asperity_share",
+            "shear_heating": False,
+            "shaft_speed_rad_s": 1700.0,
+            "radial_load_n": 7500.0,
+        },
+    ),
     "6208-housing-outer-spall": ("6208", "auto", 0.03, {"housing": True, "defect": "outer", "shear_heating": False}),
     "6208-5A-shear-heating": ("6208", "auto", 0.05, {"shaft_current_a": 5.0, "shear_heating": True}),
 }
 
-ROWS = {"load": L.C_LOAD, "lambda": L.C_LAMBDA, "h_min": L.C_H_MIN, "h_c": L.C_H_C, "mu": L.C_MU,
-        "capacitance": L.C_CAPACITANCE, "resistance": L.C_RESISTANCE, "force_x": L.O_FX, "force_z": L.O_FZ,
-        "torque_z": L.O_TZ, "spring_x": L.T_XI0, "spring_decay": L.C_XI_DECAY,
-        "rolling_per_speed": L.C_ROLLING_PER_SPEED, "tangent_damping": L.C_TANGENT_DAMPING}
+ROWS = {
+    "load": L.C_LOAD,
+    "lambda": L.C_LAMBDA,
+    "h_min": L.C_H_MIN,
+    "h_c": L.C_H_C,
+    "mu": L.C_MU,
+    "capacitance": L.C_CAPACITANCE,
+    "resistance": L.C_RESISTANCE,
+    "force_x": L.O_FX,
+    "force_z": L.O_FZ,
+    "torque_z": L.O_TZ,
+    "spring_x": L.T_XI0,
+    "spring_decay": L.C_XI_DECAY,
+    "rolling_per_speed": L.C_ROLLING_PER_SPEED,
+    "tangent_damping": L.C_TANGENT_DAMPING,
+}
 
 
 def run_case(designation: str, time_step_s, seconds: float, extra: dict) -> dict:
     """One case from its warm start: the arrays of the module docstring, by name."""
     spec = catalog.bearing(designation)
     if extra.get("housing"):
-        spec = BearingSpec.model_validate({**spec.model_dump(), "housing": {**spec.housing.model_dump(), "enabled": True}})
-    spec = BearingSpec.model_validate({**spec.model_dump(), "thermal": {
-        **spec.thermal.model_dump(), "shear_heating": bool(extra["shear_heating"])}})
+        spec = BearingSpec.model_validate(
+            {**spec.model_dump(), "housing": {**spec.housing.model_dump(), "enabled": True}}
+        )
+    spec = BearingSpec.model_validate(
+        {**spec.model_dump(), "thermal": {**spec.thermal.model_dump(), "shear_heating": bool(extra["shear_heating"])}}
+    )
     options = {"time_step_s": time_step_s}
     if "friction_model" in extra:
         options["friction_model"] = extra["friction_model"]
-    twin = Twin(spec, options=ModelOptions(**options), setpoint=Setpoint(
-        shaft_speed_rad_s=extra.get("shaft_speed_rad_s", 500.0), radial_load_n=extra.get("radial_load_n", 3000.0),
-        axial_load_n=extra.get("axial_load_n", 0.0), shaft_current_a=extra.get("shaft_current_a", 0.0)))
+    twin = Twin(
+        spec,
+        options=ModelOptions(**options),
+        setpoint=Setpoint(
+            shaft_speed_rad_s=extra.get("shaft_speed_rad_s", 500.0),
+            radial_load_n=extra.get("radial_load_n", 3000.0),
+            axial_load_n=extra.get("axial_load_n", 0.0),
+            shaft_current_a=extra.get("shaft_current_a", 0.0),
+        ),
+    )
     if extra.get("defect"):
         twin.set_defects([defect_for(extra["defect"], spec.geometry)])
     twin.advance(seconds)
     s = twin.state
     contacts = s.contacts
     out = {name: contacts[row].copy() for name, row in ROWS.items()}
-    out.update(scalars=s.scalars.copy(), ball_position=s.ball_position_m.copy(),
-               ball_spin=s.ball_angular_velocity_rad_s.copy(), cage_load=s.cage_load_n.copy(),
-               status=np.array([0.0 if twin.status == "ok" else 1.0]))
+    out.update(
+        scalars=s.scalars.copy(),
+        ball_position=s.ball_position_m.copy(),
+        ball_spin=s.ball_angular_velocity_rad_s.copy(),
+        cage_load=s.cage_load_n.copy(),
+        status=np.array([0.0 if twin.status == "ok" else 1.0]),
+    )
     return out
 
 
@@ -83,8 +118,15 @@ def dump(path: str) -> None:
     for case, (designation, dt, seconds, extra) in CASES.items():
         for name, value in run_case(designation, dt, seconds, extra).items():
             arrays[f"{case}/{name}"] = value
-        print(case, "cage speed", arrays[f"{case}/scalars"][L.X_CAGE_SPEED], "rad/s, torque",
-              arrays[f"{case}/scalars"][L.X_DRIVE_TORQUE], "N m", flush=True)
+        print(
+            case,
+            "cage speed",
+            arrays[f"{case}/scalars"][L.X_CAGE_SPEED],
+            "rad/s, torque",
+            arrays[f"{case}/scalars"][L.X_DRIVE_TORQUE],
+            "N m",
+            flush=True,
+        )
     np.savez(path, **arrays)
 
 

@@ -45,17 +45,25 @@ def reference_outputs(case: tuple, settle_s: float = 0.01, window_s: float = 0.0
     # (the strip solve then every 20 refreshes: 178 us at the 7208's 4.444 us auto step)
     # the inlet that engine had: isothermal (seed 000's Hamrock-Dowson film), Thermal.shear_heating off
     base = catalog.bearing(designation)
-    spec = BearingSpec.model_validate({**base.model_dump(), "thermal": {**base.thermal.model_dump(),
-                                                                         "shear_heating": False}})
+    spec = BearingSpec.model_validate(
+        {**base.model_dump(), "thermal": {**base.thermal.model_dump(), "shear_heating": False}}
+    )
     step_s = make_model(spec, ModelOptions(time_step_s=dt)).dt_s
     traction_s = REFERENCE_TRACTION_REFRESHES * steps_per_period(REFERENCE_TRIBOLOGY_PERIOD_S, step_s) * step_s
     # and with the refresh at its own step (centred_refresh=False), as that engine had it: the
     # centred refresh is a change of the numerics (measured: load 2e-4 of the largest, Lambda 4e-4,
     # torque 5e-5 at these 10 us), proven by the sub-rate study (twin.validation.subrate_study), not
     # a change of operations this comparison is made to catch
-    twin = Twin(spec, options=ModelOptions(time_step_s=dt, tribology_period_s=REFERENCE_TRIBOLOGY_PERIOD_S,
-                                           traction_period_s=traction_s, centred_refresh=False),
-                setpoint=Setpoint(shaft_speed_rad_s=speed, radial_load_n=fr, axial_load_n=fa))
+    twin = Twin(
+        spec,
+        options=ModelOptions(
+            time_step_s=dt,
+            tribology_period_s=REFERENCE_TRIBOLOGY_PERIOD_S,
+            traction_period_s=traction_s,
+            centred_refresh=False,
+        ),
+        setpoint=Setpoint(shaft_speed_rad_s=speed, radial_load_n=fr, axial_load_n=fa),
+    )
     twin.advance(settle_s)
     frames = round(window_s / 1e-3)
     loads, lams, torque, cage, ring = [], [], [], [], []
@@ -67,10 +75,16 @@ def reference_outputs(case: tuple, settle_s: float = 0.01, window_s: float = 0.0
         torque.append(twin._last_torque_n_m)
         cage.append(float(twin.state.scalars[L.X_CAGE_SPEED]))
         ring.append(twin.state.ring_position_m.copy())
-    return {"status": twin.status, "time_s": twin.time_s, "time_step_s": twin.model.dt_s,
-            "load_n": np.mean(loads, axis=0).tolist(), "lambda": np.mean(lams, axis=0).tolist(),
-            "torque_n_m": float(np.mean(torque)), "cage_speed_rad_s": float(np.mean(cage)),
-            "ring_displacement_m": np.mean(ring, axis=0).tolist()}
+    return {
+        "status": twin.status,
+        "time_s": twin.time_s,
+        "time_step_s": twin.model.dt_s,
+        "load_n": np.mean(loads, axis=0).tolist(),
+        "lambda": np.mean(lams, axis=0).tolist(),
+        "torque_n_m": float(np.mean(torque)),
+        "cage_speed_rad_s": float(np.mean(cage)),
+        "ring_displacement_m": np.mean(ring, axis=0).tolist(),
+    }
 
 
 def main() -> None:

@@ -40,9 +40,27 @@ from numba import njit
 from twin.jit import JIT, JIT_STEP
 from twin.kernels.contacts import raceway_forces, raceway_geometry
 from twin.kernels.layout import (
-    C_LOAD, CW, E_SLIP, G_DELTA, G_LOAD, K_ORBIT, O_FX, O_TX, P_ALPHA_E,
-    P_BALL_INERTIA, P_BALL_RADIUS, P_CAGE_INERTIA, P_DT, P_KT_RATIO, P_SUBSTEPS, P_TRACTION_EVERY,
-    S_VISCOSITY, X_CAGE_ANGLE, X_CAGE_SPEED, X_CAGE_TORQUE, padded_lane_count,
+    C_LOAD,
+    CW,
+    E_SLIP,
+    G_DELTA,
+    G_LOAD,
+    K_ORBIT,
+    O_FX,
+    O_TX,
+    P_ALPHA_E,
+    P_BALL_INERTIA,
+    P_BALL_RADIUS,
+    P_CAGE_INERTIA,
+    P_DT,
+    P_KT_RATIO,
+    P_SUBSTEPS,
+    P_TRACTION_EVERY,
+    S_VISCOSITY,
+    X_CAGE_ANGLE,
+    X_CAGE_SPEED,
+    X_CAGE_TORQUE,
+    padded_lane_count,
 )
 from twin.kernels.step import ELECTRICAL_EVERY, _cos_sin, ball_loads_and_cage, gather_lanes, refresh_contact, step_n
 from twin.kernels.structures import StateArrays
@@ -104,7 +122,7 @@ def _traction_moments(w, nl, reps):
 def _traction_solve(w, nc, p, eta, reps):
     # every solve from the same warm start (the last solution of the running twin), not from the
     # previous solve's own solution, which would converge at once
-    start = w[E_SLIP * CW:E_SLIP * CW + nc].copy()
+    start = w[E_SLIP * CW : E_SLIP * CW + nc].copy()
     for _ in range(reps):
         for c in range(nc):
             w[E_SLIP * CW + c] = start[c]
@@ -116,8 +134,9 @@ def _traction_solve(w, nc, p, eta, reps):
 def _cage(p, scal, bx, bv, ba, balpha, w, cage_load, ct, st, reps):
     acc = 0.0
     for _ in range(reps):
-        ring_fx, ring_fy, ring_fz, ring_tz, cage_tz = ball_loads_and_cage(p, scal, bx, bv, ba, balpha, w,
-                                                                          cage_load, ct, st)
+        ring_fx, ring_fy, ring_fz, ring_tz, cage_tz = ball_loads_and_cage(
+            p, scal, bx, bv, ba, balpha, w, cage_load, ct, st
+        )
         acc += cage_tz + ring_tz + ring_fx + 1e-300 * (ring_fy + ring_fz)
     return acc
 
@@ -164,7 +183,9 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     traction_steps = substeps * max(int(p[P_TRACTION_EVERY]), 1)
 
     def copies():
-        return StateArrays(*(a.copy() for a in s.arrays()))  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, ...
+        return StateArrays(
+            *(a.copy() for a in s.arrays())
+        )  # scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load, ...
 
     scal, bx, bv, bw, ba, balpha, rx, rv, ra, w, cage_load = copies()[:11]
     ct, st = math.cos(0.5 * p[P_DT] * scal[X_CAGE_SPEED]), math.sin(0.5 * p[P_DT] * scal[X_CAGE_SPEED])
@@ -191,15 +212,19 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     ig = copies()
     _integration(p, ig[0], ig[1], ig[2], ig[3], ig[4], ig[5], ig[6], ig[7], ig[8], 1)
     best, median = _best_median_ns(
-        lambda n: _integration(p, ig[0], ig[1], ig[2], ig[3], ig[4], ig[5], ig[6], ig[7], ig[8], n),
-        reps, repeats)
+        lambda n: _integration(p, ig[0], ig[1], ig[2], ig[3], ig[4], ig[5], ig[6], ig[7], ig[8], n), reps, repeats
+    )
     out["integration"] = {"best_ns": best, "median_ns": median}
     # per step: the refreshes weighted by their periods in steps
     t0, t1, t2 = (out[k] for k in ("tribology_no_refresh", "tribology_refresh", "tribology_refresh_electrical"))
-    out["tribology"] = {key: t0[key] + (t1[key] - t0[key]) / substeps
-                        + (t2[key] - t1[key]) / (substeps * ELECTRICAL_EVERY) for key in ("best_ns", "median_ns")}
-    out["traction"] = {key: out["traction_moments"][key] + out["traction_solve"][key] / traction_steps
-                       for key in ("best_ns", "median_ns")}
+    out["tribology"] = {
+        key: t0[key] + (t1[key] - t0[key]) / substeps + (t2[key] - t1[key]) / (substeps * ELECTRICAL_EVERY)
+        for key in ("best_ns", "median_ns")
+    }
+    out["traction"] = {
+        key: out["traction_moments"][key] + out["traction_solve"][key] / traction_steps
+        for key in ("best_ns", "median_ns")
+    }
     # the real step on a copy of the state
     full = copies()
     model_arrays = m.arrays()
@@ -212,4 +237,3 @@ def time_passes(twin, reps: int = 20000, repeats: int = 5) -> dict:
     out["electrical_steps_per_refresh"] = substeps * ELECTRICAL_EVERY
     out["traction_steps_per_solve"] = traction_steps
     return out
-

@@ -39,8 +39,16 @@ from twin.validation import timestep_study as ts
 REFERENCE = (1e-5, 2e-4)  # (tribology_period_s, traction_period_s) before the study [s]
 # the candidates: tribology periods with the reference traction period, traction periods with the
 # reference tribology period, and one combination
-PERIODS = ((2e-5, 2e-4), (3e-5, 2e-4), (4e-5, 2e-4), (6e-5, 2e-4), (2e-5, 4e-4), (3e-5, 3e-4), (4e-5, 4e-4),
-           (6e-5, 4e-4))
+PERIODS = (
+    (2e-5, 2e-4),
+    (3e-5, 2e-4),
+    (4e-5, 2e-4),
+    (6e-5, 2e-4),
+    (2e-5, 4e-4),
+    (3e-5, 3e-4),
+    (4e-5, 4e-4),
+    (6e-5, 4e-4),
+)
 # the choice (ModelOptions defaults), with the centred refresh: 40 us / 400 us passes every case
 # against the reference sub-rates and against 1 us with a margin of 1.58 on the closest quantity (the
 # 7208 at 1700 rad/s, 7500 N + 3000 N: loads 0.32 % of 0.5 %; torque 1.14 % of 2 %, impedance 1.2 %
@@ -65,19 +73,26 @@ def _verdict(run, ref, case: ts.Case) -> tuple[dict, bool]:
     dev = ts.compare(run, ref, case.shaft_current_a > 0.0)
     if run.restarts or ref.restarts:
         dev = {q: math.inf for q in ts.QUANTITIES}
-    ok = (run.status == "ok" and ref.status == "ok" and run.restarts == 0 and ref.restarts == 0
-          and all(not (dev[q] > ts.TOLERANCES[q]) for q in ts.QUANTITIES))
+    ok = (
+        run.status == "ok"
+        and ref.status == "ok"
+        and run.restarts == 0
+        and ref.restarts == 0
+        and all(not (dev[q] > ts.TOLERANCES[q]) for q in ts.QUANTITIES)
+    )
     return dev, ok
 
 
-def run_study(cases: list[ts.Case] | None = None, periods=PERIODS, *, against_1us: bool = False,
-              progress=None) -> list[dict]:
+def run_study(
+    cases: list[ts.Case] | None = None, periods=PERIODS, *, against_1us: bool = False, progress=None
+) -> list[dict]:
     """One row per case and candidate (tribology, traction period): the largest relative deviation of
     every quantity from the reference sub-rates at the auto step (and from 1 us with `against_1us`),
     and whether all hold. `progress(case, label)` is called before each run if given."""
     cases = cases if cases is not None else ts.envelope_cases()
     rows = []
     for case in cases:
+
         def run(label, dt, trib, trac, case=case):
             if progress:
                 progress(case, label)
@@ -88,11 +103,19 @@ def run_study(cases: list[ts.Case] | None = None, periods=PERIODS, *, against_1u
         for p in periods:
             r = run(_label(p), ts.timestep.AUTO, *p)
             dev, ok = _verdict(r, ref, case)
-            row = {**asdict(case), "tribology_period_s": p[0], "traction_period_s": p[1],
-                   "time_step_s": r.time_step_s, "window_s": r.window_s, "status": r.status,
-                   "restarts": r.restarts, "deviation": dev, "within_tolerance": ok,
-                   "friction_torque_n_m": r.scalars["friction_torque"],
-                   "reference_friction_torque_n_m": ref.scalars["friction_torque"]}
+            row = {
+                **asdict(case),
+                "tribology_period_s": p[0],
+                "traction_period_s": p[1],
+                "time_step_s": r.time_step_s,
+                "window_s": r.window_s,
+                "status": r.status,
+                "restarts": r.restarts,
+                "deviation": dev,
+                "within_tolerance": ok,
+                "friction_torque_n_m": r.scalars["friction_torque"],
+                "reference_friction_torque_n_m": ref.scalars["friction_torque"],
+            }
             if fine is not None:
                 dev1, ok1 = _verdict(r, fine, case)
                 row |= {"deviation_from_1us": dev1, "within_tolerance_of_1us": ok1}
@@ -117,10 +140,19 @@ def summary(rows: list[dict], key: str = "deviation") -> list[dict]:
             values = [r[key][q] for r in mine if r[key][q] is not None and not math.isnan(r[key][q])]
             worst[q] = max(values) if values else math.nan
         verdict = "within_tolerance" if key == "deviation" else "within_tolerance_of_1us"
-        out.append({"tribology_period_s": p[0], "traction_period_s": p[1], "largest": worst,
-                    "cases": len(mine), "all_within_tolerance": all(r[verdict] for r in mine),
-                    "margin": min((ts.TOLERANCES[q] / worst[q] for q in ts.QUANTITIES
-                                   if not math.isnan(worst[q]) and worst[q] > 0.0), default=math.inf)})
+        out.append(
+            {
+                "tribology_period_s": p[0],
+                "traction_period_s": p[1],
+                "largest": worst,
+                "cases": len(mine),
+                "all_within_tolerance": all(r[verdict] for r in mine),
+                "margin": min(
+                    (ts.TOLERANCES[q] / worst[q] for q in ts.QUANTITIES if not math.isnan(worst[q]) and worst[q] > 0.0),
+                    default=math.inf,
+                ),
+            }
+        )
     return out
 
 
@@ -128,19 +160,27 @@ def markdown_table(rows: list[dict], key: str = "deviation") -> str:
     """The study as a Markdown table (largest deviation in %, per case and candidate), then the
     largest over the cases per candidate."""
     head = ts._HEAD
-    lines = ["| case | tribology / traction period | " + " | ".join(ts._TITLE) + " | within |",
-             "|---|---|" + "---|" * len(head) + "---|"]
+    lines = [
+        "| case | tribology / traction period | " + " | ".join(ts._TITLE) + " | within |",
+        "|---|---|" + "---|" * len(head) + "---|",
+    ]
     verdict = "within_tolerance" if key == "deviation" else "within_tolerance_of_1us"
     for r in rows:
         if key not in r:
             continue
         p = (r["tribology_period_s"], r["traction_period_s"])
-        lines.append(f"| {r['id']} | {_label(p)} | " + " | ".join(ts._pct(r[key][q]) for q in head)
-                     + f" | {'yes' if r[verdict] else 'no'} |")
+        lines.append(
+            f"| {r['id']} | {_label(p)} | "
+            + " | ".join(ts._pct(r[key][q]) for q in head)
+            + f" | {'yes' if r[verdict] else 'no'} |"
+        )
     for s in summary(rows, key):
         p = (s["tribology_period_s"], s["traction_period_s"])
-        lines.append(f"| **largest** | {_label(p)} | " + " | ".join(ts._pct(s['largest'][q]) for q in head)
-                     + f" | {'yes' if s['all_within_tolerance'] else 'no'} |")
+        lines.append(
+            f"| **largest** | {_label(p)} | "
+            + " | ".join(ts._pct(s["largest"][q]) for q in head)
+            + f" | {'yes' if s['all_within_tolerance'] else 'no'} |"
+        )
     lines.append("| tolerance | | " + " | ".join(ts._pct(ts.TOLERANCES[q]) for q in head) + " | |")
     return "\n".join(lines)
 
@@ -148,8 +188,14 @@ def markdown_table(rows: list[dict], key: str = "deviation") -> str:
 def run_all(*, quick: bool = False, against_1us: bool = False, progress=None) -> dict:
     """The study over the envelope (or `representative_cases` with quick)."""
     rows = run_study(representative_cases() if quick else None, against_1us=against_1us, progress=progress)
-    out = {"reference_periods_s": list(REFERENCE), "candidates_s": [list(p) for p in PERIODS],
-           "tolerances": dict(ts.TOLERANCES), "quick": quick, "cases": rows, "summary": summary(rows)}
+    out = {
+        "reference_periods_s": list(REFERENCE),
+        "candidates_s": [list(p) for p in PERIODS],
+        "tolerances": dict(ts.TOLERANCES),
+        "quick": quick,
+        "cases": rows,
+        "summary": summary(rows),
+    }
     if against_1us:
         out["summary_against_1us"] = summary(rows, "deviation_from_1us")
     return out
@@ -159,26 +205,35 @@ def summary_table(result: dict) -> str:
     """Largest deviation [%] over the cases per candidate, against the reference sub-rates and (if run)
     against 1 us, as a Markdown table."""
     head = ts._HEAD
-    lines = ["| tribology / traction period | against | " + " | ".join(ts._TITLE) + " | every case within |",
-             "|---|---|" + "---|" * len(head) + "---|"]
+    lines = [
+        "| tribology / traction period | against | " + " | ".join(ts._TITLE) + " | every case within |",
+        "|---|---|" + "---|" * len(head) + "---|",
+    ]
     for key, against in (("summary", _label(REFERENCE)), ("summary_against_1us", "1 us step")):
         for s in result.get(key, []):
             p = (s["tribology_period_s"], s["traction_period_s"])
-            lines.append(f"| {_label(p)} | {against} | " + " | ".join(ts._pct(s["largest"][q]) for q in head)
-                         + f" | {'yes' if s['all_within_tolerance'] else 'no'} |")
+            lines.append(
+                f"| {_label(p)} | {against} | "
+                + " | ".join(ts._pct(s["largest"][q]) for q in head)
+                + f" | {'yes' if s['all_within_tolerance'] else 'no'} |"
+            )
     lines.append("| tolerance | | " + " | ".join(ts._pct(ts.TOLERANCES[q]) for q in head) + " | |")
     return "\n".join(lines)
 
 
 def markdown(result: dict) -> str:
     """The tables of `run_all` as Markdown: the summary, then per case."""
-    text = (f"Largest deviation [%] over {len({r['id'] for r in result['cases']})} cases, whole cage revolutions "
-            "at the auto step\n\n" + summary_table(result)
-            + "\n\nPer case, against the reference sub-rates (tribology 10 us / traction 200 us)\n\n"
-            + markdown_table(result["cases"]))
+    text = (
+        f"Largest deviation [%] over {len({r['id'] for r in result['cases']})} cases, whole cage revolutions "
+        "at the auto step\n\n"
+        + summary_table(result)
+        + "\n\nPer case, against the reference sub-rates (tribology 10 us / traction 200 us)\n\n"
+        + markdown_table(result["cases"])
+    )
     if "summary_against_1us" in result:
-        text += ("\n\nPer case, against the 1 us step (10 us / 200 us)\n\n"
-                 + markdown_table(result["cases"], "deviation_from_1us"))
+        text += "\n\nPer case, against the 1 us step (10 us / 200 us)\n\n" + markdown_table(
+            result["cases"], "deviation_from_1us"
+        )
     return text
 
 

@@ -27,30 +27,42 @@ class Transient:
     """Samples of a transient (network time [s]; per-node temperatures [degC])."""
 
     network_time_s: np.ndarray
-    temperatures_c: np.ndarray       # (n, nodes)
-    viscosity_pa_s: np.ndarray       # inlet viscosity
-    min_lambda: np.ndarray           # smallest Lambda of the loaded contacts
+    temperatures_c: np.ndarray  # (n, nodes)
+    viscosity_pa_s: np.ndarray  # inlet viscosity
+    min_lambda: np.ndarray  # smallest Lambda of the loaded contacts
     friction_torque_n_m: np.ndarray  # mean over the last network period (its heat / shaft speed)
-    heat_w: np.ndarray               # total friction heat
-    shear_rise_k: np.ndarray         # inlet shear heating's equivalent temperature rise (Thermal.shear_heating)
-    time_constants_s: tuple[float, ...]   # the network's at the end, real heat capacities, slowest first
+    heat_w: np.ndarray  # total friction heat
+    shear_rise_k: np.ndarray  # inlet shear heating's equivalent temperature rise (Thermal.shear_heating)
+    time_constants_s: tuple[float, ...]  # the network's at the end, real heat capacities, slowest first
     heat_capacity_scale: float
-    network: Network                 # as assembled at the last network step (heat capacities scaled)
+    network: Network  # as assembled at the last network step (heat capacities scaled)
 
 
-def startup_transient(designation: str = "6208", shaft_speed_rad_s: float = 1000.0, radial_load_n: float = 3000.0,
-                      ambient_c: float = 20.0, duration_network_s: float = 1800.0,
-                      heat_capacity_scale: float = 1e-3, thermal_step_s: float = 1.0,
-                      sample_every_network_s: float = 30.0, settings: ThermalNetworkSettings | None = None,
-                      lubricant=None) -> Transient:
+def startup_transient(
+    designation: str = "6208",
+    shaft_speed_rad_s: float = 1000.0,
+    radial_load_n: float = 3000.0,
+    ambient_c: float = 20.0,
+    duration_network_s: float = 1800.0,
+    heat_capacity_scale: float = 1e-3,
+    thermal_step_s: float = 1.0,
+    sample_every_network_s: float = 30.0,
+    settings: ThermalNetworkSettings | None = None,
+    lubricant=None,
+) -> Transient:
     """The start-up from cold: every node at `ambient_c`, the shaft at speed from the warm start."""
     net_settings = (settings or ThermalNetworkSettings()).model_copy(
-        update={"heat_capacity_scale": heat_capacity_scale})
+        update={"heat_capacity_scale": heat_capacity_scale}
+    )
     spec = catalog.bearing(designation, lubricant=lubricant) if lubricant is not None else designation
     options = ModelOptions(thermal="network", thermal_period_s=thermal_step_s, thermal_network=net_settings)
-    twin = Twin(spec, options=options,
-                setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n,
-                                  oil_temperature_c=ambient_c))
+    twin = Twin(
+        spec,
+        options=options,
+        setpoint=Setpoint(
+            shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n, oil_temperature_c=ambient_c
+        ),
+    )
     coupling = twin.thermal
     if coupling is None:
         raise ValueError("thermal: the transient needs ModelOptions.thermal = 'network'")
@@ -67,8 +79,18 @@ def startup_transient(designation: str = "6208", shaft_speed_rad_s: float = 1000
         raise ValueError(f"duration_network_s = {duration_network_s!r}: shorter than one network step")
     a = np.array(rows)
     tau = tuple(float(x) for x in coupling.time_constants_s())
-    return Transient(a[:, 0], a[:, 1:1 + len(NODE_NAMES)], a[:, -5], a[:, -4], a[:, -3], a[:, -2], a[:, -1], tau,
-                     heat_capacity_scale, coupling.network)
+    return Transient(
+        a[:, 0],
+        a[:, 1 : 1 + len(NODE_NAMES)],
+        a[:, -5],
+        a[:, -4],
+        a[:, -3],
+        a[:, -2],
+        a[:, -1],
+        tau,
+        heat_capacity_scale,
+        coupling.network,
+    )
 
 
 def _row(snap, t: float) -> list[float]:
@@ -76,30 +98,42 @@ def _row(snap, t: float) -> list[float]:
     lams = [c.lambda_ for b in snap.balls for c in (b.inner, b.outer) if c.lambda_ is not None]
     heat = sum(th.heat_w.values())
     torque = heat / snap.shaft_speed_rad_s if t > 0.0 and snap.shaft_speed_rad_s > 0.0 else snap.friction_torque_n_m
-    return [t, *(th.temperatures_c[n] for n in NODE_NAMES), snap.viscosity_pa_s,
-            min(lams) if lams else float("nan"), torque, heat, snap.electrical.shear_temperature_rise_k]
+    return [
+        t,
+        *(th.temperatures_c[n] for n in NODE_NAMES),
+        snap.viscosity_pa_s,
+        min(lams) if lams else float("nan"),
+        torque,
+        heat,
+        snap.electrical.shear_temperature_rise_k,
+    ]
 
 
-def period_study(thermal_steps_s=(1.0, 5.0, 20.0, 50.0), heat_capacity_scale: float = 1e-3,
-                 **transient) -> dict[float, float]:
+def period_study(
+    thermal_steps_s=(1.0, 5.0, 20.0, 50.0), heat_capacity_scale: float = 1e-3, **transient
+) -> dict[float, float]:
     """Largest |T_node(step) - T_node(finest step)| over the nodes and the reference's sample times
     after the first network step of the coarsest [K], per network step in thermal time [s]
     (ModelOptions.thermal_period_s; each run's samples are interpolated in network time onto the
     finest run's)."""
-    runs = {h: startup_transient(thermal_step_s=h, heat_capacity_scale=heat_capacity_scale, **transient)
-            for h in thermal_steps_s}
+    runs = {
+        h: startup_transient(thermal_step_s=h, heat_capacity_scale=heat_capacity_scale, **transient)
+        for h in thermal_steps_s
+    }
     ref = runs[min(thermal_steps_s)]
     t = ref.network_time_s
     keep = t >= max(thermal_steps_s)
     out = {}
     for h, r in runs.items():
-        dev = [np.abs(np.interp(t[keep], r.network_time_s, r.temperatures_c[:, k]) - ref.temperatures_c[keep, k]).max()
-               for k in range(len(NODE_NAMES))]
+        dev = [
+            np.abs(np.interp(t[keep], r.network_time_s, r.temperatures_c[:, k]) - ref.temperatures_c[keep, k]).max()
+            for k in range(len(NODE_NAMES))
+        ]
         out[h] = float(max(dev))
     return out
 
 
-INLET_WEIGHTS = np.array([0.0, 0.25, 0.5, 0.25, 0.0, 0.0])   # T_in = (T_i + T_o + 2 T_b) / 4 (twin.thermal.coupling)
+INLET_WEIGHTS = np.array([0.0, 0.25, 0.5, 0.25, 0.0, 0.0])  # T_in = (T_i + T_o + 2 T_b) / 4 (twin.thermal.coupling)
 HEAT_SHARE = np.array([0.0, 0.5 * RING_SHARE, 1.0 - RING_SHARE, 0.5 * RING_SHARE, 0.0, 0.0])  # inner ~ outer heat
 
 

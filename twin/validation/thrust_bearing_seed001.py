@@ -104,11 +104,16 @@ class Seed001Torque:
     k_radii_ratio: float  # Ry/Rx [-]
 
 
-def thrust_torque_seed001(ball_diameter_m: float, ball_load_n: float, rpm: float,
-                          law: str = "transition", eta_pa_s: float = VISCOSITY_PA_S,
-                          groove_radius_m: float = GROOVE_RADIUS_M,
-                          pitch_radius_m: float = RACE_PITCH_RADIUS_M,
-                          e_star_pa: float = E_STAR_PA) -> Seed001Torque:
+def thrust_torque_seed001(
+    ball_diameter_m: float,
+    ball_load_n: float,
+    rpm: float,
+    law: str = "transition",
+    eta_pa_s: float = VISCOSITY_PA_S,
+    groove_radius_m: float = GROOVE_RADIUS_M,
+    pitch_radius_m: float = RACE_PITCH_RADIUS_M,
+    e_star_pa: float = E_STAR_PA,
+) -> Seed001Torque:
     """Hydrodynamic friction torque of the 3-ball 51205 bearing, Tz = 6 r FR [N m]
     (seed 001 eqs. 14 and 22; FR from eqs. 1-5 per `law` = "ivr" | "ehl" | "transition").
 
@@ -143,10 +148,14 @@ def thrust_torque_seed001(ball_diameter_m: float, ball_load_n: float, rpm: float
     )
 
 
-def secondary_torques_seed001(ball_diameter_m: float, ball_load_n: float, mu_s: float,
-                              groove_radius_m: float = GROOVE_RADIUS_M,
-                              pitch_radius_m: float = RACE_PITCH_RADIUS_M,
-                              e_star_pa: float = E_STAR_PA) -> tuple[float, float]:
+def secondary_torques_seed001(
+    ball_diameter_m: float,
+    ball_load_n: float,
+    mu_s: float,
+    groove_radius_m: float = GROOVE_RADIUS_M,
+    pitch_radius_m: float = RACE_PITCH_RADIUS_M,
+    e_star_pa: float = E_STAR_PA,
+) -> tuple[float, float]:
     """(Tz_MER, Tz_MP) [N m]: hysteresis torque 6 r MER / d and pivoting torque 3 MP of the
     3-ball bearing (seed 001 eq. 14 with eqs. 9 and 11), both speed independent. The seed
     neglects them (Appendix A: with inertia, 5.6 % to 2.6 % of the hydrodynamic torque for

@@ -50,17 +50,25 @@ from twin.setpoint import Setpoint
 from twin.spec import ModelOptions
 
 REFERENCE_TIME_STEP_S = 1e-6  # seed 000's step
-SETTLE_S = 0.02               # after the warm start, before averaging [s] (two thermal refreshes)
-MIN_WINDOW_S = 0.03           # at least this many seconds of whole cage revolutions [s]
+SETTLE_S = 0.02  # after the warm start, before averaging [s] (two thermal refreshes)
+MIN_WINDOW_S = 0.03  # at least this many seconds of whole cage revolutions [s]
 SAMPLES_PER_REVOLUTION = 360
 ELECTRICAL_EVERY_SAMPLES = 10  # the bearing network is evaluated every this many samples
 AZIMUTH_BINS = 36
 MIN_BIN_SAMPLES = 3
-LOADED_FRACTION = 0.05         # bins with a mean load above this fraction of the peak: loaded zone
+LOADED_FRACTION = 0.05  # bins with a mean load above this fraction of the peak: loaded zone
 TOLERANCES = {  # relative
-    "ball_load": 0.005, "lambda": 0.005, "h_min": 0.005, "mu": 0.005,
-    "cage_speed": 0.005, "ball_spin": 0.005, "ball_orbital_speed": 0.005,
-    "friction_torque": 0.02, "impedance": 0.02, "capacitance": 0.02, "current_heating": 0.02,
+    "ball_load": 0.005,
+    "lambda": 0.005,
+    "h_min": 0.005,
+    "mu": 0.005,
+    "cage_speed": 0.005,
+    "ball_spin": 0.005,
+    "ball_orbital_speed": 0.005,
+    "friction_torque": 0.02,
+    "impedance": 0.02,
+    "capacitance": 0.02,
+    "current_heating": 0.02,
 }
 QUANTITIES = tuple(TOLERANCES)
 
@@ -127,21 +135,28 @@ class _Run:
     status: str
     restarts: int
     window_s: float
-    load: np.ndarray        # (2, bins) mean load per azimuth bin [N]
-    lam: np.ndarray         # (2, bins) mean over closed samples
+    load: np.ndarray  # (2, bins) mean load per azimuth bin [N]
+    lam: np.ndarray  # (2, bins) mean over closed samples
     h_min: np.ndarray
     mu: np.ndarray
-    closed: np.ndarray      # (2, bins) bool: closed in every sample, enough samples
+    closed: np.ndarray  # (2, bins) bool: closed in every sample, enough samples
     scalars: dict
 
 
 def run_case(case: Case, time_step_s: float | Literal["auto"], **options) -> _Run:
     """Warm start, settle, average over whole cage revolutions at the given step (`options`:
     further ModelOptions fields)."""
-    twin = Twin(case.designation, options=ModelOptions(time_step_s=time_step_s, **options),
-                setpoint=Setpoint(shaft_speed_rad_s=case.shaft_speed_rad_s, radial_load_n=case.radial_load_n,
-                                  axial_load_n=case.axial_load_n, shaft_current_a=case.shaft_current_a),
-                diametral_clearance_m=case.diametral_clearance_m)
+    twin = Twin(
+        case.designation,
+        options=ModelOptions(time_step_s=time_step_s, **options),
+        setpoint=Setpoint(
+            shaft_speed_rad_s=case.shaft_speed_rad_s,
+            radial_load_n=case.radial_load_n,
+            axial_load_n=case.axial_load_n,
+            shaft_current_a=case.shaft_current_a,
+        ),
+        diametral_clearance_m=case.diametral_clearance_m,
+    )
     dt = twin.model.dt_s
     restarts0 = twin.restarts
     twin.advance(SETTLE_S, max_restarts=1)
@@ -205,17 +220,26 @@ def run_case(case: Case, time_step_s: float | Literal["auto"], **options) -> _Ru
     with np.errstate(invalid="ignore", divide="ignore"):
         closed_n = np.maximum(closed_count, 1.0)
         run = _Run(
-            time_step_s=dt, status=twin.status, restarts=twin.restarts - restarts0,
-            window_s=total_steps * dt, load=load_sum / np.maximum(count, 1.0),
-            lam=lam_sum / closed_n, h_min=h_sum / closed_n, mu=mu_sum / closed_n,
+            time_step_s=dt,
+            status=twin.status,
+            restarts=twin.restarts - restarts0,
+            window_s=total_steps * dt,
+            load=load_sum / np.maximum(count, 1.0),
+            lam=lam_sum / closed_n,
+            h_min=h_sum / closed_n,
+            mu=mu_sum / closed_n,
             closed=(closed_count == count) & (count >= MIN_BIN_SAMPLES),
-            scalars={"cage_speed": cage / samples, "ball_spin": spin / samples,
-                     "ball_orbital_speed": orbit / samples,
-                     "friction_torque": torque_sum / max(torque_steps, 1.0),
-                     "impedance": imp_sum / max(elec_n, 1),
-                     "capacitance": cap_sum / cap_n if cap_n else math.nan,
-                     "capacitive_everywhere": cap_n == elec_n > 0,
-                     "current_heating": heat_sum / max(elec_n, 1)})
+            scalars={
+                "cage_speed": cage / samples,
+                "ball_spin": spin / samples,
+                "ball_orbital_speed": orbit / samples,
+                "friction_torque": torque_sum / max(torque_steps, 1.0),
+                "impedance": imp_sum / max(elec_n, 1),
+                "capacitance": cap_sum / cap_n if cap_n else math.nan,
+                "capacitive_everywhere": cap_n == elec_n > 0,
+                "current_heating": heat_sum / max(elec_n, 1),
+            },
+        )
     return run
 
 
@@ -245,11 +269,14 @@ def compare(run: _Run, ref: _Run, with_current: bool) -> dict[str, float]:
         out[key] = max(worst) if worst else math.nan
     for key in ("cage_speed", "ball_spin", "ball_orbital_speed", "friction_torque", "impedance"):
         out[key] = _relative(run.scalars[key], ref.scalars[key])
-    out["capacitance"] = (_relative(run.scalars["capacitance"], ref.scalars["capacitance"])
-                          if run.scalars["capacitive_everywhere"] and ref.scalars["capacitive_everywhere"]
-                          else math.nan)
-    out["current_heating"] = (_relative(run.scalars["current_heating"], ref.scalars["current_heating"])
-                              if with_current else math.nan)
+    out["capacitance"] = (
+        _relative(run.scalars["capacitance"], ref.scalars["capacitance"])
+        if run.scalars["capacitive_everywhere"] and ref.scalars["capacitive_everywhere"]
+        else math.nan
+    )
+    out["current_heating"] = (
+        _relative(run.scalars["current_heating"], ref.scalars["current_heating"]) if with_current else math.nan
+    )
     return out
 
 
@@ -273,18 +300,31 @@ def run_study(cases: list[Case] | None = None, *, quick: bool = False, progress=
             dev = compare(run, ref, case.shaft_current_a > 0.0)
             if run.restarts or ref.restarts:  # diverged: nothing to compare
                 dev = {q: math.inf for q in QUANTITIES}
-            ok = (run.status == "ok" and ref.status == "ok" and run.restarts == 0
-                  and all(not (dev[q] > TOLERANCES[q]) for q in QUANTITIES))
-            rows.append({
-                **asdict(case), "step": label, "time_step_s": run.time_step_s,
-                "critical_time_step_s": crit, "reference_time_step_s": ref.time_step_s,
-                "window_s": run.window_s, "status": run.status, "reference_status": ref.status,
-                "restarts": run.restarts, "deviation": dev, "within_tolerance": ok,
-                "friction_torque_n_m": run.scalars["friction_torque"],
-                "reference_friction_torque_n_m": ref.scalars["friction_torque"],
-                "impedance_ohm": run.scalars["impedance"],
-                "capacitance_f": run.scalars["capacitance"],
-            })
+            ok = (
+                run.status == "ok"
+                and ref.status == "ok"
+                and run.restarts == 0
+                and all(not (dev[q] > TOLERANCES[q]) for q in QUANTITIES)
+            )
+            rows.append(
+                {
+                    **asdict(case),
+                    "step": label,
+                    "time_step_s": run.time_step_s,
+                    "critical_time_step_s": crit,
+                    "reference_time_step_s": ref.time_step_s,
+                    "window_s": run.window_s,
+                    "status": run.status,
+                    "reference_status": ref.status,
+                    "restarts": run.restarts,
+                    "deviation": dev,
+                    "within_tolerance": ok,
+                    "friction_torque_n_m": run.scalars["friction_torque"],
+                    "reference_friction_torque_n_m": ref.scalars["friction_torque"],
+                    "impedance_ohm": run.scalars["impedance"],
+                    "capacitance_f": run.scalars["capacitance"],
+                }
+            )
     return rows
 
 
@@ -292,14 +332,28 @@ def summary(rows: list[dict], step: str = "auto") -> dict[str, float]:
     """Largest deviation of each quantity over the rows of one step label."""
     out = {}
     for q in QUANTITIES:
-        values = [r["deviation"][q] for r in rows if r["step"] == step and r["deviation"][q] is not None
-                  and not math.isnan(r["deviation"][q])]
+        values = [
+            r["deviation"][q]
+            for r in rows
+            if r["step"] == step and r["deviation"][q] is not None and not math.isnan(r["deviation"][q])
+        ]
         out[q] = max(values) if values else math.nan
     return out
 
 
-_HEAD = ("ball_load", "lambda", "h_min", "mu", "cage_speed", "ball_spin", "ball_orbital_speed",
-         "friction_torque", "impedance", "capacitance", "current_heating")
+_HEAD = (
+    "ball_load",
+    "lambda",
+    "h_min",
+    "mu",
+    "cage_speed",
+    "ball_spin",
+    "ball_orbital_speed",
+    "friction_torque",
+    "impedance",
+    "capacitance",
+    "current_heating",
+)
 _TITLE = ("load", "Lambda", "h_min", "mu", "cage", "spin", "orbit", "torque", "abs Z", "C", "heating")
 
 
@@ -311,13 +365,16 @@ def _pct(x: float | None) -> str:
 
 def markdown_table(rows: list[dict]) -> str:
     """The study as a Markdown table: largest deviation from 1 us in %, per case and step."""
-    lines = ["| case | step | dt [us] | " + " | ".join(_TITLE) + " | within |",
-             "|---|---|---|" + "---|" * len(_TITLE) + "---|"]
+    lines = [
+        "| case | step | dt [us] | " + " | ".join(_TITLE) + " | within |",
+        "|---|---|---|" + "---|" * len(_TITLE) + "---|",
+    ]
     for r in rows:
         cells = [_pct(r["deviation"][q]) for q in _HEAD]
         verdict = "yes" if r["within_tolerance"] else ("no" if not r["restarts"] else "no: diverged")
-        lines.append(f"| {r['id']} | {r['step']} | {r['time_step_s'] * 1e6:.3f} | " + " | ".join(cells)
-                     + f" | {verdict} |")
+        lines.append(
+            f"| {r['id']} | {r['step']} | {r['time_step_s'] * 1e6:.3f} | " + " | ".join(cells) + f" | {verdict} |"
+        )
     for step in ("auto", "2x auto"):
         s = summary(rows, step)
         lines.append(f"| **largest** | {step} | | " + " | ".join(_pct(s[q]) for q in _HEAD) + " | |")
@@ -340,13 +397,25 @@ def stability_study(designations: list[str] | None = None) -> list[dict]:
         model = make_model(catalog.bearing(d))
         crit = model.time_step
         load = 0.999 * model.max_radial_load_n
-        row = {"designation": d, "radial_load_n": load, "shaft_speed_rad_s": STABILITY_SPEED_RAD_S,
-               "critical_time_step_s": crit.critical_step_s, "limiting_element": crit.limiting_element,
-               "auto_time_step_s": crit.auto_time_step_s, "static_load_n": crit.static_load_n}
-        for key, dt in (("auto", crit.auto_time_step_s), ("critical", crit.critical_step_s),
-                        ("unstable", UNSTABLE_FACTOR * crit.critical_step_s)):
-            twin = Twin(d, options=ModelOptions(time_step_s=dt),
-                        setpoint=Setpoint(shaft_speed_rad_s=STABILITY_SPEED_RAD_S, radial_load_n=load))
+        row = {
+            "designation": d,
+            "radial_load_n": load,
+            "shaft_speed_rad_s": STABILITY_SPEED_RAD_S,
+            "critical_time_step_s": crit.critical_step_s,
+            "limiting_element": crit.limiting_element,
+            "auto_time_step_s": crit.auto_time_step_s,
+            "static_load_n": crit.static_load_n,
+        }
+        for key, dt in (
+            ("auto", crit.auto_time_step_s),
+            ("critical", crit.critical_step_s),
+            ("unstable", UNSTABLE_FACTOR * crit.critical_step_s),
+        ):
+            twin = Twin(
+                d,
+                options=ModelOptions(time_step_s=dt),
+                setpoint=Setpoint(shaft_speed_rad_s=STABILITY_SPEED_RAD_S, radial_load_n=load),
+            )
             twin.advance(STABILITY_RUN_S, max_restarts=1)
             row[f"{key}_stable"] = twin.restarts == 0 and twin.status == "ok"
             row[f"{key}_status"] = twin.status
@@ -356,13 +425,18 @@ def stability_study(designations: list[str] | None = None) -> list[dict]:
 
 def stability_markdown(rows: list[dict]) -> str:
     """The stability check as a Markdown table."""
-    lines = ["| bearing | radial load [N] | critical step [us] | limiting element | auto [us] | runs at auto | "
-             f"at critical | at {UNSTABLE_FACTOR:g} x critical |", "|---|---|---|---|---|---|---|---|"]
+    lines = [
+        "| bearing | radial load [N] | critical step [us] | limiting element | auto [us] | runs at auto | "
+        f"at critical | at {UNSTABLE_FACTOR:g} x critical |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
     for r in rows:
         yn = lambda ok: "runs" if ok else "diverges"  # noqa: E731
-        lines.append(f"| {r['designation']} | {r['radial_load_n']:.0f} | {r['critical_time_step_s'] * 1e6:.3f} | "
-                     f"{r['limiting_element']} | {r['auto_time_step_s'] * 1e6:.3f} | {yn(r['auto_stable'])} | "
-                     f"{yn(r['critical_stable'])} | {yn(r['unstable_stable'])} |")
+        lines.append(
+            f"| {r['designation']} | {r['radial_load_n']:.0f} | {r['critical_time_step_s'] * 1e6:.3f} | "
+            f"{r['limiting_element']} | {r['auto_time_step_s'] * 1e6:.3f} | {yn(r['auto_stable'])} | "
+            f"{yn(r['critical_stable'])} | {yn(r['unstable_stable'])} |"
+        )
     return "\n".join(lines)
 
 
@@ -372,8 +446,11 @@ def run_all(*, quick: bool = False, progress=None) -> dict:
     rows = run_study(quick=quick, progress=progress)
     stability = stability_study(["6208"] if quick else None)
     return {
-        "reference_time_step_s": REFERENCE_TIME_STEP_S, "safety_factor": timestep.SAFETY_FACTOR,
-        "tolerances": dict(TOLERANCES), "quick": quick, "cases": rows,
+        "reference_time_step_s": REFERENCE_TIME_STEP_S,
+        "safety_factor": timestep.SAFETY_FACTOR,
+        "tolerances": dict(TOLERANCES),
+        "quick": quick,
+        "cases": rows,
         "summary": {"auto": summary(rows, "auto"), "2x auto": summary(rows, "2x auto")},
         "all_within_tolerance_at_auto": all(r["within_tolerance"] for r in rows if r["step"] == "auto"),
         "stability": stability,
@@ -383,8 +460,12 @@ def run_all(*, quick: bool = False, progress=None) -> dict:
 
 def markdown(result: dict) -> str:
     """Both tables of `run_all` as Markdown."""
-    return ("Largest deviation from 1 us [%] over whole cage revolutions\n\n" + markdown_table(result["cases"])
-            + "\n\nStability at the static capacity (10 rad/s, 10 ms)\n\n" + stability_markdown(result["stability"]))
+    return (
+        "Largest deviation from 1 us [%] over whole cage revolutions\n\n"
+        + markdown_table(result["cases"])
+        + "\n\nStability at the static capacity (10 rad/s, 10 ms)\n\n"
+        + stability_markdown(result["stability"])
+    )
 
 
 def _finite(value):

@@ -18,14 +18,20 @@ from twin.setpoint import Setpoint
 from twin.spec import BearingSpec
 from twin.vibration.run import run_vibration
 
-DEFAULT_DEFECT_SIZE_M = 0.5e-3     # width along the rolling direction [m]
-DEFAULT_DEFECT_DEPTH_M = 50e-6     # [m]
+DEFAULT_DEFECT_SIZE_M = 0.5e-3  # width along the rolling direction [m]
+DEFAULT_DEFECT_DEPTH_M = 50e-6  # [m]
 DEFAULT_LENGTH_OF_BALL_RADIUS = 0.6  # length across the rolling direction, x the ball radius
-SETTLE_S = 0.05                    # simulated time run and discarded before the analysis [s]
+SETTLE_S = 0.05  # simulated time run and discarded before the analysis [s]
 
 
-def defect_for(kind: str, geometry, size_m: float = DEFAULT_DEFECT_SIZE_M, length_m: float | None = None,
-               depth_m: float = DEFAULT_DEFECT_DEPTH_M, angle_deg: float = 0.0) -> dict:
+def defect_for(
+    kind: str,
+    geometry,
+    size_m: float = DEFAULT_DEFECT_SIZE_M,
+    length_m: float | None = None,
+    depth_m: float = DEFAULT_DEFECT_DEPTH_M,
+    angle_deg: float = 0.0,
+) -> dict:
     """The defect of `bearing-twin vibration --defect KIND --defect-size SIZE`: a pit `size_m`
     wide along the rolling direction, `length_m` across it (default 0.6 x the ball radius, 3.8 mm
     on the 6208: a pit shorter across than the contact ellipse takes only the load of its strip,
@@ -45,14 +51,24 @@ def defect_for(kind: str, geometry, size_m: float = DEFAULT_DEFECT_SIZE_M, lengt
     return out
 
 
-def simulate_vibration(bearing="6208", shaft_speed_rad_s: float = 500.0, radial_load_n: float | None = 3000.0,
-                       axial_load_n: float = 0.0, *, defect: str | None = None,
-                       defect_size_m: float = DEFAULT_DEFECT_SIZE_M, defect_length_m: float | None = None,
-                       defect_depth_m: float = DEFAULT_DEFECT_DEPTH_M, defect_angle_deg: float = 0.0,
-                       duration_s: float = 1.0,
-                       settle_s: float = SETTLE_S, noise_density_m_s2_rthz: float | None = None,
-                       sample_rate_hz: float | None = None, window_s: float | None = None,
-                       band: str | tuple[float, float] = "resonance") -> tuple[dict, np.ndarray]:
+def simulate_vibration(
+    bearing="6208",
+    shaft_speed_rad_s: float = 500.0,
+    radial_load_n: float | None = 3000.0,
+    axial_load_n: float = 0.0,
+    *,
+    defect: str | None = None,
+    defect_size_m: float = DEFAULT_DEFECT_SIZE_M,
+    defect_length_m: float | None = None,
+    defect_depth_m: float = DEFAULT_DEFECT_DEPTH_M,
+    defect_angle_deg: float = 0.0,
+    duration_s: float = 1.0,
+    settle_s: float = SETTLE_S,
+    noise_density_m_s2_rthz: float | None = None,
+    sample_rate_hz: float | None = None,
+    window_s: float | None = None,
+    band: str | tuple[float, float] = "resonance",
+) -> tuple[dict, np.ndarray]:
     """Run the twin with its housing on (and a defect, `defect_for`) and analyse the accelerometer:
     `settle_s` of simulated time is discarded, then `duration_s` is sampled (in-kernel decimator)
     and passed to `run_vibration` with the loaded contact angle of the contacts at the end.
@@ -76,38 +92,58 @@ def simulate_vibration(bearing="6208", shaft_speed_rad_s: float = 500.0, radial_
     data = spec.model_dump()
     acc = data["housing"]["accelerometer"]
     data["housing"]["enabled"] = True
-    for key, value in (("noise_density_m_s2_rthz", noise_density_m_s2_rthz), ("sample_rate_hz", sample_rate_hz),
-                       ("window_s", window_s)):
+    for key, value in (
+        ("noise_density_m_s2_rthz", noise_density_m_s2_rthz),
+        ("sample_rate_hz", sample_rate_hz),
+        ("window_s", window_s),
+    ):
         if value is not None:
             acc[key] = value
     spec = BearingSpec.model_validate(data)
-    twin = Twin(spec, setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n,
-                                        axial_load_n=axial_load_n))
+    twin = Twin(
+        spec,
+        setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n, axial_load_n=axial_load_n),
+    )
     if defect is not None:
-        twin.set_defects([defect_for(defect, spec.geometry, defect_size_m, defect_length_m, defect_depth_m,
-                                     defect_angle_deg)])
+        twin.set_defects(
+            [defect_for(defect, spec.geometry, defect_size_m, defect_length_m, defect_depth_m, defect_angle_deg)]
+        )
     for k, span in enumerate((settle_s, duration_s)):
         if k == 1:
-            twin.drain_waveform()   # the settling part is discarded
+            twin.drain_waveform()  # the settling part is discarded
         left = twin.advance(span)
         if left or twin.halted:
-            raise RuntimeError(f"bearing {spec.designation!r} at {shaft_speed_rad_s:g} rad/s, {radial_load_n:g} N: "
-                               f"the twin stopped at t = {twin.time_s:.6f} s after {twin.restarts} restarts "
-                               f"({twin.status})")
+            raise RuntimeError(
+                f"bearing {spec.designation!r} at {shaft_speed_rad_s:g} rad/s, {radial_load_n:g} N: "
+                f"the twin stopped at t = {twin.time_s:.6f} s after {twin.restarts} restarts "
+                f"({twin.status})"
+            )
     blocks = twin.drain_waveform()
     x = np.concatenate([b.samples for b in blocks]).astype(float) if blocks else np.zeros(0)
     angle = contact_angle_of_lanes_rad(twin.model, twin.state)
     decimator = twin.model.decimator
     assert decimator is not None  # the housing is on
-    result = run_vibration(x, decimator.output_rate_hz, spec, float(twin.state.scalars[L.X_SHAFT_SPEED]),
-                           contact_angle_rad=angle, housing=spec.housing,
-                           window_s=spec.housing.accelerometer.window_s, band=band)
-    result.update({
-        "bearing": spec.designation, "shaft_speed_rad_s": float(twin.state.scalars[L.X_SHAFT_SPEED]),
-        "radial_load_n": radial_load_n, "axial_load_n": axial_load_n,
-        "defect": twin.defects[0].model_dump() if twin.defects else None,
-        "time_step_s": twin.model.dt_s, "decimation_ratio": decimator.ratio,
-        "noise_density_m_s2_rthz": spec.housing.accelerometer.noise_density_m_s2_rthz,
-        "status": twin.status,
-    })
+    result = run_vibration(
+        x,
+        decimator.output_rate_hz,
+        spec,
+        float(twin.state.scalars[L.X_SHAFT_SPEED]),
+        contact_angle_rad=angle,
+        housing=spec.housing,
+        window_s=spec.housing.accelerometer.window_s,
+        band=band,
+    )
+    result.update(
+        {
+            "bearing": spec.designation,
+            "shaft_speed_rad_s": float(twin.state.scalars[L.X_SHAFT_SPEED]),
+            "radial_load_n": radial_load_n,
+            "axial_load_n": axial_load_n,
+            "defect": twin.defects[0].model_dump() if twin.defects else None,
+            "time_step_s": twin.model.dt_s,
+            "decimation_ratio": decimator.ratio,
+            "noise_density_m_s2_rthz": spec.housing.accelerometer.noise_density_m_s2_rthz,
+            "status": twin.status,
+        }
+    )
     return result, x

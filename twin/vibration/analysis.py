@@ -39,15 +39,15 @@ from twin.vibration import indicators
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.kurtogram import fast_kurtogram
 
-LINE_TOLERANCE = 0.01            # relative half-width of the search around a line [-]
+LINE_TOLERANCE = 0.01  # relative half-width of the search around a line [-]
 BACKGROUND_HALF_WIDTH_HZ = 20.0  # the local background: median of +-20 Hz around the peak
-SHAFT_HARMONICS = 3              # 1x, 2x, 3x shaft among the defect lines
+SHAFT_HARMONICS = 3  # 1x, 2x, 3x shaft among the defect lines
 LABEL_DEFECT_HARMONICS = 5
 LABEL_SHAFT_HARMONICS = 10
 MIN_SAMPLES = 1024
 MAX_SAMPLE_RATE_HZ = 1.0e6
-MAX_BAND_FRACTION = 0.45         # of fs: the highest envelope-band edge (anti-aliasing passband)
-DEFAULT_MAX_MULTIPLE = 10.0      # highest line multiple assumed when no defect line is given
+MAX_BAND_FRACTION = 0.45  # of fs: the highest envelope-band edge (anti-aliasing passband)
+DEFAULT_MAX_MULTIPLE = 10.0  # highest line multiple assumed when no defect line is given
 
 
 class AnalysisInputError(ValueError):
@@ -105,8 +105,8 @@ class VibrationAnalysis:
     crest_factor: float
     kurtosis: float
     envelope_band_hz: tuple[float, float]
-    envelope_band_source: str                  # 'kurtogram' or 'given'
-    band_spectral_kurtosis: float | None       # fast-kurtogram value of the band [-] (None if given)
+    envelope_band_source: str  # 'kurtogram' or 'given'
+    band_spectral_kurtosis: float | None  # fast-kurtogram value of the band [-] (None if given)
     kurtogram_level: float | None
     envelope_resolution_hz: float
     line_search_max_hz: float
@@ -126,19 +126,30 @@ class VibrationAnalysis:
         """JSON-ready dict (lists, floats); with spectrum=True also `envelope_spectrum`
         {start_hz, step_hz, amplitude_m_s2} from 0 Hz to the line-search limit."""
         out = {
-            "sample_rate_hz": self.sample_rate_hz, "n_samples": self.n_samples, "duration_s": self.duration_s,
-            "shaft_hz": self.shaft_hz, "rms_m_s2": self.rms_m_s2, "peak_m_s2": self.peak_m_s2,
-            "crest_factor": self.crest_factor, "kurtosis": self.kurtosis,
-            "envelope_band_hz": list(self.envelope_band_hz), "envelope_band_source": self.envelope_band_source,
-            "band_spectral_kurtosis": self.band_spectral_kurtosis, "kurtogram_level": self.kurtogram_level,
-            "envelope_resolution_hz": self.envelope_resolution_hz, "line_search_max_hz": self.line_search_max_hz,
+            "sample_rate_hz": self.sample_rate_hz,
+            "n_samples": self.n_samples,
+            "duration_s": self.duration_s,
+            "shaft_hz": self.shaft_hz,
+            "rms_m_s2": self.rms_m_s2,
+            "peak_m_s2": self.peak_m_s2,
+            "crest_factor": self.crest_factor,
+            "kurtosis": self.kurtosis,
+            "envelope_band_hz": list(self.envelope_band_hz),
+            "envelope_band_source": self.envelope_band_source,
+            "band_spectral_kurtosis": self.band_spectral_kurtosis,
+            "kurtogram_level": self.kurtogram_level,
+            "envelope_resolution_hz": self.envelope_resolution_hz,
+            "line_search_max_hz": self.line_search_max_hz,
             "defect_lines": [{**d.__dict__, "relative_error": d.relative_error} for d in self.defect_lines],
             "largest_lines": [dict(p.__dict__) for p in self.largest_lines],
         }
         if spectrum:
             keep = self.envelope_frequency_hz <= self.line_search_max_hz
-            out["envelope_spectrum"] = {"start_hz": 0.0, "step_hz": self.envelope_resolution_hz,
-                                        "amplitude_m_s2": self.envelope_amplitude_m_s2[keep].tolist()}
+            out["envelope_spectrum"] = {
+                "start_hz": 0.0,
+                "step_hz": self.envelope_resolution_hz,
+                "amplitude_m_s2": self.envelope_amplitude_m_s2[keep].tolist(),
+            }
         return out
 
 
@@ -163,8 +174,9 @@ def _checked_signal(signal_m_s2) -> np.ndarray:
         raise AnalysisInputError("signal_m_s2", f"{x.size} samples; at least {MIN_SAMPLES} needed")
     bad = np.flatnonzero(~np.isfinite(x))
     if bad.size:
-        raise AnalysisInputError("signal_m_s2", f"{bad.size} non-finite samples (first at index {bad[0]}); "
-                                 "all samples must be finite")
+        raise AnalysisInputError(
+            "signal_m_s2", f"{bad.size} non-finite samples (first at index {bad[0]}); all samples must be finite"
+        )
     return x
 
 
@@ -189,9 +201,14 @@ def _height_db(peak: float, background: float) -> float:
     return 0.0
 
 
-def measure_line(freqs: np.ndarray, amp: np.ndarray, name: str, expected_hz: float,
-                 tolerance: float = LINE_TOLERANCE,
-                 background_half_width_hz: float = BACKGROUND_HALF_WIDTH_HZ) -> DefectLine:
+def measure_line(
+    freqs: np.ndarray,
+    amp: np.ndarray,
+    name: str,
+    expected_hz: float,
+    tolerance: float = LINE_TOLERANCE,
+    background_half_width_hz: float = BACKGROUND_HALF_WIDTH_HZ,
+) -> DefectLine:
     """The envelope line near expected_hz (module docstring): largest bin within +-tolerance
     (at least the nearest bin), its height over the median of +-background_half_width_hz."""
     half = max(tolerance * expected_hz, 0.5 * (freqs[1] - freqs[0]))
@@ -199,8 +216,14 @@ def measure_line(freqs: np.ndarray, amp: np.ndarray, name: str, expected_hz: flo
     i = int(idx[np.argmax(amp[idx])])
     peak = float(amp[i])
     bg = _background(freqs, amp, float(freqs[i]), background_half_width_hz)
-    return DefectLine(name=name, expected_hz=float(expected_hz), peak_hz=float(freqs[i]), peak_m_s2=peak,
-                      background_m_s2=bg, height_db=_height_db(peak, bg))
+    return DefectLine(
+        name=name,
+        expected_hz=float(expected_hz),
+        peak_hz=float(freqs[i]),
+        peak_m_s2=peak,
+        background_m_s2=bg,
+        height_db=_height_db(peak, bg),
+    )
 
 
 def _label(frequency_hz: float, candidates: list[tuple[str, float]], tolerance: float) -> str | None:
@@ -212,11 +235,17 @@ def _label(frequency_hz: float, candidates: list[tuple[str, float]], tolerance: 
     return best
 
 
-def analyse_signal(signal_m_s2, sample_rate_hz: float, shaft_hz: float,
-                   defect_multiples: dict[str, float] | None = None,
-                   band_hz: tuple[float, float] | None = None, *, peak_count: int = 5,
-                   line_tolerance: float = LINE_TOLERANCE,
-                   background_half_width_hz: float = BACKGROUND_HALF_WIDTH_HZ) -> VibrationAnalysis:
+def analyse_signal(
+    signal_m_s2,
+    sample_rate_hz: float,
+    shaft_hz: float,
+    defect_multiples: dict[str, float] | None = None,
+    band_hz: tuple[float, float] | None = None,
+    *,
+    peak_count: int = 5,
+    line_tolerance: float = LINE_TOLERANCE,
+    background_half_width_hz: float = BACKGROUND_HALF_WIDTH_HZ,
+) -> VibrationAnalysis:
     """Analyse one accelerometer record (module docstring).
 
     signal_m_s2: 1-D samples [m/s^2] (at least 1024, all finite); sample_rate_hz (0, 1e6] [Hz];
@@ -237,8 +266,7 @@ def analyse_signal(signal_m_s2, sample_rate_hz: float, shaft_hz: float,
     min_band = 2.0 * (top + 1.0) * f_shaft
     if band_hz is None:
         try:
-            kg = fast_kurtogram(x, fs, min_bandwidth_hz=min_band,
-                                low_edge_range_hz=(min_band, MAX_BAND_FRACTION * fs))
+            kg = fast_kurtogram(x, fs, min_bandwidth_hz=min_band, low_edge_range_hz=(min_band, MAX_BAND_FRACTION * fs))
         except ValueError as exc:
             raise AnalysisInputError("band_hz", f"no kurtogram band fits ({exc}); give the band by hand") from None
         lo, hi = kg.band_hz[0], min(kg.band_hz[1], MAX_BAND_FRACTION * fs)
@@ -256,25 +284,50 @@ def analyse_signal(signal_m_s2, sample_rate_hz: float, shaft_hz: float,
     max_hz = min(0.5 * (hi - lo), 5.0 * top * f_shaft, float(freqs[-1]))
     lines = [(name, m * f_shaft) for name, m in multiples.items()]
     lines += [(_harmonic_label("shaft", k), k * f_shaft) for k in range(1, SHAFT_HARMONICS + 1)]
-    defect_lines = tuple(measure_line(freqs, amp, name, f, line_tolerance, background_half_width_hz)
-                         for name, f in lines if f <= freqs[-1])
-    candidates = [(_harmonic_label(name, k), k * m * f_shaft) for name, m in multiples.items()
-                  for k in range(1, LABEL_DEFECT_HARMONICS + 1)]
+    defect_lines = tuple(
+        measure_line(freqs, amp, name, f, line_tolerance, background_half_width_hz)
+        for name, f in lines
+        if f <= freqs[-1]
+    )
+    candidates = [
+        (_harmonic_label(name, k), k * m * f_shaft)
+        for name, m in multiples.items()
+        for k in range(1, LABEL_DEFECT_HARMONICS + 1)
+    ]
     candidates += [(_harmonic_label("shaft", k), k * f_shaft) for k in range(1, LABEL_SHAFT_HARMONICS + 1)]
     largest = []
     for p in indicators.envelope_peaks(freqs, amp, peak_count, max_hz=max_hz):
         f = p["frequency_hz"]
         bg = _background(freqs, amp, f, background_half_width_hz)
-        largest.append(EnvelopeLine(frequency_hz=f, amplitude_m_s2=p["amplitude"], shaft_order=f / f_shaft,
-                                    height_db=_height_db(p["amplitude"], bg),
-                                    label=_label(f, candidates, line_tolerance)))
+        largest.append(
+            EnvelopeLine(
+                frequency_hz=f,
+                amplitude_m_s2=p["amplitude"],
+                shaft_order=f / f_shaft,
+                height_db=_height_db(p["amplitude"], bg),
+                label=_label(f, candidates, line_tolerance),
+            )
+        )
     return VibrationAnalysis(
-        sample_rate_hz=fs, n_samples=int(x.size), duration_s=x.size / fs, shaft_hz=f_shaft,
-        rms_m_s2=t["rms_m_s2"], peak_m_s2=t["peak_m_s2"], crest_factor=t["crest_factor"], kurtosis=t["kurtosis"],
-        envelope_band_hz=(float(lo), float(hi)), envelope_band_source=source, band_spectral_kurtosis=sk,
-        kurtogram_level=level, envelope_resolution_hz=float(freqs[1] - freqs[0]), line_search_max_hz=float(max_hz),
-        defect_lines=defect_lines, largest_lines=tuple(largest),
-        envelope_frequency_hz=freqs, envelope_amplitude_m_s2=amp)
+        sample_rate_hz=fs,
+        n_samples=int(x.size),
+        duration_s=x.size / fs,
+        shaft_hz=f_shaft,
+        rms_m_s2=t["rms_m_s2"],
+        peak_m_s2=t["peak_m_s2"],
+        crest_factor=t["crest_factor"],
+        kurtosis=t["kurtosis"],
+        envelope_band_hz=(float(lo), float(hi)),
+        envelope_band_source=source,
+        band_spectral_kurtosis=sk,
+        kurtogram_level=level,
+        envelope_resolution_hz=float(freqs[1] - freqs[0]),
+        line_search_max_hz=float(max_hz),
+        defect_lines=defect_lines,
+        largest_lines=tuple(largest),
+        envelope_frequency_hz=freqs,
+        envelope_amplitude_m_s2=amp,
+    )
 
 
 def defect_multiples_of(geometry, contact_angle_rad: float | None = None) -> dict[str, float]:
@@ -284,5 +337,12 @@ def defect_multiples_of(geometry, contact_angle_rad: float | None = None) -> dic
     return {"BPFO": o["bpfo"], "BPFI": o["bpfi"], "2xBSF": o["two_bsf"], "FTF": o["ftf"]}
 
 
-__all__ = ["AnalysisInputError", "DefectLine", "EnvelopeLine", "VibrationAnalysis", "analyse_signal",
-           "defect_multiples_of", "measure_line"]
+__all__ = [
+    "AnalysisInputError",
+    "DefectLine",
+    "EnvelopeLine",
+    "VibrationAnalysis",
+    "analyse_signal",
+    "defect_multiples_of",
+    "measure_line",
+]

@@ -45,8 +45,13 @@ class DefectFrequencies:
 
     def as_dict(self) -> dict[str, float]:
         """{'ftf', 'bpfo', 'bpfi', 'bsf', 'two_bsf'} in Hz (the CLI JSON `defect_frequencies_hz`)."""
-        return {"ftf": self.ftf_hz, "bpfo": self.bpfo_hz, "bpfi": self.bpfi_hz,
-                "bsf": self.bsf_hz, "two_bsf": self.two_bsf_hz}
+        return {
+            "ftf": self.ftf_hz,
+            "bpfo": self.bpfo_hz,
+            "bpfi": self.bpfi_hz,
+            "bsf": self.bsf_hz,
+            "two_bsf": self.two_bsf_hz,
+        }
 
     def orders(self) -> dict[str, float]:
         """The same as multiples of the shaft frequency [-] (how catalogues tabulate them)."""
@@ -54,15 +59,21 @@ class DefectFrequencies:
         return {k: v / f for k, v in self.as_dict().items()}
 
 
-def defect_frequencies(ball_diameter_m: float, pitch_diameter_m: float, ball_count: int,
-                       shaft_speed_rad_s: float, contact_angle_rad: float = 0.0) -> DefectFrequencies:
+def defect_frequencies(
+    ball_diameter_m: float,
+    pitch_diameter_m: float,
+    ball_count: int,
+    shaft_speed_rad_s: float,
+    contact_angle_rad: float = 0.0,
+) -> DefectFrequencies:
     """FTF, BPFO, BPFI, BSF [Hz] (module docstring; Randall & Antoni 2011 eqs. 1-4).
 
     ball_diameter_m D [m], pitch_diameter_m d_m [m], ball_count Z, shaft_speed_rad_s [rad/s] (sign
     ignored: the frequencies are rates), contact_angle_rad the loaded contact angle [rad]."""
     if not (ball_diameter_m > 0.0 and pitch_diameter_m > ball_diameter_m):
-        raise ValueError(f"need 0 < ball_diameter_m < pitch_diameter_m, got {ball_diameter_m:g}, "
-                         f"{pitch_diameter_m:g} m")
+        raise ValueError(
+            f"need 0 < ball_diameter_m < pitch_diameter_m, got {ball_diameter_m:g}, {pitch_diameter_m:g} m"
+        )
     if ball_count < 1:
         raise ValueError(f"ball_count = {ball_count}: must be >= 1")
     if not (0.0 <= abs(contact_angle_rad) < 0.5 * math.pi):
@@ -71,24 +82,27 @@ def defect_frequencies(ball_diameter_m: float, pitch_diameter_m: float, ball_cou
     gamma = ball_diameter_m * math.cos(contact_angle_rad) / pitch_diameter_m
     ftf = 0.5 * fs * (1.0 - gamma)
     return DefectFrequencies(
-        shaft_hz=fs, ftf_hz=ftf, bpfo_hz=ball_count * ftf,
+        shaft_hz=fs,
+        ftf_hz=ftf,
+        bpfo_hz=ball_count * ftf,
         bpfi_hz=0.5 * ball_count * fs * (1.0 + gamma),
         bsf_hz=pitch_diameter_m / (2.0 * ball_diameter_m) * fs * (1.0 - gamma * gamma),
-        contact_angle_rad=float(contact_angle_rad))
+        contact_angle_rad=float(contact_angle_rad),
+    )
 
 
-def bearing_defect_frequencies(geometry, shaft_speed_rad_s: float,
-                               contact_angle_rad: float | None = None) -> DefectFrequencies:
+def bearing_defect_frequencies(
+    geometry, shaft_speed_rad_s: float, contact_angle_rad: float | None = None
+) -> DefectFrequencies:
     """`defect_frequencies` of a `twin.spec.Geometry` (ball radius, pitch radius, ball count);
     contact_angle_rad None -> the nominal (unloaded) contact angle of the geometry."""
-    alpha = (math.radians(geometry.nominal_contact_angle_deg) if contact_angle_rad is None
-             else contact_angle_rad)
-    return defect_frequencies(2.0 * geometry.ball_radius_m, 2.0 * geometry.pitch_radius_m,
-                              geometry.ball_count, shaft_speed_rad_s, alpha)
+    alpha = math.radians(geometry.nominal_contact_angle_deg) if contact_angle_rad is None else contact_angle_rad
+    return defect_frequencies(
+        2.0 * geometry.ball_radius_m, 2.0 * geometry.pitch_radius_m, geometry.ball_count, shaft_speed_rad_s, alpha
+    )
 
 
-def loaded_contact_angle_rad(normal_z: np.ndarray, load_n: np.ndarray,
-                             min_load_fraction: float = 0.01) -> float:
+def loaded_contact_angle_rad(normal_z: np.ndarray, load_n: np.ndarray, min_load_fraction: float = 0.01) -> float:
     """Mean contact angle [rad] over the loaded balls.
 
     normal_z[c], load_n[c]: per ball-raceway contact c = 2 ball + race (race 0 inner, 1 outer; the

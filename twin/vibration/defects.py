@@ -62,20 +62,20 @@ from twin.jit import JIT
 _FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
 # ---- defect row layout (one float64 row per active defect; `defect_row` builds it) ---------------
-D_KIND = 0          # KIND_*
-D_ANGLE = 1         # outer: azimuth [rad]; inner: angle on the ring from its reference mark [rad]
-D_BALL = 2          # ball index (ball defect)
-D_BODY_X = 3        # ball defect centre, unit vector in ball body coordinates
+D_KIND = 0  # KIND_*
+D_ANGLE = 1  # outer: azimuth [rad]; inner: angle on the ring from its reference mark [rad]
+D_BALL = 2  # ball index (ball defect)
+D_BODY_X = 3  # ball defect centre, unit vector in ball body coordinates
 D_BODY_Y = 4
 D_BODY_Z = 5
-D_HALF_WIDTH = 6    # half width along the rolling direction [m]
-D_HALF_LENGTH = 7   # half length across it [m]
-D_DEPTH = 8         # [m]
-D_EDGE_RADIUS = 9   # [m], 0 = sharp
-D_CENTRE_NZ = 10    # race spall: axial component of the contact normal at the spall's centre line
+D_HALF_WIDTH = 6  # half width along the rolling direction [m]
+D_HALF_LENGTH = 7  # half length across it [m]
+D_DEPTH = 8  # [m]
+D_EDGE_RADIUS = 9  # [m], 0 = sharp
+D_CENTRE_NZ = 10  # race spall: axial component of the contact normal at the spall's centre line
 # race spall, for the kernel's quick test of which balls can be over it (twin.kernels.vibration):
-D_REACH_COS = 11    # cos of REACH_MARGIN x (half width + edge radius) / raceway radius (-2: every ball)
-D_CENTRE_COS = 12   # cos, sin of the spall centre's angle (outer: azimuth; inner: on the ring)
+D_REACH_COS = 11  # cos of REACH_MARGIN x (half width + edge radius) / raceway radius (-2: every ball)
+D_CENTRE_COS = 12  # cos, sin of the spall centre's angle (outer: azimuth; inner: on the ring)
 D_CENTRE_SIN = 13
 N_DEFECT_PARAMS = 14
 
@@ -99,15 +99,18 @@ class _Pit(BaseModel):
     width_m: float = Field(gt=0.0, le=0.05, description="Size along the rolling direction [m].")
     length_m: float = Field(gt=0.0, le=0.05, description="Size across the rolling direction [m].")
     depth_m: float = Field(gt=0.0, le=0.01, description="Depth [m].")
-    edge_radius_m: float = Field(default=0.0, ge=0.0, le=0.01,
-                                 description="Radius of the rounded edges [m]; 0 = sharp edges.")
+    edge_radius_m: float = Field(
+        default=0.0, ge=0.0, le=0.01, description="Radius of the rounded edges [m]; 0 = sharp edges."
+    )
 
     @model_validator(mode="after")
     def _edges(self) -> _Pit:
         half = 0.5 * min(self.width_m, self.length_m)
         if self.edge_radius_m > half:
-            raise ValueError(f"edge_radius_m = {self.edge_radius_m:g} m: must be in [0, {half:g}] m "
-                             "(half the smaller of width_m and length_m)")
+            raise ValueError(
+                f"edge_radius_m = {self.edge_radius_m:g} m: must be in [0, {half:g}] m "
+                "(half the smaller of width_m and length_m)"
+            )
         return self
 
 
@@ -115,8 +118,12 @@ class OuterRaceSpall(_Pit):
     """Spall on the stationary outer race at a fixed azimuth."""
 
     kind: Literal["outer"] = "outer"
-    azimuth_deg: float = Field(default=0.0, ge=0.0, lt=360.0,
-                               description="Azimuth of the spall centre [deg] from +x (load direction) about +z.")
+    azimuth_deg: float = Field(
+        default=0.0,
+        ge=0.0,
+        lt=360.0,
+        description="Azimuth of the spall centre [deg] from +x (load direction) about +z.",
+    )
 
     @model_validator(mode="after")
     def _fits(self, info: ValidationInfo) -> OuterRaceSpall:
@@ -129,9 +136,12 @@ class InnerRaceSpall(_Pit):
 
     kind: Literal["inner"] = "inner"
     ring_angle_deg: float = Field(
-        default=0.0, ge=0.0, lt=360.0,
+        default=0.0,
+        ge=0.0,
+        lt=360.0,
         description="Angle of the spall centre on the inner ring [deg] from the ring's reference mark (the mark "
-        "is at azimuth 0 when the shaft angle is 0), about +z.")
+        "is at azimuth 0 when the shaft angle is 0), about +z.",
+    )
 
     @model_validator(mode="after")
     def _fits(self, info: ValidationInfo) -> InnerRaceSpall:
@@ -145,10 +155,15 @@ class BallDefect(_Pit):
 
     kind: Literal["ball"] = "ball"
     ball_index: int = Field(default=0, ge=0, le=15, description="Which ball [-], 0 .. ball_count - 1.")
-    colatitude_deg: float = Field(default=90.0, ge=0.0, le=180.0,
-                                  description="Polar angle of the defect centre from the body +z axis [deg].")
-    longitude_deg: float = Field(default=0.0, ge=0.0, lt=360.0,
-                                 description="Azimuth of the defect centre about the body +z axis from body +x [deg].")
+    colatitude_deg: float = Field(
+        default=90.0, ge=0.0, le=180.0, description="Polar angle of the defect centre from the body +z axis [deg]."
+    )
+    longitude_deg: float = Field(
+        default=0.0,
+        ge=0.0,
+        lt=360.0,
+        description="Azimuth of the defect centre about the body +z axis from body +x [deg].",
+    )
 
     @property
     def body_point(self) -> tuple[float, float, float]:
@@ -163,13 +178,16 @@ class BallDefect(_Pit):
             return self
         rb = geometry.ball_radius_m
         if self.ball_index >= geometry.ball_count:
-            raise ValueError(f"ball_index = {self.ball_index}: must be in [0, {geometry.ball_count - 1}] "
-                             f"(the bearing has {geometry.ball_count} balls)")
+            raise ValueError(
+                f"ball_index = {self.ball_index}: must be in [0, {geometry.ball_count - 1}] "
+                f"(the bearing has {geometry.ball_count} balls)"
+            )
         for name in ("width_m", "length_m"):
             value = getattr(self, name)
             if value > rb:
-                raise ValueError(f"{name} = {value:g} m: must be in (0, {rb:g}] m for a local ball defect "
-                                 "(at most the ball radius)")
+                raise ValueError(
+                    f"{name} = {value:g} m: must be in (0, {rb:g}] m for a local ball defect (at most the ball radius)"
+                )
         _check_depth(self, rb)
         return self
 
@@ -187,8 +205,10 @@ def _geometry(info: ValidationInfo):
 def _check_depth(pit: _Pit, rb: float) -> None:
     limit = 0.5 * rb
     if pit.depth_m > limit:
-        raise ValueError(f"depth_m = {pit.depth_m:g} m: must be in (0, {limit:g}] m (a quarter of the ball "
-                         "diameter: beyond it the defect is no longer a local pit under a ball)")
+        raise ValueError(
+            f"depth_m = {pit.depth_m:g} m: must be in (0, {limit:g}] m (a quarter of the ball "
+            "diameter: beyond it the defect is no longer a local pit under a ball)"
+        )
 
 
 def race_limits(geometry, outer: bool) -> dict[str, float]:
@@ -202,9 +222,11 @@ def race_limits(geometry, outer: bool) -> dict[str, float]:
     rb = geometry.ball_radius_m
     radius = geometry.outer_raceway_radius_m if outer else geometry.inner_raceway_radius_m
     rg = geometry.outer_groove_radius_m if outer else geometry.inner_groove_radius_m
-    return {"width_m": 2.0 * math.pi * radius / geometry.ball_count,
-            "length_m": 2.0 * rg * math.asin(min(rb / rg, 1.0)),
-            "depth_m": 0.5 * rb}
+    return {
+        "width_m": 2.0 * math.pi * radius / geometry.ball_count,
+        "length_m": 2.0 * rg * math.asin(min(rb / rg, 1.0)),
+        "depth_m": 0.5 * rb,
+    }
 
 
 def _check_race(pit: _Pit, info: ValidationInfo, outer: bool) -> None:
@@ -213,8 +235,10 @@ def _check_race(pit: _Pit, info: ValidationInfo, outer: bool) -> None:
         return
     lim = race_limits(geometry, outer)
     race = "outer" if outer else "inner"
-    why = {"width_m": f"the ball spacing on the {race} raceway, 2 pi R / Z",
-           "length_m": f"the {race} groove arc the ball can touch, 2 Rg asin(Rb / Rg)"}
+    why = {
+        "width_m": f"the ball spacing on the {race} raceway, 2 pi R / Z",
+        "length_m": f"the {race} groove arc the ball can touch, 2 Rg asin(Rb / Rg)",
+    }
     for name, reason in why.items():
         value = getattr(pit, name)
         if value > lim[name]:
@@ -251,7 +275,7 @@ def defect_row(defect, geometry) -> np.ndarray:
     if defect.kind == "outer":
         row[D_KIND] = KIND_OUTER
         row[D_ANGLE] = math.radians(defect.azimuth_deg)
-        row[D_CENTRE_NZ] = sin_a       # outer normal (groove centre -> ball) points up under +z load
+        row[D_CENTRE_NZ] = sin_a  # outer normal (groove centre -> ball) points up under +z load
     elif defect.kind == "inner":
         row[D_KIND] = KIND_INNER
         row[D_ANGLE] = math.radians(defect.ring_angle_deg)
@@ -259,7 +283,7 @@ def defect_row(defect, geometry) -> np.ndarray:
     else:
         row[D_KIND] = KIND_BALL
         row[D_BALL] = defect.ball_index
-        row[D_BODY_X:D_BODY_Z + 1] = defect.body_point
+        row[D_BODY_X : D_BODY_Z + 1] = defect.body_point
     return row
 
 
@@ -283,12 +307,12 @@ def edge_drop_m(inside_m, edge_radius_m, relative_radius_m):
 def _slice_load_integral(s, eta, s_star):
     """Integral of min(1 - t^2, eta) dt from -1 to s (|s| <= 1), with s_star = sqrt(1 - eta) the
     slice where 1 - t^2 = eta (0 when eta >= 1)."""
-    g_low = -s_star + s_star ** 3 / 3.0 + 2.0 / 3.0   # integral of 1 - t^2 from -1 to -s_star
+    g_low = -s_star + s_star**3 / 3.0 + 2.0 / 3.0  # integral of 1 - t^2 from -1 to -s_star
     if s <= -s_star:
-        return s - s ** 3 / 3.0 + 2.0 / 3.0
+        return s - s**3 / 3.0 + 2.0 / 3.0
     if s <= s_star:
         return g_low + eta * (s + s_star)
-    return g_low + 2.0 * eta * s_star + (s - s ** 3 / 3.0) - (s_star - s_star ** 3 / 3.0)
+    return g_low + 2.0 * eta * s_star + (s - s**3 / 3.0) - (s_star - s_star**3 / 3.0)
 
 
 @njit(**JIT)
@@ -316,8 +340,7 @@ def pit_drop_m(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx
     """Extra radial clearance [m] equivalent to the pit's load loss: delta (1 - (1 - lambda)^(2/3)),
     so that K (delta - drop)^1.5 is the load the contact keeps (`pit_load_loss`); 0 for an open
     contact. For a pit that covers the ellipse across it is min(delta, h(u)), Sawalhi & Randall's drop."""
-    lost = pit_load_loss(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, delta_m,
-                         semi_major_m)
+    lost = pit_load_loss(u_m, v_m, half_width_m, half_length_m, depth_m, edge_radius_m, rx_m, delta_m, semi_major_m)
     if lost <= 0.0:
         return 0.0
     if lost >= 1.0:
@@ -332,8 +355,30 @@ def wrap_angle(a):
 
 
 @njit(**JIT)
-def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_angle,
-                          qw, qx, qy, qz, rb, race_radius, groove_radius, rx, delta, semi_major):
+def contact_defect_drop_m(
+    d,
+    race,
+    ball,
+    px,
+    py,
+    nx,
+    ny,
+    nz,
+    wx,
+    wy,
+    wz,
+    shaft_angle,
+    qw,
+    qx,
+    qy,
+    qz,
+    rb,
+    race_radius,
+    groove_radius,
+    rx,
+    delta,
+    semi_major,
+):
     """Extra radial clearance [m] that the defect row `d` (D_* layout) opens at the contact of
     ball `ball` with race `race` (0 inner, 1 outer): the kernel subtracts it from the contact's
     deflection.
@@ -387,10 +432,12 @@ def contact_defect_drop_m(d, race, ball, px, py, nx, ny, nz, wx, wy, wz, shaft_a
 @njit(**JIT)
 def quat_multiply(aw, ax, ay, az, bw, bx, by, bz):
     """Hamilton product a (x) b."""
-    return (aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw)
+    return (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
 
 
 @njit(**JIT)
@@ -400,9 +447,7 @@ def quat_rotate(qw, qx, qy, qz, vx, vy, vz):
     tx = 2.0 * (qy * vz - qz * vy)
     ty = 2.0 * (qz * vx - qx * vz)
     tz = 2.0 * (qx * vy - qy * vx)
-    return (vx + qw * tx + (qy * tz - qz * ty),
-            vy + qw * ty + (qz * tx - qx * tz),
-            vz + qw * tz + (qx * ty - qy * tx))
+    return (vx + qw * tx + (qy * tz - qz * ty), vy + qw * ty + (qz * tx - qx * tz), vz + qw * tz + (qx * ty - qy * tx))
 
 
 @njit(**JIT)

@@ -57,24 +57,24 @@ _FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=Fal
 HOUSING_ENABLED_BY_DEFAULT = False
 
 # ---- housing parameter vector (immutable, from `housing_params`) ---------------------------------
-H_PEDESTAL_MASS = 0      # m_p [kg] (outer ring + pedestal)
-H_RADIAL_STIFFNESS = 1   # k_p [N/m] in x and y
-H_RADIAL_DAMPING = 2     # c_p [N s/m]
-H_AXIAL_STIFFNESS = 3    # [N/m] in z
-H_AXIAL_DAMPING = 4      # [N s/m]
-H_SPRUNG_MASS = 5        # m_r [kg]
-H_SPRUNG_STIFFNESS = 6   # k_r [N/m]
-H_SPRUNG_DAMPING = 7     # c_r [N s/m]
-H_EX = 8                 # accelerometer axis e, unit vector (world frame)
+H_PEDESTAL_MASS = 0  # m_p [kg] (outer ring + pedestal)
+H_RADIAL_STIFFNESS = 1  # k_p [N/m] in x and y
+H_RADIAL_DAMPING = 2  # c_p [N s/m]
+H_AXIAL_STIFFNESS = 3  # [N/m] in z
+H_AXIAL_DAMPING = 4  # [N s/m]
+H_SPRUNG_MASS = 5  # m_r [kg]
+H_SPRUNG_STIFFNESS = 6  # k_r [N/m]
+H_SPRUNG_DAMPING = 7  # c_r [N s/m]
+H_EX = 8  # accelerometer axis e, unit vector (world frame)
 H_EY = 9
 H_EZ = 10
 N_HOUSING_PARAMS = 11
 
 # ---- housing state (displacement, velocity, acceleration arrays of this length) -----------------
-HX = 0   # outer ring / pedestal centre [m]
+HX = 0  # outer ring / pedestal centre [m]
 HY = 1
 HZ = 2
-HR = 3   # sprung mass along e [m]
+HR = 3  # sprung mass along e [m]
 N_HOUSING_DOF = 4
 
 
@@ -84,24 +84,40 @@ class Accelerometer(BaseModel):
     model_config = _FROZEN
 
     azimuth_deg: float = Field(
-        default=0.0, ge=0.0, lt=360.0,
+        default=0.0,
+        ge=0.0,
+        lt=360.0,
         description="Azimuth of the sensor on the housing [deg] from +x (the radial load direction, the "
-        "centre of the load zone), positive about the bearing axis +z.")
+        "centre of the load zone), positive about the bearing axis +z.",
+    )
     direction: Literal["radial", "axial"] = Field(
-        default="radial", description="Measuring axis: radial at the sensor's azimuth, or axial (+z).")
+        default="radial", description="Measuring axis: radial at the sensor's azimuth, or axial (+z)."
+    )
     sample_rate_hz: float = Field(
-        default=51200.0, ge=1000.0, le=204800.0,
-        description="Output sample rate of the in-kernel decimator [Hz] (51.2 kHz: a usual DAQ rate).")
+        default=51200.0,
+        ge=1000.0,
+        le=204800.0,
+        description="Output sample rate of the in-kernel decimator [Hz] (51.2 kHz: a usual DAQ rate).",
+    )
     window_s: float = Field(
-        default=1.0, ge=0.05, le=60.0,
-        description="Indicator window [s]: RMS, kurtosis, envelope spectrum ... are computed on each whole window.")
+        default=1.0,
+        ge=0.05,
+        le=60.0,
+        description="Indicator window [s]: RMS, kurtosis, envelope spectrum ... are computed on each whole window.",
+    )
     noise_density_m_s2_rthz: float = Field(
-        default=0.0, ge=0.0, le=1.0,
+        default=0.0,
+        ge=0.0,
+        le=1.0,
         description="White sensor noise density [m/s^2/sqrt(Hz)] (one-sided); 0 = noiseless. A general-purpose "
-        "ICP accelerometer is ~1e-3 (100 ug/sqrt(Hz)).")
+        "ICP accelerometer is ~1e-3 (100 ug/sqrt(Hz)).",
+    )
     noise_seed: int | None = Field(
-        default=None, ge=0, le=2 ** 32 - 1,
-        description="Seed of the twin's sensor noise generator (numpy); null: fresh entropy.")
+        default=None,
+        ge=0,
+        le=2**32 - 1,
+        description="Seed of the twin's sensor noise generator (numpy); null: fresh entropy.",
+    )
 
     @property
     def axis(self) -> tuple[float, float, float]:
@@ -122,26 +138,39 @@ class Housing(BaseModel):
     enabled: bool = Field(
         default=HOUSING_ENABLED_BY_DEFAULT,
         description="Outer ring on the housing support, accelerometer sampled in the kernel (twin.vibration). "
-        "False: seed 000's rigid, fixed outer ring, no vibration signal.")
+        "False: seed 000's rigid, fixed outer ring, no vibration signal.",
+    )
 
     pedestal_mass_kg: float = Field(
-        default=6.638, gt=0.01, le=1e4, description="Outer ring + pedestal mass m_p [kg] (Sawalhi & Randall 2008).")
+        default=6.638, gt=0.01, le=1e4, description="Outer ring + pedestal mass m_p [kg] (Sawalhi & Randall 2008)."
+    )
     radial_stiffness_n_m: float = Field(
-        default=1.51e7, gt=1e3, le=1e12, description="Pedestal radial stiffness k_p in x and y [N/m].")
+        default=1.51e7, gt=1e3, le=1e12, description="Pedestal radial stiffness k_p in x and y [N/m]."
+    )
     radial_damping_n_s_m: float = Field(
-        default=2210.7, ge=0.0, le=1e8, description="Pedestal radial damping c_p [N s/m].")
+        default=2210.7, ge=0.0, le=1e8, description="Pedestal radial damping c_p [N s/m]."
+    )
     axial_stiffness_n_m: float = Field(
-        default=1.51e7, gt=1e3, le=1e12,
-        description="Pedestal axial stiffness [N/m] (not in Sawalhi & Randall: the radial value is assumed).")
+        default=1.51e7,
+        gt=1e3,
+        le=1e12,
+        description="Pedestal axial stiffness [N/m] (not in Sawalhi & Randall: the radial value is assumed).",
+    )
     axial_damping_n_s_m: float = Field(
-        default=2210.7, ge=0.0, le=1e8, description="Pedestal axial damping [N s/m] (radial value assumed).")
+        default=2210.7, ge=0.0, le=1e8, description="Pedestal axial damping [N s/m] (radial value assumed)."
+    )
     sprung_mass_kg: float = Field(
-        default=1.0, gt=1e-4, le=1e3, description="Sprung mass m_r carrying the accelerometer [kg].")
+        default=1.0, gt=1e-4, le=1e3, description="Sprung mass m_r carrying the accelerometer [kg]."
+    )
     sprung_stiffness_n_m: float = Field(
-        default=8.8826e9, gt=1e3, le=1e13,
-        description="Sprung-mass stiffness k_r [N/m] (8.8826e9 with 1 kg: a 15.0 kHz resonance).")
+        default=8.8826e9,
+        gt=1e3,
+        le=1e13,
+        description="Sprung-mass stiffness k_r [N/m] (8.8826e9 with 1 kg: a 15.0 kHz resonance).",
+    )
     sprung_damping_n_s_m: float = Field(
-        default=9424.8, ge=0.0, le=1e8, description="Sprung-mass damping c_r [N s/m] (5 % of critical).")
+        default=9424.8, ge=0.0, le=1e8, description="Sprung-mass damping c_r [N s/m] (5 % of critical)."
+    )
     accelerometer: Accelerometer = Accelerometer()
 
     @model_validator(mode="after")
@@ -155,12 +184,15 @@ class Housing(BaseModel):
                 f"the sensed housing resonance is {f:.0f} Hz, above the anti-aliasing passband "
                 f"({PASSBAND_FRACTION:g} x accelerometer.sample_rate_hz = {limit:.0f} Hz): raise "
                 f"accelerometer.sample_rate_hz to at least {f / PASSBAND_FRACTION:.0f} Hz or soften "
-                "sprung_stiffness_n_m")
+                "sprung_stiffness_n_m"
+            )
         acc = self.accelerometer
         if acc.window_s * acc.sample_rate_hz < 1024:
-            raise ValueError(f"accelerometer.window_s = {acc.window_s:g} s holds {acc.window_s * acc.sample_rate_hz:.0f} "
-                             f"samples at {acc.sample_rate_hz:g} Hz: must be in [{1024 / acc.sample_rate_hz:g}, 60] s "
-                             "(at least 1024 samples per indicator window)")
+            raise ValueError(
+                f"accelerometer.window_s = {acc.window_s:g} s holds {acc.window_s * acc.sample_rate_hz:.0f} "
+                f"samples at {acc.sample_rate_hz:g} Hz: must be in [{1024 / acc.sample_rate_hz:g}, 60] s "
+                "(at least 1024 samples per indicator window)"
+            )
         return self
 
 
@@ -179,7 +211,7 @@ def housing_params(housing: Housing) -> np.ndarray:
     p[H_SPRUNG_MASS] = housing.sprung_mass_kg
     p[H_SPRUNG_STIFFNESS] = housing.sprung_stiffness_n_m
     p[H_SPRUNG_DAMPING] = housing.sprung_damping_n_s_m
-    p[H_EX:H_EZ + 1] = housing.accelerometer.axis
+    p[H_EX : H_EZ + 1] = housing.accelerometer.axis
     p.setflags(write=False)
     return p
 

@@ -70,9 +70,8 @@ def time_indicators(a_m_s2: np.ndarray) -> dict[str, float]:
     ms = float(np.mean(x * x))
     rms = math.sqrt(ms)
     peak = float(np.max(np.abs(x)))
-    kurt = float(np.mean(x ** 4) / (ms * ms)) if ms > 0.0 else 0.0
-    return {"rms_m_s2": rms, "peak_m_s2": peak, "crest_factor": peak / rms if rms > 0.0 else 0.0,
-            "kurtosis": kurt}
+    kurt = float(np.mean(x**4) / (ms * ms)) if ms > 0.0 else 0.0
+    return {"rms_m_s2": rms, "peak_m_s2": peak, "crest_factor": peak / rms if rms > 0.0 else 0.0, "kurtosis": kurt}
 
 
 def band_pass(a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[float, float]) -> np.ndarray:
@@ -96,8 +95,9 @@ def band_kurtosis(a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[floa
     return time_indicators(band_pass(a_m_s2, sample_rate_hz, band_hz))["kurtosis"]
 
 
-def velocity_rms_mm_s(a_m_s2: np.ndarray, sample_rate_hz: float,
-                      band_hz: tuple[float, float] = ISO_20816_BAND_HZ) -> float:
+def velocity_rms_mm_s(
+    a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[float, float] = ISO_20816_BAND_HZ
+) -> float:
     """RMS velocity [mm/s] in band_hz (ISO 20816-1: 10-1000 Hz) from acceleration [m/s^2], by
     integration in the frequency domain (module docstring)."""
     x = np.asarray(a_m_s2, dtype=float)
@@ -112,34 +112,43 @@ def velocity_rms_mm_s(a_m_s2: np.ndarray, sample_rate_hz: float,
     return 1e3 * math.sqrt(ms)
 
 
-def kurtogram_band(a_m_s2: np.ndarray, sample_rate_hz: float, min_bandwidth_hz: float = 0.0,
-                   max_frequency_hz: float | None = None) -> tuple[float, float, float]:
+def kurtogram_band(
+    a_m_s2: np.ndarray, sample_rate_hz: float, min_bandwidth_hz: float = 0.0, max_frequency_hz: float | None = None
+) -> tuple[float, float, float]:
     """(low [Hz], high [Hz], SK [-]) of the band of highest spectral kurtosis: Antoni's fast
     kurtogram (twin.vibration.kurtogram, MSSP 21, 2007) among its bands at least min_bandwidth_hz
     wide that neither reach 0 Hz nor pass max_frequency_hz (default: 0.45 fs, inside the
     anti-aliasing passband)."""
     fs = float(sample_rate_hz)
     fmax = 0.45 * fs if max_frequency_hz is None else min(max_frequency_hz, 0.5 * fs)
-    kg = fast_kurtogram(a_m_s2, fs, min_bandwidth_hz=min_bandwidth_hz,
-                        low_edge_range_hz=(np.nextafter(0.0, 1.0), fmax), max_high_edge_hz=fmax)
+    kg = fast_kurtogram(
+        a_m_s2,
+        fs,
+        min_bandwidth_hz=min_bandwidth_hz,
+        low_edge_range_hz=(np.nextafter(0.0, 1.0), fmax),
+        max_high_edge_hz=fmax,
+    )
     return kg.band_hz[0], kg.band_hz[1], kg.band_kurtosis
 
 
-def resonance_band(resonance_hz: float, damping_ratio: float, sample_rate_hz: float,
-                   min_bandwidth_hz: float = 0.0) -> tuple[float, float]:
+def resonance_band(
+    resonance_hz: float, damping_ratio: float, sample_rate_hz: float, min_bandwidth_hz: float = 0.0
+) -> tuple[float, float]:
     """Band [Hz] centred on a structural resonance: +-3 half-power half-widths (3 zeta f_r), at
     least min_bandwidth_hz wide, kept inside (0, 0.45 fs)."""
     half = max(3.0 * damping_ratio * resonance_hz, 0.5 * min_bandwidth_hz)
     lo = max(resonance_hz - half, 0.01 * sample_rate_hz)
     hi = min(resonance_hz + half, 0.45 * sample_rate_hz)
     if not lo < hi:
-        raise ValueError(f"resonance at {resonance_hz:g} Hz is outside the usable band of a "
-                         f"{sample_rate_hz:g} Hz signal")
+        raise ValueError(
+            f"resonance at {resonance_hz:g} Hz is outside the usable band of a {sample_rate_hz:g} Hz signal"
+        )
     return lo, hi
 
 
-def envelope_spectrum(a_m_s2: np.ndarray, sample_rate_hz: float,
-                      band_hz: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+def envelope_spectrum(
+    a_m_s2: np.ndarray, sample_rate_hz: float, band_hz: tuple[float, float]
+) -> tuple[np.ndarray, np.ndarray]:
     """(frequencies [Hz], amplitude [m/s^2]) of the envelope of a band-passed to band_hz
     (module docstring: Butterworth 4 zero-phase, Hilbert, Hann, amplitude-corrected)."""
     y = band_pass(a_m_s2, sample_rate_hz, band_hz)
@@ -150,8 +159,9 @@ def envelope_spectrum(a_m_s2: np.ndarray, sample_rate_hz: float,
     return np.fft.rfftfreq(env.size, 1.0 / float(sample_rate_hz)), amp
 
 
-def amplitude_spectrum(a_m_s2: np.ndarray, sample_rate_hz: float,
-                       max_bins: int = AMPLITUDE_MAX_BINS) -> tuple[float, float, np.ndarray]:
+def amplitude_spectrum(
+    a_m_s2: np.ndarray, sample_rate_hz: float, max_bins: int = AMPLITUDE_MAX_BINS
+) -> tuple[float, float, np.ndarray]:
     """(start [Hz], step [Hz], amplitude [m/s^2]) of the window's one-sided amplitude spectrum
     from 0 to fs / 2 (module docstring): the mean-removed window's DFT X_k, power P_k = w_k
     |X_k|^2 / N^2 (w = 2, 1 at 0 Hz and at fs / 2 for even N: sum P_k = mean square, Parseval),
@@ -165,33 +175,34 @@ def amplitude_spectrum(a_m_s2: np.ndarray, sample_rate_hz: float,
     if max_bins < 1:
         raise ValueError(f"max_bins = {max_bins}: must be >= 1")
     spec = np.fft.rfft(x - x.mean())
-    power = (spec.real ** 2 + spec.imag ** 2) * (2.0 / (n * n))
+    power = (spec.real**2 + spec.imag**2) * (2.0 / (n * n))
     power[0] *= 0.5
     if n % 2 == 0:
         power[-1] *= 0.5
     g = -(-power.size // max_bins)
     m = -(-power.size // g)
     padded = np.zeros(m * g)
-    padded[:power.size] = power
+    padded[: power.size] = power
     df = float(sample_rate_hz) / n
     return 0.5 * (g - 1) * df, g * df, np.sqrt(2.0 * padded.reshape(m, g).sum(axis=1))
 
 
-def envelope_spectrum_view(freqs: np.ndarray, amp: np.ndarray, max_hz: float,
-                           max_bins: int = ENVELOPE_MAX_BINS) -> tuple[float, float, np.ndarray]:
+def envelope_spectrum_view(
+    freqs: np.ndarray, amp: np.ndarray, max_hz: float, max_bins: int = ENVELOPE_MAX_BINS
+) -> tuple[float, float, np.ndarray]:
     """(start [Hz], step [Hz], amplitude [m/s^2]) of an envelope spectrum (`envelope_spectrum`)
     from 0 Hz to max_hz (the bins at or below it): the values themselves when they are at most
     max_bins, else the largest of each group of g = ceil(bins / max_bins) (peak hold: a line keeps
     its height), centre start + j step as in `amplitude_spectrum`."""
     df = float(freqs[1] - freqs[0])
     keep = int(np.searchsorted(freqs, max_hz, side="right"))
-    a = np.asarray(amp[:max(keep, 1)], dtype=float)
+    a = np.asarray(amp[: max(keep, 1)], dtype=float)
     g = -(-a.size // max_bins)
     if g == 1:
         return 0.0, df, a.copy()
     m = -(-a.size // g)
     padded = np.zeros(m * g)
-    padded[:a.size] = a
+    padded[: a.size] = a
     return 0.5 * (g - 1) * df, g * df, padded.reshape(m, g).max(axis=1)
 
 
@@ -206,8 +217,9 @@ def _refine(freqs: np.ndarray, amp: np.ndarray, i: int) -> tuple[float, float]:
     return float(freqs[i]), float(amp[i])
 
 
-def envelope_peaks(freqs: np.ndarray, amp: np.ndarray, count: int = 5, min_hz: float | None = None,
-                   max_hz: float | None = None) -> list[dict[str, float]]:
+def envelope_peaks(
+    freqs: np.ndarray, amp: np.ndarray, count: int = 5, min_hz: float | None = None, max_hz: float | None = None
+) -> list[dict[str, float]]:
     """The `count` largest local maxima of an envelope spectrum in [min_hz, max_hz], largest
     first: [{'frequency_hz', 'amplitude'}] (parabolic interpolation between bins). Defaults: from
     3 bins above 0 Hz to the end."""
@@ -241,18 +253,23 @@ def line_amplitude(freqs: np.ndarray, amp: np.ndarray, f_hz: float, tolerance: f
     return float(np.max(amp[sel])) if np.any(sel) else 0.0
 
 
-def defect_line_amplitudes(freqs: np.ndarray, amp: np.ndarray, freq: DefectFrequencies,
-                           harmonics: int = 3, tolerance: float = 0.01) -> dict[str, dict]:
+def defect_line_amplitudes(
+    freqs: np.ndarray, amp: np.ndarray, freq: DefectFrequencies, harmonics: int = 3, tolerance: float = 0.01
+) -> dict[str, dict]:
     """Envelope amplitudes [m/s^2] at each defect frequency: {'ftf', 'bpfo', 'bpfi', 'bsf',
     'two_bsf'} -> {'frequency_hz', 'harmonics': [1x, 2x, ...], 'sidebands': {'lower', 'upper'}
     (BPFI +- shaft frequency, 2 x BSF +- FTF, at the fundamental; absent for the others)}."""
     side = {"bpfi": freq.shaft_hz, "two_bsf": freq.ftf_hz}
     out = {}
     for name, f in freq.as_dict().items():
-        entry = {"frequency_hz": f,
-                 "harmonics": [line_amplitude(freqs, amp, k * f, tolerance) for k in range(1, harmonics + 1)]}
+        entry = {
+            "frequency_hz": f,
+            "harmonics": [line_amplitude(freqs, amp, k * f, tolerance) for k in range(1, harmonics + 1)],
+        }
         if name in side:
-            entry["sidebands"] = {"lower": line_amplitude(freqs, amp, f - side[name], tolerance),
-                                  "upper": line_amplitude(freqs, amp, f + side[name], tolerance)}
+            entry["sidebands"] = {
+                "lower": line_amplitude(freqs, amp, f - side[name], tolerance),
+                "upper": line_amplitude(freqs, amp, f + side[name], tolerance),
+            }
         out[name] = entry
     return out

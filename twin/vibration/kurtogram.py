@@ -33,7 +33,7 @@ import numpy as np
 import scipy.signal
 
 _BINARY_ORDER = 16
-_BINARY_CUTOFF = 0.4          # of Nyquist (Antoni 2007 sec. 3.3)
+_BINARY_CUTOFF = 0.4  # of Nyquist (Antoni 2007 sec. 3.3)
 
 
 def _filters() -> tuple[np.ndarray, ...]:
@@ -59,7 +59,7 @@ def complex_envelope_kurtosis(nodes: np.ndarray) -> np.ndarray:
     0 for a row of zero energy."""
     c = np.atleast_2d(nodes)
     c = c - c.mean(axis=1, keepdims=True)
-    power = c.real ** 2 + c.imag ** 2 if np.iscomplexobj(c) else c * c
+    power = c.real**2 + c.imag**2 if np.iscomplexobj(c) else c * c
     p2 = np.mean(power, axis=1)
     p4 = np.mean(power * power, axis=1)
     offset = 2.0 if np.iscomplexobj(c) else 3.0
@@ -81,7 +81,7 @@ def _filter_bank(nodes: np.ndarray, taps: np.ndarray, factor: int) -> np.ndarray
         acc = out[:, :, m]
         for k in range(length):
             start = factor - 1 + length - 1 - k
-            acc += padded[:, start:start + factor * count:factor] * taps[k, m]
+            acc += padded[:, start : start + factor * count : factor] * taps[k, m]
     return out
 
 
@@ -126,9 +126,14 @@ def max_level(n_samples: int) -> int:
     return math.floor(math.log2(max(n_samples, 1))) - 7
 
 
-def fast_kurtogram(signal: np.ndarray, sample_rate_hz: float, nlevel: int | None = None,
-                   min_bandwidth_hz: float = 0.0, low_edge_range_hz: tuple[float, float] | None = None,
-                   max_high_edge_hz: float | None = None) -> Kurtogram:
+def fast_kurtogram(
+    signal: np.ndarray,
+    sample_rate_hz: float,
+    nlevel: int | None = None,
+    min_bandwidth_hz: float = 0.0,
+    low_edge_range_hz: tuple[float, float] | None = None,
+    max_high_edge_hz: float | None = None,
+) -> Kurtogram:
     """The fast kurtogram of a real signal (module docstring) up to level `nlevel` (default and
     upper bound `max_level`), and its best band among those at least min_bandwidth_hz [Hz] wide
     whose lower edge lies in low_edge_range_hz = [min, max) [Hz] and upper edge at most
@@ -145,17 +150,17 @@ def fast_kurtogram(signal: np.ndarray, sample_rate_hz: float, nlevel: int | None
         raise ValueError(f"nlevel = {nlevel}: must be in [1, {deepest}] for {x.size} samples")
     x = x - x.mean()
     lh = _H.size
-    columns = 3 * 2 ** nlevel
+    columns = 3 * 2**nlevel
     binary_rows = [np.full(columns, complex_envelope_kurtosis(x[None, :])[0])]
     ternary_rows = []
     nodes = x[None, :].astype(complex)
     for k in range(nlevel):
         if k <= nlevel - 2:
             # the ternary split of level k, level k + log2(3): bands of width fs / (3 x 2^(k + 1))
-            kq = complex_envelope_kurtosis(_ternary_split(nodes)[:, lh - 1:])
+            kq = complex_envelope_kurtosis(_ternary_split(nodes)[:, lh - 1 :])
             ternary_rows.append(np.repeat(kq, columns // kq.size))
         nodes = _binary_split(nodes)
-        kb = complex_envelope_kurtosis(nodes[:, lh - 1:])
+        kb = complex_envelope_kurtosis(nodes[:, lh - 1 :])
         binary_rows.append(np.repeat(kb, columns // kb.size))
     levels, rows = [0.0], [binary_rows[0]]
     for k in range(1, nlevel + 1):
@@ -175,14 +180,22 @@ def fast_kurtogram(signal: np.ndarray, sample_rate_hz: float, nlevel: int | None
     if max_high_edge_hz is not None:
         usable = usable & (low_edge + bandwidth[:, None] <= max_high_edge_hz * (1.0 + 1e-12))
     if not np.any(usable):
-        raise ValueError(f"min_bandwidth_hz = {min_bandwidth_hz:g}, low_edge_range_hz = {low_edge_range_hz}, "
-                         f"max_high_edge_hz = {max_high_edge_hz}: "
-                         f"no band of the kurtogram (0 - {0.5 * fs:g} Hz) is eligible")
+        raise ValueError(
+            f"min_bandwidth_hz = {min_bandwidth_hz:g}, low_edge_range_hz = {low_edge_range_hz}, "
+            f"max_high_edge_hz = {max_high_edge_hz}: "
+            f"no band of the kurtogram (0 - {0.5 * fs:g} Hz) is eligible"
+        )
     masked = np.where(usable, kurt, -1.0)
-    flat = int(np.argmax(masked.T.ravel()))      # column-major: lowest column, then coarsest level
+    flat = int(np.argmax(masked.T.ravel()))  # column-major: lowest column, then coarsest level
     j, i = divmod(flat, masked.shape[0])
     bw = float(bandwidth[i])
     lo = float(low_edge[i, j])
-    return Kurtogram(sample_rate_hz=fs, levels=levels_arr, bandwidth_hz=bandwidth, kurtosis=kurt,
-                     band_hz=(lo, lo + bw), level=float(levels_arr[i]),
-                     band_kurtosis=float(kurt[i, j]))
+    return Kurtogram(
+        sample_rate_hz=fs,
+        levels=levels_arr,
+        bandwidth_hz=bandwidth,
+        kurtosis=kurt,
+        band_hz=(lo, lo + bw),
+        level=float(levels_arr[i]),
+        band_kurtosis=float(kurt[i, j]),
+    )

@@ -17,10 +17,19 @@ from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.housing import Housing, sensor_resonance
 
 
-def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s: float, *,
-                  contact_angle_rad: float | None = None, housing: Housing | None = None,
-                  window_s: float = 1.0, band: str | tuple[float, float] = "resonance",
-                  peak_count: int = 5, spectra: bool = False) -> dict:
+def run_vibration(
+    signal_m_s2,
+    sample_rate_hz: float,
+    bearing,
+    shaft_speed_rad_s: float,
+    *,
+    contact_angle_rad: float | None = None,
+    housing: Housing | None = None,
+    window_s: float = 1.0,
+    band: str | tuple[float, float] = "resonance",
+    peak_count: int = 5,
+    spectra: bool = False,
+) -> dict:
     """Indicators of a housing-acceleration waveform (JSON-ready; every number finite).
 
     signal_m_s2: samples [m/s^2] at sample_rate_hz [Hz]; bearing: a `twin.spec.Geometry` or a
@@ -62,7 +71,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         f_r, zeta = sensor_resonance(housing or Housing())
         lo, hi = ind.resonance_band(f_r, zeta, fs, min_bw)
     elif isinstance(band, str) and band == "kurtogram":
-        lo, hi, _ = ind.kurtogram_band(x[:n_win * count], fs, min_bandwidth_hz=min_bw)
+        lo, hi, _ = ind.kurtogram_band(x[: n_win * count], fs, min_bandwidth_hz=min_bw)
     elif isinstance(band, str):
         raise ValueError(f"band = {band!r}: 'resonance', 'kurtogram' or (low, high) in Hz")
     else:
@@ -71,7 +80,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
     amp_sum = None
     power_sum = None
     for k in range(count):
-        seg = x[k * n_win:(k + 1) * n_win]
+        seg = x[k * n_win : (k + 1) * n_win]
         row = ind.time_indicators(seg)
         row["velocity_rms_mm_s"] = ind.velocity_rms_mm_s(seg, fs)
         row["band_kurtosis"] = ind.band_kurtosis(seg, fs, (lo, hi))
@@ -80,7 +89,7 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         amp_sum = amp if amp_sum is None else amp_sum + amp
         if spectra:
             a_start, a_step, a_amp = ind.amplitude_spectrum(seg, fs)
-            power_sum = a_amp ** 2 if power_sum is None else power_sum + a_amp ** 2
+            power_sum = a_amp**2 if power_sum is None else power_sum + a_amp**2
     assert amp_sum is not None  # count >= 1 windows
     amp = amp_sum / count
     max_hz = min(0.5 * (hi - lo), 5.0 * top)
@@ -109,6 +118,9 @@ def run_vibration(signal_m_s2, sample_rate_hz: float, bearing, shaft_speed_rad_s
         assert power_sum is not None  # summed over the same windows
         e_start, e_step, e_amp = ind.envelope_spectrum_view(freqs, amp, max_hz)
         out["envelope_spectrum"] = {"start_hz": e_start, "step_hz": e_step, "amplitude_m_s2": e_amp}
-        out["amplitude_spectrum"] = {"start_hz": a_start, "step_hz": a_step,
-                                     "amplitude_m_s2": np.sqrt(power_sum / count)}
+        out["amplitude_spectrum"] = {
+            "start_hz": a_start,
+            "step_hz": a_step,
+            "amplitude_m_s2": np.sqrt(power_sum / count),
+        }
     return out

@@ -39,13 +39,13 @@ from twin.jit import JIT
 
 JIT_INLINE = dict(JIT, inline="always")  # called by the kernel every step (twin.vibration.housing)
 
-PASSBAND_FRACTION = 0.4   # of the output rate
+PASSBAND_FRACTION = 0.4  # of the output rate
 STOPBAND_FRACTION = 0.5
 
 # decimator state vector layout (float64): counters, then the accumulator ring
-DS_PHASE = 0      # input index modulo R
-DS_POS = 1        # ring slot of the newest output (output index modulo K)
-DS_OUTPUTS = 2    # outputs produced since reset
+DS_PHASE = 0  # input index modulo R
+DS_POS = 1  # ring slot of the newest output (output index modulo K)
+DS_OUTPUTS = 2  # outputs produced since reset
 N_DS_HEADER = 3
 
 
@@ -70,8 +70,7 @@ class DecimatorDesign:
     def phases(self) -> np.ndarray:
         """Polyphase taps (R, K), contiguous: phases[r, i] = taps[K R - 1 - r - i R], the tap input
         n (n mod R = r) contributes to the i-th newest pending output."""
-        idx = (self.ring * self.ratio - 1 - np.arange(self.ratio)[:, None]
-               - self.ratio * np.arange(self.ring)[None, :])
+        idx = self.ring * self.ratio - 1 - np.arange(self.ratio)[:, None] - self.ratio * np.arange(self.ring)[None, :]
         out = np.ascontiguousarray(self.taps[idx])
         out.setflags(write=False)
         return out
@@ -107,21 +106,29 @@ def integer_ratio_time_step(max_time_step_s: float, output_rate_hz: float) -> tu
         raise ValueError("max_time_step_s and output_rate_hz must be positive")
     ratio = math.ceil(1.0 / (max_time_step_s * output_rate_hz) - 1e-9)
     if ratio < 2:
-        raise ValueError(f"output_rate_hz = {output_rate_hz:g} Hz: needs a time step below "
-                         f"{0.5 / output_rate_hz:g} s (at least 2 steps per sample), got {max_time_step_s:g} s")
+        raise ValueError(
+            f"output_rate_hz = {output_rate_hz:g} Hz: needs a time step below "
+            f"{0.5 / output_rate_hz:g} s (at least 2 steps per sample), got {max_time_step_s:g} s"
+        )
     return 1.0 / (ratio * output_rate_hz), ratio
 
 
-def design_decimator(input_rate_hz: float, output_rate_hz: float, attenuation_db: float = 80.0,
-                     passband_fraction: float = PASSBAND_FRACTION,
-                     stopband_fraction: float = STOPBAND_FRACTION) -> DecimatorDesign:
+def design_decimator(
+    input_rate_hz: float,
+    output_rate_hz: float,
+    attenuation_db: float = 80.0,
+    passband_fraction: float = PASSBAND_FRACTION,
+    stopband_fraction: float = STOPBAND_FRACTION,
+) -> DecimatorDesign:
     """Kaiser-window FIR low-pass for decimation from input_rate_hz to output_rate_hz (module
     docstring). The ratio must be an integer within 1e-6 (see `integer_ratio_time_step`)."""
     ratio_f = input_rate_hz / output_rate_hz
     ratio = int(round(ratio_f))
     if ratio < 2 or abs(ratio_f - ratio) > 1e-6 * ratio_f:
-        raise ValueError(f"input_rate_hz / output_rate_hz = {ratio_f:.6g}: must be an integer >= 2 "
-                         "(snap the time step with integer_ratio_time_step)")
+        raise ValueError(
+            f"input_rate_hz / output_rate_hz = {ratio_f:.6g}: must be an integer >= 2 "
+            "(snap the time step with integer_ratio_time_step)"
+        )
     if not 0.0 < passband_fraction < stopband_fraction <= 0.5 * ratio:
         raise ValueError("need 0 < passband_fraction < stopband_fraction")
     nyq = 0.5 * input_rate_hz
@@ -134,8 +141,14 @@ def design_decimator(input_rate_hz: float, output_rate_hz: float, attenuation_db
     taps = np.zeros(ring * ratio)
     taps[:n] = h
     taps.setflags(write=False)
-    return DecimatorDesign(taps=taps, ratio=ratio, ring=ring, input_rate_hz=float(input_rate_hz),
-                           output_rate_hz=float(output_rate_hz), taps_used=int(n))
+    return DecimatorDesign(
+        taps=taps,
+        ratio=ratio,
+        ring=ring,
+        input_rate_hz=float(input_rate_hz),
+        output_rate_hz=float(output_rate_hz),
+        taps_used=int(n),
+    )
 
 
 @njit(**JIT)
@@ -209,9 +222,9 @@ def add_sensor_noise(y, sigma):
 # product that LLVM vectorises (reassociation allowed for that sum only; the same outputs as the
 # polyphase form to rounding, tests/vibration/test_signal.py): K R / R = K multiply-adds per input
 # on average, in SIMD. Its outputs come in a burst every R steps, which a 1 ms frame does not see.
-DD_POS = 0       # next history slot (input index modulo K R)
-DD_PHASE = 1     # input index modulo R
-DD_OUTPUTS = 2   # outputs produced since reset
+DD_POS = 0  # next history slot (input index modulo K R)
+DD_PHASE = 1  # input index modulo R
+DD_OUTPUTS = 2  # outputs produced since reset
 N_DD_HEADER = 3
 
 
@@ -249,7 +262,7 @@ def decimator_push_direct(reversed_taps, ratio, state, x):
 
 
 # ---- the sensor as the kernel sees it: decimator + noise + a ring of output samples ---------------
-RS_WRITTEN = 0    # ring state: output samples written since reset (the reader's cursor is its own)
+RS_WRITTEN = 0  # ring state: output samples written since reset (the reader's cursor is its own)
 N_RS_HEADER = 1
 
 

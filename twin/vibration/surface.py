@@ -40,7 +40,7 @@ from pydantic import BaseModel, ConfigDict, Field
 
 _FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
 
-PROFILE_POINTS = 4096   # points of a race profile over its circumference (the kernel's table length)
+PROFILE_POINTS = 4096  # points of a race profile over its circumference (the kernel's table length)
 
 
 class SurfaceProfile(BaseModel):
@@ -50,25 +50,41 @@ class SurfaceProfile(BaseModel):
     model_config = _FROZEN
 
     enabled: bool = Field(
-        default=False, description="Race profiles and ball-size spread excite the contacts (twin.vibration.surface).")
+        default=False, description="Race profiles and ball-size spread excite the contacts (twin.vibration.surface)."
+    )
     race_profile_rms_m: float = Field(
-        default=0.05e-6, ge=0.0, le=5e-6,
+        default=0.05e-6,
+        ge=0.0,
+        le=5e-6,
         description="RMS of each race's profile over the orders 2 .. n_max [m] (waviness and the roughness the "
-        "contact follows; superfinished raceways: a few hundredths of a micrometre to ~0.1 um).")
+        "contact follows; superfinished raceways: a few hundredths of a micrometre to ~0.1 um).",
+    )
     shortest_wavelength_m: float = Field(
-        default=0.3e-3, ge=20e-6, le=0.01,
+        default=0.3e-3,
+        ge=20e-6,
+        le=0.01,
         description="Shortest wavelength of the profile [m]: about the Hertz contact length 2b, over which the "
-        "contact averages shorter ones out.")
+        "contact averages shorter ones out.",
+    )
     ball_diameter_spread_m: float = Field(
-        default=0.125e-6, ge=0.0, le=5e-6,
+        default=0.125e-6,
+        ge=0.0,
+        le=5e-6,
         description="Standard deviation of the balls' diameters [m] (ISO 3290-1 grade G10: lot diameter "
-        "variation 0.5 um, taken as 4 standard deviations).")
-    seed: int = Field(default=0, ge=0, le=2 ** 32 - 1,
-                      description="Seed of the profiles' random phases and the ball sizes (numpy).")
+        "variation 0.5 um, taken as 4 standard deviations).",
+    )
+    seed: int = Field(
+        default=0, ge=0, le=2**32 - 1, description="Seed of the profiles' random phases and the ball sizes (numpy)."
+    )
 
 
-def race_profile_m(rms_m: float, raceway_radius_m: float, shortest_wavelength_m: float,
-                   rng: np.random.Generator, points: int = PROFILE_POINTS) -> np.ndarray:
+def race_profile_m(
+    rms_m: float,
+    raceway_radius_m: float,
+    shortest_wavelength_m: float,
+    rng: np.random.Generator,
+    points: int = PROFILE_POINTS,
+) -> np.ndarray:
     """Heights [m] of one race's profile at `points` equally spaced angles (module docstring): equal
     amplitudes of random phase over the orders 2 .. n_max = 2 pi R / lambda_min (at most
     points / 4, so that linear interpolation resolves the shortest wave), RMS `rms_m`."""

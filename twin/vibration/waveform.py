@@ -61,22 +61,34 @@ def _header_bytes(id_len: int) -> int:
     return (_FIXED.size + id_len + 3) // 4 * 4
 
 
-def encode_chunk(twin_id: str, seq: int, t0_s: float, sample_rate_hz: float, samples,
-                 units: str = "m/s^2") -> bytes:
+def encode_chunk(twin_id: str, seq: int, t0_s: float, sample_rate_hz: float, samples, units: str = "m/s^2") -> bytes:
     """Bytes of one chunk (layout in the module docstring). Samples are stored as float32."""
     ident = twin_id.encode("utf-8")
     if len(ident) > MAX_ID_BYTES:
         raise ValueError(f"twin_id is {len(ident)} bytes in UTF-8: at most {MAX_ID_BYTES}")
     if units not in _UNIT_CODES:
         raise ValueError(f"units = {units!r}: one of {sorted(_UNIT_CODES)}")
-    if not (0 <= seq < 2 ** 64):
+    if not (0 <= seq < 2**64):
         raise ValueError(f"seq = {seq}: must be in [0, 2^64)")
     if not (sample_rate_hz > 0.0 and np.isfinite(sample_rate_hz) and np.isfinite(t0_s)):
         raise ValueError("sample_rate_hz must be positive and finite, t0_s finite")
     data = np.ascontiguousarray(samples, dtype="<f4").ravel()
     hb = _header_bytes(len(ident))
-    head = _FIXED.pack(MAGIC, VERSION, hb, _UNIT_CODES[units], DTYPE_FLOAT32_LE, seq, float(t0_s),
-                       float(sample_rate_hz), data.size, len(ident)) + ident
+    head = (
+        _FIXED.pack(
+            MAGIC,
+            VERSION,
+            hb,
+            _UNIT_CODES[units],
+            DTYPE_FLOAT32_LE,
+            seq,
+            float(t0_s),
+            float(sample_rate_hz),
+            data.size,
+            len(ident),
+        )
+        + ident
+    )
     return head + bytes(hb - len(head)) + data.tobytes()
 
 
@@ -97,7 +109,8 @@ def decode_chunk(payload: bytes) -> WaveformChunk:
         raise ValueError(f"waveform units code {unit}: one of {sorted(UNITS)}")
     if hb < _FIXED.size + id_len or len(buf) < hb + 4 * count:
         raise ValueError(f"waveform chunk truncated: {len(buf)} bytes, header says {hb} + 4 x {count}")
-    twin_id = bytes(buf[_FIXED.size:_FIXED.size + id_len]).decode("utf-8")
+    twin_id = bytes(buf[_FIXED.size : _FIXED.size + id_len]).decode("utf-8")
     samples = np.frombuffer(buf, dtype="<f4", count=count, offset=hb).copy()
-    return WaveformChunk(twin_id=twin_id, seq=int(seq), t0_s=float(t0), sample_rate_hz=float(rate),
-                         units=UNITS[unit], samples=samples)
+    return WaveformChunk(
+        twin_id=twin_id, seq=int(seq), t0_s=float(t0), sample_rate_hz=float(rate), units=UNITS[unit], samples=samples
+    )

@@ -16,7 +16,11 @@ def health(registry: RegistryDep, request: Request) -> Health:
     """Service status, uptime and per-twin real-time factor, overruns and drops."""
     tarpit = getattr(request.app.state, "tarpit", None)
     opcua = getattr(registry, "opcua", None)
-    return Health(**registry.health(), http_slow_closed=closures.headers + closures.body,
-                  opcua_guard=opcua.guard.figures() if opcua is not None else None,
-                  http_tarpit={**tarpit.record(), "errors_over_budget": registry.gate.errors_over_budget}
-                  if tarpit is not None else None)
+    return Health(
+        **registry.health(),
+        http_slow_closed=closures.headers + closures.body,
+        opcua_guard=opcua.guard.figures() if opcua is not None else None,
+        http_tarpit={**tarpit.record(), "errors_over_budget": registry.gate.errors_over_budget}
+        if tarpit is not None
+        else None,
+    )

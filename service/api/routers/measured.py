@@ -26,10 +26,18 @@ read = APIRouter(prefix="/v1/bearings", tags=["vibration"])
 write = APIRouter(prefix="/v1/bearings", tags=["vibration"])
 
 
-@write.post("/{bearing_id}/vibration/measured", dependencies=[Depends(setpoint_rate)],
-            responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY})
-async def post_measured(entry: TwinDep, request: Request, sample_rate_hz: float | None = None,
-                        units: str = "m/s2", shaft_hz: float | None = None) -> dict[str, Any]:
+@write.post(
+    "/{bearing_id}/vibration/measured",
+    dependencies=[Depends(setpoint_rate)],
+    responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY},
+)
+async def post_measured(
+    entry: TwinDep,
+    request: Request,
+    sample_rate_hz: float | None = None,
+    units: str = "m/s2",
+    shaft_hz: float | None = None,
+) -> dict[str, Any]:
     """Analyse one measured window with the twin's analysis and compare it with the twin's
     prediction at the same operating point (module docstring). 422 names the field and the
     allowed range (sample_rate_hz, units, samples, shaft_hz); takes the twin's setpoint budget."""
@@ -46,8 +54,12 @@ async def post_measured(entry: TwinDep, request: Request, sample_rate_hz: float 
             raise InputError.one(None, "body is not valid JSON") from None
         window = window_from_json(data)
     else:
-        raise InputError.one(None, f"content type {kind!r}: application/json or application/octet-stream",
-                             ["application/json", "application/octet-stream"], status_code=415)
+        raise InputError.one(
+            None,
+            f"content type {kind!r}: application/json or application/octet-stream",
+            ["application/json", "application/octet-stream"],
+            status_code=415,
+        )
     comparator = entry.measured
     assert comparator is not None  # every twin gets one at creation (TwinRegistry)
     return await run_in_threadpool(comparator.receive, window)

@@ -23,5 +23,6 @@ def post_recording(entry: TwinDep, body: RecordingRequest, registry: RegistryDep
     if body.path is not None:
         raise InputError.one("path", "give a path only with action 'start'")
     stopped, rows = registry.stop_recording(entry)
-    return RecordingStatus(bearing_id=entry.id, recording=False,
-                           path=str(stopped) if stopped is not None else None, rows_logged=rows)
+    return RecordingStatus(
+        bearing_id=entry.id, recording=False, path=str(stopped) if stopped is not None else None, rows_logged=rows
+    )

@@ -13,15 +13,27 @@ from twin.setpoint import SetpointUpdate
 
 write = APIRouter(prefix="/v1/bearings", tags=["bearings"])
 
-TOO_MANY: dict[int | str, dict[str, Any]] = {429: {"model": ErrorResponse, "description": "Too many setpoints for this twin; see Retry-After",
-                  "headers": {"Retry-After": {"schema": {"type": "integer"}, "description": "seconds"}}}}
+TOO_MANY: dict[int | str, dict[str, Any]] = {
+    429: {
+        "model": ErrorResponse,
+        "description": "Too many setpoints for this twin; see Retry-After",
+        "headers": {"Retry-After": {"schema": {"type": "integer"}, "description": "seconds"}},
+    }
+}
 
 
-@write.put("/{bearing_id}/setpoint", response_model=SetpointResponse,
-           dependencies=[Depends(setpoint_rate)], responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY})
-async def put_setpoint(entry: TwinDep,
-                 update: Annotated[SetpointUpdate, Body(description="Partial setpoint: missing fields keep "
-                                                        "their value; units in the field names.")]) -> SetpointResponse:
+@write.put(
+    "/{bearing_id}/setpoint",
+    response_model=SetpointResponse,
+    dependencies=[Depends(setpoint_rate)],
+    responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY},
+)
+async def put_setpoint(
+    entry: TwinDep,
+    update: Annotated[
+        SetpointUpdate, Body(description="Partial setpoint: missing fields keep their value; units in the field names.")
+    ],
+) -> SetpointResponse:
     """Partial setpoint update, checked once against the bearing's own limits; applied by the
     twin's runner at its next frame. Returns the complete setpoint.
 

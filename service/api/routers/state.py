@@ -14,9 +14,15 @@ from twin.snapshot import Snapshot
 read = APIRouter(prefix="/v1/bearings", tags=["bearings"])
 
 
-@read.get("/{bearing_id}/state",
-          responses={200: {"model": Snapshot, "description": "Latest snapshot, schema bearing-twin/state/1"},
-                     **UNKNOWN_TWIN, **INVALID, 503: {"model": ErrorResponse, "description": "No snapshot yet"}})
+@read.get(
+    "/{bearing_id}/state",
+    responses={
+        200: {"model": Snapshot, "description": "Latest snapshot, schema bearing-twin/state/1"},
+        **UNKNOWN_TWIN,
+        **INVALID,
+        503: {"model": ErrorResponse, "description": "No snapshot yet"},
+    },
+)
 async def get_state(entry: TwinDep) -> Response:
     """The latest published snapshot (the public contract, schema bearing-twin/state/1).
 

@@ -31,8 +31,12 @@ class TemperatureResponse(BaseModel):
     temperature_c: float = Field(description="Measured temperature [degC].")
 
 
-@write.put("/{bearing_id}/temperature", response_model=TemperatureResponse, dependencies=[Depends(setpoint_rate)],
-           responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY})
+@write.put(
+    "/{bearing_id}/temperature",
+    response_model=TemperatureResponse,
+    dependencies=[Depends(setpoint_rate)],
+    responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY},
+)
 def put_temperature(entry: TwinDep, body: TemperatureRequest) -> TemperatureResponse:
     """Hand a measured temperature to the twin's dissipation estimator; the snapshot's `thermal`
     block then carries the estimate, its uncertainty and the residual (409 with the fixed oil

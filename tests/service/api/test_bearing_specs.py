@@ -15,10 +15,13 @@ from twin import catalog
 
 @pytest.fixture(scope="module")
 def client(support):
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
-                               admission="off", max_twins=3)
-    with support.ThreadServer(settings, start_timeout_s=60.0, stop_timeout_s=15.0) as srv, \
-            httpx.Client(base_url=srv.url, timeout=120.0) as c:
+    settings = ServiceSettings(
+        enable_zenoh=False, enable_recording=False, start_twin=False, admission="off", max_twins=3
+    )
+    with (
+        support.ThreadServer(settings, start_timeout_s=60.0, stop_timeout_s=15.0) as srv,
+        httpx.Client(base_url=srv.url, timeout=120.0) as c,
+    ):
         yield c
 
 
@@ -45,21 +48,28 @@ def test_a_twin_from_a_spec_runs_with_its_geometry(client, own_spec, support):
     # the default id is the spec's designation, made a valid twin name
     assert info["id"] == "MY-6205-8-1"
     assert info["designation"] == "MY 6205/8" and info["ball_count"] == 8
-    state = support.wait_for(lambda: client.get(f"/v1/bearings/{info['id']}/state"),
-                             lambda s: s.status_code == 200, timeout=30.0).json()
+    state = support.wait_for(
+        lambda: client.get(f"/v1/bearings/{info['id']}/state"), lambda s: s.status_code == 200, timeout=30.0
+    ).json()
     assert state["designation"] == "MY 6205/8" and len(state["balls"]) == 8
     # an inline scenario naming the same spec runs on it; another spec or a file path does not
-    scenario = {"name": "own", "duration_s": 0.02, "bearing": own_spec,
-                "steps": [{"at_s": 0.0, "set": {"radial_load_n": 800.0}}]}
+    scenario = {
+        "name": "own",
+        "duration_s": 0.02,
+        "bearing": own_spec,
+        "steps": [{"at_s": 0.0, "set": {"radial_load_n": 800.0}}],
+    }
     r = client.post(f"/v1/bearings/{info['id']}/scenario", json={"scenario": scenario})
     assert r.status_code == 202, r.text
     other = copy.deepcopy(own_spec)
     other["geometry"]["ball_count"] = 7
-    err = only_error(client.post(f"/v1/bearings/{info['id']}/scenario",
-                                 json={"scenario": {**scenario, "bearing": other}}))
+    err = only_error(
+        client.post(f"/v1/bearings/{info['id']}/scenario", json={"scenario": {**scenario, "bearing": other}})
+    )
     assert err["field"] == "bearing" and "POST /v1/bearings with 'spec'" in err["message"]
-    err = only_error(client.post(f"/v1/bearings/{info['id']}/scenario",
-                                 json={"scenario": {**scenario, "bearing": "own.yaml"}}))
+    err = only_error(
+        client.post(f"/v1/bearings/{info['id']}/scenario", json={"scenario": {**scenario, "bearing": "own.yaml"}})
+    )
     assert err["field"] == "scenario.bearing"
     assert "spec file" in err["message"] and "mapping of BearingSpec fields" in err["message"]
     assert client.delete(f"/v1/bearings/{info['id']}").status_code == 200
@@ -80,13 +90,16 @@ def test_an_invalid_spec_is_refused_naming_the_field_and_range(client, own_spec)
     assert err["field"] == "spec.geometry" and "required" in err["message"].lower()
 
 
-@pytest.mark.parametrize("extra, field, inside", [
-    ({"designation": "6208"}, "designation", "not both"),
-    ({"lubricant": "ISO VG 68"}, "lubricant", "spec.lubricant"),
-    ({"diametral_clearance_m": 1e-5}, "diametral_clearance_m", "spec.mounting.diametral_clearance_m"),
-    ({"thermal": {"shear_heating": True}}, "thermal", "spec.thermal"),
-    ({"housing": {"enabled": True}}, "housing", "spec.housing"),
-])
+@pytest.mark.parametrize(
+    "extra, field, inside",
+    [
+        ({"designation": "6208"}, "designation", "not both"),
+        ({"lubricant": "ISO VG 68"}, "lubricant", "spec.lubricant"),
+        ({"diametral_clearance_m": 1e-5}, "diametral_clearance_m", "spec.mounting.diametral_clearance_m"),
+        ({"thermal": {"shear_heating": True}}, "thermal", "spec.thermal"),
+        ({"housing": {"enabled": True}}, "housing", "spec.housing"),
+    ],
+)
 def test_a_spec_beside_a_designation_or_an_override_is_refused(client, own_spec, extra, field, inside):
     err = only_error(client.post("/v1/bearings", json={"spec": own_spec, **extra}))
     assert err["field"] == field and inside in err["message"]
@@ -96,8 +109,15 @@ def test_openapi_shows_the_spec_fields_with_units(client):
     schemas = client.get("/openapi.json").json()["components"]["schemas"]
     spec_ref = str(schemas["BearingCreate"]["properties"]["spec"])
     assert "BearingSpec" in spec_ref
-    assert set(schemas["BearingSpec"]["properties"]) >= {"designation", "geometry", "material", "lubricant",
-                                                         "mounting", "housing", "surface_profile"}
+    assert set(schemas["BearingSpec"]["properties"]) >= {
+        "designation",
+        "geometry",
+        "material",
+        "lubricant",
+        "mounting",
+        "housing",
+        "surface_profile",
+    }
     geometry = schemas["Geometry"]["properties"]
     assert "[m]" in geometry["ball_radius_m"]["description"]
     assert "[-]" in geometry["ball_count"]["description"]
@@ -129,7 +149,20 @@ def test_a_nested_housing_error_gives_both_sides_of_its_range(client, own_spec):
 
 def test_every_spec_field_in_the_openapi_carries_its_unit(client):
     schemas = client.get("/openapi.json").json()["components"]["schemas"]
-    missing = [f"{name}.{prop}" for name in ("BearingSpec", "Geometry", "Material", "Surface", "Lubricant", "Mounting",
-                                             "Lubrication", "Electrical", "Thermal")
-               for prop, p in schemas[name]["properties"].items() if "[" not in p.get("description", "")]
+    missing = [
+        f"{name}.{prop}"
+        for name in (
+            "BearingSpec",
+            "Geometry",
+            "Material",
+            "Surface",
+            "Lubricant",
+            "Mounting",
+            "Lubrication",
+            "Electrical",
+            "Thermal",
+        )
+        for prop, p in schemas[name]["properties"].items()
+        if "[" not in p.get("description", "")
+    ]
     assert not missing, f"fields without a [unit] in their description: {missing}"

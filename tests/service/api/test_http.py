@@ -30,10 +30,17 @@ def recordings(tmp_path_factory):
 
 @pytest.fixture(scope="module")
 def client(recordings, support):
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, scenario_dir=SCENARIOS,
-                               record=recordings / "service.rrd", max_twins=4)
-    with support.ThreadServer(settings, start_timeout_s=60.0, stop_timeout_s=15.0) as srv, \
-            httpx.Client(base_url=srv.url, timeout=120.0) as c:
+    settings = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        scenario_dir=SCENARIOS,
+        record=recordings / "service.rrd",
+        max_twins=4,
+    )
+    with (
+        support.ThreadServer(settings, start_timeout_s=60.0, stop_timeout_s=15.0) as srv,
+        httpx.Client(base_url=srv.url, timeout=120.0) as c,
+    ):
         yield c
 
 
@@ -58,8 +65,19 @@ def test_health(client):
     assert h["uptime_s"] >= 0.0
     assert h["zenoh"] is False and h["recording"] is None
     (tw,) = [t for t in h["twins"] if t["id"] == "default"]
-    for key in ("real_time_factor", "late_fraction", "lateness_s", "frame_s", "overruns", "dropped", "frames",
-                "published", "errors", "mode", "cost"):
+    for key in (
+        "real_time_factor",
+        "late_fraction",
+        "lateness_s",
+        "frame_s",
+        "overruns",
+        "dropped",
+        "frames",
+        "published",
+        "errors",
+        "mode",
+        "cost",
+    ):
         assert key in tw
     cap = h["capacity"]
     assert cap["admission"] in ("measured", "off") and cap["stepping_threads"] >= 1
@@ -88,23 +106,29 @@ def test_put_setpoint_shows_up_in_state(client, wait_for):
     assert r.status_code == 200, r.text
     body = r.json()
     assert body["setpoint"]["radial_load_n"] == 4200.0
-    assert body["setpoint"]["shaft_speed_rad_s"] == 500.0          # partial: the rest is kept
-    wait_for(lambda: client.get("/v1/bearings/default/state").json(),
-             lambda s: s["setpoint"]["radial_load_n"] == 4200.0, timeout=10.0)
+    assert body["setpoint"]["shaft_speed_rad_s"] == 500.0  # partial: the rest is kept
+    wait_for(
+        lambda: client.get("/v1/bearings/default/state").json(),
+        lambda s: s["setpoint"]["radial_load_n"] == 4200.0,
+        timeout=10.0,
+    )
     info = client.get("/v1/bearings/default").json()
     assert info["setpoint"]["radial_load_n"] == 4200.0
-    assert client.put("/v1/bearings/default/setpoint", json={}).status_code == 200   # empty = no change
+    assert client.put("/v1/bearings/default/setpoint", json={}).status_code == 200  # empty = no change
 
 
-@pytest.mark.parametrize("body, field, low, high", [
-    ({"radial_load_n": -1}, "radial_load_n", 0.0, None),
-    ({"shaft_speed_rad_s": 1e9}, "shaft_speed_rad_s", 0.0, None),
-    ({"shaft_speed_rad_s": 3000.0}, "shaft_speed_rad_s", 0.0, None),   # within the schema, above the 6208's limit
-    ({"oil_temperature_c": 200.0}, "oil_temperature_c", -30.0, 150.0),
-    ({"axial_load_n": "lots"}, "axial_load_n", None, None),
-    ({"radial_load_n": True}, "radial_load_n", 0.0, None),              # a bool is not a load
-    ({"radial_load_n": "3000"}, "radial_load_n", 0.0, None),            # nor is a string
-])
+@pytest.mark.parametrize(
+    "body, field, low, high",
+    [
+        ({"radial_load_n": -1}, "radial_load_n", 0.0, None),
+        ({"shaft_speed_rad_s": 1e9}, "shaft_speed_rad_s", 0.0, None),
+        ({"shaft_speed_rad_s": 3000.0}, "shaft_speed_rad_s", 0.0, None),  # within the schema, above the 6208's limit
+        ({"oil_temperature_c": 200.0}, "oil_temperature_c", -30.0, 150.0),
+        ({"axial_load_n": "lots"}, "axial_load_n", None, None),
+        ({"radial_load_n": True}, "radial_load_n", 0.0, None),  # a bool is not a load
+        ({"radial_load_n": "3000"}, "radial_load_n", 0.0, None),  # nor is a string
+    ],
+)
 def test_invalid_setpoint_names_field_and_range(client, body, field, low, high):
     r = client.put("/v1/bearings/default/setpoint", json=body)
     assert r.status_code == 422, r.text
@@ -129,7 +153,7 @@ def test_strict_types_and_the_bearings_own_range(client):
         assert r.status_code == 422, (body, r.text)
         (err,) = detail(r)
         assert err["field"] == next(iter(body)) and "number" in err["message"]
-    assert client.get("/v1/bearings/default").json()["setpoint"] == before   # nothing applied
+    assert client.get("/v1/bearings/default").json()["setpoint"] == before  # nothing applied
     r = client.put("/v1/bearings/default/setpoint", json={"shaft_speed_rad_s": 3000.0})
     (err,) = detail(r)
     assert err["allowed"][0] == 0.0 and err["allowed"][1] == pytest.approx(2073.66, abs=0.005)
@@ -153,8 +177,9 @@ def test_docs_are_served_without_a_cdn(client):
     assert {"201", "409", "422", "503"} <= set(spec["paths"]["/v1/bearings"]["post"]["responses"])
 
 
-@pytest.mark.parametrize("raw", [b'{"shaft_speed_rad_s": NaN}', b'{"shaft_speed_rad_s": Infinity}',
-                                 b'{"radial_load_n": -Infinity}'])
+@pytest.mark.parametrize(
+    "raw", [b'{"shaft_speed_rad_s": NaN}', b'{"shaft_speed_rad_s": Infinity}', b'{"radial_load_n": -Infinity}']
+)
 def test_non_finite_values_are_refused_by_field(client, raw):
     r = client.put("/v1/bearings/default/setpoint", content=raw, headers={"content-type": "application/json"})
     assert r.status_code == 422, r.text
@@ -163,11 +188,12 @@ def test_non_finite_values_are_refused_by_field(client, raw):
     assert err["field"] == field and "finite" in err["message"]
 
 
-@pytest.mark.parametrize("raw", [b"{", b"[1, 2]", b'"text"', b"", b'{"radial_load_n": 1, "nonsense": 2}',
-                                 b"\xff\xfe\x00"])
+@pytest.mark.parametrize(
+    "raw", [b"{", b"[1, 2]", b'"text"', b"", b'{"radial_load_n": 1, "nonsense": 2}', b"\xff\xfe\x00"]
+)
 def test_garbage_is_a_clean_4xx_never_a_500(client, raw):
     r = client.put("/v1/bearings/default/setpoint", content=raw, headers={"content-type": "application/json"})
-    assert r.status_code in (400, 422), r.text   # 400: bytes that are not even text
+    assert r.status_code in (400, 422), r.text  # 400: bytes that are not even text
     errs = detail(r)
     assert "Traceback" not in r.text
     if b"nonsense" in raw:
@@ -176,11 +202,14 @@ def test_garbage_is_a_clean_4xx_never_a_500(client, raw):
 
 
 def test_unknown_twin_is_404(client):
-    for method, url, body in (("GET", "/v1/bearings/nope/state", None), ("GET", "/v1/bearings/nope", None),
-                              ("PUT", "/v1/bearings/nope/setpoint", {"radial_load_n": 1.0}),
-                              ("DELETE", "/v1/bearings/nope", None),
-                              ("POST", "/v1/bearings/nope/scenario", {"name": "seed000_load_sweep"}),
-                              ("POST", "/v1/bearings/nope/recording", {"action": "stop"})):
+    for method, url, body in (
+        ("GET", "/v1/bearings/nope/state", None),
+        ("GET", "/v1/bearings/nope", None),
+        ("PUT", "/v1/bearings/nope/setpoint", {"radial_load_n": 1.0}),
+        ("DELETE", "/v1/bearings/nope", None),
+        ("POST", "/v1/bearings/nope/scenario", {"name": "seed000_load_sweep"}),
+        ("POST", "/v1/bearings/nope/recording", {"action": "stop"}),
+    ):
         r = client.request(method, url, json=body)
         assert r.status_code == 404, (method, url, r.text)
         (err,) = detail(r)
@@ -188,9 +217,16 @@ def test_unknown_twin_is_404(client):
 
 
 def test_create_two_twins_duplicate_and_delete(client, wait_for):
-    r = client.post("/v1/bearings", json={"id": "pump-7208", "designation": "7208",
-                                          "diametral_clearance_m": 5e-6, "lubricant": "ISO VG 68",
-                                          "setpoint": {"shaft_speed_rad_s": 300.0, "axial_load_n": 1000.0}})
+    r = client.post(
+        "/v1/bearings",
+        json={
+            "id": "pump-7208",
+            "designation": "7208",
+            "diametral_clearance_m": 5e-6,
+            "lubricant": "ISO VG 68",
+            "setpoint": {"shaft_speed_rad_s": 300.0, "axial_load_n": 1000.0},
+        },
+    )
     assert r.status_code == 201, r.text
     info = r.json()
     assert info["designation"] == "7208" and info["ball_count"] == 13 and info["lubricant"] == "ISO VG 68"
@@ -205,8 +241,10 @@ def test_create_two_twins_duplicate_and_delete(client, wait_for):
         assert "default" in ids and "pump-7208" in ids
         # independent twins
         client.put("/v1/bearings/pump-7208/setpoint", json={"radial_load_n": 1234.0})
-        s = wait_for(lambda: client.get("/v1/bearings/pump-7208/state").json(),
-                     lambda s: s["setpoint"]["radial_load_n"] == 1234.0)
+        s = wait_for(
+            lambda: client.get("/v1/bearings/pump-7208/state").json(),
+            lambda s: s["setpoint"]["radial_load_n"] == 1234.0,
+        )
         assert s["designation"] == "7208" and len(s["balls"]) == 13
         assert client.get("/v1/bearings/default/state").json()["setpoint"]["radial_load_n"] != 1234.0
         assert {t["id"] for t in client.get("/health").json()["twins"]} >= {"default", "pump-7208"}
@@ -220,18 +258,21 @@ def test_create_two_twins_duplicate_and_delete(client, wait_for):
     assert "pump-7208" not in [b["id"] for b in client.get("/v1/bearings").json()]
 
 
-@pytest.mark.parametrize("body, field", [
-    ({"designation": "9999"}, "designation"),
-    ({"lubricant": "olive oil"}, "lubricant"),
-    ({"diametral_clearance_m": 1.0}, "diametral_clearance_m"),
-    ({"id": "a/b"}, "id"),
-    ({"setpoint": {"shaft_speed_rad_s": 5000.0}}, "setpoint.shaft_speed_rad_s"),
-    ({"setpoint": {"radial_load_n": float("-1")}}, "setpoint.radial_load_n"),
-    ({"colour": "red"}, "colour"),
-    ({"thermal": {"equivalent_resistance_ohm": -1.0}}, "thermal.equivalent_resistance_ohm"),
-    ({"thermal": {"crater_depth_m": 0.0}}, "thermal.crater_depth_m"),
-    ({"thermal": {"shear_heating": "maybe"}}, "thermal.shear_heating"),
-])
+@pytest.mark.parametrize(
+    "body, field",
+    [
+        ({"designation": "9999"}, "designation"),
+        ({"lubricant": "olive oil"}, "lubricant"),
+        ({"diametral_clearance_m": 1.0}, "diametral_clearance_m"),
+        ({"id": "a/b"}, "id"),
+        ({"setpoint": {"shaft_speed_rad_s": 5000.0}}, "setpoint.shaft_speed_rad_s"),
+        ({"setpoint": {"radial_load_n": float("-1")}}, "setpoint.radial_load_n"),
+        ({"colour": "red"}, "colour"),
+        ({"thermal": {"equivalent_resistance_ohm": -1.0}}, "thermal.equivalent_resistance_ohm"),
+        ({"thermal": {"crater_depth_m": 0.0}}, "thermal.crater_depth_m"),
+        ({"thermal": {"shear_heating": "maybe"}}, "thermal.shear_heating"),
+    ],
+)
 def test_invalid_creation_is_422(client, body, field):
     r = client.post("/v1/bearings", json=body)
     assert r.status_code == 422, r.text
@@ -241,21 +282,35 @@ def test_invalid_creation_is_422(client, body, field):
 def test_ev_twin_with_shear_and_current_heating(client, wait_for):
     # seed 003: a 6200 created with shear heating on, driven at 20 000 rpm and 10 A, publishes the
     # inlet heating and a thinner film than the isothermal film (factor < 1)
-    r = client.post("/v1/bearings", json={
-        "id": "ev", "designation": "6200", "lubricant": "ISO VG 32", "thermal": {"shear_heating": True},
-        "setpoint": {"shaft_speed_rad_s": 2094.4, "radial_load_n": 300.0, "shaft_current_a": 10.0}})
+    r = client.post(
+        "/v1/bearings",
+        json={
+            "id": "ev",
+            "designation": "6200",
+            "lubricant": "ISO VG 32",
+            "thermal": {"shear_heating": True},
+            "setpoint": {"shaft_speed_rad_s": 2094.4, "radial_load_n": 300.0, "shaft_current_a": 10.0},
+        },
+    )
     assert r.status_code == 201, r.text
     try:
-        state = wait_for(lambda: client.get("/v1/bearings/ev/state").json(),
-                         lambda s: s["electrical"]["shear_temperature_rise_k"] > 0.0)
+        state = wait_for(
+            lambda: client.get("/v1/bearings/ev/state").json(),
+            lambda s: s["electrical"]["shear_temperature_rise_k"] > 0.0,
+        )
         e = state["electrical"]
         assert e["current_temperature_rise_k"] > 0.0 and 0.0 < e["film_thermal_factor"] < 1.0
         # the EV scenario's thermal options match this twin: accepted
         ok = client.post("/v1/bearings/ev/scenario", json={"name": "ev_motor_current_ramp"})
         assert ok.status_code == 202, ok.text
         # a scenario for an isothermal twin of the same bearing is refused by 'thermal'
-        inline = {"name": "cold", "bearing": "6200", "lubricant": "ISO VG 32", "duration_s": 0.01,
-                  "thermal": {"shear_heating": False}}
+        inline = {
+            "name": "cold",
+            "bearing": "6200",
+            "lubricant": "ISO VG 32",
+            "duration_s": 0.01,
+            "thermal": {"shear_heating": False},
+        }
         bad = client.post("/v1/bearings/ev/scenario", json={"scenario": inline})
         assert bad.status_code == 422 and detail(bad)[0]["field"] == "thermal", bad.text
     finally:
@@ -274,8 +329,11 @@ def test_scenarios(client, wait_for):
         assert body["accepted"] and body["expected_duration_s"] == pytest.approx(0.36)
         wait_for(lambda: client.get("/v1/bearings/scn/scenario").json(), lambda s: s["state"] == "running")
         # an inline scenario replaces it and runs to its end
-        inline = {"name": "inline", "duration_s": 0.05,
-                  "steps": [{"at_s": 0.0, "ramp": {"radial_load_n": 1500.0}, "over_s": 0.02}]}
+        inline = {
+            "name": "inline",
+            "duration_s": 0.05,
+            "steps": [{"at_s": 0.0, "ramp": {"radial_load_n": 1500.0}, "over_s": 0.02}],
+        }
         r = client.post("/v1/bearings/scn/scenario", json={"scenario": inline})
         assert r.status_code == 202, r.text
         assert r.json()["replaced"] == "seed000_load_sweep"
@@ -296,15 +354,17 @@ def test_scenarios(client, wait_for):
         assert "seed000_load_sweep" in detail(bad)[0]["allowed"]
         bad = client.post("/v1/bearings/scn/scenario", json={})
         assert bad.status_code == 422
-        bad = client.post("/v1/bearings/scn/scenario", json={"scenario": {**inline, "steps": [
-            {"at_s": 0.0, "set": {"shaft_speed_rad_s": 9000.0}}]}})
+        bad = client.post(
+            "/v1/bearings/scn/scenario",
+            json={"scenario": {**inline, "steps": [{"at_s": 0.0, "set": {"shaft_speed_rad_s": 9000.0}}]}},
+        )
         assert bad.status_code == 422
         err = detail(bad)[0]
         assert err["field"] == "scenario.steps[0].set.shaft_speed_rad_s" and err["allowed"][1] < 9000.0
         bad = client.post("/v1/bearings/scn/scenario", json={"scenario": {**inline, "duration_s": -1}})
         assert bad.status_code == 422 and detail(bad)[0]["field"] == "scenario.duration_s"
         ev = client.post("/v1/bearings/scn/scenario", json={"name": "ev_motor_current_ramp"})
-        assert ev.status_code == 422 and detail(ev)[0]["field"] == "bearing"      # needs a 6200 twin
+        assert ev.status_code == 422 and detail(ev)[0]["field"] == "bearing"  # needs a 6200 twin
     finally:
         client.delete("/v1/bearings/scn")
 
@@ -337,12 +397,15 @@ def test_recording_start_stop(client, recordings):
     assert client.post("/v1/bearings/default/recording", json={"action": "stop"}).json()["recording"] is False
 
 
-@pytest.mark.parametrize("body, field", [
-    ({"action": "start", "path": "../escape.rrd"}, "path"),
-    ({"action": "start", "path": "/etc/x.rrd"}, "path"),
-    ({"action": "start", "path": "x.txt"}, "path"),
-    ({"action": "pause"}, "action"),
-])
+@pytest.mark.parametrize(
+    "body, field",
+    [
+        ({"action": "start", "path": "../escape.rrd"}, "path"),
+        ({"action": "start", "path": "/etc/x.rrd"}, "path"),
+        ({"action": "start", "path": "x.txt"}, "path"),
+        ({"action": "pause"}, "action"),
+    ],
+)
 def test_recording_bad_input(client, body, field):
     r = client.post("/v1/bearings/default/recording", json=body)
     assert r.status_code == 422, r.text
@@ -356,9 +419,20 @@ def _schemas(openapi: dict) -> dict:
 def test_openapi_fields_carry_units(client):
     spec = client.get("/openapi.json").json()
     schemas = _schemas(spec)
-    ours = ["BearingCreate", "BearingInfo", "Health", "TwinHealth", "SetpointResponse", "ScenarioRequest",
-            "ScenarioAccepted", "ScenarioStatus", "RecordingRequest", "RecordingStatus", "FieldError",
-            "SetpointUpdate"]
+    ours = [
+        "BearingCreate",
+        "BearingInfo",
+        "Health",
+        "TwinHealth",
+        "SetpointResponse",
+        "ScenarioRequest",
+        "ScenarioAccepted",
+        "ScenarioStatus",
+        "RecordingRequest",
+        "RecordingStatus",
+        "FieldError",
+        "SetpointUpdate",
+    ]
     missing = []
     for name in ours:
         assert name in schemas, name
@@ -376,9 +450,15 @@ def test_openapi_fields_carry_units(client):
                 numbers.append(f"{name}.{prop}")
     assert not numbers, f"numeric fields without a [unit]: {numbers}"
     paths = spec["paths"]
-    for path in ("/health", "/v1/bearings", "/v1/bearings/{bearing_id}", "/v1/bearings/{bearing_id}/setpoint",
-                 "/v1/bearings/{bearing_id}/state", "/v1/bearings/{bearing_id}/scenario",
-                 "/v1/bearings/{bearing_id}/recording"):
+    for path in (
+        "/health",
+        "/v1/bearings",
+        "/v1/bearings/{bearing_id}",
+        "/v1/bearings/{bearing_id}/setpoint",
+        "/v1/bearings/{bearing_id}/state",
+        "/v1/bearings/{bearing_id}/scenario",
+        "/v1/bearings/{bearing_id}/recording",
+    ):
         assert path in paths, path
 
 

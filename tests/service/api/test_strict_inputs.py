@@ -31,25 +31,35 @@ def _refused(model, data: dict, field: str) -> None:
     assert any(loc.endswith(field) for loc in locs), locs
 
 
-@pytest.mark.parametrize(("data", "field"), [
-    ({"diametral_clearance_m": "1e-5"}, "diametral_clearance_m"),            # str for float
-    ({"diametral_clearance_m": True}, "diametral_clearance_m"),              # bool for float
-    ({"designation": 6208}, "designation"),                                  # int for str
-    ({"housing": {"enabled": "off"}}, "housing.enabled"),                    # str for bool
-    ({"housing": {"enabled": 1}}, "housing.enabled"),                        # int for bool
-    ({"housing": {"enabled": True, "pedestal_mass_kg": "6.6"}}, "housing.pedestal_mass_kg"),
-    ({"housing": {"enabled": True, "accelerometer": {"sample_rate_hz": "51200"}}},
-     "housing.accelerometer.sample_rate_hz"),                                # nested model
-    ({"thermal": {"shear_heating": "yes"}}, "thermal.shear_heating"),
-    ({"setpoint": {"radial_load_n": "3000"}}, "setpoint.radial_load_n"),
-])
+@pytest.mark.parametrize(
+    ("data", "field"),
+    [
+        ({"diametral_clearance_m": "1e-5"}, "diametral_clearance_m"),  # str for float
+        ({"diametral_clearance_m": True}, "diametral_clearance_m"),  # bool for float
+        ({"designation": 6208}, "designation"),  # int for str
+        ({"housing": {"enabled": "off"}}, "housing.enabled"),  # str for bool
+        ({"housing": {"enabled": 1}}, "housing.enabled"),  # int for bool
+        ({"housing": {"enabled": True, "pedestal_mass_kg": "6.6"}}, "housing.pedestal_mass_kg"),
+        (
+            {"housing": {"enabled": True, "accelerometer": {"sample_rate_hz": "51200"}}},
+            "housing.accelerometer.sample_rate_hz",
+        ),  # nested model
+        ({"thermal": {"shear_heating": "yes"}}, "thermal.shear_heating"),
+        ({"setpoint": {"radial_load_n": "3000"}}, "setpoint.radial_load_n"),
+    ],
+)
 def test_bearing_create_refuses_wrong_types(data, field):
     _refused(BearingCreate, data, field)
 
 
 def test_bearing_create_takes_integers_for_floats_and_types_the_housing():
-    body = BearingCreate.model_validate({"diametral_clearance_m": 0, "housing": {"enabled": True, "pedestal_mass_kg": 7},
-                                         "setpoint": {"radial_load_n": 3000}})
+    body = BearingCreate.model_validate(
+        {
+            "diametral_clearance_m": 0,
+            "housing": {"enabled": True, "pedestal_mass_kg": 7},
+            "setpoint": {"radial_load_n": 3000},
+        }
+    )
     assert isinstance(body.housing, Housing) and body.housing.enabled is True
     assert body.housing.pedestal_mass_kg == 7.0 and body.diametral_clearance_m == 0.0
     assert body.setpoint.radial_load_n == 3000.0
@@ -58,13 +68,16 @@ def test_bearing_create_takes_integers_for_floats_and_types_the_housing():
     assert "pedestal_mass_kg" in schema["$defs"]["Housing"]["properties"]
 
 
-@pytest.mark.parametrize(("defect", "field"), [
-    ({**SPALL, "width_m": "5e-4"}, "defects[0].width_m"),       # str for float
-    ({**SPALL, "azimuth_deg": True}, "defects[0].azimuth_deg"),  # bool for float
-    ({**BALL, "ball_index": "2"}, "defects[0].ball_index"),      # str for int
-    ({**BALL, "ball_index": 2.0}, "defects[0].ball_index"),      # float for int
-    ({**SPALL, "kind": 1}, "defects[0]"),                        # int for the discriminator
-])
+@pytest.mark.parametrize(
+    ("defect", "field"),
+    [
+        ({**SPALL, "width_m": "5e-4"}, "defects[0].width_m"),  # str for float
+        ({**SPALL, "azimuth_deg": True}, "defects[0].azimuth_deg"),  # bool for float
+        ({**BALL, "ball_index": "2"}, "defects[0].ball_index"),  # str for int
+        ({**BALL, "ball_index": 2.0}, "defects[0].ball_index"),  # float for int
+        ({**SPALL, "kind": 1}, "defects[0]"),  # int for the discriminator
+    ],
+)
 def test_defects_refuse_wrong_types(defect, field):
     with pytest.raises(InputError) as info:
         parse_defects([defect], GEOMETRY)
@@ -86,15 +99,22 @@ def test_other_bodies_are_strict():
     _refused(SetpointUpdate, {"shaft_speed_rad_s": "500"}, "shaft_speed_rad_s")
 
 
-SCENARIO = {"name": "s", "duration_s": 0.01, "initial": {"radial_load_n": 2000.0},
-            "steps": [{"at_s": 0.0, "set": {"radial_load_n": 3000.0}}]}
+SCENARIO = {
+    "name": "s",
+    "duration_s": 0.01,
+    "initial": {"radial_load_n": 2000.0},
+    "steps": [{"at_s": 0.0, "set": {"radial_load_n": 3000.0}}],
+}
 
 
-@pytest.mark.parametrize(("patch", "field"), [
-    ({"duration_s": "0.01"}, "duration_s"),
-    ({"diametral_clearance_m": False}, "diametral_clearance_m"),
-    ({"steps": [{"at_s": "0", "set": {"radial_load_n": 3000.0}}]}, "at_s"),
-])
+@pytest.mark.parametrize(
+    ("patch", "field"),
+    [
+        ({"duration_s": "0.01"}, "duration_s"),
+        ({"diametral_clearance_m": False}, "diametral_clearance_m"),
+        ({"steps": [{"at_s": "0", "set": {"radial_load_n": 3000.0}}]}, "at_s"),
+    ],
+)
 def test_scenarios_are_strict(patch, field):
     with pytest.raises(Exception) as info:
         scenario_from_dict({**SCENARIO, **patch})
@@ -103,7 +123,8 @@ def test_scenarios_are_strict(patch, field):
 
 def test_scenario_files_read_exponents_as_numbers():
     """YAML 1.2 numbers: `5e-4` in a scenario file is a float, `1` an int (a valid float)."""
-    data = yaml.load("name: s\nduration_s: 1e-2\nsample_every_s: 1\ninitial: {radial_load_n: 2e3}\n",
-                     Loader=ScenarioLoader)
+    data = yaml.load(
+        "name: s\nduration_s: 1e-2\nsample_every_s: 1\ninitial: {radial_load_n: 2e3}\n", Loader=ScenarioLoader
+    )
     scenario = scenario_from_dict(data)
     assert scenario.duration_s == 0.01 and scenario.sample_every_s == 1.0

@@ -32,8 +32,9 @@ def _snapshot(vibration=None):
 def _vibration(kurtosis: float, bpfi_over_floor: float):
     lines = {k: SimpleNamespace(harmonics=(1.0, 0.5, 0.2)) for k in ("bpfo", "two_bsf")}
     lines["bpfi"] = SimpleNamespace(harmonics=(bpfi_over_floor, 1.0, 1.0))
-    return SimpleNamespace(envelope_noise_floor_m_s2=1.0, envelope_lines=lines, rms_m_s2=2.0,
-                           kurtosis=kurtosis, crest_factor=5.0)
+    return SimpleNamespace(
+        envelope_noise_floor_m_s2=1.0, envelope_lines=lines, rms_m_s2=2.0, kurtosis=kurtosis, crest_factor=5.0
+    )
 
 
 def test_frame_round_trip():
@@ -49,13 +50,16 @@ def test_frame_round_trip():
     assert err.value.errors[0].field == "header"
 
 
-@pytest.mark.parametrize("make, field", [
-    (lambda: window_from_json({"sample_rate_hz": 12000.0, "samples": [0.0] * 2000, "speed": 1}), "speed"),
-    (lambda: window_from_json({"samples": [0.0] * 2000}), "sample_rate_hz"),
-    (lambda: window_from_json({"sample_rate_hz": 12000.0, "samples": ["a"] * 2000}), "samples"),
-    (lambda: window_from_float32(b"\0" * 4098, 12000.0), "samples"),
-    (lambda: window_from_float32(b"\0" * 8192, float("nan")), "sample_rate_hz"),
-])
+@pytest.mark.parametrize(
+    "make, field",
+    [
+        (lambda: window_from_json({"sample_rate_hz": 12000.0, "samples": [0.0] * 2000, "speed": 1}), "speed"),
+        (lambda: window_from_json({"samples": [0.0] * 2000}), "sample_rate_hz"),
+        (lambda: window_from_json({"sample_rate_hz": 12000.0, "samples": ["a"] * 2000}), "samples"),
+        (lambda: window_from_float32(b"\0" * 4098, 12000.0), "samples"),
+        (lambda: window_from_float32(b"\0" * 8192, float("nan")), "sample_rate_hz"),
+    ],
+)
 def test_bad_windows_name_the_field(make, field):
     with pytest.raises(InputError) as err:
         make()

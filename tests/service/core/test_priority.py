@@ -60,9 +60,9 @@ def check_every_thread_but_the_kept_ones_gets_the_io_nice_and_new_threads_are_sw
     try:
         assert prio.sweep() >= 1
         assert thread_nice(other.tid) == io
-        assert thread_nice(threading.get_native_id()) == io   # this (main) thread too
+        assert thread_nice(threading.get_native_id()) == io  # this (main) thread too
         assert thread_nice(kept.tid) == restored
-        assert prio.sweep() == 0                                          # each thread once
+        assert prio.sweep() == 0  # each thread once
         # a thread created by a reniced thread inherits its nice (Linux clone semantics)
         other.release.set()
         other.thread.join(10.0)
@@ -135,20 +135,19 @@ def check_a_service_keeps_its_stepping_threads_above_its_other_threads():
     now, _ = _now_and_restored()
     io, asked = ServiceSettings().runner.io_thread_nice, ServiceSettings().runner.stepping_thread_nice
     assert io == -5 and asked == -10 and now == BASE_NICE == 0
-    raised = asked if os.geteuid() == 0 else now      # a higher priority needs root / CAP_SYS_NICE
+    raised = asked if os.geteuid() == 0 else now  # a higher priority needs root / CAP_SYS_NICE
     io_got = io if os.geteuid() == 0 else now
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
-                               stepping_threads=2)
+    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False, stepping_threads=2)
     reg = TwinRegistry(settings).open()
     try:
         stepping = reg.pool.native_ids()
-        assert len(stepping) == 3                                    # 2 stepping + the publish worker
+        assert len(stepping) == 3  # 2 stepping + the publish worker
         for tid in stepping:
             assert thread_nice(tid) == raised
         assert thread_nice(threading.get_native_id()) == io_got
         others = [t for t in process_threads() if t not in stepping]
         assert others and all(thread_nice(t) == io_got for t in others if thread_nice(t) is not None)
-        reg.priority.keep_thread(threading.get_native_id())          # the event loop's thread
+        reg.priority.keep_thread(threading.get_native_id())  # the event loop's thread
         assert reg.priority.kept_nice == io and thread_nice(threading.get_native_id()) == io_got
         health = reg.health()["thread_priority"]
         assert health["active"] and health["io_thread_nice"] == io and health["stepping_thread_nice_asked"] == asked
@@ -164,8 +163,11 @@ def check_a_negative_io_nice_raises_the_io_threads_and_the_event_loop_with_them(
     from service.core.registry import TwinRegistry
     from service.settings import ServiceSettings
 
-    reg = TwinRegistry(ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
-                                       stepping_threads=1, io_thread_nice=-5)).open()
+    reg = TwinRegistry(
+        ServiceSettings(
+            enable_zenoh=False, enable_recording=False, start_twin=False, stepping_threads=1, io_thread_nice=-5
+        )
+    ).open()
     try:
         stepping = reg.pool.native_ids()
         reg.priority.keep_thread(threading.get_native_id())
@@ -190,14 +192,15 @@ def check_an_open_service_freezes_its_start_up_heap():
     from service.settings import ServiceSettings
 
     assert gc.get_freeze_count() == 0
-    reg = TwinRegistry(ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
-                                       gc_freeze=False)).open()
+    reg = TwinRegistry(
+        ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False, gc_freeze=False)
+    ).open()
     reg.close()
     assert gc.get_freeze_count() == 0
     reg = TwinRegistry(ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False)).open()
     try:
         frozen = gc.get_freeze_count()
-        assert frozen > 10_000                    # the imported modules at least
+        assert frozen > 10_000  # the imported modules at least
         later = [[i] for i in range(1000)]
         assert gc.get_freeze_count() == frozen and gc.is_tracked(later[0])
     finally:
@@ -205,8 +208,11 @@ def check_an_open_service_freezes_its_start_up_heap():
 
 
 def _run(check: str) -> None:
-    env = {k: v for k, v in os.environ.items()
-           if k not in ("BEARING_TWIN_IO_THREAD_NICE", "BEARING_TWIN_STEPPING_THREAD_NICE", "BEARING_TWIN_GC_FREEZE")}
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if k not in ("BEARING_TWIN_IO_THREAD_NICE", "BEARING_TWIN_STEPPING_THREAD_NICE", "BEARING_TWIN_GC_FREEZE")
+    }
     root = str(Path(__file__).resolve().parents[3])
     env["PYTHONPATH"] = os.pathsep.join([root, *filter(None, [env.get("PYTHONPATH")])])
     code = f"import runpy; runpy.run_path({str(Path(__file__))!r})[{check!r}]()"

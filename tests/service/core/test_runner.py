@@ -93,7 +93,7 @@ def test_mailbox_latest_wins_and_merges_in_order(twin, make_runner):
     first = sink.snapshots[0]
     assert first.setpoint.radial_load_n == 3000.0  # published before the first frame
     assert wait_until(lambda: runner.frames >= 3)
-    assert runner.setpoints_applied == 1           # three updates, one application
+    assert runner.setpoints_applied == 1  # three updates, one application
     assert runner.setpoints_accepted == 3
     sp = twin.setpoint
     assert (sp.radial_load_n, sp.shaft_speed_rad_s, sp.oil_temperature_c) == (5000.0, 300.0, 60.0)
@@ -122,10 +122,14 @@ def test_zenoh_setpoint_handler_never_raises(twin, make_runner):
     intake = SetpointIntake(twin.bearing_id, AdmissionGate(), runner)
     ok = intake(b'{"radial_load_n": 2500}')
     assert ok["accepted"] is True and ok["setpoint"]["radial_load_n"] == 2500.0
-    for payload, field in ((b'{"radial_load_n": NaN}', "radial_load_n"),
-                           (b'{"shaft_speed_rad_s": 1e9}', "shaft_speed_rad_s"),
-                           (b'{"axial_load_n": "x"}', "axial_load_n"),
-                           (b"not json", None), (b"[1, 2]", None), (b"\xff\xfe", None)):
+    for payload, field in (
+        (b'{"radial_load_n": NaN}', "radial_load_n"),
+        (b'{"shaft_speed_rad_s": 1e9}', "shaft_speed_rad_s"),
+        (b'{"axial_load_n": "x"}', "axial_load_n"),
+        (b"not json", None),
+        (b"[1, 2]", None),
+        (b"\xff\xfe", None),
+    ):
         res = intake(payload)
         assert res["accepted"] is False, payload
         json.dumps(res, allow_nan=False)  # the refusal itself is valid JSON
@@ -168,7 +172,7 @@ def test_setpoints_only_change_between_frames(twin, make_runner):
     for t in threads:
         t.join(5.0)
     assert not violations
-    assert writers == set(runner.stepping_threads)   # the stepping thread, never the submitters
+    assert writers == set(runner.stepping_threads)  # the stepping thread, never the submitters
 
 
 class _TimedSink(ListSink):
@@ -192,7 +196,7 @@ def test_real_time_pacing(twin, make_runner):
     runner = make_runner(twin, publish_rate_hz=50.0, sinks=[sink])
     t0 = time.perf_counter()
     runner.start()
-    assert wait_until(lambda: runner.frames >= 50 and runner.published >= 3)   # progress (bounded wait)
+    assert wait_until(lambda: runner.frames >= 50 and runner.published >= 3)  # progress (bounded wait)
     assert runner.stop(timeout=10.0)
     wall = time.perf_counter() - t0
     sim = runner.sim_elapsed_s
@@ -220,7 +224,7 @@ class _FakeClock:
     def __call__(self):
         return self.t
 
-    def wait(self, seconds):       # threading.Event.wait as the pacing uses it
+    def wait(self, seconds):  # threading.Event.wait as the pacing uses it
         assert seconds >= 0.0
         self.t += seconds
         self.slept += seconds
@@ -270,18 +274,25 @@ def test_setpoint_timing_records_first_reflecting_snapshot(twin, make_runner):
 
 
 def _scenario(**kw):
-    data = {"name": "t", "duration_s": 0.03, "sample_every_s": 0.001,
-            "initial": {"radial_load_n": 2000.0},
-            "steps": [{"at_s": 0.005, "set": {"oil_temperature_c": 60.0}},
-                      {"at_s": 0.01, "ramp": {"radial_load_n": 4000.0}, "over_s": 0.01}]}
+    data = {
+        "name": "t",
+        "duration_s": 0.03,
+        "sample_every_s": 0.001,
+        "initial": {"radial_load_n": 2000.0},
+        "steps": [
+            {"at_s": 0.005, "set": {"oil_temperature_c": 60.0}},
+            {"at_s": 0.01, "ramp": {"radial_load_n": 4000.0}, "over_s": 0.01},
+        ],
+    }
     data.update(kw)
     return scenario_from_dict(data)
 
 
 def test_scenario_runs_in_the_runner_thread(twin, make_runner):
     sink = ListSink()
-    runner = make_runner(twin, fast=True, publish_rate_hz=1000.0, sinks=[sink],
-                         idle_without_scenario=True).start(publish_initial=False)
+    runner = make_runner(twin, fast=True, publish_rate_hz=1000.0, sinks=[sink], idle_without_scenario=True).start(
+        publish_initial=False
+    )
     writers = set()
     set_setpoint = twin.set_setpoint
 
@@ -306,7 +317,7 @@ def test_scenario_runs_in_the_runner_thread(twin, make_runner):
     # ramp's value at t - frame_s: 2000 + 2000 * (0.014 - 0.010) / 0.010
     assert by_t[0.015].radial_load_n == pytest.approx(2800.0)
     assert by_t[0.025].radial_load_n == 4000.0
-    assert max(by_t) == pytest.approx(0.03)                              # last sample at the end
+    assert max(by_t) == pytest.approx(0.03)  # last sample at the end
     # idle afterwards: no frames without a scenario
     frames = runner.frames
     time.sleep(0.1)
@@ -335,8 +346,8 @@ def test_scenario_restart_warm_starts_at_the_initial_setpoint(twin, make_runner)
     handle, _ = runner.start_scenario(run, restart=True)
     assert handle.wait(WAIT_S) and handle.state == "done"
     assert twin.setpoint.radial_load_n == 1000.0
-    assert twin.time_s > before                 # time went on through the restart
-    assert runner.latest.shaft_speed_rad_s == pytest.approx(200.0)   # started there, not ramped
+    assert twin.time_s > before  # time went on through the restart
+    assert runner.latest.shaft_speed_rad_s == pytest.approx(200.0)  # started there, not ramped
 
 
 def test_scenario_outside_the_bearing_limits_is_refused(twin, make_runner):
@@ -366,7 +377,7 @@ def test_loop_exception_is_counted_shown_and_survived(twin, make_runner):
     assert "injected failure" in runner.latest.status
     assert "injected failure" in runner.stats()["status"]
     times = [s.time_s for s in sink.snapshots]
-    assert times == sorted(times)          # the warm restart keeps the simulated clock
+    assert times == sorted(times)  # the warm restart keeps the simulated clock
 
 
 def test_repeated_exceptions_stop_the_runner_with_a_status(twin, make_runner):
@@ -397,9 +408,9 @@ def test_a_setpoint_ends_the_frame_in_progress(twin, make_runner):
     assert snap is not None
     dt = twin.model.dt_s
     cut_steps = round((snap.time_s - runner.setpoint_frame_steps * dt - t_init) / dt)
-    assert cut_steps % runner.frame_steps != 0          # the frame was cut short
-    assert snap.time_s < t_init + runner.frame_s        # within the first long frame
-    assert runner.stop(timeout=10.0)                     # stop interrupts the frame as well
+    assert cut_steps % runner.frame_steps != 0  # the frame was cut short
+    assert snap.time_s < t_init + runner.frame_s  # within the first long frame
+    assert runner.stop(timeout=10.0)  # stop interrupts the frame as well
     assert runner.sim_elapsed_s == pytest.approx(twin.time_s - t_init, abs=0.5 * dt)
 
 
@@ -408,15 +419,14 @@ def test_a_setpoint_is_published_at_the_end_of_the_frame_that_applied_it(twin, m
     published because its frame applied it, once, right after that frame (counted in
     publications and in steps of simulated time, not in wall time)."""
     sink = ListSink()
-    runner = make_runner(twin, publish_rate_hz=0.001, frame_s=0.005, setpoint_frame_s=0.001,
-                         sinks=[sink]).start()
+    runner = make_runner(twin, publish_rate_hz=0.001, frame_s=0.005, setpoint_frame_s=0.001, sinks=[sink]).start()
     assert wait_until(lambda: runner.frames >= 5)
-    assert runner.published == 1                       # the initial snapshot only
+    assert runner.published == 1  # the initial snapshot only
     runner.submit(radial_load_n=4321.0)
     snap = sink.wait_for(lambda s: s.setpoint.radial_load_n == 4321.0)
     assert snap is not None and snap.seq == sink.snapshots[0].seq + 1
     assert wait_until(lambda: runner.frames >= 20)
-    assert runner.published == 2                       # no other publication since
+    assert runner.published == 2  # no other publication since
     (timing,) = runner.setpoint_latencies()
     assert timing.seq == snap.seq and timing.published_wall_s >= timing.applied_wall_s
 

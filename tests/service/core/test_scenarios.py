@@ -33,8 +33,14 @@ def base(**kw):
 
 def test_shipped_scenarios_load():
     found = list_scenarios(SCENARIOS)
-    for name in ("seed000_startup_steady_slowdown", "seed000_load_sweep", "seed000_clearance_sweep",
-                 "seed000_speed_sweep", "ev_motor_current_ramp", "ev_motor_resistance_temperature"):
+    for name in (
+        "seed000_startup_steady_slowdown",
+        "seed000_load_sweep",
+        "seed000_clearance_sweep",
+        "seed000_speed_sweep",
+        "ev_motor_current_ramp",
+        "ev_motor_resistance_temperature",
+    ):
         assert name in found
         scenario = load_scenario(found[name])
         assert scenario.name == name
@@ -46,11 +52,17 @@ def test_seed000_contents():
     run = s.resolved_runs()[0]
     assert run.initial.radial_load_n == 3000.0 and run.initial.shaft_speed_rad_s == 0.0
     assert max(v for _, f, v in run.iter_values() if f == "shaft_speed_rad_s") == 500.0
-    loads = [v for _, f, v in load_scenario(SCENARIOS / "seed000_load_sweep.yaml").resolved_runs()[0].iter_values()
-             if f == "radial_load_n"]
+    loads = [
+        v
+        for _, f, v in load_scenario(SCENARIOS / "seed000_load_sweep.yaml").resolved_runs()[0].iter_values()
+        if f == "radial_load_n"
+    ]
     assert min(loads) == 750.0 and max(loads) == 7500.0 and len(set(loads)) == 6
-    speeds = {v for _, f, v in load_scenario(SCENARIOS / "seed000_speed_sweep.yaml").resolved_runs()[0].iter_values()
-              if f == "shaft_speed_rad_s"}
+    speeds = {
+        v
+        for _, f, v in load_scenario(SCENARIOS / "seed000_speed_sweep.yaml").resolved_runs()[0].iter_values()
+        if f == "shaft_speed_rad_s"
+    }
     assert speeds == set(range(100, 1701, 200))
     runs = load_scenario(SCENARIOS / "seed000_clearance_sweep.yaml").resolved_runs()
     pd = [r.diametral_clearance_m for r in runs]
@@ -64,9 +76,9 @@ def test_ev_scenario_fits_its_bearing_and_drives_the_current():
     speeds = [v for _, f, v in run.iter_values() if f == "shaft_speed_rad_s"]
     assert min(speeds) == pytest.approx(10000 * 2 * 3.141592653589793 / 60, rel=1e-3)
     assert max(speeds) == pytest.approx(50000 * 2 * 3.141592653589793 / 60, rel=1e-3)
-    run.check_limits(Twin(run.bearing, warm=False).limits)       # the 6200 allows 50 000 rpm
+    run.check_limits(Twin(run.bearing, warm=False).limits)  # the 6200 allows 50 000 rpm
     with pytest.raises(ScenarioError) as exc:
-        run.check_limits(Twin("6208", warm=False).limits)         # the 6208 does not
+        run.check_limits(Twin("6208", warm=False).limits)  # the 6208 does not
     assert "shaft_speed_rad_s" in exc.value.field
     assert max(v for _, f, v in run.iter_values() if f == "shaft_current_a") == 30.0
     assert run.thermal is not None and run.thermal.shear_heating and run.thermal.current_heating
@@ -83,7 +95,7 @@ def test_ev_resistance_temperature_scenario_seed003_figs_8_and_10(tmp_path):
     assert main(["scenario", "run", str(path), "--table", str(out), "--no-progress"]) == 0
     rows = pq.read_table(out).to_pylist()
 
-    def film(run, current):   # last sample of the phase (30 ms after the step)
+    def film(run, current):  # last sample of the phase (30 ms after the step)
         phase = [r for r in rows if r["run"] == run and r["setpoint_shaft_current_a"] == current]
         return phase[-1]["electrical_film_thermal_factor"], phase[-1]
 
@@ -100,7 +112,9 @@ def test_ev_resistance_temperature_scenario_seed003_figs_8_and_10(tmp_path):
         return max(v for k, v in row.items() if k.endswith("_inner_h_min_m") and v is not None)
 
     for current in (10.0, 20.0):
-        assert thickest_inner_film_m(film("rb_292uohm_80c", current)[1]) < thickest_inner_film_m(film("rb_292uohm_40c", current)[1])
+        assert thickest_inner_film_m(film("rb_292uohm_80c", current)[1]) < thickest_inner_film_m(
+            film("rb_292uohm_40c", current)[1]
+        )
 
 
 def test_typos_are_errors():
@@ -109,21 +123,32 @@ def test_typos_are_errors():
     assert exc.value.field == "steps[0].set.radial_lod_n"
 
 
-@pytest.mark.parametrize("data, field", [
-    (base(steps=[{"at_s": 0.0, "ramp": {"radial_load_n": 1.0}}]), "steps[0]"),                 # no over_s
-    (base(steps=[{"at_s": 0.0, "set": {"radial_load_n": 1.0}, "ramp": {"radial_load_n": 2.0}, "over_s": 0.1}]), "steps[0]"),
-    (base(steps=[{"at_s": 0.05, "ramp": {"radial_load_n": 1.0}, "over_s": 0.1}]), "steps[0].over_s"),    # ends after duration
-    (base(steps=[{"at_s": 0.05, "set": {"radial_load_n": 1.0}},
-                 {"at_s": 0.01, "set": {"radial_load_n": 2.0}}]), "steps[1].at_s"),              # out of order
-    (base(steps=[{"at_s": -1.0, "set": {"radial_load_n": 1.0}}]), "steps[0].at_s"),
-    (base(steps=[{"at_s": 0.0, "set": {"radial_load_n": float("nan")}}]), "steps[0].set.radial_load_n"),
-    (base(duration_s=0.0), "duration_s"),
-    (base(bearing="9999"), "bearing"),
-    (base(lubricant="olive oil"), "lubricant"),
-    (base(name="has space"), "name"),
-    (base(unknown_key=1), "unknown_key"),
-    (base(runs=[{"id": "a"}, {"id": "a"}]), "runs"),
-])
+@pytest.mark.parametrize(
+    "data, field",
+    [
+        (base(steps=[{"at_s": 0.0, "ramp": {"radial_load_n": 1.0}}]), "steps[0]"),  # no over_s
+        (
+            base(steps=[{"at_s": 0.0, "set": {"radial_load_n": 1.0}, "ramp": {"radial_load_n": 2.0}, "over_s": 0.1}]),
+            "steps[0]",
+        ),
+        (
+            base(steps=[{"at_s": 0.05, "ramp": {"radial_load_n": 1.0}, "over_s": 0.1}]),
+            "steps[0].over_s",
+        ),  # ends after duration
+        (
+            base(steps=[{"at_s": 0.05, "set": {"radial_load_n": 1.0}}, {"at_s": 0.01, "set": {"radial_load_n": 2.0}}]),
+            "steps[1].at_s",
+        ),  # out of order
+        (base(steps=[{"at_s": -1.0, "set": {"radial_load_n": 1.0}}]), "steps[0].at_s"),
+        (base(steps=[{"at_s": 0.0, "set": {"radial_load_n": float("nan")}}]), "steps[0].set.radial_load_n"),
+        (base(duration_s=0.0), "duration_s"),
+        (base(bearing="9999"), "bearing"),
+        (base(lubricant="olive oil"), "lubricant"),
+        (base(name="has space"), "name"),
+        (base(unknown_key=1), "unknown_key"),
+        (base(runs=[{"id": "a"}, {"id": "a"}]), "runs"),
+    ],
+)
 def test_invalid_scenarios_name_the_field(data, field):
     with pytest.raises(ScenarioError) as exc:
         scenario_from_dict(data)
@@ -141,11 +166,16 @@ def test_invalid_yaml_file(tmp_path):
 
 
 def test_executor_steps_and_ramps():
-    s = scenario_from_dict(base(
-        initial={"radial_load_n": 1000.0},
-        steps=[{"at_s": 0.0, "ramp": {"shaft_speed_rad_s": 100.0}, "over_s": 0.04},
-               {"at_s": 0.02, "set": {"radial_load_n": 2000.0}},
-               {"at_s": 0.05, "ramp": {"radial_load_n": 0.0, "oil_temperature_c": 80.0}, "over_s": 0.05}]))
+    s = scenario_from_dict(
+        base(
+            initial={"radial_load_n": 1000.0},
+            steps=[
+                {"at_s": 0.0, "ramp": {"shaft_speed_rad_s": 100.0}, "over_s": 0.04},
+                {"at_s": 0.02, "set": {"radial_load_n": 2000.0}},
+                {"at_s": 0.05, "ramp": {"radial_load_n": 0.0, "oil_temperature_c": 80.0}, "over_s": 0.05},
+            ],
+        )
+    )
     ex = ScenarioExecutor(s.resolved_runs()[0])
     sp = Setpoint(shaft_speed_rad_s=500.0)
     seen = {}
@@ -155,7 +185,7 @@ def test_executor_steps_and_ramps():
         seen[k] = sp
         if ex.done(t):
             break
-    assert seen[0].radial_load_n == 1000.0 and seen[0].shaft_speed_rad_s == 500.0   # ramp starts from the current value
+    assert seen[0].radial_load_n == 1000.0 and seen[0].shaft_speed_rad_s == 500.0  # ramp starts from the current value
     assert seen[20].shaft_speed_rad_s == pytest.approx(300.0)
     assert seen[20].radial_load_n == 2000.0
     assert seen[40].shaft_speed_rad_s == 100.0
@@ -185,22 +215,39 @@ def _write(tmp_path, data) -> Path:
 
 def test_scenario_run_command_writes_the_table(tmp_path, capsys):
     pq = pytest.importorskip("pyarrow.parquet")
-    path = _write(tmp_path, {
-        "name": "short", "duration_s": 0.02, "sample_every_s": 0.002,
-        "initial": {"shaft_speed_rad_s": 400.0, "radial_load_n": 2000.0},
-        "steps": [{"at_s": 0.0, "phase": "up", "ramp": {"radial_load_n": 3000.0}, "over_s": 0.01},
-                  {"at_s": 0.01, "phase": "hold", "set": {"radial_load_n": 3000.0}}]})
+    path = _write(
+        tmp_path,
+        {
+            "name": "short",
+            "duration_s": 0.02,
+            "sample_every_s": 0.002,
+            "initial": {"shaft_speed_rad_s": 400.0, "radial_load_n": 2000.0},
+            "steps": [
+                {"at_s": 0.0, "phase": "up", "ramp": {"radial_load_n": 3000.0}, "over_s": 0.01},
+                {"at_s": 0.01, "phase": "hold", "set": {"radial_load_n": 3000.0}},
+            ],
+        },
+    )
     out = tmp_path / "short.parquet"
     assert main(["scenario", "run", str(path), "--table", str(out), "--no-progress"]) == 0
     table = pq.read_table(out).to_pylist()
-    assert len(table) == 11                                   # 0, 2, ..., 20 ms
+    assert len(table) == 11  # 0, 2, ..., 20 ms
     assert [r["scenario_time_s"] for r in table] == pytest.approx([0.002 * i for i in range(11)])
     assert table[0]["setpoint_radial_load_n"] == 2000.0 and table[-1]["setpoint_radial_load_n"] == 3000.0
     assert table[0]["phase"] == "up" and table[-1]["phase"] == "hold"
     row = table[-1]
-    for col in ("time_s", "seq", "shaft_speed_rad_s", "friction_torque_n_m", "ball0_azimuth_rad",
-                "ball0_inner_load_n", "ball0_inner_lambda", "ball0_inner_regime", "ball8_outer_h_min_m",
-                "inner_ring_displacement_x_m"):
+    for col in (
+        "time_s",
+        "seq",
+        "shaft_speed_rad_s",
+        "friction_torque_n_m",
+        "ball0_azimuth_rad",
+        "ball0_inner_load_n",
+        "ball0_inner_lambda",
+        "ball0_inner_regime",
+        "ball8_outer_h_min_m",
+        "inner_ring_displacement_x_m",
+    ):
         assert col in row, col
     assert max(row[f"ball{i}_inner_load_n"] for i in range(9)) > 0
     assert "done" in capsys.readouterr().out
@@ -222,11 +269,19 @@ def test_scenario_table_starts_at_zero_however_late_the_caller(tmp_path, monkeyp
         return out
 
     monkeypatch.setattr(offline.TwinRunner, "start_scenario", slow_caller)
-    path = _write(tmp_path, {
-        "name": "late", "duration_s": 0.02, "sample_every_s": 0.002,
-        "initial": {"shaft_speed_rad_s": 400.0, "radial_load_n": 2000.0},
-        "steps": [{"at_s": 0.0, "phase": "up", "ramp": {"radial_load_n": 3000.0}, "over_s": 0.01},
-                  {"at_s": 0.01, "phase": "hold", "set": {"radial_load_n": 3000.0}}]})
+    path = _write(
+        tmp_path,
+        {
+            "name": "late",
+            "duration_s": 0.02,
+            "sample_every_s": 0.002,
+            "initial": {"shaft_speed_rad_s": 400.0, "radial_load_n": 2000.0},
+            "steps": [
+                {"at_s": 0.0, "phase": "up", "ramp": {"radial_load_n": 3000.0}, "over_s": 0.01},
+                {"at_s": 0.01, "phase": "hold", "set": {"radial_load_n": 3000.0}},
+            ],
+        },
+    )
     out = tmp_path / "late.parquet"
     assert main(["scenario", "run", str(path), "--table", str(out), "--no-progress"]) == 0
     table = pq.read_table(out).to_pylist()
@@ -250,8 +305,10 @@ def test_scenario_run_with_runs(tmp_path):
 def test_scenario_run_command_writes_a_recording(tmp_path):
     from rerun.chunk import RrdReader
 
-    path = _write(tmp_path, {"name": "rec", "duration_s": 0.01, "sample_every_s": 0.001,
-                             "initial": {"radial_load_n": 2500.0}, "steps": []})
+    path = _write(
+        tmp_path,
+        {"name": "rec", "duration_s": 0.01, "sample_every_s": 0.001, "initial": {"radial_load_n": 2500.0}, "steps": []},
+    )
     rrd = tmp_path / "rec.rrd"
     assert main(["scenario", "run", str(path), "--record", str(rrd), "--no-progress"]) == 0
     reader = RrdReader(str(rrd))
@@ -264,12 +321,14 @@ def test_scenario_run_command_writes_a_recording(tmp_path):
     # now every 0.5 s and the contacts every 1 s from the first sample on (one row each here)
     assert rows["/bearing/rec/friction_torque_n_m"] == 1
     assert rows["/bearing/rec/balls"] == 1
-    assert rows["/bearing/rec/contacts/load_n"] == 1          # all contacts of a sample in one row
+    assert rows["/bearing/rec/contacts/load_n"] == 1  # all contacts of a sample in one row
 
 
 def test_scenario_run_refuses_bad_input(tmp_path, capsys):
-    path = _write(tmp_path, {"name": "fast6208", "duration_s": 0.01,
-                             "steps": [{"at_s": 0.0, "set": {"shaft_speed_rad_s": 5000.0}}]})
+    path = _write(
+        tmp_path,
+        {"name": "fast6208", "duration_s": 0.01, "steps": [{"at_s": 0.0, "set": {"shaft_speed_rad_s": 5000.0}}]},
+    )
     assert main(["scenario", "run", str(path), "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "shaft_speed_rad_s" in err and "allowed range" in err
@@ -280,8 +339,15 @@ def test_scenario_run_refuses_bad_input(tmp_path, capsys):
 def test_scenario_check_checks_the_bearing_limits_like_run(tmp_path, capsys):
     """A scenario over the bearing's speed limit (the 6208's 2073.66 rad/s, inside the static
     bound of 1e4) fails `scenario check` as it fails `scenario run`, with the bearing's range."""
-    path = _write(tmp_path, {"name": "too_fast", "bearing": "6208", "duration_s": 0.01,
-                             "steps": [{"at_s": 0.0, "ramp": {"shaft_speed_rad_s": 3000.0}, "over_s": 0.01}]})
+    path = _write(
+        tmp_path,
+        {
+            "name": "too_fast",
+            "bearing": "6208",
+            "duration_s": 0.01,
+            "steps": [{"at_s": 0.0, "ramp": {"shaft_speed_rad_s": 3000.0}, "over_s": 0.01}],
+        },
+    )
     assert main(["scenario", "check", str(path)]) == 2
     err = capsys.readouterr().err
     assert "steps[0].ramp.shaft_speed_rad_s" in err
@@ -289,15 +355,28 @@ def test_scenario_check_checks_the_bearing_limits_like_run(tmp_path, capsys):
     assert main(["scenario", "run", str(path), "--no-progress"]) == 2
     assert "[0, 2073.66] rad/s" in capsys.readouterr().err
     # the same timeline on a 6200 (a smaller bearing, a higher limit) is fine
-    ok = _write(tmp_path, {"name": "fast_6200", "bearing": "6200", "duration_s": 0.01,
-                           "steps": [{"at_s": 0.0, "ramp": {"shaft_speed_rad_s": 3000.0}, "over_s": 0.01}]})
+    ok = _write(
+        tmp_path,
+        {
+            "name": "fast_6200",
+            "bearing": "6200",
+            "duration_s": 0.01,
+            "steps": [{"at_s": 0.0, "ramp": {"shaft_speed_rad_s": 3000.0}, "over_s": 0.01}],
+        },
+    )
     assert main(["scenario", "check", str(ok)]) == 0
 
 
 def test_multi_run_limits_name_the_run():
-    s = scenario_from_dict(base(initial={"radial_load_n": 1000.0},
-                                runs=[{"id": "small", "bearing": "6200"}, {"id": "big", "bearing": "6208",
-                                      "steps": [{"at_s": 0.0, "set": {"shaft_speed_rad_s": 2500.0}}]}]))
+    s = scenario_from_dict(
+        base(
+            initial={"radial_load_n": 1000.0},
+            runs=[
+                {"id": "small", "bearing": "6200"},
+                {"id": "big", "bearing": "6208", "steps": [{"at_s": 0.0, "set": {"shaft_speed_rad_s": 2500.0}}]},
+            ],
+        )
+    )
     with pytest.raises(ScenarioError) as exc:
         s.check_bearing_limits()
     assert exc.value.field == "runs[1].steps[0].set.shaft_speed_rad_s"
@@ -305,8 +384,7 @@ def test_multi_run_limits_name_the_run():
 
 def test_yaml_integer_designation_and_errors_name_the_field_once(tmp_path):
     path = tmp_path / "int.yaml"
-    path.write_text("name: int_bearing\nbearing: 6208\nduration_s: 0.01\n"
-                    "runs:\n  - {id: a, bearing: 6200}\n")
+    path.write_text("name: int_bearing\nbearing: 6208\nduration_s: 0.01\nruns:\n  - {id: a, bearing: 6200}\n")
     s = load_scenario(path)
     assert s.bearing == "6208" and s.resolved_runs()[0].bearing == "6200"
     bad = tmp_path / "bad.yaml"
@@ -315,7 +393,7 @@ def test_yaml_integer_designation_and_errors_name_the_field_once(tmp_path):
         load_scenario(bad)
     assert exc.value.field == "bearing"
     assert str(exc.value).count("bearing:") == 1 and "unknown bearing '9999'" in str(exc.value)
-    for flag in ("true", "yes"):                      # a YAML bool is not a designation
+    for flag in ("true", "yes"):  # a YAML bool is not a designation
         bad.write_text(f"name: bad\nbearing: {flag}\nduration_s: 0.01\n")
         with pytest.raises(ScenarioError):
             load_scenario(bad)
@@ -344,11 +422,18 @@ def test_bearing_spec_inline_and_from_a_file_next_to_the_scenario(tmp_path, monk
     pq = pytest.importorskip("pyarrow.parquet")
     (tmp_path / "specs").mkdir()
     (tmp_path / "specs" / "own.yaml").write_text(yaml.safe_dump(_own_spec()))
-    path = _write(tmp_path, base(name="own", duration_s=0.01, sample_every_s=0.005, bearing="specs/own.yaml",
-                                 initial={"shaft_speed_rad_s": 300.0, "radial_load_n": 800.0},
-                                 runs=[{"id": "file"}, {"id": "inline", "bearing": _own_spec(),
-                                                        "diametral_clearance_m": 10e-6}]))
-    monkeypatch.chdir(tmp_path / "specs")              # the path is the scenario file's, not the cwd's
+    path = _write(
+        tmp_path,
+        base(
+            name="own",
+            duration_s=0.01,
+            sample_every_s=0.005,
+            bearing="specs/own.yaml",
+            initial={"shaft_speed_rad_s": 300.0, "radial_load_n": 800.0},
+            runs=[{"id": "file"}, {"id": "inline", "bearing": _own_spec(), "diametral_clearance_m": 10e-6}],
+        ),
+    )
+    monkeypatch.chdir(tmp_path / "specs")  # the path is the scenario file's, not the cwd's
     runs = load_scenario(path).resolved_runs()
     assert [r.designation for r in runs] == ["MY-6205-8", "MY-6205-8"]
     assert [r.spec().geometry.ball_count for r in runs] == [8, 8]

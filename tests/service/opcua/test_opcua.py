@@ -28,9 +28,15 @@ PUBLISH_HZ = 20.0
 
 @pytest.fixture(scope="module")
 def server(support):
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, token=TOKEN, max_twins=3,
-                               publish_rate_hz=PUBLISH_HZ, opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
-                               opcua_security="none")
+    settings = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        token=TOKEN,
+        max_twins=3,
+        publish_rate_hz=PUBLISH_HZ,
+        opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
+        opcua_security="none",
+    )
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=30.0) as srv:
         yield srv
 
@@ -83,6 +89,7 @@ def test_browse_the_namespace_folders_and_setpoint(url):
             assert ua.AccessLevel.CurrentWrite in await node.get_access_level()
             eu = await (await node.get_child(f"{idx}:EURange")).read_value()
             return eu
+
     eu = run(main())
     # the bearing's own range: the 6208's radial-load limit of the compiled model (static capacity,
     # 4.2 GPa with the exact Hertz constants)
@@ -96,6 +103,7 @@ def test_browse_the_namespace_folders_and_setpoint(url):
 def test_state_is_within_one_publish_period_of_http(url, http):
     """The facade copies each new snapshot within half a publish period: an OPC UA read made right
     after an HTTP read sees that snapshot or the one before it (seq counts publications)."""
+
     async def main():
         async with client(url, password=None) as c:
             idx, twin = await twin_node(c)
@@ -104,10 +112,11 @@ def test_state_is_within_one_publish_period_of_http(url, http):
             pairs = []
             for _ in range(10):
                 h = (await asyncio.to_thread(http.get, "/v1/bearings/default/state")).json()
-                seq, time_s = await c.read_values([seq_node, time_node])    # one Read: one snapshot
+                seq, time_s = await c.read_values([seq_node, time_node])  # one Read: one snapshot
                 pairs.append((h["seq"], h["time_s"], seq, time_s))
                 await asyncio.sleep(0.5 / PUBLISH_HZ)
             return pairs
+
     pairs = run(main())
     for seq_http, time_http, seq_opc, time_opc in pairs:
         assert seq_opc >= seq_http - 1, pairs
@@ -123,13 +132,17 @@ def test_authenticated_write_goes_the_http_way(url, http, support):
             await node.write_value(3500.0)
             last = json.loads(await read(c, "Setpoint", LAST_RESULT))
             return last, await node.read_value()
+
     last, value = run(main())
     assert last["accepted"] is True and last["status"] == "Good" and last["setpoint"]["radial_load_n"] == 3500.0
     assert value == 3500.0
     assert http.get("/v1/bearings/default").json()["setpoint"]["radial_load_n"] == 3500.0
     # the runner applies it at its next frame: the snapshot's setpoint in force follows
-    support.wait_for(lambda: http.get("/v1/bearings/default/state").json()["setpoint"]["radial_load_n"],
-                     lambda v: v == 3500.0, timeout=WAIT_S)
+    support.wait_for(
+        lambda: http.get("/v1/bearings/default/state").json()["setpoint"]["radial_load_n"],
+        lambda v: v == 3500.0,
+        timeout=WAIT_S,
+    )
 
     async def in_force():
         async with client(url, password=None) as c:
@@ -138,6 +151,7 @@ def test_authenticated_write_goes_the_http_way(url, http, support):
                     return True
                 await asyncio.sleep(0.05)
             return False
+
     assert run(in_force())
 
 
@@ -153,20 +167,27 @@ def test_out_of_range_write_is_refused_with_bad_out_of_range_and_a_message_namin
             idx, twin = await twin_node(c)
             node = await twin.get_child([f"{idx}:Setpoint", f"{idx}:radial_load_n"])
             results = {}
-            for label, variant in (("too_large", ua.Variant(1e7, ua.VariantType.Double)),
-                                   ("nan", ua.Variant(math.nan, ua.VariantType.Double)),
-                                   ("text", ua.Variant("3000", ua.VariantType.String)),
-                                   ("bool", ua.Variant(True, ua.VariantType.Boolean))):
+            for label, variant in (
+                ("too_large", ua.Variant(1e7, ua.VariantType.Double)),
+                ("nan", ua.Variant(math.nan, ua.VariantType.Double)),
+                ("text", ua.Variant("3000", ua.VariantType.String)),
+                ("bool", ua.Variant(True, ua.VariantType.Boolean)),
+            ):
                 with pytest.raises(ua.UaStatusCodeError) as err:
                     await node.write_value(variant)
                 results[label] = (err.value.code, json.loads(await read(c, "Setpoint", LAST_RESULT)))
             return results, await node.read_value()
+
     results, value = run(main())
     code, last = results["too_large"]
     assert code == ua.StatusCodes.BadOutOfRange
-    assert last == {"accepted": False, "status": "BadOutOfRange", "field": "radial_load_n",
-                    "error": f"radial_load_n: {http_message}"}
-    assert f"[{low:g}, {high:g}] N for bearing 6208" in last["error"]     # the bearing's own range
+    assert last == {
+        "accepted": False,
+        "status": "BadOutOfRange",
+        "field": "radial_load_n",
+        "error": f"radial_load_n: {http_message}",
+    }
+    assert f"[{low:g}, {high:g}] N for bearing 6208" in last["error"]  # the bearing's own range
     assert results["nan"][0] == ua.StatusCodes.BadOutOfRange
     assert results["text"][0] == ua.StatusCodes.BadTypeMismatch and "String" in results["text"][1]["error"]
     assert results["bool"][0] == ua.StatusCodes.BadTypeMismatch
@@ -181,12 +202,13 @@ def test_anonymous_write_is_refused_when_a_token_is_set(url, http, server):
 
     async def main():
         async with client(url, password=None) as c:
-            assert await read(c, "Identification", "designation") == "6208"     # reads are open
+            assert await read(c, "Identification", "designation") == "6208"  # reads are open
             idx, twin = await twin_node(c)
             node = await twin.get_child([f"{idx}:Setpoint", f"{idx}:shaft_speed_rad_s"])
             with pytest.raises(ua.UaStatusCodeError) as err:
                 await node.write_value(100.0)
             return err.value.code, json.loads(await read(c, "Setpoint", LAST_RESULT))
+
     code, last = run(main())
     assert code == ua.StatusCodes.BadUserAccessDenied
     assert last["status"] == "BadUserAccessDenied" and "token" in last["error"]
@@ -201,8 +223,9 @@ def test_a_wrong_password_refuses_the_session(url, server):
         c = client(url, password="not-the-token")
         with pytest.raises(ua.UaStatusCodeError) as err:
             await c.connect()
-        c.disconnect_socket()      # (connect already dropped it; idempotent)
+        c.disconnect_socket()  # (connect already dropped it; idempotent)
         return err.value.code
+
     assert run(main()) == ua.StatusCodes.BadUserAccessDenied
     assert server.service.gate.unauthorized == unauthorized + 1
 
@@ -216,7 +239,7 @@ def test_twins_created_and_deleted_at_runtime_appear_and_disappear(url, http):
         root = await c.nodes.objects.get_child(f"{idx}:{ROOT_FOLDER}")
         out = []
         for n in await root.get_children():
-            try:                          # a twin deleted between the browse and the read is gone
+            try:  # a twin deleted between the browse and the read is gone
                 out.append((await n.read_browse_name()).Name)
             except ua.uaerrors.BadNodeIdUnknown:
                 pass
@@ -236,5 +259,6 @@ def test_twins_created_and_deleted_at_runtime_appear_and_disappear(url, http):
             await asyncio.to_thread(lambda: http.delete("/v1/bearings/pump-2").raise_for_status())
             gone = await until(c, lambda n: "pump-2" not in n)
             return got, gone
+
     got, gone = run(appear())
     assert sorted(got) == ["default", "pump-2"] and gone == ["default"]

@@ -24,16 +24,31 @@ from service.settings import ServiceSettings  # noqa: E402
 TOKEN = "opc-guard-token-789"
 WAIT_S = 60.0
 PUBLISH_HZ = 20.0
-LIMITS = dict(opcua_max_sessions=3, opcua_max_subscriptions_per_session=2, opcua_max_monitored_items_per_session=6,
-              opcua_max_notifications_per_s=40.0, opcua_min_publishing_interval_ms=100.0, opcua_max_queue_size=4,
-              opcua_login_free_failures=1, opcua_login_backoff_s=3.0, opcua_login_backoff_max_s=6.0)
+LIMITS = dict(
+    opcua_max_sessions=3,
+    opcua_max_subscriptions_per_session=2,
+    opcua_max_monitored_items_per_session=6,
+    opcua_max_notifications_per_s=40.0,
+    opcua_min_publishing_interval_ms=100.0,
+    opcua_max_queue_size=4,
+    opcua_login_free_failures=1,
+    opcua_login_backoff_s=3.0,
+    opcua_login_backoff_max_s=6.0,
+)
 
 
 @pytest.fixture(scope="module")
 def server(support):
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, token=TOKEN, max_twins=1,
-                               publish_rate_hz=PUBLISH_HZ, opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
-                               opcua_security="none", **LIMITS)
+    settings = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        token=TOKEN,
+        max_twins=1,
+        publish_rate_hz=PUBLISH_HZ,
+        opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
+        opcua_security="none",
+        **LIMITS,
+    )
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=30.0) as srv:
         yield srv
 
@@ -75,7 +90,7 @@ def test_the_backoff_schedule_and_one_log_line_per_burst(caplog):
         t.failed("10.0.0.7")
         waits.append(t.wait_s("10.0.0.7"))
     assert waits == [0.0, 1.0, 2.0, 4.0, 4.0, 4.0]
-    assert t.wait_s("10.0.0.8") == 0.0                          # per address
+    assert t.wait_s("10.0.0.8") == 0.0  # per address
     t.refuse("10.0.0.7")
     now[0] = 3.0
     assert t.wait_s("10.0.0.7") == pytest.approx(1.0)
@@ -92,9 +107,9 @@ def test_the_backoff_schedule_and_one_log_line_per_burst(caplog):
 
 def test_an_item_costs_what_it_may_send():
     limits = GuardLimits(publish_rate_hz=50.0)
-    assert limits.item_rate_hz(1, 1000.0) == 1.0                # one latest value per publish
-    assert limits.item_rate_hz(4, 1000.0) == 4.0                # up to a queue per publish
-    assert limits.item_rate_hz(10, 50.0) == 50.0                # never more than the variable changes
+    assert limits.item_rate_hz(1, 1000.0) == 1.0  # one latest value per publish
+    assert limits.item_rate_hz(4, 1000.0) == 4.0  # up to a queue per publish
+    assert limits.item_rate_hz(10, 50.0) == 50.0  # never more than the variable changes
 
 
 def test_failed_logins_back_off_per_address_and_log_once(facade, server, caplog):
@@ -107,14 +122,15 @@ def test_failed_logins_back_off_per_address_and_log_once(facade, server, caplog)
 
     async def main():
         codes = [await refused(client(facade.url, password=f"guess-{i}")) for i in range(4)]
-        in_backoff = await refused(client(facade.url))              # the token, during the backoff
-        async with client(facade.url, password=None) as c:           # anonymous (read-only): not slowed
+        in_backoff = await refused(client(facade.url))  # the token, during the backoff
+        async with client(facade.url, password=None) as c:  # anonymous (read-only): not slowed
             await c.nodes.objects.read_browse_name()
-        assert guard.logins.wait_s("127.0.0.1") > 0                  # ... and it does not end the backoff
+        assert guard.logins.wait_s("127.0.0.1") > 0  # ... and it does not end the backoff
         await asyncio.sleep(guard.logins.wait_s("127.0.0.1") + 0.2)
-        async with client(facade.url) as c:                          # after it: accepted
+        async with client(facade.url) as c:  # after it: accepted
             await c.nodes.objects.read_browse_name()
         return codes, in_backoff
+
     codes, in_backoff = run(main())
     assert codes == [ua.StatusCodes.BadUserAccessDenied] * 4 and in_backoff == ua.StatusCodes.BadUserAccessDenied
     figures = guard.figures()
@@ -139,11 +155,12 @@ def test_sessions_are_capped(facade):
             code = await refused(client(facade.url))
         finally:
             await clients.pop().disconnect()
-        async with client(facade.url) as c:                          # one closed: room again
+        async with client(facade.url) as c:  # one closed: room again
             await c.nodes.objects.read_browse_name()
         for c in clients:
             await c.disconnect()
         return code
+
     assert run(main()) == ua.StatusCodes.BadTooManySessions
 
 
@@ -159,11 +176,12 @@ def test_subscriptions_items_and_notifications_are_capped(facade):
     """2 subscriptions per session, a third refused; 1 ms asked, 100 ms granted; items beyond the
     session's notification budget (40/s at 10/s each: 4) refused one by one, and beyond its count
     (6) too; the notifications received stay within that budget."""
+
     async def main():
         async with client(facade.url) as c:
             counter = _Counter()
             sub = await c.create_subscription(1, counter)
-            assert sub.parameters.RequestedPublishingInterval == 100.0      # as revised by the server
+            assert sub.parameters.RequestedPublishingInterval == 100.0  # as revised by the server
             other = await c.create_subscription(500, counter)
             with pytest.raises(ua.UaStatusCodeError) as err:
                 await c.create_subscription(1000, counter)
@@ -177,9 +195,10 @@ def test_subscriptions_items_and_notifications_are_capped(facade):
             n0, t0 = counter.n, time.monotonic()
             await asyncio.sleep(3.0)
             rate = (counter.n - n0) / (time.monotonic() - t0)
-            await sub.unsubscribe(handles[0])            # 3 items at 10/s left; at 500 ms an item costs 2/s
+            await sub.unsubscribe(handles[0])  # 3 items at 10/s left; at 500 ms an item costs 2/s
             again = await other.subscribe_data_change(nodes[:4], queuesize=1)
-            assert [isinstance(r, int) for r in again] == [True, True, True, False]   # the 7th: over the count
+            assert [isinstance(r, int) for r in again] == [True, True, True, False]  # the 7th: over the count
             return rate
+
     rate = run(main())
-    assert 0 < rate <= 40.0 * 1.2      # the budget; 20 % for the sleep's own jitter
+    assert 0 < rate <= 40.0 * 1.2  # the budget; 20 % for the sleep's own jitter

@@ -44,8 +44,12 @@ def make_client_cert(folder: Path, name: str) -> tuple[Path, Path, str]:
     uri = f"urn:bearing-twin-test:{name}"
     key = cert_gen.generate_private_key()
     cert = cert_gen.generate_self_signed_app_certificate(
-        key, name, {"organizationName": "bearing-twin tests"}, [x509.UniformResourceIdentifier(uri)],
-        extended=[ExtendedKeyUsageOID.CLIENT_AUTH])
+        key,
+        name,
+        {"organizationName": "bearing-twin tests"},
+        [x509.UniformResourceIdentifier(uri)],
+        extended=[ExtendedKeyUsageOID.CLIENT_AUTH],
+    )
     cert_path, key_path = folder / f"{name}.der", folder / f"{name}-key.pem"
     cert_path.write_bytes(cert.public_bytes(serialization.Encoding.DER))
     key_path.write_bytes(cert_gen.dump_private_key_as_pem(key))
@@ -60,15 +64,21 @@ def pki(tmp_path_factory):
     clients.mkdir()
     good = make_client_cert(clients, "operator-hmi")
     bad = make_client_cert(clients, "stranger")
-    (trusted / "operator-hmi.der").write_bytes(good[0].read_bytes())      # trusted: copied in
+    (trusted / "operator-hmi.der").write_bytes(good[0].read_bytes())  # trusted: copied in
     return {"root": root, "server": root / "server-pki", "trusted": trusted, "good": good, "bad": bad}
 
 
 @pytest.fixture(scope="module")
 def server(support, pki):
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, token=TOKEN, max_twins=2,
-                               opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
-                               opcua_pki_dir=pki["server"], opcua_trusted_dir=pki["trusted"])
+    settings = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        token=TOKEN,
+        max_twins=2,
+        opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
+        opcua_pki_dir=pki["server"],
+        opcua_trusted_dir=pki["trusted"],
+    )
     assert settings.opcua.security == "auto" and settings.opcua_security_mode == "both"
     with support.ThreadServer(settings, start_timeout_s=120.0, stop_timeout_s=30.0) as srv:
         yield srv
@@ -89,13 +99,16 @@ async def secure_client(facade, who, policy=B256, mode=SE, password: str | None 
 async def setpoint_node(c: Client, name: str):
     idx = await c.get_namespace_index(NAMESPACE_URI)
     twin = await c.nodes.objects.get_child([f"{idx}:{ROOT_FOLDER}", f"{idx}:default"])
-    return (await twin.get_child([f"{idx}:Setpoint", f"{idx}:{name}"]),
-            await twin.get_child([f"{idx}:Setpoint", f"{idx}:{LAST_RESULT}"]))
+    return (
+        await twin.get_child([f"{idx}:Setpoint", f"{idx}:{name}"]),
+        await twin.get_child([f"{idx}:Setpoint", f"{idx}:{LAST_RESULT}"]),
+    )
 
 
 def test_basic256sha256_sign_and_encrypt_writes_a_setpoint_that_lands(facade, pki, http, support):
     """(1) Basic256Sha256 SignAndEncrypt, the client's own certificate (trusted), the token as
     password: the write is accepted and the twin runs with it (its published state)."""
+
     async def main():
         c = await secure_client(facade, pki["good"])
         async with c:
@@ -103,17 +116,28 @@ def test_basic256sha256_sign_and_encrypt_writes_a_setpoint_that_lands(facade, pk
             node, last = await setpoint_node(c, "radial_load_n")
             await node.write_value(4200.0)
             return server_der, json.loads(await last.read_value()), await node.read_value()
+
     server_der, last, value = run(main())
     assert hashlib.sha1(server_der).hexdigest().upper() == facade.pki.thumbprint_sha1
     assert last["accepted"] is True and last["setpoint"]["radial_load_n"] == 4200.0 and value == 4200.0
-    support.wait_for(lambda: http.get("/v1/bearings/default/state").json()["setpoint"]["radial_load_n"],
-                     lambda v: v == 4200.0, timeout=WAIT_S)
+    support.wait_for(
+        lambda: http.get("/v1/bearings/default/state").json()["setpoint"]["radial_load_n"],
+        lambda v: v == 4200.0,
+        timeout=WAIT_S,
+    )
 
 
-@pytest.mark.parametrize("policy, mode", [(B256, S), (AES128, SE), (AES128, S), (AES256, SE), (AES256, S)],
-                         ids=["Basic256Sha256-Sign", "Aes128_Sha256_RsaOaep-SignAndEncrypt",
-                              "Aes128_Sha256_RsaOaep-Sign", "Aes256_Sha256_RsaPss-SignAndEncrypt",
-                              "Aes256_Sha256_RsaPss-Sign"])
+@pytest.mark.parametrize(
+    "policy, mode",
+    [(B256, S), (AES128, SE), (AES128, S), (AES256, SE), (AES256, S)],
+    ids=[
+        "Basic256Sha256-Sign",
+        "Aes128_Sha256_RsaOaep-SignAndEncrypt",
+        "Aes128_Sha256_RsaOaep-Sign",
+        "Aes256_Sha256_RsaPss-SignAndEncrypt",
+        "Aes256_Sha256_RsaPss-Sign",
+    ],
+)
 def test_every_offered_policy_and_mode_authenticates_and_writes(facade, pki, policy, mode):
     """The other five endpoints: each session authenticates with the token and may write."""
     value = {S: 1500.0, SE: 2500.0}[mode] + (100.0 if policy is AES128 else 200.0 if policy is AES256 else 0.0)
@@ -123,29 +147,33 @@ def test_every_offered_policy_and_mode_authenticates_and_writes(facade, pki, pol
             node, last = await setpoint_node(c, "radial_load_n")
             await node.write_value(value)
             return json.loads(await last.read_value())
+
     last = run(main())
     assert last["accepted"] is True and last["setpoint"]["radial_load_n"] == value
 
 
 def test_the_endpoints_offer_six_secure_policies_and_encrypt_the_password(facade):
-    assert facade.security == "both"    # the default `auto` with a token: Sign and SignAndEncrypt
+    assert facade.security == "both"  # the default `auto` with a token: Sign and SignAndEncrypt
 
     async def main():
         return await Client(facade.url, timeout=20).connect_and_get_server_endpoints()
+
     endpoints = run(main())
     offered = {(e.SecurityPolicyUri.split("#")[1], e.SecurityMode) for e in endpoints}
-    assert offered == {(p, m) for p in ("Basic256Sha256", "Aes128_Sha256_RsaOaep", "Aes256_Sha256_RsaPss")
-                       for m in (S, SE)}
+    assert offered == {
+        (p, m) for p in ("Basic256Sha256", "Aes128_Sha256_RsaOaep", "Aes256_Sha256_RsaPss") for m in (S, SE)
+    }
     for e in endpoints:
         assert hashlib.sha1(e.ServerCertificate).hexdigest().upper() == facade.pki.thumbprint_sha1
         names = [t for t in e.UserIdentityTokens if t.TokenType == ua.UserTokenType.UserName]
-        assert [t.SecurityPolicyUri for t in names] == [e.SecurityPolicyUri]   # password RSA-encrypted
+        assert [t.SecurityPolicyUri for t in names] == [e.SecurityPolicyUri]  # password RSA-encrypted
 
 
 def test_a_client_on_the_none_policy_is_refused(facade, server, monkeypatch):
     """(2) No None endpoint: asyncua's client finds none (UaError before any session); a client that
     skips that check gets a None channel (asyncua opens one for discovery) but its session is
     refused at ActivateSession with BadSecurityPolicyRejected."""
+
     async def plain():
         c = Client(facade.url, timeout=20, watchdog_intervall=10.0)
         c.set_user("operator")
@@ -163,6 +191,7 @@ def test_a_client_on_the_none_policy_is_refused(facade, server, monkeypatch):
             await c.connect()
         c.disconnect_socket()
         return err.value.code
+
     assert not isinstance(run(plain()), ua.UaStatusCodeError)
     assert run(pushy()) == ua.StatusCodes.BadSecurityPolicyRejected
 
@@ -175,11 +204,13 @@ def test_a_password_sent_unencrypted_is_refused(facade, pki, server):
     async def main():
         c = await secure_client(facade, pki["good"])
         c.server_policy = lambda token_type: ua.UserTokenPolicy(
-            PolicyId="username", TokenType=token_type, SecurityPolicyUri=security_policies.SecurityPolicyNone.URI)
+            PolicyId="username", TokenType=token_type, SecurityPolicyUri=security_policies.SecurityPolicyNone.URI
+        )
         with pytest.raises(ua.UaStatusCodeError) as err:
             await c.connect()
         c.disconnect_socket()
         return err.value.code
+
     assert run(main()) == ua.StatusCodes.BadIdentityTokenRejected
     assert server.service.gate.unauthorized == unauthorized
 
@@ -189,6 +220,7 @@ def test_only_trusted_client_certificates_open_a_session(facade, pki):
     (BadCertificateUntrusted, asyncua's CertificateValidator + TrustStore); a stranger that opens
     the channel with its own certificate but announces the trusted one at CreateSession is refused
     at ActivateSession (the facade checks the channel's certificate); the trusted one reads."""
+
     async def stranger():
         c = await secure_client(facade, pki["bad"])
         with pytest.raises(ua.UaStatusCodeError) as err:
@@ -205,6 +237,7 @@ def test_only_trusted_client_certificates_open_a_session(facade, pki):
         async def lying_create_session(params):
             params.ClientCertificate = trusted_der
             return await create(params)
+
         c.uaclient.create_session = lying_create_session
         with pytest.raises(ua.UaStatusCodeError) as err:
             await c.connect()
@@ -212,11 +245,13 @@ def test_only_trusted_client_certificates_open_a_session(facade, pki):
         return err.value.code
 
     async def friend():
-        async with await secure_client(facade, pki["good"], password=None) as c:     # anonymous: reads
+        async with await secure_client(facade, pki["good"], password=None) as c:  # anonymous: reads
             idx = await c.get_namespace_index(NAMESPACE_URI)
-            node = await c.nodes.objects.get_child([f"{idx}:{ROOT_FOLDER}", f"{idx}:default",
-                                                    f"{idx}:Identification", f"{idx}:designation"])
+            node = await c.nodes.objects.get_child(
+                [f"{idx}:{ROOT_FOLDER}", f"{idx}:default", f"{idx}:Identification", f"{idx}:designation"]
+            )
             return await node.read_value()
+
     assert run(stranger()) == ua.StatusCodes.BadCertificateUntrusted
     assert run(impostor()) == ua.StatusCodes.BadCertificateUntrusted
     assert run(friend()) == "6208"
@@ -231,8 +266,14 @@ def _open(settings):
 
 def _light(support, tmp_path, **extra) -> ServiceSettings:
     """A service without twins, zenoh or recording: only the OPC UA facade."""
-    return ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False, token=TOKEN,
-                           opcua=f"opc.tcp://127.0.0.1:{support.free_port()}", **extra)
+    return ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        start_twin=False,
+        token=TOKEN,
+        opcua=f"opc.tcp://127.0.0.1:{support.free_port()}",
+        **extra,
+    )
 
 
 def test_the_generated_certificate_is_kept_across_a_restart(support, tmp_path):
@@ -260,6 +301,7 @@ def test_the_generated_certificate_is_kept_across_a_restart(support, tmp_path):
             await c.set_security(B256, str(client[0]), str(client[1]), server_certificate=str(pinned), mode=SE)
             async with c:
                 return await c.get_namespace_array()
+
         namespaces = run(main())
     finally:
         second.close()
@@ -285,18 +327,27 @@ def test_a_given_certificate_is_used_and_checked(support, tmp_path):
     def server_cert(name: str, uri: str):
         key = cert_gen.generate_private_key()
         cert = cert_gen.generate_self_signed_app_certificate(
-            key, name, {}, [x509.UniformResourceIdentifier(uri)], extended=[ExtendedKeyUsageOID.SERVER_AUTH])
+            key, name, {}, [x509.UniformResourceIdentifier(uri)], extended=[ExtendedKeyUsageOID.SERVER_AUTH]
+        )
         c, k = tmp_path / f"{name}.pem", tmp_path / f"{name}-key.pem"
         c.write_bytes(cert.public_bytes(serialization.Encoding.PEM))
         k.write_bytes(cert_gen.dump_private_key_as_pem(key))
         return c, k, cert
+
     good_cert, good_key, cert = server_cert("plant-issued", APPLICATION_URI)
     wrong_cert, wrong_key, _ = server_cert("other-app", "urn:someone-else:server")
-    svc = _open(_light(support, tmp_path, opcua_certificate=good_cert, opcua_private_key=good_key,
-                       opcua_pki_dir=tmp_path / "unused"))
+    svc = _open(
+        _light(
+            support,
+            tmp_path,
+            opcua_certificate=good_cert,
+            opcua_private_key=good_key,
+            opcua_pki_dir=tmp_path / "unused",
+        )
+    )
     try:
         assert svc.opcua.pki.thumbprint_sha1 == cert.fingerprint(hashes.SHA1()).hex().upper()
-        assert not (tmp_path / "unused").exists()                                 # nothing generated
+        assert not (tmp_path / "unused").exists()  # nothing generated
     finally:
         svc.close()
     with pytest.raises(WiringError) as err:
@@ -326,6 +377,7 @@ def test_all_mode_offers_none_for_anonymous_reads_only(support, tmp_path):
                 await c.connect()
             c.disconnect_socket()
             return err.value.code
+
         assert NAMESPACE_URI in run(anonymous())
         assert run(user()) == ua.StatusCodes.BadIdentityTokenRejected
     finally:

@@ -20,22 +20,22 @@ def test_the_token_is_the_password():
     gate = AdmissionGate(token="s3cret")
     users = TokenUserManager(gate, read_requires_token=False)
     anonymous = users.get_user(None)
-    assert anonymous is not None and anonymous.authenticated is False      # reads, cannot write
+    assert anonymous is not None and anonymous.authenticated is False  # reads, cannot write
     good = users.get_user(None, username="op", password="s3cret")
     assert good is not None and good.authenticated and good.name == "op"
     assert gate.unauthorized == 0
-    assert users.get_user(None, username="op", password="wrong") is None   # session refused
+    assert users.get_user(None, username="op", password="wrong") is None  # session refused
     assert users.get_user(None, username="op", password=None) is None
     assert gate.unauthorized == 2
     strict = TokenUserManager(gate, read_requires_token=True)
-    assert strict.get_user(None) is None and gate.unauthorized == 3          # anonymous refused
+    assert strict.get_user(None) is None and gate.unauthorized == 3  # anonymous refused
     open_gate = TokenUserManager(AdmissionGate(token=None))
-    assert open_gate.get_user(None).authenticated is True                   # no token: anyone writes
+    assert open_gate.get_user(None).authenticated is True  # no token: anyone writes
     assert open_gate.get_user(None, username="x", password="anything").authenticated is True
 
 
 def test_the_endpoint_setting_and_flag():
-    assert ServiceSettings().opcua.endpoint is None                                   # off by default
+    assert ServiceSettings().opcua.endpoint is None  # off by default
     assert ServiceSettings(opcua="opc.tcp://127.0.0.1:4840").opcua.endpoint == "opc.tcp://127.0.0.1:4840"
     with pytest.raises(ValidationError, match="opcua"):
         ServiceSettings(opcua="http://127.0.0.1:4840")
@@ -53,8 +53,9 @@ def test_a_busy_port_is_a_one_line_wiring_error():
         taken.bind(("127.0.0.1", 0))
         taken.listen()
         port = taken.getsockname()[1]
-        settings = ServiceSettings(enable_zenoh=False, enable_recording=False, start_twin=False,
-                                   opcua=f"opc.tcp://127.0.0.1:{port}")
+        settings = ServiceSettings(
+            enable_zenoh=False, enable_recording=False, start_twin=False, opcua=f"opc.tcp://127.0.0.1:{port}"
+        )
         with pytest.raises(WiringError) as err:
             TwinService(settings).open()
     text = str(err.value)
@@ -80,18 +81,31 @@ def test_the_security_settings_and_flags(tmp_path):
     with pytest.raises(ValidationError, match="opcua_trusted_dir: .* is not a folder"):
         ServiceSettings(token="s3cret", opcua_trusted_dir=cert)
     with pytest.raises(ValidationError, match="opcua_trusted_dir: trusting clients by certificate"):
-        ServiceSettings(opcua_trusted_dir=tmp_path)                      # auto without a token: None
+        ServiceSettings(opcua_trusted_dir=tmp_path)  # auto without a token: None
     with pytest.raises(ValidationError, match="opcua_trusted_dir: trusting clients by certificate"):
         ServiceSettings(token="s3cret", opcua_security="all", opcua_trusted_dir=tmp_path)
     assert ServiceSettings(opcua_security="sign", opcua_trusted_dir=tmp_path).opcua.trusted_dir == tmp_path
     from service.tools.cli import _serve_settings, build_parser
 
-    args = build_parser().parse_args(["serve", "--opcua", "opc.tcp://127.0.0.1:4841", "--opcua-security",
-                                      "sign_and_encrypt", "--opcua-pki-dir", str(tmp_path / "pki"),
-                                      "--opcua-trusted-dir", str(tmp_path)])
+    args = build_parser().parse_args(
+        [
+            "serve",
+            "--opcua",
+            "opc.tcp://127.0.0.1:4841",
+            "--opcua-security",
+            "sign_and_encrypt",
+            "--opcua-pki-dir",
+            str(tmp_path / "pki"),
+            "--opcua-trusted-dir",
+            str(tmp_path),
+        ]
+    )
     settings = _serve_settings(args)
-    assert (settings.opcua.security, settings.opcua.pki_dir, settings.opcua.trusted_dir) == \
-        ("sign_and_encrypt", tmp_path / "pki", tmp_path)
+    assert (settings.opcua.security, settings.opcua.pki_dir, settings.opcua.trusted_dir) == (
+        "sign_and_encrypt",
+        tmp_path / "pki",
+        tmp_path,
+    )
     with pytest.raises(SystemExit):
         build_parser().parse_args(["serve", "--opcua-security", "encrypt"])
 
@@ -106,10 +120,10 @@ def test_the_security_rules_of_the_user_manager():
     gate = AdmissionGate(token="s3cret")
     strict = TokenUserManager(gate, secure=True, none_offered=False)
     with pytest.raises(ServiceError) as err:
-        strict.get_user(None, certificate=b"")                              # anonymous on None
+        strict.get_user(None, certificate=b"")  # anonymous on None
     assert err.value.code == ua.StatusCodes.BadSecurityPolicyRejected
     relaxed = TokenUserManager(gate, secure=True, none_offered=True)
-    assert relaxed.get_user(None, certificate=b"").authenticated is False    # anonymous reads on None
+    assert relaxed.get_user(None, certificate=b"").authenticated is False  # anonymous reads on None
     relaxed.password_encrypted = True
     with pytest.raises(ServiceError) as err:
         relaxed.get_user(None, username="op", password="s3cret", certificate=b"")
@@ -120,4 +134,4 @@ def test_the_security_rules_of_the_user_manager():
     assert err.value.code == ua.StatusCodes.BadIdentityTokenRejected
     relaxed.password_encrypted = True
     assert relaxed.get_user(None, username="op", password="s3cret", certificate=b"DER").authenticated
-    assert gate.unauthorized == 0                                          # refused before the password
+    assert gate.unauthorized == 0  # refused before the password

@@ -10,21 +10,28 @@ import pytest
 
 
 def _run(*args, timeout=300):
-    return subprocess.run([sys.executable, "-m", "service.cli", *args], capture_output=True, text=True,
-                          timeout=timeout)
+    return subprocess.run([sys.executable, "-m", "service.cli", *args], capture_output=True, text=True, timeout=timeout)
 
 
 def test_simulate_json_is_the_contract():
-    res = _run("simulate", "--bearing", "6208", "--radial-load", "3000", "--speed", "500",
-               "--duration", "0.005", "--json")
+    res = _run(
+        "simulate", "--bearing", "6208", "--radial-load", "3000", "--speed", "500", "--duration", "0.005", "--json"
+    )
     assert res.returncode == 0, res.stderr
     snap = json.loads(res.stdout, parse_constant=lambda c: pytest.fail(f"non-finite {c}"))
     assert snap["schema"] == "bearing-twin/state/1"
     assert snap["time_s"] == pytest.approx(0.005)
     assert len(snap["balls"]) == 9
     ball = snap["balls"][0]
-    assert set(ball["inner"]) >= {"load_n", "entrainment_speed_m_s", "slide_roll_ratio", "h_min_m", "lambda",
-                                  "regime", "mu"}
+    assert set(ball["inner"]) >= {
+        "load_n",
+        "entrainment_speed_m_s",
+        "slide_roll_ratio",
+        "h_min_m",
+        "lambda",
+        "regime",
+        "mu",
+    }
     assert snap["setpoint"]["radial_load_n"] == 3000.0
 
 
@@ -40,11 +47,22 @@ def test_report_quick(tmp_path):
     res = _run("report", "--out", str(tmp_path), "--quick", timeout=600)
     assert res.returncode == 0, res.stderr
     text = (tmp_path / "report.md").read_text()
-    for png in ("lambda_azimuth_500.png", "lambda_speed.png", "lambda_load.png", "lambda_clearance.png",
-                "startup.png", "seed001_torque.png", "seed003_reduction.png", "seed003_fig7_speed.png",
-                "seed003_temperature_resistance.png", "ehl_centre_line_isothermal.png",
-                "ehl_centre_line_current.png", "ehl_film_vs_speed.png", "angular_contact_jones.png",
-                "cwru_comparison.png"):
+    for png in (
+        "lambda_azimuth_500.png",
+        "lambda_speed.png",
+        "lambda_load.png",
+        "lambda_clearance.png",
+        "startup.png",
+        "seed001_torque.png",
+        "seed003_reduction.png",
+        "seed003_fig7_speed.png",
+        "seed003_temperature_resistance.png",
+        "ehl_centre_line_isothermal.png",
+        "ehl_centre_line_current.png",
+        "ehl_film_vs_speed.png",
+        "angular_contact_jones.png",
+        "cwru_comparison.png",
+    ):
         assert (tmp_path / png).stat().st_size > 10_000
         assert png in text
     assert "0.6797" in text and "-0.0727" in text
@@ -68,15 +86,18 @@ def test_negative_numbers_in_scientific_notation_are_values():
         res = _run("simulate", *args, "--duration", "0.001", "--json")
         assert res.returncode == 0, res.stderr
         assert json.loads(res.stdout)["status"] == "ok"
-    res = _run("simulate", "--clear", "0", "--duration", "0.001")      # no abbreviations
+    res = _run("simulate", "--clear", "0", "--duration", "0.001")  # no abbreviations
     assert res.returncode == 2 and "unrecognized arguments" in res.stderr
 
 
 def test_a_closed_pipe_ends_quietly():
     """`simulate --json | head -c 100`: the reader goes away; no BrokenPipeError traceback."""
-    proc = subprocess.Popen([sys.executable, "-m", "service.cli", "simulate", "--duration", "0.001", "--json"],
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    proc.stdout.close()                    # nothing reads: the first write fails with EPIPE
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "service.cli", "simulate", "--duration", "0.001", "--json"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    proc.stdout.close()  # nothing reads: the first write fails with EPIPE
     _out, err = proc.communicate(timeout=300)
     assert proc.returncode == 141, err
     assert b"Traceback" not in err and b"BrokenPipeError" not in err
@@ -87,9 +108,23 @@ def test_a_busy_zenoh_port_is_a_one_line_error(tmp_path):
         busy.bind(("127.0.0.1", 0))
         busy.listen()
         port = busy.getsockname()[1]
-        res = subprocess.run([sys.executable, "-m", "service.cli", "serve", "--port", "0", "--no-record",
-                              "--zenoh-listen", f"tcp/127.0.0.1:{port}"], capture_output=True, text=True,
-                             timeout=300, cwd=tmp_path)
+        res = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "service.cli",
+                "serve",
+                "--port",
+                "0",
+                "--no-record",
+                "--zenoh-listen",
+                f"tcp/127.0.0.1:{port}",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            cwd=tmp_path,
+        )
     assert res.returncode == 2
     lines = [line for line in res.stderr.splitlines() if line.strip()]
     assert len(lines) == 1 and lines[0].startswith("error: zenoh") and "already in use" in lines[0], res.stderr
@@ -101,13 +136,30 @@ def test_scenario_run_names_the_recording_it_wrote(tmp_path):
     <stem>.run2.rrd and says so (issue 16: it used to print the name it did not write)."""
     pytest.importorskip("rerun")
     scenario = tmp_path / "tiny.yaml"
-    scenario.write_text("name: tiny\nbearing: \"6208\"\ninitial: {shaft_speed_rad_s: 300.0, radial_load_n: 3000.0}\n"
-                        "duration_s: 0.01\nsample_every_s: 0.005\nsteps:\n  - at_s: 0.0\n"
-                        "    set: {shaft_speed_rad_s: 300.0}\n")
+    scenario.write_text(
+        'name: tiny\nbearing: "6208"\ninitial: {shaft_speed_rad_s: 300.0, radial_load_n: 3000.0}\n'
+        "duration_s: 0.01\nsample_every_s: 0.005\nsteps:\n  - at_s: 0.0\n"
+        "    set: {shaft_speed_rad_s: 300.0}\n"
+    )
     taken = tmp_path / "x.rrd"
     taken.write_bytes(b"an earlier run")
-    res = subprocess.run([sys.executable, "-m", "service.cli", "scenario", "run", str(scenario), "--record",
-                          str(taken), "--no-progress"], capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    res = subprocess.run(
+        [
+            sys.executable,
+            "-m",
+            "service.cli",
+            "scenario",
+            "run",
+            str(scenario),
+            "--record",
+            str(taken),
+            "--no-progress",
+        ],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=tmp_path,
+    )
     assert res.returncode == 0, res.stdout + res.stderr
     written = tmp_path / "x.run2.rrd"
     assert f"recording: {written}" in res.stdout, res.stdout

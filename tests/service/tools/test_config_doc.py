@@ -9,8 +9,7 @@ from service.tools.config_doc import DOC, configuration_markdown, main
 
 
 def test_configuration_doc_is_current():
-    assert DOC.read_text(encoding="utf-8") == configuration_markdown(), \
-        "run: python -m service.tools.config_doc"
+    assert DOC.read_text(encoding="utf-8") == configuration_markdown(), "run: python -m service.tools.config_doc"
     assert main(["--check"]) == 0
 
 

@@ -6,13 +6,23 @@ import sys
 
 import pytest
 
-KEYS = {"kappa", "a_iso", "l10_h", "l10m_h", "l10_contact_loads_h", "damage_fraction", "remaining_life_h",
-        "dynamic_load_rating_n", "equivalent_load_n"}
+KEYS = {
+    "kappa",
+    "a_iso",
+    "l10_h",
+    "l10m_h",
+    "l10_contact_loads_h",
+    "damage_fraction",
+    "remaining_life_h",
+    "dynamic_load_rating_n",
+    "equivalent_load_n",
+}
 
 
 def _run(*args, timeout=600):
-    return subprocess.run([sys.executable, "-m", "service.cli", "life", *args], capture_output=True, text=True,
-                          timeout=timeout)
+    return subprocess.run(
+        [sys.executable, "-m", "service.cli", "life", *args], capture_output=True, text=True, timeout=timeout
+    )
 
 
 def _json(res):
@@ -37,8 +47,7 @@ def test_life_json_keys_and_iso_numbers():
 
 def test_life_combined_load_and_table_output():
     """Fa = 1000 N on the 6208: P = 0.56 Fr + Y Fa = 3373 N (ISO 281 Table 3); the human table."""
-    out = _json(_run("--bearing", "6208", "--radial-load", "3000", "--axial-load", "1000", "--speed", "500",
-                     "--json"))
+    out = _json(_run("--bearing", "6208", "--radial-load", "3000", "--axial-load", "1000", "--speed", "500", "--json"))
     assert out["equivalent_load_n"] == pytest.approx(3373.4, abs=0.2)
     res = _run("--bearing", "6208", "--radial-load", "3000", "--speed", "500", "--oil-temperature", "70")
     assert res.returncode == 0, res.stderr

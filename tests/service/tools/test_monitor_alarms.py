@@ -51,21 +51,23 @@ def test_alarm_events_reach_zenoh_and_the_monitor(support):
     try:
         channel = bus.attach_twin("a1", lambda: None, lambda p: {})
         peer.subscribe("bearing/a1/alarm")
-        got = peer.wait_for(lambda s: s.key == "bearing/a1/alarm", poke=lambda: channel.publish_alarm(raised),
-                            poke_every_s=0.1)
+        got = peer.wait_for(
+            lambda s: s.key == "bearing/a1/alarm", poke=lambda: channel.publish_alarm(raised), poke_every_s=0.1
+        )
         body = support.strict_loads(got.payload)
         assert body == {**raised, "bearing_id": "a1"} and body["schema"] == "bearing-twin/alarm/1"
 
         def keep_publishing():
             while not stop.wait(0.05):
                 channel.publish_alarm(raised)
+
         thread = threading.Thread(target=keep_publishing, daemon=True)
         thread.start()
         rows = run_monitor([endpoint], [], duration_s=4.0, out=io.StringIO())
         stop.set()
         thread.join(5.0)
         channel.detach()
-        channel.publish_alarm(raised)            # after detach: a no-op
+        channel.publish_alarm(raised)  # after detach: a no-op
     finally:
         stop.set()
         peer.close()

@@ -29,8 +29,23 @@ def _own_spec(**geometry) -> dict:
 def test_simulate_runs_the_spec_file(tmp_path, capsys):
     path = tmp_path / "own.json"
     path.write_text(json.dumps(_own_spec()))
-    assert main(["simulate", "--bearing", str(path), "--speed", "300", "--radial-load", "800",
-                 "--duration", "0.002", "--json"]) == 0
+    assert (
+        main(
+            [
+                "simulate",
+                "--bearing",
+                str(path),
+                "--speed",
+                "300",
+                "--radial-load",
+                "800",
+                "--duration",
+                "0.002",
+                "--json",
+            ]
+        )
+        == 0
+    )
     snap = json.loads(capsys.readouterr().out)
     assert snap["designation"] == "MY-6205-8" and len(snap["balls"]) == 8
 
@@ -41,8 +56,7 @@ def test_a_bad_spec_file_names_the_field(tmp_path, capsys):
     assert main(["simulate", "--bearing", str(path), "--duration", "0.001"]) == 2
     err = capsys.readouterr().err
     assert "geometry.ball_count" in err and "16" in err and "Traceback" not in err
-    assert main(["thermal", "--bearing", str(tmp_path / "none.yaml"), "--speed", "300",
-                 "--radial-load", "800"]) == 2
+    assert main(["thermal", "--bearing", str(tmp_path / "none.yaml"), "--speed", "300", "--radial-load", "800"]) == 2
     assert "cannot read spec file" in capsys.readouterr().err
 
 
@@ -53,8 +67,25 @@ def test_vibration_analyse_takes_the_lines_from_a_spec_file(tmp_path, capsys):
     path.write_text(yaml.safe_dump(catalog.bearing("CWRU-DE").model_dump(mode="json")))
     results = []
     for bearing in ("CWRU-DE", str(path)):
-        assert main(["vibration", "analyse", str(RECORD), "--sample-rate", "12000", "--rpm", "1797",
-                     "--units", "g", "--bearing", bearing, "--json"]) == 0
+        assert (
+            main(
+                [
+                    "vibration",
+                    "analyse",
+                    str(RECORD),
+                    "--sample-rate",
+                    "12000",
+                    "--rpm",
+                    "1797",
+                    "--units",
+                    "g",
+                    "--bearing",
+                    bearing,
+                    "--json",
+                ]
+            )
+            == 0
+        )
         results.append(json.loads(capsys.readouterr().out))
     assert results[0] == results[1]
     assert results[1]["largest_lines"][0]["label"] == "BPFI"
@@ -65,8 +96,10 @@ def test_serve_starts_its_twin_from_a_spec_file(tmp_path, support):
     path = tmp_path / "own.yaml"
     path.write_text(yaml.safe_dump(_own_spec()))
     settings = ServiceSettings(enable_zenoh=False, enable_recording=False, admission="off", bearing=str(path))
-    with support.ThreadServer(settings, start_timeout_s=60.0, stop_timeout_s=15.0) as srv, \
-            httpx.Client(base_url=srv.url, timeout=60.0) as c:
+    with (
+        support.ThreadServer(settings, start_timeout_s=60.0, stop_timeout_s=15.0) as srv,
+        httpx.Client(base_url=srv.url, timeout=60.0) as c,
+    ):
         info = c.get("/v1/bearings/default").json()
     assert info["designation"] == "MY-6205-8" and info["ball_count"] == 8
 

@@ -51,33 +51,42 @@ def test_csv_and_wav_read_the_same_record(tmp_path, capsys):
     pcm = tmp_path / "pcm.wav"
     scipy.io.wavfile.write(pcm, 12000, np.round(x / 4.0 * 32768).astype(np.int16))
     rms = float(np.std(x.astype(float))) * G
-    for path, extra, tol in ((csv, ["--sample-rate", 12000], 1e-6), (wav, [], 1e-6),
-                             (pcm, ["--full-scale", 4.0], 1e-3)):
+    for path, extra, tol in (
+        (csv, ["--sample-rate", 12000], 1e-6),
+        (wav, [], 1e-6),
+        (pcm, ["--full-scale", 4.0], 1e-3),
+    ):
         code, out, err = _run(capsys, path, *extra, "--rpm", 1797, "--units", "g", "--bearing", "6205", "--json")
         assert code == 0, err
         assert json.loads(out)["rms_m_s2"] == pytest.approx(rms, rel=tol)
 
 
 def test_given_band_and_text_output(capsys):
-    code, out, err = _run(capsys, RECORD, "--sample-rate", 12000, "--rpm", 1797, "--units", "g", "--bearing",
-                          "6205", "--band", 2000, 5000)
+    code, out, err = _run(
+        capsys, RECORD, "--sample-rate", 12000, "--rpm", 1797, "--units", "g", "--bearing", "6205", "--band", 2000, 5000
+    )
     assert code == 0, err
     assert "2000-5000 Hz (given)" in out and "BPFI" in out
 
 
-@pytest.mark.parametrize("args, message", [
-    (["missing.npy", "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205"], "FILE: "),
-    (["rec.txt", "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205"], "FILE: rec.txt: unknown format"),
-    ([RECORD, "--rpm", 1797, "--bearing", "6205"], "--sample-rate: required"),
-    ([RECORD, "--sample-rate", -5, "--rpm", 1797, "--bearing", "6205"],
-     "--sample-rate: -5 is out of range; allowed (0, 1e+06] Hz"),
-    ([RECORD, "--sample-rate", 12000, "--rpm", 0, "--bearing", "6205"], "--rpm: 0; allowed (0, 36000]"),
-    ([RECORD, "--sample-rate", 12000, "--rpm", 1e6, "--bearing", "6205"], "--rpm: "),
-    ([RECORD, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "9999"], "--bearing: "),
-    ([RECORD, "--sample-rate", 12000, "--rpm", 1797], "--bearing: required"),
-    ([RECORD, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205", "--band", 5000, 2000], "--band: "),
-    ([RECORD, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205", "--column", 1], "--column: 1"),
-])
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["missing.npy", "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205"], "FILE: "),
+        (["rec.txt", "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205"], "FILE: rec.txt: unknown format"),
+        ([RECORD, "--rpm", 1797, "--bearing", "6205"], "--sample-rate: required"),
+        (
+            [RECORD, "--sample-rate", -5, "--rpm", 1797, "--bearing", "6205"],
+            "--sample-rate: -5 is out of range; allowed (0, 1e+06] Hz",
+        ),
+        ([RECORD, "--sample-rate", 12000, "--rpm", 0, "--bearing", "6205"], "--rpm: 0; allowed (0, 36000]"),
+        ([RECORD, "--sample-rate", 12000, "--rpm", 1e6, "--bearing", "6205"], "--rpm: "),
+        ([RECORD, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "9999"], "--bearing: "),
+        ([RECORD, "--sample-rate", 12000, "--rpm", 1797], "--bearing: required"),
+        ([RECORD, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205", "--band", 5000, 2000], "--band: "),
+        ([RECORD, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205", "--column", 1], "--column: 1"),
+    ],
+)
 def test_errors_name_the_option(capsys, args, message):
     code, out, err = _run(capsys, *args)
     assert code == 2 and out == ""
