@@ -13,8 +13,8 @@ import queue
 import socket
 import threading
 import time
-from typing import Any, NamedTuple
 from collections.abc import Callable
+from typing import Any, NamedTuple
 
 PEER_WAIT_S = 30.0
 

@@ -29,7 +29,6 @@ from typing import TYPE_CHECKING, Any
 import numba
 from numba.core import caching
 
-
 # the package whose kernels the stripped-source locator serves and whose code names the cache
 ENGINE_ROOT = Path(__file__).resolve().parent
 

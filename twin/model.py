@@ -20,6 +20,7 @@ import numpy as np
 
 from twin import timestep
 from twin.kernels import layout as L
+from twin.kernels.profile import write_profile_params
 from twin.kernels.structures import ModelArrays
 from twin.kernels.tribology import N_TRIBOLOGY, T_PIVOT, tribology_coefficients
 from twin.physics import hertz
@@ -28,7 +29,6 @@ from twin.physics.traction import deformed_surface_radius_m, hertz_strip_table
 from twin.physics.viscosity import dynamic_viscosity_pa_s
 from twin.spec import BearingSpec, ModelOptions
 from twin.vibration.housing import housing_params
-from twin.kernels.profile import write_profile_params
 from twin.vibration.signal import DecimatorDesign, design_decimator, integer_ratio_time_step
 
 # ISO 76 static limit for ball bearings: 4.2 GPa; the model refuses loads whose analytic maximum

@@ -8,9 +8,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin.kernels import layout as L
-from twin.model import BearingModel
 from twin.kernels.layout import MAX_DEFECTS
 from twin.kernels.structures import StateArrays
+from twin.model import BearingModel
 from twin.vibration.defects import N_DEFECT_PARAMS
 from twin.vibration.housing import N_HOUSING_DOF
 from twin.vibration.signal import N_DD_HEADER, N_RS_HEADER

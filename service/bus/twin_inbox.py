@@ -22,7 +22,7 @@ from typing import Any
 import zenoh
 
 from service.bus.twin_outbox import undeclare
-from service.bus.wire import Bus, JSON_ENCODING, dumps, one_line, payload
+from service.bus.wire import JSON_ENCODING, Bus, dumps, one_line, payload
 from service.keys import (
     DEFECTS,
     DEFECTS_RESULT,

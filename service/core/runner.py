@@ -47,9 +47,9 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.capacity import CpuMeter, TwinCost
 from service.core.defects import DefectBox, parse_defects
+from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.faults import Fallback, FaultPolicy
 from service.core.mailbox import Mailbox, SetpointTiming
 from service.core.pacing import PacingClock

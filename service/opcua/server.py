@@ -72,6 +72,7 @@ from asyncua.server.user_managers import UserManager
 
 from service.core.alarms import AlarmEvent, inputs_from_snapshot
 from service.core.errors import InputError
+from service.opcua.guard import OpcUaGuard
 from service.opcua.layout import (
     APPLICATION_URI,
     EVENT_TYPE,
@@ -83,7 +84,6 @@ from service.opcua.layout import (
     View,
     identification,
 )
-from service.opcua.guard import OpcUaGuard
 from service.opcua.security import POLICIES, ClientTrust, PkiError, ServerPki, given_pki, self_signed_pki
 
 log = logging.getLogger(__name__)

@@ -24,8 +24,8 @@ import numpy as np
 from service.core.alarms import ALARM_IDS
 from service.recording import alarm_columns as A
 from service.recording import columns as C
-from service.recording import vibration_columns as V
 from service.recording import trends
+from service.recording import vibration_columns as V
 from service.recording.archive import WaveformArchive, is_spectrum
 from service.recording.layout import TwinLayout, send_static
 

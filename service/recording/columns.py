@@ -19,7 +19,6 @@ import numpy as np
 import rerun as rr
 
 from service.recording.arrow import bar_columns
-from twin.snapshot import LAMBDA_KEY
 from service.recording.layout import (
     CONTACT_SERIES,
     LOAD_ZONE,
@@ -30,6 +29,7 @@ from service.recording.layout import (
     SIM_TIME,
     TwinLayout,
 )
+from twin.snapshot import LAMBDA_KEY
 
 # contact fields per ball and side, in this order (getattr with a None default)
 CONTACT_FIELDS = ("load_n", "lambda_", "mu", "contact_angle_rad", "resistance_ohm", "capacitance_f")

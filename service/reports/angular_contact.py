@@ -15,9 +15,9 @@ from pathlib import Path
 import numpy as np
 
 from service.reports.figures import pyplot, save
-from twin.validation import analytic
 from twin.engine import Twin
 from twin.setpoint import Setpoint
+from twin.validation import analytic
 
 FAMILY = (("7208", 40.0), ("7208AC", 25.0), ("7208C", 15.0))
 LOADS = ((3000.0, 3000.0), (0.0, 3000.0))  # (Fr, Fa) [N]

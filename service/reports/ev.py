@@ -17,10 +17,10 @@ from pathlib import Path
 import numpy as np
 
 from service.reports.figures import pyplot, save
-from twin.validation import studies
-from twin.validation import thermal_law_fit as tcal
 from twin.ehl_solver import params as prm
 from twin.spec import Thermal
+from twin.validation import studies
+from twin.validation import thermal_law_fit as tcal
 
 BAND = (0.576, 0.848)  # seed 003 Fig. 2: reduction of the minimum film
 CURRENTS_A = (0.0, 10.0, 20.0, 30.0)

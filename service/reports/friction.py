@@ -12,10 +12,9 @@ from pathlib import Path
 from service.reports.figures import pyplot, save
 from service.reports.friction_reference import iso15312_markdown, iso15312_rows, skf_markdown, skf_rows
 from twin import catalog
-from twin.validation import skf_friction
-from twin.validation import studies
 from twin.physics import viscosity
 from twin.spec import ModelOptions
+from twin.validation import skf_friction, studies
 
 # designation: (bore mm, outside diameter mm); the seed oil at 40 degC
 BEARINGS = {"6208": (40.0, 80.0), "6210": (50.0, 90.0)}

@@ -11,14 +11,14 @@ import numpy as np
 from tqdm import tqdm
 
 from service.reports.figures import pyplot, save
-from twin.validation import studies, timestep_study
-from twin.validation.bench import run_engine_benchmark
 from twin import catalog
 from twin.engine import Twin
 from twin.kernels import layout as L
-from twin.validation import thrust_bearing_seed001 as s001
 from twin.setpoint import Setpoint
 from twin.spec import ModelOptions
+from twin.validation import studies, timestep_study
+from twin.validation import thrust_bearing_seed001 as s001
+from twin.validation.bench import run_engine_benchmark
 
 SPEEDS = [100, 300, 500, 700, 900, 1100, 1300, 1500, 1700]
 LOADS = [750, 1500, 3000, 4500, 6000, 7500]
@@ -188,8 +188,8 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
     from service.reports import ev as report_ev
     from service.reports.angular_contact import angular_contact_section
     from service.reports.cwru import cwru_section
-    from service.reports.friction import friction_section
     from service.reports.ehl import write_ehl_section
+    from service.reports.friction import friction_section
     from service.reports.thermal import thermal_section
     from service.reports.vibration import vibration_section
 

@@ -8,11 +8,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
-
 from service.reports.figures import pyplot, save
 from twin.thermal.network import NODE_NAMES
-from twin.validation.thermal_studies import decay_time_constant_s, startup_transient, transient_time_constants_s
 from twin.validation.thermal_steady import steady_operating_point
+from twin.validation.thermal_studies import decay_time_constant_s, startup_transient, transient_time_constants_s
 
 
 def thermal_section(out: Path, quick: bool) -> list[str]:

@@ -14,8 +14,8 @@ import sys
 from pathlib import Path
 
 from service import __version__
-from service.tools.bench_results import save as save_result
 from service.settings import ServiceSettings
+from service.tools.bench_results import save as save_result
 from service.tools.messages import error_text
 from service.tools.scenario_cli import add_scenario_command
 from service.tools.settings_flags import add_settings_flags, flag_overrides, settings_error_text
@@ -164,10 +164,9 @@ def _cmd_timestep_study(args: argparse.Namespace) -> int:
 def _cmd_vibration(args: argparse.Namespace) -> int:
     from pydantic import ValidationError
 
+    from twin import catalog
     from twin.setpoint import SetpointError
     from twin.validation.vibration_simulation import simulate_vibration
-
-    from twin import catalog
 
     if args.speed is None:
         print("error: vibration: --speed required (or `vibration analyse FILE`)", file=sys.stderr)
@@ -442,10 +441,9 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     import logging
 
     from pydantic import ValidationError
+    from pydantic_settings import SettingsError
 
     from twin import catalog
-
-    from pydantic_settings import SettingsError
 
     try:
         settings = _serve_settings(args)

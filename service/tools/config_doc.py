@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
+
 from pydantic import BaseModel
 
 from service.settings import ENV_PREFIX, AlarmSettings, FlatSetting, RouterSettings, ServiceSettings, flat_settings

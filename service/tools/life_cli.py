@@ -64,8 +64,8 @@ def _cmd_life(args: argparse.Namespace) -> int:
 
     from twin import catalog
     from twin.life.settings import LifeSettings
-    from twin.validation.life_rating import rate_operating_point
     from twin.setpoint import SetpointError
+    from twin.validation.life_rating import rate_operating_point
 
     try:
         spec = catalog.bearing_or_file(args.bearing)

@@ -58,8 +58,8 @@ def _alarm_settings_from_env() -> AlarmSettings:
 
 
 def _cmd_scenario_run(args: argparse.Namespace) -> int:
-    from service.tools.offline import TableSink, run_scenario, write_table
     from service.core.scenarios import ScenarioError, load_scenario
+    from service.tools.offline import TableSink, run_scenario, write_table
 
     try:
         scenario = load_scenario(args.file)

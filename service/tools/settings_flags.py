@@ -16,7 +16,6 @@ from pydantic import BaseModel, SecretStr, ValidationError
 
 from service.settings import FlatSetting, flat_settings
 
-
 _METAVARS = {int: "N", float: "VALUE", Path: "PATH"}
 
 

@@ -42,8 +42,8 @@ import numpy as np
 import pytest
 
 from twin.ehl_solver import film_reduction as calibration
-from twin.ehl_solver import solve_point_contact
 from twin.ehl_solver import params as prm
+from twin.ehl_solver import solve_point_contact
 from twin.ehl_solver.elastic import Deflection
 from twin.ehl_solver.solver import DEFAULT_DOMAIN, _Level
 

@@ -14,12 +14,12 @@ import pytest
 from scipy import optimize
 
 from twin import catalog
-from twin.validation import analytic
 from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.model import contact_constants, make_model
 from twin.setpoint import Setpoint
 from twin.spec import BearingSpec, ModelOptions
+from twin.validation import analytic
 
 SPEED = 500.0
 SETTLE_S = 0.03

@@ -6,8 +6,8 @@ import pytest
 
 from twin import catalog
 from twin.engine import Twin
-from twin.kernels import layout as L
 from twin.friction_power import boundary_dimensions_m, oil_level_m
+from twin.kernels import layout as L
 from twin.physics import drag, starvation
 from twin.physics.viscosity import density_kg_m3
 from twin.setpoint import Setpoint

@@ -14,10 +14,10 @@ Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) that an earlier reading of seed 000 eq. 2 carrie
 import numpy as np
 import pytest
 
-from twin.validation import analytic
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 from twin.spec import ModelOptions
+from twin.validation import analytic
 
 TOL = 0.03  # the 3 % agreement
 

@@ -5,8 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from twin.validation import studies
 from twin.spec import ModelOptions
+from twin.validation import studies
 
 SPEEDS = [100, 300, 500, 700, 900, 1100, 1300, 1500, 1700]
 EDGE = 0.02  # Table 3's band edges are rounded: a value within 2 % of an edge counts as inside

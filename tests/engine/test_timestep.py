@@ -11,11 +11,11 @@ import pytest
 from pydantic import ValidationError
 
 from twin import catalog, timestep
-from twin.validation import timestep_study
 from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.model import make_model
 from twin.spec import ModelOptions
+from twin.validation import timestep_study
 
 
 def _leapfrog_stability_limit(zeta: float) -> float:

@@ -14,8 +14,8 @@ from pathlib import Path
 
 import pytest
 
-from service.settings import ServiceSettings
 from loadtest.soak import SoakConfig, _memory, format_report, run_soak
+from service.settings import ServiceSettings
 
 # `python -m loadtest` from any folder finds this tree's package
 LOADTEST_ENV = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parents[2])}

@@ -6,8 +6,7 @@ import math
 
 import pytest
 
-from twin import catalog
-from twin import life
+from twin import catalog, life
 from twin.model import make_model
 
 FR = 3000.0

@@ -5,8 +5,7 @@ import math
 
 import pytest
 
-from twin import catalog
-from twin import life
+from twin import catalog, life
 
 TWO_PI = 2.0 * math.pi
 

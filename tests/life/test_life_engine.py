@@ -7,10 +7,9 @@ import math
 
 import pytest
 
-from twin import life
+from twin import catalog, life
 from twin.engine import Twin
 from twin.model import make_model
-from twin import catalog
 from twin.physics.thermal import roelands_temperature_viscosity_pa_s
 from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 

@@ -5,11 +5,11 @@ import numpy as np
 import pytest
 
 from twin import catalog
-from twin.validation import skf_friction, studies
-from twin.physics import viscosity
 from twin.kernels import layout as L
 from twin.kernels.step import evaluate
+from twin.physics import viscosity
 from twin.spec import ModelOptions
+from twin.validation import skf_friction, studies
 
 LOADS_N = (750.0, 1500.0, 3000.0, 7500.0)
 

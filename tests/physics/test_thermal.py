@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 
 from twin import catalog
-from twin.validation import studies
 from twin.engine import Twin
 from twin.physics import thermal, viscosity
 from twin.setpoint import Setpoint
 from twin.spec import BearingSpec, ModelOptions, Thermal
+from twin.validation import studies
 
 
 def test_roelands_temperature_law_by_hand():

@@ -12,11 +12,10 @@ wait is bounded; nothing here is a wall-clock threshold."""
 
 from __future__ import annotations
 
+import asyncio
 import json
 import queue
 import time
-
-import asyncio
 
 import httpx
 import numpy as np

@@ -16,9 +16,9 @@ pytest.importorskip("rerun")
 from service.core.alarms import ALARM_IDS
 from service.recording import RerunRecorder, describe_recording, read_column, read_index
 from service.recording.archive import WaveformArchive
-from service.recording.vibration_columns import WaveRow
 from service.recording.layout import SERIES, TREND_BANDS, TwinLayout, blueprint
 from service.recording.trends import OFF_SCALE_DECADES, _capacitance_scale, split_windows
+from service.recording.vibration_columns import WaveRow
 from twin.engine import Twin
 
 FRAME_S = 0.02  # 50 Hz snapshots

@@ -6,7 +6,7 @@ import pytest
 
 from twin import catalog
 from twin.thermal.estimator import DissipationEstimator, EstimatorSettings, convergence_time_s
-from twin.thermal.integrator import step_c, steady_state_c
+from twin.thermal.integrator import steady_state_c, step_c
 from twin.thermal.network import NODE_NAMES, Operating, assemble, network_geometry
 from twin.thermal.settings import ThermalNetworkSettings
 

@@ -8,7 +8,7 @@ from scipy.linalg import expm
 
 from twin import catalog
 from twin.thermal import correlations as cr
-from twin.thermal.integrator import step_c, steady_state_c, transition
+from twin.thermal.integrator import steady_state_c, step_c, transition
 from twin.thermal.materials import AIR_CONDUCTIVITY_W_M_K, AIR_KINEMATIC_VISCOSITY_M2_S, AIR_PRANDTL
 from twin.thermal.network import NODE_NAMES, Network, Operating, assemble, network_geometry
 from twin.thermal.settings import ThermalNetworkSettings

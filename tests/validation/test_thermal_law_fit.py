@@ -2,9 +2,9 @@
 
 import pytest
 
-from twin.validation import thermal_law_fit as tc
 from twin.ehl_solver import params as prm
 from twin.spec import Thermal
+from twin.validation import thermal_law_fit as tc
 
 
 @pytest.fixture(scope="module")

@@ -9,10 +9,10 @@ from pydantic import ValidationError
 
 from twin import catalog
 from twin.kernels import layout as L
+from twin.kernels.profile import profile_height_m
+from twin.validation.vibration_simulation import defect_for
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.housing import sensor_resonance
-from twin.validation.vibration_simulation import defect_for
-from twin.kernels.profile import profile_height_m
 from twin.vibration.surface import ball_radius_offsets_m, race_profile_m
 
 

@@ -26,7 +26,6 @@ import math
 from numba import njit
 
 from twin.jit import JIT, JIT_VECTOR
-
 from twin.kernels.layout import (
     CW,
     G_DEFECT_DROP,
@@ -48,19 +47,19 @@ from twin.kernels.layout import (
     O_FZ,
     P_PROFILE_ON,
     P_VIB,
-    W_DEFECTS,
-    W_ORIENTATION,
+    V_INNER_FOOTPRINT,
     V_INNER_GROOVE_RADIUS,
     V_INNER_RACEWAY_RADIUS,
     V_INNER_RX,
-    V_INNER_FOOTPRINT,
+    V_OUTER_FOOTPRINT,
     V_OUTER_GROOVE_RADIUS,
     V_OUTER_RACEWAY_RADIUS,
     V_OUTER_RX,
-    V_OUTER_FOOTPRINT,
+    W_DEFECTS,
+    W_ORIENTATION,
 )
+from twin.kernels.profile import profile_drops
 from twin.vibration.defects import (
-    N_DEFECT_PARAMS,
     D_BALL,
     D_CENTRE_COS,
     D_CENTRE_SIN,
@@ -69,10 +68,10 @@ from twin.vibration.defects import (
     KIND_BALL,
     KIND_INNER,
     KIND_OUTER,
+    N_DEFECT_PARAMS,
     contact_defect_drop_m,
     quat_integrate,
 )
-from twin.kernels.profile import profile_drops
 
 # Called every step: inlined at numba level (a call that passes arrays costs their reference
 # counting, ~100 ns per step on the test machine for these passes); the rare ones stay calls.

@@ -34,7 +34,6 @@ import statistics
 import time
 from typing import Any
 
-
 from numba import njit
 
 from twin.jit import JIT, JIT_STEP

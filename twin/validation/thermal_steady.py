@@ -26,7 +26,6 @@ from twin.thermal.network import NODE_NAMES
 from twin.thermal.settings import ThermalNetworkSettings
 from twin.thermal.sources import HeatSources
 
-
 STEADY_PERIOD_S = 0.05  # network step of the steady iteration [s] (real heat capacities: 50 ms of simulated time)
 
 

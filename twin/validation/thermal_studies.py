@@ -18,8 +18,8 @@ from twin.engine import Twin
 from twin.setpoint import Setpoint
 from twin.spec import ModelOptions
 from twin.thermal.network import NODE_NAMES, Network, coupled_time_constants_s
-from twin.thermal.sources import RING_SHARE
 from twin.thermal.settings import ThermalNetworkSettings
+from twin.thermal.sources import RING_SHARE
 
 
 @dataclass(frozen=True)

@@ -15,8 +15,8 @@ rc, so 1/Ry = 2/d - 1/rc, i.e. Ry = rc (d/2) / (rc - d/2) and k = Ry/Rx = rc / (
 Check: d = 7.938 mm gives k = 21.78, the value seed 001 Section 4.5 states.
 """
 
-from dataclasses import dataclass
 import math
+from dataclasses import dataclass
 
 from twin.physics.hertz import semi_major_axis_m
 from twin.physics.rolling import (
