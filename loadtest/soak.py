@@ -30,7 +30,8 @@ What it does, for `minutes` of wall time:
 * an unexpected answer is an error: a 5xx, a transport failure, a refusal of a valid setpoint
   other than 429, an acceptance of an invalid one;
 * with `--start` it launches `bearing-twin serve` on free loopback ports with a token, zenoh
-  access control (a generated users file: the writer `soak`) and a recording in a temp dir, and at the end stops it with SIGTERM (bounded wait) and reads the
+  access control (a generated users file: the writer `soak`) and a recording in a temp dir, and at the end stops it
+  with SIGTERM (bounded wait) and reads the
   recording back, every segment of it (`service.recording.recording_segments`; `--record-segment-s`
   sets the service's rotation period): complete = every segment readable on its own (one
   recording id, the static geometry, a blueprint), together at least the rows the service

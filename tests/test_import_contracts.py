@@ -1,6 +1,7 @@
 """The import rules of the README's "Architecture" section, as import-linter contracts in
 pyproject.toml ([tool.importlinter]): `twin` never imports `service` (nor fastapi, zenoh, rerun,
-matplotlib); the runtime engine never imports `twin.validation` (the offline science); `service.core` imports no fastapi, zenoh or rerun, nor the wings built on them;
+matplotlib); the runtime engine never imports `twin.validation` (the offline science); `service.core` imports no
+fastapi, zenoh or rerun, nor the wings built on them;
 the service's layers go tools > reports > api > wiring > bus | recording > core > settings; twin's
 layers go validation > engine > its couplings > state > model > spec > kernels > laws > jit, with
 every module of twin placed in a layer (exhaustive); no import cycle among the modules of `service`

@@ -14,7 +14,8 @@ generator per twin seeded with `Accelerometer.noise_seed` (reproducible whatever
 
 Every `Accelerometer.window_s` of samples the indicators are computed (`run_vibration`, envelope
 band around the housing's sensed resonance; with the window's full envelope and amplitude spectra,
-`VibrationState.envelope_spectrum` / `amplitude_spectrum`, kept out of the snapshot's JSON) with the defect frequencies of the window's mean shaft
+`VibrationState.envelope_spectrum` / `amplitude_spectrum`, kept out of the snapshot's JSON) with the defect frequencies
+of the window's mean shaft
 speed and the loaded contact angle measured on the contact lanes at the window's end
 (`defect_frequencies.loaded_contact_angle_rad`; the nominal angle while no ball is loaded).
 """

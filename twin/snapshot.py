@@ -79,7 +79,8 @@ class ElectricalState(BaseModel):
         description="Equivalent parallel resistance 1/Re(Y) at the frequency [ohm]; null: no conduction."
     )
     capacitance_f: float | None = Field(
-        description="Equivalent parallel capacitance Im(Y)/omega [F], published where the network is capacitive (impedance "
+        description="Equivalent parallel capacitance Im(Y)/omega [F], published where the network is capacitive "
+        "(impedance "
         "phase at or below -45 deg); null otherwise, with capacitance_reason."
     )
     capacitance_reason: str | None = Field(
@@ -104,7 +105,8 @@ class ElectricalState(BaseModel):
     )
     shear_temperature_rise_k: float = Field(
         default=0.0,
-        description="Inlet shear-heating temperature rise (seed 003 eq. 6 at the inlet; 0 when shear heating is off) [K].",
+        description="Inlet shear-heating temperature rise (seed 003 eq. 6 at the inlet; 0 when shear heating is off) "
+        "[K].",
     )
     film_thermal_factor: float = Field(
         default=1.0, description="Film thickness / isothermal film thickness from the heating (1: none) [-]."
@@ -123,7 +125,8 @@ class LifeState(BaseModel):
     )
     a_iso: float | None = Field(
         default=None,
-        description="Life modification factor a_ISO (ISO 281:2007 clause 9.3, <= 50) [-]; null at rest or for kappa < 0.1.",
+        description="Life modification factor a_ISO (ISO 281:2007 clause 9.3, <= 50) [-]; null at rest or for kappa < "
+        "0.1.",
     )
     l10_h: float | None = Field(
         default=None, description="Basic rating life L10 = (C/P)^3 at the current shaft speed [h]; null when unbounded."
@@ -134,7 +137,8 @@ class LifeState(BaseModel):
     )
     l10_contact_loads_h: float | None = Field(
         default=None,
-        description="Lundberg-Palmgren life from the twin's ball loads (ISO/TS 16281 spirit), running mean over the ball passages [h]; null when unbounded.",
+        description="Lundberg-Palmgren life from the twin's ball loads (ISO/TS 16281 spirit), running mean over the "
+        "ball passages [h]; null when unbounded.",
     )
     damage_fraction: float = Field(
         default=0.0, description="Palmgren-Miner damage accumulated along the twin's history [-] (1 = life used up)."
@@ -345,7 +349,9 @@ class Snapshot(BaseModel):
     )
     late_fraction: float | None = Field(
         default=None,
-        description="Fraction of the frames of the last 10 s of wall time that ended later than the service's lateness (5 ms by default) after their wall-clock deadline [-]; null when not measured (fast mode, before the first frame, outside the service).",
+        description="Fraction of the frames of the last 10 s of wall time that ended later than the service's lateness "
+        "(5 ms by default) after their wall-clock deadline [-]; null when not measured (fast mode, before the first "
+        "frame, outside the service).",
     )
     status: str = Field(description="'ok' or what went wrong and what the twin did about it.")
     restarts: int = Field(description="Warm restarts after a diverged or overloaded state.")
@@ -358,7 +364,8 @@ class Snapshot(BaseModel):
         description="Inner ring centre relative to the outer ring's (x along the radial load, y, z axial) [m]."
     )
     friction_torque_n_m: float = Field(
-        description="Friction torque of the bearing averaged over the last frame [N m]: the torque its outer ring holds "
+        description="Friction torque of the bearing averaged over the last frame [N m]: the torque its outer ring "
+        "holds "
         "(the shaft's drive torque less the rate of change of the balls' and cage's angular momentum) plus the balls' "
         "drag and the seals."
     )
@@ -366,7 +373,8 @@ class Snapshot(BaseModel):
         default=None, description="Friction power by source at time_s [W] (rolling, sliding, spin, drag, seal)."
     )
     viscosity_pa_s: float = Field(
-        description="Inlet viscosity: the oil at the oil temperature plus the inlet's current and shear heating (Roelands, seed 003 eq. 3) [Pa s]."
+        description="Inlet viscosity: the oil at the oil temperature plus the inlet's current and shear heating "
+        "(Roelands, seed 003 eq. 3) [Pa s]."
     )
     electrical: ElectricalState
     balls: tuple[BallState, ...]

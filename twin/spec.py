@@ -307,7 +307,8 @@ class Thermal(BaseModel):
         description="Reduce the film by the inlet shear heating of a rolling contact, the Murch-Wilson factor "
         "phi_T = 3.94 / (3.94 + L^0.62), L = beta eta u^2 / k' (Murch and Wilson 1975; twin.physics.thermal). On by "
         "default: a real inlet is shear-heated (SKF's frictional-moment model applies the same physics as phi_ish). "
-        "False: the isothermal inlet of seed 000's Hamrock-Dowson solution, which its validations (Table 3, Figs. 8-12; "
+        "False: the isothermal inlet of seed 000's Hamrock-Dowson solution, which its validations (Table 3, Figs. "
+        "8-12; "
         "twin.validation.studies) state explicitly [bool].",
     )
     film_temperature_exponent: float = Field(
@@ -315,7 +316,8 @@ class Thermal(BaseModel):
         gt=0.0,
         le=5.0,
         description="c_T of the loop's current-heating film law h/h_iso = g(dT)^c_T [-], fitted to the current heating "
-        "of the thermal EHL solver (twin.validation.thermal_law_fit: the solver's film with current over its film without, "
+        "of the thermal EHL solver (twin.validation.thermal_law_fit: the solver's film with current over its film "
+        "without, "
         "28 cells of seed 003 Appendix 2, rms 13 % in ln h, max error 6.4 points of reduction).",
     )
 
@@ -455,7 +457,8 @@ class ModelOptions(BaseModel):
         default=12,
         ge=2,
         le=32,
-        description="Strips across the major axis of each contact ellipse (ellipse_traction) [-]; 12: moments within 0.5 % "
+        description="Strips across the major axis of each contact ellipse (ellipse_traction) [-]; 12: moments within "
+        "0.5 % "
         "(spin moment 2 %) of 32 strips (tests/kernels/test_traction.py).",
     )
     traction_period_s: float = Field(
@@ -466,7 +469,8 @@ class ModelOptions(BaseModel):
         "refreshes (the nearest, at least 1); 400 us (10 refreshes of 40 us): over the envelope at the auto step "
         "(twin.validation.subrate_study) every output stays within the study's tolerances of "
         "the 10 us / 200 us sub-rates and of the 1 us step (torque 1.14 % of 2 % on the 7208 at 1700 rad/s, "
-        "7500 N + 3000 N); 800 us does not (loads 1.3 %, torque 3.1 % there). The torque moves by under 0.5 % from a solve at every "
+        "7500 N + 3000 N); 800 us does not (loads 1.3 %, torque 3.1 % there). The torque moves by under 0.5 % from a "
+        "solve at every "
         "refresh, the 7208 B's spin moments (Fr = Fa = 3000 N) by under 5 % (tests/physics/test_friction_torque.py), "
         "first order in the period.",
     )
@@ -509,7 +513,8 @@ class ModelOptions(BaseModel):
         description="Evaluate each tribology refresh at the load, entrainment speed and contact angle of the middle of "
         "the period it is held for (extrapolated from the previous refresh and the step's rates, "
         "twin.kernels.step.centred_inputs): the held values' error becomes second order in tribology_period_s "
-        "instead of first. False: at the refresh's own step (the engine before it; tests/engine/test_step_reference.py).",
+        "instead of first. False: at the refresh's own step (the engine before it; "
+        "tests/engine/test_step_reference.py).",
     )
     thermal: Literal["network", "fixed"] = Field(
         default="network",
@@ -525,7 +530,8 @@ class ModelOptions(BaseModel):
         description="The thermal network's step [s of thermal time]: every thermal_period_s x heat_capacity_scale of "
         "simulated time, a whole number of frames (the nearest, at least 1). The exponential step is exact for any "
         "step; the heat is held over it while the friction falls with the temperature (an explicit coupling), so it "
-        "stays short against the balls' time constants (2-10 s). twin.validation.thermal_studies.period_study (6208 start-up "
+        "stays short against the balls' time constants (2-10 s). twin.validation.thermal_studies.period_study (6208 "
+        "start-up "
         "from cold, 1000 rad/s, 3000 N, accelerated x1000, 900 s): 5 s moves the node temperatures by 0.43 K from "
         "1 s, 20 s by 1.4 K, 50 s by 18 K (the first step's held heat overshoots the balls); first order, so 1 s "
         "lies within about 0.1 K of the limit.",

@@ -3,7 +3,8 @@
 The engine integrates with the leapfrog form of velocity-Verlet (seed 000 eq. 10), velocity-
 dependent forces taking the half-step velocity (turned on by the cage's half-step rotation, a
 turn of under 1e-3 rad that leaves the limit below unchanged, `twin.validation.timestep_study` measures it):
-the central-difference scheme. For a linear oscillator of circular frequency omega and damping ratio zeta it is stable for
+the central-difference scheme. For a linear oscillator of circular frequency omega and damping ratio zeta it is stable
+for
 
     dt <= dt_crit = 2 / omega (sqrt(1 + zeta^2) - zeta)
 

@@ -6,7 +6,8 @@
 * `AdmissionGate`: the service's HTTP token, body/payload size cap, per-twin setpoint rate (one
   token bucket per twin, shared by HTTP and zenoh), per-client read rate and per-client error
   budget (one token bucket per client address each, the most recently seen `MAX_READ_CLIENTS`
-  kept) and whether setpoints from the bus are taken at all. Each check returns None (admitted) or a `Refusal` with the status the transport
+  kept) and whether setpoints from the bus are taken at all. Each check returns None (admitted) or a `Refusal` with the
+  status the transport
   answers with (401, 403, 413, 429), the field and a message; the HTTP layer turns it into its
   error answer (service.api.deps), the zenoh intake into a refusal on the result key
   (service.core.intake).

@@ -20,12 +20,14 @@ class FieldError(BaseModel):
     """One thing wrong with a request."""
 
     field: str | None = Field(
-        description="Where: the field name or path (e.g. 'radial_load_n', 'steps[2].at_s'); null when the request as a whole is wrong [text]."
+        description="Where: the field name or path (e.g. 'radial_load_n', 'steps[2].at_s'); null when the request as a "
+        "whole is wrong [text]."
     )
     message: str = Field(description="What is wrong, with the allowed range and unit when there is one [text].")
     allowed: list[Any] | None = Field(
         default=None,
-        description="Allowed [low, high] in the field's unit, or the allowed names; null when not applicable [field unit].",
+        description="Allowed [low, high] in the field's unit, or the allowed names; null when not applicable [field "
+        "unit].",
     )
 
 

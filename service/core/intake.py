@@ -1,5 +1,5 @@
-"""Setpoints (and local defects, `DefectIntake`) that arrive as raw payloads (zenoh `{prefix}/{id}/setpoint`): the admission gate,
-then the same validation and mailbox as HTTP.
+"""Setpoints (and local defects, `DefectIntake`) that arrive as raw payloads (zenoh
+`{prefix}/{id}/setpoint`): the admission gate, then the same validation and mailbox as HTTP.
 
 `SetpointIntake(bearing_id, gate, runner)(payload) -> dict` never raises. In order: whether the
 bus may write at all (403 when the HTTP API needs a token but zenoh access control is off: see

@@ -230,7 +230,8 @@ class Scenario(BaseModel):
     lubricant: str = Field(default="seed-000", max_length=64, description="Lubricant: 'seed-000' or 'ISO VG n' [text].")
     thermal: Thermal | None = Field(
         default=None,
-        description="Electro-thermal options of the bearing (twin.spec.Thermal: shear / current heating, R_b, H_c; units in each field); default: the spec's.",
+        description="Electro-thermal options of the bearing (twin.spec.Thermal: shear / current heating, R_b, H_c; "
+        "units in each field); default: the spec's.",
     )
     initial: SetpointUpdate = Field(
         default_factory=SetpointUpdate, description="Setpoint applied at t = 0 (fields with units)."

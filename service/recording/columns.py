@@ -181,7 +181,8 @@ def _defect_text(d) -> str:
     """'outer spall 0.5 x 0.6 mm, 50 um deep at 0 deg' of a twin.vibration.defects model."""
     get = d.get if isinstance(d, Mapping) else (lambda k, default=None: getattr(d, k, default))
     kind = get("kind")
-    size = f"{format_number(get('width_m', 0.0) * 1e3)} x {format_number(get('length_m', 0.0) * 1e3)} mm, {format_number(get('depth_m', 0.0) * 1e6)} um deep"
+    width_mm, length_mm = format_number(get("width_m", 0.0) * 1e3), format_number(get("length_m", 0.0) * 1e3)
+    size = f"{width_mm} x {length_mm} mm, {format_number(get('depth_m', 0.0) * 1e6)} um deep"
     where = {
         "outer": f"outer spall {size} at azimuth {format_number(get('azimuth_deg', 0.0))} deg",
         "inner": f"inner spall {size} at ring angle {format_number(get('ring_angle_deg', 0.0))} deg",

@@ -424,7 +424,8 @@ def _window(seconds: float | None):
 def twin_blueprint(tw: TwinLayout, series_window_s: float | None, live: bool = True) -> rrb.Container:
     """The default layout of one twin: top, the bearing in 3D, the load zone now and the
     bearing-level trends with the setpoint beside them; bottom, the events, the alarms (states
-    and events) and the electrical panel. The per-contact series (`contacts/...`) are not in it (add them from the streams)."""
+    and events) and the electrical panel. The per-contact series (`contacts/...`) are not in it (add them from the
+    streams)."""
     root = f"/{tw.root}"
     tag = tw.bearing_id
     window = _window(series_window_s)

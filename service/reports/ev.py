@@ -147,7 +147,8 @@ def write_ev_section(out: Path, quick: bool = False, progress=None) -> list[str]
         f"R_b = {th.equivalent_resistance_ohm:g} ohm and H_c = {th.crater_depth_m:g} m, the EHL solver's anchored "
         "reading of Appendix 2) and multiplies the isothermal film by g(dT)^c_T, c_T = "
         f"{th.film_temperature_exponent:g} fitted to the current heating of the thermal EHL solver "
-        "(`python -m twin.validation.thermal_law_fit`); the inlet's shear heating multiplies it by the Murch-Wilson factor "
+        "(`python -m twin.validation.thermal_law_fit`); the inlet's shear heating multiplies it by the Murch-Wilson "
+        "factor "
         "3.94 / (3.94 + L^0.62), L = beta eta u^2 / k' (an established rolling-contact inlet law; seed 003's eq. 6 "
         "is a Hertz-zone temperature).\n",
         "### Film reduction against current (seed 003 Figs. 2 and 4)\n",

@@ -262,7 +262,8 @@ def write_report(out_dir: str | Path = "reports", quick: bool = False) -> Path:
     md += [f"| {pd:+.1f} | {eps:.3f} | {q:.0f} | {lam:.3f} |" for pd, eps, q, lam in cl_rows]
     md += [
         "\nThe seed prints eps = 0.685 / 0.5 / 0.4 for Pd = -12.6 / 0 / +12.6 um; the exact Hertz constants "
-        "(docs/physics.md, readings) give 0.684 / 0.500 / 0.402 for the rigid-ring equilibrium, which the twin reproduces.\n",
+        "(docs/physics.md, readings) give 0.684 / 0.500 / 0.402 for the rigid-ring equilibrium, which the twin "
+        "reproduces.\n",
         "## Start-up, steady, slow-down (seed 000 Figs. 7-8)\n",
         f"![startup]({st_png})\n",
         f"Steady ball spin {st['steady_ball_spin']:.2f} rad/s (seed 000: 952.38 rad/s).\n",

@@ -136,7 +136,8 @@ class AlarmSettings(BaseModel):
         default=0.0,
         ge=0.0,
         le=3600.0,
-        description="A temperature alarm rises after its value stays beyond the threshold this long [s of simulated time].",
+        description="A temperature alarm rises after its value stays beyond the threshold this long [s of simulated "
+        "time].",
     )
     history: int = Field(
         default=200, ge=1, le=100000, description="Alarm events kept per twin for GET .../alarms [count]."

@@ -215,7 +215,8 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
         f"(contact angle {result['contact_angle_deg']:.2f} deg)"
     )
     print(
-        f"  RMS {result['rms_m_s2']:.4g} m/s2, peak {result['peak_m_s2']:.4g} m/s2, crest {result['crest_factor']:.2f}, "
+        f"  RMS {result['rms_m_s2']:.4g} m/s2, peak {result['peak_m_s2']:.4g} m/s2, crest "
+        f"{result['crest_factor']:.2f}, "
         f"kurtosis {result['kurtosis']:.2f} (band {result['band_kurtosis']:.2f}), "
         f"velocity RMS {result['velocity_rms_mm_s']:.4g} mm/s"
     )
@@ -477,7 +478,8 @@ def _cmd_serve(args: argparse.Namespace) -> int:
     port = settings.http.port if settings.http.port else "<a free port, see uvicorn's line below>"
     print(
         f"bearing-twin: HTTP on http://{host}:{port} ({where}); "
-        f"twin `{settings.twin.id}` = {default_spec.designation}, {'fast' if settings.runner.fast else 'real-time'} mode",
+        f"twin `{settings.twin.id}` = {default_spec.designation}, {'fast' if settings.runner.fast else 'real-time'} "
+        f"mode",
         flush=True,
     )
     from service.api.app import access_summary

@@ -11,7 +11,8 @@ with rich: the twin's key without the prefix when the prefix is concrete (`defau
 key under a pattern (`plant1/line2/motor7/de`). A twin whose liveliness token goes (its service
 stopped or lost) is shown gone, and dropped after --forget-after seconds. zenoh credentials
 come from the environment (BEARING_TWIN_ZENOH_USER / _PASSWORD, or _TLS_*). zenoh callbacks only
-push into a queue; the main thread parses, aggregates and renders. Alarm events `{prefix}/*/alarm` fill the `alarms` column (the active alarms seen since the
+push into a queue; the main thread parses, aggregates and renders. Alarm events `{prefix}/*/alarm` fill the `alarms`
+column (the active alarms seen since the
 monitor started, `id:severity`; GET /v1/bearings/{id}/alarms lists them all).
 """
 

@@ -2,7 +2,8 @@
 zenoh access control): the report's structure, and no 5xx and no non-finite number in the
 hostile HTTP flood, the unauthenticated read flood and the zenoh flood, every zenoh setpoint
 answered; the zenoh squatter blocks nothing, no guessed OPC UA password is accepted, the OPC UA
-session and subscription floods meet the guard's limits. The real-time factor and /health latency are reported, never asserted (shared host)."""
+session and subscription floods meet the guard's limits. The real-time factor and /health latency are reported, never
+asserted (shared host)."""
 
 from __future__ import annotations
 

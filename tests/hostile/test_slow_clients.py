@@ -149,7 +149,8 @@ def test_slowloris_connections_are_closed_and_health_answers(guarded):
                     pass
     assert len(closed) == SLOW, f"{SLOW - len(closed)} slow connections still open after 60 s"
     print(
-        f"\n{peak - baseline} slow connections open at once; {SLOW} closed after {min(closed.values()):.2f}-{max(closed.values()):.2f} s "
+        f"\n{peak - baseline} slow connections open at once; {SLOW} closed after "
+        f"{min(closed.values()):.2f}-{max(closed.values()):.2f} s "
         f"(deadlines: headers {HEADER_S:g} s, body {BODY_S:g} s)"
     )
     for s, field, _ in socks:

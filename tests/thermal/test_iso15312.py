@@ -12,7 +12,8 @@ twin's speed limit (n d_m <= 1.2e6 mm r/min, twin.model) stops the seed 6208 (d_
 
 The contacts' inlet is shear-heated (Thermal.shear_heating, the Murch-Wilson factor of
 twin.physics.thermal: at these speeds and VG 32 at 70 degC it takes 24-29 % off the contacts'
-friction; the SKF model's phi_ish takes 31-34 % off its rolling moment there) and no ball churns oil ('flooded'): the standard's heat flow is the
+friction; the SKF model's phi_ish takes 31-34 % off its rolling moment there) and no ball churns oil ('flooded'): the
+standard's heat flow is the
 bearing's whole friction, and with the standard's own oil level (to the centre of the lowest
 ball) the drag of the balls alone exceeds it at these speeds, by the SKF model's drag term
 (twin.physics.drag.oil_bath_drag_moment_n_m: 6208 at 19 800 r/min and 70 degC, 195 W against

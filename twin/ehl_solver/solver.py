@@ -20,7 +20,8 @@ Full Approximation Storage multigrid (Venner & Lubrecht, "Multilevel methods in 
 Elsevier 2000): Gauss-Seidel line relaxation where the Poiseuille terms dominate (omega 0.5),
 Jacobi distributive line relaxation (zebra order, omega 0.25) in the Hertzian zone, its
 pentadiagonal line model with the far film response lumped onto the band edges (kernels.relax_jd);
-full-weighting restriction of residuals (zero in the cavitated zone), injection of pressures, bilinear prolongation of the
+full-weighting restriction of residuals (zero in the cavitated zone), injection of pressures, bilinear prolongation of
+the
 corrections except within two nodes of the cavitation boundary (the exit spike, which coarse
 grids cannot represent); every grid has its own influence coefficients (FAS: the coarse film is
 that of the coarse pressure). V(2,1) cycles after a nested iteration from the coarsest grid (17 x

@@ -164,7 +164,8 @@ ROLLING_REGULARISATION_SPEED = 0.01
 SPIN_CREEP_FACTOR = 1.3
 
 # The contacts' parallel RC is refreshed every ELECTRICAL_EVERY tribology refreshes (200 us at
-# the default 40 us, twin.validation.subrate_study): it only feeds the network evaluated between frames (1 ms) and the 10 ms
+# the default 40 us, twin.validation.subrate_study): it only feeds the network evaluated between frames (1 ms) and the
+# 10 ms
 # electro-thermal coupling, and refreshing it every 10 us cost ~90 ns per step (10 % of the
 # budget). A contact that has just closed gets its RC at once.
 ELECTRICAL_EVERY = 5

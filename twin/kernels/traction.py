@@ -31,7 +31,8 @@ all-sliding value, so that it follows the spin rate without a sign chatter.
 Cost: the strip solve (a few exponentials per strip pair, one to three Newton passes from the
 last solution) runs every `P_TRACTION_EVERY` tribology refreshes (400 us by default): the torque moves by
 under 0.04 % between a solve every 10 us and every 500 us (tests/physics/test_friction_torque.py),
-and 12 strips hold the moments within 0.5 % of 32 (tests/kernels/test_traction.py). No allocation: the per-strip values of the contact being solved
+and 12 strips hold the moments within 0.5 % of 32 (tests/kernels/test_traction.py). No allocation: the per-strip values
+of the contact being solved
 live in scratch rows of the lane array.
 """
 
@@ -128,7 +129,8 @@ def limiting_traction_coefficient_share(film_parameter, asperity_share, limiting
 @njit(**JIT)
 def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
     """For every loaded contact: the traction capacity (the tangential spring's Coulomb limit,
-    C_MU, `limiting_traction_coefficient`) and the strip integration of the module docstring, written to the E_* rows. Open
+    C_MU, `limiting_traction_coefficient`) and the strip integration of the module docstring, written to the E_* rows.
+    Open
     contacts get zero moments. Reads the contact lanes after the tribology refresh."""
     n_strips = int(p[P_TRACTION_STRIPS])
     gamma = p[P_LIMITING_SHEAR]

@@ -118,7 +118,8 @@ def _lane_drop(defects, k, c, w, bq, shaft_angle, vp, rb):
 @njit(**JIT_INLINE)
 def defect_drops(w, nc, defects, bq, shaft_angle, vp, rb):
     """Row G_DEFECT_DROP of every lane: the largest extra clearance [m] any active defect row opens
-    there (0 elsewhere); returns whether any lane has one. Race spalls visit the lanes of their race whose ball lies within the
+    there (0 elsewhere); returns whether any lane has one. Race spalls visit the lanes of their race whose ball lies
+    within the
     spall's reach (D_REACH_COS, twin.vibration.defects.REACH_MARGIN; a dot product, no root or
     angle); a ball defect the two lanes of its ball."""
     for c in range(nc):

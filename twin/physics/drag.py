@@ -15,7 +15,8 @@ most 1.2 d_m), nu [mm^2/s], V_M the drag loss factor of the catalogue's diagram 
 (ball bearings; `BALL_DRAG_LOSS_FACTOR`), K_z = 3.1 deep-groove, 4.4 angular-contact.
 
 Oil-air mixture (jet, oil-air): each ball orbits at the pitch radius through a medium of
-effective density rho_e and is braked by the fluid drag of a sphere (Harris and Kotzalas, Advanced Concepts of Bearing Technology,
+effective density rho_e and is braked by the fluid drag of a sphere (Harris and Kotzalas, Advanced Concepts of Bearing
+Technology,
 5th ed., 2007, ch. 3 'High-speed operation of ball bearings', ball drag force):
 
     F_D = (1/2) C_D rho_e (pi D^2 / 4) v^2,   v = d_m omega_c / 2                        [N]

@@ -30,7 +30,8 @@ module knows nothing of the twin's engine; it takes the designation's boundary d
 Readings that differ between editions: mu_bl = 0.15 (General Catalogue 6000 EN, 2003, taken here);
 the 2018 catalogue's transcription (github.com/JRaposo-m/SKF-Bearing-Selection-Tool) has 0.12 while
 turning and 0.15 at start. Over 100-1500 rad/s with the seed oil at 40 degC phi_bl <= 0.04
-(6205 at 100 rad/s), so M_sl moves by 2 % at most. The deep-groove G_rr and G_sl carry no centrifugal load; the same table's
+(6205 at 100 rad/s), so M_sl moves by 2 % at most. The deep-groove G_rr and G_sl carry no centrifugal load; the same
+table's
 angular-contact and self-aligning rows add F_g = R3 d_m^4 n^2 (tests/physics/test_skf_high_speed.py).
 """
 

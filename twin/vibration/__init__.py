@@ -21,7 +21,8 @@ In the engine: the model holds `housing_params` (H_*), `vibration_params`
 (twin.kernels.layout V_*) and the decimator's reversed taps (the step snapped to dt = 1 / (R f_s));
 the state the housing DOFs, ball quaternions, decimator state, sample ring and up to MAX_DEFECTS
 defect rows; `twin.kernels.step.step_n` leapfrogs the housing with the balls, evaluates the forces
-in the outer ring's frame (`twin.kernels.vibration.shift_frame`), takes the defect drops off the deflections between the geometry and
+in the outer ring's frame (`twin.kernels.vibration.shift_frame`), takes the defect drops off the deflections between
+the geometry and
 the force pass (`twin.kernels.vibration`), drives the housing with the outer contacts' forces,
 integrates the quaternion of a ball carrying a defect, and pushes the sensed acceleration into the
 decimator (`signal.sensor_push_direct`) every step. `Twin.set_defects` / `clear_defects` validate

@@ -29,7 +29,8 @@ proportional to 1 - y^2/a^2; the slices' sum is K delta^1.5 because a^2 is propo
 seed 000 eq. 2). The slices over the pit (|y - y_pit| < half length) lose h(u) of their
 interference, so the contact keeps the load fraction
 
-    F / (K delta^1.5) = 1 - lambda,   lambda = 3/4 integral over the pit's slices (s = y/a) of min(1 - s^2, h / delta) ds.
+    F / (K delta^1.5) = 1 - lambda,   lambda = 3/4 integral over the pit's slices (s = y/a) of min(1 - s^2, h / delta)
+    ds.
 
 Two limits hold exactly: a pit longer across than the ellipse gives 1 - lambda = (1 - h/delta)^1.5,
 the load K (delta - h)^1.5 of Sawalhi & Randall's drop; a pit deeper than the interference

@@ -23,7 +23,8 @@ Full spectra of a window (`amplitude_spectrum`, `envelope_spectrum_view`), for t
 fs / 2 (no window: the whole window is the record, mean removed), its FFT bins power-summed into at
 most AMPLITUDE_MAX_BINS bins, so that Parseval holds on it (sum A_j^2 / 2 = mean square of the
 window: Parseval's relation of the DFT, sum |x[n]|^2 = (1/N) sum |X[k]|^2, Oppenheim & Schafer,
-"Discrete-Time Signal Processing", Table 8.2, taken one-sided as in `velocity_rms_mm_s`) and a line of amplitude A reads A (its leakage falls in the bin or the next); the
+"Discrete-Time Signal Processing", Table 8.2, taken one-sided as in `velocity_rms_mm_s`) and a line of amplitude A
+reads A (its leakage falls in the bin or the next); the
 envelope spectrum (the one the peaks, lines and noise floor come from, same bins and values) from
 0 Hz to the limit of the peak search and the noise floor, min(half the envelope band width,
 5 x max(BPFI, 2 x BSF)), peak-held (max of each group) into at most ENVELOPE_MAX_BINS bins only

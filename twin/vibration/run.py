@@ -42,7 +42,8 @@ def run_vibration(
     Returns sample_rate_hz, duration_s, window_s, windows, defect_frequencies_hz {ftf, bpfo, bpfi,
     bsf, two_bsf}, contact_angle_deg, envelope_band_hz [low, high], band_method,
     envelope_peaks_hz (the `peak_count` largest: frequency_hz, amplitude [m/s^2]) of the
-    window-averaged envelope spectrum, kurtosis, band_kurtosis (in the envelope band), rms_m_s2, peak_m_s2, crest_factor,
+    window-averaged envelope spectrum, kurtosis, band_kurtosis (in the envelope band), rms_m_s2, peak_m_s2,
+    crest_factor,
     velocity_rms_mm_s (window means; RMS as the root of the mean square), noise_floor_m_s2,
     defect_lines (twin.vibration.indicators.defect_line_amplitudes) and per_window. With
     spectra=True also (not JSON-ready: numpy arrays) envelope_spectrum and amplitude_spectrum,
