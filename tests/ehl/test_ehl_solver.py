@@ -362,7 +362,7 @@ def test_shipped_film_reduction_table_has_provenance_and_consistent_factors():
     default speed is the anchor (84.8 % reduction, tol 0.01)."""
     t = calibration.load_table()
     prov = t["provenance"]
-    for key in ("generated_utc", "command", "grid", "inputs"):
+    for key in ("generated_unix_s", "command", "grid", "inputs"):
         assert key in prov
     assert prov["inputs"]["bearing_resistance_ohm"] == pytest.approx(prm.DEFAULT_BEARING_RESISTANCE_OHM)
     currents, speeds, f = calibration.table_arrays("h_min", t)

@@ -26,11 +26,11 @@ Regenerate: `bearing-twin ehl calibrate` (or `python -m twin.ehl_solver.film_red
 from __future__ import annotations
 
 import argparse
-import datetime as _dt
 import json
 import math
 import platform
 import sys
+import time
 from functools import lru_cache
 from pathlib import Path
 
@@ -257,7 +257,7 @@ def generate_table(
         "isothermal_h_c_m": iso_c,
         "hamrock_dowson_h_min_m": hd_min,
         "provenance": {
-            "generated_utc": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+            "generated_unix_s": int(time.time()),
             "command": command or "python -m twin.ehl_solver.film_reduction",
             "solver": "twin.ehl_solver.solve_point_contact (FAS multigrid, seed 003 eqs. 1-11)",
             "grid": grid,
