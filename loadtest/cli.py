@@ -74,6 +74,12 @@ def _cmd_bench_service(args: argparse.Namespace) -> int:
         print(f"  service overhead: {f(overhead['overhead_cpu_s_per_s'], '{:.3f}')} CPU s/s beside the engines' "
               f"{f(overhead['engine_cpu_s_per_s'], '{:.3f}')} = {f(overhead['overhead_fraction'], '{:.1%}')} "
               f"(goal <= {overhead['goal_fraction']:.0%})")
+    if overhead.get("twin_overhead_fraction") is not None:
+        roles = ", ".join(f"{k.removesuffix('_cpu_s_per_s')} {v:.3f}" for k, v in overhead.items()
+                          if k.endswith("_cpu_s_per_s") and not k.startswith(("twin_", "process_", "engine_", "overhead_")))
+        print(f"  by thread [CPU s/s]: {roles}")
+        print(f"  twin overhead (all but http, opcua): {overhead['twin_overhead_cpu_s_per_s']:.3f} CPU s/s = "
+              f"{overhead['twin_overhead_fraction']:.1%} of the engines")
     if cap:
         print(f"  capacity: {f(cap.get('used_cpu_s_per_s'), '{:.3f}')} of {f(cap.get('budget_cpu_s_per_s'), '{:.3f}')} "
               f"CPU s per s in use; max twins like the last calibrated one: {cap.get('max_twins')}")
