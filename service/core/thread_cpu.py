@@ -100,21 +100,27 @@ class ThreadCpuMeter:
         """Flat figures of the last closed window: `<role>_cpu_s_per_s` for each role (stepping
         less the engines' CPU), `twin_overhead_cpu_s_per_s` (the roles a twin brings),
         `twin_overhead_per_twin_cpu_s_per_s` and `twin_overhead_fraction` (of the engines' CPU)
-        [CPU s / s, -]; {} before a window closes or without per-thread clocks."""
+        [CPU s / s, -]; beside them the totals of the live threads so far, `<role>_cpu_s_total`,
+        `twin_overhead_cpu_s_total` and the engines' `engine_cpu_s_total` [CPU s], from which a client computes the figures over a
+        window of its own (`bench-service` over its whole measurement). {} before a window
+        closes or without per-thread clocks."""
         now, totals = self._clock(), self._sample()
         if not totals:
             return {}
+        totals = {**totals, "stepping": max(0.0, totals.get("stepping", 0.0) - engine_cpu_s_total)}
+        cumulative: dict[str, float | None] = {f"{role}_cpu_s_total": totals.get(role, 0.0) for role in ROLES}
+        cumulative["twin_overhead_cpu_s_total"] = sum(v for role, v in totals.items() if role not in CLIENT_ROLES)
+        cumulative["engine_cpu_s_total"] = engine_cpu_s_total
         with self._lock:
             mark = self._mark
             if mark is None or engine_cpu_s_total < mark[2]:
                 self._mark = (now, totals, engine_cpu_s_total)
-                return self._last
+                return {**self._last, **cumulative} if self._last else {}
             wall = now - mark[0]
             if wall < self.min_window_s:
-                return self._last
+                return {**self._last, **cumulative} if self._last else {}
             engine = (engine_cpu_s_total - mark[2]) / wall
             rates = {role: max(0.0, (totals.get(role, 0.0) - mark[1].get(role, 0.0)) / wall) for role in ROLES}
-            rates["stepping"] = max(0.0, rates["stepping"] - engine)
             twin = sum(v for role, v in rates.items() if role not in CLIENT_ROLES)
             out: dict[str, float | None] = {f"{role}_cpu_s_per_s": v for role, v in rates.items()}
             out["twin_overhead_cpu_s_per_s"] = twin
@@ -122,4 +128,4 @@ class ThreadCpuMeter:
             out["twin_overhead_fraction"] = twin / engine if engine > 0 else None
             self._last = out
             self._mark = (now, totals, engine_cpu_s_total)
-            return out
+            return {**out, **cumulative}

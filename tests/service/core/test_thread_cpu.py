@@ -37,8 +37,12 @@ def test_rates_per_role_with_the_engines_taken_from_the_stepping_threads():
     assert out["twin_overhead_cpu_s_per_s"] == pytest.approx(0.1 + 0.05 + 0.02 + 0.01, abs=1e-12)
     assert out["twin_overhead_per_twin_cpu_s_per_s"] == pytest.approx(0.09, abs=1e-12)
     assert out["twin_overhead_fraction"] == pytest.approx(0.18 / 0.5, abs=1e-12)
-    now[0] = 2.5                      # a window shorter than 1 s keeps the last figures
-    assert meter.sample(1.1, 2) is out
+    assert out["stepping_cpu_s_total"] == pytest.approx(1.2 - 1.0, abs=1e-12)
+    assert out["twin_overhead_cpu_s_total"] == pytest.approx(0.2 + 0.1 + 0.04 + 0.02, abs=1e-12)
+    now[0] = 2.5                      # a window shorter than 1 s keeps the last rates
+    again = meter.sample(1.1, 2)
+    assert again["twin_overhead_fraction"] == out["twin_overhead_fraction"]
+    assert again["stepping_cpu_s_total"] == pytest.approx(1.2 - 1.1, abs=1e-12)
 
 
 def test_a_busy_python_thread_is_counted_under_its_role():
