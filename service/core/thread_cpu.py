@@ -2,7 +2,7 @@
 
 The service overhead (service.core.capacity.ServiceOverheadMeter) is the process's CPU less the
 engines'. `ThreadCpuMeter` splits it by the job of the threads that spend it, from each Python
-thread's own CPU clock (`time.pthread_getcpuclockid`, nanoseconds) and the process's
+thread's own CPU clock (Linux, by its kernel id, nanoseconds) and the process's
 (`time.process_time`); the threads without a Python name (zenoh's and rerun's native runtimes)
 are what the process spent beyond the Python threads:
 
@@ -24,12 +24,13 @@ native             the process less its Python threads: zenoh's and rerun's runt
 
 The roles a twin brings with it (stepping, publish_worker, zenoh_outbox, zenoh_inbox, alarms,
 recording, native) make `twin_overhead_cpu_s_per_s`; http and opcua serve clients and grow with
-their requests, not with the twins. Linux and macOS (a per-thread CPU clock); elsewhere the
+their requests, not with the twins. Linux (a per-thread CPU clock by kernel id); elsewhere the
 breakdown is empty.
 """
 
 from __future__ import annotations
 
+import sys
 import threading
 import time
 from collections.abc import Callable
@@ -60,21 +61,27 @@ def thread_role(name: str) -> str:
     return "other"
 
 
+def thread_cpu_clock(native_id: int) -> int:
+    """The CPU-time clock of a thread by its kernel id (Linux: the clock id glibc's
+    pthread_getcpuclockid makes, `MAKE_THREAD_CPUCLOCK(tid, CPUCLOCK_SCHED)`). Made from the kernel
+    id, a thread that has ended gives EINVAL instead of a read through a freed pthread handle."""
+    return ((~native_id) << 3) | 6
+
+
 def thread_cpu_by_role() -> dict[str, float]:
     """CPU seconds spent so far by the live Python threads of each role, and `native` (the
     process's CPU less theirs) [s]. Threads that ended take their CPU out of the Python roles and
-    into `native`: the rates of a window over such an end are approximate."""
-    totals = dict.fromkeys(ROLES, 0.0)
-    clock_of = getattr(time, "pthread_getcpuclockid", None)
-    process = time.process_time()
-    if clock_of is None:
+    into `native`: the rates of a window over such an end are approximate. {} off Linux."""
+    if not sys.platform.startswith("linux"):
         return {}
+    totals = dict.fromkeys(ROLES, 0.0)
+    process = time.process_time()
     python = 0.0
     for t in threading.enumerate():
-        if t.ident is None:
+        if t.native_id is None:
             continue
         try:
-            cpu = time.clock_gettime(clock_of(t.ident))
+            cpu = time.clock_gettime(thread_cpu_clock(t.native_id))
         except (OSError, OverflowError, ValueError):   # the thread ended meanwhile
             continue
         totals[thread_role(t.name)] += cpu

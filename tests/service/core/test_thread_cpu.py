@@ -71,3 +71,18 @@ def test_a_busy_python_thread_is_counted_under_its_role():
     t.join()
     assert after["publish_worker"] - before["publish_worker"] >= 0.2
     assert sum(after.values()) <= time.process_time() + 1e-3
+
+
+@pytest.mark.skipif(not hasattr(time, "pthread_getcpuclockid"), reason="no per-thread CPU clocks here")
+def test_the_clock_by_kernel_id_is_the_threads_own_and_an_ended_thread_has_none():
+    """thread_cpu_clock(native id) is the clock pthread_getcpuclockid gives for the same thread;
+    for a thread that has ended the kernel refuses the clock (OSError), which the sampler skips."""
+    from service.core.thread_cpu import thread_cpu_clock
+
+    me = threading.current_thread()
+    assert thread_cpu_clock(me.native_id) == time.pthread_getcpuclockid(me.ident)
+    t = threading.Thread(target=lambda: None)
+    t.start()
+    t.join()
+    with pytest.raises(OSError):
+        time.clock_gettime(thread_cpu_clock(t.native_id))
