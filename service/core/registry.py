@@ -441,8 +441,7 @@ class TwinRegistry:
         used = sum(c.cpu_s_per_s for c in costs)
         overhead = self.overhead.sample(engine_cpu_s, running)
         by_role = self.thread_cpu.sample(engine_cpu_s, running)
-        if overhead is not None:
-            overhead = {**overhead, **by_role}
+        overhead = {**overhead, **by_role} if overhead is not None else (by_role or None)
         typical = self.last_calibration
         cap = self.capacity
         estimate = cap.estimate_max_twins(typical, running, used)

@@ -109,8 +109,8 @@ class ThreadCpuMeter:
         `twin_overhead_per_twin_cpu_s_per_s` and `twin_overhead_fraction` (of the engines' CPU)
         [CPU s / s, -]; beside them the totals of the live threads so far, `<role>_cpu_s_total`,
         `twin_overhead_cpu_s_total` and the engines' `engine_cpu_s_total` [CPU s], from which a client computes the figures over a
-        window of its own (`bench-service` over its whole measurement). {} before a window
-        closes or without per-thread clocks."""
+        window of its own (`bench-service` over its whole measurement). Only the totals before
+        a window closes; {} without per-thread clocks."""
         now, totals = self._clock(), self._sample()
         if not totals:
             return {}
@@ -122,10 +122,10 @@ class ThreadCpuMeter:
             mark = self._mark
             if mark is None or engine_cpu_s_total < mark[2]:
                 self._mark = (now, totals, engine_cpu_s_total)
-                return {**self._last, **cumulative} if self._last else {}
+                return {**self._last, **cumulative}
             wall = now - mark[0]
             if wall < self.min_window_s:
-                return {**self._last, **cumulative} if self._last else {}
+                return {**self._last, **cumulative}
             engine = (engine_cpu_s_total - mark[2]) / wall
             rates = {role: max(0.0, (totals.get(role, 0.0) - mark[1].get(role, 0.0)) / wall) for role in ROLES}
             twin = sum(v for role, v in rates.items() if role not in CLIENT_ROLES)
