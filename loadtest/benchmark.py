@@ -184,7 +184,10 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
                         break
                     time.sleep(0.2)
                 time.sleep(settle_s)
-                first = {t["id"]: t for t in http.get("/health").json()["twins"]}
+                h0 = http.get("/health").json()
+                first = {t["id"]: t for t in h0["twins"]}
+                totals0 = (h0.get("capacity") or {}).get("service_overhead") or {}
+                wall0 = time.perf_counter()
                 latencies: dict[str, list[float]] = {tid: [] for tid, _ in running}
                 lost = k = 0
                 put_s: list[float] = []
@@ -220,6 +223,7 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
                                 samples.setdefault(t["id"], []).append(t["real_time_factor"])
                     time.sleep(max(0.0, t0 + 1.0 / rate_hz - time.perf_counter()))
                 health = http.get("/health").json()
+                run_wall_s = time.perf_counter() - wall0
         finally:
             if sub is not None:
                 sub.undeclare()
@@ -258,4 +262,20 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
         "client_lost": lost,
         "http_put_ms_p50": ms(_percentile(put_s, 50)), "http_put_ms_p99": ms(_percentile(put_s, 99)),
         "capacity": health.get("capacity"), "recording_rows": health.get("recording_rows"),
+        "overhead_over_run": overhead_over_run(totals0, (health.get("capacity") or {}).get("service_overhead") or {},
+                                               run_wall_s, len(running)),
     }
+
+
+def overhead_over_run(before: dict, after: dict, wall_s: float, twins: int) -> dict | None:
+    """The service overhead by thread role over the whole measurement, from the cumulative totals
+    of /health `capacity.service_overhead` (service.core.thread_cpu) at its start and end:
+    `<role>_cpu_s_per_s`, `engine_cpu_s_per_s`, `twin_overhead_cpu_s_per_s`, per twin, and
+    `twin_overhead_fraction` (of the engines' CPU); None when the service gives no totals."""
+    if wall_s <= 0 or "twin_overhead_cpu_s_total" not in after or "twin_overhead_cpu_s_total" not in before:
+        return None
+    rate = {k.removesuffix("_cpu_s_total") + "_cpu_s_per_s": (after[k] - before.get(k, 0.0)) / wall_s
+            for k in after if k.endswith("_cpu_s_total") and after[k] is not None and before.get(k) is not None}
+    engine, twin = rate.get("engine_cpu_s_per_s") or 0.0, rate["twin_overhead_cpu_s_per_s"]
+    return {"window_s": wall_s, **rate, "twin_overhead_per_twin_cpu_s_per_s": twin / twins if twins else None,
+            "twin_overhead_fraction": twin / engine if engine > 0 else None}

@@ -7,12 +7,14 @@ import argparse
 import importlib
 import json
 import sys
+from pathlib import Path
 
 from loadtest.attack import add_attack_command
 from loadtest.benchmark import run_service_benchmark
 from loadtest.soak import add_soak_command
 from service.tools.cli import ArgumentParser, _positive_float, _positive_int
 
+SAVE_KIND = "servicebench"   # file kind: not matched by the engine bench's `*-bench*.json`
 EXTRA_HINT = "the load tools need httpx: pip install -c constraints.txt '.[loadtest]'"
 
 
@@ -32,6 +34,9 @@ def build_parser() -> argparse.ArgumentParser:
     bsv.add_argument("--no-zenoh", action="store_true", help="without zenoh (then no setpoint delay)")
     bsv.add_argument("--no-record", action="store_true", help="without the rerun recording")
     bsv.add_argument("--json", action="store_true")
+    bsv.add_argument("--save", nargs="?", const="benchmarks/results", default=None, metavar="DIR",
+                     help="also write the result with the CPU model, versions and git commit to "
+                     "DIR/<UTC date>-<cpu>-servicebench.json (default DIR: benchmarks/results)")
     bsv.set_defaults(func=_cmd_bench_service)
     add_soak_command(sub)
     add_attack_command(sub)
@@ -45,6 +50,12 @@ def _cmd_bench_service(args: argparse.Namespace) -> int:
     except RuntimeError as exc:
         print(f"error: {' '.join(str(exc).split())[:2000]}", file=sys.stderr)
         return 1
+    if args.save is not None:
+        from service.tools.bench_results import save
+
+        command = "bearing-twin-loadtest bench-service " + " ".join(sys.argv[2:] if len(sys.argv) > 2 else [])
+        path = save(r, SAVE_KIND, command.strip(), Path(args.save))
+        print(f"saved {path}", file=sys.stderr)
     if args.json:
         print(json.dumps(r))
         return 0
@@ -74,6 +85,13 @@ def _cmd_bench_service(args: argparse.Namespace) -> int:
         print(f"  service overhead: {f(overhead['overhead_cpu_s_per_s'], '{:.3f}')} CPU s/s beside the engines' "
               f"{f(overhead['engine_cpu_s_per_s'], '{:.3f}')} = {f(overhead['overhead_fraction'], '{:.1%}')} "
               f"(goal <= {overhead['goal_fraction']:.0%})")
+    run = r.get("overhead_over_run") or {}
+    if run.get("twin_overhead_fraction") is not None:
+        roles = ", ".join(f"{k.removesuffix('_cpu_s_per_s')} {v:.3f}" for k, v in run.items()
+                          if k.endswith("_cpu_s_per_s") and not k.startswith(("twin_", "engine_")))
+        print(f"  over the {run['window_s']:.0f} s measured, by thread [CPU s/s]: {roles}")
+        print(f"  twin overhead (every thread but http and opcua): {run['twin_overhead_cpu_s_per_s']:.3f} CPU s/s "
+              f"beside the engines' {run['engine_cpu_s_per_s']:.3f} = {run['twin_overhead_fraction']:.1%}")
     if cap:
         print(f"  capacity: {f(cap.get('used_cpu_s_per_s'), '{:.3f}')} of {f(cap.get('budget_cpu_s_per_s'), '{:.3f}')} "
               f"CPU s per s in use; max twins like the last calibrated one: {cap.get('max_twins')}")

@@ -231,6 +231,8 @@ class TwinChannel:
     published = property(lambda self: self.outbox.published, doc="Snapshots fully put on the bus.")
     errors = property(lambda self: self.outbox.errors, doc="Snapshots that failed to serialise or put.")
     waveform_chunks = property(lambda self: self.outbox.waveform_chunks, doc="Waveform chunks put on the bus.")
+    unmatched = property(lambda self: self.outbox.unmatched,
+                         doc="Messages not made: no subscriber matched their key (service.bus.twin_outbox).")
     setpoints_received = property(lambda self: self.inbox.setpoints_received, doc="Setpoint messages taken.")
     setpoints_refused_busy = property(lambda self: self.inbox.setpoints_refused_busy,
                                       doc="Setpoints refused with 429 because the control queue was full.")

@@ -26,7 +26,10 @@ applied a new setpoint (at most one such extra publication every `setpoint_publi
 a closer one waits for the next frame after that interval). The regular ticks do not hold a
 setpoint's publication back: the state carrying a fresh setpoint goes out at the end of the
 frame that applied it even right after a tick (holding it to the interval would delay one setpoint in
-ten by a frame at 50 Hz). In fast mode every 1/publish_rate_hz of SIMULATED time (a
+ten by a frame at 50 Hz). Such a publication stands for the period's tick: the next regular one
+follows a period after it, so setpoints add no snapshots while they come slower than the publish
+rate (each snapshot costs its build, its messages, its alarm evaluation and its recording rows),
+and the gap between two publications never exceeds a period. In fast mode every 1/publish_rate_hz of SIMULATED time (a
 scenario's samples sit on a regular grid of simulated time however fast the machine is).
 """
 
@@ -135,6 +138,7 @@ class PacingClock:
             return True
         if self._publish_soon and now - self.last_setpoint_publish_wall >= self.setpoint_publish_min_interval_s:
             self.last_setpoint_publish_wall = now
+            self._next_publish_wall = now + self.publish_period_s   # it stands for this period's tick
             return True
         return False
 

@@ -23,6 +23,13 @@ most one thread at a time: its twin's state has one writer at any moment (which 
 may change from frame to frame). `wake(job)` releases a waiting job now (a setpoint arrived, a
 scenario started, the twin is asked to stop).
 
+Wake-ups. A thread that puts a job back is free at once and itself waits for the earliest
+release (or takes a released job), so putting back wakes nobody; a thread that takes a job
+while other jobs wait wakes one free thread, which takes over the timer of the next release.
+Every waiting job so has a free thread timing it whenever one is free, and the free threads do
+not all wake at every frame (with one twin and two stepping threads, the idle one sleeps until
+a second job arrives). `add`, `wake` and `close` wake every thread.
+
 The queue is plain data (no threads, no clock): the tests drive it with a fake clock.
 """
 
@@ -292,6 +299,8 @@ class SteppingPool:
                     job = q.take(now)
                     if job is not None:
                         job.wake_pending = False
+                        if q.next_release() is not None:
+                            cond.notify()    # another job waits: one free thread takes over its timer
                         break
                     nxt = q.next_release()
                     cond.wait(None if nxt is None else max(0.0, nxt - now))
@@ -308,8 +317,7 @@ class SteppingPool:
                     if job.wake_pending:
                         schedule = Schedule(min(schedule.release, self.clock()), schedule.deadline)
                         job.wake_pending = False
-                    q.put(job, schedule)
-                cond.notify_all()
+                    q.put(job, schedule)   # this thread is free again and times it: no wake-up
             if schedule is None:
                 try:
                     job.task.left_pool()

@@ -31,7 +31,9 @@ behind the other twins' captures) was the largest stage of the PUT -> zenoh stat
 2.4 ms at the median and 9 ms at the 99th percentile with one twin (`bench-service`,
 `setpoint_latency_ms.publish` in /health). Setpoints are rate-limited per twin (the admission
 gate), so the stepping thread builds at most that many snapshots itself (about 0.3 ms each for
-a 9-ball twin).
+a 9-ball twin). It builds them from the live twin, not a frozen copy: it is the twin's only
+writer and steps it again only after the delivery, and the copy (with the thermal block it
+evaluates) cost as much CPU on the stepping thread as a third of the snapshot.
 """
 
 from __future__ import annotations
@@ -206,7 +208,7 @@ class Publisher:
         if timings and not self.lossless:
             with self._deliver_lock:
                 self._drain_locked()
-                self._deliver(Capture(twin.frozen(), real_time_factor, late_fraction, self.note, timings, waveform))
+                self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings, waveform))
             return
         cap = Capture(twin.frozen(), real_time_factor, late_fraction, self.note, timings, waveform)
         with self._cv:

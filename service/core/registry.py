@@ -51,6 +51,7 @@ from service.core.heap import freeze_heap
 from service.core.priority import EGRESS_THREAD_NAMES, ThreadPriority
 from service.core.runner import TwinRunner
 from service.core.sinks import SnapshotSink
+from service.core.thread_cpu import ThreadCpuMeter
 from service.settings import ServiceSettings
 from twin import catalog
 from twin.engine import Twin
@@ -148,6 +149,7 @@ class TwinRegistry:
         self.priority = ThreadPriority(self.pool.native_ids, settings.runner.io_thread_nice, settings.runner.stepping_thread_nice,
                                        keep_names=EGRESS_THREAD_NAMES)
         self.overhead = ServiceOverheadMeter()
+        self.thread_cpu = ThreadCpuMeter()   # the overhead by the job of its threads
         self.capacity = Capacity(threads, settings.runner.capacity_core_fraction,
                                  reserve_cores=settings.runner.capacity_reserve_cores)
         self.last_calibration: TwinCost | None = None
@@ -438,6 +440,8 @@ class TwinRegistry:
             engine_cpu_s = sum(e.runner.engine_cpu.cpu_s for e in self._twins.values())
         used = sum(c.cpu_s_per_s for c in costs)
         overhead = self.overhead.sample(engine_cpu_s, running)
+        by_role = self.thread_cpu.sample(engine_cpu_s, running)
+        overhead = {**overhead, **by_role} if overhead is not None else (by_role or None)
         typical = self.last_calibration
         cap = self.capacity
         estimate = cap.estimate_max_twins(typical, running, used)

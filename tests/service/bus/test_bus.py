@@ -506,6 +506,34 @@ def test_monitor_command_registers_with_argparse():
     assert bad.func(bad) == 2
 
 
+def test_ball_messages_are_made_only_for_a_subscriber(bus, client, twin, support):
+    """The outbox reads each ball publisher's zenoh matching status and makes no ball message
+    nobody subscribes to (service.bus.twin_outbox): without a subscriber every ball of every
+    snapshot is counted unmatched; a subscriber to one ball gets that ball's messages and the
+    other balls stay unmade."""
+    snap = twin.snapshot()
+    channel = bus.attach_twin("t1", lambda: snap, lambda p: {})
+    balls = len(snap.balls)
+    for _ in range(3):
+        channel.publish(snap)
+    assert support.wait_until(lambda: channel.published == 3, 5.0), channel.published
+    assert channel.unmatched == 3 * balls
+    client.subscribe("bearing/t1/ball/2")
+    sent = [3]
+
+    def poke():
+        sent[0] += 1
+        channel.publish(snap)
+
+    got = client.wait_for(lambda item: item[0] == "bearing/t1/ball/2", poke=poke, poke_every_s=0.05)
+    assert loads(got[2])["index"] == 2
+    assert support.wait_until(lambda: channel.published + channel.dropped == sent[0], 5.0)
+    before = channel.unmatched
+    channel.publish(snap)
+    assert support.wait_until(lambda: channel.published + channel.dropped == sent[0] + 1, 5.0)
+    assert channel.unmatched - before == balls - 1
+
+
 # ---- (f) publish never blocks ----------------------------------------------------------------
 class _Blocker:
     """A 'snapshot' whose state message goes out (`publish` puts it on the caller's thread) and

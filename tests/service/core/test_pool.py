@@ -227,7 +227,8 @@ def test_a_setpoint_is_published_at_the_end_of_its_frame_even_right_after_a_tick
     """service.core.pacing: the state carrying a fresh setpoint goes out at the end of the frame
     that applied it, not one frame later because a regular 50 Hz tick went out less than
     setpoint_publish_min_interval_s before; that interval still spaces the setpoint
-    publications themselves (a closer one is deferred, not dropped); the ticks keep their grid."""
+    publications themselves (a closer one is deferred, not dropped); a setpoint's publication
+    stands for the period's tick: the next tick is one period after it."""
     p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: 0.0, setpoint_publish_min_interval_s=0.002)
     p.start(0.0)
     assert not p.publish_due(0.019, 0.019, False)
@@ -240,7 +241,11 @@ def test_a_setpoint_is_published_at_the_end_of_its_frame_even_right_after_a_tick
     assert p.publish_due(0.0226, 0.0226, False)          # ... to the first frame 2 ms after the last
     p.published(0.0226, 0.0226)
     assert not p.publish_due(0.030, 0.030, False)
-    assert p.publish_due(0.040, 0.040, False)            # the 50 Hz grid is unchanged
+    assert not p.publish_due(0.0425, 0.0425, False)      # no tick 20 ms after the tick at 0.020 ...
+    assert p.publish_due(0.0426, 0.0426, False)          # ... but 20 ms after the setpoint's publication
+    p.published(0.0426, 0.0426)
+    assert not p.publish_due(0.0625, 0.0625, False)
+    assert p.publish_due(0.0626, 0.0626, False)          # and on that grid from then on
 
 
 def test_fast_mode_is_never_late():
