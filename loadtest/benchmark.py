@@ -78,8 +78,14 @@ class _Serve:
     """`bearing-twin serve` in a subprocess, its output kept."""
 
     def __init__(self, args: list[str], env: dict, cwd: Path):
-        self.proc = subprocess.Popen([sys.executable, "-m", "service.cli", "serve", *args], cwd=cwd, env=env,
-                                     stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+        self.proc = subprocess.Popen(
+            [sys.executable, "-m", "service.cli", "serve", *args],
+            cwd=cwd,
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+        )
         self.log: list[str] = []
         threading.Thread(target=self._read, daemon=True).start()
 
@@ -98,9 +104,17 @@ class _Serve:
                 self.proc.wait(10.0)
 
 
-def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: float = 20.0, *,
-                          record: bool = True, zenoh_on: bool = True, force: bool = False,
-                          settle_s: float = 3.0, start_timeout_s: float = 300.0) -> dict:
+def run_service_benchmark(
+    twins: int | str = 1,
+    seconds: float = 10.0,
+    rate_hz: float = 20.0,
+    *,
+    record: bool = True,
+    zenoh_on: bool = True,
+    force: bool = False,
+    settle_s: float = 3.0,
+    start_timeout_s: float = 300.0,
+) -> dict:
     import httpx
 
     auto = twins == "auto"
@@ -110,21 +124,23 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
     port, zport = _free_port(), _free_port()
     endpoint = f"tcp/127.0.0.1:{zport}"
     repo = Path(__file__).resolve().parents[1]
-    env = {**os.environ, "PYTHONUNBUFFERED": "1",
-           "PYTHONPATH": os.pathsep.join(filter(None, [str(repo), os.environ.get("PYTHONPATH")]))}
+    env = {
+        **os.environ,
+        "PYTHONUNBUFFERED": "1",
+        "PYTHONPATH": os.pathsep.join(filter(None, [str(repo), os.environ.get("PYTHONPATH")])),
+    }
     if force:
         env["BEARING_TWIN_ADMISSION"] = "off"
     first_id, first_designation, first_setpoint = plan[0]
     with tempfile.TemporaryDirectory(prefix="bearing-twin-bench-") as tmp:
-        args = ["--port", str(port), "--twin-id", first_id, "--bearing", first_designation,
-                "--log-level", "warning"]
+        args = ["--port", str(port), "--twin-id", first_id, "--bearing", first_designation, "--log-level", "warning"]
         args += ["--zenoh-listen", endpoint] if zenoh_on else ["--no-zenoh"]
         args += ["--record", str(Path(tmp) / "bench.rrd")] if record else ["--no-record"]
         serve = _Serve(args, env, Path(tmp))
         session = sub = None
         from service.settings import ZenohAccessSettings
 
-        prefix = ZenohAccessSettings().zenoh.prefix   # the service it starts inherits the environment
+        prefix = ZenohAccessSettings().zenoh.prefix  # the service it starts inherits the environment
         inbox: queue.SimpleQueue = queue.SimpleQueue()
         url = f"http://127.0.0.1:{port}"
         refused: list[dict] = []
@@ -149,8 +165,10 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
                 if auto:
                     held = capacity_at_start.get("max_twins")
                     if held is None:
-                        raise RuntimeError("--twins auto: the service states no capacity (admission off, or no "
-                                           "twin calibrated): give a number of twins")
+                        raise RuntimeError(
+                            "--twins auto: the service states no capacity (admission off, or no "
+                            "twin calibrated): give a number of twins"
+                        )
                     plan = twin_plan(max(1, int(held)))
                 running = [(first_id, first_designation)]
                 for twin_id, designation, setpoint in plan[1:]:
@@ -160,10 +178,17 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
                         running.append((twin_id, designation))
                     else:
                         detail = r.json().get("detail") or [{}]
-                        refused.append({"id": twin_id, "designation": designation, "status": r.status_code,
-                                        "message": detail[0].get("message")})
-                base_load = {tid: http.get(f"/v1/bearings/{tid}").json()["setpoint"]["radial_load_n"]
-                             for tid, _ in running}
+                        refused.append(
+                            {
+                                "id": twin_id,
+                                "designation": designation,
+                                "status": r.status_code,
+                                "message": detail[0].get("message"),
+                            }
+                        )
+                base_load = {
+                    tid: http.get(f"/v1/bearings/{tid}").json()["setpoint"]["radial_load_n"] for tid, _ in running
+                }
                 if zenoh_on:
                     import zenoh
 
@@ -196,7 +221,7 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
                 while time.perf_counter() < t_end:
                     tid = running[k % len(running)][0]
                     k += 1
-                    load = base_load[tid] - 0.5 * (k % 400)        # a new value every time, in range
+                    load = base_load[tid] - 0.5 * (k % 400)  # a new value every time, in range
                     pattern = re.compile(rb'"radial_load_n":' + re.escape(repr(float(load)).encode()) + rb"[,}]")
                     key = twin_key(prefix, tid, STATE)
                     t0 = time.perf_counter()
@@ -238,32 +263,50 @@ def run_service_benchmark(twins: int | str = 1, seconds: float = 10.0, rate_hz: 
         frames = b.get("frames", 0) - a.get("frames", 0)
         late = b.get("overruns", 0) - a.get("overruns", 0)
         rtf = samples.get(tid, [])
-        rows.append({
-            "id": tid, "designation": designation,
-            "real_time_factor_median": statistics.median(rtf) if rtf else None,
-            "real_time_factor_min": min(rtf) if rtf else None,
-            "late_fraction": late / frames if frames else None,
-            "frames": frames, "late_frames": late, "resyncs": b.get("resyncs", 0) - a.get("resyncs", 0),
-            "dropped": b.get("dropped"), "publish_skipped": b.get("publish_skipped"),
-            "cost": b.get("cost"), "setpoints": len(latencies.get(tid, [])),
-            "client_latency_ms_p99": ms(_percentile(latencies.get(tid, []), 99)),
-            "service_latency_ms": b.get("setpoint_latency_ms"),
-        })
+        rows.append(
+            {
+                "id": tid,
+                "designation": designation,
+                "real_time_factor_median": statistics.median(rtf) if rtf else None,
+                "real_time_factor_min": min(rtf) if rtf else None,
+                "late_fraction": late / frames if frames else None,
+                "frames": frames,
+                "late_frames": late,
+                "resyncs": b.get("resyncs", 0) - a.get("resyncs", 0),
+                "dropped": b.get("dropped"),
+                "publish_skipped": b.get("publish_skipped"),
+                "cost": b.get("cost"),
+                "setpoints": len(latencies.get(tid, [])),
+                "client_latency_ms_p99": ms(_percentile(latencies.get(tid, []), 99)),
+                "service_latency_ms": b.get("setpoint_latency_ms"),
+            }
+        )
     every = [v for values in latencies.values() for v in values]
     return {
-        "twins_requested": twins, "twins_planned": len(plan), "capacity_at_start": capacity_at_start, "seconds": seconds, "rate_hz": rate_hz, "zenoh": zenoh_on,
-        "recording": record, "admission": "off" if force else health.get("capacity", {}).get("admission"),
+        "twins_requested": twins,
+        "twins_planned": len(plan),
+        "capacity_at_start": capacity_at_start,
+        "seconds": seconds,
+        "rate_hz": rate_hz,
+        "zenoh": zenoh_on,
+        "recording": record,
+        "admission": "off" if force else health.get("capacity", {}).get("admission"),
         "frame_s": (last.get(running[0][0]) or {}).get("frame_s"),
         "lateness_s": (last.get(running[0][0]) or {}).get("lateness_s"),
-        "twins": rows, "refused": refused, "setpoints": k,
+        "twins": rows,
+        "refused": refused,
+        "setpoints": k,
         "client_latency_ms_p50": ms(_percentile(every, 50)),
         "client_latency_ms_p99": ms(_percentile(every, 99)),
         "client_latency_ms_max": ms(max(every)) if every else None,
         "client_lost": lost,
-        "http_put_ms_p50": ms(_percentile(put_s, 50)), "http_put_ms_p99": ms(_percentile(put_s, 99)),
-        "capacity": health.get("capacity"), "recording_rows": health.get("recording_rows"),
-        "overhead_over_run": overhead_over_run(totals0, (health.get("capacity") or {}).get("service_overhead") or {},
-                                               run_wall_s, len(running)),
+        "http_put_ms_p50": ms(_percentile(put_s, 50)),
+        "http_put_ms_p99": ms(_percentile(put_s, 99)),
+        "capacity": health.get("capacity"),
+        "recording_rows": health.get("recording_rows"),
+        "overhead_over_run": overhead_over_run(
+            totals0, (health.get("capacity") or {}).get("service_overhead") or {}, run_wall_s, len(running)
+        ),
     }
 
 
@@ -274,8 +317,15 @@ def overhead_over_run(before: dict, after: dict, wall_s: float, twins: int) -> d
     `twin_overhead_fraction` (of the engines' CPU); None when the service gives no totals."""
     if wall_s <= 0 or "twin_overhead_cpu_s_total" not in after or "twin_overhead_cpu_s_total" not in before:
         return None
-    rate = {k.removesuffix("_cpu_s_total") + "_cpu_s_per_s": (after[k] - before.get(k, 0.0)) / wall_s
-            for k in after if k.endswith("_cpu_s_total") and after[k] is not None and before.get(k) is not None}
+    rate = {
+        k.removesuffix("_cpu_s_total") + "_cpu_s_per_s": (after[k] - before.get(k, 0.0)) / wall_s
+        for k in after
+        if k.endswith("_cpu_s_total") and after[k] is not None and before.get(k) is not None
+    }
     engine, twin = rate.get("engine_cpu_s_per_s") or 0.0, rate["twin_overhead_cpu_s_per_s"]
-    return {"window_s": wall_s, **rate, "twin_overhead_per_twin_cpu_s_per_s": twin / twins if twins else None,
-            "twin_overhead_fraction": twin / engine if engine > 0 else None}
+    return {
+        "window_s": wall_s,
+        **rate,
+        "twin_overhead_per_twin_cpu_s_per_s": twin / twins if twins else None,
+        "twin_overhead_fraction": twin / engine if engine > 0 else None,
+    }

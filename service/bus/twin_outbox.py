@@ -27,7 +27,7 @@ from typing import Any
 
 import zenoh
 
-from service.bus.wire import Bus, JSON_ENCODING, Waveform, dumps, one_line, spectrum_json
+from service.bus.wire import JSON_ENCODING, Bus, Waveform, dumps, one_line, spectrum_json
 from service.keys import ALARM, STATE, ball_key, twin_key
 from twin.snapshot import Snapshot
 
@@ -49,23 +49,26 @@ class TwinOutbox:
         self._cond = threading.Condition()
         self._stopping = False
         self._dropped = 0
-        self.published = 0          # snapshots fully put on the bus
-        self.errors = 0             # snapshots that failed to serialise or put
-        self.waveform_chunks = 0    # waveform chunks put on the bus
-        self.unmatched = 0          # messages not made: no subscriber matched their key
+        self.published = 0  # snapshots fully put on the bus
+        self.errors = 0  # snapshots that failed to serialise or put
+        self.waveform_chunks = 0  # waveform chunks put on the bus
+        self.unmatched = 0  # messages not made: no subscriber matched their key
         self._last: tuple[Any, str] | None = None  # (snapshot object, its state JSON)
         self._last_lock = threading.Lock()
         self._pub_lock = threading.Lock()
-        self._gone = False          # publishers undeclared
+        self._gone = False  # publishers undeclared
         self._ball_publishers: dict[int, zenoh.Publisher] = {}
-        self._alarm_pub: zenoh.Publisher | None = None       # declared with the first alarm
-        self._vibration_pub: zenoh.Publisher | None = None   # declared with the first window
-        self._waveform_pub: zenoh.Publisher | None = None    # declared with the first samples
+        self._alarm_pub: zenoh.Publisher | None = None  # declared with the first alarm
+        self._vibration_pub: zenoh.Publisher | None = None  # declared with the first window
+        self._waveform_pub: zenoh.Publisher | None = None  # declared with the first samples
         self._last_window_end_s: float | None = None
         # express: the state message is sent at once, not held for a batch with other messages
         self._state_pub = bus.session.declare_publisher(
-            twin_key(bus.prefix, bearing_id, STATE), encoding=JSON_ENCODING,
-            congestion_control=zenoh.CongestionControl.DROP, express=True)
+            twin_key(bus.prefix, bearing_id, STATE),
+            encoding=JSON_ENCODING,
+            congestion_control=zenoh.CongestionControl.DROP,
+            express=True,
+        )
         self._thread = threading.Thread(target=self._loop, name=f"zenoh-pub-{bearing_id}", daemon=True)
         self._thread.start()
 
@@ -103,7 +106,8 @@ class TwinOutbox:
                 return
             if self._alarm_pub is None:
                 self._alarm_pub = self.bus.session.declare_publisher(
-                    twin_key(self.bus.prefix, self.bearing_id, ALARM), encoding=JSON_ENCODING)
+                    twin_key(self.bus.prefix, self.bearing_id, ALARM), encoding=JSON_ENCODING
+                )
             pub = self._alarm_pub
         pub.put(dumps({**event, "bearing_id": self.bearing_id}))
 
@@ -172,8 +176,16 @@ class TwinOutbox:
         them): json.dumps of the merged dicts held the GIL about five times longer, the stepping
         threads waiting (service.core.priority)."""
         # each ball's message is the head's fields then the ball's: {"schema":..,"bearing_id":..,"time_s":..,<ball>}
-        head = dumps({"schema": snapshot.schema_, "bearing_id": snapshot.bearing_id or self.bearing_id,
-                      "time_s": snapshot.time_s})[:-1] + ","
+        head = (
+            dumps(
+                {
+                    "schema": snapshot.schema_,
+                    "bearing_id": snapshot.bearing_id or self.bearing_id,
+                    "time_s": snapshot.time_s,
+                }
+            )[:-1]
+            + ","
+        )
         for position, ball in enumerate(snapshot.balls):
             index = getattr(ball, "index", position)
             pub = self._ball_publisher(int(index))
@@ -200,12 +212,23 @@ class TwinOutbox:
             return
         if pub is not None:
             vib = block.model_dump(by_alias=True, mode="json")
-            spectra = {key: spectrum_json(getattr(block, key, None))
-                       for key in ("envelope_spectrum", "amplitude_spectrum")}
+            spectra = {
+                key: spectrum_json(getattr(block, key, None)) for key in ("envelope_spectrum", "amplitude_spectrum")
+            }
             defects = [d.model_dump(by_alias=True, mode="json") for d in (getattr(snapshot, "defects", None) or ())]
-            pub.put(dumps({"schema": VIBRATION_SCHEMA, "bearing_id": self.bearing_id, "seq": snapshot.seq,
-                           "time_s": snapshot.time_s, "defects": defects, **vib,
-                           **{k: v for k, v in spectra.items() if v is not None}}))
+            pub.put(
+                dumps(
+                    {
+                        "schema": VIBRATION_SCHEMA,
+                        "bearing_id": self.bearing_id,
+                        "seq": snapshot.seq,
+                        "time_s": snapshot.time_s,
+                        "defects": defects,
+                        **vib,
+                        **{k: v for k, v in spectra.items() if v is not None},
+                    }
+                )
+            )
 
     def _send_waveform(self, blocks: list) -> None:
         """One binary chunk per block on `P/{id}/vibration/waveform` (twin.vibration.waveform)."""
@@ -220,17 +243,20 @@ class TwinOutbox:
         for block in blocks:
             if len(block.samples) == 0:
                 continue
-            pub.put(encode_chunk(self.bearing_id, self.waveform_chunks, block.t0_s, block.sample_rate_hz,
-                                 block.samples))
+            pub.put(
+                encode_chunk(self.bearing_id, self.waveform_chunks, block.t0_s, block.sample_rate_hz, block.samples)
+            )
             self.waveform_chunks += 1
 
     def _lazy_publisher(self, attr: str, suffix: str, encoding: str) -> zenoh.Publisher | None:
         with self._pub_lock:
             pub = getattr(self, attr)
             if pub is None and not self._gone:
-                pub = self.bus.session.declare_publisher(twin_key(self.bus.prefix, self.bearing_id, suffix),
-                                                         encoding=encoding,
-                                                         congestion_control=zenoh.CongestionControl.DROP)
+                pub = self.bus.session.declare_publisher(
+                    twin_key(self.bus.prefix, self.bearing_id, suffix),
+                    encoding=encoding,
+                    congestion_control=zenoh.CongestionControl.DROP,
+                )
                 setattr(self, attr, pub)
             return pub
 
@@ -239,8 +265,10 @@ class TwinOutbox:
             pub = self._ball_publishers.get(index)
             if pub is None and not self._gone and not self._stopping:
                 pub = self.bus.session.declare_publisher(
-                    ball_key(self.bus.prefix, self.bearing_id, index), encoding=JSON_ENCODING,
-                    congestion_control=zenoh.CongestionControl.DROP)
+                    ball_key(self.bus.prefix, self.bearing_id, index),
+                    encoding=JSON_ENCODING,
+                    congestion_control=zenoh.CongestionControl.DROP,
+                )
                 self._ball_publishers[index] = pub
             return pub
 

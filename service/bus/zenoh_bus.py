@@ -108,12 +108,12 @@ from typing import Any, Self
 import zenoh
 
 from service.bus.access import ZenohAccess
-from service.keys import (ALIVE, DEFAULT_PREFIX, TWIN_ID_RE, check_prefix, twin_key)
 from service.bus.twin_inbox import CONTROL_QUEUE_SIZE, TwinInbox
 from service.bus.twin_outbox import TwinOutbox, undeclare
 from service.bus.wire import one_line as _one_line
 from service.bus.wire import quoted as _quoted
 from service.core.errors import InputError
+from service.keys import ALIVE, DEFAULT_PREFIX, TWIN_ID_RE, check_prefix, twin_key
 from twin.snapshot import Snapshot
 
 log = logging.getLogger(__name__)
@@ -123,12 +123,18 @@ DEFAULT_QUEUE_SIZE = 64
 _CONTROL_QUEUE_SIZE = CONTROL_QUEUE_SIZE
 
 
-_ZID_RE = re.compile(r"^[0-9a-f]{1,32}$")            # a zenoh id as zenoh writes it (hex)
+_ZID_RE = re.compile(r"^[0-9a-f]{1,32}$")  # a zenoh id as zenoh writes it (hex)
 
 
-def make_config(listen: Iterable[str] | None = None, connect: Iterable[str] | None = None,
-                mode: str = "peer", *, gossip: bool = True, access: ZenohAccess | None = None,
-                prefix: str | Iterable[str] = DEFAULT_PREFIX) -> zenoh.Config:
+def make_config(
+    listen: Iterable[str] | None = None,
+    connect: Iterable[str] | None = None,
+    mode: str = "peer",
+    *,
+    gossip: bool = True,
+    access: ZenohAccess | None = None,
+    prefix: str | Iterable[str] = DEFAULT_PREFIX,
+) -> zenoh.Config:
     """A zenoh config that touches only what it is told.
 
     `listen` None means DEFAULT_LISTEN (loopback 7447); an empty list means do not listen.
@@ -155,8 +161,13 @@ def make_config(listen: Iterable[str] | None = None, connect: Iterable[str] | No
     return config
 
 
-def client_config(connect: Iterable[str], *, access: ZenohAccess | None = None,
-                  listen: Iterable[str] | None = None, prefix: str = DEFAULT_PREFIX) -> zenoh.Config:
+def client_config(
+    connect: Iterable[str],
+    *,
+    access: ZenohAccess | None = None,
+    listen: Iterable[str] | None = None,
+    prefix: str = DEFAULT_PREFIX,
+) -> zenoh.Config:
     """The config of a bundled client (monitor, soak, benchmarks): a zenoh client of the
     endpoints (a router or a service), or a peer when it listens itself; credentials from the
     environment (BEARING_TWIN_ZENOH_USER / _PASSWORD, _TLS_*) unless `access` is given."""
@@ -192,19 +203,34 @@ class TwinChannel:
     publishes, the `TwinInbox` (service.bus.twin_inbox) takes and answers what reaches it, and
     the channel holds the liveliness token and detaches the whole in order."""
 
-    def __init__(self, bus: ZenohBus, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
-                 on_setpoint: Callable[[bytes], dict], *, queue_size: int = DEFAULT_QUEUE_SIZE,
-                 flush_timeout_s: float = 2.0, on_defects: Callable[[bytes], dict] | None = None,
-                 on_measured: Callable[[bytes], dict] | None = None):
+    def __init__(
+        self,
+        bus: ZenohBus,
+        bearing_id: str,
+        get_snapshot: Callable[[], Snapshot | None],
+        on_setpoint: Callable[[bytes], dict],
+        *,
+        queue_size: int = DEFAULT_QUEUE_SIZE,
+        flush_timeout_s: float = 2.0,
+        on_defects: Callable[[bytes], dict] | None = None,
+        on_measured: Callable[[bytes], dict] | None = None,
+    ):
         self.bus = bus
         self.bearing_id = bearing_id
-        self.prefix = twin_key(bus.prefix, bearing_id)   # the twin's key: P/{id}
+        self.prefix = twin_key(bus.prefix, bearing_id)  # the twin's key: P/{id}
         self._flush_timeout_s = flush_timeout_s
         self._closed = False
         self._close_lock = threading.Lock()
         self.outbox = TwinOutbox(bus, bearing_id, queue_size=queue_size)
-        self.inbox = TwinInbox(bus, bearing_id, get_snapshot, on_setpoint, on_defects=on_defects,
-                               on_measured=on_measured, known_state=self.outbox.last_state)
+        self.inbox = TwinInbox(
+            bus,
+            bearing_id,
+            get_snapshot,
+            on_setpoint,
+            on_defects=on_defects,
+            on_measured=on_measured,
+            known_state=self.outbox.last_state,
+        )
         self._token = bus.session.liveliness().declare_token(twin_key(bus.prefix, bearing_id, ALIVE))
 
     # ---- SnapshotSink -----------------------------------------------------------------------
@@ -231,11 +257,15 @@ class TwinChannel:
     published = property(lambda self: self.outbox.published, doc="Snapshots fully put on the bus.")
     errors = property(lambda self: self.outbox.errors, doc="Snapshots that failed to serialise or put.")
     waveform_chunks = property(lambda self: self.outbox.waveform_chunks, doc="Waveform chunks put on the bus.")
-    unmatched = property(lambda self: self.outbox.unmatched,
-                         doc="Messages not made: no subscriber matched their key (service.bus.twin_outbox).")
+    unmatched = property(
+        lambda self: self.outbox.unmatched,
+        doc="Messages not made: no subscriber matched their key (service.bus.twin_outbox).",
+    )
     setpoints_received = property(lambda self: self.inbox.setpoints_received, doc="Setpoint messages taken.")
-    setpoints_refused_busy = property(lambda self: self.inbox.setpoints_refused_busy,
-                                      doc="Setpoints refused with 429 because the control queue was full.")
+    setpoints_refused_busy = property(
+        lambda self: self.inbox.setpoints_refused_busy,
+        doc="Setpoints refused with 429 because the control queue was full.",
+    )
     queries_answered = property(lambda self: self.inbox.queries_answered, doc="Snapshot queries answered.")
 
     @property
@@ -261,13 +291,14 @@ class TwinChannel:
         self.bus._forget(self)
 
 
-
 def _closer(ref: weakref.ref) -> Callable[[], None]:
     """atexit safety net: close the bus if the owner forgot (an open session can hang exit)."""
+
     def close() -> None:
         bus = ref()
         if bus is not None:
             bus.close()
+
     return close
 
 
@@ -282,10 +313,19 @@ class ZenohBus:
     Open it after any fork (in the service lifespan), never at import time.
     """
 
-    def __init__(self, listen: Iterable[str] | None = None, connect: Iterable[str] | None = None,
-                 mode: str = "peer", *, gossip: bool = True, prefix: str = DEFAULT_PREFIX,
-                 access: ZenohAccess | None = None, owner: dict | None = None,
-                 claim_timeout_s: float = 2.0, trust_claims: bool = True):
+    def __init__(
+        self,
+        listen: Iterable[str] | None = None,
+        connect: Iterable[str] | None = None,
+        mode: str = "peer",
+        *,
+        gossip: bool = True,
+        prefix: str = DEFAULT_PREFIX,
+        access: ZenohAccess | None = None,
+        owner: dict | None = None,
+        claim_timeout_s: float = 2.0,
+        trust_claims: bool = True,
+    ):
         """`prefix`: the key prefix P of every twin (docs/service.md "A fleet"); `access`: zenoh's
         authentication and access-control rules (service.bus.access); `owner`: what P/{id}/owner
         tells about this process besides pid, host and zenoh id (e.g. {"http": url});
@@ -304,21 +344,28 @@ class ZenohBus:
         self._claiming: set[str] = set()
         self._lock = threading.Lock()
         self._closed = True  # until the session is open
-        config = make_config(self.listen, self.connect, mode, gossip=gossip, access=self.access,
-                             prefix=self.prefix)  # ValueError on typos
+        config = make_config(
+            self.listen, self.connect, mode, gossip=gossip, access=self.access, prefix=self.prefix
+        )  # ValueError on typos
         try:
             self.session = zenoh.open(config)
         except Exception as exc:
-            raise RuntimeError(f"zenoh: cannot open a {mode} session (listen={self.listen}, "
-                               f"connect={self.connect}): {_one_line(exc)}") from exc
+            raise RuntimeError(
+                f"zenoh: cannot open a {mode} session (listen={self.listen}, connect={self.connect}): {_one_line(exc)}"
+            ) from exc
         self.zid = str(self.session.info.zid())
         self._closed = False
         self._atexit = _closer(weakref.ref(self))
         atexit.register(self._atexit)
 
     @classmethod
-    def open(cls, listen: Iterable[str] | None = None, connect: Iterable[str] | None = None,
-             mode: str = "peer", **kwargs: Any) -> ZenohBus:
+    def open(
+        cls,
+        listen: Iterable[str] | None = None,
+        connect: Iterable[str] | None = None,
+        mode: str = "peer",
+        **kwargs: Any,
+    ) -> ZenohBus:
         """Open a bus (same as the constructor)."""
         return cls(listen, connect, mode, **kwargs)
 
@@ -337,19 +384,26 @@ class ZenohBus:
         with self._lock:
             return dict(self._channels)
 
-    def attach_twin(self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
-                    on_setpoint: Callable[[bytes], dict], *,
-                    queue_size: int = DEFAULT_QUEUE_SIZE,
-                    on_defects: Callable[[bytes], dict] | None = None,
-                    on_measured: Callable[[bytes], dict] | None = None) -> TwinChannel:
+    def attach_twin(
+        self,
+        bearing_id: str,
+        get_snapshot: Callable[[], Snapshot | None],
+        on_setpoint: Callable[[bytes], dict],
+        *,
+        queue_size: int = DEFAULT_QUEUE_SIZE,
+        on_defects: Callable[[bytes], dict] | None = None,
+        on_measured: Callable[[bytes], dict] | None = None,
+    ) -> TwinChannel:
         """Declare the twin's publishers, setpoint subscriber, snapshot and owner queryables and
         liveliness token; return its channel (a SnapshotSink: hand it to the runner).
 
         InputError 409 (field `id`) naming the other process when the id is taken under this
         prefix anywhere on the zenoh network (see the module docstring)."""
         if not isinstance(bearing_id, str) or not TWIN_ID_RE.match(bearing_id):
-            raise ValueError(f"bearing id {bearing_id!r} is not a single key-expression chunk "
-                             "(letters, digits, _ . - ... ; no '/', '*', '$', '?', '#')")
+            raise ValueError(
+                f"bearing id {bearing_id!r} is not a single key-expression chunk "
+                "(letters, digits, _ . - ... ; no '/', '*', '$', '?', '#')"
+            )
         with self._lock:
             if self._closed:
                 raise RuntimeError("zenoh bus is closed")
@@ -361,13 +415,24 @@ class ZenohBus:
             if self._alive_elsewhere(key):
                 if self.trust_claims:
                     raise self._taken(bearing_id, self._claimants(key))
-                log.warning("twin %r: a zenoh peer holds the liveliness token %s/alive, but zenoh did not "
-                            "authenticate it (zenoh access control is off while the HTTP API needs a token): "
-                            "the claim is not trusted and the twin starts here", bearing_id, key)
-            channel = TwinChannel(self, bearing_id, get_snapshot, on_setpoint, queue_size=queue_size,
-                                  on_defects=on_defects, on_measured=on_measured)
+                log.warning(
+                    "twin %r: a zenoh peer holds the liveliness token %s/alive, but zenoh did not "
+                    "authenticate it (zenoh access control is off while the HTTP API needs a token): "
+                    "the claim is not trusted and the twin starts here",
+                    bearing_id,
+                    key,
+                )
+            channel = TwinChannel(
+                self,
+                bearing_id,
+                get_snapshot,
+                on_setpoint,
+                queue_size=queue_size,
+                on_defects=on_defects,
+                on_measured=on_measured,
+            )
             others = self._claimants(key) if self.trust_claims else []
-            if others:                      # claimed at the same moment elsewhere: withdraw
+            if others:  # claimed at the same moment elsewhere: withdraw
                 channel.detach()
                 raise self._taken(bearing_id, others)
             with self._lock:
@@ -383,8 +448,7 @@ class ZenohBus:
     # ---- one id per prefix across processes ---------------------------------------------
     def owner(self, bearing_id: str) -> dict:
         """What P/{id}/owner answers: the twin's key, this process and its zenoh id."""
-        return {"key": twin_key(self.prefix, bearing_id), "bearing_id": bearing_id, **self._owner,
-                "zid": self.zid}
+        return {"key": twin_key(self.prefix, bearing_id), "bearing_id": bearing_id, **self._owner, "zid": self.zid}
 
     def _alive_elsewhere(self, key: str) -> bool:
         """Whether a liveliness token `key`/alive exists on the network (ours are not: the
@@ -405,9 +469,12 @@ class ZenohBus:
         `key`/owner."""
         out = []
         try:
-            replies = self.session.get(f"{key}/owner", target=zenoh.QueryTarget.ALL,
-                                       consolidation=zenoh.ConsolidationMode.NONE,
-                                       timeout=self.claim_timeout_s)
+            replies = self.session.get(
+                f"{key}/owner",
+                target=zenoh.QueryTarget.ALL,
+                consolidation=zenoh.ConsolidationMode.NONE,
+                timeout=self.claim_timeout_s,
+            )
             for reply in replies:
                 if reply.ok is None:
                     continue
@@ -430,12 +497,22 @@ class ZenohBus:
         zid = next((z for z, _o in claimants if z), None)
         who = f"another process (zenoh id {zid})" if zid else "another process"
         for z, o in claimants[:4]:
-            log.warning("twin %r already runs under %r in process %s on %s%s, zenoh id %s (as its owner answer "
-                        "says)", bearing_id, self.prefix, _quoted(o.get("pid")), _quoted(o.get("host")),
-                        f" (HTTP {_quoted(o['http'])})" if o.get("http") else "", z or _quoted(o.get("zid")))
-        return InputError.one("id", f"twin {bearing_id!r} already runs under {self.prefix!r} in {who}; "
-                              "twin ids are unique per key prefix across the zenoh network: choose "
-                              "another id or prefix (this service's log names the process)", status_code=409)
+            log.warning(
+                "twin %r already runs under %r in process %s on %s%s, zenoh id %s (as its owner answer says)",
+                bearing_id,
+                self.prefix,
+                _quoted(o.get("pid")),
+                _quoted(o.get("host")),
+                f" (HTTP {_quoted(o['http'])})" if o.get("http") else "",
+                z or _quoted(o.get("zid")),
+            )
+        return InputError.one(
+            "id",
+            f"twin {bearing_id!r} already runs under {self.prefix!r} in {who}; "
+            "twin ids are unique per key prefix across the zenoh network: choose "
+            "another id or prefix (this service's log names the process)",
+            status_code=409,
+        )
 
     def detach_twin(self, bearing_id: str) -> None:
         channel = self.channels.get(bearing_id)

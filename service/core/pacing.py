@@ -44,10 +44,19 @@ class PacingClock:
     """Deadlines, lateness, real-time factor and publishing schedule of one runner (written by
     whichever stepping thread runs the twin's frame; read by any)."""
 
-    def __init__(self, *, fast: bool, publish_period_s: float, clock: Callable[[], float],
-                 rtf_window_s: float = 1.0, resync_after_s: float = 0.25,
-                 setpoint_publish_min_interval_s: float = 0.002, lateness_s: float = 0.005,
-                 late_window_s: float = 10.0, lead_s: float = 0.0):
+    def __init__(
+        self,
+        *,
+        fast: bool,
+        publish_period_s: float,
+        clock: Callable[[], float],
+        rtf_window_s: float = 1.0,
+        resync_after_s: float = 0.25,
+        setpoint_publish_min_interval_s: float = 0.002,
+        lateness_s: float = 0.005,
+        late_window_s: float = 10.0,
+        lead_s: float = 0.0,
+    ):
         if not (lateness_s >= 0.0 and math.isfinite(lateness_s)):
             raise ValueError(f"lateness_s = {lateness_s!r}: must be >= 0 [s]")
         if not (lead_s >= 0.0 and math.isfinite(lead_s)):
@@ -61,7 +70,7 @@ class PacingClock:
         self.lateness_s = lateness_s
         self.late_window_s = late_window_s
         self.clock = clock
-        self.overruns = 0           # frames that ended more than lateness_s after their deadline
+        self.overruns = 0  # frames that ended more than lateness_s after their deadline
         self.resyncs = 0
         self._rtf: float | None = None
         self._samples: collections.deque[tuple[float, float]] = collections.deque()
@@ -72,7 +81,7 @@ class PacingClock:
         self._publish_soon = False
         self.last_publish_wall = -math.inf
         self.last_publish_sim = -math.inf
-        self.last_setpoint_publish_wall = -math.inf   # the last publication asked by publish_soon
+        self.last_setpoint_publish_wall = -math.inf  # the last publication asked by publish_soon
 
     @property
     def real_time_factor(self) -> float | None:
@@ -130,7 +139,7 @@ class PacingClock:
                 return True
             return False
         if setpoint_changed:
-            self._publish_soon = True   # deferred (not dropped) if the last one was too recent
+            self._publish_soon = True  # deferred (not dropped) if the last one was too recent
         if now >= self._next_publish_wall:
             self._next_publish_wall += self.publish_period_s
             if self._next_publish_wall <= now:
@@ -138,7 +147,7 @@ class PacingClock:
             return True
         if self._publish_soon and now - self.last_setpoint_publish_wall >= self.setpoint_publish_min_interval_s:
             self.last_setpoint_publish_wall = now
-            self._next_publish_wall = now + self.publish_period_s   # it stands for this period's tick
+            self._next_publish_wall = now + self.publish_period_s  # it stands for this period's tick
             return True
         return False
 

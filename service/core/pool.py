@@ -79,10 +79,10 @@ class Job:
     task: Steppable
     release: float = 0.0
     deadline: float = math.inf
-    state: str = "waiting"          # waiting | ready | running | done
-    gen: int = 0                    # heap entries of older generations are stale
-    wake_pending: bool = False      # woken while running: release at once when put back
-    frames: int = 0                 # steps run (for the tests and the accounting)
+    state: str = "waiting"  # waiting | ready | running | done
+    gen: int = 0  # heap entries of older generations are stale
+    wake_pending: bool = False  # woken while running: release at once when put back
+    frames: int = 0  # steps run (for the tests and the accounting)
     done: threading.Event = field(default_factory=threading.Event)
 
     @property
@@ -300,7 +300,7 @@ class SteppingPool:
                     if job is not None:
                         job.wake_pending = False
                         if q.next_release() is not None:
-                            cond.notify()    # another job waits: one free thread takes over its timer
+                            cond.notify()  # another job waits: one free thread takes over its timer
                         break
                     nxt = q.next_release()
                     cond.wait(None if nxt is None else max(0.0, nxt - now))
@@ -317,7 +317,7 @@ class SteppingPool:
                     if job.wake_pending:
                         schedule = Schedule(min(schedule.release, self.clock()), schedule.deadline)
                         job.wake_pending = False
-                    q.put(job, schedule)   # this thread is free again and times it: no wake-up
+                    q.put(job, schedule)  # this thread is free again and times it: no wake-up
             if schedule is None:
                 try:
                     job.task.left_pool()

@@ -64,37 +64,45 @@ class Capture:
     late_fraction: float | None
     note: str | None
     timings: list[SetpointTiming] = field(default_factory=list)
-    waveform: list = field(default_factory=list)   # accelerometer blocks drained with it
+    waveform: list = field(default_factory=list)  # accelerometer blocks drained with it
 
 
 class Publisher:
     """Sinks, the latest snapshot, the status note and the captures waiting for the worker of
     one twin (see the module docstring)."""
 
-    def __init__(self, bearing_id: str, sinks: Iterable[SnapshotSink] = (), timing_history: int = 10000,
-                 *, max_pending: int = 8, lossless: bool = False, clock: Callable[[], float] = time.perf_counter):
+    def __init__(
+        self,
+        bearing_id: str,
+        sinks: Iterable[SnapshotSink] = (),
+        timing_history: int = 10000,
+        *,
+        max_pending: int = 8,
+        lossless: bool = False,
+        clock: Callable[[], float] = time.perf_counter,
+    ):
         self.bearing_id = bearing_id
         self.max_pending = max(1, int(max_pending))
         self.lossless = lossless
         self.clock = clock
         self._lock = threading.Lock()
         self._cv = threading.Condition(threading.Lock())
-        self._deliver_lock = threading.Lock()     # one delivery of this twin at a time, in capture order
+        self._deliver_lock = threading.Lock()  # one delivery of this twin at a time, in capture order
         self._sinks: list[SnapshotSink] = list(sinks)
         self._latest: Snapshot | None = None
-        self._latest_json: tuple[Snapshot, bytes] | None = None   # (snapshot, its contract JSON)
+        self._latest_json: tuple[Snapshot, bytes] | None = None  # (snapshot, its contract JSON)
         self._json_lock = threading.Lock()
         self._unpublished: list[SetpointTiming] = []
         self._pending: collections.deque[Capture] = collections.deque()
         self._timings: collections.deque[SetpointTiming] = collections.deque(maxlen=timing_history)
         self._worker: PublishWorker | None = None
         self._seq: int | None = None
-        self._carry: list[SetpointTiming] = []   # timings of a capture whose snapshot failed (worker)
-        self.note: str | None = None     # the runner's word on the twin's state, or None
+        self._carry: list[SetpointTiming] = []  # timings of a capture whose snapshot failed (worker)
+        self.note: str | None = None  # the runner's word on the twin's state, or None
         self.published = 0
         self.sink_errors = 0
-        self.skipped = 0                 # captures dropped before they were built (real time, worker behind)
-        self.cpu = CpuMeter(window=50)   # CPU s per snapshot built and handed to the sinks
+        self.skipped = 0  # captures dropped before they were built (real time, worker behind)
+        self.cpu = CpuMeter(window=50)  # CPU s per snapshot built and handed to the sinks
 
     # ---- any thread ------------------------------------------------------------------------
     @property
@@ -191,8 +199,14 @@ class Publisher:
         """The latest snapshot without publishing it (before the runner starts)."""
         self._latest = snapshot
 
-    def capture(self, twin: Twin, real_time_factor: float | None, late_fraction: float | None = None,
-                *, stop: threading.Event | None = None) -> None:
+    def capture(
+        self,
+        twin: Twin,
+        real_time_factor: float | None,
+        late_fraction: float | None = None,
+        *,
+        stop: threading.Event | None = None,
+    ) -> None:
         """Capture `twin` for publication (frozen copy when a worker builds it later)."""
         worker = self._worker
         timings, self._unpublished = self._unpublished, []
@@ -200,7 +214,7 @@ class Publisher:
             now = self.clock()
             for t in timings:
                 t.captured_wall_s = now
-        waveform = twin.drain_waveform()      # [] without the housing
+        waveform = twin.drain_waveform()  # [] without the housing
         if worker is None or not worker.alive:
             with self._deliver_lock:
                 self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings, waveform))
@@ -213,13 +227,14 @@ class Publisher:
         cap = Capture(twin.frozen(), real_time_factor, late_fraction, self.note, timings, waveform)
         with self._cv:
             if self.lossless:
-                while (len(self._pending) >= self.max_pending and worker.alive
-                       and not (stop is not None and stop.is_set())):
+                while (
+                    len(self._pending) >= self.max_pending and worker.alive and not (stop is not None and stop.is_set())
+                ):
                     self._cv.wait(0.1)
             elif len(self._pending) >= self.max_pending:
                 old = self._pending.popleft()
                 cap.timings[:0] = old.timings
-                cap.waveform[:0] = old.waveform       # the samples are not the snapshot's: keep them
+                cap.waveform[:0] = old.waveform  # the samples are not the snapshot's: keep them
                 self.skipped += 1
             self._pending.append(cap)
         if not worker.submit(self._deliver_next):
@@ -255,7 +270,7 @@ class Publisher:
         try:
             tw = cap.twin
             if self._seq is not None:
-                tw.seq = self._seq            # the publisher numbers the snapshots of its twin
+                tw.seq = self._seq  # the publisher numbers the snapshots of its twin
             snap = tw.snapshot(real_time_factor=cap.real_time_factor)
             self._seq = snap.seq
             update = {"late_fraction": cap.late_fraction} if cap.late_fraction is not None else {}
@@ -265,7 +280,7 @@ class Publisher:
                 snap = snap.model_copy(update=update)
         except Exception as exc:  # noqa: BLE001 - counted; the twin goes on
             self.sink_errors += 1
-            self._carry = cap.timings       # completed by the next snapshot that is built
+            self._carry = cap.timings  # completed by the next snapshot that is built
             log.warning("twin %s: snapshot failed: %s", self.bearing_id, exc)
             return
         if cap.timings:

@@ -43,15 +43,15 @@ from service.core.alarm_hub import AlarmHub
 from service.core.alarms import AlarmEvent
 from service.core.capacity import Capacity, ServiceOverheadMeter, TwinCost, calibrate, usable_cores
 from service.core.errors import InputError, field_errors, setpoint_field_errors
+from service.core.heap import freeze_heap
 from service.core.intake import DefectIntake, SetpointIntake
 from service.core.measured import MeasuredComparator, MeasuredIntake
 from service.core.pool import SteppingPool
-from service.keys import TWIN_ID_PATTERN, TWIN_ID_RE
-from service.core.heap import freeze_heap
 from service.core.priority import EGRESS_THREAD_NAMES, ThreadPriority
 from service.core.runner import TwinRunner
 from service.core.sinks import SnapshotSink
 from service.core.thread_cpu import ThreadCpuMeter
+from service.keys import TWIN_ID_PATTERN, TWIN_ID_RE
 from service.settings import ServiceSettings
 from twin import catalog
 from twin.engine import Twin
@@ -69,13 +69,20 @@ _REC_PATH_RE = re.compile(r"^(?=.{1,256}$)(?:[A-Za-z0-9_][A-Za-z0-9_.-]*/)*[A-Za
 
 def admission_gate(settings: ServiceSettings) -> AdmissionGate:
     """The service's one admission gate (HTTP and zenoh) from its settings."""
-    bus_writes = ("authorized" if settings.zenoh.access_control
-                  else "closed" if settings.security.token is not None else "open")
-    return AdmissionGate(token=settings.security.token_value, setpoint_rate_hz=settings.security.setpoint_rate_hz or None,
-                         setpoint_burst=settings.security.setpoint_burst, max_payload_bytes=settings.security.max_body_bytes,
-                         bus_writes=bus_writes, read_rate_hz=settings.security.read_rate_hz or None,
-                         read_burst=settings.security.read_burst, error_rate_hz=settings.security.client_error_rate_hz or None,
-                         error_burst=settings.security.client_error_burst)
+    bus_writes = (
+        "authorized" if settings.zenoh.access_control else "closed" if settings.security.token is not None else "open"
+    )
+    return AdmissionGate(
+        token=settings.security.token_value,
+        setpoint_rate_hz=settings.security.setpoint_rate_hz or None,
+        setpoint_burst=settings.security.setpoint_burst,
+        max_payload_bytes=settings.security.max_body_bytes,
+        bus_writes=bus_writes,
+        read_rate_hz=settings.security.read_rate_hz or None,
+        read_burst=settings.security.read_burst,
+        error_rate_hz=settings.security.client_error_rate_hz or None,
+        error_burst=settings.security.client_error_burst,
+    )
 
 
 class Channel(SnapshotSink, Protocol):
@@ -91,8 +98,9 @@ class Bus(Protocol):
 
     closed: bool
 
-    def attach_twin(self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None],
-                    on_setpoint: Callable[[bytes], dict]) -> Channel: ...
+    def attach_twin(
+        self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None], on_setpoint: Callable[[bytes], dict]
+    ) -> Channel: ...
 
     def close(self) -> None: ...
 
@@ -117,11 +125,11 @@ class TwinEntry:
     runner: TwinRunner
     intake: SetpointIntake
     lubricant: str
-    channel: Any = None                 # the bus channel (a sink)
-    recording: Any = None               # this twin's own recording (POST .../recording)
+    channel: Any = None  # the bus channel (a sink)
+    recording: Any = None  # this twin's own recording (POST .../recording)
     recording_path: Path | None = None
     created_wall_s: float = field(default_factory=time.time)
-    measured: MeasuredComparator | None = None   # measured vibration beside the twin (service.core.measured)
+    measured: MeasuredComparator | None = None  # measured vibration beside the twin (service.core.measured)
 
     @property
     def designation(self) -> str:
@@ -142,23 +150,28 @@ class TwinRegistry:
         self.recorder: Recorder | None = None
         self.started_wall_s = time.monotonic()
         self._twins: dict[str, TwinEntry] = {}
-        self._reserved: set[str] = set()    # ids of twins being built
-        self._admitting: dict[str, TwinCost] = {}   # costs of twins admitted, not yet running
+        self._reserved: set[str] = set()  # ids of twins being built
+        self._admitting: dict[str, TwinCost] = {}  # costs of twins admitted, not yet running
         threads = settings.runner.stepping_threads or usable_cores()
         self.pool = SteppingPool(threads, name="step")
-        self.priority = ThreadPriority(self.pool.native_ids, settings.runner.io_thread_nice, settings.runner.stepping_thread_nice,
-                                       keep_names=EGRESS_THREAD_NAMES)
+        self.priority = ThreadPriority(
+            self.pool.native_ids,
+            settings.runner.io_thread_nice,
+            settings.runner.stepping_thread_nice,
+            keep_names=EGRESS_THREAD_NAMES,
+        )
         self.overhead = ServiceOverheadMeter()
-        self.thread_cpu = ThreadCpuMeter()   # the overhead by the job of its threads
-        self.capacity = Capacity(threads, settings.runner.capacity_core_fraction,
-                                 reserve_cores=settings.runner.capacity_reserve_cores)
+        self.thread_cpu = ThreadCpuMeter()  # the overhead by the job of its threads
+        self.capacity = Capacity(
+            threads, settings.runner.capacity_core_fraction, reserve_cores=settings.runner.capacity_reserve_cores
+        )
         self.last_calibration: TwinCost | None = None
-        self.over_capacity: str | None = None     # why the configured twin runs over capacity
+        self.over_capacity: str | None = None  # why the configured twin runs over capacity
         self._over_capacity_id: str | None = None
         self._recording_lock = threading.RLock()
         self._lock = threading.RLock()
         self._closed = False
-        self.alarms = AlarmHub(settings.alarms)    # every twin's alarms (a sink on each runner)
+        self.alarms = AlarmHub(settings.alarms)  # every twin's alarms (a sink on each runner)
         self.alarms.subscribe(self._alarm_to_bus)
 
     def _alarm_to_bus(self, event: AlarmEvent) -> None:
@@ -187,7 +200,7 @@ class TwinRegistry:
             sys.setswitchinterval(self.settings.runner.gil_switch_interval_s)  # process-wide, see settings
         try:
             self.pool.start()
-            self.priority.start()              # after the pool: its threads keep their nice
+            self.priority.start()  # after the pool: its threads keep their nice
             self._open_outputs()
             if default_twin and self.settings.twin.start:
                 self.create_twin(id=self.settings.twin.id, over_capacity_ok=True, **self._configured_bearing())
@@ -219,7 +232,7 @@ class TwinRegistry:
             self._closed = True
             entries = list(self._twins.values())
             self._twins.clear()
-        for e in entries:                     # ask all to stop first, then join
+        for e in entries:  # ask all to stop first, then join
             e.runner.request_stop()
         for e in entries:
             try:
@@ -260,8 +273,12 @@ class TwinRegistry:
             entry = self._twins.get(bearing_id)
             known = sorted(self._twins)
         if entry is None:
-            raise InputError.one("bearing_id", f"unknown twin {bearing_id!r}; known: "
-                                 f"{', '.join(known) or 'none'}", known, status_code=404)
+            raise InputError.one(
+                "bearing_id",
+                f"unknown twin {bearing_id!r}; known: {', '.join(known) or 'none'}",
+                known,
+                status_code=404,
+            )
         return entry
 
     def find(self, bearing_id: str) -> TwinEntry | None:
@@ -275,11 +292,17 @@ class TwinRegistry:
             n += 1
         return f"{stem}-{n}"
 
-    def build_twin(self, bearing_id: str, designation: str = catalog.DEFAULT_DESIGNATION,
-                   diametral_clearance_m: float = 0.0,
-                   lubricant: str = "seed-000", setpoint: SetpointUpdate | None = None,
-                   thermal: Thermal | None = None, housing: Any = None,
-                   spec: BearingSpec | dict | None = None) -> Twin:
+    def build_twin(
+        self,
+        bearing_id: str,
+        designation: str = catalog.DEFAULT_DESIGNATION,
+        diametral_clearance_m: float = 0.0,
+        lubricant: str = "seed-000",
+        setpoint: SetpointUpdate | None = None,
+        thermal: Thermal | None = None,
+        housing: Any = None,
+        spec: BearingSpec | dict | None = None,
+    ) -> Twin:
         """A warm-started Twin (InputError naming the field if a value is not valid). `housing`:
         twin.vibration.housing.Housing (or its dict); `{"enabled": true}` puts the outer ring on
         the housing support with the accelerometer. `spec`: a whole bearing spec
@@ -292,12 +315,15 @@ class TwinRegistry:
                 raise InputError(field_errors([{**e, "loc": ("spec", *e["loc"])} for e in exc.errors()])) from None
             try:
                 twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
-            except (ValueError, ArithmeticError) as exc:   # a valid spec the model cannot compile
-                raise InputError.one("spec", f"bearing {spec.designation!r} cannot be modelled: "
-                                     f"{' '.join(str(exc).split())[:300]}") from None
+            except (ValueError, ArithmeticError) as exc:  # a valid spec the model cannot compile
+                raise InputError.one(
+                    "spec", f"bearing {spec.designation!r} cannot be modelled: {' '.join(str(exc).split())[:300]}"
+                ) from None
         else:
-            twin = Twin(self._catalog_spec(designation, diametral_clearance_m, lubricant, thermal, housing),
-                        bearing_id=bearing_id)
+            twin = Twin(
+                self._catalog_spec(designation, diametral_clearance_m, lubricant, thermal, housing),
+                bearing_id=bearing_id,
+            )
         if setpoint is not None:
             try:
                 twin.set_setpoint(setpoint)
@@ -307,8 +333,9 @@ class TwinRegistry:
         return twin
 
     @staticmethod
-    def _catalog_spec(designation: str, diametral_clearance_m: float, lubricant: str,
-                      thermal: Thermal | None, housing: Any) -> BearingSpec:
+    def _catalog_spec(
+        designation: str, diametral_clearance_m: float, lubricant: str, thermal: Thermal | None, housing: Any
+    ) -> BearingSpec:
         """The catalog bearing with its overrides (InputError naming the field)."""
         wanted = designation
         designation = designation.strip().upper()
@@ -326,11 +353,18 @@ class TwinRegistry:
         except ValidationError as exc:
             raise InputError(field_errors(exc.errors())) from None
 
-    def create_twin(self, id: str | None = None, designation: str = catalog.DEFAULT_DESIGNATION, *,
-                    over_capacity_ok: bool = False, **options: Any) -> TwinEntry:
+    def create_twin(
+        self,
+        id: str | None = None,
+        designation: str = catalog.DEFAULT_DESIGNATION,
+        *,
+        over_capacity_ok: bool = False,
+        **options: Any,
+    ) -> TwinEntry:
         """Create, wire and start a twin (`options`: diametral_clearance_m, lubricant, setpoint,
         thermal, housing; or spec: a whole BearingSpec, whose designation names the twin by default).
-        InputError 409 on a duplicate id or at max_twins, 503 when this host cannot run it in real time (admission 'measured'; `over_capacity_ok`: start it anyway, with a
+        InputError 409 on a duplicate id or at max_twins, 503 when this host cannot run it in real time (admission
+        'measured'; `over_capacity_ok`: start it anyway, with a
         warning: the twin of the configuration), 422 for an invalid value."""
         s = self.settings
         with self._lock:
@@ -343,32 +377,54 @@ class TwinRegistry:
                 designation = str(spec.get("designation", "bearing"))
             bearing_id = id or self._new_id(designation.strip().upper())
             if not TWIN_ID_RE.match(bearing_id):
-                raise InputError.one("id", f"{bearing_id!r}: letters, digits, '_', '.', '-' only "
-                                     "(it is used in URLs and zenoh key expressions)")
+                raise InputError.one(
+                    "id",
+                    f"{bearing_id!r}: letters, digits, '_', '.', '-' only "
+                    "(it is used in URLs and zenoh key expressions)",
+                )
             if bearing_id in self._twins or bearing_id in self._reserved:
-                raise InputError.one("id", f"a twin named {bearing_id!r} already exists",
-                                     status_code=409)
+                raise InputError.one("id", f"a twin named {bearing_id!r} already exists", status_code=409)
             limit = s.runner.twin_limit
             if len(self._twins) + len(self._reserved) >= limit:
-                raise InputError.one(None, f"this service already runs {len(self._twins)} twins "
-                                     f"(max_twins = {limit})", [0, limit], status_code=409)
+                raise InputError.one(
+                    None,
+                    f"this service already runs {len(self._twins)} twins (max_twins = {limit})",
+                    [0, limit],
+                    status_code=409,
+                )
             # reserve the id while the (slow) model is built outside the lock
             self._reserved.add(bearing_id)
         entry = None
         try:
             twin = self.build_twin(bearing_id, designation, **options)
             cost = self._admit(bearing_id, twin, over_capacity_ok)
-            runner = TwinRunner(twin, fast=s.runner.fast, publish_rate_hz=s.runner.publish_rate_hz, frame_s=s.runner.frame_s,
-                                setpoint_frame_s=s.runner.setpoint_frame_s, lateness_s=s.runner.lateness_s, lead_s=s.runner.frame_lead_s,
-                                pool=self.pool, cost=cost)
-            entry = TwinEntry(id=bearing_id, twin=twin, runner=runner,
-                              intake=SetpointIntake(bearing_id, self.gate, runner),
-                              lubricant=twin.model.spec.lubricant.name,
-                              measured=MeasuredComparator(bearing_id, twin.model.spec.geometry, runner))
+            runner = TwinRunner(
+                twin,
+                fast=s.runner.fast,
+                publish_rate_hz=s.runner.publish_rate_hz,
+                frame_s=s.runner.frame_s,
+                setpoint_frame_s=s.runner.setpoint_frame_s,
+                lateness_s=s.runner.lateness_s,
+                lead_s=s.runner.frame_lead_s,
+                pool=self.pool,
+                cost=cost,
+            )
+            entry = TwinEntry(
+                id=bearing_id,
+                twin=twin,
+                runner=runner,
+                intake=SetpointIntake(bearing_id, self.gate, runner),
+                lubricant=twin.model.spec.lubricant.name,
+                measured=MeasuredComparator(bearing_id, twin.model.spec.geometry, runner),
+            )
             if self.bus is not None:
-                entry.channel = self.bus.attach_twin(bearing_id, runner.latest_snapshot, entry.intake,
-                                                     on_defects=DefectIntake(bearing_id, self.gate, runner),
-                                                     on_measured=MeasuredIntake(bearing_id, self.gate, entry.measured))
+                entry.channel = self.bus.attach_twin(
+                    bearing_id,
+                    runner.latest_snapshot,
+                    entry.intake,
+                    on_defects=DefectIntake(bearing_id, self.gate, runner),
+                    on_measured=MeasuredIntake(bearing_id, self.gate, entry.measured),
+                )
                 runner.add_sink(entry.channel)
             if self.recorder is not None:
                 self.recorder.add_twin_from(twin)
@@ -390,13 +446,19 @@ class TwinRegistry:
         with self._lock:
             self._reserved.discard(bearing_id)
             self._admitting.pop(bearing_id, None)
-            if self._closed:   # closed while building: do not leak a running twin
+            if self._closed:  # closed while building: do not leak a running twin
                 entry.runner.stop(timeout=2.0)
                 self._unwire(entry)
                 raise InputError.one(None, "the service is shutting down", status_code=503)
             self._twins[bearing_id] = entry
-        log.info("twin %s started (%s, Pd = %g m, %s, %s mode)", bearing_id, entry.designation,
-                 entry.diametral_clearance_m, entry.lubricant, runner.mode)
+        log.info(
+            "twin %s started (%s, Pd = %g m, %s, %s mode)",
+            bearing_id,
+            entry.designation,
+            entry.diametral_clearance_m,
+            entry.lubricant,
+            runner.mode,
+        )
         return entry
 
     # ---- admission by measured capacity ----------------------------------------------------
@@ -407,8 +469,12 @@ class TwinRegistry:
         s = self.settings
         if s.runner.admission == "off" or s.runner.fast:
             return None
-        cost = calibrate(twin, sim_s=s.runner.calibration_s, frame_steps=max(1, round(s.runner.frame_s / twin.model.dt_s)),
-                         publish_rate_hz=s.runner.publish_rate_hz)
+        cost = calibrate(
+            twin,
+            sim_s=s.runner.calibration_s,
+            frame_steps=max(1, round(s.runner.frame_s / twin.model.dt_s)),
+            publish_rate_hz=s.runner.publish_rate_hz,
+        )
         with self._lock:
             self.last_calibration = cost
             verdict = self.capacity.check(cost, self._running_costs())
@@ -416,14 +482,31 @@ class TwinRegistry:
                 if not over_capacity_ok:
                     log.warning("twin %s (%s) refused: %s", bearing_id, twin.model.spec.designation, verdict.reason)
                     raise InputError.one(
-                        None, f"twin {bearing_id!r} ({twin.model.spec.designation}) refused: {verdict.reason}",
-                        [0.0, round(max(0.0, min(verdict.per_twin_cpu_s_per_s,
-                                                 verdict.budget_cpu_s_per_s - verdict.used_cpu_s_per_s)), 4)],
-                        status_code=503)
+                        None,
+                        f"twin {bearing_id!r} ({twin.model.spec.designation}) refused: {verdict.reason}",
+                        [
+                            0.0,
+                            round(
+                                max(
+                                    0.0,
+                                    min(
+                                        verdict.per_twin_cpu_s_per_s,
+                                        verdict.budget_cpu_s_per_s - verdict.used_cpu_s_per_s,
+                                    ),
+                                ),
+                                4,
+                            ),
+                        ],
+                        status_code=503,
+                    )
                 self.over_capacity = f"twin {bearing_id!r}: {verdict.reason}"
                 self._over_capacity_id = bearing_id
-                log.warning("twin %s (%s) started over capacity (it is the configured twin): %s",
-                            bearing_id, twin.model.spec.designation, verdict.reason)
+                log.warning(
+                    "twin %s (%s) started over capacity (it is the configured twin): %s",
+                    bearing_id,
+                    twin.model.spec.designation,
+                    verdict.reason,
+                )
             self._admitting[bearing_id] = cost
         return cost
 
@@ -446,15 +529,24 @@ class TwinRegistry:
         cap = self.capacity
         estimate = cap.estimate_max_twins(typical, running, used)
         if self.settings.runner.max_twins is not None:
-            estimate = self.settings.runner.max_twins if estimate is None else min(estimate, self.settings.runner.max_twins)
+            estimate = (
+                self.settings.runner.max_twins if estimate is None else min(estimate, self.settings.runner.max_twins)
+            )
         return {
             "admission": "off" if self.settings.runner.fast else self.settings.runner.admission,
-            "cores": cap.cores, "stepping_threads": cap.stepping_threads,
-            "core_fraction": cap.core_fraction, "reserve_cores": cap.reserve_cores, "budget_cpu_s_per_s": cap.budget_cpu_s_per_s,
-            "used_cpu_s_per_s": used, "over_budget": used > cap.budget_cpu_s_per_s, "max_twins": estimate, "max_twins_set": self.settings.runner.max_twins,
+            "cores": cap.cores,
+            "stepping_threads": cap.stepping_threads,
+            "core_fraction": cap.core_fraction,
+            "reserve_cores": cap.reserve_cores,
+            "budget_cpu_s_per_s": cap.budget_cpu_s_per_s,
+            "used_cpu_s_per_s": used,
+            "over_budget": used > cap.budget_cpu_s_per_s,
+            "max_twins": estimate,
+            "max_twins_set": self.settings.runner.max_twins,
             "last_calibration": typical.as_dict() if typical is not None else None,
             "over_capacity": self.over_capacity,
-            "formula": cap.formula(typical, running, used), "service_overhead": overhead,
+            "formula": cap.formula(typical, running, used),
+            "service_overhead": overhead,
         }
 
     def delete_twin(self, bearing_id: str) -> TwinEntry:
@@ -481,13 +573,17 @@ class TwinRegistry:
             stamp = datetime.now(UTC).strftime("%Y%m%dT%H%M%SZ")
             return base / f"{bearing_id}-{stamp}.rrd"
         if not _REC_PATH_RE.match(path):
-            raise InputError.one("path", "a recording path is a relative path of letters, digits "
-                                 "and '_', '.', '-' (folders separated by '/', none starting with "
-                                 "'.'), ending in .rrd, at most 256 characters")
+            raise InputError.one(
+                "path",
+                "a recording path is a relative path of letters, digits "
+                "and '_', '.', '-' (folders separated by '/', none starting with "
+                "'.'), ending in .rrd, at most 256 characters",
+            )
         p = Path(path)
         if p.is_absolute() or ".." in p.parts:
-            raise InputError.one("path", f"{path!r}: give a path relative to the recordings "
-                                 f"directory {str(base)!r}, without '..'")
+            raise InputError.one(
+                "path", f"{path!r}: give a path relative to the recordings directory {str(base)!r}, without '..'"
+            )
         if p.suffix != ".rrd":
             raise InputError.one("path", f"{path!r}: a rerun recording ends in .rrd")
         return base / p
@@ -505,9 +601,10 @@ class TwinRegistry:
                 raise InputError.one("path", f"{str(target)!r} exists and is not a file")
             try:
                 rec = self._new_recording(target)
-            except (OSError, RuntimeError, ValueError) as exc:   # e.g. a folder that is a file
-                raise InputError.one("path", f"cannot record to {str(target)!r}: "
-                                     f"{' '.join(str(exc).split())[:200]}") from None
+            except (OSError, RuntimeError, ValueError) as exc:  # e.g. a folder that is a file
+                raise InputError.one(
+                    "path", f"cannot record to {str(target)!r}: {' '.join(str(exc).split())[:200]}"
+                ) from None
             rec.add_twin_from(entry.twin)
             entry.recording, entry.recording_path = rec, target
             entry.runner.add_sink(rec)
@@ -529,9 +626,13 @@ class TwinRegistry:
 
     # ---- health ----------------------------------------------------------------------------
     def health(self) -> dict:
-        twins = [e.runner.stats(setpoints_refused=e.intake.refused + int(getattr(e.channel, "setpoints_refused_busy", 0)),
-                                setpoints_rate_limited=self.gate.rate_limited(e.id))
-                 for e in self.entries()]
+        twins = [
+            e.runner.stats(
+                setpoints_refused=e.intake.refused + int(getattr(e.channel, "setpoints_refused_busy", 0)),
+                setpoints_rate_limited=self.gate.rate_limited(e.id),
+            )
+            for e in self.entries()
+        ]
         degraded = any((not t["running"]) or t["errors"] for t in twins)
         rec = self.recorder
         return {

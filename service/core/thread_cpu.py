@@ -35,8 +35,18 @@ import threading
 import time
 from collections.abc import Callable
 
-ROLES = ("stepping", "publish_worker", "zenoh_outbox", "zenoh_inbox", "alarms", "recording", "http",
-         "opcua", "other", "native")
+ROLES = (
+    "stepping",
+    "publish_worker",
+    "zenoh_outbox",
+    "zenoh_inbox",
+    "alarms",
+    "recording",
+    "http",
+    "opcua",
+    "other",
+    "native",
+)
 CLIENT_ROLES = frozenset({"http", "opcua"})
 
 
@@ -82,7 +92,7 @@ def thread_cpu_by_role() -> dict[str, float]:
             continue
         try:
             cpu = time.clock_gettime(thread_cpu_clock(t.native_id))
-        except (OSError, OverflowError, ValueError):   # the thread ended meanwhile
+        except (OSError, OverflowError, ValueError):  # the thread ended meanwhile
             continue
         totals[thread_role(t.name)] += cpu
         python += cpu
@@ -94,13 +104,18 @@ class ThreadCpuMeter:
     """CPU per wall second by role over the last closed window of at least `min_window_s`
     (see the module docstring). Thread-safe."""
 
-    def __init__(self, min_window_s: float = 1.0, *, clock: Callable[[], float] = time.monotonic,
-                 sample: Callable[[], dict[str, float]] = thread_cpu_by_role):
+    def __init__(
+        self,
+        min_window_s: float = 1.0,
+        *,
+        clock: Callable[[], float] = time.monotonic,
+        sample: Callable[[], dict[str, float]] = thread_cpu_by_role,
+    ):
         self.min_window_s = float(min_window_s)
         self._clock = clock
         self._sample = sample
         self._lock = threading.Lock()
-        self._mark: tuple[float, dict[str, float], float] | None = None   # (wall, role totals, engine CPU)
+        self._mark: tuple[float, dict[str, float], float] | None = None  # (wall, role totals, engine CPU)
         self._last: dict[str, float | None] = {}
 
     def sample(self, engine_cpu_s_total: float, twins: int) -> dict[str, float | None]:
@@ -108,7 +123,8 @@ class ThreadCpuMeter:
         less the engines' CPU), `twin_overhead_cpu_s_per_s` (the roles a twin brings),
         `twin_overhead_per_twin_cpu_s_per_s` and `twin_overhead_fraction` (of the engines' CPU)
         [CPU s / s, -]; beside them the totals of the live threads so far, `<role>_cpu_s_total`,
-        `twin_overhead_cpu_s_total` and the engines' `engine_cpu_s_total` [CPU s], from which a client computes the figures over a
+        `twin_overhead_cpu_s_total` and the engines' `engine_cpu_s_total` [CPU s], from which a client computes the
+        figures over a
         window of its own (`bench-service` over its whole measurement). Only the totals before
         a window closes; {} without per-thread clocks."""
         now, totals = self._clock(), self._sample()

@@ -34,8 +34,17 @@ from twin.physics.viscosity import kinematic_viscosity_m2_s
 from twin.snapshot import ThermalState
 from twin.thermal.estimator import DissipationEstimator, EstimatorSettings
 from twin.thermal.expansion import Expansion, expansion
-from twin.thermal.network import (BALLS, INNER_RING, NODE_NAMES, OIL, OUTER_RING, Network, Operating, assemble,
-                                  network_geometry)
+from twin.thermal.network import (
+    BALLS,
+    INNER_RING,
+    NODE_NAMES,
+    OIL,
+    OUTER_RING,
+    Network,
+    Operating,
+    assemble,
+    network_geometry,
+)
 from twin.thermal.settings import ThermalNetworkSettings
 from twin.thermal.sources import HeatSources, friction_heat
 
@@ -54,8 +63,14 @@ class Measurement:
 class ThermalCoupling:
     """The network's state and its exchange with the engine (see the module docstring)."""
 
-    def __init__(self, model, settings: ThermalNetworkSettings, period_s: float, ambient_c: float,
-                 estimator: EstimatorSettings | None = None):
+    def __init__(
+        self,
+        model,
+        settings: ThermalNetworkSettings,
+        period_s: float,
+        ambient_c: float,
+        estimator: EstimatorSettings | None = None,
+    ):
         self.model = model
         self.settings = settings
         self.period_s = period_s
@@ -65,12 +80,12 @@ class ThermalCoupling:
         self.filter = DissipationEstimator(self.reference_c.copy(), estimator)
         self.heat = HeatSources(per_contact_w=np.zeros((2 * model.ball_count, 3)))
         self.network: Network | None = None
-        self.network_time_s = 0.0       # thermal time: simulated time / heat_capacity_scale [s]
+        self.network_time_s = 0.0  # thermal time: simulated time / heat_capacity_scale [s]
         self.since_step_s = 0.0
         self.pending: Measurement | None = None
         self.last_measurement: Measurement | None = None
         self._rate_history: list[tuple[float, float]] = []
-        self._time_constants: tuple[Network, float, np.ndarray] | None = None   # (network, s, tau) of the last call
+        self._time_constants: tuple[Network, float, np.ndarray] | None = None  # (network, s, tau) of the last call
         self._work_j = 0.0
         self._work_s = 0.0
 
@@ -84,7 +99,7 @@ class ThermalCoupling:
         """A new ambient / oil-inlet temperature [degC]: every node shifts by the change."""
         shift = float(ambient_c) - self.ambient_c
         if shift != 0.0:
-            self.filter.x[:len(NODE_NAMES)] += shift
+            self.filter.x[: len(NODE_NAMES)] += shift
             self.reference_c += shift
             self.ambient_c = float(ambient_c)
 
@@ -113,8 +128,14 @@ class ThermalCoupling:
     def expansion(self) -> Expansion:
         """Growth of the raceways and balls over their start temperatures [m]."""
         g, rise = self.model.spec.geometry, self.temperature_c - self.reference_c
-        return expansion(rise[INNER_RING], rise[OUTER_RING], rise[BALLS], g.inner_raceway_radius_m,
-                         g.outer_raceway_radius_m, g.ball_radius_m)
+        return expansion(
+            rise[INNER_RING],
+            rise[OUTER_RING],
+            rise[BALLS],
+            g.inner_raceway_radius_m,
+            g.outer_raceway_radius_m,
+            g.ball_radius_m,
+        )
 
     def dissipated_w(self) -> float:
         """Heat carried to the surroundings and the oil supply now [W]."""
@@ -122,8 +143,10 @@ class ThermalCoupling:
             return 0.0
         t = self.temperature_c
         s = self.filter.dissipation_factor
-        return float(np.sum(self.network.ambient_w_k * s * (t - self.ambient_c))
-                     + np.sum(self.network.supply_w_k * (t - self.ambient_c)))
+        return float(
+            np.sum(self.network.ambient_w_k * s * (t - self.ambient_c))
+            + np.sum(self.network.supply_w_k * (t - self.ambient_c))
+        )
 
     def time_constants_s(self) -> np.ndarray:
         """The network's time constants at the last operating point, in network time (real heat
@@ -135,7 +158,11 @@ class ThermalCoupling:
         if memo is None or memo[0] is not net or memo[1] != factor:
             # an eigenvalue problem per call (about 0.3 ms on the stepping thread at every snapshot);
             # network and factor change only at a network step, the snapshots come 50 times as often
-            memo = self._time_constants = (net, factor, net.time_constants_s(factor) / self.settings.heat_capacity_scale)
+            memo = self._time_constants = (
+                net,
+                factor,
+                net.time_constants_s(factor) / self.settings.heat_capacity_scale,
+            )
         return memo[2].copy()
 
     def rate_k_per_min(self, node: int = OUTER_RING) -> float:
@@ -166,28 +193,44 @@ class ThermalCoupling:
     def operating_point(self, contacts: np.ndarray, scalars: np.ndarray, ball_spin_rad_s: float) -> Operating:
         """The conductances' operating point from the engine's state."""
         z = self.model.ball_count
-        c = contacts[:, :2 * z]
+        c = contacts[:, : 2 * z]
         axes = np.stack([c[L.C_SEMI_MAJOR], c[L.C_SEMI_MINOR]], axis=1)
         loaded = c[L.C_LOAD] > 0.0
         inner = axes[0::2][loaded[0::2]]
         outer = axes[1::2][loaded[1::2]]
         lub = self.model.spec.lubricant
         oil_c = float(self.temperature_c[OIL])
-        nu = kinematic_viscosity_m2_s(lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s,
-                                      min(max(oil_c, -30.0), 250.0))
-        return Operating(float(scalars[L.X_SHAFT_SPEED]), float(scalars[L.X_CAGE_SPEED]), ball_spin_rad_s,
-                         inner, outer, self.temperature_c.copy(), self.ambient_c, nu)
+        nu = kinematic_viscosity_m2_s(
+            lub.kinematic_viscosity_40c_m2_s, lub.kinematic_viscosity_100c_m2_s, min(max(oil_c, -30.0), 250.0)
+        )
+        return Operating(
+            float(scalars[L.X_SHAFT_SPEED]),
+            float(scalars[L.X_CAGE_SPEED]),
+            ball_spin_rad_s,
+            inner,
+            outer,
+            self.temperature_c.copy(),
+            self.ambient_c,
+            nu,
+        )
 
-    def step(self, contacts: np.ndarray, scalars: np.ndarray, drive_power_w: float, ball_spin_rad_s: float,
-             ellipse: bool, time_s: float, heat: HeatSources | None = None) -> None:
+    def step(
+        self,
+        contacts: np.ndarray,
+        scalars: np.ndarray,
+        drive_power_w: float,
+        ball_spin_rad_s: float,
+        ellipse: bool,
+        time_s: float,
+        heat: HeatSources | None = None,
+    ) -> None:
         """Advance the network over the elapsed period with the heat of the engine's state
         (`heat`: the friction laws' own split when given, else twin.thermal.sources from the lanes)."""
         elapsed = self.since_step_s
         self.since_step_s = 0.0
         if elapsed <= 0.0:
             return
-        self.heat = heat if heat is not None else friction_heat(contacts, self.model.ball_count, drive_power_w,
-                                                                ellipse)
+        self.heat = heat if heat is not None else friction_heat(contacts, self.model.ball_count, drive_power_w, ellipse)
         op = self.operating_point(contacts, scalars, ball_spin_rad_s)
         self.network = assemble(self.geometry, op, self.model.spec, self.settings)
         scale = self.settings.heat_capacity_scale
@@ -208,15 +251,24 @@ class ThermalCoupling:
         m = self.last_measurement
         tau = self.time_constants_s()
         return ThermalState(
-            accelerated=self.accelerated, heat_capacity_scale=self.settings.heat_capacity_scale,
-            network_time_s=self.network_time_s, ambient_c=self.ambient_c,
+            accelerated=self.accelerated,
+            heat_capacity_scale=self.settings.heat_capacity_scale,
+            network_time_s=self.network_time_s,
+            ambient_c=self.ambient_c,
             temperatures_c={n: float(t) for n, t in zip(NODE_NAMES, self.temperature_c)},
-            inlet_temperature_c=self.inlet_temperature_c, heat_w=self.heat.by_source_w,
-            heat_inner_contacts_w=float(per[0::2].sum()), heat_outer_contacts_w=float(per[1::2].sum()),
+            inlet_temperature_c=self.inlet_temperature_c,
+            heat_w=self.heat.by_source_w,
+            heat_inner_contacts_w=float(per[0::2].sum()),
+            heat_outer_contacts_w=float(per[1::2].sum()),
             dissipated_w=self.dissipated_w(),
             slowest_time_constant_s=float(tau[0]) if tau.size else None,
             clearance_change_m=self.expansion.diametral_clearance_change_m,
             outer_ring_rate_k_per_min=self.rate_k_per_min(),
-            dissipation_factor=f.dissipation_factor, dissipation_factor_sigma=f.dissipation_factor_sigma,
-            measured_node=m.node if m else None, measured_c=m.temperature_c if m else None,
-            residual_k=f.residual_k, residual_sigma_k=f.innovation_sigma_k, unexplained_heating=f.unexplained)
+            dissipation_factor=f.dissipation_factor,
+            dissipation_factor_sigma=f.dissipation_factor_sigma,
+            measured_node=m.node if m else None,
+            measured_c=m.temperature_c if m else None,
+            residual_k=f.residual_k,
+            residual_sigma_k=f.innovation_sigma_k,
+            unexplained_heating=f.unexplained,
+        )

@@ -61,9 +61,10 @@ def client(endpoint, bus, support):
 def validating_on_setpoint(applied: list):
     def on_setpoint(payload: bytes) -> dict:
         update = SetpointUpdate.model_validate_json(payload)  # raises on bad types
-        SetpointLimits.static().check(update)                  # and on values out of range
+        SetpointLimits.static().check(update)  # and on values out of range
         applied.append(update)
         return {"accepted": True, "setpoint": update.model_dump(exclude_none=True)}
+
     return on_setpoint
 
 
@@ -159,8 +160,15 @@ def test_setpoints_are_applied_and_refusals_reported(bus, client, twin):
     assert result["setpoint"] == {"shaft_speed_rad_s": 300.0}
     assert applied and applied[-1].shaft_speed_rad_s == 300.0
 
-    for bad in (b"not json", b'{"shaft_speed_rad_s": "fast"}', b'{"shaft_speed_rad_s": NaN}',
-                b'{"shaft_speed_rad_s": -5}', b'{"warp_factor": 9}', b"\xff\xfe", b""):
+    for bad in (
+        b"not json",
+        b'{"shaft_speed_rad_s": "fast"}',
+        b'{"shaft_speed_rad_s": NaN}',
+        b'{"shaft_speed_rad_s": -5}',
+        b'{"warp_factor": 9}',
+        b"\xff\xfe",
+        b"",
+    ):
         result = put_and_wait(bad)
         assert result["accepted"] is False, bad
         assert isinstance(result["error"], str) and result["error"], bad
@@ -277,8 +285,16 @@ def test_twin_ids_are_unique_per_prefix_across_buses(endpoint, support, caplog):
         first = bus1.attach_twin("x", lambda: None, lambda p: {})
         assert first.prefix == "plant1/line2/x"
         owners = bus2._owners("plant1/line2/x")
-        assert owners == [{"key": "plant1/line2/x", "bearing_id": "x", "pid": os.getpid(),
-                           "host": bus1.owner("x")["host"], "http": "http://127.0.0.1:8001", "zid": bus1.zid}]
+        assert owners == [
+            {
+                "key": "plant1/line2/x",
+                "bearing_id": "x",
+                "pid": os.getpid(),
+                "host": bus1.owner("x")["host"],
+                "http": "http://127.0.0.1:8001",
+                "zid": bus1.zid,
+            }
+        ]
         with pytest.raises(InputError) as err:
             bus2.attach_twin("x", lambda: None, lambda p: {})
         assert err.value.status_code == 409 and err.value.errors[0].field == "id"
@@ -291,7 +307,7 @@ def test_twin_ids_are_unique_per_prefix_across_buses(endpoint, support, caplog):
         first.detach()
         assert support.wait_until(lambda: not bus2._alive_elsewhere("plant1/line2/x"), WAIT_S)
         assert bus2.attach_twin("x", lambda: None, lambda p: {}).prefix == "plant1/line2/x"
-        with pytest.raises(InputError):          # and now the first one is refused
+        with pytest.raises(InputError):  # and now the first one is refused
             bus1.attach_twin("x", lambda: None, lambda p: {})
     finally:
         bus3.close()
@@ -359,13 +375,13 @@ def test_monitor_names_rows_and_forgets_gone_twins():
     table.on_alive("plant1/l/a/alive", True)
     table.on_state("plant1/l/a/state", state)
     table.on_alive("plant1/l/a/alive", False)
-    table.on_state("plant1/l/a/state", state)          # a late snapshot after the token went
+    table.on_state("plant1/l/a/state", state)  # a late snapshot after the token went
     assert table.rows["plant1/l/a"]["alive"] is False and table.rows["plant1/l/a"]["messages"] == 1
     assert table.forget_gone(time.monotonic() + 0.5) == []
     assert table.forget_gone(time.monotonic() + 1.5) == ["plant1/l/a"]
-    table.on_state("plant1/l/a/state", state)          # does not bring it back
+    table.on_state("plant1/l/a/state", state)  # does not bring it back
     assert "plant1/l/a" not in table.rows
-    table.on_alive("plant1/l/a/alive", True)           # a twin of that name started again
+    table.on_alive("plant1/l/a/alive", True)  # a twin of that name started again
     assert table.rows["plant1/l/a"]["alive"] is True
 
 
@@ -374,8 +390,9 @@ def test_listen_conflict_is_a_clear_error(endpoint, bus):
         ZenohBus(listen=[endpoint], connect=[])
 
 
-@pytest.mark.parametrize("bad", ["tcp/127.0.0.1:notaport", "127.0.0.1:7447", "tcp/127.0.0.1",
-                                 "tcp/:7447", "tcp/127.0.0.1:70000", ""])
+@pytest.mark.parametrize(
+    "bad", ["tcp/127.0.0.1:notaport", "127.0.0.1:7447", "tcp/127.0.0.1", "tcp/:7447", "tcp/127.0.0.1:70000", ""]
+)
 def test_malformed_endpoints_are_refused_up_front(bad):
     with pytest.raises(ValueError, match="not a zenoh endpoint"):
         make_config([], [bad])
@@ -384,8 +401,10 @@ def test_malformed_endpoints_are_refused_up_front(bad):
 
 
 def test_endpoint_forms_that_are_accepted():
-    make_config(["tcp/127.0.0.1:0", "tcp/[::1]:7447"], ["tcp/localhost:7447", "udp/127.0.0.1:7447",
-                                                         "unixsock-stream/tmp/x.sock"])
+    make_config(
+        ["tcp/127.0.0.1:0", "tcp/[::1]:7447"],
+        ["tcp/localhost:7447", "udp/127.0.0.1:7447", "unixsock-stream/tmp/x.sock"],
+    )
 
 
 # ---- (e) monitor -----------------------------------------------------------------------------
@@ -398,9 +417,10 @@ def test_monitor_sees_twins_of_two_services(endpoint, twin, support):
         base = twin.snapshot()
         names = ("m1", "m2", "m3")
         snaps = {name: base.model_copy(update={"bearing_id": name}) for name in names}
-        channels = {name: (bus1 if name != "m3" else bus2).attach_twin(name, lambda n=name: snaps[n],
-                                                                        lambda p: {})
-                    for name in names}
+        channels = {
+            name: (bus1 if name != "m3" else bus2).attach_twin(name, lambda n=name: snaps[n], lambda p: {})
+            for name in names
+        }
 
         def runner():  # the runners' job: publish at a fixed rate (20 Hz here)
             seq = 0
@@ -446,8 +466,9 @@ def test_monitor_counts_gaps_marks_gone_and_reads_electrical(endpoint, twin, sup
         base["bearing_id"] = "g1"
         base["electrical"] = {"discharge_risk": 0.75}
 
-        th = threading.Thread(target=lambda: result.update(
-            run_monitor([endpoint], None, duration_s=3.0, out=io.StringIO())), daemon=True)
+        th = threading.Thread(
+            target=lambda: result.update(run_monitor([endpoint], None, duration_s=3.0, out=io.StringIO())), daemon=True
+        )
         th.start()
         # wait until the monitor's subscriber is routed to this publisher (NB: matching_status
         # is a MatchingStatus object, always truthy: read .matching), then send seq 1..10
@@ -475,8 +496,9 @@ def test_monitor_once_prints_one_table_and_returns(endpoint, twin):
     try:
         snap = twin.snapshot().model_copy(update={"bearing_id": "o1"})
         channel = bus.attach_twin("o1", lambda: snap, lambda p: {})
-        thread = threading.Thread(target=lambda: [channel.publish(snap) for _ in iter(lambda: stop.wait(0.05), True)],
-                                  daemon=True)
+        thread = threading.Thread(
+            target=lambda: [channel.publish(snap) for _ in iter(lambda: stop.wait(0.05), True)], daemon=True
+        )
         thread.start()
         out = io.StringIO()
         t0 = time.monotonic()
@@ -495,12 +517,22 @@ def test_monitor_command_registers_with_argparse():
     parser = argparse.ArgumentParser(prog="bearing-twin")
     sub = parser.add_subparsers(dest="command", required=True)
     add_monitor_command(sub)
-    args = parser.parse_args(["monitor", "--connect", "tcp/127.0.0.1:1", "--connect",
-                              "tcp/127.0.0.1:2", "--duration", "1", "bearing/x/state"])
+    args = parser.parse_args(
+        [
+            "monitor",
+            "--connect",
+            "tcp/127.0.0.1:1",
+            "--connect",
+            "tcp/127.0.0.1:2",
+            "--duration",
+            "1",
+            "bearing/x/state",
+        ]
+    )
     assert args.connect == ["tcp/127.0.0.1:1", "tcp/127.0.0.1:2"]
     assert args.keyexpr == "bearing/x/state" and args.duration == 1.0 and callable(args.func)
     args = parser.parse_args(["monitor"])
-    assert args.keyexpr is None and args.prefix is None and not args.once   # {prefix}/*/state
+    assert args.keyexpr is None and args.prefix is None and not args.once  # {prefix}/*/state
     assert args.forget_after == 10.0
     bad = parser.parse_args(["monitor", "--connect", "tcp/127.0.0.1:notaport", "--duration", "0.2"])
     assert bad.func(bad) == 2
@@ -547,7 +579,7 @@ class _Blocker:
         return "{}"
 
     @property
-    def schema_(self):        # the first thing the publisher thread reads for the ball messages
+    def schema_(self):  # the first thing the publisher thread reads for the ball messages
         self.entered.set()
         self.release.wait(10.0)
         raise RuntimeError("not a real snapshot")  # must not kill the publisher thread
@@ -570,8 +602,10 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin, support):
     assert channel.dropped == 200 - 8 and channel.errors == 1
     blocker.release.set()
     # the thread survives the failure and drains the queue
-    assert support.wait_until(lambda: channel.published == 8 and channel.errors == 2, 5.0), \
-        (channel.published, channel.errors)
+    assert support.wait_until(lambda: channel.published == 8 and channel.errors == 2, 5.0), (
+        channel.published,
+        channel.errors,
+    )
     client.subscribe("bearing/t1/state")
     client.wait_for(lambda item: True, poke=lambda: channel.publish(snap))
     channel.detach()
@@ -587,7 +621,7 @@ def test_the_state_message_goes_out_on_the_callers_thread(bus, client, twin):
     client.subscribe("bearing/t1/state")
     blocker = _Blocker()
     channel.publish(blocker)
-    assert blocker.entered.wait(5.0)        # the channel thread is held from now on
+    assert blocker.entered.wait(5.0)  # the channel thread is held from now on
     try:
         got = []
 
@@ -634,9 +668,8 @@ def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
 
     channel = bus.attach_twin("t1", lambda: None, on_setpoint)
     client.subscribe("bearing/t1/setpoint/result")
-    pub = client.session.declare_publisher("bearing/t1/setpoint",
-                                           congestion_control=zenoh.CongestionControl.BLOCK)
-    client.wait_for(lambda item: True, poke=lambda: pub.put(b"warm"), poke_every_s=0.5)   # routes up
+    pub = client.session.declare_publisher("bearing/t1/setpoint", congestion_control=zenoh.CongestionControl.BLOCK)
+    client.wait_for(lambda item: True, poke=lambda: pub.put(b"warm"), poke_every_s=0.5)  # routes up
     deadline = time.monotonic() + WAIT_S
     while not entered.is_set() and time.monotonic() < deadline:
         client.drain()
@@ -644,7 +677,7 @@ def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
         entered.wait(0.5)
     assert entered.is_set()
     time.sleep(0.5)
-    client.drain()                          # warm-up results (the held setpoint's comes later)
+    client.drain()  # warm-up results (the held setpoint's comes later)
     over = 40
     for i in range(_CONTROL_QUEUE_SIZE + over):
         pub.put(f"n{i}".encode())
@@ -661,7 +694,7 @@ def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
         except queue.Empty:
             pass
     refused = [r for r in results if not r["accepted"]]
-    assert len(results) == _CONTROL_QUEUE_SIZE + over + 1        # the held one, the queued, the refused
+    assert len(results) == _CONTROL_QUEUE_SIZE + over + 1  # the held one, the queued, the refused
     assert len(refused) == over
     assert all(r["status"] == 429 and r["retry_after_s"] > 0 and "retry" in r["error"] for r in refused)
     pub.undeclare()

@@ -38,8 +38,8 @@ def test_released_job_with_the_earliest_deadline_goes_first():
     a, b, c, d = (_job(n) for n in "abcd")
     q.put(a, Schedule(release=0.000, deadline=0.010))
     q.put(b, Schedule(release=0.000, deadline=0.006))
-    q.put(c, Schedule(release=0.004, deadline=0.005))   # earliest deadline, not yet released
-    q.put(d, Schedule(release=0.000))                   # no deadline (fast mode): after the others
+    q.put(c, Schedule(release=0.004, deadline=0.005))  # earliest deadline, not yet released
+    q.put(d, Schedule(release=0.000))  # no deadline (fast mode): after the others
     assert q.take(0.001) is b
     assert q.take(0.001) is a
     assert q.take(0.001) is d
@@ -58,7 +58,7 @@ def test_jobs_without_deadline_go_round_robin():
     for _ in range(9):
         j = q.take(1.0)
         order.append(j.task.name)
-        q.put(j, Schedule(1.0))          # back at the end of the line
+        q.put(j, Schedule(1.0))  # back at the end of the line
     assert "".join(order) == "abcabcabc"
 
 
@@ -68,13 +68,13 @@ def test_wake_releases_a_waiting_job_now_and_stale_entries_are_ignored():
     q.put(a, Schedule(release=0.050, deadline=0.055))
     q.put(b, Schedule(release=0.010, deadline=0.015))
     assert q.take(0.001) is None
-    assert q.wake(a, 0.001)                  # a setpoint arrived: released now, deadline kept
-    assert not q.wake(a, 0.001)              # already released
+    assert q.wake(a, 0.001)  # a setpoint arrived: released now, deadline kept
+    assert not q.wake(a, 0.001)  # already released
     assert q.take(0.001) is a
-    assert not q.wake(a, 0.002)              # running: nothing to release
+    assert not q.wake(a, 0.002)  # running: nothing to release
     q.put(a, Schedule(release=0.020, deadline=0.025))
     assert q.take(0.012) is b
-    assert q.take(0.012) is None             # a's old entry (release 0.050) is stale, its new one waits
+    assert q.take(0.012) is None  # a's old entry (release 0.050) is stale, its new one waits
     assert q.next_release() == pytest.approx(0.020)
     q.remove(a)
     assert q.take(1.0) is None and q.next_release() is None
@@ -110,7 +110,7 @@ def simulate(twins, workers, until, joins=()):
     for t in twins:
         q.put(Job(t), Schedule(0.0, t.frame_s))
     joins = sorted(joins, key=lambda jt: jt[0])
-    running = []            # heap of (end, n, job, schedule)
+    running = []  # heap of (end, n, job, schedule)
     n = 0
     now = 0.0
     while now < until:
@@ -150,7 +150,7 @@ def test_twins_within_capacity_are_never_late():
         twins = simulate(_fake_twins(costs), workers, until=2.0)
         for t in twins:
             assert t.pacing.overruns == 0 and t.pacing.late_fraction == 0.0
-            assert t.sim_s == pytest.approx(2.0, abs=2 * t.frame_s)   # real time: no more, no less
+            assert t.sim_s == pytest.approx(2.0, abs=2 * t.frame_s)  # real time: no more, no less
             assert t.pacing.real_time_factor == pytest.approx(1.0, abs=0.01)
 
 
@@ -159,10 +159,10 @@ def test_overloaded_twins_fall_behind_together():
     # them level (the one furthest behind goes next): each runs at 2 / 2.4 of real time, none starves.
     twins = simulate(_fake_twins([0.004] * 3), 2, until=3.0)
     sims = [t.sim_s for t in twins]
-    assert max(sims) - min(sims) <= 0.005 + 1e-12            # within one frame of each other
+    assert max(sims) - min(sims) <= 0.005 + 1e-12  # within one frame of each other
     for t in twins:
         assert t.sim_s / 3.0 == pytest.approx(2.0 / 2.4, abs=0.02)
-        assert t.pacing.late_fraction > 0.5                  # and they say so
+        assert t.pacing.late_fraction > 0.5  # and they say so
     # a twin alone on a thread beside them would have been on time: the pool, not the twin, is full
 
 
@@ -177,15 +177,14 @@ def test_a_twin_added_to_an_overloaded_pool_gets_its_share():
     late.name = "late"
     simulate(twins, 2, until=3.0, joins=[(1.0, late)])
     assert late.frames > 0
-    assert late.sim_s / 2.0 == pytest.approx(2.0 / 3.2, abs=0.05)     # its share from its first second on
-    for t in twins:                                                   # and theirs after it joined
+    assert late.sim_s / 2.0 == pytest.approx(2.0 / 3.2, abs=0.05)  # its share from its first second on
+    for t in twins:  # and theirs after it joined
         assert t.sim_s == pytest.approx(1.0 * 2.0 / 2.4 + 2.0 * 2.0 / 3.2, abs=0.05)
 
 
 def test_lateness_counts_frames_ending_beyond_it_not_every_microsecond():
     clock = {"now": 0.0}
-    p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: clock["now"], lateness_s=0.005,
-                    late_window_s=10.0)
+    p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: clock["now"], lateness_s=0.005, late_window_s=10.0)
     p.start(0.0)
     assert p.late_fraction is None
     # frames of 5 ms ending 1 us, 4.9 ms and 6 ms after their deadline
@@ -212,12 +211,13 @@ def test_a_lead_releases_frames_before_the_wall_clock_and_absorbs_a_stall():
     within the lateness instead of 8 - 1.6 = 6.4 ms behind."""
     for lead, late in ((0.0, 1), (0.005, 0)):
         clock = {"now": 0.0}
-        p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda c=clock: c["now"], lateness_s=0.005,
-                        lead_s=lead)
+        p = PacingClock(
+            fast=False, publish_period_s=0.02, clock=lambda c=clock: c["now"], lateness_s=0.005, lead_s=lead
+        )
         p.start(0.0)
-        release = p.frame_done(0.0034, 0.005)            # 5 ms of simulated time in 3.4 ms
-        assert release == pytest.approx(max(0.0034, 0.005 - lead))   # never before now
-        p.frame_done(release + 0.0034 + 0.008, 0.010)    # the next frame, started at its release, stalls 8 ms
+        release = p.frame_done(0.0034, 0.005)  # 5 ms of simulated time in 3.4 ms
+        assert release == pytest.approx(max(0.0034, 0.005 - lead))  # never before now
+        p.frame_done(release + 0.0034 + 0.008, 0.010)  # the next frame, started at its release, stalls 8 ms
         assert p.overruns == late, lead
     with pytest.raises(ValueError, match="lead_s"):
         PacingClock(fast=False, publish_period_s=0.02, clock=lambda: 0.0, lead_s=-1.0)
@@ -232,20 +232,20 @@ def test_a_setpoint_is_published_at_the_end_of_its_frame_even_right_after_a_tick
     p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: 0.0, setpoint_publish_min_interval_s=0.002)
     p.start(0.0)
     assert not p.publish_due(0.019, 0.019, False)
-    assert p.publish_due(0.020, 0.020, False)            # the tick
+    assert p.publish_due(0.020, 0.020, False)  # the tick
     p.published(0.020, 0.020)
-    assert p.publish_due(0.0205, 0.0205, True)           # a setpoint frame 0.5 ms after it: at once
+    assert p.publish_due(0.0205, 0.0205, True)  # a setpoint frame 0.5 ms after it: at once
     p.published(0.0205, 0.0205)
-    assert not p.publish_due(0.021, 0.021, True)         # another, 0.5 ms later: deferred
+    assert not p.publish_due(0.021, 0.021, True)  # another, 0.5 ms later: deferred
     assert not p.publish_due(0.022, 0.022, False)
-    assert p.publish_due(0.0226, 0.0226, False)          # ... to the first frame 2 ms after the last
+    assert p.publish_due(0.0226, 0.0226, False)  # ... to the first frame 2 ms after the last
     p.published(0.0226, 0.0226)
     assert not p.publish_due(0.030, 0.030, False)
-    assert not p.publish_due(0.0425, 0.0425, False)      # no tick 20 ms after the tick at 0.020 ...
-    assert p.publish_due(0.0426, 0.0426, False)          # ... but 20 ms after the setpoint's publication
+    assert not p.publish_due(0.0425, 0.0425, False)  # no tick 20 ms after the tick at 0.020 ...
+    assert p.publish_due(0.0426, 0.0426, False)  # ... but 20 ms after the setpoint's publication
     p.published(0.0426, 0.0426)
     assert not p.publish_due(0.0625, 0.0625, False)
-    assert p.publish_due(0.0626, 0.0626, False)          # and on that grid from then on
+    assert p.publish_due(0.0626, 0.0626, False)  # and on that grid from then on
 
 
 def test_fast_mode_is_never_late():
@@ -319,7 +319,7 @@ def test_a_twin_added_to_a_pool_of_late_twins_runs():
     # the 4th twin ran 0 frames in 20 s, the 3rd none in its first 15 s).
     pool = SteppingPool(1, name="t-late").start()
     hogs = [LateJob(f"hog{i}") for i in range(2)]
-    newcomer = CountingJob("new", 1)              # its first frame, then it leaves
+    newcomer = CountingJob("new", 1)  # its first frame, then it leaves
     try:
         for h in hogs:
             pool.add(h)
@@ -331,7 +331,7 @@ def test_a_twin_added_to_a_pool_of_late_twins_runs():
         assert newcomer.steps == 1
     finally:
         for h in hogs:
-            h.step = lambda now: None            # leave the pool at their next frame
+            h.step = lambda now: None  # leave the pool at their next frame
         assert pool.close(timeout=10.0)
 
 
@@ -385,10 +385,10 @@ def test_capacity_rule():
     assert cap.budget_cpu_s_per_s == pytest.approx(1.7)
     small = TwinCost(0.3, 0.05)
     assert cap.check(small, []).admitted
-    assert cap.check(small, [small] * 3).admitted                 # 1.4 of 1.7
-    full = cap.check(small, [small] * 4)                           # 1.75 > 1.7
+    assert cap.check(small, [small] * 3).admitted  # 1.4 of 1.7
+    full = cap.check(small, [small] * 4)  # 1.75 > 1.7
     assert not full.admitted and "no capacity left" in full.reason and "1.400 of 1.700" in full.reason
-    big = cap.check(TwinCost(0.9, 0.05), [])                       # one core's share is 0.85
+    big = cap.check(TwinCost(0.9, 0.05), [])  # one core's share is 0.85
     assert not big.admitted and "cannot run the twin in real time" in big.reason
     assert cap.estimate_max_twins(small, running=1, used_cpu_s_per_s=0.35) == 1 + 3
     # more threads than cores buy nothing; fewer threads than cores limit the budget
@@ -397,9 +397,9 @@ def test_capacity_rule():
     # the service's reserve comes off the budget, never below one twin's share
     reserved = Capacity(2, 0.85, cores=2, reserve_cores=0.5)
     assert reserved.budget_cpu_s_per_s == pytest.approx(1.2)
-    twin = TwinCost(0.68, 0.06)                                    # a default 6208 on this VM: 0.74
+    twin = TwinCost(0.68, 0.06)  # a default 6208 on this VM: 0.74
     assert reserved.check(twin, []).admitted
-    second = reserved.check(twin, [twin])                          # 1.48 > 1.2
+    second = reserved.check(twin, [twin])  # 1.48 > 1.2
     assert not second.admitted and "less 0.5 reserved for the service" in second.reason
     assert Capacity(1, 0.85, cores=1, reserve_cores=0.5).budget_cpu_s_per_s == pytest.approx(0.85)
     with pytest.raises(ValueError, match="reserve_cores"):
@@ -407,9 +407,9 @@ def test_capacity_rule():
 
 
 def test_capacity_formula_states_the_figures_it_counts_with():
-    cap = Capacity(2, 0.85, cores=2, reserve_cores=0.5)            # budget 2 x 0.85 - 0.5 = 1.2
+    cap = Capacity(2, 0.85, cores=2, reserve_cores=0.5)  # budget 2 x 0.85 - 0.5 = 1.2
     assert "no twin calibrated yet" in cap.formula(None, 0, 0.0)
-    twin = TwinCost(0.25, 0.03)                                    # c = 0.28: floor((1.2 - 0.28) / 0.28) = 3
+    twin = TwinCost(0.25, 0.03)  # c = 0.28: floor((1.2 - 0.28) / 0.28) = 3
     text = cap.formula(twin, 1, 0.28)
     assert cap.estimate_max_twins(twin, 1, 0.28) == 4
     assert "= 1.200 CPU s/s" in text and "c = engine 0.250 + snapshots 0.030 = 0.280" in text
@@ -420,18 +420,18 @@ def test_capacity_formula_states_the_figures_it_counts_with():
 def test_service_overhead_is_the_process_cpu_beside_the_engines():
     wall, cpu = [0.0], [0.0]
     meter = ServiceOverheadMeter(1.0, clock=lambda: wall[0], cpu_clock=lambda: cpu[0])
-    assert meter.sample(0.0, 2) is None                            # the first mark
+    assert meter.sample(0.0, 2) is None  # the first mark
     wall[0], cpu[0] = 0.5, 0.3
-    assert meter.sample(0.25, 2) is None                           # the window is not closed yet
-    wall[0], cpu[0] = 2.0, 1.1                                     # 0.55 CPU s/s, engines 0.5
+    assert meter.sample(0.25, 2) is None  # the window is not closed yet
+    wall[0], cpu[0] = 2.0, 1.1  # 0.55 CPU s/s, engines 0.5
     out = meter.sample(1.0, 2)
     assert out["process_cpu_s_per_s"] == pytest.approx(0.55) and out["engine_cpu_s_per_s"] == pytest.approx(0.5)
     assert out["overhead_cpu_s_per_s"] == pytest.approx(0.05)
     assert out["overhead_per_twin_cpu_s_per_s"] == pytest.approx(0.025)
     assert out["overhead_fraction"] == pytest.approx(0.10) and out["goal_fraction"] == OVERHEAD_GOAL
     wall[0] = 2.5
-    assert meter.sample(1.2, 2) is out                             # kept until the next window closes
-    assert meter.sample(0.1, 1) is out                             # a twin left: a new mark, no negative figure
+    assert meter.sample(1.2, 2) is out  # kept until the next window closes
+    assert meter.sample(0.1, 1) is out  # a twin left: a new mark, no negative figure
 
 
 def test_calibration_measures_thread_cpu_per_simulated_second():
@@ -439,43 +439,48 @@ def test_calibration_measures_thread_cpu_per_simulated_second():
 
     twin = Twin("6205", bearing_id="cal")
     seq = twin.seq
-    ticks = iter([0.0, 0.012, 1.0, 1.011, 2.0, 2.0005])         # two halves of 10 ms, one snapshot
+    ticks = iter([0.0, 0.012, 1.0, 1.011, 2.0, 2.0005])  # two halves of 10 ms, one snapshot
     cost = calibrate(twin, sim_s=0.02, frame_steps=1000, publish_rate_hz=50.0, cpu_clock=lambda: next(ticks))
-    assert cost.engine_cpu_s_per_sim_s == pytest.approx(0.011 / 0.01)    # the cheaper half
+    assert cost.engine_cpu_s_per_sim_s == pytest.approx(0.011 / 0.01)  # the cheaper half
     assert cost.publish_cpu_s_per_s == pytest.approx(0.0005 * 50.0)
-    assert twin.time_s == pytest.approx(0.021)                           # warm-up frame + 20 ms
-    assert twin.seq == seq                                               # nothing published
+    assert twin.time_s == pytest.approx(0.021)  # warm-up frame + 20 ms
+    assert twin.seq == seq  # nothing published
 
 
 # ---- the registry: 503 with the reason, the configured twin over capacity --------------------------
 def test_registry_refuses_a_twin_beyond_the_measured_capacity(monkeypatch):
     import service.core.registry as registry_module
     from service.core.registry import TwinRegistry
-    from service.settings import ServiceSettings
-
     from service.core.runner import TwinRunner
+    from service.settings import ServiceSettings
 
     costs = iter([TwinCost(0.6, 0.05), TwinCost(0.6, 0.05), TwinCost(0.9, 0.05), TwinCost(0.6, 0.05)])
     monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: next(costs))
     # the running twins' costs as calibrated (not as this machine's speed would measure them)
     monkeypatch.setattr(TwinRunner, "cost", property(lambda self: self.calibration))
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, admission="measured",
-                               stepping_threads=2, capacity_core_fraction=0.85, start_twin=False,
-                               capacity_reserve_cores=0.0)   # the arithmetic below without the reserve
+    settings = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        admission="measured",
+        stepping_threads=2,
+        capacity_core_fraction=0.85,
+        start_twin=False,
+        capacity_reserve_cores=0.0,
+    )  # the arithmetic below without the reserve
     reg = TwinRegistry(settings)
-    reg.capacity.cores = 2                       # this test's host has 2 cores, whatever runs it
+    reg.capacity.cores = 2  # this test's host has 2 cores, whatever runs it
     reg.open()
     try:
-        reg.create_twin(id="a", designation="6205")                           # 0.65 of 1.7
-        reg.create_twin(id="b", designation="6205")                           # 1.3 of 1.7
-        with pytest.raises(InputError) as exc:                                # 0.95 > one core's 0.85
+        reg.create_twin(id="a", designation="6205")  # 0.65 of 1.7
+        reg.create_twin(id="b", designation="6205")  # 1.3 of 1.7
+        with pytest.raises(InputError) as exc:  # 0.95 > one core's 0.85
             reg.create_twin(id="c", designation="6205")
         assert exc.value.status_code == 503
         err = exc.value.errors[0]
         assert "refused" in err.message and "cannot run the twin in real time" in err.message
         assert "0.950" in err.message and "0.850" in err.message
         assert [e.id for e in reg.entries()] == ["a", "b"]
-        with pytest.raises(InputError) as exc:                                # 1.3 + 0.65 > 1.7
+        with pytest.raises(InputError) as exc:  # 1.3 + 0.65 > 1.7
             reg.create_twin(id="d", designation="6205")
         assert exc.value.status_code == 503 and "no capacity left" in exc.value.errors[0].message
         cap = reg.health()["capacity"]
@@ -492,8 +497,9 @@ def test_configured_twin_starts_over_capacity_and_says_so(monkeypatch):
     from service.settings import ServiceSettings
 
     monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: TwinCost(1.5, 0.05))
-    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, admission="measured",
-                               bearing="6205", stepping_threads=1)
+    settings = ServiceSettings(
+        enable_zenoh=False, enable_recording=False, admission="measured", bearing="6205", stepping_threads=1
+    )
     reg = TwinRegistry(settings).open()
     try:
         assert [e.id for e in reg.entries()] == ["default"]

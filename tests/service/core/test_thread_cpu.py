@@ -10,12 +10,24 @@ import pytest
 from service.core.thread_cpu import ROLES, ThreadCpuMeter, thread_cpu_by_role, thread_role
 
 
-@pytest.mark.parametrize(("name", "role"), [
-    ("step-0", "stepping"), ("step-publish", "publish_worker"), ("twin-b1-0", "stepping"),
-    ("twin-b1-publish", "publish_worker"), ("zenoh-pub-b1", "zenoh_outbox"), ("zenoh-ctl-b1", "zenoh_inbox"),
-    ("Thread-3 (pyo3-closure)", "zenoh_inbox"), ("alarms", "alarms"), ("rerun-recorder", "recording"),
-    ("MainThread", "http"), ("AnyIO worker thread", "http"), ("opcua", "opcua"), ("thread-priority", "other"),
-])
+@pytest.mark.parametrize(
+    ("name", "role"),
+    [
+        ("step-0", "stepping"),
+        ("step-publish", "publish_worker"),
+        ("twin-b1-0", "stepping"),
+        ("twin-b1-publish", "publish_worker"),
+        ("zenoh-pub-b1", "zenoh_outbox"),
+        ("zenoh-ctl-b1", "zenoh_inbox"),
+        ("Thread-3 (pyo3-closure)", "zenoh_inbox"),
+        ("alarms", "alarms"),
+        ("rerun-recorder", "recording"),
+        ("MainThread", "http"),
+        ("AnyIO worker thread", "http"),
+        ("opcua", "opcua"),
+        ("thread-priority", "other"),
+    ],
+)
 def test_threads_are_given_their_role_by_name(name, role):
     assert thread_role(name) == role
 
@@ -26,11 +38,18 @@ def test_rates_per_role_with_the_engines_taken_from_the_stepping_threads():
     now = [0.0]
     totals = [dict.fromkeys(ROLES, 0.0)]
     meter = ThreadCpuMeter(1.0, clock=lambda: now[0], sample=lambda: dict(totals[0]))
-    first = meter.sample(0.0, 2)      # no window yet: the totals only
+    first = meter.sample(0.0, 2)  # no window yet: the totals only
     assert "twin_overhead_fraction" not in first and first["engine_cpu_s_total"] == 0.0
     now[0] = 2.0
-    totals[0] = {**dict.fromkeys(ROLES, 0.0), "stepping": 1.2, "publish_worker": 0.1, "recording": 0.04,
-                 "http": 0.3, "opcua": 0.1, "native": 0.02}
+    totals[0] = {
+        **dict.fromkeys(ROLES, 0.0),
+        "stepping": 1.2,
+        "publish_worker": 0.1,
+        "recording": 0.04,
+        "http": 0.3,
+        "opcua": 0.1,
+        "native": 0.02,
+    }
     out = meter.sample(1.0, 2)
     assert out["stepping_cpu_s_per_s"] == pytest.approx(0.6 - 0.5, abs=1e-12)
     assert out["publish_worker_cpu_s_per_s"] == pytest.approx(0.05, abs=1e-12)
@@ -40,7 +59,7 @@ def test_rates_per_role_with_the_engines_taken_from_the_stepping_threads():
     assert out["twin_overhead_fraction"] == pytest.approx(0.18 / 0.5, abs=1e-12)
     assert out["stepping_cpu_s_total"] == pytest.approx(1.2 - 1.0, abs=1e-12)
     assert out["twin_overhead_cpu_s_total"] == pytest.approx(0.2 + 0.1 + 0.04 + 0.02, abs=1e-12)
-    now[0] = 2.5                      # a window shorter than 1 s keeps the last rates
+    now[0] = 2.5  # a window shorter than 1 s keeps the last rates
     again = meter.sample(1.1, 2)
     assert again["twin_overhead_fraction"] == out["twin_overhead_fraction"]
     assert again["stepping_cpu_s_total"] == pytest.approx(1.2 - 1.1, abs=1e-12)
@@ -84,7 +103,7 @@ def test_the_clock_by_kernel_id_is_the_threads_own_and_an_ended_thread_has_none(
     assert thread_cpu_clock(me.native_id) == time.pthread_getcpuclockid(me.ident)
     t = threading.Thread(target=lambda: None)
     t.start()
-    t.join()              # returns as the thread finishes in Python; the kernel thread ends just after
+    t.join()  # returns as the thread finishes in Python; the kernel thread ends just after
 
     def gone() -> bool:
         try:

@@ -14,7 +14,12 @@ from loadtest.benchmark import overhead_over_run, run_service_benchmark, twin_pl
 def test_twin_plan_cycles_the_designations():
     plan = twin_plan(5)
     assert [(d, sp.get("shaft_current_a")) for _, d, sp in plan] == [
-        ("6208", None), ("6205", None), ("7208", None), ("6208", 5.0), ("6208", None)]
+        ("6208", None),
+        ("6205", None),
+        ("7208", None),
+        ("6208", 5.0),
+        ("6208", None),
+    ]
     assert len({i for i, _, _ in plan}) == 5
 
 
@@ -39,14 +44,27 @@ def test_overhead_over_the_run_is_the_totals_difference_over_the_wall_time():
     """From the cumulative totals of /health capacity.service_overhead at the start and the end
     of a 10 s measurement: each role's difference / 10 s, the twin overhead per twin and over the
     engines' CPU; None when the service gives no totals (an older service)."""
-    before = {"engine_cpu_s_total": 1.0, "twin_overhead_cpu_s_total": 0.5, "publish_worker_cpu_s_total": 0.2,
-              "http_cpu_s_total": 0.1}
-    after = {"engine_cpu_s_total": 6.0, "twin_overhead_cpu_s_total": 2.0, "publish_worker_cpu_s_total": 0.7,
-             "http_cpu_s_total": 0.4}
+    before = {
+        "engine_cpu_s_total": 1.0,
+        "twin_overhead_cpu_s_total": 0.5,
+        "publish_worker_cpu_s_total": 0.2,
+        "http_cpu_s_total": 0.1,
+    }
+    after = {
+        "engine_cpu_s_total": 6.0,
+        "twin_overhead_cpu_s_total": 2.0,
+        "publish_worker_cpu_s_total": 0.7,
+        "http_cpu_s_total": 0.4,
+    }
     run = overhead_over_run(before, after, 10.0, 2)
-    expected = {"engine_cpu_s_per_s": 0.5, "publish_worker_cpu_s_per_s": 0.05, "http_cpu_s_per_s": 0.03,
-                "twin_overhead_cpu_s_per_s": 0.15, "twin_overhead_per_twin_cpu_s_per_s": 0.075,
-                "twin_overhead_fraction": 0.3}
+    expected = {
+        "engine_cpu_s_per_s": 0.5,
+        "publish_worker_cpu_s_per_s": 0.05,
+        "http_cpu_s_per_s": 0.03,
+        "twin_overhead_cpu_s_per_s": 0.15,
+        "twin_overhead_per_twin_cpu_s_per_s": 0.075,
+        "twin_overhead_fraction": 0.3,
+    }
     for key, value in expected.items():
         assert run[key] == pytest.approx(value, abs=1e-12), key
     assert overhead_over_run({}, after, 10.0, 2) is None
