@@ -3,7 +3,8 @@
 `AlarmEvaluator(bearing_id, settings).update(inputs) -> [AlarmEvent]` follows one twin. Its
 inputs are typed (`AlarmInputs`), made from a snapshot by `inputs_from_snapshot`; the blocks a
 snapshot may not carry yet (`life`, `vibration`) are optional, and their alarms stay quiet while
-they are absent.
+they are absent. The alarm ids, the zone table and the `Rule` / `Level` types live in
+service.core.alarm_rules; the inputs and their reading from a snapshot in service.core.alarm_inputs.
 
 The alarms (ids are stable; docs/service.md "Alarms"):
 
@@ -65,246 +66,32 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
-from typing import Any, Literal
+from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
 from service.core.measured import KURTOSIS_MARGIN, LINE_ALARM_DB
-from service.settings import AlarmSettings
-from twin.snapshot import LAMBDA_KEY
-
-__all__ = [
-    "ALARM_IDS",
-    "ISO_20816_3_ZONES",
-    "Alarm",
-    "AlarmEvaluator",
-    "AlarmEvent",
-    "AlarmInputs",
-    "AlarmSettings",
-    "AlarmTracker",
-    "Level",
-    "Rule",
-    "VibrationInputs",
-    "inputs_from_snapshot",
-    "vibration_inputs",
-    "vibration_zone",
-    "zone_boundaries",
-]
-
-EVENT_SCHEMA = "bearing-twin/alarm/1"
-
-Severity = Literal["warning", "critical"]
-Transition = Literal["raised", "escalated", "deescalated", "cleared"]
-Direction = Literal["above", "below"]
-
-# OPC UA event Severity (1..1000, OPC 10000-5 BaseEventType) of each level
-OPCUA_SEVERITY = {"warning": 500, "critical": 800, None: 100}
-
-# ISO 20816-3:2022 Annex A: zone boundaries A/B, B/C, C/D of the broadband velocity RMS [mm/s]
-# (10-1000 Hz), Table A.1 (group 1) and Table A.2 (group 2), by support class.
-ISO_20816_3_ZONES: Mapping[tuple[int, str], tuple[float, float, float]] = {
-    (1, "rigid"): (2.3, 4.5, 7.1),
-    (1, "flexible"): (3.5, 7.1, 11.0),
-    (2, "rigid"): (1.4, 2.8, 4.5),
-    (2, "flexible"): (2.3, 4.5, 7.1),
-}
-
-DEFECT_LINES = ("ftf", "bpfo", "bpfi", "bsf", "two_bsf")  # keys of VibrationState.envelope_lines
-_TIME_EPS_S = 1e-9  # a delay of 0.2 s is over at t = 0.3 after 0.1 (0.3 - 0.1 = 0.19999999999999998)
-DISCHARGE_LEVELS = {"none": 0.0, "possible": 1.0, "likely": 2.0}
-
-# the alarms on measured accelerometer windows (service.core.measured): fed by `update_measured`
-MEASURED_ALARMS = ("measured_line", "measured_kurtosis")
-ALARM_IDS: tuple[str, ...] = (
-    "vibration_zone",
-    "lubrication_kappa",
-    "lubrication_boundary",
-    "electrical_discharge",
-    *(f"defect_{n}" for n in DEFECT_LINES),
-    "life_used",
-    "temperature_zone",
-    "temperature_rate",
-    "temperature_unexplained",
-    *MEASURED_ALARMS,
+from service.core.alarm_inputs import AlarmInputs, VibrationInputs, finite_number
+from service.core.alarm_rules import (
+    DEFECT_LINES,
+    DISCHARGE_LEVELS,
+    EVENT_SCHEMA,
+    OPCUA_SEVERITY,
+    TIME_EPS_S,
+    Level,
+    Rule,
+    Severity,
+    Transition,
+    line_name,
+    vibration_zone,
+    zone_boundaries,
 )
+from service.settings import AlarmSettings
 
-
-def _line_name(name: str) -> str:
-    """'BPFO', ..., '2 x BSF' for the envelope line keys."""
-    return "2 x BSF" if name == "two_bsf" else name.upper()
-
-
-def zone_boundaries(machine_group: int, support: str) -> tuple[float, float, float]:
-    """(A/B, B/C, C/D) boundaries [mm/s] of ISO 20816-3:2022 Table A.1 (group 1) / A.2 (group 2)."""
-    try:
-        return ISO_20816_3_ZONES[(int(machine_group), support)]
-    except KeyError:
-        raise ValueError(
-            f"no ISO 20816-3 zones for machine group {machine_group!r} and support "
-            f"{support!r}; known: {sorted(ISO_20816_3_ZONES)}"
-        ) from None
-
-
-def vibration_zone(velocity_rms_mm_s: float, machine_group: int = 2, support: str = "rigid") -> str:
-    """ISO 20816-3 evaluation zone 'A', 'B', 'C' or 'D' of a velocity RMS [mm/s] (a value on a
-    boundary belongs to the worse zone)."""
-    ab, bc, cd = zone_boundaries(machine_group, support)
-    v = float(velocity_rms_mm_s)
-    return "A" if v < ab else "B" if v < bc else "C" if v < cd else "D"
-
-
-# ---- inputs ------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class VibrationInputs:
-    """What the vibration indicators give the alarms (twin.vibration.indicators)."""
-
-    velocity_rms_mm_s: float | None = None  # ISO 20816 band 10-1000 Hz [mm/s]
-    line_amplitudes_m_s2: Mapping[str, float] = field(default_factory=dict)  # envelope, fundamental [m/s^2]
-    noise_floor_m_s2: float | None = None  # median envelope amplitude [m/s^2]
-
-
-@dataclass(frozen=True)
-class AlarmInputs:
-    """One twin at one instant, as the alarms see it (SI unless the name says otherwise)."""
-
-    time_s: float  # simulated time [s]
-    seq: int | None = None  # the snapshot's seq (None: not from a snapshot)
-    min_loaded_lambda: float | None = None  # smallest Lambda over the loaded contacts [-]
-    boundary_contacts: int = 0  # loaded contacts with Lambda <= boundary_lambda
-    kappa: float | None = None  # ISO 281 viscosity ratio [-]
-    discharge_risk: str | None = None  # 'none' | 'possible' | 'likely'
-    discharge_reason: str = ""
-    damage_fraction: float | None = None  # Palmgren-Miner damage [-]
-    vibration: VibrationInputs | None = None
-    outer_ring_c: float | None = None  # outer-ring temperature [degC]
-    outer_ring_rate_k_per_min: float | None = None  # its rate of rise [K/min]
-    unexplained_heating: bool | None = None  # the estimator gated the last measurement
-    residual_k: float | None = None  # measured - predicted temperature [K]
-
-
-def _get(obj: Any, name: str) -> Any:
-    """Field `name` of `obj`: a snapshot model's attribute, or its wire key in the snapshot's dict
-    (`lambda_` is `lambda` on the wire); None when absent."""
-    if obj is None:
-        return None
-    if isinstance(obj, Mapping):
-        return obj.get(LAMBDA_KEY if name == "lambda_" else name)
-    return getattr(obj, name, None)
-
-
-def finite_number(value: Any) -> float | None:
-    """A JSON or model value as a finite float; None for anything else (None, bool, text, NaN, inf)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    value = float(value)
-    return value if math.isfinite(value) else None
-
-
-def _line_amplitude(entry: Any) -> float | None:
-    """A defect line's fundamental amplitude [m/s^2]: `harmonics[0]` of a
-    twin.snapshot.DefectLine (or its dict)."""
-    harmonics = _get(entry, "harmonics")
-    if isinstance(harmonics, (list, tuple)) and harmonics:
-        return finite_number(harmonics[0])
-    return None
-
-
-def vibration_inputs(block: Any) -> VibrationInputs | None:
-    """`VibrationInputs` from a snapshot's `vibration` block (twin.snapshot.VibrationState, or
-    its dict): `velocity_rms_mm_s`, the fundamentals of `envelope_lines` {ftf, bpfo, bpfi, bsf,
-    two_bsf: DefectLine}, `envelope_noise_floor_m_s2`. None without a block."""
-    if block is None:
-        return None
-    lines: dict[str, float] = {}
-    table = _get(block, "envelope_lines")
-    if isinstance(table, Mapping):
-        for name, entry in table.items():
-            a = _line_amplitude(entry)
-            if a is not None and name in DEFECT_LINES:
-                lines[str(name)] = a
-    return VibrationInputs(
-        velocity_rms_mm_s=finite_number(_get(block, "velocity_rms_mm_s")),
-        line_amplitudes_m_s2=lines,
-        noise_floor_m_s2=finite_number(_get(block, "envelope_noise_floor_m_s2")),
-    )
-
-
-def _seq(value: Any) -> int | None:
-    return int(value) if isinstance(value, int) and not isinstance(value, bool) else None
-
-
-def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -> AlarmInputs:
-    """The alarms' inputs from a `twin.snapshot.Snapshot` (or its dict): contacts, electrical,
-    and the optional `life` and `vibration` blocks."""
-    s = settings or AlarmSettings()
-    contacts = []
-    for ball in _get(snapshot, "balls") or ():
-        for side in ("inner", "outer"):
-            c = _get(ball, side)
-            if c is not None:
-                contacts.append(c)
-    loads = [(finite_number(_get(c, "load_n")) or 0.0) for c in contacts]
-    peak = max(loads, default=0.0)
-    min_lambda, boundary = None, 0
-    if peak > 0.0:
-        cut = s.loaded_contact_fraction * peak
-        for c, load in zip(contacts, loads, strict=True):
-            if load <= 0.0 or load < cut:
-                continue
-            lam = finite_number(_get(c, "lambda_"))
-            if lam is None:
-                continue
-            min_lambda = lam if min_lambda is None else min(min_lambda, lam)
-            if lam <= s.boundary_lambda:
-                boundary += 1
-    electrical = _get(snapshot, "electrical")
-    life = _get(snapshot, "life")
-    thermal = _get(snapshot, "thermal")
-    temps = _get(thermal, "temperatures_c") or {}
-    unexplained = _get(thermal, "unexplained_heating")
-    return AlarmInputs(
-        time_s=float(_get(snapshot, "time_s") or 0.0),
-        seq=_seq(_get(snapshot, "seq")),
-        min_loaded_lambda=min_lambda,
-        boundary_contacts=boundary,
-        kappa=finite_number(_get(life, "kappa")),
-        discharge_risk=_get(electrical, "discharge_risk"),
-        discharge_reason=str(_get(electrical, "reason") or ""),
-        damage_fraction=finite_number(_get(life, "damage_fraction")),
-        vibration=vibration_inputs(_get(snapshot, "vibration")),
-        outer_ring_c=finite_number(temps.get("outer_ring")) if thermal is not None else None,
-        outer_ring_rate_k_per_min=finite_number(_get(thermal, "outer_ring_rate_k_per_min")),
-        unexplained_heating=bool(unexplained) if unexplained is not None else None,
-        residual_k=finite_number(_get(thermal, "residual_k")),
-    )
+__all__ = ["Alarm", "AlarmEvaluator", "AlarmEvent", "AlarmTracker"]
 
 
 # ---- state machine -----------------------------------------------------------------------------
-@dataclass(frozen=True)
-class Level:
-    """One level of an alarm: raised beyond `threshold`, left on the safe side of `clear`."""
-
-    severity: Severity
-    threshold: float
-    clear: float
-
-
-@dataclass(frozen=True)
-class Rule:
-    """What an alarm watches: its id, category, unit, direction and timing."""
-
-    id: str
-    category: str
-    unit: str
-    direction: Direction
-    raise_delay_s: float
-    clear_hold_s: float
-    description: str
-
-    def beyond(self, value: float, limit: float) -> bool:
-        """Whether `value` is on the alarm side of `limit` (inclusive)."""
-        return value >= limit if self.direction == "above" else value <= limit
 
 
 class AlarmEvent(BaseModel):
@@ -414,7 +201,7 @@ class AlarmTracker:
             if self._pending_since is None:
                 self._pending_since = t
             self._pending_level = raised
-            if t - self._pending_since >= rule.raise_delay_s - _TIME_EPS_S:
+            if t - self._pending_since >= rule.raise_delay_s - TIME_EPS_S:
                 was = self.level
                 self.level = raised
                 self._reset_timers()
@@ -427,7 +214,7 @@ class AlarmTracker:
         if held < self.level:  # back past the clear threshold: off-delay
             if self._clear_since is None:
                 self._clear_since = t
-            if t - self._clear_since >= rule.clear_hold_s - _TIME_EPS_S:
+            if t - self._clear_since >= rule.clear_hold_s - TIME_EPS_S:
                 self.level = held
                 self._clear_since = None
                 if held < 0:
@@ -530,7 +317,7 @@ class AlarmEvaluator:
                     "above",
                     s.defect_delay_s,
                     hold,
-                    f"envelope amplitude at {_line_name(n)} above {s.defect_amplitude_m_s2:g} m/s^2 and "
+                    f"envelope amplitude at {line_name(n)} above {s.defect_amplitude_m_s2:g} m/s^2 and "
                     f"{s.defect_significance:g} x the envelope noise floor",
                 )
                 for n in DEFECT_LINES
@@ -655,7 +442,7 @@ class AlarmEvaluator:
         lines = vib.line_amplitudes_m_s2 if vib is not None else {}
         for n in DEFECT_LINES:
             a = lines.get(n)
-            out[f"defect_{n}"] = (a, "" if a is None else f"envelope amplitude at {_line_name(n)} {a:.3g} m/s^2")
+            out[f"defect_{n}"] = (a, "" if a is None else f"envelope amplitude at {line_name(n)} {a:.3g} m/s^2")
         d = x.damage_fraction
         out["life_used"] = (d, "" if d is None else f"damage fraction {d:.3g}")
         t = x.outer_ring_c

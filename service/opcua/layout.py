@@ -16,7 +16,11 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any, Literal
 
-from service.core.alarms import ALARM_IDS, Alarm, AlarmInputs, vibration_zone
+from service.core.alarm_inputs import AlarmInputs
+
+from service.core.alarm_rules import ALARM_IDS, vibration_zone
+
+from service.core.alarms import Alarm
 from service.settings import AlarmSettings
 from twin.life.iso281 import ratings_for
 from twin.setpoint import FIELDS as SETPOINT_FIELDS

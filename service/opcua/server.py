@@ -70,7 +70,9 @@ from asyncua.server.address_space import AttributeService
 from asyncua.server.event_generator import EventGenerator
 from asyncua.server.user_managers import UserManager
 
-from service.core.alarms import AlarmEvent, inputs_from_snapshot
+from service.core.alarm_inputs import inputs_from_snapshot
+
+from service.core.alarms import AlarmEvent
 from service.core.errors import InputError
 from service.opcua.guard import OpcUaGuard
 from service.opcua.layout import (

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from service.core.alarms import ALARM_IDS
+from service.core.alarm_rules import ALARM_IDS
 from service.recording import alarm_columns as A
 from service.recording import columns as C
 from service.recording import trends

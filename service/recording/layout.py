@@ -89,7 +89,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 from rerun.encodings import TimeRange
 
-from service.core.alarms import ALARM_IDS
+from service.core.alarm_rules import ALARM_IDS
 from twin.snapshot import LAMBDA_KEY
 
 SIM_TIME = "sim_time"

@@ -26,7 +26,7 @@ import sys
 import time
 from typing import Any, Literal
 
-from service.core.alarms import finite_number
+from service.core.alarm_inputs import finite_number
 from service.keys import ALIVE, DEFAULT_PREFIX, STATE, all_twins
 from service.tools.client import strict_json
 from twin.snapshot import LAMBDA_KEY

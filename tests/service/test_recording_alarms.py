@@ -10,7 +10,11 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.core.alarms import ALARM_IDS, AlarmEvaluator, AlarmInputs
+from service.core.alarm_inputs import AlarmInputs
+
+from service.core.alarm_rules import ALARM_IDS
+
+from service.core.alarms import AlarmEvaluator
 from service.recording import RerunRecorder, describe_recording, read_column, recording_segments
 from service.settings import AlarmSettings
 from twin.engine import Twin

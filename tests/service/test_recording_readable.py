@@ -13,7 +13,7 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.core.alarms import ALARM_IDS
+from service.core.alarm_rules import ALARM_IDS
 from service.recording import RerunRecorder, describe_recording, read_column, read_index
 from service.recording.archive import WaveformArchive
 from service.recording.layout import SERIES, TREND_BANDS, TwinLayout, blueprint

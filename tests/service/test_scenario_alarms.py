@@ -14,7 +14,7 @@ import pytest
 
 pytest.importorskip("rerun")
 
-from service.core.alarms import inputs_from_snapshot
+from service.core.alarm_inputs import inputs_from_snapshot
 from service.core.scenarios import load_scenario
 from service.recording import read_column
 from service.settings import AlarmSettings, ServiceSettings

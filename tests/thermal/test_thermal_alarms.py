@@ -3,7 +3,11 @@ and heat the dissipation estimator cannot explain."""
 
 import pytest
 
-from service.core.alarms import ALARM_IDS, AlarmEvaluator, AlarmInputs, inputs_from_snapshot
+from service.core.alarm_inputs import AlarmInputs, inputs_from_snapshot
+
+from service.core.alarm_rules import ALARM_IDS
+
+from service.core.alarms import AlarmEvaluator
 from service.settings import AlarmSettings
 
 

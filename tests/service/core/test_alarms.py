@@ -12,19 +12,9 @@ from types import SimpleNamespace
 import pytest
 
 from service.core.alarm_hub import AlarmHub
-from service.core.alarms import (
-    ALARM_IDS,
-    AlarmEvaluator,
-    AlarmInputs,
-    AlarmTracker,
-    Level,
-    Rule,
-    VibrationInputs,
-    inputs_from_snapshot,
-    vibration_inputs,
-    vibration_zone,
-    zone_boundaries,
-)
+from service.core.alarm_inputs import AlarmInputs, VibrationInputs, inputs_from_snapshot, vibration_inputs
+from service.core.alarm_rules import ALARM_IDS, Level, Rule, vibration_zone, zone_boundaries
+from service.core.alarms import AlarmEvaluator, AlarmTracker
 from service.settings import AlarmSettings
 
 

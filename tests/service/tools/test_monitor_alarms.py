@@ -12,7 +12,8 @@ import pytest
 pytest.importorskip("zenoh")
 
 from service.bus.zenoh_bus import ZenohBus
-from service.core.alarms import AlarmEvaluator, AlarmInputs
+from service.core.alarm_inputs import AlarmInputs
+from service.core.alarms import AlarmEvaluator
 from service.tools.monitor import TwinTable, run_monitor
 
 
