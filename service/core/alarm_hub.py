@@ -26,7 +26,6 @@ from dataclasses import dataclass
 from typing import Any
 
 from service.core.alarm_inputs import inputs_from_snapshot
-
 from service.core.alarms import Alarm, AlarmEvaluator, AlarmEvent
 from service.settings import AlarmSettings
 from twin.snapshot import Snapshot

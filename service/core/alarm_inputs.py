@@ -9,7 +9,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-
 from service.core.alarm_rules import DEFECT_LINES
 from service.settings import AlarmSettings
 from twin.snapshot import LAMBDA_KEY

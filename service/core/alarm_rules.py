@@ -8,7 +8,6 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Literal
 
-
 EVENT_SCHEMA = "bearing-twin/alarm/1"
 
 Severity = Literal["warning", "critical"]

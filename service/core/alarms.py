@@ -70,7 +70,6 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from service.core.measured import KURTOSIS_MARGIN, LINE_ALARM_DB
 from service.core.alarm_inputs import AlarmInputs, VibrationInputs, finite_number
 from service.core.alarm_rules import (
     DEFECT_LINES,
@@ -86,6 +85,7 @@ from service.core.alarm_rules import (
     vibration_zone,
     zone_boundaries,
 )
+from service.core.measured import KURTOSIS_MARGIN, LINE_ALARM_DB
 from service.settings import AlarmSettings
 
 __all__ = ["Alarm", "AlarmEvaluator", "AlarmEvent", "AlarmTracker"]

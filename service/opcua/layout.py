@@ -17,9 +17,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 from service.core.alarm_inputs import AlarmInputs
-
 from service.core.alarm_rules import ALARM_IDS, vibration_zone
-
 from service.core.alarms import Alarm
 from service.settings import AlarmSettings
 from twin.life.iso281 import ratings_for

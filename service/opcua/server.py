@@ -8,7 +8,7 @@ The server runs its own asyncio loop in a daemon thread. Every half publish peri
 twin's latest published snapshot (`runner.latest`, no work on the stepping threads) and, when
 the snapshot is new, writes the variables that changed; twins created or deleted in the
 registry appear or disappear at the same pace. Address space: service.opcua.layout (docs/service.md
-"OPC UA").
+"OPC UA"); the nodes of a twin: service.opcua.nodes; the users: service.opcua.identity.
 
 Writes. The Setpoint variables are answered by `_GatedAttributeService` (it replaces asyncua's
 attribute service and passes every other write on): the same admission gate and setpoint path as
@@ -31,7 +31,7 @@ Sign and/or SignAndEncrypt with the server certificate `opcua_certificate` / `op
 or a self-signed one made once in `opcua_pki_dir` (key 0600, never overwritten; its SHA-1
 thumbprint is logged at start and kept in `facade.pki`). Rules of a secure server:
 - Every secure endpoint's user-name policy asks for the password RSA-encrypted with the server's
-  key under the endpoint's own policy (`_Server`; asyncua would leave it in clear inside
+  key under the endpoint's own policy (`TokenServer`; asyncua would leave it in clear inside
   SignAndEncrypt); `TokenUserManager` refuses a password that came unencrypted
   (BadIdentityTokenRejected, the password is not tried).
 - asyncua opens a None channel even when None is not offered (discovery needs one): no session
@@ -58,23 +58,20 @@ import json
 import logging
 import math
 import threading
-from dataclasses import dataclass
 from datetime import UTC
 from typing import Any
 from urllib.parse import urlparse
 
-from asyncua import Server, ua
-from asyncua.common.utils import ServiceError
+from asyncua import ua
 from asyncua.crypto.permission_rules import User, UserRole
 from asyncua.server.address_space import AttributeService
 from asyncua.server.event_generator import EventGenerator
-from asyncua.server.user_managers import UserManager
 
 from service.core.alarm_inputs import inputs_from_snapshot
-
 from service.core.alarms import AlarmEvent
 from service.core.errors import InputError
 from service.opcua.guard import OpcUaGuard
+from service.opcua.identity import TokenServer, TokenUserManager
 from service.opcua.layout import (
     APPLICATION_URI,
     EVENT_TYPE,
@@ -86,136 +83,14 @@ from service.opcua.layout import (
     View,
     identification,
 )
+from service.opcua.nodes import EVENT_FIELDS, NUMERIC_TYPES, VARIANT_TYPES, TwinNodes, node_id, status_code
 from service.opcua.security import POLICIES, ClientTrust, PkiError, ServerPki, given_pki, self_signed_pki
 
 log = logging.getLogger(__name__)
 
-_VT = {
-    "Double": ua.VariantType.Double,
-    "String": ua.VariantType.String,
-    "UInt32": ua.VariantType.UInt32,
-    "Int64": ua.VariantType.Int64,
-    "Boolean": ua.VariantType.Boolean,
-}
-_NUMERIC = {
-    ua.VariantType.Double,
-    ua.VariantType.Float,
-    ua.VariantType.SByte,
-    ua.VariantType.Byte,
-    ua.VariantType.Int16,
-    ua.VariantType.UInt16,
-    ua.VariantType.Int32,
-    ua.VariantType.UInt32,
-    ua.VariantType.Int64,
-    ua.VariantType.UInt64,
-}
-_EVENT_FIELDS = (
-    ("alarm_id", ua.VariantType.String),
-    ("category", ua.VariantType.String),
-    ("transition", ua.VariantType.String),
-    ("active", ua.VariantType.Boolean),
-    ("level", ua.VariantType.String),
-    ("value", ua.VariantType.Double),
-    ("threshold", ua.VariantType.Double),
-    ("clear_threshold", ua.VariantType.Double),
-    ("unit", ua.VariantType.String),
-    ("since_s", ua.VariantType.Double),
-    ("time_s", ua.VariantType.Double),
-)
-
 
 class OpcUaError(RuntimeError):
     """The OPC UA server could not start (e.g. the port is taken)."""
-
-
-@dataclass
-class TwinUser(User):
-    """A session's user: `authenticated` when it gave the token as its password."""
-
-    authenticated: bool = False
-
-
-class TokenUserManager(UserManager):
-    """asyncua user manager: the service token is the password (see the module docstring).
-
-    `secure`: the server offers secure policies (has a certificate); then a password must come
-    encrypted with the server's key and a user name is refused on a None channel. `trust`: the
-    trusted client certificates, checked against the secure channel's certificate."""
-
-    def __init__(
-        self,
-        gate: Any,
-        read_requires_token: bool = False,
-        *,
-        secure: bool = False,
-        none_offered: bool = True,
-        trust: ClientTrust | None = None,
-    ):
-        self.gate, self.read_requires_token = gate, read_requires_token
-        self.secure, self.none_offered, self.trust = secure, none_offered, trust
-        self.password_encrypted: bool | None = None  # set by `decrypt_user_token` just before get_user
-
-    def wrap(self, iserver: Any) -> None:
-        """Watch asyncua's InternalServer.decrypt_user_token: it runs in ActivateSession right before
-        get_user (same call, no await between), so `password_encrypted` is that token's."""
-        decrypt = iserver.decrypt_user_token
-
-        def decrypt_user_token(isession: Any, token: ua.UserNameIdentityToken):
-            self.password_encrypted = bool(token.EncryptionAlgorithm)
-            return decrypt(isession, token)
-
-        iserver.decrypt_user_token = decrypt_user_token
-
-    def get_user(
-        self, iserver: Any, username: str | None = None, password: str | None = None, certificate: Any = None
-    ) -> User | None:
-        encrypted, self.password_encrypted = self.password_encrypted, None
-        if not certificate and not self.none_offered:  # asyncua gives b"" on a None channel
-            # asyncua opens a None channel even when None is not offered (discovery needs one);
-            # no session may be activated on it
-            log.warning("OPC UA: a session on the None security policy is refused (not offered)")
-            raise ServiceError(ua.StatusCodes.BadSecurityPolicyRejected)
-        if self.trust is not None:
-            refusal = self.trust.refusal(certificate)
-            if refusal is not None:
-                log.warning(
-                    "OPC UA: session refused (%s): the client certificate is not in %s", refusal, self.trust.folder
-                )
-                raise ServiceError(getattr(ua.StatusCodes, refusal))
-        if username is None and password is None:
-            if self.gate.requires_token and self.read_requires_token:
-                self.gate.check_token(None)  # counted as unauthorized
-                return None
-            # role User: asyncua's ruleset gives the Anonymous role nothing, not even reads
-            return TwinUser(role=UserRole.User, name=None, authenticated=not self.gate.requires_token)
-        if self.secure and not certificate:
-            log.warning("OPC UA: a user name on the None security policy is refused (only anonymous reads there)")
-            raise ServiceError(ua.StatusCodes.BadIdentityTokenRejected)
-        if self.secure and encrypted is False:
-            log.warning(
-                "OPC UA: a password sent unencrypted is refused (the endpoint asks for it encrypted "
-                "with the server certificate); the token may have been exposed"
-            )
-            raise ServiceError(ua.StatusCodes.BadIdentityTokenRejected)
-        if self.gate.check_token(password or "") is not None:
-            return None  # BadUserAccessDenied at ActivateSession
-        return TwinUser(role=UserRole.User, name=username or "user", authenticated=True)
-
-
-class _Server(Server):
-    """asyncua's Server with the password always encrypted with the server's key: on a secure
-    endpoint by the endpoint's own policy (asyncua leaves it in clear inside SignAndEncrypt). The
-    None endpoint of a secure server keeps asyncua's choice (the first SignAndEncrypt policy), so
-    a client that tries a user name there still sends no password in clear before the refusal."""
-
-    secure: bool = False
-
-    def _set_endpoints(self, policy: Any, mode: ua.MessageSecurityMode, level: int) -> None:
-        super()._set_endpoints(policy, mode, level)
-        if self.secure and mode != ua.MessageSecurityMode.None_:
-            for t in self.iserver.endpoints[-1].UserIdentityTokens:
-                if t.TokenType == ua.UserTokenType.UserName:
-                    t.SecurityPolicyUri = policy.URI
 
 
 _ADMIN = User(role=UserRole.Admin)  # asyncua's default user of a server-side write
@@ -239,28 +114,6 @@ class _GatedAttributeService(AttributeService):
             else:
                 results.extend(await super().write(ua.WriteParameters(NodesToWrite=[w]), user))
         return results
-
-
-def _node_id(identifier: int | str, namespace: int = 0) -> ua.NodeId:
-    """asyncua annotates NodeId's fields with its own int / str subclasses; it takes the built-ins."""
-    return ua.NodeId(identifier, namespace)  # type: ignore[arg-type]
-
-
-def _status(name: str) -> ua.StatusCode:
-    return ua.StatusCode(getattr(ua.StatusCodes, name))
-
-
-class _TwinNodes:
-    """The nodes of one twin in the server."""
-
-    def __init__(self, bearing_id: str, obj: Any):
-        self.bearing_id = bearing_id
-        self.obj = obj
-        self.vars: dict[str, tuple[ua.NodeId, ua.VariantType, Any]] = {}  # key -> (node id, type, reader)
-        self.last: dict[str, Any] = {}
-        self.seq: int | None = None
-        self.generators: list[EventGenerator] = []
-        self.last_result: ua.NodeId | None = None
 
 
 class OpcUaFacade:
@@ -304,7 +157,7 @@ class OpcUaFacade:
         self.updates = 0
         self.events_sent = 0
         self._setpoint_nodes: dict[ua.NodeId, tuple[str, str]] = {}
-        self._twins: dict[str, _TwinNodes] = {}
+        self._twins: dict[str, TwinNodes] = {}
         self._loop: asyncio.AbstractEventLoop | None = None
         self._alarms: asyncio.Queue | None = None
         self._stop: asyncio.Event | None = None
@@ -384,7 +237,7 @@ class OpcUaFacade:
             none_offered=ua.SecurityPolicyType.NoSecurity in POLICIES[self.security],
             trust=self.trust,
         )
-        server = self.server = _Server(user_manager=users)
+        server = self.server = TokenServer(user_manager=users)
         server.secure = secure
         await server.init()
         users.wrap(server.iserver)
@@ -402,10 +255,10 @@ class OpcUaFacade:
         server.iserver.attribute_service = _GatedAttributeService(server.iserver.aspace, self)
         idx = self.namespace_index = await server.register_namespace(NAMESPACE_URI)
         self._root = await server.nodes.objects.add_folder(
-            _node_id(ROOT_FOLDER, idx), ua.QualifiedName(ROOT_FOLDER, idx)
+            node_id(ROOT_FOLDER, idx), ua.QualifiedName(ROOT_FOLDER, idx)
         )
         self._event_type = await server.create_custom_event_type(
-            idx, EVENT_TYPE, ua.ObjectIds.BaseEventType, list(_EVENT_FIELDS)
+            idx, EVENT_TYPE, ua.ObjectIds.BaseEventType, list(EVENT_FIELDS)
         )
         await server.start()
         try:
@@ -484,9 +337,9 @@ class OpcUaFacade:
         return self.namespace_index
 
     def _nid(self, *parts: str) -> ua.NodeId:
-        return _node_id("/".join(parts), self._namespace())
+        return node_id("/".join(parts), self._namespace())
 
-    async def _add_twin(self, entry: Any) -> _TwinNodes:
+    async def _add_twin(self, entry: Any) -> TwinNodes:
         obj = await self._root.add_object(self._nid(entry.id), ua.QualifiedName(entry.id, self._namespace()))
         try:
             return await self._populate(entry, obj)
@@ -496,13 +349,13 @@ class OpcUaFacade:
             await self.server.delete_nodes([obj], recursive=True)  # tried again next time
             raise
 
-    async def _populate(self, entry: Any, obj: Any) -> _TwinNodes:
+    async def _populate(self, entry: Any, obj: Any) -> TwinNodes:
         idx, bid = self._namespace(), entry.id
         qn = lambda name: ua.QualifiedName(name, idx)  # noqa: E731
-        nodes = _TwinNodes(bid, obj)
+        nodes = TwinNodes(bid, obj)
         ident = await obj.add_folder(self._nid(bid, "Identification"), qn("Identification"))
         for name, vtype, desc, value in identification(entry):
-            vt = _VT[vtype]
+            vt = VARIANT_TYPES[vtype]
             node = await ident.add_variable(
                 self._nid(bid, "Identification", name),
                 qn(name),
@@ -511,11 +364,11 @@ class OpcUaFacade:
             )
             await node.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(desc))))
             if value is None:
-                await self.server.write_attribute_value(node.nodeid, ua.DataValue(StatusCode=_status("BadNoValue")))
+                await self.server.write_attribute_value(node.nodeid, ua.DataValue(StatusCode=status_code("BadNoValue")))
         for folder, variables in (*FOLDERS.items(), ("Setpoint", SETPOINT_VARS)):
             fnode = await obj.add_folder(self._nid(bid, folder), qn(folder))
             for var in variables:
-                vt = _VT[var.type]
+                vt = VARIANT_TYPES[var.type]
                 node = await fnode.add_variable(
                     self._nid(bid, folder, var.name),
                     qn(var.name),
@@ -523,7 +376,7 @@ class OpcUaFacade:
                     varianttype=vt,
                 )
                 await self.server.write_attribute_value(
-                    node.nodeid, ua.DataValue(StatusCode=_status("BadWaitingForInitialData"))
+                    node.nodeid, ua.DataValue(StatusCode=status_code("BadWaitingForInitialData"))
                 )
                 await node.write_attribute(
                     ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(var.description)))
@@ -554,7 +407,7 @@ class OpcUaFacade:
                 nodes.last_result = last.nodeid
         # alarm events: from the twin object, and from the Server object (SourceNode = the twin)
         isession = self.server.iserver.isession
-        for emitter, add_ref in ((obj.nodeid, True), (_node_id(ua.ObjectIds.Server), False)):
+        for emitter, add_ref in ((obj.nodeid, True), (node_id(ua.ObjectIds.Server), False)):
             gen = EventGenerator(isession)
             await gen.init(self._event_type, emitting_node=emitter, add_generates_event=add_ref)
             gen.event.SourceNode, gen.event.SourceName = obj.nodeid, bid
@@ -570,7 +423,7 @@ class OpcUaFacade:
         await self.server.delete_nodes([nodes.obj], recursive=True)
         log.info("OPC UA: twin %s removed", bearing_id)
 
-    async def _update(self, nodes: _TwinNodes, entry: Any) -> None:
+    async def _update(self, nodes: TwinNodes, entry: Any) -> None:
         snap = entry.runner.latest
         seq = None if snap is None else snap.seq
         target = entry.runner.target_setpoint
@@ -601,7 +454,7 @@ class OpcUaFacade:
             nodes.last[key] = value
             if value is None:
                 dv = ua.DataValue(
-                    StatusCode=_status("BadNoValue" if snap is not None else "BadWaitingForInitialData"),
+                    StatusCode=status_code("BadNoValue" if snap is not None else "BadWaitingForInitialData"),
                     SourceTimestamp=now,
                     ServerTimestamp=now,
                 )
@@ -624,7 +477,7 @@ class OpcUaFacade:
             for gen in nodes.generators:
                 ev = gen.event
                 ev.Severity = event.opcua_severity
-                for name, _vt in _EVENT_FIELDS:
+                for name, _vt in EVENT_FIELDS:
                     value = event.severity if name == "level" else getattr(event, name)
                     setattr(ev, name, "" if value is None and name == "level" else value)
                 await gen.trigger(message=event.message)
@@ -644,10 +497,10 @@ class OpcUaFacade:
                     nodes.last_result,
                     ua.DataValue(ua.Variant(json.dumps(body, allow_nan=False), ua.VariantType.String)),
                 )
-            return _status(status) if status != "Good" else ua.StatusCode()
+            return status_code(status) if status != "Good" else ua.StatusCode()
 
         if w.AttributeId != ua.AttributeIds.Value:
-            return _status("BadNotWritable")
+            return status_code("BadNotWritable")
         gate = self.registry.gate
         if gate.requires_token and not getattr(user, "authenticated", False):
             refusal = gate.check_token(
@@ -657,7 +510,7 @@ class OpcUaFacade:
             )
             return await answer("BadUserAccessDenied", refusal.message if refusal else None)
         variant = w.Value.Value if w.Value is not None else None
-        if variant is None or variant.VariantType not in _NUMERIC or variant.is_array:
+        if variant is None or variant.VariantType not in NUMERIC_TYPES or variant.is_array:
             kind = "nothing" if variant is None else variant.VariantType.name
             return await answer("BadTypeMismatch", f"{name}: a setpoint is a number (Double), got {kind}")
         value = variant.Value

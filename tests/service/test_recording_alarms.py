@@ -11,9 +11,7 @@ import pytest
 pytest.importorskip("rerun")
 
 from service.core.alarm_inputs import AlarmInputs
-
 from service.core.alarm_rules import ALARM_IDS
-
 from service.core.alarms import AlarmEvaluator
 from service.recording import RerunRecorder, describe_recording, read_column, recording_segments
 from service.settings import AlarmSettings

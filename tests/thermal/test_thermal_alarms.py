@@ -4,9 +4,7 @@ and heat the dissipation estimator cannot explain."""
 import pytest
 
 from service.core.alarm_inputs import AlarmInputs, inputs_from_snapshot
-
 from service.core.alarm_rules import ALARM_IDS
-
 from service.core.alarms import AlarmEvaluator
 from service.settings import AlarmSettings
 

@@ -12,7 +12,7 @@ from pydantic import ValidationError
 pytest.importorskip("asyncua")
 
 from service.core.admission import AdmissionGate
-from service.opcua.server import TokenUserManager
+from service.opcua.identity import TokenUserManager
 from service.settings import ServiceSettings
 
 
