@@ -54,20 +54,16 @@ Rules:
 A twin in a service runs one run of a scenario at a time (`POST /v1/bearings/{id}/scenario`): the
 runs must not change the twin's bearing, mounting, lubricant or thermal options (those are fixed
 when a twin is created); `bearing-twin scenario run FILE` creates a fresh twin for every run.
+Reading and validating a scenario (`load_scenario`, `scenario_from_dict`): service.core.scenario_files.
 """
 
 from __future__ import annotations
 
-import re
-from collections.abc import Mapping
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Annotated, Any, Literal
 
-import yaml
-from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator, model_validator
 
-from service.core.errors import loc_text
 from service.keys import TWIN_ID_PATTERN
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointLimits, SetpointUpdate
@@ -79,15 +75,15 @@ _NAME_RE = TWIN_ID_PATTERN  # a scenario or run name names the twin of an offlin
 _FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
 
-_DESIGNATION_TAG, _SPEC_TAG = "designation-text", "inline-spec"  # union tags, dropped from error paths
+DESIGNATION_TAG, SPEC_TAG = "designation-text", "inline-spec"  # union tags, dropped from error paths
 
 
 def _bearing_kind(value: Any) -> str:
-    return _SPEC_TAG if isinstance(value, (dict, BearingSpec)) else _DESIGNATION_TAG
+    return SPEC_TAG if isinstance(value, (dict, BearingSpec)) else DESIGNATION_TAG
 
 
 Bearing = Annotated[
-    Annotated[str, Tag(_DESIGNATION_TAG), Field(max_length=32)] | Annotated[BearingSpec, Tag(_SPEC_TAG)],
+    Annotated[str, Tag(DESIGNATION_TAG), Field(max_length=32)] | Annotated[BearingSpec, Tag(SPEC_TAG)],
     Discriminator(_bearing_kind),
     Field(
         description="Catalog designation [text], or a whole bearing spec (twin.spec.BearingSpec, fields with units) "
@@ -523,121 +519,3 @@ class ResolvedRun:
                 raise ScenarioError(
                     f"{where}{place}.{name}", p.message(limits.bearing or self.designation), [p.low, p.high]
                 )
-
-
-# ---- loading ----------------------------------------------------------------------------------
-def scenario_from_dict(data: Any, *, source: str = "scenario") -> Scenario:
-    """Validate a parsed scenario. Raises ScenarioError naming the field (first error) and
-    keeps pydantic's full error list in `__cause__`."""
-    if not isinstance(data, dict):
-        raise ScenarioError(
-            source, f"a scenario is a mapping (name, duration_s, steps, ...), got {type(data).__name__}"
-        )
-    try:
-        return Scenario.model_validate(data)
-    except ValidationError as exc:
-        located = [_locate(e) for e in exc.errors()]
-        where = located[0][0]
-        message = "; ".join(f"{w or source}: {m}" for w, m in located)
-        raise ScenarioError(where or source, message) from exc
-
-
-_PATH_PREFIX = re.compile(r"^([A-Za-z_][\w.\[\]]*): (.*)$", re.DOTALL)
-
-
-def _locate(error: Mapping[str, Any]) -> tuple[str, str]:
-    """(field path, message) of a pydantic error; model-level errors carry the path in front of
-    their message ('steps[2].at_s: ...')."""
-    where = loc_text([p for p in error.get("loc", ()) if p not in (_DESIGNATION_TAG, _SPEC_TAG)], skip=()) or ""
-    msg = str(error.get("msg", "")).removeprefix("Value error, ")
-    match = _PATH_PREFIX.match(msg)
-    if match:
-        path, rest = match.groups()
-        return (f"{where}.{path}" if where else path), rest
-    return where, msg
-
-
-class ScenarioLoader(yaml.SafeLoader):
-    """YAML 1.2's numbers: `5e-4` is a float (YAML 1.1, PyYAML's default, reads it as a string,
-    which the strict scenario models refuse)."""
-
-
-ScenarioLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(
-        r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
-                |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
-                |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
-                |[-+]?\.(?:inf|Inf|INF)
-                |\.(?:nan|NaN|NAN))$""",
-        re.X,
-    ),
-    list("-+0123456789."),
-)
-
-
-def load_scenario(path: str | Path) -> Scenario:
-    """Read and validate a scenario YAML file."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ScenarioError(str(path), f"cannot read: {exc.strerror or exc}") from exc
-    try:
-        data = yaml.load(text, Loader=ScenarioLoader)
-    except yaml.YAMLError as exc:
-        raise ScenarioError(str(path), f"not valid YAML: {' '.join(str(exc).split())}") from exc
-    if isinstance(data, dict):
-        data = _read_spec_files(data, path.parent)
-    return scenario_from_dict(data, source=str(path))
-
-
-def _read_spec_files(data: dict, folder: Path) -> dict:
-    """The scenario with every `bearing:` that names a spec file (top level and per run) replaced
-    by the BearingSpec read from it, the path relative to `folder` (the scenario file's).
-    ScenarioError naming `bearing` / `runs[j].bearing` (and the spec's field) when one cannot be read."""
-
-    def read(value: Any, where: str) -> Any:
-        if not (isinstance(value, str) and value.strip().lower().endswith(catalog.SPEC_FILE_SUFFIXES)):
-            return value
-        file = folder / value.strip()
-        try:
-            return catalog.load_spec_file(str(file))
-        except ValidationError as exc:
-            located = [_locate(e) for e in exc.errors()]
-            message = "; ".join(f"{w}: {m}" if w else m for w, m in located)
-            raise ScenarioError(
-                f"{where}.{located[0][0]}" if located[0][0] else where, f"spec file {str(file)!r}: {message}"
-            ) from exc
-        except ValueError as exc:
-            raise ScenarioError(where, str(exc).removeprefix("bearing: ")) from None
-
-    out = {**data, "bearing": read(data["bearing"], "bearing")} if "bearing" in data else dict(data)
-    runs = data.get("runs")
-    if isinstance(runs, list):
-        out["runs"] = [
-            {**run, "bearing": read(run["bearing"], f"runs[{j}].bearing")}
-            if isinstance(run, dict) and "bearing" in run
-            else run
-            for j, run in enumerate(runs)
-        ]
-    return out
-
-
-def list_scenarios(directory: str | Path) -> dict[str, Path]:
-    """name -> file of every *.yaml / *.yml scenario in a directory (file stem = default name)."""
-    directory = Path(directory)
-    if not directory.is_dir():
-        return {}
-    out: dict[str, Path] = {}
-    for p in sorted([*directory.glob("*.yaml"), *directory.glob("*.yml")]):
-        out[p.stem] = p
-    return out
-
-
-def find_scenario(name: str, directory: str | Path) -> Scenario:
-    """Load the named scenario from a directory (by file stem). Raises ScenarioError('name', ...)."""
-    known = list_scenarios(directory)
-    if name not in known:
-        raise ScenarioError("name", f"unknown scenario {name!r}; known: {', '.join(known) or 'none'}", sorted(known))
-    return load_scenario(known[name])

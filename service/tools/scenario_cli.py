@@ -29,7 +29,8 @@ def add_scenario_command(sub: Any) -> None:
 
 
 def _cmd_scenario_check(args: argparse.Namespace) -> int:
-    from service.core.scenarios import ScenarioError, load_scenario
+    from service.core.scenario_files import load_scenario
+    from service.core.scenarios import ScenarioError
 
     status = 0
     for file in args.files:
@@ -58,7 +59,8 @@ def _alarm_settings_from_env() -> AlarmSettings:
 
 
 def _cmd_scenario_run(args: argparse.Namespace) -> int:
-    from service.core.scenarios import ScenarioError, load_scenario
+    from service.core.scenario_files import load_scenario
+    from service.core.scenarios import ScenarioError
     from service.tools.offline import TableSink, run_scenario, write_table
 
     try:

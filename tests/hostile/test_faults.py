@@ -233,7 +233,7 @@ def test_http_state_after_a_nan_is_injected(server, hostile):
 def test_scenario_into_a_value_not_held_fails_cleanly(twin):
     """A scenario stepping into a value the twin has already failed to hold stops with the reason
     (the value is refused like an HTTP setpoint would be); the twin keeps running."""
-    from service.core.scenarios import scenario_from_dict
+    from service.core.scenario_files import scenario_from_dict
 
     runner = TwinRunner(twin)
     high = runner.limits["radial_load_n"][1]

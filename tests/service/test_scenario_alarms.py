@@ -15,7 +15,7 @@ import pytest
 pytest.importorskip("rerun")
 
 from service.core.alarm_inputs import inputs_from_snapshot
-from service.core.scenarios import load_scenario
+from service.core.scenario_files import load_scenario
 from service.recording import read_column
 from service.settings import AlarmSettings, ServiceSettings
 from service.tools.offline import TableSink, run_scenario

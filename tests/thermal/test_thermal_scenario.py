@@ -6,7 +6,8 @@ from pathlib import Path
 import pytest
 
 from service.core.scenario_driver import ScenarioExecutor
-from service.core.scenarios import ScenarioError, load_scenario, scenario_from_dict
+from service.core.scenario_files import load_scenario, scenario_from_dict
+from service.core.scenarios import ScenarioError
 from twin.setpoint import Setpoint
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "thermal_measured_outer_ring.yaml"

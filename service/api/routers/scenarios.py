@@ -8,7 +8,8 @@ from service.api.deps import SettingsDep, TwinDep
 from service.api.routers.bearings import INVALID, UNKNOWN_TWIN
 from service.api.schemas import ScenarioAccepted, ScenarioList, ScenarioRequest, ScenarioStatus
 from service.core.errors import InputError
-from service.core.scenarios import ScenarioError, find_scenario, list_scenarios, load_scenario, scenario_from_dict
+from service.core.scenario_files import find_scenario, list_scenarios, load_scenario, scenario_from_dict
+from service.core.scenarios import ScenarioError
 
 read = APIRouter(tags=["scenarios"])
 write = APIRouter(tags=["scenarios"])

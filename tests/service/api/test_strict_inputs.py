@@ -14,7 +14,7 @@ from service.api.routers.defects import DefectsRequest
 from service.api.schemas import BearingCreate, RecordingRequest, ScenarioRequest
 from service.core.defects import parse_defects
 from service.core.errors import InputError
-from service.core.scenarios import ScenarioLoader, scenario_from_dict
+from service.core.scenario_files import ScenarioLoader, scenario_from_dict
 from twin import catalog
 from twin.setpoint import SetpointUpdate
 from twin.vibration.housing import Housing

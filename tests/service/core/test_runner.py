@@ -16,7 +16,8 @@ from service.core.admission import AdmissionGate
 from service.core.errors import InputError
 from service.core.intake import SetpointIntake
 from service.core.runner import TwinRunner
-from service.core.scenarios import ScenarioError, scenario_from_dict
+from service.core.scenario_files import scenario_from_dict
+from service.core.scenarios import ScenarioError
 from twin.engine import Twin
 
 WAIT_S = 30.0

@@ -12,12 +12,8 @@ import yaml
 
 from service.cli import main
 from service.core.scenario_driver import ScenarioExecutor
-from service.core.scenarios import (
-    ScenarioError,
-    list_scenarios,
-    load_scenario,
-    scenario_from_dict,
-)
+from service.core.scenario_files import list_scenarios, load_scenario, scenario_from_dict
+from service.core.scenarios import ScenarioError
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 
