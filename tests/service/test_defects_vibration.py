@@ -389,11 +389,12 @@ def test_a_scenario_step_injects_and_clears_defects(service, support):
 
 def test_serve_housing_puts_the_default_twin_on_the_housing():
     from service.core.registry import TwinRegistry
-    from service.tools.cli import _serve_settings, build_parser
+    from service.tools.cli import build_parser
+    from service.tools.serve_cli import serve_settings
 
-    settings = _serve_settings(build_parser().parse_args(["serve", "--housing", "--no-zenoh", "--no-record", "--fast"]))
+    settings = serve_settings(build_parser().parse_args(["serve", "--housing", "--no-zenoh", "--no-record", "--fast"]))
     assert settings.twin.housing is True
-    assert _serve_settings(build_parser().parse_args(["serve", "--no-zenoh"])).twin.housing is False
+    assert serve_settings(build_parser().parse_args(["serve", "--no-zenoh"])).twin.housing is False
     registry = TwinRegistry(settings).open()
     try:
         entry = registry.get("default")

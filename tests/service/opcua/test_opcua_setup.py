@@ -39,11 +39,12 @@ def test_the_endpoint_setting_and_flag():
     assert ServiceSettings(opcua="opc.tcp://127.0.0.1:4840").opcua.endpoint == "opc.tcp://127.0.0.1:4840"
     with pytest.raises(ValidationError, match="opcua"):
         ServiceSettings(opcua="http://127.0.0.1:4840")
-    from service.tools.cli import _serve_settings, build_parser
+    from service.tools.cli import build_parser
+    from service.tools.serve_cli import serve_settings
 
     args = build_parser().parse_args(["serve", "--opcua", "opc.tcp://127.0.0.1:4841"])
     assert isinstance(args, argparse.Namespace)
-    assert _serve_settings(args).opcua.endpoint == "opc.tcp://127.0.0.1:4841"
+    assert serve_settings(args).opcua.endpoint == "opc.tcp://127.0.0.1:4841"
 
 
 def test_a_busy_port_is_a_one_line_wiring_error():
@@ -85,7 +86,8 @@ def test_the_security_settings_and_flags(tmp_path):
     with pytest.raises(ValidationError, match="opcua_trusted_dir: trusting clients by certificate"):
         ServiceSettings(token="s3cret", opcua_security="all", opcua_trusted_dir=tmp_path)
     assert ServiceSettings(opcua_security="sign", opcua_trusted_dir=tmp_path).opcua.trusted_dir == tmp_path
-    from service.tools.cli import _serve_settings, build_parser
+    from service.tools.cli import build_parser
+    from service.tools.serve_cli import serve_settings
 
     args = build_parser().parse_args(
         [
@@ -100,7 +102,7 @@ def test_the_security_settings_and_flags(tmp_path):
             str(tmp_path),
         ]
     )
-    settings = _serve_settings(args)
+    settings = serve_settings(args)
     assert (settings.opcua.security, settings.opcua.pki_dir, settings.opcua.trusted_dir) == (
         "sign_and_encrypt",
         tmp_path / "pki",

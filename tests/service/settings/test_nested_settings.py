@@ -12,7 +12,8 @@ import pytest
 from pydantic import SecretStr, ValidationError
 
 from service.settings import RouterSettings, ServiceSettings, ZenohAccessSettings, flat_settings
-from service.tools.cli import _serve_settings, build_parser
+from service.tools.cli import build_parser
+from service.tools.serve_cli import serve_settings
 from service.tools.settings_flags import flag_of
 
 # Every flat environment name the single-level ServiceSettings read, with the group path it now
@@ -286,7 +287,7 @@ FLAGS = [
 
 @pytest.mark.parametrize(("argv", "path", "expected"), FLAGS, ids=[f[0][0] for f in FLAGS])
 def test_every_existing_serve_flag_sets_its_field(clean_env, argv, path, expected):
-    assert _get(_serve_settings(build_parser().parse_args(["serve", *argv])), path) == expected
+    assert _get(serve_settings(build_parser().parse_args(["serve", *argv])), path) == expected
 
 
 def test_a_flag_for_every_setting_named_after_it_and_only_given_flags_override(clean_env, tmp_path):
@@ -295,7 +296,7 @@ def test_a_flag_for_every_setting_named_after_it_and_only_given_flags_override(c
     assert not any("." in dest for dest in vars(args))  # argparse.SUPPRESS: nothing given
     clean_env.setenv("BEARING_TWIN_PORT", "8111")
     clean_env.setenv("BEARING_TWIN_FAST", "true")
-    s = _serve_settings(
+    s = serve_settings(
         parser.parse_args(
             [
                 "serve",
@@ -334,7 +335,7 @@ def test_a_bad_flag_value_is_refused(clean_env):
     with pytest.raises(SystemExit):
         build_parser().parse_args(["serve", "--port", "eighty"])
     with pytest.raises(ValidationError, match="publish_rate_hz"):
-        _serve_settings(argparse.Namespace(**{"runner.publish_rate_hz": -1.0}))
+        serve_settings(argparse.Namespace(**{"runner.publish_rate_hz": -1.0}))
 
 
 def test_a_serve_error_names_the_group_field_its_variable_and_flag(clean_env, capsys):
