@@ -55,7 +55,7 @@ from typing import Any, Self
 
 from service.recording.archive import WaveformArchive
 from service.recording.batcher import RowBatcher, TwinRows
-from service.recording.layout import blueprint
+from service.recording.blueprint import blueprint
 from service.recording.paths import CreatedFile, RecordingPathError, create_recording
 from service.recording.retention import Retention
 from service.recording.segments import RecordingWriteError, is_segment_of
@@ -603,7 +603,7 @@ class RerunRecorder:
 
     # ---- blueprint --------------------------------------------------------------------------
     def blueprint(self, live: bool = False):
-        """The default layout (`service.recording.layout.blueprint`); `live`: for a viewer (the
+        """The default layout (`service.recording.blueprint.blueprint`); `live`: for a viewer (the
         time cursor follows the newest data), else for a file."""
         return blueprint(list(self._rows.twins.values()), self.series_window_s, live=live)
 

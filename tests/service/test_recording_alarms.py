@@ -141,7 +141,8 @@ def test_a_new_segment_starts_with_the_alarms_in_force(tmp_path, run):
 def test_the_blueprint_has_the_alarm_views():
     import rerun.blueprint as rrb
 
-    from service.recording.layout import TwinLayout, twin_blueprint
+    from service.recording.blueprint import twin_blueprint
+    from service.recording.layout import TwinLayout
 
     views = []
 

@@ -16,7 +16,8 @@ pytest.importorskip("rerun")
 from service.core.alarm_rules import ALARM_IDS
 from service.recording import RerunRecorder, describe_recording, read_column, read_index
 from service.recording.archive import WaveformArchive
-from service.recording.layout import SERIES, TREND_BANDS, TwinLayout, blueprint
+from service.recording.blueprint import blueprint
+from service.recording.layout import SERIES, TREND_BANDS, TwinLayout
 from service.recording.trends import OFF_SCALE_DECADES, _capacitance_scale, split_windows
 from service.recording.vibration_columns import WaveRow
 from twin.engine import Twin

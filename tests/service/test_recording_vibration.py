@@ -141,7 +141,8 @@ def _tensor(cell) -> np.ndarray:
 def test_the_vibration_views_only_with_the_housing():
     import rerun.blueprint as rrb
 
-    from service.recording.layout import TwinLayout, twin_blueprint
+    from service.recording.blueprint import twin_blueprint
+    from service.recording.layout import TwinLayout
 
     def names(tw):
         out = []
