@@ -1,5 +1,8 @@
 """`RerunRecorder`: a `SnapshotSink` that records one or more twins into one rerun recording.
 
+One module for one facade: its length is this contract and the one-line properties that forward to
+the two parts doing the work, so a split would scatter one public surface.
+
 A thin facade over two parts: `service.recording.batcher.RowBatcher` (the queues the publishers
 fill, drop-oldest, and the rows per twin) and `service.recording.writer.SegmentWriter` (the
 outputs, segment rotation, write faults and retry). The runner thread calls `publish(snapshot)`,
