@@ -45,7 +45,8 @@ from twin.ehl_solver import film_reduction as calibration
 from twin.ehl_solver import params as prm
 from twin.ehl_solver import solve_point_contact
 from twin.ehl_solver.elastic import Deflection
-from twin.ehl_solver.solver import DEFAULT_DOMAIN, _Level
+from twin.ehl_solver.multigrid import GridLevel
+from twin.ehl_solver.solver import DEFAULT_DOMAIN
 
 SPEEDS = prm.SEED_SPEEDS_M_S  # seed 003 Fig. 1: 0.832-4.16 m/s (10,000-50,000 rpm)
 DEFAULT_SPEED = prm.DEFAULT_ENTRAINMENT_SPEED_M_S
@@ -139,7 +140,7 @@ def test_hertz_pressure_gives_the_hertz_approach():
     """eq. 4 with the Hertz pressure: gap + deflection is flat inside the contact and equals the
     Hertz approach (1 in units of a^2/R), the check of the influence coefficients (tol 1e-3)."""
     hz = prm.hertz_scales(prm.LOAD_N, prm.RX_M, prm.RY_M, prm.E_PRIME_PA)
-    lv = _Level(129, DEFAULT_DOMAIN, hz, prm.RX_M, prm.RY_M, prm.E_PRIME_PA)
+    lv = GridLevel(129, DEFAULT_DOMAIN, hz, prm.RX_M, prm.RY_M, prm.E_PRIME_PA)
     p = prm.hertz_pressure(lv.x[:, None], lv.y[None, :])
     g = lv.gap + lv.defl(p)
     inside = (lv.x[:, None] ** 2 + lv.y[None, :] ** 2) < 0.9

@@ -9,6 +9,7 @@
 """
 
 from twin.ehl_solver.film_reduction import film_reduction_factor
-from twin.ehl_solver.solver import EHLResult, solve_point_contact
+from twin.ehl_solver.result import EHLResult
+from twin.ehl_solver.solver import solve_point_contact
 
 __all__ = ["EHLResult", "film_reduction_factor", "solve_point_contact"]

@@ -90,134 +90,19 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from twin.ehl_solver import kernels as K
 from twin.ehl_solver import params as prm
-from twin.ehl_solver.elastic import Deflection
+from twin.ehl_solver.multigrid import GridLevel, prolong_bilinear, restrict_full_weighting
+from twin.ehl_solver.result import EHLResult
 
 DEFAULT_DOMAIN = (-3.0, 1.5, -2.0, 2.0)  # X = x/ax, Y = y/ay (see the module docstring)
 TEMPERATURE_CAP_K = 1000.0
 TEMPERATURE_TOL_K = 0.05  # thermal case: max change of the temperature field in the last cycle
 STAGNATION_WINDOW = 30  # cycles without progress before giving up (see _stagnated)
-
-
-@dataclass
-class EHLResult:
-    """Solution of one point contact. Maps are indexed [i, j] = [x_m[i], y_m[j]]; SI units.
-    When converged is False the scalar results are NaN (message says why); the maps and the
-    history of the last iterate are kept for diagnosis."""
-
-    pressure_pa: np.ndarray
-    film_m: np.ndarray
-    temperature_rise_map_k: np.ndarray
-    x_m: np.ndarray
-    y_m: np.ndarray
-    h_c_m: float
-    h_min_m: float
-    max_pressure_pa: float
-    temperature_rise_k: float  # mean over the Hertzian contact area (eq. 6 + eq. 10)
-    current_temperature_rise_k: float  # eq. 10 part alone
-    converged: bool
-    iterations: int
-    history: dict = field(default_factory=dict)
-    inputs: dict = field(default_factory=dict)
-    hertz: dict = field(default_factory=dict)
-    hamrock_dowson_h_min_m: float = float("nan")
-    hamrock_dowson_h_c_m: float = float("nan")
-    message: str = ""
-    wall_time_s: float = float("nan")
-
-    def centre_line(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(x [m], p [Pa], h [m]) along y = 0 (the node row nearest to it)."""
-        j = int(np.argmin(np.abs(self.y_m)))
-        return self.x_m.copy(), self.pressure_pa[:, j].copy(), self.film_m[:, j].copy()
-
-    def summary(self) -> dict:
-        """Scalars only (JSON-ready)."""
-        return {
-            "h_min_m": self.h_min_m,
-            "h_c_m": self.h_c_m,
-            "max_pressure_pa": self.max_pressure_pa,
-            "temperature_rise_k": self.temperature_rise_k,
-            "current_temperature_rise_k": self.current_temperature_rise_k,
-            "converged": self.converged,
-            "iterations": self.iterations,
-            "hamrock_dowson_h_min_m": self.hamrock_dowson_h_min_m,
-            "hamrock_dowson_h_c_m": self.hamrock_dowson_h_c_m,
-            "hertz_pressure_pa": self.hertz.get("p_hertz_pa"),
-            "message": self.message,
-            "wall_time_s": self.wall_time_s,
-        }
-
-
-class _Level:
-    """Arrays and operators of one grid."""
-
-    def __init__(self, n: int, domain, hz: prm.HertzScales, rx_m, ry_m, e_prime_pa):
-        x0, x1, y0, y1 = domain
-        self.n = n
-        self.hx = (x1 - x0) / (n - 1)
-        self.hy = (y1 - y0) / (n - 1)
-        self.x = x0 + self.hx * np.arange(n)
-        self.y = y0 + self.hy * np.arange(n)
-        b = (rx_m / ry_m) * (hz.ay_m / hz.ax_m) ** 2
-        self.gap = 0.5 * self.x[:, None] ** 2 + 0.5 * b * self.y[None, :] ** 2
-        self.defl = Deflection(
-            n,
-            n,
-            self.hx,
-            self.hy,
-            ax_m=hz.ax_m,
-            ay_m=hz.ay_m,
-            rx_m=rx_m,
-            p_hertz_pa=hz.p_hertz_pa,
-            e_prime_pa=e_prime_pa,
-        )
-        self.kc = self.defl.coef
-        shape = (n, n)
-        self.p = np.zeros(shape)
-        self.f = np.zeros(shape)
-        self.h = np.zeros(shape)
-        self.eta = np.ones(shape)
-        self.rho = np.ones(shape)
-        self.eps = np.zeros(shape)
-        self.dtheta = np.zeros(shape)
-        self.r = np.zeros(shape)
-        self.delta = np.zeros(shape)
-        self.kind = np.zeros(shape, dtype=np.int8)
-        self.band = np.zeros((n, 5))
-        self.rhs = np.zeros(n)
-        self.xw = np.zeros(n)
-        self.load_target = 0.0
-        self.area = self.hx * self.hy
-
-    def load(self) -> float:
-        return float(self.p.sum()) * self.area
-
-
-def _restrict_full_weighting(r: np.ndarray, out: np.ndarray) -> None:
-    out[:] = 0.0
-    c = r[2:-2:2, 2:-2:2]
-    out[1:-1, 1:-1] = (
-        4.0 * c
-        + 2.0 * (r[1:-3:2, 2:-2:2] + r[3:-1:2, 2:-2:2] + r[2:-2:2, 1:-3:2] + r[2:-2:2, 3:-1:2])
-        + r[1:-3:2, 1:-3:2]
-        + r[3:-1:2, 1:-3:2]
-        + r[1:-3:2, 3:-1:2]
-        + r[3:-1:2, 3:-1:2]
-    ) / 16.0
-
-
-def _prolong_bilinear(ec: np.ndarray, nf: int) -> np.ndarray:
-    ef = np.zeros((nf, nf))
-    ef[::2, ::2] = ec
-    ef[1::2, ::2] = 0.5 * (ec[:-1, :] + ec[1:, :])
-    ef[::2, 1::2] = 0.5 * (ec[:, :-1] + ec[:, 1:])
-    ef[1::2, 1::2] = 0.25 * (ec[:-1, :-1] + ec[1:, :-1] + ec[:-1, 1:] + ec[1:, 1:])
-    return ef
 
 
 @dataclass
@@ -257,10 +142,10 @@ class _Solver:
         dt_rel,
         settings: _Settings,
     ):
-        self.levels: list[_Level] = []
+        self.levels: list[GridLevel] = []
         n = n_fine
         while True:
-            self.levels.append(_Level(n, domain, hz, rx_m, ry_m, e_prime_pa))
+            self.levels.append(GridLevel(n, domain, hz, rx_m, ry_m, e_prime_pa))
             if n <= n_coarse or (n - 1) % 2 or n < 9:
                 break
             n = (n - 1) // 2 + 1
@@ -277,10 +162,10 @@ class _Solver:
         self.zero_pivots = 0
 
     # -- film and fields -------------------------------------------------------------------
-    def film(self, lv: _Level) -> None:
+    def film(self, lv: GridLevel) -> None:
         lv.h[:] = self.h0 + lv.gap + lv.defl(lv.p)
 
-    def fields(self, lv: _Level) -> None:
+    def fields(self, lv: GridLevel) -> None:
         self.bad += K.update_fields(
             lv.p,
             lv.h,
@@ -299,13 +184,13 @@ class _Solver:
             self.incompressible,
         )
 
-    def operator(self, lv: _Level) -> float:
+    def operator(self, lv: GridLevel) -> float:
         """Film, fields and residual r = f - L(P); returns sum |r| over nodes with P > 0."""
         self.film(lv)
         self.fields(lv)
         return K.residual(lv.p, lv.h, lv.rho, lv.eps, lv.f, lv.hx, lv.hy, self.kappa2, self.s.xi0, lv.r)
 
-    def relax(self, lv: _Level, sweeps: int, load_balance: bool) -> None:
+    def relax(self, lv: GridLevel, sweeps: int, load_balance: bool) -> None:
         s = self.s
         for _ in range(sweeps):
             self.film(lv)
@@ -369,7 +254,7 @@ class _Solver:
         cv = self.levels[k + 1]
         cv.p[:] = lv.p[::2, ::2]
         cv.dtheta[:] = lv.dtheta[::2, ::2]
-        _restrict_full_weighting(lv.r, cv.r)
+        restrict_full_weighting(lv.r, cv.r)
         restricted = cv.r.copy()
         cv.f[:] = 0.0
         self.operator(cv)  # cv.r = 0 - L_c(P_c)
@@ -379,7 +264,7 @@ class _Solver:
         p_old = cv.p.copy()
         for _ in range(self.s.gamma):
             self.cycle(k + 1)
-        corr = _prolong_bilinear(cv.p - p_old, lv.n)
+        corr = prolong_bilinear(cv.p - p_old, lv.n)
         mask = _away_from_cavitation(lv.p, self.s.cgc_margin)
         lv.p[mask] += corr[mask]
         np.maximum(lv.p, 0.0, out=lv.p)
@@ -536,7 +421,7 @@ def solve_point_contact(
 
     t_work = np.zeros((grid, grid))
 
-    def temperature(lv: _Level) -> tuple[int, float]:
+    def temperature(lv: GridLevel) -> tuple[int, float]:
         """Coarser grids: the uniform current rise (eq. 10) only. Finest grid: eq. 6 + eq. 10 from
         the current P and H, under-relaxed (omega_t) into lv.dtheta. Returns (#capped nodes,
         max |change| of dtheta [K])."""
@@ -593,7 +478,7 @@ def solve_point_contact(
         lv.f[:] = 0.0
         lv.load_target = target
         if k < len(levels) - 1:
-            lv.p[:] = _prolong_bilinear(levels[k + 1].p, lv.n)
+            lv.p[:] = prolong_bilinear(levels[k + 1].p, lv.n)
         lv.dtheta[:] = current_rise
         finest = k == 0
         n_cycles = max_iter if finest else 4
@@ -705,7 +590,7 @@ def _stagnated(dps: list, tol_p: float) -> bool:
     return recent > 10.0 * tol_p and recent > 0.9 * before
 
 
-def _centre_value(lv: _Level) -> float:
+def _centre_value(lv: GridLevel) -> float:
     """H at X = Y = 0 by bilinear interpolation."""
     fx = (0.0 - lv.x[0]) / lv.hx
     fy = (0.0 - lv.y[0]) / lv.hy

@@ -1,5 +1,8 @@
 """The hot loop: `step_n` integrates the bearing for n steps of velocity-Verlet (seed 000 eq. 10).
 
+One module for one kernel: the functions before `step_n` are its stages, inlined into it
+(`inline="always"`) and compiled with it as one unit, and a sixth of the lines imports the lane indices.
+
 One compiled call per frame, no allocation, no Python objects, no array passed to another
 function inside the loop; problems are reported through the returned status code
 (`twin.kernels.layout.STATUS_*`), never raised.
