@@ -9,7 +9,6 @@ from typing import Any
 from asyncua import ua
 from asyncua.server.event_generator import EventGenerator
 
-
 VARIANT_TYPES = {
     "Double": ua.VariantType.Double,
     "String": ua.VariantType.String,
