@@ -20,6 +20,11 @@ worker.
 
 A twin's own recording (`start_recording`) goes to a path under the recordings directory
 (relative, plain names, .rrd), made by `_new_recording(path)`.
+
+The module is longer than the project's 600 lines because it is the one place where a twin's
+life is wired (create, admission, delete, close, its recording, health) and each step of that
+wiring must be read beside the others; the policies it applies live elsewhere (capacity, pool,
+intake, alarm hub).
 """
 
 from __future__ import annotations
