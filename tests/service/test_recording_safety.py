@@ -294,18 +294,16 @@ def test_create_delete_cycles_free_the_recorder_entries(server):
         assert c.delete(f"/v1/bearings/tmp-{i}").status_code == 200
 
     for i in range(20):  # warm-up: numba, rerun, arrow and allocator pools fill up
-        cycle(i)  # (about 5 MB, then flat; before: +0.3 MB every cycle)
+        cycle(i)  # (about 5 MB, then flat)
     threads = _threads()
-    # two blocks of 15 cycles: a leak of the recorder's entries (0.3 MB a cycle) grows both by
-    # 4.5 MB or more; a one-off growth of an allocator pool, which the process's history (the
-    # tests before this one) decides, shows in one block only
-    grown = []
-    for block in (range(20, 35), range(35, 50)):
-        rss = _rss_bytes()
-        for i in block:
-            cycle(i)
-        grown.append((_rss_bytes() - rss) / 1e6)
-    print(f"\n2 x 15 create/delete cycles: threads {threads} -> {_threads()}, RSS {grown[0]:+.2f}, {grown[1]:+.2f} MB")
+    # 60 cycles: a leak of the recorder's entries (0.3 MB a cycle) grows the process by 18 MB; the
+    # RSS after a collection and malloc_trim still moves by +-5 MB between reads (allocator pools,
+    # whatever the tests before this one left), so the bound is half the leak
+    rss = _rss_bytes()
+    for i in range(20, 80):
+        cycle(i)
+    grown = (_rss_bytes() - rss) / 1e6
+    print(f"\n60 create/delete cycles: threads {threads} -> {_threads()}, RSS {grown:+.2f} MB")
     assert srv.service.recorder.bearing_ids == ["default"]
     assert _threads() <= threads
-    assert min(grown) < 2.5, grown
+    assert grown < 9.0
