@@ -296,9 +296,10 @@ def test_create_delete_cycles_free_the_recorder_entries(server):
     for i in range(20):  # warm-up: numba, rerun, arrow and allocator pools fill up
         cycle(i)  # (about 5 MB, then flat)
     threads = _threads()
-    # 60 cycles: a leak of the recorder's entries (0.3 MB a cycle) grows the process by 18 MB; the
-    # RSS after a collection and malloc_trim still moves by +-5 MB between reads (allocator pools,
-    # whatever the tests before this one left), so the bound is half the leak
+    # 60 cycles: the RSS after a collection and malloc_trim moves by +-5 MB between reads, and in
+    # the full suite's process the allocator's pools grow by about 0.2 MB a cycle (3-4 MB over the
+    # 60 cycles when this module runs alone; Python objects grow by about 85 a cycle either way);
+    # the bound is what a leak of the recorder's entries adds, 0.3 MB a cycle
     rss = _rss_bytes()
     for i in range(20, 80):
         cycle(i)
@@ -306,4 +307,4 @@ def test_create_delete_cycles_free_the_recorder_entries(server):
     print(f"\n60 create/delete cycles: threads {threads} -> {_threads()}, RSS {grown:+.2f} MB")
     assert srv.service.recorder.bearing_ids == ["default"]
     assert _threads() <= threads
-    assert grown < 9.0
+    assert grown < 18.0
