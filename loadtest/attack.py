@@ -54,8 +54,6 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from loadtest import attack_watchers
-from service.keys import DEFAULT_PREFIX
-from service.settings import ZenohAccessSettings
 from service.tools.client import (
     TargetConfig,
     add_target_arguments,
@@ -515,7 +513,7 @@ def run_attack(cfg: AttackConfig) -> dict:
                     {
                         "endpoint": zenoh_endpoint,
                         "bearing_id": cfg.bearing_id,
-                        "prefix": DEFAULT_PREFIX if started is not None else ZenohAccessSettings().zenoh.prefix,
+                        "prefix": attack_watchers.target_prefix(started),
                         "user": zuser,
                         "password": zpass,
                         "seconds": cfg.seconds,

@@ -33,6 +33,12 @@ FORGED_HOST = "evil-squatter"  # the forged owner text; never to be found in an 
 WATCHERS = ("squat", "opcua_logins", "opcua_sessions", "opcua_subscriptions")
 
 
+def target_prefix(started: object | None) -> str:
+    """The zenoh key prefix of the attacked service: the default for one the attack started
+    (its environment holds no BEARING_TWIN_* setting), else the settings' (flat or nested variable)."""
+    return DEFAULT_PREFIX if started is not None else ZenohAccessSettings().zenoh.prefix
+
+
 def specs(cfg: Any, started: Any, url: str, zenoh_endpoint: str | None, token: str | None) -> list:
     """(target, spec) of each flood of this module the attack `cfg` asks for (a child process each)."""
     specs = []
@@ -48,7 +54,7 @@ def specs(cfg: Any, started: Any, url: str, zenoh_endpoint: str | None, token: s
                     "endpoint": zenoh_endpoint,
                     "seconds": cfg.seconds,
                     "max_ids": 3,
-                    "prefix": DEFAULT_PREFIX if started is not None else ZenohAccessSettings().zenoh.prefix,
+                    "prefix": target_prefix(started),
                 },
             )
         )
