@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import copy
 import math
+from typing import Any
 
 import numpy as np
 
@@ -34,7 +35,8 @@ from twin.physics.thermal import MAX_CURRENT_HEATING_K, current_heating_temperat
 from twin.physics.viscosity import density_kg_m3, dynamic_viscosity_pa_s, temperature_viscosity_coefficient_k_inv
 from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
 from twin.snapshot import FrictionPowerState, LifeState, Snapshot, ThermalState
-from twin.snapshot_blocks import ball_states, electrical_state, finite_or_none
+from twin.snapshot_blocks import ball_arrays, electrical_state, finite_or_none
+from twin.snapshot_frame import SnapshotFrame
 from twin.spec import BearingSpec, ModelOptions
 from twin.state import MAX_DEFECTS, TwinState, make_state
 from twin.thermal.coupling import ThermalCoupling
@@ -568,11 +570,17 @@ class Twin:
 
     def snapshot(self, real_time_factor: float | None = None) -> Snapshot:
         """An immutable copy of the public state (schema bearing-twin/state/1)."""
+        return self.frame(real_time_factor).snapshot
+
+    def frame(self, real_time_factor: float | None = None, **head: Any) -> SnapshotFrame:
+        """The public state captured as a `twin.snapshot_frame.SnapshotFrame`: the balls as
+        arrays, the pydantic tree built only when read. `head`: snapshot fields set beside the
+        engine's (late_fraction, status)."""
         s = self.state
         net = self.electrical()
-        balls = ball_states(self.model, s, net, self._effective_mu)
+        balls = ball_arrays(self.model, s, net, self._effective_mu)
         self.seq += 1
-        return Snapshot(
+        fields = dict(
             bearing_id=self.bearing_id,
             designation=self.model.spec.designation,
             seq=self.seq,
@@ -588,13 +596,14 @@ class Twin:
             friction_power_w=FrictionPowerState(**self.friction_power_w().by_source_w()),
             viscosity_pa_s=float(self.inlet.inlet_viscosity_pa_s),
             electrical=electrical_state(net, self.inlet),
-            balls=balls,
+            balls=(),
             life=self._life_state(),
             outer_ring_displacement_m=tuple(float(h) for h in s.housing_displacement_m[:3]),
             defects=self._defects,
             vibration=self.vibration,
             thermal=self._thermal_state(),
         )
+        return SnapshotFrame(Snapshot(**{**fields, **head}), balls)
 
     def _life_state(self) -> LifeState | None:
         block = self.life_monitor.block(self.time_s)

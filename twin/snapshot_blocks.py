@@ -1,26 +1,64 @@
 """The snapshot's per-ball, per-contact and electrical blocks (twin.snapshot), read from the
 state's lanes, the electrical network and the inlet film at one instant.
 
-The contact lanes are read once per snapshot as lists of floats (`contacts.T.tolist()`), and the
-network's per-contact values likewise, instead of element by element from the arrays (element
-reads from numpy cost a third of the snapshot's time).
+The balls and their contacts are captured at once into arrays (`BallArrays`: numpy over the
+contact lanes, no Python object per ball); the pydantic tree (`BallState`, `ContactState`) is
+built from them only for a consumer that reads it (`ball_states`), and the state message's
+`balls` JSON is written straight from them (`balls_json`: one typed pydantic serialisation of
+every number, then a fixed template), the same text the tree serialises to.
 """
 
 from __future__ import annotations
 
 import math
+import operator
+from dataclasses import dataclass
+from typing import Final
 
 import numpy as np
+from numba import njit
+from pydantic import TypeAdapter
 
 from twin.electrical_network import ElectricalNetwork
 from twin.inlet_film import InletFilm
+from twin.jit import JIT
 from twin.kernels import layout as L
 from twin.model import BearingModel
 from twin.physics.friction import REGIME_NAMES
-from twin.physics.hertz import max_pressure_pa
-from twin.snapshot import BallState, ContactState, ElectricalState
+from twin.snapshot import LAMBDA_KEY, BallState, ContactState, ElectricalState
 from twin.state import TwinState
 from twin.state_measures import ball_azimuths_rad
+
+CONTACT_FIELDS: Final = (
+    "load_n",
+    "h_min_m",
+    "h_c_m",
+    LAMBDA_KEY,
+    "mu",
+    "entrainment_speed_m_s",
+    "slide_roll_ratio",
+    "contact_angle_rad",
+    "max_pressure_pa",
+    "resistance_ohm",
+    "capacitance_f",
+)
+"""Columns of `BallArrays.contacts`, in the contract's order of `ContactState` (its `regime` is
+`BallArrays.regimes`)."""
+K_LOAD, K_H_MIN, K_H_C, K_LAMBDA, K_MU, K_ENTRAINMENT, K_SRR, K_ANGLE, K_P_MAX, K_R, K_C = range(len(CONTACT_FIELDS))
+BALL_FIELDS: Final = (
+    "azimuth_rad",
+    "spin_rad_s",
+    "orbital_speed_rad_s",
+    "cage_load_n",
+    "resistance_ohm",
+    "capacitance_f",
+)
+"""Columns of `BallArrays.balls`, in the contract's order of `BallState`."""
+B_AZIMUTH, B_SPIN, B_ORBITAL, B_CAGE, B_R, B_C = range(len(BALL_FIELDS))
+_NULLABLE_CONTACT: Final = (K_H_MIN, K_H_C, K_LAMBDA, K_R)  # NaN in these columns is null on the wire
+_NULLABLE_BALL: Final = (B_R,)
+
+_FLOATS = TypeAdapter(list[float])  # NaN and inf serialise as null (pydantic's default)
 
 
 def finite_or_none(value: float) -> float | None:
@@ -28,76 +66,233 @@ def finite_or_none(value: float) -> float | None:
     return float(value) if math.isfinite(value) else None
 
 
-def contact_mu(model: BearingModel, column: list[float], effective_mu: bool) -> float:
-    """Published mu of one loaded contact's lane column: with the ellipse friction
-    (`effective_mu`) the effective coefficient |F_t| / Q (the tangential spring's elastic force,
-    which the strips transmit, over the normal load); with the centre-point laws their Coulomb
-    coefficient."""
-    c = column
-    if not effective_mu:
-        return float(c[L.C_MU])
-    kt = model.options.tangential_stiffness_ratio * 1.5 * c[L.M_STIFFNESS] * c[L.G_SQRT_DELTA]
-    return float(kt * math.sqrt(c[L.T_XI0] ** 2 + c[L.T_XI1] ** 2 + c[L.T_XI2] ** 2) / c[L.C_LOAD])
+@dataclass(frozen=True, slots=True, eq=False)
+class BallArrays:
+    """Every ball and contact of one snapshot as numbers: `contacts` (2Z, CONTACT_FIELDS) with
+    contact k = 2j inner and 2j + 1 outer of ball j, `regimes` (2Z,) the index of each contact's
+    regime in REGIME_NAMES (0: no_contact), `balls` (Z, BALL_FIELDS). NaN stands for null (the
+    film of an unloaded contact, an open circuit's resistance); every other value is finite. Read
+    only: the arrays are the snapshot's own."""
+
+    contacts: np.ndarray
+    regimes: np.ndarray
+    balls: np.ndarray
+
+    @property
+    def ball_count(self) -> int:
+        return int(self.balls.shape[0])
 
 
-def contact_state(
-    model: BearingModel, column: list[float], resistance_ohm: float, capacitance_f: float, effective_mu: bool
-) -> ContactState:
-    """One contact's block from its lane column and its parallel-RC values; the film, regime,
-    friction and kinematics are null / no_contact / 0 when it carries no load."""
-    c = column
-    loaded = c[L.C_LOAD] > 0.0
-    regime = REGIME_NAMES[int(c[L.C_REGIME])] if loaded else "no_contact"
-    return ContactState(
-        load_n=float(c[L.C_LOAD]),
-        h_min_m=finite_or_none(c[L.C_H_MIN]) if loaded else None,
-        h_c_m=finite_or_none(c[L.C_H_C]) if loaded else None,
-        lambda_=finite_or_none(c[L.C_LAMBDA]) if loaded else None,
-        regime=regime,
-        mu=contact_mu(model, c, effective_mu) if loaded else 0.0,
-        entrainment_speed_m_s=float(c[L.C_ENTRAINMENT]) if loaded else 0.0,
-        slide_roll_ratio=float(c[L.C_SRR]) if loaded else 0.0,
-        contact_angle_rad=float(math.asin(min(1.0, max(-1.0, c[L.G_NZ])))) if loaded else 0.0,
-        max_pressure_pa=float(max_pressure_pa(c[L.C_LOAD], c[L.C_SEMI_MAJOR], c[L.C_SEMI_MINOR])),
-        resistance_ohm=finite_or_none(resistance_ohm),
-        capacitance_f=float(capacitance_f),
-    )
+@njit(**JIT)
+def capture_contacts(contacts, loaded_mu_scale, out, regimes):
+    """Write every contact's published numbers (CONTACT_FIELDS but the network's R and C) into
+    `out` (2Z, CONTACT_FIELDS) and its regime index into `regimes` (2Z,) from the contact lanes
+    `contacts` (lanes, 2Z). `loaded_mu_scale` > 0: mu is the effective |F_t| / Q of the ellipse
+    friction, with the tangential stiffness loaded_mu_scale x M_STIFFNESS x G_SQRT_DELTA
+    (loaded_mu_scale: the tangential stiffness ratio x 1.5); <= 0: the lane's Coulomb coefficient.
+    An unloaded contact's film
+    is NaN (null), its mu, speeds and angle 0, its regime 0 (no_contact). p_max = 3 Q / (2 pi a b)
+    (twin.physics.hertz.max_pressure_pa)."""
+    for k in range(contacts.shape[1]):
+        load = contacts[L.C_LOAD, k]
+        out[k, K_LOAD] = load
+        if load > 0.0:
+            out[k, K_H_MIN] = contacts[L.C_H_MIN, k]
+            out[k, K_H_C] = contacts[L.C_H_C, k]
+            out[k, K_LAMBDA] = contacts[L.C_LAMBDA, k]
+            if loaded_mu_scale > 0.0:
+                kt = loaded_mu_scale * contacts[L.M_STIFFNESS, k] * contacts[L.G_SQRT_DELTA, k]
+                x0, x1, x2 = contacts[L.T_XI0, k], contacts[L.T_XI1, k], contacts[L.T_XI2, k]
+                out[k, K_MU] = kt * math.sqrt(x0 * x0 + x1 * x1 + x2 * x2) / load
+            else:
+                out[k, K_MU] = contacts[L.C_MU, k]
+            out[k, K_ENTRAINMENT] = contacts[L.C_ENTRAINMENT, k]
+            out[k, K_SRR] = contacts[L.C_SRR, k]
+            out[k, K_ANGLE] = math.asin(min(1.0, max(-1.0, contacts[L.G_NZ, k])))
+            regimes[k] = int(contacts[L.C_REGIME, k])
+        else:
+            out[k, K_H_MIN] = np.nan
+            out[k, K_H_C] = np.nan
+            out[k, K_LAMBDA] = np.nan
+            out[k, K_MU] = 0.0
+            out[k, K_ENTRAINMENT] = 0.0
+            out[k, K_SRR] = 0.0
+            out[k, K_ANGLE] = 0.0
+            regimes[k] = 0
+        a, b = contacts[L.C_SEMI_MAJOR, k], contacts[L.C_SEMI_MINOR, k]
+        out[k, K_P_MAX] = 1.5 * load / (math.pi * a * b) if a > 0.0 and b > 0.0 else 0.0
 
 
-def ball_states(
-    model: BearingModel, state: TwinState, net: ElectricalNetwork, effective_mu: bool
-) -> tuple[BallState, ...]:
-    """Every ball's block: azimuth, spin, orbital speed about the bearing axis, cage load, its
-    inner (k = 2j) and outer (k = 2j + 1) contacts and their series RC."""
+@njit(**JIT)
+def capture_balls(position, velocity, angular_velocity, cage_load, out):
+    """Write every ball's spin |omega|, orbital speed (x v_y - y v_x) / (x^2 + y^2) about the
+    bearing axis and largest cage load into `out` (Z, BALL_FIELDS)."""
+    for j in range(position.shape[0]):
+        w0, w1, w2 = angular_velocity[j, 0], angular_velocity[j, 1], angular_velocity[j, 2]
+        out[j, B_SPIN] = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+        x, y = position[j, 0], position[j, 1]
+        out[j, B_ORBITAL] = (x * velocity[j, 1] - y * velocity[j, 0]) / (x * x + y * y)
+        largest = cage_load[j, 0]
+        for i in range(1, cage_load.shape[1]):
+            largest = max(largest, cage_load[j, i])
+        out[j, B_CAGE] = largest
+
+
+def ball_arrays(model: BearingModel, state: TwinState, net: ElectricalNetwork, effective_mu: bool) -> BallArrays:
+    """Capture every ball's block: azimuth, spin, orbital speed about the bearing axis, cage load,
+    its inner and outer contacts (`capture_contacts`: one compiled pass over the lanes) and their
+    series RC. Published mu: with the ellipse friction (`effective_mu`) the effective coefficient
+    |F_t| / Q (the tangential spring's elastic force, which the strips transmit, over the normal
+    load); with the centre-point laws their Coulomb coefficient. ValueError naming the field when
+    a value that may not be null is not finite."""
     s = state
-    x, v, w = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s, s.ball_angular_velocity_rad_s
-    az = ball_azimuths_rad(s)
-    rho2 = x[:, 0] ** 2 + x[:, 1] ** 2
-    orbital = (x[:, 0] * v[:, 1] - x[:, 1] * v[:, 0]) / rho2
-    spin = np.linalg.norm(w, axis=1)
-    columns = s.contacts.T.tolist()
-    resistance = np.asarray(net.contact_resistance_ohm, dtype=float).tolist()
-    capacitance = np.asarray(net.contact_capacitance_f, dtype=float).tolist()
-    az, spin, orbital = az.tolist(), spin.tolist(), orbital.tolist()
-    cage = s.cage_load_n.max(axis=1).tolist()
+    z = model.ball_count
+    out = np.empty((2 * z, len(CONTACT_FIELDS)))
+    regimes = np.empty(2 * z, dtype=np.int8)
+    scale = model.options.tangential_stiffness_ratio * 1.5 if effective_mu else 0.0
+    capture_contacts(s.contacts, scale, out, regimes)
+    out[:, K_R] = net.contact_resistance_ohm
+    out[:, K_C] = net.contact_capacitance_f
+    balls = np.empty((z, len(BALL_FIELDS)))
+    balls[:, B_AZIMUTH] = ball_azimuths_rad(s)
+    capture_balls(
+        s.ball_position_in_bearing_m,
+        s.ball_velocity_in_bearing_m_s,
+        s.ball_angular_velocity_rad_s,
+        s.cage_load_n,
+        balls,
+    )
+    balls[:, B_R] = net.ball_resistance_ohm
+    balls[:, B_C] = net.ball_capacitance_f
+    # null where the contract allows it (inf resistance: open circuit), an error elsewhere
+    for k in _NULLABLE_CONTACT:
+        col = out[:, k]
+        col[~np.isfinite(col)] = np.nan
+    col = balls[:, B_R]
+    col[~np.isfinite(col)] = np.nan
+    _check_finite(out, CONTACT_FIELDS, _NULLABLE_CONTACT, "contact")
+    _check_finite(balls, BALL_FIELDS, _NULLABLE_BALL, "ball")
+    return BallArrays(out, regimes, balls)
+
+
+def _check_finite(values: np.ndarray, names: tuple[str, ...], nullable: tuple[int, ...], what: str) -> None:
+    finite = np.isfinite(values)
+    finite[:, list(nullable)] = True
+    if not finite.all():
+        row, col = (int(i) for i in np.argwhere(~finite)[0])
+        raise ValueError(f"snapshot: {what} {row} {names[col]} = {values[row, col]!r} is not finite")
+
+
+def _value(v: float) -> float | None:
+    return None if v != v else v  # NaN: null
+
+
+def ball_states(arrays: BallArrays) -> tuple[BallState, ...]:
+    """The balls' pydantic tree (`BallState` with its `ContactState`s) from the captured arrays."""
+    rows = arrays.contacts.tolist()
+    codes = arrays.regimes.tolist()
 
     def contact(k: int) -> ContactState:
-        return contact_state(model, columns[k], resistance[k], capacitance[k], effective_mu)
+        values = {name: _value(v) for name, v in zip(CONTACT_FIELDS, rows[k], strict=True)}
+        return ContactState.model_validate({**values, "regime": REGIME_NAMES[codes[k]]})
 
     return tuple(
-        BallState(
-            index=j,
-            azimuth_rad=az[j],
-            spin_rad_s=spin[j],
-            orbital_speed_rad_s=orbital[j],
-            cage_load_n=cage[j],
-            inner=contact(2 * j),
-            outer=contact(2 * j + 1),
-            resistance_ohm=finite_or_none(net.ball_resistance_ohm[j]),
-            capacitance_f=float(net.ball_capacitance_f[j]),
+        BallState.model_validate(
+            {
+                "index": j,
+                **{name: _value(v) for name, v in zip(BALL_FIELDS, ball, strict=True)},
+                "inner": contact(2 * j),
+                "outer": contact(2 * j + 1),
+            }
         )
-        for j in range(model.ball_count)
+        for j, ball in enumerate(arrays.balls.tolist())
     )
+
+
+class _Template:
+    """JSON text with holes: `render(values)` joins the literal pieces with `values[i]` for each
+    hole i, in one join (a `str.format` of the same text parses its fields on every call: three
+    times slower)."""
+
+    def __init__(self, pieces: list[str | int]):
+        literals: list[str] = [""]
+        holes: list[int] = []
+        for piece in pieces:
+            if isinstance(piece, int):
+                holes.append(piece)
+                literals.append("")
+            else:
+                literals[-1] += piece
+        self.literals = literals
+        self.pick = operator.itemgetter(*holes)
+        self.size = 2 * len(holes) + 1
+
+    def render(self, values: list[str]) -> str:
+        parts: list = [None] * self.size
+        parts[0::2] = self.literals
+        parts[1::2] = self.pick(values)
+        return "".join(parts)
+
+
+def _ball_pieces(z: int, j: int) -> list[str | int]:
+    """Ball j's JSON block as literal pieces and value indices: its numbers are values
+    28 j ... 28 j + 27 (its first four fields, the inner then the outer contact's numbers, its R
+    and C: the order of `_numbers_in_order`), its contacts' regime names values 28 z + 2 j and
+    28 z + 2 j + 1."""
+    n = 4 + 2 * len(CONTACT_FIELDS) + 2
+    fields = iter(range(n * j, n * (j + 1)))
+    pieces: list[str | int] = [f'{{"index":{j}']
+
+    def numbers(names: tuple[str, ...], first: str = ",") -> None:
+        for k, name in enumerate(names):
+            pieces.extend((f'{first if k == 0 else ","}"{name}":', next(fields)))
+
+    numbers(BALL_FIELDS[:4])
+    for side, key in enumerate(("inner", "outer")):
+        pieces.append(f',"{key}":{{')
+        numbers(CONTACT_FIELDS[:4], first="")
+        pieces.extend((',"regime":"', n * z + 2 * j + side, '"'))
+        numbers(CONTACT_FIELDS[4:])
+        pieces.append("}")
+    numbers(BALL_FIELDS[4:])
+    pieces.append("}")
+    return pieces
+
+
+_TEMPLATES: dict[int, tuple[list[_Template], _Template]] = {}
+
+
+def _templates(z: int) -> tuple[list[_Template], _Template]:
+    """(each ball's template, the balls array's template) for z balls, made once."""
+    found = _TEMPLATES.get(z)
+    if found is None:
+        balls = [_ball_pieces(z, j) for j in range(z)]
+        whole: list[str | int] = ["["]
+        for j, pieces in enumerate(balls):
+            whole.extend(([","] if j else []) + pieces)
+        whole.append("]")
+        found = _TEMPLATES[z] = ([_Template(b) for b in balls], _Template(whole))
+    return found
+
+
+def _numbers_in_order(arrays: BallArrays) -> list[str]:
+    """Every number of the balls' blocks as JSON text, in the templates' order: pydantic's
+    serialiser (one typed call for all of them, null for NaN), then the regime names."""
+    b, c = arrays.balls, arrays.contacts
+    table = np.concatenate((b[:, :4], c[0::2], c[1::2], b[:, 4:]), axis=1)
+    tokens = _FLOATS.dump_json(table.ravel().tolist()).decode()[1:-1].split(",")
+    return tokens + [REGIME_NAMES[k] for k in arrays.regimes.tolist()]
+
+
+def ball_json_items(arrays: BallArrays) -> list[str]:
+    """Each ball's block of the state message (JSON text), as `ball_states` serialises it."""
+    values = _numbers_in_order(arrays)
+    return [t.render(values) for t in _templates(arrays.ball_count)[0]]
+
+
+def balls_json(arrays: BallArrays) -> str:
+    """The `balls` array of the state message (JSON text), as `ball_states` serialises it."""
+    return _templates(arrays.ball_count)[1].render(_numbers_in_order(arrays))
 
 
 def electrical_state(net: ElectricalNetwork, inlet: InletFilm) -> ElectricalState:

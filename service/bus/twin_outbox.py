@@ -30,6 +30,8 @@ import zenoh
 from service.bus.wire import JSON_ENCODING, Bus, Waveform, dumps, one_line, spectrum_json
 from service.keys import ALARM, STATE, ball_key, twin_key
 from twin.snapshot import Snapshot
+from twin.snapshot_blocks import ball_json_items
+from twin.snapshot_frame import SnapshotFrame
 
 log = logging.getLogger(__name__)
 
@@ -78,13 +80,21 @@ class TwinOutbox:
         return self._dropped
 
     def last_state(self, snapshot: Snapshot) -> str | None:
-        """The state JSON already made for `snapshot` (None when it was not the last one put)."""
+        """The state JSON already made for `snapshot` (None when it was not the last one put):
+        the snapshot itself, or the tree of the frame that was put."""
         with self._last_lock:
             last = self._last
-        return last[1] if last is not None and last[0] is snapshot else None
+        if last is None:
+            return None
+        put = last[0]
+        if put is snapshot or (isinstance(put, SnapshotFrame) and put.built is snapshot):
+            return last[1]
+        return None
 
     # ---- any thread -------------------------------------------------------------------------
-    def publish(self, snapshot: Snapshot) -> None:
+    accepts_frames = True  # Publisher hands it SnapshotFrames (service.core.sinks)
+
+    def publish(self, snapshot: Snapshot | SnapshotFrame) -> None:
         """Put the state message now and queue the rest; never waits on the network, never raises."""
         try:
             self._send_state(snapshot)
@@ -126,7 +136,7 @@ class TwinOutbox:
         for pub in publishers:
             undeclare(pub)
 
-    def _send_state(self, snapshot: Snapshot) -> None:
+    def _send_state(self, snapshot: Snapshot | SnapshotFrame) -> None:
         """The state message, serialised once (kept for the snapshot queryable) and put."""
         with self._pub_lock:
             if self._gone or self._stopping:
@@ -170,11 +180,12 @@ class TwinOutbox:
                 if self.errors <= 3 or self.errors % 1000 == 0:
                     log.warning("%s: snapshot not published (%d so far): %s", self.prefix, self.errors, one_line(exc))
 
-    def _send(self, snapshot: Snapshot) -> None:
-        """The ball and vibration messages of a snapshot whose state `publish` has put. The JSON
-        comes from pydantic's serialiser (a Snapshot never holds NaN/Infinity, its models refuse
-        them): json.dumps of the merged dicts held the GIL about five times longer, the stepping
-        threads waiting (service.core.priority)."""
+    def _send(self, snapshot: Snapshot | SnapshotFrame) -> None:
+        """The ball and vibration messages of a snapshot whose state `publish` has put. A ball's
+        message is made only for a matching subscriber: from a frame's arrays
+        (twin.snapshot_blocks.ball_json_items, the text pydantic gives the ball's model), from a
+        snapshot by pydantic's serialiser (a Snapshot never holds NaN/Infinity, its models
+        refuse them; json.dumps of the merged dicts held the GIL about five times longer)."""
         # each ball's message is the head's fields then the ball's: {"schema":..,"bearing_id":..,"time_s":..,<ball>}
         head = (
             dumps(
@@ -186,18 +197,32 @@ class TwinOutbox:
             )[:-1]
             + ","
         )
-        for position, ball in enumerate(snapshot.balls):
-            index = getattr(ball, "index", position)
-            pub = self._ball_publisher(int(index))
-            if pub is None:
-                return  # detaching
-            if not matched(pub):
-                self.unmatched += 1
-                continue
-            pub.put(head + ball.model_dump_json(by_alias=True)[1:])
+        if isinstance(snapshot, SnapshotFrame):
+            count = snapshot.ball_arrays.ball_count
+            texts: list[str] | None = None
+            for index in range(count):
+                pub = self._ball_publisher(index)
+                if pub is None:
+                    return  # detaching
+                if not matched(pub):
+                    self.unmatched += 1
+                    continue
+                if texts is None:
+                    texts = ball_json_items(snapshot.ball_arrays)
+                pub.put(head + texts[index][1:])
+        else:
+            for position, ball in enumerate(snapshot.balls):
+                index = getattr(ball, "index", position)
+                pub = self._ball_publisher(int(index))
+                if pub is None:
+                    return  # detaching
+                if not matched(pub):
+                    self.unmatched += 1
+                    continue
+                pub.put(head + ball.model_dump_json(by_alias=True)[1:])
         self._send_vibration(snapshot)
 
-    def _send_vibration(self, snapshot: Snapshot) -> None:
+    def _send_vibration(self, snapshot: Snapshot | SnapshotFrame) -> None:
         """`P/{id}/vibration` when the snapshot carries a new accelerometer window."""
         block = getattr(snapshot, "vibration", None)
         if block is None:

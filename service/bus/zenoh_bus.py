@@ -234,6 +234,8 @@ class TwinChannel:
         self._token = bus.session.liveliness().declare_token(twin_key(bus.prefix, bearing_id, ALIVE))
 
     # ---- SnapshotSink -----------------------------------------------------------------------
+    accepts_frames = True  # the outbox writes a frame's messages from its arrays
+
     def publish(self, snapshot: Snapshot) -> None:
         """Put the snapshot's state message now and queue the rest (balls, vibration); never waits
         on the network, never raises. No rate limiting: the caller (runner) decides the rate."""

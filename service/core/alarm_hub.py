@@ -29,6 +29,7 @@ from service.core.alarm_inputs import inputs_from_snapshot
 from service.core.alarms import Alarm, AlarmEvaluator, AlarmEvent
 from service.settings import AlarmSettings
 from twin.snapshot import Snapshot
+from twin.snapshot_frame import SnapshotFrame
 
 log = logging.getLogger(__name__)
 
@@ -55,7 +56,7 @@ class AlarmHub:
     ):
         self.settings = settings or AlarmSettings()
         self._wall_clock = wall_clock
-        self._queue: collections.deque[Snapshot | MeasuredItem] = collections.deque(maxlen=queue_size)
+        self._queue: collections.deque[Snapshot | SnapshotFrame | MeasuredItem] = collections.deque(maxlen=queue_size)
         self._cond = threading.Condition()
         self._evaluators: dict[str, AlarmEvaluator] = {}
         self._history: dict[str, collections.deque[AlarmEvent]] = {}
@@ -108,14 +109,16 @@ class AlarmHub:
         return history if limit is None else history[-limit:] if limit > 0 else []
 
     # ---- SnapshotSink ------------------------------------------------------------------------
-    def publish(self, snapshot: Snapshot) -> None:
+    accepts_frames = True  # its inputs read a frame's arrays (service.core.alarm_inputs)
+
+    def publish(self, snapshot: Snapshot | SnapshotFrame) -> None:
         self._put(snapshot)
 
     def observe_measured(self, comparison: Mapping[str, Any]) -> None:
         """Queue a measured-window comparison of a twin (a MeasuredComparator listener: never blocks)."""
         self._put(MeasuredItem(str(comparison.get("bearing_id")), comparison))
 
-    def _put(self, item: Snapshot | MeasuredItem) -> None:
+    def _put(self, item: Snapshot | SnapshotFrame | MeasuredItem) -> None:
         with self._cond:
             if self._closed:
                 return
@@ -168,7 +171,7 @@ class AlarmHub:
                     self._busy = False
                     self._cond.notify_all()
 
-    def _evaluate(self, item: Snapshot | MeasuredItem) -> None:
+    def _evaluate(self, item: Snapshot | SnapshotFrame | MeasuredItem) -> None:
         with self._lock:
             ev = self._evaluators.get(item.bearing_id)
             if ev is None:

@@ -9,9 +9,13 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from service.core.alarm_rules import DEFECT_LINES
 from service.settings import AlarmSettings
 from twin.snapshot import LAMBDA_KEY
+from twin.snapshot_blocks import K_LAMBDA, K_LOAD
+from twin.snapshot_frame import SnapshotFrame
 
 
 # ---- inputs ------------------------------------------------------------------------------------
@@ -94,30 +98,38 @@ def _seq(value: Any) -> int | None:
     return int(value) if isinstance(value, int) and not isinstance(value, bool) else None
 
 
+def loaded_lambda(loads_n: np.ndarray, lambdas: np.ndarray, settings: AlarmSettings) -> tuple[float | None, int]:
+    """(smallest Lambda, contacts at or below `boundary_lambda`) over the loaded contacts: those
+    carrying at least `loaded_contact_fraction` of the largest load, with a finite Lambda."""
+    loads = np.where(np.isfinite(loads_n), loads_n, 0.0)
+    peak = float(loads.max(initial=0.0))
+    if peak <= 0.0:
+        return None, 0
+    lam = lambdas[(loads > 0.0) & (loads >= settings.loaded_contact_fraction * peak) & np.isfinite(lambdas)]
+    if lam.size == 0:
+        return None, 0
+    return float(lam.min()), int(np.count_nonzero(lam <= settings.boundary_lambda))
+
+
 def inputs_from_snapshot(snapshot: Any, settings: AlarmSettings | None = None) -> AlarmInputs:
-    """The alarms' inputs from a `twin.snapshot.Snapshot` (or its dict): contacts, electrical,
-    and the optional `life` and `vibration` blocks."""
+    """The alarms' inputs from a `twin.snapshot.Snapshot` (or its dict, or a
+    twin.snapshot_frame.SnapshotFrame: its contact arrays, without building its tree): contacts,
+    electrical, and the optional `life` and `vibration` blocks."""
     s = settings or AlarmSettings()
-    contacts = []
-    for ball in _get(snapshot, "balls") or ():
-        for side in ("inner", "outer"):
-            c = _get(ball, side)
-            if c is not None:
-                contacts.append(c)
-    loads = [(finite_number(_get(c, "load_n")) or 0.0) for c in contacts]
-    peak = max(loads, default=0.0)
-    min_lambda, boundary = None, 0
-    if peak > 0.0:
-        cut = s.loaded_contact_fraction * peak
-        for c, load in zip(contacts, loads, strict=True):
-            if load <= 0.0 or load < cut:
-                continue
-            lam = finite_number(_get(c, "lambda_"))
-            if lam is None:
-                continue
-            min_lambda = lam if min_lambda is None else min(min_lambda, lam)
-            if lam <= s.boundary_lambda:
-                boundary += 1
+    if isinstance(snapshot, SnapshotFrame):
+        contacts = snapshot.ball_arrays.contacts
+        min_lambda, boundary = loaded_lambda(contacts[:, K_LOAD], contacts[:, K_LAMBDA], s)
+        snapshot = snapshot.head
+    else:
+        rows = []
+        for ball in _get(snapshot, "balls") or ():
+            for side in ("inner", "outer"):
+                c = _get(ball, side)
+                if c is not None:
+                    load, lam = finite_number(_get(c, "load_n")), finite_number(_get(c, "lambda_"))
+                    rows.append((math.nan if load is None else load, math.nan if lam is None else lam))
+        table = np.array(rows, dtype=float).reshape(-1, 2)
+        min_lambda, boundary = loaded_lambda(table[:, 0], table[:, 1], s)
     electrical = _get(snapshot, "electrical")
     life = _get(snapshot, "life")
     thermal = _get(snapshot, "thermal")

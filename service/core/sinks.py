@@ -10,7 +10,12 @@ from twin.snapshot import Snapshot
 
 
 class SnapshotSink(Protocol):
-    """Receives every published snapshot of the twins it is attached to."""
+    """Receives every published snapshot of the twins it is attached to.
+
+    A sink whose class sets `accepts_frames = True` is handed each state as the
+    twin.snapshot_frame.SnapshotFrame the publisher captured (its balls as arrays; every
+    snapshot attribute reads alike, `snapshot` builds the pydantic tree); any other sink gets the
+    `Snapshot` (its tree built for it)."""
 
     def publish(self, snapshot: Snapshot) -> None:
         """Hand a snapshot over without blocking (drop the oldest queued one if full)."""

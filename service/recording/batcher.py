@@ -296,8 +296,9 @@ class RowBatcher:
         if self.min_interval_s > 0.0 and tw.last_time_s <= t < tw.last_time_s + self.min_interval_s:
             self.skipped += 1
             return
-        if len(snapshot.balls) != tw.ball_count:
-            raise ValueError(f"{len(snapshot.balls)} balls in the snapshot, {tw.ball_count} registered")
+        balls = C.ball_count(snapshot)
+        if balls != tw.ball_count:
+            raise ValueError(f"{balls} balls in the snapshot, {tw.ball_count} registered")
         if pos is not None and pos.shape != (tw.ball_count, 3):
             raise ValueError(f"positions_m has shape {pos.shape}, expected ({tw.ball_count}, 3)")
         row = C.extract(snapshot, pos, context)
@@ -323,7 +324,9 @@ class RowBatcher:
             snapshot.bearing_id,
         )
         tw = TwinRows(
-            bearing_id=str(snapshot.bearing_id), designation=str(snapshot.designation), ball_count=len(snapshot.balls)
+            bearing_id=str(snapshot.bearing_id),
+            designation=str(snapshot.designation),
+            ball_count=C.ball_count(snapshot),
         )
         self.register(tw, None, [])
         return tw

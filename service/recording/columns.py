@@ -29,11 +29,18 @@ from service.recording.layout import (
     SIM_TIME,
     TwinLayout,
 )
+from twin.physics.friction import REGIME_NAMES
 from twin.snapshot import LAMBDA_KEY
+from twin.snapshot_blocks import B_AZIMUTH
+from twin.snapshot_blocks import CONTACT_FIELDS as FRAME_CONTACT_FIELDS
+from twin.snapshot_frame import SnapshotFrame
 
 # contact fields per ball and side, in this order (getattr with a None default)
 CONTACT_FIELDS = ("load_n", "lambda_", "mu", "contact_angle_rad", "resistance_ohm", "capacitance_f")
 F_LOAD, F_LAMBDA, F_MU, F_ANGLE, F_R, F_C = range(len(CONTACT_FIELDS))
+# the same fields' columns in a frame's contact arrays (twin.snapshot_blocks.BallArrays)
+_FRAME_COLUMNS = [FRAME_CONTACT_FIELDS.index(LAMBDA_KEY if n == "lambda_" else n) for n in CONTACT_FIELDS]
+_FRAME_REGIME_CODES = np.array([REGIME_CODE[name] for name in REGIME_NAMES], dtype=np.int8)  # frame code -> ours
 SETPOINT_FIELDS = (
     "shaft_speed_rad_s",
     "radial_load_n",
@@ -109,7 +116,22 @@ def _num(v) -> float:
         return math.nan
 
 
+def ball_count(snapshot) -> int:
+    """Balls of a snapshot or a frame (twin.snapshot_frame.SnapshotFrame: without building its tree)."""
+    if isinstance(snapshot, SnapshotFrame):
+        return snapshot.ball_arrays.ball_count
+    return len(snapshot.balls)
+
+
 def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None = None) -> Row:
+    """A snapshot (or a frame: its arrays, without building its tree) as a `Row`."""
+    if isinstance(snapshot, SnapshotFrame):
+        arrays = snapshot.ball_arrays
+        z = arrays.ball_count
+        contacts = arrays.contacts[:, _FRAME_COLUMNS].reshape(z, 2, len(CONTACT_FIELDS))
+        regimes = _FRAME_REGIME_CODES[arrays.regimes].reshape(z, 2)
+        azimuth = arrays.balls[:, B_AZIMUTH]
+        return _row(snapshot.head, contacts, regimes, azimuth, positions_m, context)
     balls = snapshot.balls
     z = len(balls)
     contacts = np.full((z, 2, len(CONTACT_FIELDS)), math.nan)
@@ -125,6 +147,11 @@ def extract(snapshot, positions_m: np.ndarray | None = None, context: str | None
                     if name is not None:
                         row[k] = _num(getattr(c, name))
                 regimes[i, side] = REGIME_CODE.get(str(getattr(c, "regime", "")), 0)
+    return _row(snapshot, contacts, regimes, azimuth, positions_m, context)
+
+
+def _row(snapshot, contacts, regimes, azimuth, positions_m, context) -> Row:
+    """The row of a snapshot's bearing-level fields around its per-contact arrays."""
     electrical: dict = {}
     risk = reason = None
     el = getattr(snapshot, "electrical", None) if _present(snapshot, ("electrical",))[0] else None

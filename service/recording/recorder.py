@@ -345,6 +345,8 @@ class RerunRecorder:
             return self._out.rotate()
 
     # ---- the sink ---------------------------------------------------------------------------
+    accepts_frames = True  # rows are read from a frame's arrays (service.recording.columns.extract)
+
     def publish(self, snapshot, positions_m: Any = None) -> None:
         """Queue a snapshot (and optionally the ball centres, shape (Z, 3) [m]); never blocks.
         When the queue is full the oldest queued snapshot is dropped and counted."""
