@@ -4,9 +4,17 @@ stepping threads.
 After a frame that is due to publish, the stepping thread only CAPTURES the twin: a frozen copy
 (`Twin.frozen`: the twin object shallow-copied with its state arrays copied, some microseconds) with
 the real-time factor, the late fraction and the runner's status note of that moment. The
-pool's `PublishWorker` thread builds the `Snapshot` from it (pydantic, about a millisecond) and
-hands it to the sinks, in capture order. Without a worker (before the runner starts) a capture
-is built and delivered at once.
+pool's `PublishWorker` thread captures its public state as a `twin.snapshot_frame.SnapshotFrame`
+(`Twin.frame`: the balls and contacts as arrays in one compiled pass, the bearing-level blocks
+as a few pydantic models; about 0.2 ms for a 9-ball twin, of which the electrical network and the
+friction power are half) and hands it to the sinks, in capture order. Without a worker (before
+the runner starts) a capture is built and delivered at once.
+
+Frames. The sinks that declare `accepts_frames` (the zenoh channel, the recorder, the alarm hub)
+read the frame's arrays and its state JSON, written from them; any other sink gets the
+`Snapshot`, whose per-ball pydantic tree the frame builds on the first read (about 0.1 ms). The
+latest frame is `latest` (its tree, built for an HTTP read, OPC UA or /health at their own rate)
+and `latest_json` (the state message already made for zenoh).
 
 Back-pressure. At most `max_pending` captures of a twin wait for the worker. Real-time mode:
 one more drops the oldest waiting capture (counted in `skipped`; the setpoint timings it
@@ -30,7 +38,7 @@ at a time, `_deliver_lock`). The hop to the worker thread (a thread wake-up and 
 behind the other twins' captures) was the largest stage of the PUT -> zenoh state latency:
 2.4 ms at the median and 9 ms at the 99th percentile with one twin (`bench-service`,
 `setpoint_latency_ms.publish` in /health). Setpoints are rate-limited per twin (the admission
-gate), so the stepping thread builds at most that many snapshots itself (about 0.3 ms each for
+gate), so the stepping thread builds at most that many frames itself (about 0.2 ms each for
 a 9-ball twin). It builds them from the live twin, not a frozen copy: it is the twin's only
 writer and steps it again only after the delivery, and the copy (with the thermal block it
 evaluates) cost as much CPU on the stepping thread as a third of the snapshot.
