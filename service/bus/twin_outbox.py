@@ -212,6 +212,7 @@ class TwinOutbox:
                     texts, head = ball_json_items(snapshot.ball_arrays), self._ball_head(snapshot)
                 pub.put(f"{head}{texts[index][1:]}")
         else:
+            head = self._ball_head(snapshot)
             for position, ball in enumerate(snapshot.balls):
                 index = getattr(ball, "index", position)
                 pub = self._ball_publisher(int(index))
@@ -220,7 +221,6 @@ class TwinOutbox:
                 if not matched(pub):
                     self.unmatched += 1
                     continue
-                head = head or self._ball_head(snapshot)
                 pub.put(head + ball.model_dump_json(by_alias=True)[1:])
         self._send_vibration(snapshot)
 
