@@ -273,7 +273,7 @@ class Publisher:
                 tw.seq = self._seq  # the publisher numbers the snapshots of its twin
             snap = tw.snapshot(real_time_factor=cap.real_time_factor)
             self._seq = snap.seq
-            update = {"late_fraction": cap.late_fraction} if cap.late_fraction is not None else {}
+            update: dict[str, object] = {"late_fraction": cap.late_fraction} if cap.late_fraction is not None else {}
             if cap.note is not None:
                 update["status"] = self.status_text(snap.status, cap.note)
             if update:
