@@ -2,8 +2,8 @@
 table's light-load, high-speed departures lie below it.
 
 SKF Rolling bearings catalogue, deep groove ball bearings, 'Loads', 'Minimum load':
-F_rm = k_r (nu n / 1000)^(2/3) (d_m / 100)^2 kN, nu [mm^2/s], n [r/min], d_m [mm], k_r = 0.025 for
-the 62 series (product tables; twin.validation.skf_friction). Below F_rm the catalogue expects the
+F_rm = k_r (nu n / 1000)^(2/3) (d_m / 100)^2 kN, nu [mm^2/s], n [r/min], d_m [mm], k_r = 0.025 for the
+6205 / 6208 / 6210 (product tables; twin.validation.skf_friction). Below F_rm the catalogue expects the
 balls' inertia and the lubricant's drag, not the load, to govern the rolling: the load-dependent
 formula M_rr = phi_ish phi_rs R1 d_m^1.96 F_r^0.54 (nu n)^0.6 is outside its domain. The friction
 table (6205 / 6208 / 6210, 100-1500 rad/s, 0.02-0.2 C0, the seed oil at 40 degC, 46.7 mm^2/s)
@@ -53,6 +53,10 @@ def test_the_minimum_load_formula():
         2.0 ** (2.0 / 3.0) * _f_rm("6208", 1500.0), rel=1e-12
     )
     assert skf_friction.minimum_radial_load_n("6308", 40.0, 80.0, 1500.0, nu) == pytest.approx(
+        1.2 * _f_rm("6208", 1500.0), rel=1e-12
+    )
+    # k_r of the product tables (2018 catalogue): 0.025 for the 6205 / 6208 / 6210, 0.03 for the 6200
+    assert skf_friction.minimum_radial_load_n("6200", 40.0, 80.0, 1500.0, nu) == pytest.approx(
         1.2 * _f_rm("6208", 1500.0), rel=1e-12
     )
     assert skf_friction.minimum_radial_load_n("6208", 20.0, 100.0, 1500.0, nu) == pytest.approx(
