@@ -165,8 +165,8 @@ class RunnerSettings(BaseModel):
         le=0,
         json_schema_extra=flat(
             "stepping_thread_nice",
-            details="One above the process's own priority needs CAP_SYS_NICE; "
-            "without it they keep the process's (/health thread_priority).",
+            details="A priority above the process's own needs CAP_SYS_NICE; without it the threads keep "
+            "the process's nice (/health thread_priority).",
         ),
         description="Nice value asked for the stepping threads and the "
         "publish worker (Linux, per thread) [-]; 0 = not raised.",
