@@ -49,6 +49,11 @@ FRAME_S = 1e-3  # simulated time per compiled call [s] (1000 steps at dt = 1 us)
 RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
 
 
+def _xyz(vector: np.ndarray) -> tuple[float, float, float]:
+    """The first three components of a state vector (x, y, z) as floats."""
+    return float(vector[0]), float(vector[1]), float(vector[2])
+
+
 class Twin:
     """A running bearing twin.
 
@@ -192,6 +197,7 @@ class Twin:
         """One network period: heat from the engine's state, node temperatures, then the inlet
         viscosity and the expansion of the rings and balls (written into the contacts' groove lanes)."""
         s, th = self.state, self.thermal
+        assert th is not None, "the thermal step runs only with the network on"
         spin = float(np.mean(np.linalg.norm(s.ball_angular_velocity_rad_s, axis=1)))
         # the drive power is the contacts' friction plus the balls' drag and the seals' rubbing:
         # the contacts' share is split over the contacts by their lanes, drag heats the oil and
@@ -311,6 +317,7 @@ class Twin:
         m = self.model
         if m.housing_on:
             place_on_housing(m, self.state, sp.radial_load_n if warm else 0.0, sp.axial_load_n if warm else 0.0)
+        if self._sensor is not None:
             self._sensor.reset(t)
         evaluate(*self._kernel_args())
         if self._setpoint.shaft_current_a > 0.0 or m.spec.thermal.shear_heating:
@@ -591,14 +598,14 @@ class Twin:
             setpoint=self._setpoint,
             shaft_speed_rad_s=float(s.scalars[L.X_SHAFT_SPEED]),
             cage_speed_rad_s=float(s.scalars[L.X_CAGE_SPEED]),
-            inner_ring_displacement_m=tuple(float(a) for a in s.inner_ring_offset_m),
+            inner_ring_displacement_m=_xyz(s.inner_ring_offset_m),
             friction_torque_n_m=float(self._last_torque_n_m),
             friction_power_w=FrictionPowerState(**self.friction_power_w().by_source_w()),
             viscosity_pa_s=float(self.inlet.inlet_viscosity_pa_s),
             electrical=electrical_state(net, self.inlet),
             balls=(),
             life=self._life_state(),
-            outer_ring_displacement_m=tuple(float(h) for h in s.housing_displacement_m[:3]),
+            outer_ring_displacement_m=_xyz(s.housing_displacement_m),
             defects=self._defects,
             vibration=self.vibration,
             thermal=self._thermal_state(),

@@ -12,6 +12,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from service.core.errors import FieldError, InputError
+from service.core.runner import RunMode
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointUpdate
 from twin.spec import (
@@ -163,9 +164,7 @@ class BearingInfo(BaseModel):
     ball_count: int = Field(description="Number of balls [-].")
     diametral_clearance_m: float = Field(description="Diametral clearance Pd [m]; negative = preload.")
     lubricant: str = Field(description="Lubricant name [text].")
-    mode: Literal["real_time", "fast"] = Field(
-        description="Pacing: real_time (paced to the wall clock) or fast [text]."
-    )
+    mode: RunMode = Field(description="Pacing: real_time (paced to the wall clock) or fast [text].")
     running: bool = Field(description="Whether the twin is being stepped (started, neither stopped nor failed) [bool].")
     time_s: float = Field(description="Simulated time of the latest snapshot [s].")
     setpoint: Setpoint = Field(description="The setpoint in force or pending (latest accepted) [fields with units].")
@@ -222,7 +221,7 @@ class ScenarioAccepted(BaseModel):
     expected_duration_s: float = Field(
         description="Scenario length [s of simulated time]; in real-time mode also about the wall time it takes."
     )
-    mode: Literal["real_time", "fast"] = Field(description="Pacing of the twin that runs it [text].")
+    mode: RunMode = Field(description="Pacing of the twin that runs it [text].")
     replaced: str | None = Field(
         default=None, description="Name of a scenario that was still running and is cancelled [text]."
     )
@@ -330,7 +329,7 @@ class TwinHealth(BaseModel):
     id: str = Field(description="Twin name [text].")
     running: bool = Field(description="Whether the twin is being stepped (started, neither stopped nor failed) [bool].")
     status: str = Field(description="'ok' or what went wrong [text].")
-    mode: Literal["real_time", "fast"] = Field(description="Pacing [text].")
+    mode: RunMode = Field(description="Pacing [text].")
     time_s: float = Field(description="Simulated time [s].")
     real_time_factor: float | None = Field(
         description="Simulated seconds per wall second over the last second [-]; null before it is measured."

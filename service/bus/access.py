@@ -213,6 +213,10 @@ class ZenohAccess:
                 "connect_private_key": self.tls_private_key,
             }
             for key, path in tls.items():
+                if path is None:
+                    raise ValueError(
+                        f"zenoh TLS needs its {key.replace('_', ' ')}: give CA, certificate and key together"
+                    )
                 config.insert_json5(f"transport/link/tls/{key}", json.dumps(str(Path(path).resolve())))
             config.insert_json5("transport/link/tls/enable_mtls", "true")
         if self.roles is not None and listening:

@@ -156,7 +156,7 @@ def make_config(
     config.insert_json5("connect/endpoints", json.dumps(connect))
     config.insert_json5("scouting/multicast/enabled", "false")
     config.insert_json5("scouting/gossip/enabled", json.dumps(bool(gossip) and not secured))
-    if secured:
+    if secured and access is not None:
         access.apply(config, [prefix] if isinstance(prefix, str) else list(prefix), listening=bool(listen))
     return config
 

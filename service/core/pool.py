@@ -158,7 +158,7 @@ class PublishWorker:
 
     def __init__(self, name: str = "publish"):
         self.name = name
-        self._queue: queue.SimpleQueue[Callable[[], None] | None] = queue.SimpleQueue()
+        self._queue: queue.SimpleQueue[Callable[[], object] | None] = queue.SimpleQueue()
         self._thread: threading.Thread | None = None
         self._lock = threading.Lock()
         self._closed = False
@@ -182,7 +182,7 @@ class PublishWorker:
                 self._thread = threading.Thread(target=self._run, name=self.name, daemon=True)
                 self._thread.start()
 
-    def submit(self, fn: Callable[[], None]) -> bool:
+    def submit(self, fn: Callable[[], object]) -> bool:
         """Queue `fn`; False (not queued) when the worker is not running: run it yourself."""
         if not self.alive or self._closed:
             return False

@@ -60,7 +60,7 @@ import re
 import sys
 import threading
 import weakref
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import ClassVar
 
 log = logging.getLogger(__name__)
@@ -88,6 +88,11 @@ def thread_nice(native_id: int) -> int | None:
         return os.getpriority(os.PRIO_PROCESS, native_id)
     except (OSError, AttributeError):
         return None
+
+
+def _nice_values(native_ids: Iterable[int]) -> list[int]:
+    """The distinct known nice values of these threads, ascending."""
+    return sorted({n for n in map(thread_nice, native_ids) if n is not None})
 
 
 def thread_name(native_id: int) -> str | None:
@@ -233,7 +238,7 @@ class ThreadPriority:
         self._thread.start()
         log.debug(
             "stepping threads at nice %s, the service's other threads at nice %d",
-            sorted({thread_nice(t) for t in self.keep()} - {None}),
+            _nice_values(self.keep()),
             self.io_nice,
         )
         return self
@@ -257,10 +262,10 @@ class ThreadPriority:
             "active": self.active,
             "io_thread_nice": self.io_nice if self.active else 0,
             "stepping_thread_nice_asked": self.stepping_nice if self.active else BASE_NICE,
-            "stepping_thread_nice": sorted({thread_nice(t) for t in self.keep()} - {None}),
+            "stepping_thread_nice": _nice_values(self.keep()),
             "threads_reniced": self.reniced,
             "errors": self.errors,
             "stepping_priority_refused": self.raise_refused,
-            "egress_threads": sorted({thread_nice(t) for t in self._named} - {None}),
+            "egress_threads": _nice_values(self._named),
             "egress_priority_refused": self.egress_refused,
         }

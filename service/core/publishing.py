@@ -52,6 +52,7 @@ import threading
 import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
+from typing import Any
 
 from service.core.capacity import CpuMeter
 from service.core.mailbox import SetpointTiming
@@ -283,7 +284,7 @@ class Publisher:
             tw = cap.twin
             if self._seq is not None:
                 tw.seq = self._seq  # the publisher numbers the snapshots of its twin
-            head: dict = {"late_fraction": cap.late_fraction} if cap.late_fraction is not None else {}
+            head: dict[str, object] = {"late_fraction": cap.late_fraction} if cap.late_fraction is not None else {}
             if cap.note is not None:
                 head["status"] = self.status_text(tw.status, cap.note)
             frame = tw.frame(cap.real_time_factor, **head)
@@ -301,7 +302,9 @@ class Publisher:
         self.published += 1
         for sink in self.sinks:
             try:
-                sink.publish(frame if getattr(sink, "accepts_frames", False) else frame.snapshot)
+                # a sink that declares accepts_frames reads a frame as it reads a snapshot (service.core.sinks)
+                item: Any = frame if getattr(sink, "accepts_frames", False) else frame.snapshot
+                sink.publish(item)
                 if cap.waveform:
                     publish_waveform = getattr(sink, "publish_waveform", None)
                     if publish_waveform is not None:

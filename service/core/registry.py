@@ -104,7 +104,13 @@ class Bus(Protocol):
     closed: bool
 
     def attach_twin(
-        self, bearing_id: str, get_snapshot: Callable[[], Snapshot | None], on_setpoint: Callable[[bytes], dict]
+        self,
+        bearing_id: str,
+        get_snapshot: Callable[[], Snapshot | None],
+        on_setpoint: Callable[[bytes], dict],
+        *,
+        on_defects: Callable[[bytes], dict] | None = None,
+        on_measured: Callable[[bytes], dict] | None = None,
     ) -> Channel: ...
 
     def close(self) -> None: ...
@@ -130,11 +136,11 @@ class TwinEntry:
     runner: TwinRunner
     intake: SetpointIntake
     lubricant: str
+    measured: MeasuredComparator  # measured vibration beside the twin (service.core.measured)
     channel: Any = None  # the bus channel (a sink)
     recording: Any = None  # this twin's own recording (POST .../recording)
     recording_path: Path | None = None
     created_wall_s: float = field(default_factory=time.time)
-    measured: MeasuredComparator | None = None  # measured vibration beside the twin (service.core.measured)
 
     @property
     def designation(self) -> str:
@@ -276,15 +282,16 @@ class TwinRegistry:
         """The twin (InputError 404 naming the known ones)."""
         with self._lock:
             entry = self._twins.get(bearing_id)
-            known = sorted(self._twins)
-        if entry is None:
-            raise InputError.one(
-                "bearing_id",
-                f"unknown twin {bearing_id!r}; known: {', '.join(known) or 'none'}",
-                known,
-                status_code=404,
-            )
+            if entry is None:
+                raise self._not_found(bearing_id)
         return entry
+
+    def _not_found(self, bearing_id: str) -> InputError:
+        """The 404 naming the known twins (call with the lock held)."""
+        known = sorted(self._twins)
+        return InputError.one(
+            "bearing_id", f"unknown twin {bearing_id!r}; known: {', '.join(known) or 'none'}", known, status_code=404
+        )
 
     def find(self, bearing_id: str) -> TwinEntry | None:
         with self._lock:
@@ -558,7 +565,7 @@ class TwinRegistry:
         with self._lock:
             entry = self._twins.get(bearing_id)
             if entry is None:
-                self.get(bearing_id)  # raises the 404
+                raise self._not_found(bearing_id)
             del self._twins[bearing_id]
             if bearing_id == self._over_capacity_id:
                 self.over_capacity = self._over_capacity_id = None

@@ -43,7 +43,7 @@ import math
 import threading
 import time
 from collections.abc import Callable, Iterable
-from typing import Any
+from typing import Any, Literal
 
 from pydantic import ValidationError
 
@@ -70,6 +70,8 @@ __all__ = ["ScenarioHandle", "SetpointTiming", "TwinRunner", "parse_update"]
 
 IDLE_POLL_S = 0.05  # an idle twin (no scenario) looks at its mailbox this often [s]
 ERROR_PAUSE_S = 0.01  # pause after a caught error [s]
+
+RunMode = Literal["real_time", "fast"]  # real time, or as fast as the CPU steps (scenarios, studies)
 
 
 def parse_update(data: Any, limits: SetpointLimits) -> SetpointUpdate:
@@ -173,7 +175,7 @@ class TwinRunner:
 
     # ---- public, any thread ------------------------------------------------------------------
     @property
-    def mode(self) -> str:
+    def mode(self) -> RunMode:
         return "fast" if self.fast else "real_time"
 
     @property
@@ -220,10 +222,12 @@ class TwinRunner:
         cal = self.calibration
         engine = self.engine_cpu.rate
         snap = self.publisher.cpu.rate
-        if engine is None and cal is None:
-            return None
+        if engine is None:
+            if cal is None:
+                return None
+            engine = cal.engine_cpu_s_per_sim_s
         return TwinCost(
-            engine_cpu_s_per_sim_s=engine if engine is not None else cal.engine_cpu_s_per_sim_s,
+            engine_cpu_s_per_sim_s=engine,
             publish_cpu_s_per_s=(
                 snap * self.publish_rate_hz
                 if snap is not None

@@ -68,7 +68,7 @@ async def post_measured(
 @read.get("/{bearing_id}/vibration/comparison", responses={**UNKNOWN_TWIN})
 def get_comparison(entry: TwinDep) -> dict[str, Any]:
     """The comparison of the last measured window (404 before the first one)."""
-    latest = entry.measured.latest if entry.measured is not None else None
+    latest = entry.measured.latest
     if latest is None:
         raise InputError.one(None, f"no measured window received yet for {entry.id!r}", status_code=404)
     return latest
