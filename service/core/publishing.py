@@ -6,8 +6,9 @@ After a frame that is due to publish, the stepping thread only CAPTURES the twin
 the real-time factor, the late fraction and the runner's status note of that moment. The
 pool's `PublishWorker` thread captures its public state as a `twin.snapshot_frame.SnapshotFrame`
 (`Twin.frame`: the balls and contacts as arrays in one compiled pass, the bearing-level blocks
-as a few pydantic models; about 0.2 ms for a 9-ball twin, of which the electrical network and the
-friction power are half) and hands it to the sinks, in capture order. Without a worker (before
+as a few pydantic models; for a 9-ball twin about 0.2 ms in a loop and 0.5 ms when it comes
+alone, as here, of which the electrical network and the friction power are half or more) and
+hands it to the sinks, in capture order. Without a worker (before
 the runner starts) a capture is built and delivered at once.
 
 Frames. The sinks that declare `accepts_frames` (the zenoh channel, the recorder, the alarm hub)
@@ -38,7 +39,7 @@ at a time, `_deliver_lock`). The hop to the worker thread (a thread wake-up and 
 behind the other twins' captures) was the largest stage of the PUT -> zenoh state latency:
 2.4 ms at the median and 9 ms at the 99th percentile with one twin (`bench-service`,
 `setpoint_latency_ms.publish` in /health). Setpoints are rate-limited per twin (the admission
-gate), so the stepping thread builds at most that many frames itself (about 0.2 ms each for
+gate), so the stepping thread builds at most that many frames itself (0.2-0.5 ms each for
 a 9-ball twin). It builds them from the live twin, not a frozen copy: it is the twin's only
 writer and steps it again only after the delivery, and the copy (with the thermal block it
 evaluates) cost as much CPU on the stepping thread as a third of the snapshot.
