@@ -25,6 +25,7 @@ import json
 import logging
 import re
 import threading
+import time
 import urllib.parse
 from collections.abc import Iterable
 
@@ -32,6 +33,10 @@ import h11
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
 log = logging.getLogger(__name__)
+
+#: key of `request.state` (the ASGI scope's "state") holding when the request's headers arrived
+#: [time.perf_counter() s]: the start of a setpoint's latency (service.core.mailbox.SetpointTiming)
+RECEIVED_S = "request_received_s"
 
 REDACTED = "[redacted]"
 _SECRET_NAME = re.compile(r"token|key|secret|passw|pwd|auth|credential|signature|sig$|session", re.IGNORECASE)
@@ -70,7 +75,11 @@ class GuardedH11Protocol(H11Protocol):
         self._arm("headers", self.header_timeout_s)
 
     def data_received(self, data: bytes) -> None:
+        received = time.perf_counter()
         super().data_received(data)
+        scope = getattr(self, "scope", None)  # the request whose headers this data completed, or an earlier one
+        if scope is not None:
+            scope.setdefault("state", {}).setdefault(RECEIVED_S, received)
         self._follow()
 
     def connection_lost(self, exc: Exception | None) -> None:

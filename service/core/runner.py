@@ -269,13 +269,17 @@ class TwinRunner:
     def remove_sink(self, sink: SnapshotSink) -> None:
         self.publisher.remove_sink(sink)
 
-    def submit(self, update: SetpointUpdate | dict | None = None, **fields) -> Setpoint:
+    def submit(
+        self, update: SetpointUpdate | dict | None = None, *, received_s: float | None = None, **fields
+    ) -> Setpoint:
         """Put a partial setpoint in the mailbox: merged over what is pending (latest wins per
         field), checked against the bearing's limits once, applied by the stepping thread at
         the next frame boundary. Returns the setpoint that will be in force. Raises InputError
-        naming each field and the bearing's range."""
+        naming each field and the bearing's range. `received_s`: when the request carrying it
+        arrived (this runner's clock), the start of its `SetpointTiming`."""
+        submitted = self._clock()
         update = parse_update(fields if update is None else update, self.limits)
-        setpoint = self._offer(update, timed=True)
+        setpoint = self._offer(update, timed=True, received_s=received_s, submitted_s=submitted)
         self._interrupt()
         self._wake()
         return setpoint
@@ -399,10 +403,17 @@ class TwinRunner:
             self.twin.interrupt_frame()
 
     # ---- mailbox -------------------------------------------------------------------------------
-    def _offer(self, update: SetpointUpdate, *, timed: bool) -> Setpoint:
+    def _offer(
+        self,
+        update: SetpointUpdate,
+        *,
+        timed: bool,
+        received_s: float | None = None,
+        submitted_s: float | None = None,
+    ) -> Setpoint:
         guard = self.faults.check_held if self.faults.not_held else None
         try:
-            return self.mailbox.offer(update, timed=timed, guard=guard)
+            return self.mailbox.offer(update, timed=timed, guard=guard, received_s=received_s, submitted_s=submitted_s)
         except SetpointError as exc:
             raise InputError(setpoint_field_errors(exc)) from None
 
