@@ -89,13 +89,14 @@ class RunnerSettings(BaseModel):
         'a small share of the work (docs/service.md "Runner pool").',
     )
     setpoint_frame_s: float = Field(
-        default=0.001,
+        default=0.00025,
         ge=1e-5,
         le=0.1,
         json_schema_extra=flat("setpoint_frame_s"),
         description="Real-time mode: the frame that applies an outside setpoint (HTTP, zenoh) lasts this "
         "long when shorter than frame_s, and a twin waiting for its next frame starts it at once, so "
-        "the state carrying the setpoint is published sooner [s].",
+        "the state carrying the setpoint is published sooner [s] (0.25 ms: about 0.07 ms of engine CPU for "
+        "the default twin on the 2-core EPYC VM, against 0.27 ms for 1 ms).",
     )
     frame_lead_s: float = Field(
         default=0.005,
