@@ -10,6 +10,9 @@ access log that never shows a secret.
   `timeout_keep_alive` (`http_keep_alive_s`) closes idle kept-alive connections, and
   `limit_concurrency` (`http_max_connections`) answers 503 beyond that many open connections
   or running requests, so one host cannot hold every socket or task of the service.
+* `GuardedH11Protocol` also notes when a request's headers were read (`request.state`
+  `RECEIVED_S`, time.perf_counter): the start of a setpoint's latency, its `http` stage
+  (service.core.mailbox.SetpointTiming).
 * `RedactAccessLog`: a filter on the `uvicorn.access` logger. In the logged path the value of
   every query parameter whose name says it is a secret (token, key, secret, password, auth,
   credential, signature, ...) becomes `[redacted]`, and so does the service's token wherever it
