@@ -523,11 +523,17 @@ def run_attack(cfg: AttackConfig) -> dict:
                 )
             )
         specs += attack_watchers.specs(cfg, started, url, zenoh_endpoint, token)
+        for _, spec in specs:
+            if "connected" in spec:  # a part that connects before the floods start
+                spec["connected"] = ctx.Event()
         for target, spec in specs:
             p = ctx.Process(target=target, args=(spec, go, out), daemon=True)
             p.start()
             procs.append(p)
         time.sleep(3.0)  # the children import httpx / zenoh and connect
+        for _, spec in specs:
+            if spec.get("connected") is not None and not spec["connected"].wait(60.0):
+                log(f"attack: {spec['mode']} did not connect within 60 s")
         log(f"attack: {cfg.seconds:g} s of floods ({', '.join(s.get('mode', 'zenoh') for _, s in specs)})")
         flood_start = time.monotonic()
         go.set()

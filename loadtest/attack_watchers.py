@@ -70,7 +70,7 @@ def specs(cfg: Any, started: Any, url: str, zenoh_endpoint: str | None, token: s
         specs += [
             (run_part, {**common, "mode": "opcua_logins"}),
             (run_part, {**common, "mode": "opcua_sessions", "max_sessions": 200}),
-            (run_part, {**common, "mode": "opcua_subscriptions", "subscriptions": 50, "items": 100}),
+            (run_part, {**common, "mode": "opcua_subscriptions", "subscriptions": 50, "items": 100, "connected": None}),
         ]
     return specs
 
@@ -202,12 +202,17 @@ def opcua(spec: dict, go) -> dict:
     with tempfile.TemporaryDirectory(prefix="bearing-twin-attack-") as tmp:
         cert = _client_cert(Path(tmp)) if spec["secure"] else None
         flood = {"opcua_logins": _logins, "opcua_sessions": _sessions, "opcua_subscriptions": _subscriptions}
-        go.wait(120.0)
-        return asyncio.run(flood[spec["mode"]](spec, cert))
+        return asyncio.run(flood[spec["mode"]](spec, cert, go))
 
 
-async def _logins(spec: dict, cert) -> dict:
+async def _wait_for(go) -> None:
+    """Wait for the parent's start signal without blocking the event loop."""
+    await asyncio.get_running_loop().run_in_executor(None, go.wait, 120.0)
+
+
+async def _logins(spec: dict, cert, go) -> dict:
     counts: collections.Counter = collections.Counter()
+    await _wait_for(go)
     t0 = time.monotonic()
     while time.monotonic() - t0 < spec["seconds"]:
         c = await _client(spec["url"], cert, password=f"guess-{secrets.token_hex(6)}")
@@ -228,9 +233,10 @@ async def _logins(spec: dict, cert) -> dict:
     }
 
 
-async def _sessions(spec: dict, cert) -> dict:
+async def _sessions(spec: dict, cert, go) -> dict:
     opened: list[Any] = []
     refused: collections.Counter[str] = collections.Counter()
+    await _wait_for(go)
     t0 = time.monotonic()
     while time.monotonic() - t0 < spec["seconds"] and len(opened) < spec["max_sessions"] and not refused:
         c = await _client(spec["url"], cert)
@@ -262,16 +268,21 @@ class _Count:
         self.n += 1
 
 
-async def _subscriptions(spec: dict, cert) -> dict:
+async def _subscriptions(spec: dict, cert, go) -> dict:
+    """One session opened before the floods start (its place is not taken by the session flood, which
+    fills the server's session cap), then its subscriptions requested as fast as they are granted."""
     from asyncua import ua
 
     from service.opcua.layout import FOLDERS, NAMESPACE_URI, ROOT_FOLDER
 
     counter, granted, items = _Count(), [], 0
     refused: collections.Counter[str] = collections.Counter()
-    t0 = time.monotonic()
     c = await _client(spec["url"], cert)
     async with c:
+        if spec.get("connected") is not None:
+            spec["connected"].set()
+        await _wait_for(go)
+        t0 = time.monotonic()
         idx = await c.get_namespace_index(NAMESPACE_URI)
         twin = await c.nodes.objects.get_child([f"{idx}:{ROOT_FOLDER}", f"{idx}:{spec['bearing_id']}"])
         nodes = [

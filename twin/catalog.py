@@ -175,9 +175,11 @@ CWRU_RADIAL_LOAD_N = 36.8
 # 5-20 um; the middle of the range as the mounted diametral clearance.
 CWRU_DIAMETRAL_CLEARANCE_M = 12.5e-6
 # Calibrated once on the healthy record 97 only (twin.validation.cwru.calibrate_housing): the
-# healthy acceleration's power spectrum (Welch, 512 points at 12 kHz) has its broadband housing
-# resonance at 3234 Hz with a half-power bandwidth of 108 Hz (damping ratio 0.0167); the sprung
-# mass (1 kg on the Sawalhi & Randall pedestal) is tuned to sense that mode.
+# healthy acceleration's power spectrum (Welch, 512 points at 12 kHz) peaks in 2.95-3.6 kHz at
+# 3234 Hz with a half-power bandwidth of 108 Hz (damping ratio 0.0167); the sprung mass (1 kg on
+# the Sawalhi & Randall pedestal) is tuned to sense that mode. The spectrum is within 5 dB flat
+# there; the fault records' impacts ring at 3.43-3.59 kHz with damping ratios 0.013-0.019
+# (tests/vibration/test_cwru_ring_down.py).
 CWRU_SPRUNG_STIFFNESS_N_M = 3.587e8
 CWRU_SPRUNG_DAMPING_N_S_M = 549.9
 # Calibrated once on the healthy record 97 only (`twin.validation.cwru.calibrate_background`):

@@ -7,6 +7,8 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, field_validator, model_validator
 
+from service.settings.flat import details
+
 
 class AlarmSettings(BaseModel):
     """Alarm thresholds and timing (service.core.alarms; docs/service.md "Alarms"). Times are simulated
@@ -18,8 +20,9 @@ class AlarmSettings(BaseModel):
 
     machine_group: Literal[1, 2] = Field(
         default=2,
-        description="ISO 20816-3 machine group [1 | 2]: 1 = large machines (300 kW to "
-        "50 MW, Table A.1), 2 = medium machines (15 kW to 300 kW, Table A.2).",
+        json_schema_extra=details("Large machines: 300 kW to 50 MW; medium machines: 15 kW to 300 kW."),
+        description="ISO 20816-3 machine group [1 | 2]: 1 = large machines "
+        "(Table A.1), 2 = medium machines (Table A.2).",
     )
     support: Literal["rigid", "flexible"] = Field(
         default="rigid", description="ISO 20816-3 support class [rigid | flexible] (clause 4.4)."
@@ -28,14 +31,15 @@ class AlarmSettings(BaseModel):
         default=0.9,
         gt=0.0,
         lt=1.0,
-        description="Hysteresis of the 'above' alarms: an alarm raised at threshold T clears below "
-        "clear_ratio x T (the 'below' alarms clear above T / clear_ratio) [-].",
+        json_schema_extra=details("The 'below' alarms clear above T / clear_ratio."),
+        description="Hysteresis of the 'above' alarms: an alarm raised "
+        "at threshold T clears below clear_ratio x T [-].",
     )
     clear_hold_s: float = Field(
         default=1.0,
         ge=0.0,
         le=3600.0,
-        description="The value must stay on the clear side of the clear threshold this long before "
+        description="Time on the clear side of the clear threshold before "
         "an alarm clears or steps down [s of simulated time].",
     )
     vibration_delay_s: float = Field(
@@ -48,8 +52,10 @@ class AlarmSettings(BaseModel):
         default=1.0,
         ge=0.0,
         le=3600.0,
-        description="A lubrication alarm rises after kappa < kappa_threshold, or a loaded contact in "
-        "the boundary regime, lasts this long [s of simulated time].",
+        json_schema_extra=details(
+            "The conditions: kappa < kappa_threshold, or a loaded contact in the boundary regime."
+        ),
+        description="Time a lubrication condition lasts before its alarm rises [s of simulated time].",
     )
     kappa_threshold: float = Field(
         default=1.0,
@@ -69,30 +75,31 @@ class AlarmSettings(BaseModel):
         default=0.1,
         ge=0.0,
         le=1.0,
-        description="A contact counts as loaded when it carries at least this fraction of the "
-        "largest contact load of the snapshot [-].",
+        description="A contact is loaded when it carries this fraction of "
+        "the snapshot's largest contact load, or more [-].",
     )
     discharge_delay_s: float = Field(
         default=0.0,
         ge=0.0,
         le=3600.0,
-        description="The electrical alarm rises after the discharge risk stays 'possible' or "
-        "'likely' this long [s of simulated time].",
+        description="Time the discharge risk stays 'possible' or 'likely' "
+        "before the electrical alarm rises [s of simulated time].",
     )
     defect_amplitude_m_s2: float = Field(
         default=0.5,
         gt=0.0,
         le=1e4,
-        description="Envelope amplitude of a defect line (FTF, BPFO, BPFI, BSF) above which its "
-        "alarm rises [m/s^2]; a line must also stand defect_significance x the envelope noise "
-        "floor above it when the floor is known.",
+        json_schema_extra=details(
+            "When the envelope noise floor is known, the line must also stand defect_significance x the floor above it."
+        ),
+        description="Envelope amplitude of a defect line (FTF, BPFO, BPFI, BSF) above which its alarm rises [m/s^2].",
     )
     defect_significance: float = Field(
         default=4.0,
         ge=1.0,
         le=100.0,
-        description="Times the envelope noise floor (median) a defect line must exceed [-] "
-        "(twin.vibration.indicators.SIGNIFICANCE).",
+        json_schema_extra=details("The default is twin.vibration.indicators.SIGNIFICANCE."),
+        description="Times the envelope noise floor (median) a defect line must exceed [-].",
     )
     defect_delay_s: float = Field(
         default=0.0,
@@ -113,8 +120,10 @@ class AlarmSettings(BaseModel):
         default=82.0,
         gt=-30.0,
         le=300.0,
-        description="Outer-ring temperature above which the temperature alarm is a warning [degC] (82 degC: the oil "
-        "sump limit of ISO 13709 / API 610 for ring-oil and splash lubricated bearings).",
+        json_schema_extra=details(
+            "82 degC is the oil sump limit of ISO 13709 / API 610 for ring-oil and splash lubricated bearings."
+        ),
+        description="Outer-ring temperature above which the temperature alarm is a warning [degC].",
     )
     temperature_critical_c: float = Field(
         default=95.0,
@@ -126,8 +135,8 @@ class AlarmSettings(BaseModel):
         default=5.0,
         gt=0.0,
         le=1000.0,
-        description="Rate of rise of the outer ring (over a minute of thermal time) above which the rate alarm is a "
-        "warning [K/min].",
+        description="Rise rate of the outer ring (over a minute of thermal "
+        "time) above which the rate alarm warns [K/min].",
     )
     temperature_rate_critical_k_per_min: float = Field(
         default=10.0, gt=0.0, le=1000.0, description="Rate of rise above which the rate alarm is critical [K/min]."

@@ -7,6 +7,11 @@ A settings root (`ServiceSettings`, `RouterSettings`, `ZenohAccessSettings`) hol
 (`BEARING_TWIN_PORT`), the keyword a root accepts (`ServiceSettings(port=8001)`) and the default
 name of its `serve` flag (`--port`). The nested environment name wins over the flat one.
 
+A field's `description` is one line (what it is, its unit in brackets, what 0 or unset means): the
+`--help` of its flag and the Meaning column of docs/configuration.md. The reason, trade-offs,
+interactions and references go to its `details` (`flat(..., details=...)`, or `details(...)` for a
+field without a flat name), listed under its group's table on that page.
+
 A flat name may equal a group's name: `BEARING_TWIN_OPCUA=opc.tcp://...` is `opcua.endpoint`,
 while a JSON object in it (`BEARING_TWIN_OPCUA='{"security": "sign"}'`) is the whole group.
 """
@@ -29,18 +34,36 @@ from pydantic_settings import (
 
 ENV_PREFIX = "BEARING_TWIN_"
 NESTED_DELIMITER = "__"
+DESCRIPTION_MAX_CHARS = 110  # a description is one line of at most this many characters
 
 
-def flat(name: str, *flags: str, metavar: str | None = None) -> dict[str, Any]:
+def details(text: str) -> dict[str, Any]:
+    """The `json_schema_extra` of a settings field without a flat name that has details: the
+    sentences beyond its one-line description, shown under its group's table in the docs."""
+    return {"details": text}
+
+
+def flat(name: str, *flags: str, metavar: str | None = None, details: str | None = None) -> dict[str, Any]:
     """The `json_schema_extra` of a settings field: its flat name (lower case, without the
     prefix) and, when they differ from `--<flat-name>` (`--no-<flat-name>` for a setting on by
-    default), its `serve` flags (the first is shown)."""
+    default), its `serve` flags (the first is shown); `details`: the sentences beyond its
+    one-line description (the docs show them, `--help` does not)."""
     extra: dict[str, Any] = {"flat": name}
     if flags:
         extra["flags"] = list(flags)
     if metavar is not None:
         extra["metavar"] = metavar
+    if details is not None:
+        extra["details"] = details
     return extra
+
+
+def field_details(info: FieldInfo) -> str | None:
+    """The details of a settings field (`flat(..., details=...)` or `details(...)`), or None."""
+    extra = info.json_schema_extra
+    if isinstance(extra, dict) and extra.get("details") is not None:
+        return str(extra["details"])
+    return None
 
 
 @dataclass(frozen=True)
@@ -70,14 +93,20 @@ class FlatSetting:
         return default_text(self.info)
 
     @property
+    def details(self) -> str | None:
+        """The sentences beyond the one-line description, or None."""
+        return field_details(self.info)
+
+    @property
     def path(self) -> str:
         """The attribute path from the root, e.g. http.port."""
         return f"{self.group}.{self.field}"
 
 
 def default_text(info: FieldInfo) -> str:
-    """A field's default as text: `unset` for None, the value, or the first line of the
-    factory's docstring for a computed default (a recording name with the start time)."""
+    """A field's default as text: `unset` for None, the value (a list comma-separated, `none` when
+    empty), or the first line of the factory's docstring for a computed default (a recording name
+    with the start time)."""
     if info.default_factory is not None:
         factory = info.default_factory
         doc = (getattr(factory, "__doc__", None) or "").strip()
@@ -90,6 +119,8 @@ def default_text(info: FieldInfo) -> str:
         value = info.default
     if value is None:
         return "unset"
+    if isinstance(value, list):
+        return ",".join(str(v) for v in value) or "none"  # as the environment takes it
     return str(value)
 
 

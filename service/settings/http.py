@@ -32,18 +32,19 @@ class HttpSettings(BaseModel):
         default=10.0,
         gt=0.0,
         le=600.0,
-        json_schema_extra=flat("http_header_timeout_s"),
-        description="A request's line and headers must be complete this long after the connection "
-        "opened (or the next request's first byte arrived); else 408 and the connection is closed "
-        "(slow clients) [s].",
+        json_schema_extra=flat(
+            "http_header_timeout_s",
+            details="Counted from the connection's opening, or from the next request's "
+            "first byte on a kept-alive connection: it cuts off slow clients.",
+        ),
+        description="Time a request's line and headers may take; then 408 and the connection is closed [s].",
     )
     body_timeout_s: float = Field(
         default=30.0,
         gt=0.0,
         le=3600.0,
         json_schema_extra=flat("http_body_timeout_s"),
-        description="A request body must be complete this long after its headers; else 408 and the "
-        "connection is closed [s].",
+        description="Time a request body may take after its headers; then 408 and the connection is closed [s].",
     )
     keep_alive_s: int = Field(
         default=5,
@@ -56,9 +57,11 @@ class HttpSettings(BaseModel):
         default=256,
         ge=8,
         le=100_000,
-        json_schema_extra=flat("http_max_connections"),
-        description="Open HTTP connections (or running requests) beyond which a new request gets 503 "
-        "(uvicorn limit_concurrency) [count].",
+        json_schema_extra=flat(
+            "http_max_connections",
+            details="uvicorn's limit_concurrency.",
+        ),
+        description="Open HTTP connections (or running requests) beyond which a new request gets 503 [count].",
     )
 
 
@@ -69,9 +72,12 @@ class SecuritySettings(BaseModel):
 
     token: SecretStr | None = Field(
         default=None,
-        json_schema_extra=flat("token"),
-        description="Bearer token of every mutating HTTP request (and of reads with read_requires_token) and OPC UA "
-        "password [text]; unset = no authentication; never on zenoh; environment only (docs/operations.md).",
+        json_schema_extra=flat(
+            "token",
+            details="Reads need it too with read_requires_token. zenoh never uses "
+            'it. Environment only: it has no flag (docs/operations.md "Access").',
+        ),
+        description="Bearer token of mutating HTTP requests, and OPC UA password [text]; unset = no authentication.",
     )
     read_requires_token: bool = Field(
         default=False,
@@ -82,9 +88,11 @@ class SecuritySettings(BaseModel):
         default=50.0,
         ge=0.0,
         le=1e6,
-        json_schema_extra=flat("setpoint_rate_hz"),
-        description="Sustained setpoint rate per twin, HTTP and zenoh together [1/s]; 0 = no limit. "
-        "Beyond it: HTTP 429 with Retry-After, zenoh refusal on the result key.",
+        json_schema_extra=flat(
+            "setpoint_rate_hz",
+            details="Beyond it: HTTP 429 with Retry-After, and a refusal on the zenoh result key.",
+        ),
+        description="Sustained setpoint rate per twin, HTTP and zenoh together [1/s]; 0 = no limit.",
     )
     setpoint_burst: int = Field(
         default=100,
@@ -104,9 +112,11 @@ class SecuritySettings(BaseModel):
         default=100.0,
         ge=0.0,
         le=1e6,
-        json_schema_extra=flat("read_rate_hz"),
-        description="Sustained rate of API reads (GET/HEAD under /v1/) per client address [1/s]; 0 = no "
-        "limit. Beyond it: 429 with Retry-After naming the limit. /health and the docs are not counted.",
+        json_schema_extra=flat(
+            "read_rate_hz",
+            details="Beyond it: 429 with Retry-After naming the limit. /health and the docs are not counted.",
+        ),
+        description="Sustained rate of API reads (GET/HEAD under /v1/) per client address [1/s]; 0 = no limit.",
     )
     read_burst: int = Field(
         default=200,
@@ -119,10 +129,13 @@ class SecuritySettings(BaseModel):
         default=5.0,
         ge=0.0,
         le=1e6,
-        json_schema_extra=flat("client_error_rate_hz"),
-        description="Sustained rate of refused HTTP requests (any 4xx answer: wrong or missing token, over a rate "
-        "limit, invalid, unknown) a client address may cause before its refusals are held in the tarpit "
-        "(tarpit_delay_s) [1/s]; 0 = no tarpit. /health is never counted nor held.",
+        json_schema_extra=flat(
+            "client_error_rate_hz",
+            details="Every 4xx answer counts: a wrong or missing token, over a rate limit, invalid, unknown. Beyond "
+            "it the client's refusals are held in the tarpit (tarpit_delay_s). /health is never counted nor held.",
+        ),
+        description="Sustained rate of refused HTTP requests a client address "
+        "may cause before the tarpit [1/s]; 0 = no tarpit.",
     )
     client_error_burst: int = Field(
         default=20,
@@ -135,19 +148,26 @@ class SecuritySettings(BaseModel):
         default=2.0,
         ge=0.0,
         le=60.0,
-        json_schema_extra=flat("tarpit_delay_s"),
-        description="A client over its error budget (client_error_rate_hz) gets each refusal this long after it "
-        "was decided, with Retry-After; the wait is an asyncio timer (no thread, no CPU), so a client that waits "
-        "for its answers before sending more (a closed-loop flood) slows itself down [s]; 0 = no tarpit.",
+        json_schema_extra=flat(
+            "tarpit_delay_s",
+            details="Each refusal is answered this long after it was decided, with Retry-After. The wait is an "
+            "asyncio timer (no thread, no CPU), so a client that waits for its answers before sending more (a "
+            "closed-loop flood) slows itself down.",
+        ),
+        description="Delay of each refusal to a client over its error "
+        "budget (client_error_rate_hz) [s]; 0 = no tarpit.",
     )
     tarpit_max_held: int = Field(
         default=64,
         ge=1,
         le=100_000,
-        json_schema_extra=flat("tarpit_max_held"),
-        description="Refusals held in the tarpit at one time, at most [count]; beyond it a refusal is answered at "
-        "once (counted in /health http_tarpit). Below http_max_connections: the held connections count "
-        "against it.",
+        json_schema_extra=flat(
+            "tarpit_max_held",
+            details="Refusals answered at once are counted in /health http_tarpit. "
+            "Below http_max_connections: the held connections count against it.",
+        ),
+        description="Refusals held in the tarpit at one time, at most "
+        "[count]; beyond it a refusal is answered at once.",
     )
 
     @field_validator("token", mode="before")

@@ -22,23 +22,32 @@ class OpcUaSettings(BaseModel):
     endpoint: str | None = Field(
         default=None,
         pattern=r"^opc\.tcp://[^/\s]+:\d{1,5}(/\S*)?$",
-        json_schema_extra=flat("opcua", metavar="opc.tcp://HOST:PORT"),
-        description="OPC UA endpoint to serve the twins on [opc.tcp://HOST:PORT[/path]], e.g. "
-        "opc.tcp://127.0.0.1:4840; unset (default) = no OPC UA server.",
+        json_schema_extra=flat(
+            "opcua",
+            metavar="opc.tcp://HOST:PORT",
+            details="For example opc.tcp://127.0.0.1:4840.",
+        ),
+        description="OPC UA endpoint to serve the twins on [opc.tcp://HOST:PORT[/path]]; unset = no OPC UA server.",
     )
     security: SecurityChoice = Field(
         default="auto",
-        json_schema_extra=flat("opcua_security"),
-        description="OPC UA message security offered [auto | none | sign | sign_and_encrypt | both | all]: "
-        "Basic256Sha256, Aes128_Sha256_RsaOaep, Aes256_Sha256_RsaPss in Sign, SignAndEncrypt or both; all adds "
-        'the None policy for anonymous reads; auto = both with a token, else none (docs/service.md "OPC UA").',
+        json_schema_extra=flat(
+            "opcua_security",
+            details="The policies Basic256Sha256, Aes128_Sha256_RsaOaep and Aes256_Sha256_RsaPss, in Sign, "
+            "SignAndEncrypt or both; all adds the None policy for anonymous reads; auto = both with a token, else "
+            'none (docs/service.md "OPC UA").',
+        ),
+        description="OPC UA message security offered [auto | none | sign | sign_and_encrypt | both | all].",
     )
     certificate: Path | None = Field(
         default=None,
-        json_schema_extra=flat("opcua_certificate", metavar="CERT.der"),
-        description="The OPC UA server's certificate [path, DER or PEM], with opcua_private_key; its "
-        "subjectAltName must hold the URI urn:bearing-twin:server (OPC UA Part 6). Unset (default) = "
-        "a self-signed one made once in opcua_pki_dir and reused.",
+        json_schema_extra=flat(
+            "opcua_certificate",
+            metavar="CERT.der",
+            details="Give it with opcua_private_key; its subjectAltName must hold the URI urn:bearing-twin:server "
+            "(OPC UA Part 6). The self-signed one is made once and reused.",
+        ),
+        description="The OPC UA server's certificate [path, DER or PEM]; unset = a self-signed one in opcua_pki_dir.",
     )
     private_key: Path | None = Field(
         default=None,
@@ -47,17 +56,23 @@ class OpcUaSettings(BaseModel):
     )
     pki_dir: Path = Field(
         default=Path("opcua-pki"),
-        json_schema_extra=flat("opcua_pki_dir", metavar="DIR"),
-        description="Folder of the generated self-signed OPC UA server certificate "
-        "(server-cert.der) and key (server-key.pem, mode 0600, never overwritten) [path]; made when "
-        "a secure policy is on and opcua_certificate is unset. Default ./opcua-pki.",
+        json_schema_extra=flat(
+            "opcua_pki_dir",
+            metavar="DIR",
+            details="The certificate is server-cert.der, the key server-key.pem (mode 0600, never overwritten); made "
+            "when a secure policy is on and opcua_certificate is unset.",
+        ),
+        description="Folder of the generated self-signed OPC UA server certificate and key [path].",
     )
     trusted_dir: Path | None = Field(
         default=None,
-        json_schema_extra=flat("opcua_trusted_dir", metavar="DIR"),
-        description="Folder of trusted OPC UA client certificates (or CA certificates that signed "
-        "them) [path to a folder of .der / .pem files]: when set, only those clients may open a "
-        "session. Unset (default) = any client certificate (the token still guards writes).",
+        json_schema_extra=flat(
+            "opcua_trusted_dir",
+            metavar="DIR",
+            details="It may hold CA certificates that signed them. When set, only those clients may open a session. "
+            "Unset: any client certificate (the token still guards writes).",
+        ),
+        description="Folder of trusted OPC UA client certificates [path to .der / .pem files]; unset = any client.",
     )
     max_sessions: int = Field(
         default=16,
@@ -84,9 +99,11 @@ class OpcUaSettings(BaseModel):
         default=1000.0,
         gt=0,
         le=1e7,
-        json_schema_extra=flat("opcua_max_notifications_per_s"),
-        description="Notifications one OPC UA session's items may send, at most [1/s] (each item counted at "
-        "min(publish_rate_hz, queue size x 1000 / publishing interval ms)).",
+        json_schema_extra=flat(
+            "opcua_max_notifications_per_s",
+            details="Each item counts at min(publish_rate_hz, queue size x 1000 / publishing interval ms).",
+        ),
+        description="Notifications one OPC UA session's items may send, at most [1/s].",
     )
     min_publishing_interval_ms: float = Field(
         default=50.0,

@@ -33,29 +33,40 @@ class ZenohAccessConfig(BaseModel):
 
     prefix: str = Field(
         default=DEFAULT_PREFIX,
-        json_schema_extra=flat("zenoh_prefix", metavar="PREFIX"),
-        description="Key prefix of the twins on zenoh [key expression chunks, e.g. plant1/line2/motor7]: "
-        "a twin publishes under {prefix}/{id}/...; site / line / asset, up to 8 chunks of letters, "
-        "digits, '_', '.', '-'. The router and the monitor also take patterns with '*' and '**' "
-        "(e.g. plant1/**).",
+        json_schema_extra=flat(
+            "zenoh_prefix",
+            metavar="PREFIX",
+            details="A twin publishes under {prefix}/{id}/...; site / line / asset, up to 8 chunks of letters, "
+            "digits, '_', '.', '-'. The router and the monitor also take patterns with '*' and '**' (e.g. plant1/**).",
+        ),
+        description="Key prefix of the twins on zenoh [key expression, e.g. plant1/line2/motor7].",
     )
     user: str | None = Field(
         default=None,
-        json_schema_extra=flat("zenoh_user", metavar="USER"),
-        description="User name this process presents when it connects to a zenoh router or peer "
-        "[text]; with zenoh_password (zenoh user-password authentication).",
+        json_schema_extra=flat(
+            "zenoh_user",
+            metavar="USER",
+            details="The two are zenoh's user-password authentication.",
+        ),
+        description="User name this process presents to a zenoh router or peer [text]; with zenoh_password.",
     )
     password: SecretStr | None = Field(
         default=None,
-        json_schema_extra=flat("zenoh_password"),
-        description="Password of zenoh_user [text]; give it in the environment "
-        "(BEARING_TWIN_ZENOH_PASSWORD), never on a command line.",
+        json_schema_extra=flat(
+            "zenoh_password",
+            details="Never give it on a command line.",
+        ),
+        description="Password of zenoh_user [text]; environment only (BEARING_TWIN_ZENOH_PASSWORD).",
     )
     usersfile: Path | None = Field(
         default=None,
-        json_schema_extra=flat("zenoh_usersfile", metavar="FILE"),
-        description="Users allowed to connect to this process's zenoh endpoints [path to a file of "
-        "`user:password` lines, zenoh's usrpwd dictionary]; keep it readable by the service only.",
+        json_schema_extra=flat(
+            "zenoh_usersfile",
+            metavar="FILE",
+            details="The file is zenoh's usrpwd dictionary; keep it readable by the service only.",
+        ),
+        description="Users allowed to connect to this process's zenoh "
+        "endpoints [path to a file of `user:password` lines].",
     )
     writers: Annotated[list[str], NoDecode] = Field(
         default_factory=list,
@@ -64,22 +75,31 @@ class ZenohAccessConfig(BaseModel):
     )
     readers: Annotated[list[str], NoDecode] = Field(
         default_factory=list,
-        json_schema_extra=flat("zenoh_readers", metavar="NAME"),
-        description="Users (or certificate common names) that may only read: state, balls, "
-        "setpoint results, snapshots, liveliness [comma-separated names].",
+        json_schema_extra=flat(
+            "zenoh_readers",
+            metavar="NAME",
+            details="They read state, balls, setpoint results, snapshots and liveliness.",
+        ),
+        description="Users (or certificate common names) that may only read [comma-separated names].",
     )
     services: Annotated[list[str], NoDecode] = Field(
         default_factory=list,
-        json_schema_extra=flat("zenoh_services", metavar="NAME"),
-        description="Users (or certificate common names) of twin services joining a router: they "
-        "publish state, answer queries and declare liveliness tokens [comma-separated names]; "
-        "the service's own zenoh_user is always one.",
+        json_schema_extra=flat(
+            "zenoh_services",
+            metavar="NAME",
+            details="They publish state, answer queries and declare liveliness "
+            "tokens; the service's own zenoh_user is always one.",
+        ),
+        description="Users (or certificate common names) of twin services joining a router [comma-separated names].",
     )
     tls_root_ca: Path | None = Field(
         default=None,
-        json_schema_extra=flat("zenoh_tls_root_ca", metavar="CA.pem"),
-        description="CA certificate that signed every node's certificate [path, PEM]; "
-        "with zenoh_tls_certificate and zenoh_tls_private_key: mutual TLS on tls/ endpoints.",
+        json_schema_extra=flat(
+            "zenoh_tls_root_ca",
+            metavar="CA.pem",
+            details="With zenoh_tls_certificate and zenoh_tls_private_key: mutual TLS on tls/ endpoints.",
+        ),
+        description="CA certificate that signed every node's certificate [path, PEM].",
     )
     tls_certificate: Path | None = Field(
         default=None,
@@ -232,16 +252,23 @@ class ZenohSettings(ZenohAccessConfig):
     listen: Annotated[list[str], NoDecode] = Field(
         default=None,
         validate_default=True,
-        json_schema_extra=flat("zenoh_listen", metavar="ENDPOINT"),
-        description="zenoh endpoints to listen on [zenoh locator, e.g. tcp/127.0.0.1:7447]; default "
-        "tcp/127.0.0.1:7447, or none when zenoh_connect is given (the service joins a router).",
+        json_schema_extra=flat(
+            "zenoh_listen",
+            metavar="ENDPOINT",
+            details="With zenoh_connect the service joins a router.",
+        ),
+        description="zenoh endpoints to listen on [zenoh locator]; unset "
+        "= tcp/127.0.0.1:7447, or none with zenoh_connect.",
     )
     mode: Literal["peer", "client", "router"] = Field(
         default=None,
         validate_default=True,
-        json_schema_extra=flat("zenoh_mode"),
-        description="zenoh session mode [peer | client | router]; default client when "
-        "the service only connects (joins a router: every message goes through it), else peer.",
+        json_schema_extra=flat(
+            "zenoh_mode",
+            details="A service that only connects joins a router: every message goes through it.",
+        ),
+        description="zenoh session mode [peer | client | router]; unset "
+        "= client when the service only connects, else peer.",
     )
 
     @field_validator("connect", mode="before")

@@ -1,5 +1,7 @@
-"""The configuration table of the docs (docs/configuration.md), generated from the settings models
-so that each default, description, environment name and flag is written once, in service/settings/:
+"""The configuration tables of the docs (docs/configuration.md), generated from the settings models
+so that each default, description, details text, environment name and flag is written once, in
+service/settings/. A table row holds a field's one-line description; its details (the reason, the
+trade-off, the interactions) follow the table as a list:
 
     python -m service.tools.config_doc            # rewrite docs/configuration.md
     python -m service.tools.config_doc --check    # exit 1 if the file is not current
@@ -9,16 +11,19 @@ tests/service/tools/test_config_doc.py fails when the file and the models differ
 from __future__ import annotations
 
 import argparse
+import re
 import sys
+import unicodedata
 from pathlib import Path
 
 from pydantic import BaseModel
 
 from service.settings import ENV_PREFIX, AlarmSettings, FlatSetting, RouterSettings, ServiceSettings, flat_settings
-from service.settings.flat import default_text
+from service.settings.flat import default_text, field_details
 from service.tools.settings_flags import flag_of
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "configuration.md"
+DOC_REFERENCE = re.compile(r'docs/([\w-]+\.md)(?: "([^"]+)")?')  # docs/service.md "Runner pool"
 
 
 def _cell(text: str | None) -> str:
@@ -27,7 +32,7 @@ def _cell(text: str | None) -> str:
 
 def _default(setting: FlatSetting) -> str:
     text = setting.default_text
-    return text if text == "unset" or "<" in text else f"`{text}`"
+    return text if text in ("unset", "none") else f"`{text}`"
 
 
 def _flag(root: type[BaseModel], setting: FlatSetting) -> str:
@@ -35,8 +40,49 @@ def _flag(root: type[BaseModel], setting: FlatSetting) -> str:
     return "(environment only)" if flag is None else " ".join(f"`{f}`" for f in setting.flags)
 
 
+def _slug(heading: str) -> str:
+    """The anchor mkdocs gives a heading (Python-Markdown's toc slugify)."""
+    text = unicodedata.normalize("NFKD", heading).encode("ascii", "ignore").decode("ascii")
+    text = re.sub(r"[^\w\s-]", "", text).strip().lower()
+    return re.sub(r"[-\s]+", "-", text)
+
+
+def _headings(page: str) -> list[str]:
+    """The headings of docs/`page`, fenced code blocks skipped."""
+    headings, fenced = [], False
+    for line in (DOC.parent / page).read_text(encoding="utf-8").splitlines():
+        if line.startswith("```"):
+            fenced = not fenced
+        elif not fenced and re.match(r"#{1,6} ", line):
+            headings.append(line.lstrip("#").strip())
+    return headings
+
+
+def _doc_links(text: str) -> str:
+    """Each `docs/<page>.md "Section"` of a details text as a link to that page and to its first
+    section whose heading starts with the quoted name; ValueError when there is none."""
+
+    def link(match: re.Match[str]) -> str:
+        page, section = match.group(1), match.group(2)
+        if section is None:
+            return f"[{page}]({page})"
+        heading = next((h for h in _headings(page) if h.startswith(section)), None)
+        if heading is None:
+            raise ValueError(f"docs/{page} has no section {section!r}")
+        return f'[{page} "{section}"]({page}#{_slug(heading)})'
+
+    return DOC_REFERENCE.sub(link, text)
+
+
+def _details_list(rows: list[tuple[str, str | None]]) -> list[str]:
+    """The details of a table's fields, one item per field that has them (`name`, text), or nothing."""
+    items = [f"- `{name}`: {_doc_links(' '.join(text.split()))}" for name, text in rows if text]
+    return ["", "Details:", "", *items] if items else []
+
+
 def _group_tables(root: type[BaseModel], flags: bool = True) -> list[str]:
-    """One table per group of `root`: flat variable, default, nested variable, flag, meaning."""
+    """One table per group of `root` (flat variable, default, nested variable, flag, meaning),
+    followed by the details of its fields."""
     lines: list[str] = []
     for group, info in root.model_fields.items():
         settings = [s for s in flat_settings(root) if s.group == group]
@@ -51,6 +97,7 @@ def _group_tables(root: type[BaseModel], flags: bool = True) -> list[str]:
         for s in settings:
             flag = f" {_flag(root, s)} |" if flags else ""
             lines.append(f"| `{s.env}` | {_default(s)} | `{s.nested_env}` |{flag} {_cell(s.info.description)} |")
+        lines += _details_list([(s.env, s.details) for s in settings])
         lines.append("")
     return lines
 
@@ -59,7 +106,7 @@ def _alarm_table() -> list[str]:
     rows = ["| Field | Default | Meaning |", "|---|---|---|"]
     for name, info in AlarmSettings.model_fields.items():
         rows.append(f"| `{name}` | `{default_text(info)}` | {_cell(info.description)} |")
-    return rows
+    return rows + _details_list([(name, field_details(info)) for name, info in AlarmSettings.model_fields.items()])
 
 
 def configuration_markdown() -> str:
@@ -92,6 +139,7 @@ def configuration_markdown() -> str:
             f"| `{s.env}` | {_default(s)} | `{s.nested_env}` | `{s.flags[0]}` | {_cell(s.info.description)} |"
             for s in router_only
         ],
+        *_details_list([(s.env, s.details) for s in router_only]),
         "",
         f"## Alarms (`{ENV_PREFIX}ALARMS`, a JSON object of these fields, or `{ENV_PREFIX}ALARMS__<FIELD>`)",
         "",

@@ -26,24 +26,31 @@ def _plain_types(annotation: Any) -> list[Any]:
     return [annotation]
 
 
+def _help_text(setting: FlatSetting, kind: Any) -> str:
+    """A flag's help: the field's one-line description, its default (left out where the
+    description says what unset means) and its environment variable. A switch's help says what
+    the flag does instead of the default and the [bool] unit."""
+    text = " ".join((setting.info.description or "").split()).rstrip(".").replace("%", "%%")
+    if kind is bool:
+        text = text.removesuffix(" [bool]")
+        if setting.info.default is True:
+            return f"{text}: on unless this flag is given [{setting.env}]"
+        return f"{text} [{setting.env}]"
+    if setting.default_text == "unset" and "unset =" in text:
+        return f"{text} [{setting.env}]"
+    return f"{text} (default {setting.default_text}) [{setting.env}]"
+
+
 def _flag_options(setting: FlatSetting) -> dict[str, Any] | None:
     """argparse options of one setting's flag, or None when it has none (a secret)."""
     members = _plain_types(setting.info.annotation)
     kind = members[0] if len(members) == 1 else str
     origin = typing.get_origin(kind)
-    help_text = " ".join((setting.info.description or "").split()).replace("%", "%%")
-    options: dict[str, Any] = {
-        "dest": setting.path,
-        "default": argparse.SUPPRESS,
-        "help": f"{help_text} (default {setting.default_text}) [{setting.env}]",
-    }
+    options: dict[str, Any] = {"dest": setting.path, "default": argparse.SUPPRESS, "help": _help_text(setting, kind)}
     if kind is SecretStr:
         return None
     if kind is bool:
-        on = setting.info.default is not True
-        options.update(action="store_const", const=on)
-        if not on:
-            options["help"] = f"turn off: {options['help']}"
+        options.update(action="store_const", const=setting.info.default is not True)
         return options
     if origin is list:
         options.update(action="append")

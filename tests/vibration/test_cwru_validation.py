@@ -23,8 +23,9 @@ pytestmark = pytest.mark.slow
 
 # The targets the twin does not meet, each a strict xfail with its evidence (docs/validation.md, "Why
 # the fault records are louder than the twin"): a 0.178 mm pit under the 26-37 N ball loads of the
-# rotor's weight removes 5-10 N of one ball's load for 0.1 ms; through the housing path whose
-# healthy lines near 3.2 kHz match record 97's, that rings at ~0.04 g, where the records show 1.5-3.5 g.
+# rotor's weight removes about 8 N of one ball's load for 0.1 ms; through the Sawalhi & Randall
+# housing masses (7.6 kg) that rings at ~0.04 g, where the records show 1.5-3.5 g. The mass the
+# ball force drives is not pinned by the healthy record (tests/vibration/test_cwru_ring_down.py).
 SHORT = pytest.mark.xfail(strict=True, reason="fault excitation 30-100 x below the records' (docs/validation.md)")
 
 DURATION_S = 1.0
@@ -39,23 +40,6 @@ def results():
         s, xs = cwru.simulated(rec, DURATION_S)
         out[rec.number] = (m, s, xm, xs)
     return out
-
-
-def _largest_line_g(x, band_hz=(3000.0, 3500.0)):
-    """Largest line [g] of the Hann-windowed amplitude spectrum in the band."""
-    n = len(x)
-    amp = np.abs(np.fft.rfft(x * np.hanning(n))) / n * 4.0 / cwru.G_M_S2
-    f = np.fft.rfftfreq(n, 1.0 / cwru.SAMPLE_RATE_HZ)
-    return float(amp[(f >= band_hz[0]) & (f < band_hz[1])].max())
-
-
-def test_healthy_lines_at_the_resonance_are_as_high_as_measured(results):
-    """The healthy bearing's ball-pass lines at the 3.2 kHz housing resonance (record 97: 4.0e-3 g at
-    3205 Hz; the twin: 3.3e-3 g) agree within a factor 2: the housing path carries the bearing's
-    own forces at the measured gain (its resonance and damping are calibrated on record 97, its
-    masses are Sawalhi & Randall's), so the fault levels below are the excitation's, not the path's."""
-    _, _, xm, xs = results[97]
-    assert 0.5 <= _largest_line_g(xs) / _largest_line_g(xm) <= 2.0
 
 
 def _ratio(results, number, side):

@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import welch
+from scipy.signal import butter, hilbert, sosfiltfilt, welch
 
 from twin.validation.vibration_simulation import simulate_vibration
 from twin.vibration import indicators as ind
@@ -209,6 +209,38 @@ def calibrate_housing(
     f_lo = f[lo] + (half - p[lo]) / (p[lo + 1] - p[lo]) * (f[lo + 1] - f[lo])
     f_hi = f[hi - 1] + (half - p[hi - 1]) / (p[hi] - p[hi - 1]) * (f[hi] - f[hi - 1])
     return float(f[i]), float((f_hi - f_lo) / (2.0 * f[i]))
+
+
+RING_DOWN_S = 1.5e-3  # decay fitted over this long after an impact's envelope peak [s]
+
+
+def ring_down(
+    x_m_s2: np.ndarray, rpm: float, line_multiple: float, sample_rate_hz: float = SAMPLE_RATE_HZ
+) -> tuple[float, float]:
+    """(frequency [Hz], damping ratio [-]) of the mode a fault record's impacts ring: the signal is
+    band-passed to ENVELOPE_BAND_HZ (4th-order Butterworth, zero phase); in each period of the
+    defect line (`line_multiple` x shaft) the Hilbert envelope's decay rate sigma [1/s] is the
+    log-linear fit over RING_DOWN_S after its peak, kept where the peak stands 3 x above the
+    envelope's median; the frequency is the band's Welch peak (2048 points), and zeta = median
+    sigma / (2 pi f) (a single mode's free decay, exp(-zeta omega t)). An independent check of the
+    housing damping calibrated on the healthy record, which has no impacts."""
+    x = np.asarray(x_m_s2, dtype=float)
+    y = sosfiltfilt(butter(4, ENVELOPE_BAND_HZ, "bandpass", fs=sample_rate_hz, output="sos"), x)
+    env = np.abs(hilbert(y))
+    period = int(sample_rate_hz * 60.0 / (rpm * line_multiple))
+    tail = int(round(RING_DOWN_S * sample_rate_hz))
+    t = np.arange(tail) / sample_rate_hz
+    floor = float(np.median(env))
+    rates = []
+    for start in range(0, len(env) - period - tail, period):
+        j = start + int(np.argmax(env[start : start + period]))
+        if env[j] > 3.0 * floor:
+            rates.append(-np.polyfit(t, np.log(env[j : j + tail]), 1)[0])
+    if not rates:
+        raise ValueError("ring_down: no impact stands 3 x above the envelope's median")
+    f, p = welch(y, sample_rate_hz, nperseg=2048)
+    f_ring = float(f[np.argmax(p)])
+    return f_ring, float(np.median(rates)) / (2.0 * math.pi * f_ring)
 
 
 FLOOR_BAND_HZ = (2000.0, 2900.0)  # healthy record: between the motor's content and the resonance

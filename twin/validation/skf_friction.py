@@ -33,6 +33,21 @@ turning and 0.15 at start. Over 100-1500 rad/s with the seed oil at 40 degC phi_
 (6205 at 100 rad/s), so M_sl moves by 2 % at most. The deep-groove G_rr and G_sl carry no centrifugal load; the same
 table's
 angular-contact and self-aligning rows add F_g = R3 d_m^4 n^2 (tests/physics/test_skf_high_speed.py).
+
+The model's domain has a lower edge in load: the same catalogue asks a deep-groove ball bearing for
+a minimum radial load (section 'Loads', 'Minimum load'),
+
+    F_rm = k_r (nu n / 1000)^(2/3) (d_m / 100)^2                        [kN]
+
+with nu the operating viscosity [mm^2/s], n [r/min], d_m [mm] and the minimum load factor k_r of
+the product tables: 0.025 for the 60 and 62 series (6200: 0.03), 0.03 for the 63 series (the 2018
+catalogue's product tables as transcribed in github.com/JRaposo-m/SKF-Bearing-Selection-Tool,
+skf_model/bearings/data/deep_groove_ball/deep_groove_ball.csv, column kr: 6000-6012 and
+6201-6212 0.025, 6200 0.03, 6300-6312 0.03; also github.com/gumyr/bd_warehouse, column SKT:kr).
+Below F_rm the
+catalogue states that the balls' inertia and the lubricant's friction govern the rolling and the
+balls may skid; the frictional-moment formula, fitted to loaded bearings, is outside its domain
+there (minimum_radial_load_n).
 """
 
 from __future__ import annotations
@@ -46,6 +61,10 @@ SERIES_CONSTANTS = {
     "62": (3.9e-7, 1.7, 3.23e-3, 36.5),
     "63": (3.7e-7, 1.7, 2.84e-3, 92.8),
 }
+# minimum load factor k_r per deep-groove series, and the designations that differ from their series
+# (SKF product tables, see the module docstring)
+MINIMUM_LOAD_FACTOR = {"60": 0.025, "62": 0.025, "63": 0.03}
+MINIMUM_LOAD_FACTOR_EXCEPTIONS = {"6200": 0.03}
 K_Z_DEEP_GROOVE = 3.1
 K_RS_OIL_JET = 3e-8
 K_RS_GREASE = 6e-8
@@ -149,3 +168,21 @@ def frictional_moment(
         phi_bl=phi_bl,
         mu_sl=mu_sl,
     )
+
+
+def minimum_radial_load_n(
+    designation: str, bore_mm: float, od_mm: float, shaft_speed_rad_s: float, kinematic_viscosity_mm2_s: float
+) -> float:
+    """SKF's requisite minimum radial load of a deep-groove ball bearing [N]:
+    F_rm = k_r (nu n / 1000)^(2/3) (d_m / 100)^2 kN (SKF Rolling bearings catalogue, deep groove ball
+    bearings, 'Minimum load'; k_r from MINIMUM_LOAD_FACTOR and its exceptions). A radial load below it is outside the
+    domain of the frictional-moment model (frictional_moment)."""
+    k_r = MINIMUM_LOAD_FACTOR_EXCEPTIONS.get(designation.strip(), MINIMUM_LOAD_FACTOR[series_of(designation)])
+    if not (shaft_speed_rad_s >= 0.0 and kinematic_viscosity_mm2_s > 0.0 and od_mm > bore_mm > 0.0):
+        raise ValueError(
+            "shaft_speed_rad_s must be >= 0, kinematic_viscosity_mm2_s > 0 and od_mm > bore_mm > 0 "
+            f"(got {shaft_speed_rad_s}, {kinematic_viscosity_mm2_s}, {bore_mm}, {od_mm})"
+        )
+    n_rpm = shaft_speed_rad_s * 30.0 / math.pi
+    dm_mm = 0.5 * (bore_mm + od_mm)
+    return 1e3 * k_r * (kinematic_viscosity_mm2_s * n_rpm / 1000.0) ** (2.0 / 3.0) * (dm_mm / 100.0) ** 2

@@ -327,8 +327,9 @@ def test_a_flag_for_every_setting_named_after_it_and_only_given_flags_override(c
 
 def test_the_help_of_a_flag_is_its_description(clean_env):
     text = build_parser()._subparsers._group_actions[0].choices["serve"].format_help()  # type: ignore[union-attr]
-    assert "HTTP port [TCP port number, 0 = any free port]." in " ".join(text.split())
-    assert "[BEARING_TWIN_PUBLISH_RATE_HZ]" in " ".join(text.split())
+    flat_text = " ".join(text.split())
+    assert "HTTP port [TCP port number, 0 = any free port] (default 8000) [BEARING_TWIN_PORT]" in flat_text
+    assert "[BEARING_TWIN_PUBLISH_RATE_HZ]" in flat_text
 
 
 def test_a_bad_flag_value_is_refused(clean_env):
