@@ -283,7 +283,7 @@ class TwinRunner:
         update = parse_update(fields if update is None else update, self.limits)
         setpoint = self._offer(update, timed=True, received_s=received_s, submitted_s=submitted)
         self._interrupt()
-        self._wake()
+        self._wake(urgent=True)
         return setpoint
 
     def submit_defects(self, defects: Any) -> tuple:
@@ -294,7 +294,7 @@ class TwinRunner:
         items = parse_defects(defects, self.twin.model.spec.geometry)
         items = self.defect_box.offer(items)
         self._interrupt()
-        self._wake()
+        self._wake(urgent=True)
         return items
 
     def submit_temperature(self, node: str, temperature_c: float) -> None:
@@ -392,9 +392,11 @@ class TwinRunner:
                 self._pool.close(timeout)
         return stopped
 
-    def _wake(self) -> None:
+    def _wake(self, *, urgent: bool = False) -> None:
+        """Release the twin's next frame now (`urgent`: an outside setpoint or defects, whose frame
+        the pool runs before the frames of twins that only keep their pace, SteppingPool.wake)."""
         if self._pool is not None and self._job is not None:
-            self._pool.wake(self._job)
+            self._pool.wake(self._job, urgent=urgent and not self.fast)
 
     def _interrupt(self) -> None:
         """An outside input waits (real time): end the frame in progress at its next step
