@@ -10,7 +10,7 @@ import sys
 from pathlib import Path
 
 from loadtest.attack import add_attack_command
-from loadtest.benchmark import run_service_benchmark
+from loadtest.benchmark import CLIENT_NICE, run_service_benchmark
 from loadtest.soak import add_soak_command
 from service.tools.cli import ArgumentParser, _positive_float, _positive_int
 
@@ -41,6 +41,13 @@ def build_parser() -> argparse.ArgumentParser:
     )
     bsv.add_argument("--no-zenoh", action="store_true", help="without zenoh (then no setpoint delay)")
     bsv.add_argument("--no-record", action="store_true", help="without the rerun recording")
+    bsv.add_argument(
+        "--client-nice",
+        type=int,
+        default=CLIENT_NICE,
+        help=f"nice of the client's threads while it measures, where allowed (default {CLIENT_NICE}: the "
+        "service's I/O threads'; the host's other load is then not counted as the service's latency)",
+    )
     bsv.add_argument("--json", action="store_true")
     bsv.add_argument(
         "--save",
@@ -66,6 +73,7 @@ def _cmd_bench_service(args: argparse.Namespace) -> int:
             record=not args.no_record,
             zenoh_on=not args.no_zenoh,
             force=args.force,
+            client_nice=args.client_nice,
         )
     except RuntimeError as exc:
         print(f"error: {' '.join(str(exc).split())[:2000]}", file=sys.stderr)

@@ -135,12 +135,12 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
     reads: dict[str, Any] = (
         {"dependencies": token, "responses": _UNAUTHORIZED} if token and settings.security.read_requires_token else {}
     )
+    app.include_router(setpoint.write, **writes)  # first: the latency-critical route is matched first
     app.include_router(health.router)
     for router in (bearings.read, state.read, alarms.read, defects.read, measured.read, scenarios.read, docs.read):
         app.include_router(router, **reads)
     for router in (
         bearings.write,
-        setpoint.write,
         defects.write,
         measured.write,
         scenarios.write,

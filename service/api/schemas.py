@@ -378,7 +378,9 @@ class TwinHealth(BaseModel):
     )
     setpoint_latency_ms: dict[str, Any] | None = Field(
         default=None,
-        description="Latency of the newest 1000 outside setpoints inside the service [ms]: `apply` (accepted -> "
+        description="Latency of the newest 1000 outside setpoints inside the service [ms]: `http` (HTTP setpoints: "
+        "the request read by the server -> submitted to the twin: parsing, middleware, routing, token, rate and body "
+        "checks), `admission` (-> accepted: merged and checked against the bearing's limits), `apply` (-> "
         "applied at a frame boundary), `step` (-> the frame that applies it captured), `build` (-> its snapshot "
         "built), `publish` (-> handed to every sink, the zenoh state put), `total`, each {p50, p99, max}, and `count`; "
         "null before the first.",

@@ -10,6 +10,9 @@ access log that never shows a secret.
   `timeout_keep_alive` (`http_keep_alive_s`) closes idle kept-alive connections, and
   `limit_concurrency` (`http_max_connections`) answers 503 beyond that many open connections
   or running requests, so one host cannot hold every socket or task of the service.
+* `GuardedH11Protocol` also notes when a request's headers were read (`request.state`
+  `RECEIVED_S`, time.perf_counter): the start of a setpoint's latency, its `http` stage
+  (service.core.mailbox.SetpointTiming).
 * `RedactAccessLog`: a filter on the `uvicorn.access` logger. In the logged path the value of
   every query parameter whose name says it is a secret (token, key, secret, password, auth,
   credential, signature, ...) becomes `[redacted]`, and so does the service's token wherever it
@@ -25,6 +28,7 @@ import json
 import logging
 import re
 import threading
+import time
 import urllib.parse
 from collections.abc import Iterable
 
@@ -32,6 +36,10 @@ import h11
 from uvicorn.protocols.http.h11_impl import H11Protocol
 
 log = logging.getLogger(__name__)
+
+#: key of `request.state` (the ASGI scope's "state") holding when the request's headers arrived
+#: [time.perf_counter() s]: the start of a setpoint's latency (service.core.mailbox.SetpointTiming)
+RECEIVED_S = "request_received_s"
 
 REDACTED = "[redacted]"
 _SECRET_NAME = re.compile(r"token|key|secret|passw|pwd|auth|credential|signature|sig$|session", re.IGNORECASE)
@@ -70,7 +78,11 @@ class GuardedH11Protocol(H11Protocol):
         self._arm("headers", self.header_timeout_s)
 
     def data_received(self, data: bytes) -> None:
+        received = time.perf_counter()
         super().data_received(data)
+        scope = getattr(self, "scope", None)  # the request whose headers this data completed, or an earlier one
+        if scope is not None:
+            scope.setdefault("state", {}).setdefault(RECEIVED_S, received)
         self._follow()
 
     def connection_lost(self, exc: Exception | None) -> None:

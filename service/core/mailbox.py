@@ -7,9 +7,12 @@ The runner thread `take`s the pending one between frames and hands it to the eng
 not check it again (it is `Admitted`). A `guard` may refuse more (the fault policy refuses
 values this twin could not hold).
 
-Timing: for every offer marked `timed` (an outside setpoint) the mailbox records when it was
-accepted; the runner stamps when it was applied and the publisher when the first snapshot that
-reflects it was published (`SetpointTiming`, for the latency benchmark).
+Timing: for every offer marked `timed` (an outside setpoint) the mailbox records when its request
+arrived (when the transport says so), when it was submitted and when it was accepted; the runner
+stamps when it was applied and the publisher when the first snapshot that reflects it was
+published (`SetpointTiming`, for /health and the latency benchmark). All stamps are the runner's
+clock (`time.perf_counter` in the service: CLOCK_MONOTONIC on Linux, so a client process on the
+same host can compare its own stamps with them).
 """
 
 from __future__ import annotations
@@ -24,9 +27,11 @@ from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
 
 @dataclass
 class SetpointTiming:
-    """When a setpoint was accepted and when it was first seen in a published snapshot."""
+    """When a setpoint arrived, was accepted, and was first seen in a published snapshot."""
 
     accepted_wall_s: float  # clock() at acceptance
+    submitted_wall_s: float | None = None  # when `TwinRunner.submit` was called (None: = accepted)
+    received_wall_s: float | None = None  # when its request arrived at the server (None: unknown)
     applied_wall_s: float | None = None  # when the runner applied it (frame boundary)
     captured_wall_s: float | None = None  # when the frame that reflects it was captured for publication
     built_wall_s: float | None = None  # when that capture's snapshot was built
@@ -34,17 +39,31 @@ class SetpointTiming:
     seq: int | None = None  # that snapshot's seq
 
     @property
+    def start_wall_s(self) -> float:
+        """Where its latency counts from: the request's arrival when known, else the submission."""
+        if self.received_wall_s is not None:
+            return self.received_wall_s
+        return self.accepted_wall_s if self.submitted_wall_s is None else self.submitted_wall_s
+
+    @property
     def latency_s(self) -> float | None:
-        """Accepted -> first published snapshot reflecting it [s]."""
+        """Arrival (or submission) -> first published snapshot reflecting it [s]."""
         if self.published_wall_s is None:
             return None
-        return self.published_wall_s - self.accepted_wall_s
+        return self.published_wall_s - self.start_wall_s
 
     def stages_s(self) -> dict[str, float] | None:
-        """The latency by stage [s] (None until published): `apply` accepted -> applied at a frame
-        boundary (the stepping thread's wake-up), `step` applied -> captured (the frame that applies
-        it), `build` captured -> its snapshot built, `publish` built -> handed to every sink (the
-        zenoh state put)."""
+        """The latency by stage [s] (None until published); they add up to `latency_s`:
+
+        * `http` (only when the request's arrival is known): the request's bytes read by the
+          server -> `submit` called (parsing, middleware, routing, the token and rate checks,
+          the body's validation);
+        * `admission`: `submit` -> accepted (merged in the mailbox, checked against the bearing's
+          limits and the fault policy);
+        * `apply`: accepted -> applied at a frame boundary (the stepping thread's wake-up);
+        * `step`: applied -> captured (the frame that applies it);
+        * `build`: captured -> its snapshot built;
+        * `publish`: built -> handed to every sink (the zenoh state put)."""
         a, b, c, e, d = (
             self.accepted_wall_s,
             self.applied_wall_s,
@@ -54,7 +73,10 @@ class SetpointTiming:
         )
         if b is None or c is None or e is None or d is None:
             return None
-        return {"apply": b - a, "step": c - b, "build": e - c, "publish": d - e}
+        submitted = a if self.submitted_wall_s is None else self.submitted_wall_s
+        out = {} if self.received_wall_s is None else {"http": submitted - self.received_wall_s}
+        out.update({"admission": a - submitted, "apply": b - a, "step": c - b, "build": e - c, "publish": d - e})
+        return out
 
 
 Guard = Callable[[Setpoint, SetpointUpdate], None]
@@ -79,9 +101,19 @@ class Mailbox:
         with self._lock:
             return self._target
 
-    def offer(self, update: SetpointUpdate, *, timed: bool = True, guard: Guard | None = None) -> Setpoint:
+    def offer(
+        self,
+        update: SetpointUpdate,
+        *,
+        timed: bool = True,
+        guard: Guard | None = None,
+        received_s: float | None = None,
+        submitted_s: float | None = None,
+    ) -> Setpoint:
         """Merge `update` over the target and check it (SetpointError naming every field out of
-        the bearing's range; whatever `guard` raises). Returns the new target."""
+        the bearing's range; whatever `guard` raises). Returns the new target. `received_s`,
+        `submitted_s`: when its request arrived and when it was submitted (a timed offer's
+        `SetpointTiming`)."""
         with self._lock:
             admitted = self.limits.admit(update, self._target)
             if guard is not None:
@@ -91,7 +123,11 @@ class Mailbox:
             self._target = admitted.setpoint
             if timed:
                 self.accepted += 1
-                self._timings.append(SetpointTiming(accepted_wall_s=self._clock()))
+                self._timings.append(
+                    SetpointTiming(
+                        accepted_wall_s=self._clock(), submitted_wall_s=submitted_s, received_wall_s=received_s
+                    )
+                )
             return admitted.setpoint
 
     def take(self) -> tuple[Admitted | None, list[SetpointTiming]]:

@@ -21,7 +21,10 @@ so twins that cannot all keep up fall behind together rather than one starving. 
 deadline (fast mode) run round robin after every released real-time job. A job is held by at
 most one thread at a time: its twin's state has one writer at any moment (which thread that is
 may change from frame to frame). `wake(job)` releases a waiting job now (a setpoint arrived, a
-scenario started, the twin is asked to stop).
+scenario started, the twin is asked to stop); `wake(job, urgent=True)` also gives the frame it
+releases the deadline "now", so it goes before the released frames of twins that only keep their
+pace (an outside setpoint: with three twins on two stepping threads its wait for a thread, the
+`apply` stage of the setpoint latency, is otherwise up to a frame of each other twin).
 
 Wake-ups. A thread that puts a job back is free at once and itself waits for the earliest
 release (or takes a released job), so putting back wakes nobody; a thread that takes a job
@@ -82,6 +85,7 @@ class Job:
     state: str = "waiting"  # waiting | ready | running | done
     gen: int = 0  # heap entries of older generations are stale
     wake_pending: bool = False  # woken while running: release at once when put back
+    wake_deadline: float = math.inf  # woken urgently while running: the deadline of its next frame
     frames: int = 0  # steps run (for the tests and the accounting)
     done: threading.Event = field(default_factory=threading.Event)
 
@@ -116,12 +120,17 @@ class EdfQueue:
         job.state = "done"
         self.jobs.discard(job)
 
-    def wake(self, job: Job, now: float) -> bool:
-        """Release a waiting job now (its deadline stays). Returns whether it was waiting."""
-        if job.state != "waiting" or job.release <= now:
-            return False
-        self.put(job, Schedule(now, job.deadline))
-        return True
+    def wake(self, job: Job, now: float, deadline: float = math.inf) -> bool:
+        """Release a waiting job now, its deadline brought forward to `deadline` when that is
+        earlier (a released job not yet taken is moved up the same way). Returns whether it was
+        released or moved up."""
+        if job.state == "waiting" and job.release > now:
+            self.put(job, Schedule(now, min(job.deadline, deadline)))
+            return True
+        if job.state in ("waiting", "ready") and deadline < job.deadline:
+            self.put(job, Schedule(min(job.release, now), deadline))
+            return True
+        return False
 
     def _release_due(self, now: float) -> None:
         w = self._waiting
@@ -264,14 +273,19 @@ class SteppingPool:
             self._cond.notify_all()
         return job
 
-    def wake(self, job: Job | None) -> None:
-        """Release a waiting job now; a running one is released as soon as it is put back."""
+    def wake(self, job: Job | None, *, urgent: bool = False) -> None:
+        """Release a waiting job now; a running one is released as soon as it is put back.
+        `urgent`: the frame it releases is due now (earliest deadline first: before the frames
+        of the twins that only keep their pace)."""
         if job is None:
             return
         with self._cond:
+            now = self.clock()
             if job.state == "running":
                 job.wake_pending = True
-            elif self._queue.wake(job, self.clock()):
+                if urgent:
+                    job.wake_deadline = min(job.wake_deadline, now)
+            elif self._queue.wake(job, now, now if urgent else math.inf):
                 self._cond.notify_all()
 
     def close(self, timeout: float = 5.0) -> bool:
@@ -298,7 +312,7 @@ class SteppingPool:
                     now = self.clock()
                     job = q.take(now)
                     if job is not None:
-                        job.wake_pending = False
+                        job.wake_pending, job.wake_deadline = False, math.inf
                         if q.next_release() is not None:
                             cond.notify()  # another job waits: one free thread takes over its timer
                         break
@@ -315,8 +329,10 @@ class SteppingPool:
                     q.remove(job)
                 else:
                     if job.wake_pending:
-                        schedule = Schedule(min(schedule.release, self.clock()), schedule.deadline)
-                        job.wake_pending = False
+                        schedule = Schedule(
+                            min(schedule.release, self.clock()), min(schedule.deadline, job.wake_deadline)
+                        )
+                        job.wake_pending, job.wake_deadline = False, math.inf
                     q.put(job, schedule)  # this thread is free again and times it: no wake-up
             if schedule is None:
                 try:

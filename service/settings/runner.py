@@ -98,13 +98,14 @@ class RunnerSettings(BaseModel):
         description="Simulated time per frame; setpoints and scenario steps apply between frames [s].",
     )
     setpoint_frame_s: float = Field(
-        default=0.001,
+        default=0.00025,
         ge=1e-5,
         le=0.1,
         json_schema_extra=flat(
             "setpoint_frame_s",
             details="It applies when shorter than frame_s, and a twin waiting for its next frame starts it at once, "
-            "so the state carrying the setpoint is published sooner.",
+            "so the state carrying the setpoint is published sooner. 0.25 ms costs about 0.07 ms of engine CPU for "
+            "the default twin on the 2-core EPYC VM, 1 ms about 0.27 ms (the `step` stage of the setpoint latency).",
         ),
         description="Real-time mode: length of the frame that applies an outside setpoint (HTTP, zenoh) [s].",
     )

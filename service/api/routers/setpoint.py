@@ -4,11 +4,12 @@ from __future__ import annotations
 
 from typing import Annotated, Any
 
-from fastapi import APIRouter, Body, Depends
+from fastapi import APIRouter, Body, Request
 
-from service.api.deps import TwinDep, setpoint_rate
+from service.api.deps import BudgetedTwinDep
 from service.api.routers.bearings import INVALID, UNKNOWN_TWIN
 from service.api.schemas import ErrorResponse, SetpointResponse
+from service.api.server import RECEIVED_S
 from twin.setpoint import SetpointUpdate
 
 write = APIRouter(prefix="/v1/bearings", tags=["bearings"])
@@ -25,11 +26,11 @@ TOO_MANY: dict[int | str, dict[str, Any]] = {
 @write.put(
     "/{bearing_id}/setpoint",
     response_model=SetpointResponse,
-    dependencies=[Depends(setpoint_rate)],
     responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY},
 )
 async def put_setpoint(
-    entry: TwinDep,
+    request: Request,
+    entry: BudgetedTwinDep,
     update: Annotated[
         SetpointUpdate, Body(description="Partial setpoint: missing fields keep their value; units in the field names.")
     ],
@@ -41,5 +42,5 @@ async def put_setpoint(
     twin's mailbox under a lock and wakes its runner (tens of microseconds, never waits on a
     frame), and the hop to a worker thread (at the I/O threads' lower priority, service.core.priority)
     cost 0.8 ms at the median and 5 ms at the 99th percentile of the PUT -> zenoh state latency."""
-    setpoint = entry.runner.submit(update)
+    setpoint = entry.runner.submit(update, received_s=request.scope.get("state", {}).get(RECEIVED_S))
     return SetpointResponse(bearing_id=entry.id, setpoint=setpoint, frame_s=entry.runner.frame_s)

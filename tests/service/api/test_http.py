@@ -117,6 +117,32 @@ def test_put_setpoint_shows_up_in_state(client, wait_for):
     assert client.put("/v1/bearings/default/setpoint", json={}).status_code == 200  # empty = no change
 
 
+def test_setpoint_latency_counts_from_the_requests_arrival(client, wait_for):
+    """A setpoint's latency by stage (/health `setpoint_latency_ms`) starts where the server read
+    its request: `http` (arrival -> submit) and `admission` (submit -> accepted) come before the
+    stages inside the runner, and the `http` stage lies within the client's own round trip (the
+    server runs in this process: one clock)."""
+    r = client.post("/v1/bearings", json={"id": "latency-6205", "designation": "6205"})
+    assert r.status_code == 201, r.text
+    try:
+        t0 = time.perf_counter()
+        assert client.put("/v1/bearings/latency-6205/setpoint", json={"radial_load_n": 1500.0}).status_code == 200
+        round_trip_ms = 1e3 * (time.perf_counter() - t0)
+        health = wait_for(
+            lambda: client.get("/health").json(),
+            lambda h: any(t["id"] == "latency-6205" and t["setpoint_latency_ms"] for t in h["twins"]),
+        )
+        latency = next(t for t in health["twins"] if t["id"] == "latency-6205")["setpoint_latency_ms"]
+        assert latency["count"] == 1
+        assert set(latency) == {"http", "admission", "apply", "step", "build", "publish", "total", "count"}
+        stages = {name: latency[name]["max"] for name in ("http", "admission", "apply", "step", "build", "publish")}
+        assert all(v >= 0.0 for v in stages.values()), stages
+        assert stages["http"] + stages["admission"] <= round_trip_ms
+        assert sum(stages.values()) == pytest.approx(latency["total"]["max"], abs=0.01)  # rounded to 1 us each
+    finally:
+        client.delete("/v1/bearings/latency-6205")
+
+
 @pytest.mark.parametrize(
     "body, field, low, high",
     [

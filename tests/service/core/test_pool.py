@@ -518,3 +518,29 @@ def test_max_twins_unset_means_the_capacity_decides():
     assert ServiceSettings().runner.max_twins is None and ServiceSettings().runner.twin_limit == 256
     assert ServiceSettings(max_twins=3).runner.twin_limit == 3
     assert math.isclose(ServiceSettings().runner.frame_s, 0.005) and ServiceSettings().runner.lateness_s == 0.005
+
+
+def test_an_urgent_wake_puts_the_frame_before_the_released_frames_of_the_others():
+    """Earliest deadline first: a setpoint's frame (woken urgently) is taken before the frames of
+    twins that only keep their pace, whether its job waited for its release or was released."""
+    q = EdfQueue()
+    a, b, c = _job("a"), _job("b"), _job("c")
+    q.put(a, Schedule(release=0.050, deadline=0.055))
+    q.put(b, Schedule(release=0.000, deadline=0.004))
+    q.put(c, Schedule(release=0.000, deadline=0.006))
+    assert q.wake(a, 0.002, deadline=0.002)  # waiting: released now, due now
+    assert q.take(0.002) is a
+    q.put(a, Schedule(release=0.000, deadline=0.010))
+    assert q.take(0.003) is b  # a is released but due last
+    assert q.wake(a, 0.003, deadline=0.003)  # moved up the released jobs
+    assert not q.wake(a, 0.003, deadline=0.003)  # already due now
+    assert q.take(0.003) is a
+    assert q.take(0.003) is c
+
+
+def test_an_urgent_wake_of_a_running_job_gives_its_next_frame_the_deadline_now():
+    pool = SteppingPool(1, clock=lambda: 1.0)
+    job = Job(task=None)
+    job.state = "running"
+    pool.wake(job, urgent=True)
+    assert job.wake_pending and job.wake_deadline == 1.0

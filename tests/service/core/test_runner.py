@@ -451,10 +451,25 @@ def test_a_setpoint_snapshot_is_delivered_by_the_stepping_thread_in_order(twin, 
     assert workers <= sink.threads
     for timing in runner.setpoint_latencies():
         stages = timing.stages_s()
-        assert stages is not None and set(stages) == {"apply", "step", "build", "publish"}
+        assert stages is not None and set(stages) == {"admission", "apply", "step", "build", "publish"}
         assert all(v >= 0.0 for v in stages.values())
         assert sum(stages.values()) == pytest.approx(timing.latency_s, abs=1e-9)
     latency = runner.stats()["setpoint_latency_ms"]
     assert latency["count"] == 5
-    assert set(latency) == {"apply", "step", "build", "publish", "total", "count"}
+    assert set(latency) == {"admission", "apply", "step", "build", "publish", "total", "count"}
     assert latency["total"]["p50"] <= latency["total"]["p99"] <= latency["total"]["max"]
+
+
+def test_setpoint_timing_stages_start_at_the_requests_arrival():
+    """With the request's arrival known, the latency counts from it and the `http` stage comes
+    first; the stages add up to the latency. Without it, from the submission."""
+    from service.core.mailbox import SetpointTiming
+
+    t = SetpointTiming(accepted_wall_s=10.0003, submitted_wall_s=10.0002, received_wall_s=10.0)
+    t.applied_wall_s, t.captured_wall_s, t.built_wall_s, t.published_wall_s = 10.0005, 10.0010, 10.0012, 10.0013
+    stages = t.stages_s()
+    assert list(stages) == ["http", "admission", "apply", "step", "build", "publish"]
+    assert stages["http"] == pytest.approx(2e-4) and stages["admission"] == pytest.approx(1e-4)
+    assert sum(stages.values()) == pytest.approx(t.latency_s) == pytest.approx(1.3e-3)
+    t.received_wall_s = None
+    assert "http" not in t.stages_s() and t.latency_s == pytest.approx(1.1e-3)
