@@ -144,3 +144,24 @@ class FaultPolicy:
                 )
         if errors:
             raise InputError(errors)
+
+
+class ErrorStreak:
+    """Failed frames in a row of one twin, against the limit at which its runner gives up."""
+
+    def __init__(self, limit: int) -> None:
+        self.limit = int(limit)
+        self.count = 0
+
+    def add(self) -> int:
+        """One more failed frame; returns how many in a row."""
+        self.count += 1
+        return self.count
+
+    def clear(self) -> None:
+        """A frame succeeded."""
+        self.count = 0
+
+    @property
+    def exhausted(self) -> bool:
+        return self.count >= self.limit

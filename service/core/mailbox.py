@@ -21,8 +21,11 @@ import threading
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Generic, TypeVar
 
 from twin.setpoint import Admitted, Setpoint, SetpointLimits, SetpointUpdate
+
+T = TypeVar("T")
 
 
 @dataclass
@@ -147,3 +150,22 @@ class Mailbox:
         with self._lock:
             self._target = setpoint
             self._pending = None
+
+
+class LatestValue(Generic[T]):
+    """A one-slot mailbox between threads: the value offered last waits for the runner thread,
+    which takes it once (latest wins)."""
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._pending: T | None = None
+
+    def offer(self, value: T) -> None:
+        with self._lock:
+            self._pending = value
+
+    def take(self) -> T | None:
+        """The pending value, or None; the slot is empty afterwards."""
+        with self._lock:
+            pending, self._pending = self._pending, None
+        return pending

@@ -66,7 +66,8 @@ class Schedule:
 class Steppable(Protocol):
     """What the pool runs: one frame per `step` call."""
 
-    name: str
+    @property
+    def name(self) -> str: ...
 
     def step(self, now: float) -> Schedule | None:
         """Run one frame (or one idle poll); return when to run next, None to leave the pool."""

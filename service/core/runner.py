@@ -52,8 +52,8 @@ from pydantic import ValidationError
 from service.core.capacity import CpuMeter, TwinCost
 from service.core.defects import DefectBox, parse_defects
 from service.core.errors import InputError, field_errors, setpoint_field_errors
-from service.core.faults import Fallback, FaultPolicy
-from service.core.mailbox import Mailbox, SetpointTiming
+from service.core.faults import ErrorStreak, Fallback, FaultPolicy
+from service.core.mailbox import LatestValue, Mailbox, SetpointTiming
 from service.core.pacing import PacingClock
 from service.core.pool import Job, Schedule, SteppingPool
 from service.core.publishing import Publisher
@@ -127,23 +127,20 @@ class TwinRunner:
             raise ValueError(f"frame_s = {frame_s!r} s is shorter than the time step {dt:g} s")
         self.twin = twin
         self.bearing_id = twin.bearing_id
-        self.name = f"twin-{self.bearing_id}"
         self.fast = bool(fast)
         self.publish_rate_hz = float(publish_rate_hz)
         self.frame_steps = steps
-        self.frame_s = steps * dt
         sp_steps = steps if setpoint_frame_s is None else max(1, min(steps, round(setpoint_frame_s / dt)))
         self.setpoint_frame_steps = steps if self.fast else sp_steps
         self.idle_without_scenario = idle_without_scenario
-        self.max_consecutive_errors = max_consecutive_errors
+        self.errors_in_a_row = ErrorStreak(max_consecutive_errors)
         self.limits: SetpointLimits = twin.limits
         self.calibration: TwinCost | None = cost  # measured at admission (service.core.capacity)
         self._clock = clock
 
         self.mailbox = Mailbox(twin.setpoint, self.limits, clock=clock)
         self.defect_box = DefectBox()  # local defects waiting for the next frame
-        self._measurement_lock = threading.Lock()
-        self._measurement: tuple[str, float] | None = None  # a measured temperature for the next frame
+        self.measured_temperature: LatestValue[tuple[str, float]] = LatestValue()  # (node, degC) for the next frame
         self.faults = FaultPolicy(
             twin.setpoint,
             self.limits,
@@ -167,7 +164,6 @@ class TwinRunner:
         self.counters = LoopCounters()
         self.engine_cpu = CpuMeter(window=2.0)  # CPU s per simulated s of this twin's frames
         self._sim_steps = 0  # steps advanced by this runner (integer: no drift)
-        self._consecutive = 0
         self._reanchor = False
         self._stop = threading.Event()
         self._done = threading.Event()
@@ -176,6 +172,16 @@ class TwinRunner:
         self._job: Job | None = None
 
     # ---- public, any thread ------------------------------------------------------------------
+    @property
+    def name(self) -> str:
+        """The stepping thread's and the pool job's name."""
+        return f"twin-{self.bearing_id}"
+
+    @property
+    def frame_s(self) -> float:
+        """Simulated time of a frame [s]: a whole number of the twin's time steps."""
+        return self.frame_steps * self.twin.model.dt_s
+
     @property
     def mode(self) -> RunMode:
         return "fast" if self.fast else "real_time"
@@ -313,13 +319,11 @@ class TwinRunner:
             raise InputError.one("node", f"{node!r} cannot be measured", allowed=list(MEASURABLE_NODES))
         if not (math.isfinite(temperature_c) and -60.0 <= temperature_c <= 400.0):
             raise InputError.one("temperature_c", f"{temperature_c!r}: must be finite, in [-60, 400] degC")
-        with self._measurement_lock:
-            self._measurement = (node, float(temperature_c))
+        self.measured_temperature.offer((node, float(temperature_c)))
         self._wake()
 
     def _take_measurement(self) -> None:
-        with self._measurement_lock:
-            pending, self._measurement = self._measurement, None
+        pending = self.measured_temperature.take()
         if pending is not None and self.twin.thermal is not None:
             self.twin.measure_temperature(*pending)
 
@@ -502,16 +506,14 @@ class TwinRunner:
                 self._publish(self._clock())
                 pacing.restart_sample_grid(self.sim_elapsed_s)
             self._frame(self.setpoint_frame_steps if outside else self.frame_steps)
-            self._consecutive = 0
+            self.errors_in_a_row.clear()
         except Exception as exc:  # noqa: BLE001 - counted, shown, recovered
-            self._consecutive += 1
-            self._on_error(exc, self._consecutive)
+            streak = self.errors_in_a_row.add()
+            self._on_error(exc, streak)
             self._notify_ended()
-            if self._consecutive >= self.max_consecutive_errors:
+            if self.errors_in_a_row.exhausted:
                 self.counters.failed = True
-                self.publisher.note = (
-                    f"failed: runner stopped after {self._consecutive} errors in a row; last: {self.last_error}"
-                )
+                self.publisher.note = f"failed: runner stopped after {streak} errors in a row; last: {self.last_error}"
                 log.error("twin %s: %s", self.bearing_id, self.publisher.note)
                 self._safe_publish()
                 return None
