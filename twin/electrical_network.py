@@ -20,7 +20,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
+from twin.jit import JIT_VECTOR
 from twin.kernels import layout as L
 from twin.model import BearingModel
 from twin.physics.electrical import outer_zone_capacitance_f
@@ -52,15 +54,116 @@ class ElectricalNetwork:
     reason: str
 
 
-def _open_contact_capacitance(model: BearingModel, r: int, gap_m: np.ndarray) -> np.ndarray:
-    el = model.spec.electrical
-    rx, ry = model.race_params[r, L.R_RX], model.race_params[r, L.R_RY]
-    return np.array(
-        [
-            outer_zone_capacitance_f(el.oil_relative_permittivity, rx, ry, max(g, _MIN_GAP_M), model.gap_limit_m[r])
-            for g in gap_m
-        ]
-    )
+@njit(**JIT_VECTOR)
+def _reciprocal(re, im):
+    """1 / (re + i im) by Smith's scaling, as numpy's complex division computes it (the same
+    roundings, so the network's published values equal numpy's)."""
+    if abs(re) >= abs(im):
+        if re == 0.0 and im == 0.0:
+            return 1.0 / abs(re), 0.0 / abs(re)
+        rat = im / re
+        scl = 1.0 / (re + im * rat)
+        return (1.0 + 0.0 * rat) * scl, (0.0 - 1.0 * rat) * scl
+    rat = re / im
+    scl = 1.0 / (im + re * rat)
+    return (1.0 * rat + 0.0) * scl, (0.0 * rat - 1.0) * scl
+
+
+@njit(**JIT_VECTOR)
+def contact_impedances(
+    contacts, omega_rad_s, relative_permittivity, race_params, gap_limit_inner_m, gap_limit_outer_m
+):  # pragma: no cover - compiled
+    """The per-contact and per-ball elements of the network at angular frequency `omega_rad_s`,
+    from the contact lanes `contacts` (N_ROWS, 2Z; column 2j the inner, 2j + 1 the outer contact
+    of ball j).
+
+    A loaded contact is its lane's parallel R (inf where the lane gives none or a non-positive
+    one) and C; an open contact a pure capacitor across its gap (at least _MIN_GAP_M), integrated
+    over the ball-groove geometry of its raceway (twin.physics.electrical.outer_zone_capacitance_f).
+    Each ball is its two contacts in series: Z_ball = Z_in + Z_out, R_ball = R_in + R_out,
+    C_ball = C_in C_out / (C_in + C_out) (0 when both are 0).
+
+    Returns (r_contact [ohm], c_contact [F], z_contact [ohm], r_ball [ohm], c_ball [F],
+    z_ball [ohm], y_ball [S]); z and y complex. Their moduli are numpy's (`np.abs`, whose
+    rounding depends on the host's vector instructions), taken by the caller."""
+    n = contacts.shape[1]
+    z = n // 2
+    r_c = np.empty(n)
+    c_c = np.empty(n)
+    z_c = np.empty(n, np.complex128)
+    for k in range(n):
+        loaded = contacts[L.C_LOAD, k] > 0.0
+        r = contacts[L.C_RESISTANCE, k] if loaded else math.inf
+        r_c[k] = r if r > 0.0 else math.inf
+        if loaded:
+            c_c[k] = contacts[L.C_CAPACITANCE, k]
+        else:
+            race = k % 2
+            gap = -contacts[L.G_DELTA, k]
+            if gap < _MIN_GAP_M:
+                gap = _MIN_GAP_M
+            c_c[k] = outer_zone_capacitance_f(
+                relative_permittivity,
+                race_params[race, L.R_RX],
+                race_params[race, L.R_RY],
+                gap,
+                gap_limit_inner_m if race == 0 else gap_limit_outer_m,
+            )
+        conductance = 0.0 if math.isinf(r_c[k]) else 1.0 / r_c[k]
+        re, im = _reciprocal(conductance, omega_rad_s * c_c[k])
+        z_c[k] = complex(re, im)
+    r_ball = np.empty(z)
+    c_ball = np.empty(z)
+    z_ball = np.empty(z, np.complex128)
+    y_ball = np.empty(z, np.complex128)
+    for j in range(z):
+        z_sum = complex(z_c[2 * j].real + z_c[2 * j + 1].real, z_c[2 * j].imag + z_c[2 * j + 1].imag)
+        z_ball[j] = z_sum
+        re, im = _reciprocal(z_sum.real, z_sum.imag)
+        y_ball[j] = complex(re, im)
+        r_ball[j] = r_c[2 * j] + r_c[2 * j + 1]
+        c_in, c_out = c_c[2 * j], c_c[2 * j + 1]
+        c_sum = c_in + c_out
+        c_ball[j] = c_in * c_out / max(c_sum, 1e-300) if c_sum > 0 else 0.0
+    return r_c, c_c, z_c, r_ball, c_ball, z_ball, y_ball
+
+
+@njit(**JIT_VECTOR)
+def film_stress_maxima(
+    contacts, abs_z_contact, abs_z_ball, abs_y_ball, abs_y_sum, voltage_v, current_a
+):  # pragma: no cover - compiled
+    """(largest film field [V/m], largest apparent current density [A/m^2]) over the contacts.
+
+    Each ball carries its admittance's share of the current, I |Y_ball| / sum |Y_ball|; each film
+    sees its share of the voltage, V |Z_contact| / |Z_ball| (the moduli given), across its thickness (the lane's
+    h_min where loaded, the gap where open, at least _MIN_GAP_M); the density is the ball's
+    current over the Hertz ellipse pi a b of a loaded contact (0 for an open one). NaN propagates
+    to the maximum."""
+    n = contacts.shape[1]
+    max_field = -math.inf
+    max_density = -math.inf
+    for k in range(n):
+        j = k // 2
+        loaded = contacts[L.C_LOAD, k] > 0.0
+        v_contact = voltage_v * abs_z_contact[k] / abs_z_ball[j]
+        if loaded:
+            film = contacts[L.C_H_MIN, k]
+            if film < _MIN_GAP_M:
+                film = _MIN_GAP_M
+        else:
+            film = -contacts[L.G_DELTA, k]
+            if film < _MIN_GAP_M:
+                film = _MIN_GAP_M
+        field = v_contact / film
+        area = math.pi * contacts[L.C_SEMI_MAJOR, k] * contacts[L.C_SEMI_MINOR, k]
+        density = 0.0
+        if loaded and area > 0.0:
+            density = current_a * (abs_y_ball[j] / max(abs_y_sum, 1e-300)) / area
+        if field > max_field or math.isnan(field):
+            max_field = field if not math.isnan(max_field) else max_field
+        if density > max_density or math.isnan(density):
+            max_density = density if not math.isnan(max_density) else max_density
+    return max_field, max_density
 
 
 def bearing_network(
@@ -68,28 +171,17 @@ def bearing_network(
 ) -> ElectricalNetwork:
     """Evaluate the network for the contact rows `contacts` (TwinState.contacts view)."""
     el = model.spec.electrical
-    z = model.ball_count
     omega = 2.0 * math.pi * el.frequency_hz
-    loaded = contacts[L.C_LOAD] > 0.0
-    r_c = np.where(loaded, contacts[L.C_RESISTANCE], np.inf)
-    r_c = np.where(r_c > 0.0, r_c, np.inf)
-    c_c = contacts[L.C_CAPACITANCE].copy()
-    gap = np.maximum(-contacts[L.G_DELTA], _MIN_GAP_M)
-    for r in range(2):
-        idx = np.arange(r, 2 * z, 2)
-        open_idx = idx[~loaded[idx]]
-        if open_idx.size:
-            c_c[open_idx] = _open_contact_capacitance(model, r, gap[open_idx])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        y_c = np.where(np.isinf(r_c), 0.0, 1.0 / r_c) + 1j * omega * c_c
-        z_c = 1.0 / y_c
-        z_ball = z_c[0::2] + z_c[1::2]
-        y_ball = 1.0 / z_ball
+    r_c, c_c, z_c, r_ball, c_ball, z_ball, y_ball = contact_impedances(
+        contacts,
+        omega,
+        el.oil_relative_permittivity,
+        model.race_params,
+        model.gap_limit_m[0],
+        model.gap_limit_m[1],
+    )
     y = complex(np.sum(y_ball)) + 1j * omega * model.rest_capacitance_f
     z_total = 1.0 / y
-    r_ball = r_c[0::2] + r_c[1::2]
-    c_in, c_out = c_c[0::2], c_c[1::2]
-    c_ball = np.where(c_in + c_out > 0, c_in * c_out / np.maximum(c_in + c_out, 1e-300), 0.0)
     # drive: a voltage setpoint wins; a current alone develops I |Z|
     if shaft_voltage_v > 0.0:
         voltage = shaft_voltage_v
@@ -97,16 +189,10 @@ def bearing_network(
     else:
         current = shaft_current_a
         voltage = current * abs(z_total)
-    # each ball carries its admittance's share of the current; each film sees its share of V
-    share = np.abs(y_ball) / max(float(np.sum(np.abs(y_ball))), 1e-300)
-    i_ball = current * share
-    v_contact = voltage * np.abs(z_c) / np.repeat(np.abs(z_ball), 2)
-    film = np.where(loaded, np.maximum(contacts[L.C_H_MIN], _MIN_GAP_M), gap)
-    field = v_contact / film
-    area = math.pi * contacts[L.C_SEMI_MAJOR] * contacts[L.C_SEMI_MINOR]
-    density = np.where(loaded & (area > 0), np.repeat(i_ball, 2) / np.where(area > 0, area, 1.0), 0.0)
-    max_field = float(np.max(field)) if field.size else 0.0
-    max_density = float(np.max(density)) if density.size else 0.0
+    abs_y_ball = np.abs(y_ball)
+    max_field, max_density = film_stress_maxima(
+        contacts, np.abs(z_c), np.abs(z_ball), abs_y_ball, float(np.sum(abs_y_ball)), float(voltage), float(current)
+    )
     risk, reason = _risk(el, max_field, max_density, voltage, current)
     phase = math.atan2(z_total.imag, z_total.real)
     capacitance: float | None = y.imag / omega

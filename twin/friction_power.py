@@ -28,7 +28,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
+from twin.jit import JIT_VECTOR
 from twin.kernels import layout as L
 from twin.model import BearingModel
 from twin.physics import drag, seals, starvation
@@ -157,9 +159,8 @@ def ball_drag_power_w(
     return (oil_fraction * f_oil + (1.0 - oil_fraction) * f_air) * v
 
 
-def contact_powers_w(
-    contacts: np.ndarray, ball_angular_velocity_rad_s: np.ndarray, ball_radius_m: float
-) -> tuple[np.ndarray, ...]:
+@njit(**JIT_VECTOR)
+def contact_powers_w(contacts, ball_angular_velocity_rad_s, ball_radius_m):  # pragma: no cover - compiled
     """(rolling, sliding, spin) power of every ball-raceway contact [W], each (Z, 2), from the
     contact lanes (N_ROWS, 2Z) of the last step, the balls' angular velocities (Z, 3) and radius.
 
@@ -169,33 +170,42 @@ def contact_powers_w(
     traction's moment across the ellipse (differential slip, E_M2*) against the ball's rotation
     relative to the ring; the moment about the normal against the relative spin rate. Their sum
     over the contacts is the shaft's power in steady running. Each is floored at 0 per contact
-    (the tangential springs store and give back a little energy from step to step)."""
+    (the tangential springs store and give back a little energy from step to step), and is 0 at
+    an open contact."""
     c = contacts
-    loaded = c[L.G_DELTA] > 0.0
-    n = c[[L.G_NX, L.G_NY, L.G_NZ]]
-    e = c[[L.O_EX, L.O_EY, L.O_EZ]]
-    roll_force = c[L.C_ROLLING_PER_SPEED] * e  # on the ball [N]
-    spin = c[L.K_SPIN]
-    q = c[[L.K_PX, L.K_PY, L.K_PZ]] + ball_radius_m * n  # contact point relative to the ring centre
-    ring_velocity = c[[L.K_OVX, L.K_OVY, L.K_OVZ]].copy()
-    ring_velocity[0] -= spin * q[1]
-    ring_velocity[1] += spin * q[0]
-    centre_over_ring = c[[L.K_VX, L.K_VY, L.K_VZ]] - ring_velocity
-    rolling = -np.sum(roll_force * centre_over_ring, axis=0)
-    f = c[[L.O_FX, L.O_FY, L.O_FZ]]
-    f_t = f - np.sum(f * n, axis=0) * n - roll_force  # the friction force on the ball, tangential
-    slip = c[[L.O_SX, L.O_SY, L.O_SZ]]
-    w_rel = np.repeat(ball_angular_velocity_rad_s.T, 2, axis=1)  # (3, 2Z)
-    w_rel[2] -= spin
-    m2 = c[[L.E_M2X, L.E_M2Y, L.E_M2Z]]
-    sliding = -np.sum(f_t * slip, axis=0) - np.sum(m2 * w_rel, axis=0)
-    spin_w = np.abs(c[L.E_SPIN_MOMENT] * c[L.E_SPIN_RATE])
-    z = contacts.shape[1] // 2
-
-    def per_contact(p):
-        return np.where(loaded, np.maximum(p, 0.0), 0.0).reshape(z, 2)
-
-    return per_contact(rolling), per_contact(sliding), per_contact(spin_w)
+    z = c.shape[1] // 2
+    rolling = np.zeros((z, 2))
+    sliding = np.zeros((z, 2))
+    spin_w = np.zeros((z, 2))
+    for k in range(2 * z):
+        if not c[L.G_DELTA, k] > 0.0:
+            continue
+        j, side = k // 2, k % 2
+        nx, ny, nz = c[L.G_NX, k], c[L.G_NY, k], c[L.G_NZ, k]
+        per_speed = c[L.C_ROLLING_PER_SPEED, k]
+        rfx, rfy, rfz = per_speed * c[L.O_EX, k], per_speed * c[L.O_EY, k], per_speed * c[L.O_EZ, k]  # on the ball [N]
+        spin = c[L.K_SPIN, k]
+        qx = c[L.K_PX, k] + ball_radius_m * nx  # contact point relative to the ring centre
+        qy = c[L.K_PY, k] + ball_radius_m * ny
+        ring_vx = c[L.K_OVX, k] - spin * qy
+        ring_vy = c[L.K_OVY, k] + spin * qx
+        ring_vz = c[L.K_OVZ, k]
+        cx, cy, cz = c[L.K_VX, k] - ring_vx, c[L.K_VY, k] - ring_vy, c[L.K_VZ, k] - ring_vz
+        p_roll = -(rfx * cx + rfy * cy + rfz * cz)
+        fx, fy, fz = c[L.O_FX, k], c[L.O_FY, k], c[L.O_FZ, k]
+        f_n = fx * nx + fy * ny + fz * nz
+        ftx, fty, ftz = fx - f_n * nx - rfx, fy - f_n * ny - rfy, fz - f_n * nz - rfz  # tangential friction
+        wx = ball_angular_velocity_rad_s[j, 0]
+        wy = ball_angular_velocity_rad_s[j, 1]
+        wz = ball_angular_velocity_rad_s[j, 2] - spin
+        p_slide = -(ftx * c[L.O_SX, k] + fty * c[L.O_SY, k] + ftz * c[L.O_SZ, k]) - (
+            c[L.E_M2X, k] * wx + c[L.E_M2Y, k] * wy + c[L.E_M2Z, k] * wz
+        )
+        p_spin = abs(c[L.E_SPIN_MOMENT, k] * c[L.E_SPIN_RATE, k])
+        rolling[j, side] = p_roll if (p_roll > 0.0 or math.isnan(p_roll)) else 0.0
+        sliding[j, side] = p_slide if (p_slide > 0.0 or math.isnan(p_slide)) else 0.0
+        spin_w[j, side] = p_spin if (p_spin > 0.0 or math.isnan(p_spin)) else 0.0
+    return rolling, sliding, spin_w
 
 
 def friction_power_by_source(
@@ -215,11 +225,10 @@ def friction_power_by_source(
     rolling, sliding, spin = contact_powers_w(s.contacts, s.ball_angular_velocity_rad_s, m.ball_radius_m)
     lub = m.spec.lubricant
     rho = density_kg_m3(lub.density_15c_kg_m3, oil_temperature_c)
-    x, v = s.ball_position_in_bearing_m, s.ball_velocity_in_bearing_m_s
-    orbit_speed = np.hypot(v[:, 0], v[:, 1])
     drag_w = np.zeros(m.ball_count)
     method = m.spec.lubrication.method
     if method == "oil_bath":  # the bath's drag shared by the part of each ball in the oil
+        x = s.ball_position_in_bearing_m
         from_bottom = np.arctan2(x[:, 1], x[:, 0])  # the bath's bottom lies on the load line (+x)
         share = np.array(
             [
@@ -236,6 +245,8 @@ def friction_power_by_source(
                 * oil_bath_drag_power_w(m.spec, float(s.scalars[L.X_SHAFT_SPEED]), oil_viscosity_pa_s / rho)
             )
     elif method != "flooded":
+        v = s.ball_velocity_in_bearing_m_s
+        orbit_speed = np.hypot(v[:, 0], v[:, 1])
         for j in range(m.ball_count):
             drag_w[j] = ball_drag_power_w(
                 2.0 * m.ball_radius_m, float(orbit_speed[j]), immersed_fraction, rho, oil_viscosity_pa_s
