@@ -102,6 +102,49 @@ def test_network_identities():
     assert math.isinf(net.ball_resistance_ohm[1])
 
 
+def test_open_contacts_film_field_and_current_density_by_hand():
+    # the network's drive (module twin.electrical_network): a current alone develops V = I |Z|; an
+    # open contact is the gap capacitor of its raceway (el.outer_zone_capacitance_f); each ball
+    # carries I |Y_ball| / sum |Y|, spread over the Hertz ellipse pi a b of its loaded contacts;
+    # each film sees V |Z_contact| / |Z_ball| across its h_min (loaded) or gap (open)
+    model = Twin("6208").model
+    z = model.ball_count
+    rows = np.zeros((L.N_ROWS, 2 * z))
+    gap = 20e-6
+    rows[L.G_DELTA] = -gap
+    a, b, h_min = 1.7e-3, 0.19e-3, 1e-6
+    for c, (res, cap) in {0: (10.0, 40e-12), 1: (1e9, 30e-12)}.items():
+        rows[L.G_DELTA, c] = 1e-5
+        rows[L.C_LOAD, c] = 1000.0
+        rows[L.C_RESISTANCE, c] = res
+        rows[L.C_CAPACITANCE, c] = cap
+        rows[L.C_H_MIN, c] = h_min
+        rows[L.C_SEMI_MAJOR, c], rows[L.C_SEMI_MINOR, c] = a, b
+    current = 2.0
+    net = bearing_network(model, rows, 0.0, current)
+    w = 2 * math.pi * model.spec.electrical.frequency_hz
+    eps_r = model.spec.electrical.oil_relative_permittivity
+    open_c = [
+        el.outer_zone_capacitance_f(
+            eps_r, model.race_params[r, L.R_RX], model.race_params[r, L.R_RY], gap, model.gap_limit_m[r]
+        )
+        for r in range(2)
+    ]
+    for k in range(2, 2 * z):
+        assert net.contact_capacitance_f[k] == pytest.approx(open_c[k % 2], rel=1e-12)
+    z_contact = [1 / (1 / 10.0 + 1j * w * 40e-12), 1 / (1 / 1e9 + 1j * w * 30e-12)]
+    z_contact += [1 / (1j * w * open_c[k % 2]) for k in range(2, 2 * z)]
+    z_ball = [z_contact[2 * j] + z_contact[2 * j + 1] for j in range(z)]
+    y = sum(1 / zb for zb in z_ball) + 1j * w * model.rest_capacitance_f
+    voltage = current * abs(1 / y)
+    assert net.shaft_voltage_v == pytest.approx(voltage, rel=1e-12)
+    films = [h_min, h_min] + [gap] * (2 * z - 2)
+    field = max(voltage * abs(z_contact[k]) / abs(z_ball[k // 2]) / films[k] for k in range(2 * z))
+    assert net.max_film_field_v_m == pytest.approx(field, rel=1e-12)
+    share = abs(1 / z_ball[0]) / sum(abs(1 / zb) for zb in z_ball)
+    assert net.current_density_a_m2 == pytest.approx(current * share / (math.pi * a * b), rel=1e-12)
+
+
 def _bearing(speed, load=3000.0, temperature=40.0, isothermal=False):
     spec = studies.isothermal_spec("6208") if isothermal else catalog.bearing("6208")
     twin = Twin(spec, setpoint=Setpoint(shaft_speed_rad_s=speed, radial_load_n=load, oil_temperature_c=temperature))
