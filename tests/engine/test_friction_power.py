@@ -6,7 +6,7 @@ import pytest
 
 from twin import catalog
 from twin.engine import Twin
-from twin.friction_power import boundary_dimensions_m, oil_level_m
+from twin.friction_power import boundary_dimensions_m, contact_powers_w, oil_level_m
 from twin.kernels import layout as L
 from twin.physics import drag, starvation
 from twin.physics.viscosity import density_kg_m3
@@ -22,6 +22,42 @@ def _mean_over_frames(twin, frames=10):
         torque.append(twin.snapshot().friction_torque_n_m * float(twin.state.scalars[L.X_SHAFT_SPEED]))
         power.append(fp.rolling_w + fp.sliding_w + fp.spin_w)
     return float(np.mean(torque)), float(np.mean(power)), fp
+
+
+def test_contact_powers_of_one_contact_by_hand():
+    # the work of the DEM's forces at a contact (twin.friction_power.contact_powers_w): rolling
+    # P = -F_R . (v_ball - v_ring(q)), v_ring(q) = v_ring + omega_spin e_z x q, q = p + R n;
+    # sliding P = -F_t . s - M2 . (omega_ball - omega_spin e_z), F_t = F - (F . n) n - F_R;
+    # spin P = |M_n omega_spin|; an open contact (delta <= 0) none, a negative power floored at 0
+    rng = np.random.default_rng(7)
+    rows = rng.standard_normal((L.N_ROWS, 4))
+    rows[L.G_DELTA] = [1e-6, 1e-6, -1e-6, 1e-6]
+    rows[L.K_SPIN] = 30.0
+    radius = 6e-3
+    w_ball = rng.standard_normal((2, 3)) * 100.0
+    rolling, sliding, spin = contact_powers_w(rows, w_ball, radius)
+
+    def lane(*names, k):
+        return np.array([rows[getattr(L, n), k] for n in names])
+
+    expected = np.zeros((3, 4))
+    for k in (0, 1, 3):
+        n = lane("G_NX", "G_NY", "G_NZ", k=k)
+        f_roll = rows[L.C_ROLLING_PER_SPEED, k] * lane("O_EX", "O_EY", "O_EZ", k=k)
+        q = lane("K_PX", "K_PY", "K_PZ", k=k) + radius * n
+        spin_axis = np.array([0.0, 0.0, rows[L.K_SPIN, k]])
+        v_ring = lane("K_OVX", "K_OVY", "K_OVZ", k=k) + np.cross(spin_axis, q)
+        p_roll = -f_roll @ (lane("K_VX", "K_VY", "K_VZ", k=k) - v_ring)
+        f = lane("O_FX", "O_FY", "O_FZ", k=k)
+        f_t = f - (f @ n) * n - f_roll
+        p_slide = -f_t @ lane("O_SX", "O_SY", "O_SZ", k=k) - lane("E_M2X", "E_M2Y", "E_M2Z", k=k) @ (
+            w_ball[k // 2] - spin_axis
+        )
+        p_spin = abs(rows[L.E_SPIN_MOMENT, k] * rows[L.E_SPIN_RATE, k])
+        expected[:, k] = [max(p_roll, 0.0), max(p_slide, 0.0), p_spin]
+    for got, want in zip((rolling, sliding, spin), expected, strict=True):
+        np.testing.assert_allclose(got.reshape(-1), want, rtol=1e-12, atol=1e-12 * np.abs(want).max())
+    assert (expected[:2, [0, 1, 3]] == 0.0).any() and (expected[:2] > 0.0).any()  # both sides of the floor
 
 
 @pytest.mark.parametrize("speed, load", [(500.0, 3000.0), (1500.0, 1000.0)])
