@@ -24,7 +24,6 @@ is empty there (at most once a minute: a film in mixed lubrication breaks and he
 from __future__ import annotations
 
 import math
-import warnings
 
 import numpy as np
 import rerun as rr
@@ -126,15 +125,18 @@ def _scalars(v: np.ndarray) -> rr.ComponentColumnList:
 
 
 def _stats(values: np.ndarray, bounds: list[tuple[int, int]], band: tuple[int, ...]) -> np.ndarray:
-    """Per window: the mean of every series, then the min and max of the series in `band`."""
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # an all-NaN window stays NaN
-        mean = np.array([np.nanmean(values[a:b], axis=0) for a, b in bounds])
-        if not band:
-            return mean
-        sel = values[:, list(band)]
-        lo = np.array([np.nanmin(sel[a:b], axis=0) for a, b in bounds])
-        hi = np.array([np.nanmax(sel[a:b], axis=0) for a, b in bounds])
+    """Per window: the mean of every series, then the min and max of the series in `band`; NaN
+    values are left out, and a window of NaN only stays NaN (fmin / fmax ignore NaN, and no
+    warning is raised: this runs on the recorder's thread, where warnings filters are not safe)."""
+    finite = ~np.isnan(values)
+    zeroed = np.where(finite, values, 0.0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        mean = np.array([zeroed[a:b].sum(axis=0) / finite[a:b].sum(axis=0) for a, b in bounds])
+    if not band:
+        return mean
+    sel = values[:, list(band)]
+    lo = np.array([np.fmin.reduce(sel[a:b], axis=0) for a, b in bounds])
+    hi = np.array([np.fmax.reduce(sel[a:b], axis=0) for a, b in bounds])
     return np.hstack([mean, lo, hi])
 
 
