@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import butter, hilbert, sosfiltfilt, welch
+from scipy.signal import hilbert, welch
 
 from twin.validation.vibration_simulation import simulate_vibration
 from twin.vibration import indicators as ind
@@ -218,14 +218,13 @@ def ring_down(
     x_m_s2: np.ndarray, rpm: float, line_multiple: float, sample_rate_hz: float = SAMPLE_RATE_HZ
 ) -> tuple[float, float]:
     """(frequency [Hz], damping ratio [-]) of the mode a fault record's impacts ring: the signal is
-    band-passed to ENVELOPE_BAND_HZ (4th-order Butterworth, zero phase); in each period of the
+    band-passed to ENVELOPE_BAND_HZ (`twin.vibration.indicators.band_pass`); in each period of the
     defect line (`line_multiple` x shaft) the Hilbert envelope's decay rate sigma [1/s] is the
     log-linear fit over RING_DOWN_S after its peak, kept where the peak stands 3 x above the
     envelope's median; the frequency is the band's Welch peak (2048 points), and zeta = median
     sigma / (2 pi f) (a single mode's free decay, exp(-zeta omega t)). An independent check of the
     housing damping calibrated on the healthy record, which has no impacts."""
-    x = np.asarray(x_m_s2, dtype=float)
-    y = sosfiltfilt(butter(4, ENVELOPE_BAND_HZ, "bandpass", fs=sample_rate_hz, output="sos"), x)
+    y = ind.band_pass(x_m_s2, sample_rate_hz, ENVELOPE_BAND_HZ)
     env = np.abs(hilbert(y))
     period = int(sample_rate_hz * 60.0 / (rpm * line_multiple))
     tail = int(round(RING_DOWN_S * sample_rate_hz))
