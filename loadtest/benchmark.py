@@ -307,7 +307,6 @@ def run_service_benchmark(
                 "late_frames": late,
                 "resyncs": b.get("resyncs", 0) - a.get("resyncs", 0),
                 "dropped": b.get("dropped"),
-                "publish_skipped": b.get("publish_skipped"),
                 "cost": b.get("cost"),
                 "setpoints": len(latencies.get(tid, [])),
                 "client_latency_ms_p99": ms(_percentile(latencies.get(tid, []), 99)),

@@ -484,7 +484,7 @@ class Twin:
         """Ask the frame in progress to end at its next step boundary (after at least one step;
         any thread, without waiting): `advance` then returns the steps left undone with
         `frame_interrupted` set. A real-time runner asks it when a setpoint arrives mid-frame,
-        so the setpoint applies within a step instead of at the end of a 5 ms frame. Stays
+        so the setpoint applies within a step instead of at the end of the frame. Stays
         asked (every later frame ends after one step) until `clear_frame_interrupt`."""
         self._setpoint_vector[L.S_STOP] = 1.0
 

@@ -366,11 +366,6 @@ class TwinHealth(BaseModel):
     last_safe_setpoint: Setpoint | None = Field(
         default=None, description="The newest setpoint held without a restart, the fallback [fields with units]."
     )
-    publish_skipped: int = Field(
-        default=0,
-        description="Captured states dropped before their snapshot was built because the publish worker was behind "
-        "(real-time mode) [-].",
-    )
     cost: TwinCost | None = Field(
         default=None,
         description="CPU this twin needs in real time, as measured (its calibration until measured while running) [CPU "

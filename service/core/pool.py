@@ -6,10 +6,12 @@ GIL between its frames, and the more threads there are the longer each waits for
 others, the zenoh, rerun and HTTP threads. The engine's `step_n` releases the GIL
 (`@njit(nogil=True)`), so a frame of a twin runs in parallel with anything else; what needs the
 GIL is the Python between frames (mailbox, scenario, pacing: tens of microseconds) and building
-snapshots (about a millisecond each). So: as many stepping threads as cores (`workers`), each
-running one frame of one twin at a time; frames long enough (5 ms of simulated time by default)
-that the Python between them is a small share; the snapshot building and the sinks on one
-`PublishWorker` thread, never on a stepping thread.
+snapshots (about 0.2 ms each right after the frame). So: as many stepping threads as cores
+(`workers`), each running one frame of one twin at a time; frames long enough (20 ms of simulated
+time by default in the service) that the Python and the thread wake-up between them are a small
+share. In real time the stepping thread builds the frame's snapshot itself (a hand-off to
+another thread costs more than the build, service.core.publishing); in fast mode the snapshots
+are built and delivered by one `PublishWorker` thread while the twins step on.
 
 Scheduling (earliest deadline first, `EdfQueue`). Each twin is a job with a RELEASE time (wall
 clock: when its next frame may start; in real time, the wall-clock time its simulated clock has

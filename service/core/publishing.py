@@ -1,15 +1,24 @@
-"""Publishing of a runner: what a frame captured becomes a snapshot for every sink, off the
-stepping threads.
+"""Publishing of a runner: what a frame captured becomes a snapshot for every sink.
 
-After a frame that is due to publish, the stepping thread only CAPTURES the twin: a frozen copy
-(`Twin.frozen`: the twin object shallow-copied with its state arrays copied, some microseconds) with
-the real-time factor, the late fraction and the runner's status note of that moment. The
-pool's `PublishWorker` thread captures its public state as a `twin.snapshot_frame.SnapshotFrame`
-(`Twin.frame`: the balls and contacts as arrays in one compiled pass, the bearing-level blocks
-as a few pydantic models; for a 9-ball twin about 0.2 ms in a loop and 0.5 ms when it comes
-alone, as here, of which the electrical network and the friction power are half or more) and
-hands it to the sinks, in capture order. Without a worker (before
-the runner starts) a capture is built and delivered at once.
+Real-time mode. The stepping thread that ran the frame builds the snapshot at its end and hands
+it to the sinks itself (`Twin.frame`: a `twin.snapshot_frame.SnapshotFrame`, the balls and
+contacts as arrays in one compiled pass, the bearing-level blocks as a few pydantic models;
+about 0.2 ms for a 9-ball twin right after its frame, while its arrays are still in the cache).
+Why on the stepping thread: a hand-off to another thread costs more than the build. On the
+2-core EPYC VM, waking an idle thread costs 70-140 us of CPU on each side, and a build that
+comes alone (a frozen copy, then a cold capture on the worker) costs 0.5-0.6 ms instead of
+0.2 (docs/performance.md "Service overhead"). The stepping thread is the twin's only writer
+and steps it again only after the delivery, so no copy is needed; the sinks only enqueue (the
+zenoh channel also puts the state message, a few microseconds), so the delivery never waits on
+I/O. A capture that carries setpoint timings (the frame that applies an outside setpoint) is
+delivered the same way, so the state that reflects it goes out without a hop.
+
+Fast mode (lossless: a scenario's samples must all arrive). The stepping thread takes a frozen
+copy (`Twin.frozen`: the twin object shallow-copied with its state arrays copied) with the
+real-time factor, the late fraction and the runner's status note of that moment, and the pool's
+`PublishWorker` thread builds and delivers it, in capture order, while the twin steps on. At most
+`max_pending` captures wait for the worker; one more makes the stepping thread wait. Without a
+worker (before the runner starts) a capture is built and delivered at once.
 
 Frames. The sinks that declare `accepts_frames` (the zenoh channel, the recorder, the alarm hub)
 read the frame's arrays and its state JSON, written from them; any other sink gets the
@@ -17,32 +26,15 @@ read the frame's arrays and its state JSON, written from them; any other sink ge
 latest frame is `latest` (its tree, built for an HTTP read, OPC UA or /health at their own rate)
 and `latest_json` (the state message already made for zenoh).
 
-Back-pressure. At most `max_pending` captures of a twin wait for the worker. Real-time mode:
-one more drops the oldest waiting capture (counted in `skipped`; the setpoint timings it
-carried move to the newer one, which reflects the same setpoints). Lossless mode (fast mode: a
-scenario's samples must all arrive) makes the stepping thread wait instead.
-
 Sinks (zenoh channel, recorder, table) only enqueue (bounded, drop-oldest, counted: see
-service.core.sinks), so the worker never blocks on I/O; a sink that raises is counted and
-skipped. The runner's own status note (a fallback, a caught error) is written into the
-snapshot's `status` beside the engine's. The accelerometer samples the twin produced since the
-last capture (`Twin.drain_waveform`) are drained with each capture and handed, after
-the snapshot, to the sinks that have `publish_waveform(bearing_id, blocks, seq=...)` (zenoh
-`.../vibration/waveform`, the recorder); a capture dropped under back-pressure passes its
-samples on to the next one. The first snapshot that reflects an accepted setpoint
-completes its `SetpointTiming` (published = when the worker handed it to the sinks).
-
-Setpoint-triggered publication. In real-time mode a capture that carries setpoint timings (the
-frame that applies an outside setpoint) is built and delivered on the stepping thread itself,
-after the twin's captures still waiting (their order and numbering kept: one delivery of a twin
-at a time, `_deliver_lock`). The hop to the worker thread (a thread wake-up and a GIL hand-off
-behind the other twins' captures) was the largest stage of the PUT -> zenoh state latency:
-2.4 ms at the median and 9 ms at the 99th percentile with one twin (`bench-service`,
-`setpoint_latency_ms.publish` in /health). Setpoints are rate-limited per twin (the admission
-gate), so the stepping thread builds at most that many frames itself (0.2-0.5 ms each for
-a 9-ball twin). It builds them from the live twin, not a frozen copy: it is the twin's only
-writer and steps it again only after the delivery, and the copy (with the thermal block it
-evaluates) cost as much CPU on the stepping thread as a third of the snapshot.
+service.core.sinks); a sink that raises is counted and skipped. The runner's own status note (a
+fallback, a caught error) is written into the snapshot's `status` beside the engine's. The
+accelerometer samples the twin produced since the last capture (`Twin.drain_waveform`) are
+drained with each capture and handed, after the snapshot, to the sinks that have
+`publish_waveform(bearing_id, blocks, seq=...)` (zenoh `.../vibration/waveform`, the recorder).
+The first snapshot that reflects an accepted setpoint completes its `SetpointTiming`
+(published = when it was handed to the sinks). One delivery of a twin at a time
+(`_deliver_lock`), in capture order, with gapless sequence numbers.
 """
 
 from __future__ import annotations
@@ -112,7 +104,6 @@ class Publisher:
         self.note: str | None = None  # the runner's word on the twin's state, or None
         self.published = 0
         self.sink_errors = 0
-        self.skipped = 0  # captures dropped before they were built (real time, worker behind)
         self.cpu = CpuMeter(window=50)  # CPU s per snapshot built and handed to the sinks
 
     # ---- any thread ------------------------------------------------------------------------
@@ -221,7 +212,8 @@ class Publisher:
         *,
         stop: threading.Event | None = None,
     ) -> None:
-        """Capture `twin` for publication (frozen copy when a worker builds it later)."""
+        """Capture `twin` for publication: built and delivered now in real-time mode, a frozen copy
+        for the worker in fast mode (see the module docstring)."""
         worker = self._worker
         timings, self._unpublished = self._unpublished, []
         if timings:
@@ -233,23 +225,15 @@ class Publisher:
             with self._deliver_lock:
                 self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings, waveform))
             return
-        if timings and not self.lossless:
+        if not self.lossless:
             with self._deliver_lock:
                 self._drain_locked()
                 self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings, waveform))
             return
         cap = Capture(twin.frozen(), real_time_factor, late_fraction, self.note, timings, waveform)
         with self._cv:
-            if self.lossless:
-                while (
-                    len(self._pending) >= self.max_pending and worker.alive and not (stop is not None and stop.is_set())
-                ):
-                    self._cv.wait(0.1)
-            elif len(self._pending) >= self.max_pending:
-                old = self._pending.popleft()
-                cap.timings[:0] = old.timings
-                cap.waveform[:0] = old.waveform  # the samples are not the snapshot's: keep them
-                self.skipped += 1
+            while len(self._pending) >= self.max_pending and worker.alive and not (stop is not None and stop.is_set()):
+                self._cv.wait(0.1)
             self._pending.append(cap)
         if not worker.submit(self._deliver_next):
             self._drain()

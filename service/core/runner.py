@@ -1,11 +1,11 @@
 """`TwinRunner`: one twin's frame loop, run by a stepping pool; the ONLY writer of the twin's state.
 
-One `step` = one frame (`frame_s` of simulated time; the service runs 5 ms frames)::
+One `step` = one frame (`frame_s` of simulated time; the service runs 20 ms frames)::
 
     scenarios.tick()          take over a new scenario, offer its updates (ScenarioDriver)
     mailbox.take()            the pending setpoint, admitted once at submission (Mailbox)
     faults.advance_frame()    twin.advance(frame), fall back when not held (FaultPolicy)
-    pacing.publish_due()      publisher.capture(): a frozen copy for the publish worker (Publisher)
+    pacing.publish_due()      publisher.capture(): the snapshot built and delivered (Publisher)
     pacing.frame_done()       lateness counted; the release of the next frame is returned
 
 The jobs live in their own classes (service.core.pacing, .mailbox, .faults, .scenario_driver,

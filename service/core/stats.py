@@ -80,7 +80,6 @@ def health_record(runner: Any, *, setpoints_refused: int = 0, setpoints_rate_lim
         "setpoints_rate_limited": setpoints_rate_limited,
         "fallbacks": runner.fallbacks,
         "last_safe_setpoint": runner.last_safe_setpoint.model_dump(),
-        "publish_skipped": runner.publisher.skipped,
         "cost": cost.as_dict() if cost is not None else None,
         "setpoint_latency_ms": setpoint_latency_ms(runner.publisher.recent_timings(LATENCY_WINDOW)),
     }

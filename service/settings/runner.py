@@ -87,13 +87,14 @@ class RunnerSettings(BaseModel):
         description="Snapshot publishing rate [Hz] (of wall time in real-time mode, of simulated time in fast mode).",
     )
     frame_s: float = Field(
-        default=0.005,
+        default=0.02,
         ge=1e-5,
         le=0.1,
         json_schema_extra=flat(
             "frame_s",
-            details="A stepping thread runs one frame of one twin at a time; 5 ms keeps the Python between frames a "
-            'small share of the work (docs/service.md "Runner pool").',
+            details="A stepping thread runs one frame of one twin at a time and publishes at its end; 20 ms (one "
+            "publish period at 50 Hz) keeps the thread wake-ups and the Python between frames a small share of the "
+            'work, and an outside setpoint cuts the frame in progress (docs/service.md "Runner pool").',
         ),
         description="Simulated time per frame; setpoints and scenario steps apply between frames [s].",
     )
@@ -110,7 +111,7 @@ class RunnerSettings(BaseModel):
         description="Real-time mode: length of the frame that applies an outside setpoint (HTTP, zenoh) [s].",
     )
     frame_lead_s: float = Field(
-        default=0.005,
+        default=0.02,
         ge=0.0,
         le=0.1,
         json_schema_extra=flat(

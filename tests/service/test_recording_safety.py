@@ -18,6 +18,7 @@ import os
 import shutil
 import stat
 import subprocess
+import threading
 import time
 import weakref
 from pathlib import Path
@@ -302,7 +303,7 @@ def test_create_delete_cycles_free_the_recorder_entries(server):
 
     for i in range(20):  # warm-up: numba, rerun, arrow and allocator pools fill up
         cycle(i)  # (about 5 MB, then flat)
-    threads = _threads()
+    threads, names = _threads(), {t.name for t in threading.enumerate()}
     # 60 cycles: the RSS after a collection and malloc_trim moves by +-5 MB between reads, and in
     # the full suite's process the allocator's pools grow by about 0.2 MB a cycle (3-4 MB over the
     # 60 cycles when this module runs alone; Python objects grow by about 85 a cycle either way);
@@ -313,7 +314,7 @@ def test_create_delete_cycles_free_the_recorder_entries(server):
     grown = (_rss_bytes() - rss) / 1e6
     print(f"\n60 create/delete cycles: threads {threads} -> {_threads()}, RSS {grown:+.2f} MB")
     assert srv.service.recorder.bearing_ids == ["default"]
-    assert _threads() <= threads
+    assert _threads() <= threads, sorted({t.name for t in threading.enumerate()} - names)
     assert grown < 18.0
     # what the RSS cannot show exactly: no deleted twin is held by anything (collected after gc)
     gc.collect()

@@ -248,6 +248,22 @@ def test_a_setpoint_is_published_at_the_end_of_its_frame_even_right_after_a_tick
     assert p.publish_due(0.0626, 0.0626, False)  # and on that grid from then on
 
 
+def test_frames_as_long_as_the_publish_period_publish_every_frame_in_any_phase():
+    """service.core.pacing: 20 ms frames (the service's default) and 50 Hz publishing. Frames
+    that end just before their tick (0.1 ms, with a jitter of +-0.05 ms) publish every frame but
+    the first: the tick a frame misses is taken by the next frame, and the grid stays a tick
+    behind instead of losing every other publication."""
+    p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: 0.0)
+    p.start(0.0)
+    published = 0
+    for k in range(1, 51):
+        end = 0.02 * k - 0.0001 + (0.00005 if k % 2 else -0.00005)
+        if p.publish_due(end, end, False):
+            p.published(end, end)
+            published += 1
+    assert published == 49
+
+
 def test_fast_mode_is_never_late():
     p = PacingClock(fast=True, publish_period_s=0.02, clock=lambda: 0.0)
     p.start(0.0)
@@ -517,7 +533,7 @@ def test_max_twins_unset_means_the_capacity_decides():
 
     assert ServiceSettings().runner.max_twins is None and ServiceSettings().runner.twin_limit == 256
     assert ServiceSettings(max_twins=3).runner.twin_limit == 3
-    assert math.isclose(ServiceSettings().runner.frame_s, 0.005) and ServiceSettings().runner.lateness_s == 0.005
+    assert math.isclose(ServiceSettings().runner.frame_s, 0.02) and ServiceSettings().runner.lateness_s == 0.005
 
 
 def test_an_urgent_wake_puts_the_frame_before_the_released_frames_of_the_others():

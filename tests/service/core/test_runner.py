@@ -433,9 +433,9 @@ def test_a_setpoint_is_published_at_the_end_of_the_frame_that_applied_it(twin, m
 
 
 def test_a_setpoint_snapshot_is_delivered_by_the_stepping_thread_in_order(twin, make_runner):
-    """The snapshot that carries an outside setpoint is built and handed to the sinks on the
-    stepping thread (no hop to the publish worker); the 50 Hz snapshots stay on the worker, and
-    the seq numbers stay gapless and increasing across both paths."""
+    """Real time: every snapshot, the one that carries an outside setpoint and the 200 Hz ones,
+    is built and handed to the sinks on the stepping thread that ran its frame (no hop to the
+    publish worker, service.core.publishing), with gapless increasing seq numbers."""
     sink = ListSink()
     runner = make_runner(twin, publish_rate_hz=200.0, frame_s=0.005, sinks=[sink]).start()
     assert wait_until(lambda: runner.published >= 5)
@@ -446,9 +446,8 @@ def test_a_setpoint_snapshot_is_delivered_by_the_stepping_thread_in_order(twin, 
     assert runner.stop(timeout=10.0)
     seqs = [s.seq for s in sink.snapshots]
     assert seqs == list(range(seqs[0], seqs[0] + len(seqs)))
-    workers = {runner._pool.publisher.thread_name}
-    assert set(runner.stepping_threads) <= sink.threads <= set(runner.stepping_threads) | workers | {"MainThread"}
-    assert workers <= sink.threads
+    assert sink.threads <= set(runner.stepping_threads) | {"MainThread"}  # MainThread: before the start
+    assert runner._pool.publisher.thread_name not in sink.threads
     for timing in runner.setpoint_latencies():
         stages = timing.stages_s()
         assert stages is not None and set(stages) == {"admission", "apply", "step", "build", "publish"}
@@ -458,6 +457,21 @@ def test_a_setpoint_snapshot_is_delivered_by_the_stepping_thread_in_order(twin, 
     assert latency["count"] == 5
     assert set(latency) == {"admission", "apply", "step", "build", "publish", "total", "count"}
     assert latency["total"]["p50"] <= latency["total"]["p99"] <= latency["total"]["max"]
+
+
+def test_fast_mode_snapshots_are_built_on_the_publish_worker_without_a_gap(twin, make_runner):
+    """Fast mode: the stepping thread hands a frozen copy to the pool's publish worker, which
+    builds and delivers every sample of the grid, in order (service.core.publishing)."""
+    sink = ListSink()
+    runner = make_runner(twin, fast=True, publish_rate_hz=1000.0, sinks=[sink]).start()
+    assert wait_until(lambda: runner.published >= 30)
+    assert runner.stop(timeout=10.0)
+    seqs = [s.seq for s in sink.snapshots]
+    assert seqs == list(range(seqs[0], seqs[0] + len(seqs)))
+    assert runner._pool.publisher.thread_name in sink.threads
+    assert not sink.threads & set(runner.stepping_threads)
+    times = [s.time_s for s in sink.snapshots[1:]]
+    assert all(b > a for a, b in zip(times, times[1:]))
 
 
 def test_setpoint_timing_stages_start_at_the_requests_arrival():
