@@ -91,11 +91,12 @@ def _percentile(values: list[float], q: float) -> float | None:
     return values[k]
 
 
-def twin_plan(n: int) -> list[tuple[str, str, dict]]:
-    """(id, designation, initial setpoint) of the n twins of the benchmark."""
+def twin_plan(n: int, *, alike: bool = False) -> list[tuple[str, str, dict]]:
+    """(id, designation, initial setpoint) of the n twins of the benchmark: the mix in turn, or
+    (`alike`, for `--twins auto`) n twins like the first, the kind the capacity formula counts."""
     plan = []
     for i in range(n):
-        designation, setpoint = TWIN_MIX[i % len(TWIN_MIX)]
+        designation, setpoint = TWIN_MIX[0 if alike else i % len(TWIN_MIX)]
         tag = "-5A" if setpoint.get("shaft_current_a") else ""
         plan.append((f"b{i + 1}-{designation}{tag}", designation, dict(setpoint)))
     return plan
@@ -193,6 +194,12 @@ def run_service_benchmark(
                 if first_setpoint:
                     http.put(f"/v1/bearings/{first_id}/setpoint", json=first_setpoint).raise_for_status()
                 capacity_at_start = http.get("/health").json().get("capacity") or {}
+                settle = time.monotonic() + 10.0  # the service overhead per twin: one window of >= 1 s
+                while auto and capacity_at_start.get("service_overhead_per_twin_cpu_s_per_s") is None:
+                    if time.monotonic() > settle:
+                        break
+                    time.sleep(0.5)
+                    capacity_at_start = http.get("/health").json().get("capacity") or {}
                 if auto:
                     held = capacity_at_start.get("max_twins")
                     if held is None:
@@ -200,7 +207,7 @@ def run_service_benchmark(
                             "--twins auto: the service states no capacity (admission off, or no "
                             "twin calibrated): give a number of twins"
                         )
-                    plan = twin_plan(max(1, int(held)))
+                    plan = twin_plan(max(1, int(held)), alike=True)
                 running = [(first_id, first_designation)]
                 for twin_id, designation, setpoint in plan[1:]:
                     body = {"id": twin_id, "designation": designation, **({"setpoint": setpoint} if setpoint else {})}

@@ -32,7 +32,8 @@ def build_parser() -> argparse.ArgumentParser:
         type=_twins,
         default=1,
         help="twins to run: 6208, 6205, 7208, 6208 with 5 A, in turn (default 1); 'auto': as many "
-        "as the service's capacity states once the first is calibrated (/health capacity.max_twins)",
+        "twins like the first (6208) as the service's capacity states once the first is calibrated and "
+        "the service overhead per twin measured (/health capacity.max_twins)",
     )
     bsv.add_argument("--seconds", type=_positive_float, default=10.0, help="measurement time [s of wall time]")
     bsv.add_argument("--rate", type=_positive_float, default=20.0, help="setpoints per second, all twins [Hz]")

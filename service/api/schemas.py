@@ -286,7 +286,9 @@ class Capacity(BaseModel):
         description="Share of each core the twins may use; also the most one twin may use [-]."
     )
     budget_cpu_s_per_s: float = Field(description="min(stepping threads, cores) x core_fraction [CPU s / s].")
-    used_cpu_s_per_s: float = Field(description="What the running twins need, as measured [CPU s / s].")
+    used_cpu_s_per_s: float = Field(
+        description="What the running twins need, as measured: engines plus the service share each [CPU s / s]."
+    )
     over_budget: bool = Field(default=False, description="Whether the running twins need more than the budget [bool].")
     max_twins: int | None = Field(
         default=None,
@@ -303,10 +305,16 @@ class Capacity(BaseModel):
     reserve_cores: float = Field(
         default=0.0, description="CPU kept for the service's other threads, taken from the budget [CPU s / s]."
     )
+    service_overhead_per_twin_cpu_s_per_s: float | None = Field(
+        default=None,
+        description="The service's CPU per twin beside the engines over the last closed window, HTTP not counted; "
+        "each twin's need counts it [CPU s / s]; null before a window closes.",
+    )
     formula: str | None = Field(
         default=None,
         description="How max_twins is reached, with the figures of the moment: budget = cores x core_fraction - "
-        "reserve; max_twins = running + floor((budget - in use) / cost of a twin like the last calibrated) [text].",
+        "reserve; max_twins = running + floor((budget - in use) / need of a twin like the last calibrated: its "
+        "engine plus the service overhead per twin) [text].",
     )
     service_overhead: dict[str, float | None] | None = Field(
         default=None,

@@ -17,6 +17,11 @@ The rule (docs/service.md "Runner pool"):
   share. Why the reserve: on the 2-core VM two default 6208 twins (0.74 and 0.76 CPU s per s by
   their calibration) fitted 2 x 0.85 = 1.7, were admitted, and ran at 0.97 and 0.93 of real time
   with 93-96 % of frames late (`bearing-twin bench-service --twins 4`, zenoh and recording on).
+* The SERVICE SHARE of a twin is what the service spends for it beside its engine: the measured
+  service overhead per twin (`ThreadCpuMeter`: the stepping threads beside the engines, the zenoh,
+  recording and alarm threads, over the last closed window, HTTP not counted), or its snapshots'
+  calibrated cost while none is measured (no twin running yet), whichever is larger. A twin's
+  NEED is its engine cost plus that share.
 * A twin is admitted when (1) its own cost fits one core's share (`core_fraction`): a twin is
   stepped by one thread at a time, so it can never use more than one core, and (2) the costs of
   the running twins plus its own fit the capacity. Otherwise it is refused (HTTP 503) with the
@@ -27,8 +32,8 @@ The rule (docs/service.md "Runner pool"):
 
 The number of twins the host holds (`Capacity.estimate_max_twins`, /health `capacity.max_twins`,
 `bench-service --twins auto`) is, with C the cores the stepping threads can use, f the
-core_fraction, R the reserve, U the measured cost of the running twins and c the measured cost of
-a twin like the last one calibrated::
+core_fraction, R the reserve, U the measured need of the running twins and c the need of a twin
+like the last one calibrated (its engine plus the service share)::
 
     max_twins = running + floor((C f - R - U) / c)          (c <= f, else no more twin fits)
 
@@ -187,13 +192,38 @@ class Capacity:
     def per_twin_cpu_s_per_s(self) -> float:
         return self.core_fraction
 
-    def check(self, new: TwinCost, running: Iterable[TwinCost]) -> Verdict:
-        used = sum(c.cpu_s_per_s for c in running)
-        need = new.cpu_s_per_s
+    @staticmethod
+    def service_share(cost: TwinCost, overhead_per_twin_cpu_s_per_s: float | None = None) -> float:
+        """What the service spends for a twin beside its engine [CPU s / s]: the measured overhead
+        per twin, its snapshots' cost while none is measured, whichever is larger."""
+        o = overhead_per_twin_cpu_s_per_s
+        return max(cost.publish_cpu_s_per_s, o if o is not None and math.isfinite(o) else 0.0)
+
+    @classmethod
+    def need(cls, cost: TwinCost, overhead_per_twin_cpu_s_per_s: float | None = None) -> float:
+        """A twin's engine cost plus its service share [CPU s / s]."""
+        return cost.engine_cpu_s_per_sim_s + cls.service_share(cost, overhead_per_twin_cpu_s_per_s)
+
+    def used(self, running: Iterable[TwinCost], overhead_per_twin_cpu_s_per_s: float | None = None) -> float:
+        """What the running twins need together [CPU s / s]."""
+        return sum(self.need(c, overhead_per_twin_cpu_s_per_s) for c in running)
+
+    def _share_text(self, cost: TwinCost, overhead: float | None) -> str:
+        share = self.service_share(cost, overhead)
+        if overhead is not None and share > cost.publish_cpu_s_per_s:
+            return f"service {share:.3f} (measured per twin; its snapshots alone {cost.publish_cpu_s_per_s:.3f})"
+        return f"snapshots {cost.publish_cpu_s_per_s:.3f} (no service overhead measured yet)"
+
+    def check(
+        self, new: TwinCost, running: Iterable[TwinCost], overhead_per_twin_cpu_s_per_s: float | None = None
+    ) -> Verdict:
+        overhead = overhead_per_twin_cpu_s_per_s
+        used = self.used(running, overhead)
+        need = self.need(new, overhead)
         budget, per_twin = self.budget_cpu_s_per_s, self.per_twin_cpu_s_per_s
         figures = (
             f"it needs {need:.3f} CPU s per s (engine {new.engine_cpu_s_per_sim_s:.3f} CPU s per "
-            f"simulated s, snapshots {new.publish_cpu_s_per_s:.3f})"
+            f"simulated s, {self._share_text(new, overhead)})"
         )
         if need > per_twin:
             return Verdict(
@@ -220,7 +250,13 @@ class Capacity:
             True, f"admitted: {figures}; in use {used + need:.3f} of {budget:.3f}", need, used, budget, per_twin
         )
 
-    def formula(self, typical: TwinCost | None, running: int, used_cpu_s_per_s: float) -> str:
+    def formula(
+        self,
+        typical: TwinCost | None,
+        running: int,
+        used_cpu_s_per_s: float,
+        overhead_per_twin_cpu_s_per_s: float | None = None,
+    ) -> str:
         """How `estimate_max_twins` reaches its number, with the figures of the moment."""
         head = (
             f"budget = {self.usable_cores} cores x core_fraction {self.core_fraction:g} - reserve "
@@ -228,23 +264,33 @@ class Capacity:
         )
         if typical is None or not (typical.cpu_s_per_s > 0 and math.isfinite(typical.cpu_s_per_s)):
             return head + "; no twin calibrated yet"
-        n = self.estimate_max_twins(typical, running, used_cpu_s_per_s)
+        overhead = overhead_per_twin_cpu_s_per_s
+        c = self.need(typical, overhead)
+        n = self.estimate_max_twins(typical, running, used_cpu_s_per_s, overhead)
         return (
             f"{head}; a twin like the last calibrated needs c = engine {typical.engine_cpu_s_per_sim_s:.3f} + "
-            f"snapshots {typical.publish_cpu_s_per_s:.3f} = {typical.cpu_s_per_s:.3f} CPU s/s; max_twins = "
+            f"{self._share_text(typical, overhead)} = {c:.3f} CPU s/s; max_twins = "
             f"{running} running + floor(({self.budget_cpu_s_per_s:.3f} - {used_cpu_s_per_s:.3f} in use) / "
-            f"{typical.cpu_s_per_s:.3f}) = {n}"
+            f"{c:.3f}) = {n}"
         )
 
-    def estimate_max_twins(self, typical: TwinCost | None, running: int, used_cpu_s_per_s: float) -> int | None:
+    def estimate_max_twins(
+        self,
+        typical: TwinCost | None,
+        running: int,
+        used_cpu_s_per_s: float,
+        overhead_per_twin_cpu_s_per_s: float | None = None,
+    ) -> int | None:
         """Twins this host holds in real time: the running ones plus as many more like `typical`
-        as the budget has room for (None without a measured cost)."""
+        (its engine plus the service share) as the budget has room for (None without a measured
+        cost)."""
         if typical is None or typical.cpu_s_per_s <= 0 or not math.isfinite(typical.cpu_s_per_s):
             return None
-        if typical.cpu_s_per_s > self.per_twin_cpu_s_per_s:
+        c = self.need(typical, overhead_per_twin_cpu_s_per_s)
+        if c > self.per_twin_cpu_s_per_s:
             return running
         room = max(0.0, self.budget_cpu_s_per_s - used_cpu_s_per_s)
-        return running + int(room // typical.cpu_s_per_s)
+        return running + int(room // c)
 
 
 class ServiceOverheadMeter:

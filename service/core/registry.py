@@ -489,7 +489,7 @@ class TwinRegistry:
         )
         with self._lock:
             self.last_calibration = cost
-            verdict = self.capacity.check(cost, self._running_costs())
+            verdict = self.capacity.check(cost, self._running_costs(), self.thread_cpu.overhead_per_twin_cpu_s_per_s)
             if not verdict.admitted:
                 if not over_capacity_ok:
                     log.warning("twin %s (%s) refused: %s", bearing_id, twin.model.spec.designation, verdict.reason)
@@ -533,13 +533,14 @@ class TwinRegistry:
             costs = self._running_costs()
             running = len(self._twins)
             engine_cpu_s = sum(e.runner.engine_cpu.cpu_s for e in self._twins.values())
-        used = sum(c.cpu_s_per_s for c in costs)
         overhead = self.overhead.sample(engine_cpu_s, running)
         by_role = self.thread_cpu.sample(engine_cpu_s, running)
         overhead = {**overhead, **by_role} if overhead is not None else (by_role or None)
+        per_twin = self.thread_cpu.overhead_per_twin_cpu_s_per_s
         typical = self.last_calibration
         cap = self.capacity
-        estimate = cap.estimate_max_twins(typical, running, used)
+        used = cap.used(costs, per_twin)
+        estimate = cap.estimate_max_twins(typical, running, used, per_twin)
         if self.settings.runner.max_twins is not None:
             estimate = (
                 self.settings.runner.max_twins if estimate is None else min(estimate, self.settings.runner.max_twins)
@@ -557,7 +558,8 @@ class TwinRegistry:
             "max_twins_set": self.settings.runner.max_twins,
             "last_calibration": typical.as_dict() if typical is not None else None,
             "over_capacity": self.over_capacity,
-            "formula": cap.formula(typical, running, used),
+            "service_overhead_per_twin_cpu_s_per_s": per_twin,
+            "formula": cap.formula(typical, running, used, per_twin),
             "service_overhead": overhead,
         }
 

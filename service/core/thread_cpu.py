@@ -118,6 +118,13 @@ class ThreadCpuMeter:
         self._mark: tuple[float, dict[str, float], float] | None = None  # (wall, role totals, engine CPU)
         self._last: dict[str, float | None] = {}
 
+    @property
+    def overhead_per_twin_cpu_s_per_s(self) -> float | None:
+        """The service's CPU per twin beside the engines over the last closed window (HTTP not
+        counted), None before one closes [CPU s / s]."""
+        with self._lock:
+            return self._last.get("twin_overhead_per_twin_cpu_s_per_s")
+
     def sample(self, engine_cpu_s_total: float, twins: int) -> dict[str, float | None]:
         """Flat figures of the last closed window: `<role>_cpu_s_per_s` for each role (stepping
         less the engines' CPU), `twin_overhead_cpu_s_per_s` (the roles a twin brings),

@@ -428,9 +428,30 @@ def test_capacity_formula_states_the_figures_it_counts_with():
     twin = TwinCost(0.25, 0.03)  # c = 0.28: floor((1.2 - 0.28) / 0.28) = 3
     text = cap.formula(twin, 1, 0.28)
     assert cap.estimate_max_twins(twin, 1, 0.28) == 4
-    assert "= 1.200 CPU s/s" in text and "c = engine 0.250 + snapshots 0.030 = 0.280" in text
+    assert "= 1.200 CPU s/s" in text
+    assert "c = engine 0.250 + snapshots 0.030 (no service overhead measured yet) = 0.280" in text
     assert text.endswith("1 running + floor((1.200 - 0.280 in use) / 0.280) = 4")
     assert twin.publish_fraction == pytest.approx(0.12)
+
+
+def test_capacity_counts_the_measured_service_overhead_per_twin():
+    """service.core.capacity: once the service's overhead per twin is measured (ThreadCpuMeter),
+    each twin's need is its engine plus that share (its calibrated snapshots when larger), in the
+    check, the count and the formula."""
+    cap = Capacity(2, 0.85, cores=2, reserve_cores=0.5)  # budget 1.2
+    twin = TwinCost(0.27, 0.02)
+    assert cap.estimate_max_twins(twin, 0, 0.0) == 4  # c = 0.29
+    assert cap.need(twin, 0.09) == pytest.approx(0.36)
+    assert cap.need(twin, 0.01) == pytest.approx(0.29)  # the snapshots' cost is the floor
+    assert cap.used([twin, twin], 0.09) == pytest.approx(0.72)
+    assert cap.estimate_max_twins(twin, 0, 0.0, 0.09) == 3  # floor(1.2 / 0.36)
+    assert cap.estimate_max_twins(twin, 2, 0.72, 0.09) == 3  # 2 + floor(0.48 / 0.36)
+    text = cap.formula(twin, 2, 0.72, 0.09)
+    assert "c = engine 0.270 + service 0.090 (measured per twin; its snapshots alone 0.020) = 0.360" in text
+    assert text.endswith("2 running + floor((1.200 - 0.720 in use) / 0.360) = 3")
+    verdict = cap.check(twin, [twin, twin, twin], 0.09)  # 1.08 + 0.36 > 1.2
+    assert not verdict.admitted and "service 0.090" in verdict.reason
+    assert cap.check(twin, [twin, twin, twin]).admitted  # 0.87 + 0.29: the snapshots alone fit
 
 
 def test_service_overhead_is_the_process_cpu_beside_the_engines():

@@ -21,6 +21,12 @@ def test_twin_plan_cycles_the_designations():
         ("6208", None),
     ]
     assert len({i for i, _, _ in plan}) == 5
+    alike = twin_plan(3, alike=True)  # --twins auto: the kind the capacity formula counts
+    assert [(i, d, sp.get("shaft_current_a")) for i, d, sp in alike] == [
+        ("b1-6208", "6208", None),
+        ("b2-6208", "6208", None),
+        ("b3-6208", "6208", None),
+    ]
 
 
 def test_bench_service_two_twins_reports_per_twin_figures():
