@@ -23,6 +23,7 @@ from typing import Any
 from pydantic import ValidationError
 
 from service.core.errors import FieldError, InputError
+from service.core.mailbox import LatestValue
 
 try:  # the engine's limit (twin.state, with the vibration engine)
     from twin.state import MAX_DEFECTS
@@ -77,11 +78,12 @@ def parse_defects(data: Any, geometry, *, prefix: str = "defects") -> tuple:
 
 
 class DefectBox:
-    """The defects waiting for the runner thread (latest wins) and the ones accepted last."""
+    """The defects waiting for the runner thread (a `LatestValue`: latest wins) and the ones
+    accepted last, with counts of both."""
 
     def __init__(self) -> None:
         self._lock = threading.Lock()
-        self._pending: tuple | None = None
+        self._slot: LatestValue[tuple] = LatestValue()
         self._target: tuple = ()
         self.accepted = 0
         self.applied = 0
@@ -94,14 +96,14 @@ class DefectBox:
 
     def offer(self, defects: tuple) -> tuple:
         with self._lock:
-            self._pending = self._target = tuple(defects)
+            self._target = tuple(defects)
             self.accepted += 1
+            self._slot.offer(self._target)
             return self._target
 
     def take(self) -> tuple | None:
         """The pending defects or None (runner thread)."""
-        with self._lock:
-            pending, self._pending = self._pending, None
+        pending = self._slot.take()
         if pending is not None:
             self.applied += 1
         return pending
