@@ -10,8 +10,8 @@ are what the process spent beyond the Python threads:
 role               threads
 =================  =========================================================================
 stepping           `step-N` less the engines' own frames: the runner's Python between
-                   frames, the frozen copy of each capture, a setpoint's snapshot
-publish_worker     `step-publish`: snapshots built and handed to the sinks
+                   frames and, in real time, every snapshot built and handed to the sinks
+publish_worker     `step-publish`: fast mode's snapshots built and handed to the sinks
 zenoh_outbox       `zenoh-pub-*`: ball, vibration and waveform messages
 zenoh_inbox        `zenoh-ctl-*` and zenoh's callbacks (`pyo3-closure`)
 alarms             `alarms`
