@@ -15,6 +15,7 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
+from service.bus.twin_outbox import matched  # noqa: E402
 from service.bus.zenoh_bus import ZenohBus, make_config  # noqa: E402
 from service.tools.monitor import add_monitor_command, run_monitor  # noqa: E402
 from twin.engine import Twin  # noqa: E402
@@ -588,6 +589,9 @@ class _Blocker:
 def test_publish_never_blocks_and_counts_drops(bus, client, twin, support):
     snap = twin.snapshot()
     channel = bus.attach_twin("t1", lambda: snap, lambda p: {}, queue_size=8)
+    client.subscribe("bearing/t1/ball/0")  # a subscriber: the ball messages are queued for the outbox
+    ball = channel.outbox._ball_publisher(0)
+    assert ball is not None and support.wait_until(lambda: matched(ball), 5.0)
     blocker = _Blocker()
     channel.publish(blocker)
     assert blocker.entered.wait(5.0)
@@ -612,6 +616,21 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin, support):
     channel.publish(snap)  # after detach: a no-op, no exception
 
 
+def test_messages_nobody_subscribes_to_are_not_queued(bus, twin, support):
+    """service.bus.twin_outbox: without a subscriber to any ball, vibration or waveform key, a
+    snapshot's other messages and a waveform block are counted as unmatched on the caller's
+    thread and never queued, so the outbox's thread is not woken for them."""
+    snap = twin.snapshot()
+    channel = bus.attach_twin("t1", lambda: snap, lambda p: {}, queue_size=8)
+    balls = len(snap.balls)
+    for _ in range(20):
+        channel.publish(snap)
+    channel.publish_waveform("t1", [])
+    assert channel.published == 20 and channel.dropped == 0
+    assert channel.unmatched == 20 * balls + 1
+    assert not channel.outbox._queue
+
+
 def test_the_state_message_goes_out_on_the_callers_thread(bus, client, twin):
     """TwinChannel.publish puts the state message itself (the publish worker's thread), so it
     reaches a subscriber while the channel's own thread is held (here inside a snapshot's ball
@@ -631,7 +650,7 @@ def test_the_state_message_goes_out_on_the_callers_thread(bus, client, twin):
 
         client.wait_for(state, poke=lambda: channel.publish(snap))
         assert got[-1] == json.loads(snap.to_json())
-        assert not blocker.release.is_set() and channel.published == 0
+        assert not blocker.release.is_set() and channel.errors == 0  # the blocker is still held
     finally:
         blocker.release.set()
 
@@ -643,7 +662,7 @@ def test_publish_burst_is_cheap_and_close_is_prompt(bus, twin):
     for i in range(5000):
         channel.publish(snaps[i % 5])
     assert time.perf_counter() - t < 1.0
-    assert channel.dropped > 0
+    assert channel.dropped == 0 and channel.published == 5000  # nobody subscribes: nothing queued
     t = time.perf_counter()
     bus.close()
     assert time.perf_counter() - t < 5.0
