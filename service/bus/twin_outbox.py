@@ -218,7 +218,8 @@ class TwinOutbox:
                         self._send_waveform(item.blocks)
                         continue
                     self._send(item)
-                    self.published += 1
+                    with self._cond:  # also counted by `publish` on the caller's thread
+                        self.published += 1
                 except Exception as exc:  # noqa: BLE001 - nothing kills the publisher
                     self.errors += 1
                     if self.errors <= 3 or self.errors % 1000 == 0:
