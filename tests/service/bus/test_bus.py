@@ -575,6 +575,7 @@ class _Blocker:
     def __init__(self):
         self.entered = threading.Event()
         self.release = threading.Event()
+        self.left = threading.Event()  # the publisher thread let go (released, or gave up after 10 s)
 
     def to_json(self):
         return "{}"
@@ -583,6 +584,7 @@ class _Blocker:
     def schema_(self):  # the first thing the publisher thread reads for the ball messages
         self.entered.set()
         self.release.wait(10.0)
+        self.left.set()
         raise RuntimeError("not a real snapshot")  # must not kill the publisher thread
 
 
@@ -595,13 +597,10 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin, support):
     blocker = _Blocker()
     channel.publish(blocker)
     assert blocker.entered.wait(5.0)
-    worst = 0.0
     for _ in range(200):
-        t = time.perf_counter()
         channel.publish(snap)
-        worst = max(worst, time.perf_counter() - t)
+    assert not blocker.left.is_set()  # all 200 returned while the publisher thread was held
     assert channel.dropped == 200 - 8
-    assert worst < 0.05
     channel.publish(object())  # garbage is refused without raising: counted, not queued
     assert channel.dropped == 200 - 8 and channel.errors == 1
     blocker.release.set()
@@ -655,13 +654,11 @@ def test_the_state_message_goes_out_on_the_callers_thread(bus, client, twin):
         blocker.release.set()
 
 
-def test_publish_burst_is_cheap_and_close_is_prompt(bus, twin):
+def test_a_burst_nobody_subscribes_to_queues_nothing_and_close_is_prompt(bus, twin):
     snaps = [twin.snapshot() for _ in range(5)]
     channel = bus.attach_twin("t1", lambda: snaps[-1], lambda p: {}, queue_size=64)
-    t = time.perf_counter()
     for i in range(5000):
         channel.publish(snaps[i % 5])
-    assert time.perf_counter() - t < 1.0
     assert channel.dropped == 0 and channel.published == 5000  # nobody subscribes: nothing queued
     t = time.perf_counter()
     bus.close()
