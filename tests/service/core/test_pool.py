@@ -549,6 +549,36 @@ def test_configured_twin_starts_over_capacity_and_says_so(monkeypatch):
         reg.close()
 
 
+def test_health_counts_the_measured_service_overhead_in_the_capacity(monkeypatch):
+    """service.core.registry + capacity: once a window of the thread CPU meter has closed, /health
+    gives the service overhead per twin, counts it in what the running twin uses, and the formula
+    states it and ends with max_twins. The calibration says snapshots cost nothing and the engine
+    0.1 CPU s/s (monkeypatched), so any measured overhead is the larger share."""
+    import service.core.registry as registry_module
+    from service.core.registry import TwinRegistry
+    from service.core.runner import TwinRunner
+    from service.settings import ServiceSettings
+
+    monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: TwinCost(0.1, 0.0))
+    monkeypatch.setattr(TwinRunner, "cost", property(lambda self: self.calibration))
+    settings = ServiceSettings(enable_zenoh=False, enable_recording=False, admission="measured", bearing="6208")
+    reg = TwinRegistry(settings).open()
+    try:
+        reg.health()  # the first mark
+        deadline = time.monotonic() + 10.0
+        cap = reg.health()["capacity"]
+        while cap["service_overhead_per_twin_cpu_s_per_s"] is None and time.monotonic() < deadline:
+            time.sleep(0.3)
+            cap = reg.health()["capacity"]
+        per_twin = cap["service_overhead_per_twin_cpu_s_per_s"]
+        assert per_twin is not None and per_twin > 0.0
+        assert cap["used_cpu_s_per_s"] == pytest.approx(0.1 + per_twin)
+        assert f"service {per_twin:.3f} (measured per twin; its snapshots alone 0.000)" in cap["formula"]
+        assert cap["formula"].endswith(f"= {cap['max_twins']}")
+    finally:
+        reg.close()
+
+
 def test_max_twins_unset_means_the_capacity_decides():
     from service.settings import ServiceSettings
 
