@@ -139,12 +139,13 @@ class TwinOutbox:
             if pub is None or matched(pub):
                 return False
         block = getattr(snapshot, "vibration", None)
-        new_window = block is not None and block.window_end_s != self._last_window_end_s
+        window_end = None if block is None else block.window_end_s
+        new_window = window_end is not None and window_end != self._last_window_end_s
         if new_window:
             pub = self._lazy_publisher("_vibration_pub", "vibration", JSON_ENCODING)
             if pub is None or matched(pub):
                 return False
-            self._last_window_end_s = block.window_end_s
+            self._last_window_end_s = window_end
         with self._cond:
             self.unmatched += balls + int(new_window)
             self.published += 1
