@@ -221,13 +221,9 @@ class Publisher:
             for t in timings:
                 t.captured_wall_s = now
         waveform = twin.drain_waveform()  # [] without the housing
-        if worker is None or not worker.alive:
+        if not self.lossless or worker is None or not worker.alive:
             with self._deliver_lock:
-                self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings, waveform))
-            return
-        if not self.lossless:
-            with self._deliver_lock:
-                self._drain_locked()
+                self._drain_locked()  # captures a stopped worker left behind go first
                 self._deliver(Capture(twin, real_time_factor, late_fraction, self.note, timings, waveform))
             return
         cap = Capture(twin.frozen(), real_time_factor, late_fraction, self.note, timings, waveform)
