@@ -17,7 +17,8 @@ What it does, for `minutes` of wall time:
   prefix BEARING_TWIN_ZENOH_PREFIX (default bearing);
 * subscribes to `{prefix}/*/state` and counts gaps in each twin's `seq` (dropped messages),
   out-of-order messages and non-finite numbers, and to the setpoint result key, pairing each
-  zenoh setpoint with its result in order (zenoh keeps the order of one link);
+  zenoh setpoint with its result in order (zenoh keeps the order of one link) after a first
+  round trip (a valid setpoint put until its result arrives: then both routes exist);
 * every `sample_s` reads /health (real-time factor, frames, overruns, runner errors, restarts,
   fallbacks, rows recorded) and the service's resident memory (psutil, else /proc/<pid>/status
   VmRSS; the pid comes from /health, or the subprocess; /health's own `rss_bytes` when the
@@ -299,6 +300,28 @@ class _Stream:
             self.results.clear()
         return out
 
+    def handshake(self, payload: bytes, timeout_s: float = 30.0) -> int:
+        """Put the valid setpoint `payload` until a result comes back, then drop every result so
+        far; returns the number of puts. zenoh routes declarations asynchronously: a setpoint put
+        before the service's subscriber is known here, or answered before this session's result
+        subscriber is known there, is lost without an answer, and pairing in order would then
+        shift every later pair by one. After one round trip both routes exist."""
+        deadline = time.monotonic() + timeout_s  # a liveness bound, not a performance figure
+        puts = 0
+        while time.monotonic() < deadline:
+            self.put(payload)
+            puts += 1
+            wait_until = time.monotonic() + 0.5
+            while time.monotonic() < wait_until:
+                with self.lock:
+                    answered = bool(self.results)
+                if answered:
+                    time.sleep(0.5)  # the answers of earlier puts still on their way
+                    self.take_results()
+                    return puts
+                time.sleep(0.01)
+        raise RuntimeError(f"no zenoh setpoint result within {timeout_s} s: is the twin on this bus?")
+
     def close(self) -> None:
         for sub in self._subs:
             try:
@@ -430,6 +453,7 @@ def run_soak(cfg: SoakConfig) -> dict:
             )
             prefix = DEFAULT_PREFIX if started is not None else env.zenoh.prefix  # the started one: default
             stream = _Stream(zenoh_endpoint, cfg.bearing_id, prefix, access)
+            report["zenoh_handshake_puts"] = stream.handshake(driver.zenoh_payload(True))
             report["zenoh_access"] = access.describe(listening=False) if access.enabled else "none"
         health0 = client.get(f"{url}/health", headers=headers).json()
         pid = started.proc.pid if started is not None else health0.get("pid")
