@@ -11,17 +11,18 @@ vibration window, the waveform chunks), in batches: everything queued at once, t
 snapshots and waveform blocks; these messages come at most that much later). Publishers other
 than the state's are declared with their first message.
 
-Only what subscribers take is serialised. Before a message is made, its publisher's zenoh
-matching status (`Publisher.matching_status`: whether any subscriber, local or remote, matches
-its key; about a microsecond) is read; a message nobody subscribes to is neither serialised nor
-put (counted in `unmatched`). `publish` and `publish_waveform` read them first, on the caller's
-thread: a snapshot or a waveform block none of whose messages has a subscriber is counted there
-and never queued, so the outbox's thread is not woken for it (a wake-up of an idle thread costs
-70-140 us of CPU on a 2-core VM, more than reading the nine statuses). The ball messages were
-the outbox's largest cost (nine JSON documents per snapshot, 0.14 ms). The state message is
-always made: the snapshot queryable answers with the same text. A subscriber declared later is
-matched from then on: zenoh keeps no history of these messages for it anyway (congestion
-control DROP, no publication cache).
+Only what subscribers take is serialised. Each publisher but the state's has a zenoh matching
+listener (`Matching`): zenoh tells it when a subscriber, local or remote, starts or stops
+matching the publisher's key, so whether a message has a taker is an attribute read. A message
+nobody subscribes to is neither serialised nor put (counted in `unmatched`). `publish` and
+`publish_waveform` look first, on the caller's thread: a snapshot or a waveform block none of
+whose messages has a subscriber is counted there and never queued, so the outbox's thread is not
+woken for it (a wake-up of an idle thread costs 70-140 us of CPU on a 2-core VM; reading the nine
+balls' `Publisher.matching_status` after a frame cost about 60 us). The ball messages are the
+outbox's largest cost when subscribed (nine JSON documents per snapshot, 0.14 ms). The state
+message is always made: the snapshot queryable answers with the same text. A subscriber
+declared later is matched from then on: zenoh keeps no history of these messages for it anyway
+(congestion control DROP, no publication cache).
 """
 
 from __future__ import annotations
@@ -68,6 +69,8 @@ class TwinOutbox:
         self._pub_lock = threading.Lock()
         self._gone = False  # publishers undeclared
         self._ball_publishers: dict[int, zenoh.Publisher] = {}
+        self._ball_matching: dict[int, Matching] = {}  # ball index -> its publisher's listener
+        self._matching: dict[int, Matching] = {}  # id(publisher) -> its matching listener
         self._alarm_pub: zenoh.Publisher | None = None  # declared with the first alarm
         self._vibration_pub: zenoh.Publisher | None = None  # declared with the first window
         self._waveform_pub: zenoh.Publisher | None = None  # declared with the first samples
@@ -118,7 +121,7 @@ class TwinOutbox:
         """Queue accelerometer blocks for `P/{id}/vibration/waveform`; returns at once (counted
         in `unmatched` and not queued while nobody subscribes)."""
         pub = self._lazy_publisher("_waveform_pub", "vibration/waveform", "application/octet-stream")
-        if pub is not None and not matched(pub):
+        if pub is not None and not self._matched(pub):
             with self._cond:
                 self.unmatched += 1
             return
@@ -135,15 +138,19 @@ class TwinOutbox:
         else:
             return False
         for index in range(balls):
-            pub = self._ball_publisher(index)
-            if pub is None or matched(pub):
+            watch = self._ball_matching.get(index)
+            if watch is None:  # its publisher is declared with the first snapshot
+                watch = self._ball_matching.get(index) if self._ball_publisher(index) is not None else None
+                if watch is None:  # detaching
+                    return False
+            if watch.matching:
                 return False
         block = getattr(snapshot, "vibration", None)
         window_end = None if block is None else block.window_end_s
         new_window = window_end is not None and window_end != self._last_window_end_s
         if new_window:
             pub = self._lazy_publisher("_vibration_pub", "vibration", JSON_ENCODING)
-            if pub is None or matched(pub):
+            if pub is None or self._matched(pub):
                 return False
             self._last_window_end_s = window_end
         with self._cond:
@@ -176,6 +183,11 @@ class TwinOutbox:
             publishers = [self._state_pub, *self._ball_publishers.values()]
             publishers += [p for p in (self._alarm_pub, self._vibration_pub, self._waveform_pub) if p is not None]
             self._ball_publishers.clear()
+            watches = list(self._matching.values())
+            self._matching.clear()
+            self._ball_matching.clear()
+        for watch in watches:
+            watch.close()
         for pub in publishers:
             undeclare(pub)
 
@@ -244,7 +256,7 @@ class TwinOutbox:
                 pub = self._ball_publisher(index)
                 if pub is None:
                     return  # detaching
-                if not matched(pub):
+                if not self._matched(pub):
                     self.unmatched += 1
                     continue
                 if texts is None:
@@ -257,7 +269,7 @@ class TwinOutbox:
                 pub = self._ball_publisher(int(index))
                 if pub is None:
                     return  # detaching
-                if not matched(pub):
+                if not self._matched(pub):
                     self.unmatched += 1
                     continue
                 pub.put(head + ball.model_dump_json(by_alias=True)[1:])
@@ -282,7 +294,7 @@ class TwinOutbox:
             return
         self._last_window_end_s = end
         pub = self._lazy_publisher("_vibration_pub", "vibration", JSON_ENCODING)
-        if pub is not None and not matched(pub):
+        if pub is not None and not self._matched(pub):
             self.unmatched += 1
             return
         if pub is not None:
@@ -312,7 +324,7 @@ class TwinOutbox:
         pub = self._lazy_publisher("_waveform_pub", "vibration/waveform", "application/octet-stream")
         if pub is None:
             return
-        if not matched(pub):
+        if not self._matched(pub):
             self.unmatched += 1
             return
         for block in blocks:
@@ -332,6 +344,7 @@ class TwinOutbox:
                     encoding=encoding,
                     congestion_control=zenoh.CongestionControl.DROP,
                 )
+                self._matching[id(pub)] = Matching(pub)
                 setattr(self, attr, pub)
             return pub
 
@@ -344,8 +357,45 @@ class TwinOutbox:
                     encoding=JSON_ENCODING,
                     congestion_control=zenoh.CongestionControl.DROP,
                 )
+                self._matching[id(pub)] = self._ball_matching[index] = Matching(pub)
                 self._ball_publishers[index] = pub
             return pub
+
+    def _matched(self, pub: zenoh.Publisher) -> bool:
+        """Whether a subscriber matches `pub`'s key (its listener's word; `matched` without one)."""
+        watch = self._matching.get(id(pub))
+        return watch.matching if watch is not None else matched(pub)
+
+
+class Matching:
+    """Whether any subscriber, local or remote, matches a publisher's key, kept up to date by a
+    zenoh matching listener (zenoh calls it on each change, and at once when a subscriber
+    already matches), so a read is an attribute, not a call into zenoh. True while zenoh cannot
+    say (no listener): the message is then made and put, as `matched` does."""
+
+    def __init__(self, pub: zenoh.Publisher):
+        self.matching = True
+        self._changes = 0
+        self._listener: Any = None
+        try:
+            self._listener = pub.declare_matching_listener(self._on_change)
+        except Exception as exc:  # noqa: BLE001 - without a listener every message is made
+            log.debug("no matching listener: %s", one_line(exc))
+            return
+        seen = self._changes
+        now = matched(pub)  # the status when declared; the listener keeps it from here
+        if self._changes == seen:
+            self.matching = now
+
+    def _on_change(self, status: Any) -> None:
+        self._changes += 1
+        self.matching = bool(status.matching)
+
+    def close(self) -> None:
+        """Undeclare the listener; never raises."""
+        if self._listener is not None:
+            undeclare(self._listener)
+            self._listener = None
 
 
 def matched(pub: zenoh.Publisher) -> bool:

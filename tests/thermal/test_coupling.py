@@ -112,3 +112,43 @@ def test_measurement_is_assimilated_and_published(warmed):
     assert math.isfinite(th.dissipation_factor) and th.dissipation_factor_sigma > 0.0
     # the snapshot stays valid JSON with the block (no NaN)
     assert '"thermal"' in twin.snapshot().to_json()
+
+
+def test_the_block_is_made_again_exactly_when_the_network_changes():
+    """ThermalCoupling.block: a snapshot comes every frame, the network steps every period; the
+    block is the last one while the network's state is unchanged, and a fresh one equal to a
+    block made from scratch after a step, a new ambient, held temperatures or an assimilated
+    measurement."""
+    twin = Twin(
+        "6208",
+        options=ACCELERATED,
+        setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0),
+    )
+    th = twin.thermal
+    assert th is not None
+    twin.advance(0.01)
+    first = th.block()
+    assert th.block() is first  # nothing changed between the two
+    assert first == th._make_block()
+    steps = 0
+    while th.network_time_s == first.network_time_s:  # frames until the next network step
+        twin.advance(0.0005)
+        steps += 1
+        assert steps < 1000
+    stepped = th.block()
+    assert stepped is not first and stepped == th._make_block()
+    assert stepped.network_time_s > first.network_time_s
+    twin.set_setpoint(twin.setpoint.model_copy(update={"oil_temperature_c": 25.0}))
+    shifted = th.block()
+    assert shifted is not stepped and shifted == th._make_block() and shifted.ambient_c == 25.0
+    twin.hold_thermal_state(th.temperature_c + 1.0)
+    held = th.block()
+    assert held is not shifted and held == th._make_block()
+    assert held.temperatures_c["outer_ring"] == pytest.approx(shifted.temperatures_c["outer_ring"] + 1.0, abs=1e-9)
+    twin.measure_temperature("outer_ring", held.temperatures_c["outer_ring"] + 8.0)
+    assert th.block() is held  # assimilated at the next network step, not before
+    network_time_s = th.network_time_s
+    while th.network_time_s == network_time_s:
+        twin.advance(0.0005)
+    measured = th.block()
+    assert measured.measured_node == "outer_ring" and measured == th._make_block()

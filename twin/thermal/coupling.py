@@ -88,6 +88,7 @@ class ThermalCoupling:
         self._time_constants: tuple[Network, float, np.ndarray] | None = None  # (network, s, tau) of the last call
         self._work_j = 0.0
         self._work_s = 0.0
+        self._block: tuple[tuple, ThermalState] | None = None  # (state key, block) of the last call
 
     # ---- inputs -----------------------------------------------------------------------------
     @property
@@ -245,7 +246,32 @@ class ThermalCoupling:
             self._rate_history.pop(0)
 
     def block(self) -> ThermalState:
-        """The snapshot's `thermal` block (twin.snapshot.ThermalState)."""
+        """The snapshot's `thermal` block (twin.snapshot.ThermalState). Every field is a function
+        of the network's state (its time, ambient, estimator, heat sources and measurement), which
+        changes at a network step, a new ambient or held temperatures, not between them: the
+        block is made again only when that state differs from the last call's (a snapshot comes
+        every frame, a network step every `period_s`)."""
+        f = self.filter
+        key = (
+            self.network_time_s,
+            self.ambient_c,
+            f.x.tobytes(),
+            f.p.tobytes(),
+            f.residual_k,
+            f.innovation_sigma_k,
+            f.unexplained,
+            id(self.heat),
+            id(self.network),
+            id(self.last_measurement),
+        )
+        memo = self._block
+        if memo is not None and memo[0] == key:
+            return memo[1]
+        block = self._make_block()
+        self._block = (key, block)
+        return block
+
+    def _make_block(self) -> ThermalState:
         per = self.heat.per_contact_w.sum(axis=1)
         f = self.filter
         m = self.last_measurement

@@ -15,7 +15,7 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
-from service.bus.twin_outbox import matched  # noqa: E402
+from service.bus.twin_outbox import Matching, matched  # noqa: E402
 from service.bus.zenoh_bus import ZenohBus, make_config  # noqa: E402
 from service.tools.monitor import add_monitor_command, run_monitor  # noqa: E402
 from twin.engine import Twin  # noqa: E402
@@ -540,7 +540,7 @@ def test_monitor_command_registers_with_argparse():
 
 
 def test_ball_messages_are_made_only_for_a_subscriber(bus, client, twin, support):
-    """The outbox reads each ball publisher's zenoh matching status and makes no ball message
+    """The outbox follows each ball publisher's zenoh matching status and makes no ball message
     nobody subscribes to (service.bus.twin_outbox): without a subscriber every ball of every
     snapshot is counted unmatched; a subscriber to one ball gets that ball's messages and the
     other balls stay unmade."""
@@ -565,6 +565,28 @@ def test_ball_messages_are_made_only_for_a_subscriber(bus, client, twin, support
     channel.publish(snap)
     assert support.wait_until(lambda: channel.published + channel.dropped == sent[0] + 1, 5.0)
     assert channel.unmatched - before == balls - 1
+
+
+def test_matching_follows_a_remote_subscriber(bus, client, support):
+    """service.bus.twin_outbox.Matching: zenoh's matching listener keeps the flag the outbox
+    reads in step with the publisher's own status as a subscriber of another session arrives
+    and leaves, and with one that matched before the listener was declared."""
+    pub = bus.session.declare_publisher("bearing/m1/ball/0")
+    watch = Matching(pub)
+    try:
+        assert watch.matching is False and matched(pub) is False
+        client.subscribe("bearing/m1/**")
+        assert support.wait_until(lambda: watch.matching, WAIT_S)
+        assert matched(pub)
+        late = Matching(pub)  # declared while a subscriber matches
+        assert support.wait_until(lambda: late.matching, WAIT_S)
+        late.close()
+        client.close()
+        assert support.wait_until(lambda: not watch.matching, WAIT_S)
+        assert not matched(pub)
+    finally:
+        watch.close()
+        pub.undeclare()
 
 
 # ---- (f) publish never blocks ----------------------------------------------------------------
@@ -593,7 +615,7 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin, support):
     channel = bus.attach_twin("t1", lambda: snap, lambda p: {}, queue_size=8)
     client.subscribe("bearing/t1/ball/0")  # a subscriber: the ball messages are queued for the outbox
     ball = channel.outbox._ball_publisher(0)
-    assert ball is not None and support.wait_until(lambda: matched(ball), 5.0)
+    assert ball is not None and support.wait_until(lambda: channel.outbox._matched(ball), 5.0)
     blocker = _Blocker()
     channel.publish(blocker)
     assert blocker.entered.wait(5.0)
