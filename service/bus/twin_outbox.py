@@ -1,17 +1,18 @@
 """What a twin puts on the zenoh bus: the state message, its balls, vibration windows, waveform
 chunks and alarms (the outgoing half of `service.bus.zenoh_bus.TwinChannel`).
 
-`publish` puts the STATE message on the caller's thread (the runner's publish worker or, for the
-snapshot of a setpoint, its stepping thread): the snapshot's contract JSON (`Snapshot.to_json`,
-~0.06 ms for a 9-ball twin) and one `put` on an express publisher with congestion control DROP,
-which never waits on the network. Then it appends the snapshot to a bounded deque (drop-oldest,
-counted in `dropped`) for the outbox's own thread, which puts the rest (one message per ball, the
-vibration window, the waveform chunks), in batches: everything queued at once, then a pause of
-`batch_interval_s` (20 ms: the thread wakes about 50 times a second whatever the number of
-snapshots and waveform blocks; these messages come at most that much later). Publishers other
-than the state's are declared with their first message.
+`publish` puts the STATE message on the caller's thread (the stepping thread that built the
+snapshot, or the publish worker in fast mode): the snapshot's contract JSON (`Snapshot.to_json`,
+0.06 ms for a 9-ball twin in a loop, 0.2 ms right after a frame) and one `put` on an express
+publisher with congestion control DROP, which never waits on the network. Then it appends the
+snapshot to a bounded deque (drop-oldest, counted in `dropped`) for the outbox's own thread,
+which puts the rest (one message per ball, the vibration window, the waveform chunks), in
+batches: everything queued at once, then a pause of `batch_interval_s` (20 ms: the thread wakes
+about 50 times a second whatever the number of snapshots and waveform blocks; these messages
+come at most that much later). Publishers other than the state's are declared with their first
+message.
 
-Only what subscribers take is serialised. Each publisher but the state's has a zenoh matching
+Only what subscribers take is serialised. Each publisher but the alarms' has a zenoh matching
 listener (`Matching`): zenoh tells it when a subscriber, local or remote, starts or stops
 matching the publisher's key, so whether a message has a taker is an attribute read. A message
 nobody subscribes to is neither serialised nor put (counted in `unmatched`). `publish` and
@@ -20,7 +21,8 @@ whose messages has a subscriber is counted there and never queued, so the outbox
 woken for it (a wake-up of an idle thread costs 70-140 us of CPU on a 2-core VM; reading the nine
 balls' `Publisher.matching_status` after a frame cost about 60 us). The ball messages are the
 outbox's largest cost when subscribed (nine JSON documents per snapshot, 0.14 ms). The state
-message is always made: the snapshot queryable answers with the same text. A subscriber
+message too is made only for a subscriber; the snapshot queryable answers with the same text,
+the last one made (`last_state`) or made for the query from the latest snapshot. A subscriber
 declared later is matched from then on: zenoh keeps no history of these messages for it anyway
 (congestion control DROP, no publication cache).
 """
@@ -82,6 +84,7 @@ class TwinOutbox:
             congestion_control=zenoh.CongestionControl.DROP,
             express=True,
         )
+        self._state_matching = self._matching[id(self._state_pub)] = Matching(self._state_pub)
         self._thread = threading.Thread(target=self._loop, name=f"zenoh-pub-{bearing_id}", daemon=True)
         self._thread.start()
 
@@ -192,11 +195,16 @@ class TwinOutbox:
             undeclare(pub)
 
     def _send_state(self, snapshot: Snapshot | SnapshotFrame) -> None:
-        """The state message, serialised once (kept for the snapshot queryable) and put."""
+        """The state message, serialised once (kept for the snapshot queryable) and put; neither
+        while no subscriber takes it (counted in `unmatched`)."""
         with self._pub_lock:
             if self._gone or self._stopping:
                 return
             pub = self._state_pub
+        if not self._state_matching.matching:
+            with self._cond:
+                self.unmatched += 1
+            return
         state_json = snapshot.to_json()
         with self._last_lock:
             self._last = (snapshot, state_json)

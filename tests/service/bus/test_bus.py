@@ -550,7 +550,7 @@ def test_ball_messages_are_made_only_for_a_subscriber(bus, client, twin, support
     for _ in range(3):
         channel.publish(snap)
     assert support.wait_until(lambda: channel.published == 3, 5.0), channel.published
-    assert channel.unmatched == 3 * balls
+    assert channel.unmatched == 3 * (balls + 1)  # the balls' and the state's messages
     client.subscribe("bearing/t1/ball/2")
     sent = [3]
 
@@ -564,7 +564,7 @@ def test_ball_messages_are_made_only_for_a_subscriber(bus, client, twin, support
     before = channel.unmatched
     channel.publish(snap)
     assert support.wait_until(lambda: channel.published + channel.dropped == sent[0] + 1, 5.0)
-    assert channel.unmatched - before == balls - 1
+    assert channel.unmatched - before == balls - 1 + 1  # the other balls, and the state
 
 
 def test_matching_follows_a_remote_subscriber(bus, client, support):
@@ -614,8 +614,10 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin, support):
     snap = twin.snapshot()
     channel = bus.attach_twin("t1", lambda: snap, lambda p: {}, queue_size=8)
     client.subscribe("bearing/t1/ball/0")  # a subscriber: the ball messages are queued for the outbox
+    client.subscribe("bearing/t1/state")  # and the state message is made (and refused when garbage)
     ball = channel.outbox._ball_publisher(0)
     assert ball is not None and support.wait_until(lambda: channel.outbox._matched(ball), 5.0)
+    assert support.wait_until(lambda: channel.outbox._state_matching.matching, 5.0)
     blocker = _Blocker()
     channel.publish(blocker)
     assert blocker.entered.wait(5.0)
@@ -631,16 +633,15 @@ def test_publish_never_blocks_and_counts_drops(bus, client, twin, support):
         channel.published,
         channel.errors,
     )
-    client.subscribe("bearing/t1/state")
-    client.wait_for(lambda item: True, poke=lambda: channel.publish(snap))
+    client.wait_for(lambda item: item[0] == "bearing/t1/state", poke=lambda: channel.publish(snap))
     channel.detach()
     channel.publish(snap)  # after detach: a no-op, no exception
 
 
 def test_messages_nobody_subscribes_to_are_not_queued(bus, twin, support):
-    """service.bus.twin_outbox: without a subscriber to any ball, vibration or waveform key, a
-    snapshot's other messages and a waveform block are counted as unmatched on the caller's
-    thread and never queued, so the outbox's thread is not woken for them."""
+    """service.bus.twin_outbox: without a subscriber to any state, ball, vibration or waveform
+    key, a snapshot's messages and a waveform block are counted as unmatched on the caller's
+    thread, not made and never queued, so the outbox's thread is not woken for them."""
     snap = twin.snapshot()
     channel = bus.attach_twin("t1", lambda: snap, lambda p: {}, queue_size=8)
     balls = len(snap.balls)
@@ -648,7 +649,8 @@ def test_messages_nobody_subscribes_to_are_not_queued(bus, twin, support):
         channel.publish(snap)
     channel.publish_waveform("t1", [])
     assert channel.published == 20 and channel.dropped == 0
-    assert channel.unmatched == 20 * balls + 1
+    assert channel.unmatched == 20 * (balls + 1) + 1
+    assert channel.outbox.last_state(snap) is None  # no state message was made
     assert not channel.outbox._queue
 
 
