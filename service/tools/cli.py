@@ -180,6 +180,7 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
             duration_s=args.duration,
             noise_density_m_s2_rthz=args.noise_density,
             sample_rate_hz=args.sample_rate,
+            diametral_clearance_m=args.clearance,
         )
     except (ValidationError, SetpointError, ValueError) as exc:
         print(f"error: {error_text(exc)}", file=sys.stderr)
@@ -326,6 +327,13 @@ def build_parser() -> argparse.ArgumentParser:
         default=0.0,
         help="defect position [deg]: outer race from the centre of the load zone (CWRU 6:00, 3:00, "
         "12:00 = 0, 90, 180), inner race from the ring's mark (default 0)",
+    )
+    vib.add_argument(
+        "--clearance",
+        type=float,
+        default=None,
+        help="mounted diametral clearance [m], -50e-6 .. 200e-6, negative = preload (default: the bearing's; "
+        "CWRU-DE 12.5e-6)",
     )
     vib.add_argument("--duration", type=_positive_float, default=1.0, help="analysed simulated time [s] (default 1)")
     vib.add_argument(

@@ -68,10 +68,13 @@ def simulate_vibration(
     sample_rate_hz: float | None = None,
     window_s: float | None = None,
     band: str | tuple[float, float] = "resonance",
+    diametral_clearance_m: float | None = None,
 ) -> tuple[dict, np.ndarray]:
     """Run the twin with its housing on (and a defect, `defect_for`) and analyse the accelerometer:
     `settle_s` of simulated time is discarded, then `duration_s` is sampled (in-kernel decimator)
     and passed to `run_vibration` with the loaded contact angle of the contacts at the end.
+    `diametral_clearance_m`: the mounted clearance [m] in place of the spec's
+    (`Mounting.diametral_clearance_m`; negative = preload), for a study of its unknown value.
 
     bearing: designation or `BearingSpec` (its housing is switched on; noise density, sample rate
     and window override the spec's accelerometer when given); radial_load_n None: the rig's load of
@@ -99,6 +102,8 @@ def simulate_vibration(
     ):
         if value is not None:
             acc[key] = value
+    if diametral_clearance_m is not None:
+        data["mounting"]["diametral_clearance_m"] = diametral_clearance_m
     spec = BearingSpec.model_validate(data)
     twin = Twin(
         spec,
@@ -139,6 +144,7 @@ def simulate_vibration(
             "shaft_speed_rad_s": float(twin.state.scalars[L.X_SHAFT_SPEED]),
             "radial_load_n": radial_load_n,
             "axial_load_n": axial_load_n,
+            "diametral_clearance_m": spec.mounting.diametral_clearance_m,
             "defect": twin.defects[0].model_dump() if twin.defects else None,
             "time_step_s": twin.model.dt_s,
             "decimation_ratio": decimator.ratio,

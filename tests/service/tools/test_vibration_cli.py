@@ -93,3 +93,43 @@ def test_refuses_bad_input_by_name():
     assert res.returncode == 2 and "depth_m" in res.stderr and "Traceback" not in res.stderr
     res = _run("--bearing", "6208", "--speed", "523", "--radial-load=-5", "--duration", "0.05")
     assert res.returncode == 2 and "radial_load_n" in res.stderr and "Traceback" not in res.stderr
+
+
+def test_the_mounted_clearance_reaches_the_twin_and_bad_values_name_the_field():
+    """`--clearance` replaces the spec's mounted diametral clearance (twin.spec.Mounting, range
+    -50 .. 200 um); the CWRU rig's drive end with a 2 um preload instead of its CN 12.5 um: the
+    JSON states the clearance it ran with, and a clearance out of range names the field and its
+    bounds before any simulation."""
+    res = _run("--bearing", "CWRU-DE", "--speed", "188.1", "--clearance", "-2e-6", "--duration", "0.1", "--json")
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout)
+    assert out["diametral_clearance_m"] == -2e-6 and out["status"] == "ok"
+    bad = _run("--bearing", "CWRU-DE", "--speed", "188.1", "--clearance", "1e-3", "--json", timeout=120)
+    assert bad.returncode == 2 and "Traceback" not in bad.stderr
+    assert "diametral_clearance_m" in bad.stderr and "0.0002" in bad.stderr, bad.stderr
+
+
+def test_a_preload_loads_every_ball_of_the_cwru_rig():
+    """Seed 000 Appendix A (clearance and preload) / Harris and Kotzalas' load zone: at the CWRU
+    rig's 1797 rpm under its rotor's 36.8 N (twin.catalog.default_radial_load_n), with the CN
+    clearance (12.5 um) only the balls about the load line carry load; with a 2 um preload every
+    ball does, the one opposite the load at least 1 N (the ring's shift under 36.8 N stays below
+    the preload's interference)."""
+    from twin.engine import Twin
+    from twin.setpoint import Setpoint
+    from twin.spec import Mounting
+
+    def inner_loads_n(clearance_m: float) -> list[float]:
+        spec = catalog.bearing("CWRU-DE")
+        mounting = Mounting(diametral_clearance_m=clearance_m, rotor_mass_kg=spec.mounting.rotor_mass_kg)
+        load = catalog.default_radial_load_n("CWRU-DE")
+        assert load == 36.8
+        twin = Twin(
+            spec.model_copy(update={"mounting": mounting}),
+            setpoint=Setpoint(shaft_speed_rad_s=188.1, radial_load_n=load),
+        )
+        twin.advance(0.01)
+        return [ball.inner.load_n for ball in twin.snapshot().balls]
+
+    assert sum(q > 0.0 for q in inner_loads_n(12.5e-6)) <= 4
+    assert min(inner_loads_n(-2e-6)) >= 1.0
