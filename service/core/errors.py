@@ -6,6 +6,7 @@ vocabulary's errors. Messages never echo the input (it may hold NaN, which JSON 
 from __future__ import annotations
 
 import math
+import typing
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -107,14 +108,52 @@ def _jsonable(value: Any) -> Any:
     return str(value)
 
 
+def declared_bounds(model: type[BaseModel], loc: Sequence[Any]) -> tuple[Any, Any] | None:
+    """Both sides of the range `model` declares for the field at `loc` (a pydantic error's path:
+    nested models and list items followed), from its ge/gt and le/lt constraints; None when `loc`
+    names no such field. pydantic's error names only the side that was crossed."""
+    info = None
+    current: Any = model
+    for part in loc:
+        if isinstance(part, int):
+            continue  # an item of a list or tuple of models
+        fields = getattr(current, "model_fields", None)
+        if not fields or str(part) not in fields:
+            return None
+        info = fields[str(part)]
+        current = _model_in(info.annotation)
+    if info is None:
+        return None
+    low = high = None
+    for constraint in info.metadata:
+        for name in ("ge", "gt"):
+            low = getattr(constraint, name, None) if getattr(constraint, name, None) is not None else low
+        for name in ("le", "lt"):
+            high = getattr(constraint, name, None) if getattr(constraint, name, None) is not None else high
+    return None if low is None and high is None else (low, high)
+
+
+def _model_in(annotation: Any) -> type[BaseModel] | None:
+    """The pydantic model a field's annotation holds (itself, or inside Optional / list / tuple)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    for arg in typing.get_args(annotation):
+        found = _model_in(arg)
+        if found is not None:
+            return found
+    return None
+
+
 def field_errors(
     errors: Sequence[Mapping[str, Any]],
     limits: SetpointLimits | None = None,
     bounds: Mapping[str, tuple[Any, Any]] | None = None,
+    model: type[BaseModel] | None = None,
 ) -> list[FieldError]:
     """pydantic error dicts -> FieldErrors naming the field and its allowed range: for setpoint
     fields the bearing's (`limits`) or else the vocabulary's static bounds, for other fields
-    both sides of the declared range (`bounds`, since pydantic names only the side crossed)."""
+    both sides of the declared range (`bounds` by field name, or what `model`, the validated
+    model, declares at the error's path; pydantic names only the side crossed)."""
     out = []
     for e in errors:
         loc = tuple(e.get("loc", ()))
@@ -137,6 +176,8 @@ def field_errors(
             high_bound = ctx.get("le", ctx.get("lt"))
             if low_bound is not None or high_bound is not None:
                 known = (bounds or {}).get(leaf or "")
+                if known is None and model is not None:
+                    known = declared_bounds(model, loc)
                 if known is not None:
                     low_bound = known[0] if low_bound is None else low_bound
                     high_bound = known[1] if high_bound is None else high_bound

@@ -324,7 +324,13 @@ class TwinRegistry:
             try:
                 spec = spec if isinstance(spec, BearingSpec) else BearingSpec.model_validate(spec)
             except ValidationError as exc:
-                raise InputError(field_errors([{**e, "loc": ("spec", *e["loc"])} for e in exc.errors()])) from None
+                errors = exc.errors()
+                raise InputError(
+                    [
+                        error.model_copy(update={"field": f"spec.{error.field}" if error.field else "spec"})
+                        for error in field_errors(errors, model=BearingSpec)
+                    ]
+                ) from None
             try:
                 twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
             except (ValueError, ArithmeticError) as exc:  # a valid spec the model cannot compile
@@ -363,7 +369,7 @@ class TwinRegistry:
                 extra["housing"] = housing
             return catalog.bearing(designation, diametral_clearance_m=diametral_clearance_m, lubricant=lub, **extra)
         except ValidationError as exc:
-            raise InputError(field_errors(exc.errors())) from None
+            raise InputError(field_errors(exc.errors(), model=BearingSpec)) from None
 
     def create_twin(
         self,

@@ -1,0 +1,47 @@
+"""An input error names the field and both sides of its allowed range, whichever way the input
+came (service.core.errors): pydantic names only the side that was crossed, so the range is read
+from the model that validated it (`declared_bounds`)."""
+
+import pytest
+from pydantic import ValidationError
+
+from service.core.errors import InputError, declared_bounds, field_errors
+from service.core.registry import TwinRegistry
+from service.settings import ServiceSettings
+from service.tools.messages import error_text
+from twin import catalog
+from twin.spec import BearingSpec
+
+
+def _bad_spec(**mounting):
+    data = catalog.bearing("CWRU-DE").model_dump(mode="json")
+    data["mounting"].update(mounting)
+    return data
+
+
+def test_declared_bounds_follow_nested_models():
+    # twin.spec.Clearance: -50 .. 200 um; the accelerometer's noise density >= 0 (twin.vibration.housing)
+    assert declared_bounds(BearingSpec, ("mounting", "diametral_clearance_m")) == (-50e-6, 200e-6)
+    low, high = declared_bounds(BearingSpec, ("housing", "accelerometer", "noise_density_m_s2_rthz"))
+    assert low == 0.0 and high is not None
+    assert declared_bounds(BearingSpec, ("mounting", "no_such_field")) is None
+    assert declared_bounds(BearingSpec, ("designation",)) is None  # no range declared
+
+
+def test_a_spec_error_states_both_sides_of_the_range():
+    with pytest.raises(ValidationError) as info:
+        BearingSpec.model_validate(_bad_spec(diametral_clearance_m=1e-3))
+    (error,) = field_errors(info.value.errors(), model=BearingSpec)
+    assert error.field == "mounting.diametral_clearance_m"
+    assert error.allowed == [-5e-05, 0.0002] and "allowed range [-5e-05, 0.0002] m" in error.message
+    # the command line prints the same
+    assert error_text(info.value) == f"{error.field}: {error.message}"
+
+
+def test_a_twin_from_a_spec_names_the_spec_field_and_its_range():
+    registry = TwinRegistry(ServiceSettings(enable_zenoh=False, enable_recording=False))
+    with pytest.raises(InputError) as info:
+        registry.build_twin("x", spec=_bad_spec(diametral_clearance_m=-1e-3))
+    (error,) = info.value.errors
+    assert error.field == "spec.mounting.diametral_clearance_m"
+    assert error.allowed == [-5e-05, 0.0002], error
