@@ -125,12 +125,16 @@ def declared_bounds(model: type[BaseModel], loc: Sequence[Any]) -> tuple[Any, An
     if info is None:
         return None
     low = high = None
-    for constraint in info.metadata:
+    for constraint in info.metadata:  # annotated_types.Ge / Gt / Le / Lt
         for name in ("ge", "gt"):
-            low = getattr(constraint, name, None) if getattr(constraint, name, None) is not None else low
+            low = _or(getattr(constraint, name, None), low)
         for name in ("le", "lt"):
-            high = getattr(constraint, name, None) if getattr(constraint, name, None) is not None else high
+            high = _or(getattr(constraint, name, None), high)
     return None if low is None and high is None else (low, high)
+
+
+def _or(value: Any, default: Any) -> Any:
+    return default if value is None else value
 
 
 def _model_in(annotation: Any) -> type[BaseModel] | None:

@@ -324,11 +324,10 @@ class TwinRegistry:
             try:
                 spec = spec if isinstance(spec, BearingSpec) else BearingSpec.model_validate(spec)
             except ValidationError as exc:
-                errors = exc.errors()
                 raise InputError(
                     [
                         error.model_copy(update={"field": f"spec.{error.field}" if error.field else "spec"})
-                        for error in field_errors(errors, model=BearingSpec)
+                        for error in field_errors(exc.errors(), model=BearingSpec)
                     ]
                 ) from None
             try:
