@@ -7,7 +7,7 @@ about 0.2 ms for a 9-ball twin right after its frame, while its arrays are still
 Why on the stepping thread: a hand-off to another thread costs more than the build. On the
 2-core EPYC VM, waking an idle thread costs 70-140 us of CPU on each side, and a build that
 comes alone (a frozen copy, then a cold capture on the worker) costs 0.5-0.6 ms instead of
-0.2 (docs/performance.md "Service overhead"). The stepping thread is the twin's only writer
+0.2 (docs/performance.md, "What limits the service on this VM"). The stepping thread is the twin's only writer
 and steps it again only after the delivery, so no copy is needed; the sinks only enqueue (the
 zenoh channel also puts the state message, a few microseconds), so the delivery never waits on
 I/O. A capture that carries setpoint timings (the frame that applies an outside setpoint) is
