@@ -11,7 +11,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from service.core.errors import FieldError, InputError
+from service.core.errors import FieldError, InputError, field_bounds
 from service.core.runner import RunMode
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointUpdate
@@ -508,10 +508,7 @@ def request_bounds() -> dict[str, tuple[Any, Any]]:
         *spec_parts,
     ):
         for name, info in model.model_fields.items():
-            low = high = None
-            for m in info.metadata:
-                low = getattr(m, "ge", getattr(m, "gt", low)) if low is None else low
-                high = getattr(m, "le", getattr(m, "lt", high)) if high is None else high
-            if (low is not None or high is not None) and name not in bounds:
-                bounds[name] = (low, high)
+            declared = field_bounds(info)
+            if declared is not None and name not in bounds:
+                bounds[name] = declared
     return bounds

@@ -142,10 +142,10 @@ class TwinOutbox:
             return False
         for index in range(balls):
             watch = self._ball_matching.get(index)
-            if watch is None:  # its publisher is declared with the first snapshot
-                watch = self._ball_matching.get(index) if self._ball_publisher(index) is not None else None
-                if watch is None:  # detaching
-                    return False
+            if watch is None and self._ball_publisher(index) is not None:  # declared with the first snapshot
+                watch = self._ball_matching.get(index)
+            if watch is None:  # detaching
+                return False
             if watch.matching:
                 return False
         block = getattr(snapshot, "vibration", None)

@@ -11,6 +11,7 @@ from collections.abc import Mapping, Sequence
 from typing import Any
 
 from pydantic import BaseModel, Field
+from pydantic.fields import FieldInfo
 
 from twin.setpoint import FIELD as SETPOINT_FIELDS
 from twin.setpoint import SetpointError, SetpointLimits
@@ -122,19 +123,17 @@ def declared_bounds(model: type[BaseModel], loc: Sequence[Any]) -> tuple[Any, An
             return None
         info = fields[str(part)]
         current = _model_in(info.annotation)
-    if info is None:
-        return None
+    return None if info is None else field_bounds(info)
+
+
+def field_bounds(info: FieldInfo) -> tuple[Any, Any] | None:
+    """(low, high) a pydantic field declares (its annotated_types Ge / Gt and Le / Lt; None for a
+    side it leaves open), or None when it declares neither."""
     low = high = None
-    for constraint in info.metadata:  # annotated_types.Ge / Gt / Le / Lt
-        for name in ("ge", "gt"):
-            low = _or(getattr(constraint, name, None), low)
-        for name in ("le", "lt"):
-            high = _or(getattr(constraint, name, None), high)
+    for constraint in info.metadata:
+        low = getattr(constraint, "ge", getattr(constraint, "gt", low)) if low is None else low
+        high = getattr(constraint, "le", getattr(constraint, "lt", high)) if high is None else high
     return None if low is None and high is None else (low, high)
-
-
-def _or(value: Any, default: Any) -> Any:
-    return default if value is None else value
 
 
 def _model_in(annotation: Any) -> type[BaseModel] | None:
@@ -153,11 +152,13 @@ def field_errors(
     limits: SetpointLimits | None = None,
     bounds: Mapping[str, tuple[Any, Any]] | None = None,
     model: type[BaseModel] | None = None,
+    prefix: str = "",
 ) -> list[FieldError]:
     """pydantic error dicts -> FieldErrors naming the field and its allowed range: for setpoint
     fields the bearing's (`limits`) or else the vocabulary's static bounds, for other fields
     both sides of the declared range (`bounds` by field name, or what `model`, the validated
-    model, declares at the error's path; pydantic names only the side crossed)."""
+    model, declares at the error's path; pydantic names only the side crossed). `prefix`: put
+    before each field's path (the input nested in a request, as `setpoint_field_errors`)."""
     out = []
     for e in errors:
         loc = tuple(e.get("loc", ()))
@@ -195,5 +196,7 @@ def field_errors(
         if e.get("type") == "json_invalid":
             field = None
             msg = f"body is not valid JSON: {ctx.get('error', msg)}"
+        if prefix:
+            field = f"{prefix}{field}" if field else prefix.rstrip(".")
         out.append(FieldError(field=field, message=msg, allowed=allowed))
     return out

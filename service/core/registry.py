@@ -324,12 +324,7 @@ class TwinRegistry:
             try:
                 spec = spec if isinstance(spec, BearingSpec) else BearingSpec.model_validate(spec)
             except ValidationError as exc:
-                raise InputError(
-                    [
-                        error.model_copy(update={"field": f"spec.{error.field}" if error.field else "spec"})
-                        for error in field_errors(exc.errors(), model=BearingSpec)
-                    ]
-                ) from None
+                raise InputError(field_errors(exc.errors(), model=BearingSpec, prefix="spec.")) from None
             try:
                 twin = Twin(spec, bearing_id=bearing_id)  # at the bearing's default setpoint
             except (ValueError, ArithmeticError) as exc:  # a valid spec the model cannot compile
