@@ -1,7 +1,9 @@
 """The HTTP server around the app: uvicorn configured against slow and greedy clients, and an
 access log that never shows a secret.
 
-* `GuardedH11Protocol`: uvicorn's h11 protocol with two deadlines uvicorn does not have. The
+* `GuardedHttpToolsProtocol`: uvicorn's httptools protocol (the llhttp C parser; the pure-Python
+  h11 parser costs about 0.3 ms more per request and lengthens the latency tail of a setpoint,
+  docs/performance.md) with two deadlines uvicorn does not have. The
   request line and headers must be complete within `http_header_timeout_s` of the connection
   (or of the first byte of the next request on a kept-alive connection), and a request body
   within `http_body_timeout_s` of its headers. A client that misses one (slowloris: headers or
@@ -10,7 +12,7 @@ access log that never shows a secret.
   `timeout_keep_alive` (`http_keep_alive_s`) closes idle kept-alive connections, and
   `limit_concurrency` (`http_max_connections`) answers 503 beyond that many open connections
   or running requests, so one host cannot hold every socket or task of the service.
-* `GuardedH11Protocol` also notes when a request's headers were read (`request.state`
+* `GuardedHttpToolsProtocol` also notes when a request's headers were read (`request.state`
   `RECEIVED_S`, time.perf_counter): the start of a setpoint's latency, its `http` stage
   (service.core.mailbox.SetpointTiming).
 * `RedactAccessLog`: a filter on the `uvicorn.access` logger. In the logged path the value of
@@ -18,7 +20,7 @@ access log that never shows a secret.
   credential, signature, ...) becomes `[redacted]`, and so does the service's token wherever it
   appears (the API never reads a token from the query string, but a client may send one there).
 * `uvicorn_config(app, settings, ...)`: the uvicorn.Config of `bearing-twin serve` (and of the
-  tests' in-process server) with all of the above.
+  tests' in-process server) with all of the above, on uvloop's event loop.
 """
 
 from __future__ import annotations
@@ -32,8 +34,7 @@ import time
 import urllib.parse
 from collections.abc import Iterable
 
-import h11
-from uvicorn.protocols.http.h11_impl import H11Protocol
+from uvicorn.protocols.http.httptools_impl import HttpToolsProtocol
 
 log = logging.getLogger(__name__)
 
@@ -64,9 +65,11 @@ class _Closures:
 closures = _Closures()
 
 
-class GuardedH11Protocol(H11Protocol):
-    """uvicorn's h11 protocol with header and body deadlines (see the module docstring); the
-    deadlines are class attributes, set by `guarded_protocol`."""
+class GuardedHttpToolsProtocol(HttpToolsProtocol):
+    """uvicorn's httptools protocol with header and body deadlines (see the module docstring);
+    the deadlines are class attributes, set by `guarded_protocol`. The parser's callbacks give
+    where the client is: `headers` from the connection or the first byte of a request
+    (`on_message_begin`) to its last header, `body` from there to the request's end, then none."""
 
     header_timeout_s: float = 10.0
     body_timeout_s: float = 30.0
@@ -74,16 +77,28 @@ class GuardedH11Protocol(H11Protocol):
     def connection_made(self, transport) -> None:
         self._guard: asyncio.TimerHandle | None = None
         self._guarding: str | None = None
+        self._phase: str | None = "headers"
+        self._received_s = 0.0
         super().connection_made(transport)
-        self._arm("headers", self.header_timeout_s)
+        self._follow()
 
     def data_received(self, data: bytes) -> None:
-        received = time.perf_counter()
+        self._received_s = time.perf_counter()
         super().data_received(data)
-        scope = getattr(self, "scope", None)  # the request whose headers this data completed, or an earlier one
-        if scope is not None:
-            scope.setdefault("state", {}).setdefault(RECEIVED_S, received)
         self._follow()
+
+    def on_message_begin(self) -> None:
+        super().on_message_begin()
+        self._phase = "headers"
+
+    def on_headers_complete(self) -> None:
+        self.scope["state"].setdefault(RECEIVED_S, self._received_s)
+        self._phase = "body"
+        super().on_headers_complete()
+
+    def on_message_complete(self) -> None:
+        self._phase = None
+        super().on_message_complete()
 
     def connection_lost(self, exc: Exception | None) -> None:
         self._disarm()
@@ -91,16 +106,12 @@ class GuardedH11Protocol(H11Protocol):
 
     def _follow(self) -> None:
         """Arm, keep or drop the deadline from where the client is in its request."""
-        if self.transport is None or self.transport.is_closing():
+        if self.transport is None or self.transport.is_closing() or self._phase is None:
             self._disarm()
-            return
-        state = self.conn.their_state
-        if state is h11.IDLE:  # request line and headers not complete yet
+        elif self._phase == "headers":
             self._arm("headers", self.header_timeout_s)
-        elif state is h11.SEND_BODY:  # headers in, body still coming
+        else:
             self._arm("body", self.body_timeout_s)
-        else:  # request complete (or the connection is ending)
-            self._disarm()
 
     def _arm(self, what: str, timeout_s: float) -> None:
         if self._guarding == what:
@@ -119,9 +130,7 @@ class GuardedH11Protocol(H11Protocol):
         transport = self.transport
         if transport is None or transport.is_closing():
             return
-        if what == "headers" and self.conn.their_state is not h11.IDLE:
-            return
-        if what == "body" and self.conn.their_state is not h11.SEND_BODY:
+        if self._phase != what:
             return
         n = closures.count(what)
         if n <= 5 or n % 100 == 0:
@@ -153,11 +162,11 @@ class GuardedH11Protocol(H11Protocol):
         transport.close()
 
 
-def guarded_protocol(header_timeout_s: float, body_timeout_s: float) -> type[GuardedH11Protocol]:
-    """A `GuardedH11Protocol` class with these deadlines [s] (uvicorn instantiates the class)."""
+def guarded_protocol(header_timeout_s: float, body_timeout_s: float) -> type[GuardedHttpToolsProtocol]:
+    """A `GuardedHttpToolsProtocol` class with these deadlines [s] (uvicorn instantiates the class)."""
     return type(
-        "GuardedH11Protocol",
-        (GuardedH11Protocol,),
+        "GuardedHttpToolsProtocol",
+        (GuardedHttpToolsProtocol,),
         {"header_timeout_s": float(header_timeout_s), "body_timeout_s": float(body_timeout_s)},
     )
 
@@ -220,8 +229,9 @@ def install_access_log_redaction(token: str | None) -> RedactAccessLog:
 def uvicorn_config(
     app, settings, *, host: str | None = None, port: int | None = None, log_level: str = "info", **extra
 ):
-    """The uvicorn.Config serving `app` with the settings' slow-client limits (one worker, h11
-    with deadlines, keep-alive, concurrency) and the access-log redaction installed."""
+    """The uvicorn.Config serving `app` with the settings' slow-client limits (one worker,
+    httptools with deadlines, keep-alive, concurrency) on uvloop's event loop, and the access-log
+    redaction installed."""
     import uvicorn
 
     config = uvicorn.Config(
@@ -229,6 +239,7 @@ def uvicorn_config(
         host=settings.http.host if host is None else host,
         port=settings.http.port if port is None else port,
         workers=1,
+        loop="uvloop",
         log_level=log_level,
         lifespan="on",
         http=guarded_protocol(settings.http.header_timeout_s, settings.http.body_timeout_s),
