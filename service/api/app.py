@@ -107,6 +107,7 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
         openapi_url=None,
         docs_url=None,
         redoc_url=None,
+        telemetry={"tracing": False, "metrics": False, "logs": False},
     )
     app.state.settings = settings
     app.state.gate = gate
