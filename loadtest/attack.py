@@ -31,7 +31,7 @@ Every 200 answer with JSON is parsed strictly (NaN/Infinity refused): `nan_check
 5xx, no non-finite number, no valid setpoint refused other than by the rate limit (429), no
 hostile request accepted, no create blocked by a squatter or answered with its text, no guessed
 OPC UA password accepted, every /health probe answered, and (with --start) a clean exit. The
-real-time factor and /health p99 are reported beside the issue's targets (median real-time
+real-time factor and /health p99 are reported beside their targets (median real-time
 factor >= 0.95, /health p99 <= 100 ms) in `targets`; they are figures of the host, not part of
 `ok`. Loopback only: a URL or zenoh endpoint on another host is refused.
 """

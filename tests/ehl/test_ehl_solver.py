@@ -1,4 +1,6 @@
-"""Seed 003 point-contact EHL solver (twin.ehl_solver): what issue 7 asks it to show.
+"""Seed 003 point-contact EHL solver (twin.ehl_solver): isothermal h_min against Hamrock-Dowson (seed
+003 Fig. 1), the exit pressure spike (Fig. 5), h_c and h_min grid-independent within 2 % between the two finest
+grids used, the film reduction against current (seed 003 Fig. 5) and the CLI contract.
 
 Every test names the seed figure or equation it checks and its tolerance. Grids: 129 x 129 is
 the solver default and 257 x 257 the validation / calibration grid (domain X in [-3, 1.5],
@@ -8,7 +10,7 @@ resolved on 129 nodes; 129 and 257 at 2.5-4.2 m/s, where 129 already is within 1
 solves converge at every seed speed (11-19 s each here) but are run in CI at the two low speeds
 only, where they matter (about 25 s together).
 
-Issue 7 criteria that are NOT met and stay strict xfails, with the evidence (see also the
+Criteria that are NOT met and stay strict xfails, with the evidence (see also the
 docstring of twin/ehl_solver/solver.py):
 
 - h_min within 8 % of Hamrock-Dowson (seed 003 Fig. 1) at 0.832-2.496 m/s (Moes M = 435-191):
@@ -22,7 +24,7 @@ docstring of twin/ehl_solver/solver.py):
   over 3 in the literature, e.g. Sperka et al., Lubricants 6 (2018) 80). Seed 003 itself says
   the analytical model's accuracy "diminishes when the entrainment speed falls below 2.5 m/s".
 
-Met since the 513 grid converges (it stagnated before: see the solver docstring): h_min
+Met with the 513 grid converged (the multigrid's smoother corrections: see the solver docstring): h_min
 grid-independent within 2 % at 0.832 and 1.664 m/s between 257 and 513 nodes (1.1 % and 0.4 %;
 from 129 to 257 it moves 4.6 % and 2.3 %: the side lobes at |Y| ~ 0.94 narrow as M grows).
 
@@ -161,8 +163,9 @@ def test_isothermal_solves_converge_to_the_seed_tolerances(iso129, iso257):
 
 
 def test_513_solves_converge_to_the_seed_tolerances(iso513):
-    """eqs. 13-14 on 513 x 513 (0.832 and 1.664 m/s): the grid on which the multigrid used to
-    stagnate near a pressure change of 7e-4 per cycle (measured now: 13 and 16 cycles)."""
+    """eqs. 13-14 on 513 x 513 (0.832 and 1.664 m/s): the grid on which a multigrid without the
+    smoother corrections stagnates near a pressure change of 7e-4 per cycle (measured: 13 and 16
+    cycles)."""
     for u, res in iso513.items():
         assert res.converged, (u, res.message)
         assert res.history["dp"][-1] < 1e-5
@@ -264,7 +267,7 @@ def test_solver_reproduces_the_moes_nijenbanning_central_film():
 
 @pytest.mark.parametrize("speed", SPEEDS)
 def test_grid_refinement_minimum_film(iso129, iso257, iso513, speed):
-    """Issue 7 criterion 2: h_min changes by < 2 % between the two finest grids used, seed 003
+    """Grid refinement: h_min changes by < 2 % between the two finest grids used, seed 003
     Fig. 1 speeds: 257 -> 513 at 0.832 and 1.664 m/s (measured 1.1 % and 0.4 %; 129 -> 257 moves
     it 4.6 % and 2.3 % there, the side lobes being under-resolved on 129), 129 -> 257 above
     (measured 0.9-1.1 %)."""
@@ -273,7 +276,7 @@ def test_grid_refinement_minimum_film(iso129, iso257, iso513, speed):
 
 
 def test_central_film_is_grid_converged_at_every_speed(iso129, iso257, iso513):
-    """Issue 7 criterion 2 for h_c: < 2 % between the two finest grids used at every speed of
+    """Grid refinement for h_c: < 2 % between the two finest grids used at every speed of
     Fig. 1 (measured < 0.5 % from 129 to 257 and < 0.2 % from 257 to 513: hybrid upwind wedge,
     second order in the inlet where h_c is formed)."""
     for u in SPEEDS:
@@ -392,7 +395,7 @@ def test_film_reduction_factor_interpolates_the_table():
 
 
 def test_cli_solve_json_carries_the_required_fields():
-    """Issue 7 CLI contract: `bearing-twin ehl solve --json` (service/tools/ehl_cli.py, Appendix 2
+    """The CLI contract: `bearing-twin ehl solve --json` (service/tools/ehl_cli.py, Appendix 2
     defaults, 65 x 65 grid) carries the required fields and inputs (exact keys, eta0 = 0.04)."""
     from service.tools.ehl_cli import main
 

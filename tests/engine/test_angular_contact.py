@@ -78,7 +78,7 @@ def test_ball_loads_and_contact_angles_match_jones(settled, time_step):
     ao = np.degrees(np.abs([b.outer.contact_angle_rad for b in snap.balls]))
     dev = np.maximum(np.abs(ai - np.degrees(jones.inner_angle_rad)), np.abs(ao - np.degrees(jones.outer_angle_rad)))
     q = jones.inner_load_n / qmax
-    # The loaded balls' angles carry the bearing's load: within 0.5 deg of Jones (issue 11). A
+    # The loaded balls' angles carry the bearing's load: within 0.5 deg of Jones (twin.analytic). A
     # lightly loaded ball's angle is set by a balance of a few newtons, and Jones' quasi-static,
     # frictionless solution has neither the ball's dynamics nor the contacts' traction: the DEM's
     # angles lag at the entry of the load zone (up to +1.0 / -0.9 deg inner / outer at 0.2-0.4
@@ -133,7 +133,7 @@ def _angle_departure_by_azimuth(time_step, bins_deg, limiting_shear_coefficient=
 
 
 def test_angle_departure_from_jones_is_the_same_at_1us_and_auto():
-    """Issue 13 (the auto step changes no output beyond its tolerance) on the one quantity where
+    """The auto step changes no output beyond its tolerance, here on the one quantity where
     the DEM departs from Jones: the loaded balls' contact-angle departure, resolved by azimuth over
     the load zone (15 deg bins from -75 to +75 deg; measured: the two profiles agree within
     0.03 deg, the departure itself reaches 1.0 deg at the zone's entry), agrees within 0.1 deg."""

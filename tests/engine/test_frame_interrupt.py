@@ -1,4 +1,4 @@
-"""Twin.interrupt_frame (issue 13, setpoint latency): a frame in progress ends at its next step
+"""Twin.interrupt_frame, for setpoint latency: a frame in progress ends at its next step
 boundary when the runner has an outside input waiting, and the shorter frame changes nothing
 but where the frame boundary lies.
 

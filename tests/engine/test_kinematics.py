@@ -11,7 +11,7 @@ from twin.kernels import layout as L
 from twin.setpoint import Setpoint
 from twin.spec import ModelOptions
 
-TOL = 0.01  # the 1 %
+TOL = 0.01  # spin, cage speed and defect frequencies within 1 % of the kinematic relations
 
 
 @pytest.fixture(scope="module")

@@ -7,8 +7,9 @@ the balls' actual azimuths (`twin.validation.analytic.radial_equilibrium`) with 
 Load parameter eps: the seed prints 0.685 / 0.5 / 0.4 for Pd = -12.6 / 0 / +12.6 um, and exact
 Hertz constants (complete elliptic integrals, twin.physics.hertz) give 0.684 / 0.500 / 0.402 for
 the rigid-ring equilibrium: the DEM after settling must give the seed's values within 2 %.
-(This test used to assert 0.745 / 0.388, the values of the 32 % too stiff contact constant
-Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) that an earlier reading of seed 000 eq. 2 carried: it asserted the defect.)
+(0.745 / 0.388 are the values of the 32 % too stiff contact constant Fbar = 1 + (pi/2 - 1) ln(Ry/Rx),
+a misreading of seed 000 eq. 2's Brewe-Hamrock approximation pi/2 + (pi/2 - 1) ln(Ry/Rx): for a
+circle the misread form gives 1 where the complete elliptic integral is pi/2.)
 """
 
 import numpy as np
@@ -19,7 +20,7 @@ from twin.setpoint import Setpoint
 from twin.spec import ModelOptions
 from twin.validation import analytic
 
-TOL = 0.03  # the issue's 3 % agreement
+TOL = 0.03  # agreement with the reference equilibrium: 3 % (of Qmax for every ball load)
 
 
 @pytest.fixture(scope="module", params=[-12.6e-6, 0.0, 12.6e-6], ids=["preload", "zero", "clearance"])

@@ -1,4 +1,4 @@
-"""Long and hard runs stay finite; bad specs and setpoints are refused by name (issue 2)."""
+"""Long and hard runs stay finite; bad specs and setpoints are refused by name."""
 
 import math
 

@@ -1,7 +1,8 @@
-"""The optimised step (issue 13) reproduces the engine before the optimisation.
+"""The optimised step reproduces the reference step kept in twin.validation.step_reference.
 
-tests/engine/data/step_reference.json holds the outputs of the engine at commit 5454e19 (before
-issue 13's speed work: `python -m twin.validation.step_reference` on that tree): window means over
+tests/engine/data/step_reference.json holds the outputs of the reference engine, the step written
+law by law without reciprocals, series or fused passes (commit 5454e19:
+`python -m twin.validation.step_reference` on that tree): window means over
 10 ms after 10 ms from the warm start of every contact's load and Lambda, the friction torque,
 the cage speed and the ring displacement, for the default twin (6208, 3000 N, 500 rad/s) at the
 auto step and at 1 us, the 7208 under Fr = Fa = 3000 N and the 6208 at 1700 rad/s and 7500 N.

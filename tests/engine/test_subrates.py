@@ -1,4 +1,4 @@
-"""The tribology sub-rates of the DEM step (issue 13): the default periods of the tribology refresh
+"""The tribology sub-rates of the DEM step: the default periods of the tribology refresh
 and of the strip traction solve, chosen by the convergence study twin.validation.subrate_study,
 hold the outputs within the study's tolerances on representative cases."""
 
@@ -49,9 +49,10 @@ def test_bad_sub_rate_refused_with_field_and_range(field, value):
 
 
 def test_chosen_sub_rates_within_tolerance_on_representative_cases():
-    # issue 13: the default periods against the former ones (tribology 10 us, traction 200 us) at
-    # the auto step, and against seed 000's 1 us step, over whole cage revolutions: loads, films,
-    # Lambda, mu and speeds within 0.5 %, torque and electrical values within 2 %
+    # the default periods against the study's reference sub-rates (subrate_study.REFERENCE:
+    # tribology 10 us, traction 200 us) at the auto step, and against seed 000's 1 us step, over
+    # whole cage revolutions: loads, films, Lambda, mu and speeds within 0.5 %, torque and
+    # electrical values within 2 %
     # (timestep_study.TOLERANCES). Cases: 6208 at the serve default, 6208 at 1700 rad/s and 7500 N,
     # 7208 B at Fr = Fa = 3000 N, 6208 with a 5 A shaft current.
     cases = subrate_study.representative_cases()

@@ -1,4 +1,4 @@
-"""Helpers of the hostile-input, fault and long-run tests (issue 6): `bearing-twin serve` as a
+"""Helpers of the hostile-input, fault and long-run tests: `bearing-twin serve` as a
 subprocess on 127.0.0.1 free ports, plus the shared uvicorn-in-a-thread server and zenoh peer
 (multicast scouting off) of tests/support.py. Every wait is bounded. Exposed as fixtures (pytest
 runs with --import-mode=importlib, so test modules do not import each other)."""

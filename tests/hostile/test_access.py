@@ -1,4 +1,4 @@
-"""Access (issue 6): with BEARING_TWIN_TOKEN set, mutating HTTP requests need the bearer token
+"""Access: with BEARING_TWIN_TOKEN set, mutating HTTP requests need the bearer token
 (401 without it or with a wrong one), reads stay open unless `read_requires_token`; the service
 says what it binds and whether a token is needed. The token is HTTP only: zenoh has its own
 authentication and access control (tests/hostile/test_zenoh_access.py)."""
@@ -152,4 +152,4 @@ def test_settings_token_from_environment(monkeypatch):
     assert "has space" not in str(err.value)  # never echoed
 
 
-# zenoh setpoints no longer carry the token: tests/hostile/test_zenoh_access.py (issue 16)
+# zenoh setpoints carry no token; zenoh's own access control is tested in tests/hostile/test_zenoh_access.py

@@ -1,4 +1,4 @@
-"""`bearing-twin attack` (issue 16): a short run against its own real service on loopback (token,
+"""`bearing-twin attack`: a short run against its own real service on loopback (token,
 zenoh access control): the report's structure, and no 5xx and no non-finite number in the
 hostile HTTP flood, the unauthenticated read flood and the zenoh flood, every zenoh setpoint
 answered; the zenoh squatter blocks nothing, no guessed OPC UA password is accepted, the OPC UA

@@ -1,4 +1,4 @@
-"""Physics faults (issue 6): a state the kernel cannot hold leaves the twin in a clear `status`
+"""Physics faults: a state the kernel cannot hold leaves the twin in a clear `status`
 with a reason, it restarts from the warm start (at the last SAFE setpoint when the setpoint in
 force is the problem), `restarts` counts it, and no NaN reaches a snapshot or JSON. Checked on the
 engine, through the runner and through HTTP (status and restart count in GET state)."""

@@ -1,4 +1,4 @@
-"""Bad input, fuzzed (issue 6): hypothesis throws wrong types, NaN/Infinity (as raw JSON text),
+"""Bad input, fuzzed: hypothesis throws wrong types, NaN/Infinity (as raw JSON text),
 huge numbers, missing and extra fields, oversized bodies and non-JSON bytes at every HTTP
 endpoint of a real server (uvicorn on 127.0.0.1) and at the zenoh setpoint handler: never a 5xx,
 never a crash, and no non-finite number in any state read or snapshot published afterwards.

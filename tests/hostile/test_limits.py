@@ -1,4 +1,4 @@
-"""Rate and size limits (issue 6): setpoint bursts per twin are rate-limited (429 + Retry-After)
+"""Rate and size limits: setpoint bursts per twin are rate-limited (429 + Retry-After)
 without starving reads; request bodies are capped (413), by Content-Length and while streaming a
 chunked body; the zenoh handler applies the same limits."""
 

@@ -1,4 +1,4 @@
-"""schemathesis against the service's OpenAPI (issue 6): every operation, positive and negative
+"""schemathesis against the service's OpenAPI: every operation, positive and negative
 data generated from the spec, sent to a real uvicorn server on 127.0.0.1; the only check is
 `not_a_server_error` (no 5xx). Bounded: a few dozen examples per operation and mode, no
 shrinking; part of the normal pytest run (about a minute on the project's 2-core VM)."""

@@ -1,8 +1,8 @@
-"""Shutdown and restart (issue 6), with a real `bearing-twin serve` subprocess on free loopback
+"""Shutdown and restart, with a real `bearing-twin serve` subprocess on free loopback
 ports: SIGTERM and SIGINT flush and close the recordings (service-wide and per-twin) and zenoh
 (the liveliness token goes away), the process exits (bounded wait) and the .rrd files read back
 completely; after a kill -9 every file of the killed run is left intact and readable, and the
-service started again with the same --record on the same ports writes beside them (issue 16)."""
+service started again with the same --record on the same ports writes beside them, never over them."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Reads and slow clients cannot take the service (issue 16, "Load cannot steal real time"), with
+"""Reads and slow clients cannot take the service (load cannot steal real time), with
 real servers on 127.0.0.1:
 
 * GET state is served from the JSON serialised once per published snapshot (the same bytes for

@@ -1,4 +1,4 @@
-"""The tarpit and the cheapest refusals (issue 16, "Load cannot steal real time"), with a real
+"""The tarpit and the cheapest refusals (load cannot steal real time), with a real
 uvicorn on 127.0.0.1 (service.api.middleware `Tarpit`, `TokenGate`):
 
 * a client over its error budget (client_error_burst refusals, then client_error_rate_hz) gets

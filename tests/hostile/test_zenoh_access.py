@@ -1,4 +1,4 @@
-"""zenoh with its own security (issue 16 item 1): the HTTP token never travels on zenoh; with
+"""zenoh with its own security: the HTTP token never travels on zenoh; with
 zenoh access control on, every link is authenticated by zenoh (user-password handshake) and
 zenoh's access-control rules (service.bus.access) decide what each role may put, subscribe,
 query, answer and declare as liveliness. Anonymous peers get nothing.
@@ -347,7 +347,7 @@ def test_secured_router_fleet(hostile, users):
                 spy.subscribe("**")
                 spy.subscribe("**", liveliness=True)
             viewer.subscribe("plant1/line2/*/state", "plant1/line2/*/setpoint/result")
-            viewer.subscribe("plant1/line2/*/setpoint")  # the leak of issue 16: refused
+            viewer.subscribe("plant1/line2/*/setpoint")  # a reader may not see others' setpoints: refused
             viewer.subscribe("plant1/line2/*/alive", liveliness=True)
             op.subscribe("plant1/line2/*/setpoint/result")
             op.subscribe("plant1/line2/*/alive", liveliness=True)

@@ -1,4 +1,4 @@
-"""The centred tribology refresh (issue 13, twin.kernels.step.centred_inputs): a refresh held for a
+"""The centred tribology refresh (twin.kernels.step.centred_inputs): a refresh held for a
 period of N steps takes its inputs at the middle of that period, so that the held value's error
 over the period is second order in N instead of first."""
 

@@ -53,12 +53,12 @@ def test_no_entrainment_is_boundary_without_film_force():
     model = make_model(catalog.bearing("6208"))
     out = contact_tribology(1000.0, 0.0, 0.04, 3.75e-7, *model.race_tribology[0, :15], 0, True)
     assert out[0] == 0.0 and out[2] == 0.0 and out[3] == 1 and out[4] == 0.1
-    # every output finite but ln h_min (issue 13: the refresh's ln Lambda), -inf for h_min = 0
+    # every output finite but ln h_min (the refresh's ln Lambda comes from it), -inf for h_min = 0
     assert all(math.isfinite(v) for v in out[:10]) and out[10] == -math.inf
 
 
 def test_asperity_share_from_the_film_logarithm():
-    """Issue 13: the refresh takes ln Lambda = ln h_min - ln sigma from contact_tribology's last
+    """The refresh takes ln Lambda = ln h_min - ln sigma from contact_tribology's last
     output (no log of Lambda). It is the logarithm of the h_min it returns (to rounding: 1e-15 of
     |ln h| ~ 14, abs 1e-13), and the asperity share (seed 001 eq. A2) and the limiting traction
     coefficient through it equal those from Lambda itself to 1e-13 across Lambda = 0.1-3."""

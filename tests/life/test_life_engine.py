@@ -82,7 +82,7 @@ def test_damage_faster_under_heavier_load(runs):
 
 
 def test_snapshot_life_block(runs):
-    """The block carries the issue's keys with their values; JSON without NaN; remaining life =
+    """The block carries every life key with its value; JSON without NaN; remaining life =
     (1 - D) L10m."""
     snap = runs["iso_3000"][-1][1]
     block = json.loads(snap.to_json(), parse_constant=lambda c: pytest.fail(f"non-finite {c}"))["life"]

@@ -153,7 +153,7 @@ def _bearing(speed, load=3000.0, temperature=40.0, isothermal=False):
 
 
 def test_capacitance_null_with_a_reason_whenever_the_phase_is_above_minus_45_deg():
-    # issue 11: Im(Y)/omega of a resistive network is not a capacitance: boundary (20 rad/s),
+    # Im(Y)/omega of a resistive network is not a capacitance, so none is published above -45 deg: boundary (20 rad/s),
     # mixed with asperity conduction (300 rad/s) and hot thin oil (100 degC at 1700 rad/s) are
     # resistive (phase ~ 0); the impedance is always published
     for e in (_bearing(20.0), _bearing(300.0), _bearing(1700.0, temperature=100.0)):
@@ -194,7 +194,7 @@ def test_full_film_capacitance_falls_with_speed_rises_with_load_and_temperature(
     # gap around it: h ~ (eta u)^0.67 Q^-0.067 (Hamrock-Dowson, seed 000 eq. 6 and its h_c) and
     # a b ~ Q^(2/3), so C falls with speed, rises with load and rises as warmer, thinner oil thins
     # the film (measured 6208: 121 / 110 / 100 pF at 650 / 1000 / 1700 rad/s; 91 -> 112 pF from 750 to
-    # 7500 N; 80 -> 100 -> 121 pF at 20 / 40 / 60 degC, all at phase -90 deg). The issue's "falls with
+    # 7500 N; 80 -> 100 -> 121 pF at 20 / 40 / 60 degC, all at phase -90 deg). A capacitance that "falls with
     # temperature" is not what the film does: the capacitance rises until the film breaks down
     # (80 degC: mixed film, resistive, null). These scalings are those of the isothermal film of seed
     # 000 eq. 6, so the twin is built with an unheated inlet (studies.isothermal_spec); the default's
@@ -213,7 +213,7 @@ def test_geometry_capacitances():
     # the gap around a contact: the exact ball-groove integral (twin.physics.electrical) and the
     # paraboloid law with the geometric gap limit agree within 1 % from 0.1 to 10 um of gap (3 % at
     # 30 um, the largest gap of an unloaded ball off its raceway); the
-    # limit (0.31 mm for the 6208) replaces the former 50 um constant. The shoulder depth, an
+    # limit (0.31 mm for the 6208) follows from the exact gap integral (equivalent_gap_limit_m). The shoulder depth, an
     # assumption (0.18 D), moves the contact capacitance by under 3 % between 0.15 and 0.22 D.
     model = Twin("6208").model
     rb, rg, pitch = 6.3e-3, 6.552e-3, 30.3e-3

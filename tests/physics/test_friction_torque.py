@@ -30,9 +30,9 @@ def sweep():
 
 
 def test_torque_rises_with_load_like_published_models(sweep):
-    # issue 11: published bearing friction models give about Fr^0.8 at 500 rad/s (SKF: M_rr ~ Fr^0.54,
-    # M_sl ~ Fr^(5/3); its slope over 750-7500 N here is 0.78); the centre-point friction gave
-    # 0.40. The differential (Heathcote) slip over the ellipse supplies the missing sliding part.
+    # published bearing friction models give about Fr^0.8 at 500 rad/s (SKF: M_rr ~ Fr^0.54,
+    # M_sl ~ Fr^(5/3); its slope over 750-7500 N here is 0.78); friction at the contact centre alone
+    # gives 0.40. The differential (Heathcote) slip over the ellipse supplies the sliding part.
     slope = studies.log_slope(list(sweep), list(sweep.values()))
     skf = [
         skf_friction.frictional_moment("6208", 40.0, 80.0, f, 500.0, _nu_mm2_s(), inlet_shear=False).total_n_m
@@ -70,14 +70,13 @@ def _spin_moments(twin):
 
 
 def test_traction_sub_rate_is_converged():
-    # numerical choice: the strip integration every traction_period_s = 400 us since the centred
+    # numerical choice: the strip integration every traction_period_s = 400 us with the centred
     # tribology refresh (twin.validation.subrate_study: 40 us / 400 us; 10 refreshes of 40 us at 1 us,
     # of 9 steps of 4.44 us on the 7208). Measured at these defaults on the 7208 B
     # below, against a solve at every refresh: torque within 0.003 %, the solved spin moments within
     # 3.0 % of the largest (inside rtol 5 % + atol 1 % of the largest), the applied ones within 11.3 %
-    # of the largest. History: 200 us (a whole number of
-    # tribology refreshes: 10 of 20 us at 1 us; the 7208's auto step of 4.44 us gave 178 us when the
-    # period was 20 refreshes of 8.9 us). Measured (6208; 3000 N /
+    # of the largest. The sensitivity to the period, measured with the tribology refreshed every 8.9 us
+    # (two auto steps of the 7208; 178 us is 20 such refreshes). Measured (6208; 3000 N /
     # 500 rad/s, 750 N / 1700 rad/s, 7500 N / 100 rad/s): the torque with a solve every 10 us,
     # 100 us, 200 us and 500 us agrees within 0.04 %. 7208 B (40 deg, Fr = Fa = 3000 N, spin up to
     # 800 rad/s), against a solve at every refresh (8.9 us), at the auto step: the spin moments
@@ -88,12 +87,12 @@ def test_traction_sub_rate_is_converged():
     # period at 20 us (twin.validation.subrate_study; 22.2 us = 5 steps on the 7208, the solve every
     # 9 refreshes = 200 us) the moments applied at this test's last step differ from the reference's
     # by 11.5 % of the largest on one contact, the one entering the loaded zone (its last solve saw it
-    # nearly unloaded), and by 1.2-5.6 % at six other end instants 22-111 us apart (the former 10 us /
-    # 178 us: 0.9-4.0 %): the applied moments' bound is 15 % since, the solved ones stay at 5 %; the
+    # nearly unloaded), and by 1.2-5.6 % at six other end instants 22-111 us apart (at 10 us /
+    # 178 us: 0.9-4.0 %): the applied moments' bound is 15 %, the solved ones' 5 %; the
     # outputs of this case move by under 0.4 % (torque) in the sub-rate study. (The stored
     # solution itself is up to one period old: a ball at the edge of the loaded zone has moved
-    # 2 deg since, 10-15 % of its moment; comparing those, as this test did at first, measured
-    # when the last solve fell before the end of the run, not the sub-rate.)
+    # 2 deg since, 10-15 % of its moment; comparing those would measure when the last solve fell
+    # before the end of the run, not the sub-rate.)
     fast, _ = studies.mean_friction_torque_n_m(500.0, 3000.0, options=ModelOptions(traction_period_s=1e-6))
     default, _ = studies.mean_friction_torque_n_m(500.0, 3000.0)
     assert ModelOptions().traction_period_s == 4e-4

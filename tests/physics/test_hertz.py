@@ -47,8 +47,9 @@ def test_circle_is_hertz_sphere_formula():
 
 
 def test_6208_constants_are_the_exact_values():
-    # issue 11 / README "Readings", seed 000 eq. 2: exact Hertz gives 3.25e10 / 3.45e10 N/m^1.5
-    # (the earlier Fbar = 1 + ... reading gave 4.28e10 / 4.56e10, 32 % too stiff)
+    # seed 000 eq. 2 with exact Hertz (complete elliptic integrals; README "Readings") gives
+    # 3.25e10 / 3.45e10 N/m^1.5 (the misread Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) gives 4.28e10 / 4.56e10,
+    # 32 % too stiff)
     model = make_model(bearing("6208"))
     ki, ko = model.race_params[0, L.R_STIFFNESS], model.race_params[1, L.R_STIFFNESS]
     assert ki == pytest.approx(3.25e10, rel=2e-3)
@@ -154,7 +155,7 @@ def test_exact_hertz_against_a_numerical_contact_solution(case):
     assert b == pytest.approx(b_exact, rel=1e-3)
     assert a / b == pytest.approx(hertz.elliptic_constants(rx, ry).ellipticity, rel=2e-3)
     assert p_max == pytest.approx(hertz.max_pressure_pa(load, a_exact, b_exact), rel=2e-3)
-    # the old reading Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) is refuted by the numerical solution
+    # the misread Fbar = 1 + (pi/2 - 1) ln(Ry/Rx) is refuted by the numerical solution
     k_old = hertz.stiffness_from_constants(
         hertz.brewe_hamrock_ellipticity(rx, ry),
         1 + (math.pi / 2 - 1) * math.log(ry / rx),

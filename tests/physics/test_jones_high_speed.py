@@ -52,7 +52,7 @@ def _compare(speed_rad_s):
 def test_largest_ball_load_follows_jones_with_centrifugal_force(speed_rad_s):
     dem, jones, static = _compare(speed_rad_s)
     q_dem, q_jones = dem.max(axis=1).mean(), jones.max(axis=1).mean()
-    # the issue's acceptance: within 3 % of the largest ball load (measured: -0.2 % at 500, +1.7 % at 1500 rad/s)
+    # the DEM's largest ball load within 3 % of Jones' (measured: -0.2 % at 500, +1.7 % at 1500 rad/s)
     assert q_dem == pytest.approx(q_jones, rel=0.03)
     # the centrifugal force is what the static solution misses: 7 % at 500 rad/s, 32 % at 1500 rad/s
     gain = q_jones / static.max(axis=1).mean() - 1.0

@@ -202,10 +202,11 @@ def test_inlet_shear_heating_laws_by_hand_and_cross_check():
     "speed, band", [(100.0, (0.95, 1.0)), (500.0, (0.8, 0.95)), (1000.0, (0.6, 0.85)), (1700.0, (0.5, 0.8))]
 )
 def test_6208_film_factor_follows_murch_wilson(speed, band):
-    # issue 11: with inlet heating on, the loop's film factor within the cited law's value +-5 %
-    # across 100-1700 rad/s (6208, 3000 N, seed oil at 40 degC), and in the range established
-    # inlet laws give (0.8-0.95 at 500 rad/s, 0.5-0.8 at 1700 rad/s; eq. 6 at the inlet gave
-    # 0.41 / 0.10). Measured 0.974 / 0.833 / 0.679 / 0.523. The film itself: heated / isothermal.
+    # with inlet heating on, the loop's film factor is within the cited law's value (Murch and
+    # Wilson 1975) +-5 % across 100-1700 rad/s (6208, 3000 N, seed oil at 40 degC), and in the range
+    # established inlet laws give (0.8-0.95 at 500 rad/s, 0.5-0.8 at 1700 rad/s; seed 003's eq. 6, a
+    # Hertz-zone temperature, applied at the inlet gives 0.41 / 0.10). Measured 0.974 / 0.833 /
+    # 0.679 / 0.523. The film itself: heated / isothermal.
     base = studies.isothermal_spec("6208")  # the unheated film of seed 000's Hamrock-Dowson law
     hot = BearingSpec.model_validate({**base.model_dump(), "thermal": Thermal(shear_heating=True).model_dump()})
     films = []

@@ -1,8 +1,8 @@
-"""Issue 14's service interfaces against a REAL service (uvicorn + zenoh on 127.0.0.1, free
+"""The defect and vibration interfaces against a REAL service (uvicorn + zenoh on 127.0.0.1, free
 ports, fast mode): local defects by HTTP `PUT`/`DELETE /v1/bearings/{id}/defects` and by zenoh
 `.../defects`, validated against the bearing's own geometry; the vibration indicators on zenoh
 `.../vibration` (JSON), the accelerometer samples on `.../vibration/waveform` (the binary layout of
-twin.vibration.waveform), and the defect alarms (issue 15) of a 6208 with the housing on.
+twin.vibration.waveform), and the defect alarms of a 6208 with the housing on.
 
 The outer spall (0.5 mm along the rolling direction, 0.6 Rb across, 50 um deep, at the centre of
 the load zone; 6208, 523 rad/s, 3 kN, sensor noise 0.01 m/s^2/sqrt(Hz), 0.25 s windows) is the

@@ -1,4 +1,4 @@
-"""A fleet beyond one host (issue 13, "Beyond one host"), with real processes on loopback ports:
+"""A fleet beyond one host, with real processes on loopback ports:
 `bearing-twin router` (zenoh's own router mode) and two `bearing-twin serve` joined to it with
 `--zenoh-connect` under the key prefix plant1/line2, three twins. The monitor (a zenoh client of
 the router, prefix pattern plant1/**) lists all three; a zenoh setpoint to each lands on that twin

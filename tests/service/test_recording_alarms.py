@@ -1,4 +1,4 @@
-"""Alarm events in the rerun recording (issue 15: "logged in the rerun recording"): a real twin's
+"""Alarm events are logged in the rerun recording: a real twin's
 snapshots and the events of the real `AlarmEvaluator` go through `RerunRecorder.log_alarm`; the
 .rrd is read back. Entities (service.recording.layout): `bearing/{id}/alarms/{alarm_id}`
 (TextLog with level) and `bearing/{id}/alarm_states/{alarm_id}` (StateChange), at the simulated

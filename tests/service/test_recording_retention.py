@@ -1,4 +1,4 @@
-"""Retention (issue 12): the newest segments of the service-wide recordings are kept up to a size
+"""Retention: the newest segments of the service-wide recordings are kept up to a size
 or age limit, older ones deleted - only files of the recording's own family, never the open
 segment, never a link, never a per-twin recording. A recorder applies it after each segment."""
 

@@ -1,4 +1,4 @@
-"""Recordings are append-only history and their faults are visible (issue 16, items 2-5), with a
+"""Recordings are append-only history and their faults are visible, with a
 real uvicorn server on 127.0.0.1 and the real file system:
 
 * per-twin recording paths: a symlink, a symlinked folder, `..`, an absolute path, an existing

@@ -1,4 +1,4 @@
-"""The vibration of a twin with the housing on in the rerun recording (issue 14): the accelerometer
+"""The vibration of a twin with the housing on in the rerun recording: the accelerometer
 samples (`vibration/acceleration_m_s2`, one row per sample at its own simulated time, sent with
 send_columns), the indicators of each window, the envelope bar charts at the defect frequencies, the window's full
 envelope and acceleration spectra (bar charts, a row per window, with the defect-frequency cursors),

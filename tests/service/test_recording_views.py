@@ -1,4 +1,4 @@
-"""The recording for people (issue 12): few large chunks, the blueprint once, a log row for every
+"""The recording for people: few large chunks, the blueprint once, a log row for every
 setpoint / scenario state / restart / fallback, line breaks where rows are missing or a twin's
 id starts a new run, and the resources of a removed twin freed. Real twins, files read back."""
 
@@ -166,7 +166,7 @@ def test_a_recreated_twin_continues_after_the_previous_run(tmp_path, run):
 
 
 def test_removed_twins_leave_nothing_behind(tmp_path, run):
-    """The recorder forgets a removed twin: entry, context, buffers (issue 16: resources follow
+    """The recorder forgets a removed twin: entry, context, buffers (resources follow
     the twins); what it published before is in the file."""
     twin, snaps = run
     rec = RerunRecorder(tmp_path / "rm.rrd")

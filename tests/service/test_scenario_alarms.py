@@ -1,5 +1,5 @@
-"""Issue 15: "a scenario that raises the load and drops the oil viscosity raises, then clears, the
-lubrication alarm". A REAL 6208 twin runs `scenarios/lubrication_alarm.yaml` (3 kN, 40 degC oil
+"""A scenario that raises the load and drops the oil viscosity raises, then clears, the
+lubrication alarm. A REAL 6208 twin runs `scenarios/lubrication_alarm.yaml` (3 kN, 40 degC oil
 -> 8 kN, 110 degC -> back; 500 rad/s): offline (`bearing-twin scenario run`, default alarm
 settings) and inside a real service (uvicorn on 127.0.0.1, the scenario POSTed, recordings on).
 The on-delay and clear hold are checked against the twin's own Lambda series (the snapshots the

@@ -2,7 +2,7 @@
 P = 0.05 C0 radial, ISO VG 32, ambient 20 degC, the catalogue's thermal reference speed; the
 standard states the outer ring runs at 70 degC there. The twin's own friction heat, with the
 standard's dissipation q_r A_r per 50 K (twin.thermal.correlations), must settle the outer ring at
-70 +- 10 degC (the network's half of the issue's acceptance; the friction's magnitude at these
+70 +- 10 degC (the network's half of the check; the friction's magnitude at these
 speeds is the friction laws' half).
 
 Reference speeds: SKF Rolling bearings catalogue PUB BU/P1 17000/1 EN (2018), product tables of

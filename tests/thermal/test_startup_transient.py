@@ -1,4 +1,4 @@
-"""Start-up from cold with the network in the loop (issue acceptance): the 6208 at 1000 rad/s and
+"""Start-up from cold with the network in the loop: the 6208 at 1000 rad/s and
 3000 N, ambient 20 degC, in the accelerated mode (heat capacities x 1e-3): the temperatures rise
 with the time constants the network states, the viscosity, Lambda and friction follow, and the
 accelerated run ends where real heat capacities end (the capacity-free fixed-point steady state,

@@ -1,4 +1,4 @@
-"""The vibration the twin itself produces (issue 14): outer ring on the housing, local defects in
+"""The vibration the twin itself produces: outer ring on the housing, local defects in
 the contact geometry, the accelerometer sampled in the kernel, the indicators of each window.
 
 Every run is one engine window (the snapshot's `vibration` block, twin.accelerometer) of a twin

@@ -692,7 +692,7 @@ def test_a_burst_nobody_subscribes_to_queues_nothing_and_close_is_prompt(bus, tw
 
 
 def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
-    """Issue 16: zenoh setpoint results are never silently dropped. The twin's control thread is
+    """Zenoh setpoint results are never silently dropped. The twin's control thread is
     held inside the handler; 256 setpoints fill its queue (_CONTROL_QUEUE_SIZE) and each of the
     next 40 gets a refusal with status 429 and retry_after_s on the result key: one result for
     every setpoint sent, none lost."""

@@ -16,7 +16,7 @@ from service.tools.cli import build_parser
 from service.tools.serve_cli import serve_settings
 from service.tools.settings_flags import flag_of
 
-# Every flat environment name the single-level ServiceSettings read, with the group path it now
+# Every flat environment name ServiceSettings accepts beside the nested ones, with the group path it
 # sets: the names users have in their unit files (docs/configuration.md).
 FLAT_PATHS = {
     "zenoh_prefix": "zenoh.prefix",

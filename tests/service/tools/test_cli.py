@@ -75,7 +75,7 @@ def test_report_quick(tmp_path):
     # the CWRU records beside the twin (service/reports/cwru.py): every record's row
     assert "## Vibration against the CWRU records" in text
     assert all(f"| {n} | " in text for n in (97, 105, 118, 130, 144, 156))
-    # issue 13: the time-step study's table
+    # the time-step study's table (bearing-twin timestep-study)
     assert "## Time step: the auto step against 1 us" in text and "| 6208-serve | auto |" in text
 
 
@@ -133,7 +133,7 @@ def test_a_busy_zenoh_port_is_a_one_line_error(tmp_path):
 
 def test_scenario_run_names_the_recording_it_wrote(tmp_path):
     """A --record name that is taken is never overwritten: the run records beside it as
-    <stem>.run2.rrd and says so (issue 16: it used to print the name it did not write)."""
+    <stem>.run2.rrd and prints the name it wrote, not the one it was given."""
     pytest.importorskip("rerun")
     scenario = tmp_path / "tiny.yaml"
     scenario.write_text(

@@ -1,4 +1,4 @@
-"""`bearing-twin life`: the issue's JSON keys, ISO 281 numbers, errors that name the field."""
+"""`bearing-twin life`: its JSON keys, ISO 281 numbers, errors that name the field."""
 
 import json
 import subprocess

@@ -1,4 +1,4 @@
-"""`bearing-twin vibration`: the issue's JSON keys, BPFO of an outer-race spall from the twin's
+"""`bearing-twin vibration`: its JSON keys, BPFO of an outer-race spall from the twin's
 own signal, the figure, errors that name the field and the bearing's range."""
 
 import json
@@ -21,7 +21,7 @@ def _run(*args, timeout=900):
 
 def test_outer_spall_json_and_plot(tmp_path):
     """6208, 523 rad/s, 3000 N, a 0.5 mm outer-race spall, 0.3 s analysed (87 BPFO periods, 3.3 Hz
-    bins): the JSON keys of issue 14, FTF / BPFO / BPFI / BSF from the geometry at the loaded contact
+    bins): the JSON keys (KEYS), FTF / BPFO / BPFI / BSF from the geometry at the loaded contact
     angle (0 for the 6208 under a radial load, to 0.01 deg), the largest of the five envelope
     peaks within 1 % of BPFO; --plot writes a PNG."""
     png = tmp_path / "vib.png"
