@@ -97,8 +97,9 @@ def unit_of(field: str) -> str:
     return ""
 
 
-def _fmt(value: Any) -> str:
-    return "-inf" if value is None else (f"{value:g}" if isinstance(value, (int, float)) else str(value))
+def _fmt(value: Any, open_side: str) -> str:
+    """A bound as text; `open_side` ("-inf" or "inf") for a side the range leaves open."""
+    return open_side if value is None else (f"{value:g}" if isinstance(value, (int, float)) else str(value))
 
 
 def _jsonable(value: Any) -> Any:
@@ -188,7 +189,8 @@ def field_errors(
                     high_bound = known[1] if high_bound is None else high_bound
                 allowed = [_jsonable(low_bound), _jsonable(high_bound)]
                 unit = unit_of(leaf or "")
-                msg = f"{msg}; allowed range [{_fmt(low_bound)}, {_fmt(high_bound)}]{' ' + unit if unit else ''}"
+                low_text, high_text = _fmt(low_bound, "-inf"), _fmt(high_bound, "inf")
+                msg = f"{msg}; allowed range [{low_text}, {high_text}]{' ' + unit if unit else ''}"
         if e.get("type") == "extra_forbidden" and leaf is not None:
             msg = f"unknown field {leaf!r}"
             if limits is not None and len(loc) <= 2:

@@ -1,5 +1,5 @@
 """`bearing-twin` command line: simulate, bench, timestep-study, report, serve, router, scenario, monitor,
-ehl, life, vibration (the load tools soak, attack and bench-service are `bearing-twin-loadtest`).
+ehl, life, vibration, thermal (the load tools soak, attack and bench-service are `bearing-twin-loadtest`).
 
 Heavy imports (FastAPI, zenoh, rerun, matplotlib) happen inside the subcommand that needs them.
 """
@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import re
 import sys
@@ -67,6 +68,9 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from twin.setpoint import SetpointError, SetpointUpdate
     from twin.spec import ModelOptions
 
+    if not (math.isfinite(args.duration) and args.duration >= 0.0):
+        print(f"error: --duration = {args.duration!r}: must be a finite number of seconds >= 0", file=sys.stderr)
+        return 2
     try:
         options = ModelOptions(time_step_s=args.dt, film_formula=args.film_formula)
         update = SetpointUpdate(
@@ -216,7 +220,7 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
         f"kurtosis {result['kurtosis']:.2f} (band {result['band_kurtosis']:.2f}), "
         f"velocity RMS {result['velocity_rms_mm_s']:.4g} mm/s"
     )
-    peaks = ", ".join(f"{p['frequency_hz']:.1f} Hz ({p['amplitude']:.3g})" for p in result["envelope_peaks_hz"])
+    peaks = ", ".join(f"{p['frequency_hz']:.1f} Hz ({p['amplitude']:.3g} m/s2)" for p in result["envelope_peaks_hz"])
     print(
         f"  envelope peaks ({result['envelope_band_hz'][0]:.0f}-{result['envelope_band_hz'][1]:.0f} Hz band): {peaks}"
     )
@@ -236,28 +240,40 @@ def build_parser() -> argparse.ArgumentParser:
         default=DEFAULT_DESIGNATION,
         help=f"catalog designation (default {DEFAULT_DESIGNATION}) or a bearing spec file (.yaml, .json)",
     )
-    sim.add_argument("--radial-load", type=float, default=3000.0, help="radial load [N]")
-    sim.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
-    sim.add_argument("--speed", type=float, default=500.0, help="shaft speed [rad/s]")
-    sim.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC]")
-    sim.add_argument("--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload")
-    sim.add_argument("--duration", type=float, default=0.05, help="simulated time [s]")
+    sim.add_argument("--radial-load", type=float, default=3000.0, help="radial load [N] (default 3000)")
+    sim.add_argument("--axial-load", type=float, default=0.0, help="axial load [N] (default 0)")
+    sim.add_argument("--speed", type=float, default=500.0, help="shaft speed [rad/s] (default 500)")
+    sim.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC] (default 40)")
+    sim.add_argument(
+        "--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload (default 0)"
+    )
+    sim.add_argument("--duration", type=float, default=0.05, help="simulated time [s] (default 0.05)")
     sim.add_argument(
         "--dt",
         type=_time_step,
         default="auto",
         help="time step [s] or 'auto' (default: from the critical step, twin.timestep)",
     )
-    sim.add_argument("--film-formula", choices=["hamrock_dowson", "masjedi_khonsari"], default="hamrock_dowson")
+    sim.add_argument(
+        "--film-formula",
+        choices=["hamrock_dowson", "masjedi_khonsari"],
+        default="hamrock_dowson",
+        help="minimum film thickness formula: seed 000 eq. 6 (hamrock_dowson, default) or seed 004 eq. 6 "
+        "(masjedi_khonsari)",
+    )
     sim.add_argument("--json", action="store_true", help="print the snapshot as JSON")
     sim.set_defaults(func=_cmd_simulate)
 
     bench = sub.add_parser(
         "bench", help="engine speed: real-time factor at the default step and at 1 us, further cases, per-pass timing"
     )
-    bench.add_argument("--seconds", type=_positive_float, default=0.2, help="simulated seconds per repeat")
-    bench.add_argument("--repeats", type=int, default=5, help="repeats, at least 5 (best and median reported)")
-    bench.add_argument("--json", action="store_true")
+    bench.add_argument(
+        "--seconds", type=_positive_float, default=0.2, help="simulated seconds per repeat [s] (default 0.2)"
+    )
+    bench.add_argument(
+        "--repeats", type=int, default=5, help="repeats, at least 5 (best and median reported) (default 5)"
+    )
+    bench.add_argument("--json", action="store_true", help="print the result as JSON")
     bench.add_argument(
         "--save",
         nargs="?",
@@ -275,7 +291,7 @@ def build_parser() -> argparse.ArgumentParser:
         action="store_true",
         help="the tribology and traction sub-rates (periods) at the auto step instead of the step",
     )
-    study.add_argument("--json", action="store_true")
+    study.add_argument("--json", action="store_true", help="print the result as JSON")
     study.set_defaults(func=_cmd_timestep_study)
     report = sub.add_parser("report", help="validation report against the seeds (Markdown + PNG plots)")
     report.add_argument("--out", default="reports", help="output directory (default reports/)")

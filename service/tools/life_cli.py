@@ -36,9 +36,9 @@ def add_life_command(sub) -> None:
         help=f"catalog designation (default {DEFAULT_DESIGNATION}) or a bearing spec file (.yaml, .json)",
     )
     p.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
-    p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
+    p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N] (default 0)")
     p.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
-    p.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC]")
+    p.add_argument("--oil-temperature", type=float, default=40.0, help="oil temperature [degC] (default 40)")
     p.add_argument(
         "--clearance",
         type=float,

@@ -24,7 +24,7 @@ def add_scenario_command(sub: Any) -> None:
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
     run.set_defaults(func=_cmd_scenario_run)
     check = scenario_sub.add_parser("check", help="validate scenario files and print what they do")
-    check.add_argument("files", nargs="+")
+    check.add_argument("files", nargs="+", help="scenario YAML files (see scenarios/)")
     check.set_defaults(func=_cmd_scenario_check)
 
 

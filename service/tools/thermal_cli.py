@@ -24,8 +24,8 @@ def add_thermal_command(sub) -> None:
     )
     p.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
     p.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
-    p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N]")
-    p.add_argument("--ambient", type=float, default=20.0, help="ambient (oil bath) temperature [degC]")
+    p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N] (default 0)")
+    p.add_argument("--ambient", type=float, default=20.0, help="ambient (oil bath) temperature [degC] (default 20)")
     p.add_argument(
         "--lubricant", default=None, help="'seed-000' or 'ISO VG n' (default seed-000, or a spec file's own)"
     )
@@ -33,7 +33,7 @@ def add_thermal_command(sub) -> None:
         "--dissipation",
         choices=("housing", "iso_15312"),
         default="housing",
-        help="heat path to the surroundings: the housing correlations or ISO 15312's reference dissipation",
+        help="heat path to the surroundings: the housing correlations (default) or ISO 15312's reference dissipation",
     )
     p.add_argument("--json", action="store_true", help="print the result as JSON")
     p.set_defaults(func=_cmd_thermal)

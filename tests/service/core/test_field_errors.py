@@ -3,7 +3,7 @@ came (service.core.errors): pydantic names only the side that was crossed, so th
 from the model that validated it (`declared_bounds`)."""
 
 import pytest
-from pydantic import ValidationError
+from pydantic import BaseModel, Field, ValidationError
 
 from service.core.errors import InputError, declared_bounds, field_errors
 from service.core.registry import TwinRegistry
@@ -45,3 +45,16 @@ def test_a_twin_from_a_spec_names_the_spec_field_and_its_range():
     (error,) = info.value.errors
     assert error.field == "spec.mounting.diametral_clearance_m"
     assert error.allowed == [-5e-05, 0.0002], error
+
+
+def test_a_side_no_model_declares_reads_as_open_on_its_own_side():
+    # a bound with no model to read the other side from (a measured temperature >= -60 degC): the
+    # open side is -inf below and inf above, never -inf above
+    class Measured(BaseModel):
+        temperature_c: float = Field(ge=-60.0)
+
+    with pytest.raises(ValidationError) as info:
+        Measured.model_validate({"temperature_c": -300.0})
+    (error,) = field_errors(info.value.errors())
+    assert error.allowed == [-60.0, None]
+    assert error.message.endswith("allowed range [-60, inf] degC"), error.message

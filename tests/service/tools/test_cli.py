@@ -41,6 +41,8 @@ def test_simulate_refuses_bad_input_by_name():
     assert "radial_load_n" in res.stderr and "Traceback" not in res.stderr
     res = _run("simulate", "--clearance", "0.01", "--duration", "0.001")
     assert res.returncode == 2 and "diametral_clearance_m" in res.stderr
+    res = _run("simulate", "--duration", "-1")
+    assert res.returncode == 2 and "--duration" in res.stderr and "Traceback" not in res.stderr
 
 
 def test_report_quick(tmp_path):
