@@ -236,6 +236,14 @@ class ScenarioList(BaseModel):
 
 
 # ---- recording ----------------------------------------------------------------------------------
+class TemperatureRequest(BaseModel):
+    """One measured node temperature (PUT /v1/bearings/{id}/temperature)."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
+    node: Literal["outer_ring", "housing", "oil"] = Field(default="outer_ring", description="Measured node [text].")
+    temperature_c: float = Field(ge=-60.0, le=400.0, description="Measured temperature [degC].")
+
+
 class RecordingRequest(BaseModel):
     """Start or stop a rerun recording of one twin."""
 
@@ -500,6 +508,7 @@ def request_bounds() -> dict[str, tuple[Any, Any]]:
     for model in (
         BearingCreate,
         RecordingRequest,
+        TemperatureRequest,
         ScenarioRequest,
         Scenario,
         ScenarioRun,

@@ -22,7 +22,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from service.core.errors import FieldError, InputError
+from service.core.errors import FieldError, InputError, field_bounds, field_errors
 from service.core.mailbox import LatestValue
 
 try:  # the engine's limit (twin.state, with the vibration engine)
@@ -67,14 +67,29 @@ def parse_defects(data: Any, geometry, *, prefix: str = "defects") -> tuple:
         return tuple(validate_defects(items, geometry))
     except ValidationError as exc:
         errors = []
+        bounds = _defect_bounds()
         for e in exc.errors(include_url=False):
-            message = str(e.get("msg", "invalid")).removeprefix("Value error, ")
+            described = field_errors([e], bounds=bounds)[0]  # the message with both sides of the range
             field = _loc(prefix, tuple(e.get("loc", ())))
-            named = _NAMED.match(message)  # a model-level check names its field first
+            named = _NAMED.match(described.message)  # a model-level check names its field first
             if named and not field.endswith(f".{named.group(1)}"):
                 field = f"{field}.{named.group(1)}"
-            errors.append(FieldError(field=field, message=message))
+            errors.append(FieldError(field=field, message=described.message, allowed=described.allowed))
         raise InputError(errors) from None
+
+
+def _defect_bounds() -> dict[str, tuple[Any, Any]]:
+    """field name -> (low, high) the defect models declare (twin.vibration.defects): a pydantic
+    error names only the side of a range that was crossed."""
+    from twin.vibration.defects import BallDefect, InnerRaceSpall, OuterRaceSpall
+
+    bounds: dict[str, tuple[Any, Any]] = {}
+    for model in (OuterRaceSpall, InnerRaceSpall, BallDefect):
+        for name, info in model.model_fields.items():
+            declared = field_bounds(info)
+            if declared is not None:
+                bounds.setdefault(name, declared)
+    return bounds
 
 
 class DefectBox:

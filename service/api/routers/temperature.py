@@ -3,24 +3,15 @@ follow (twin.thermal.estimator: a Kalman filter on the dissipation to the surrou
 
 from __future__ import annotations
 
-from typing import Literal
-
 from fastapi import APIRouter, Depends
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, Field
 
 from service.api.deps import TwinDep, setpoint_rate
 from service.api.routers.bearings import INVALID, UNKNOWN_TWIN
 from service.api.routers.setpoint import TOO_MANY
+from service.api.schemas import TemperatureRequest
 
 write = APIRouter(prefix="/v1/bearings", tags=["thermal"])
-
-
-class TemperatureRequest(BaseModel):
-    """One measured node temperature."""
-
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    node: Literal["outer_ring", "housing", "oil"] = Field(default="outer_ring", description="Measured node [text].")
-    temperature_c: float = Field(ge=-60.0, le=400.0, description="Measured temperature [degC].")
 
 
 class TemperatureResponse(BaseModel):

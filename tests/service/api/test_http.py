@@ -227,6 +227,31 @@ def test_garbage_is_a_clean_4xx_never_a_500(client, raw):
         assert "radial_load_n" in errs[0]["allowed"]
 
 
+@pytest.mark.parametrize(
+    "body, field, allowed",
+    [
+        ({"node": "oil", "temperature_c": -300.0}, "temperature_c", [-60.0, 400.0]),
+        ({"node": "outer_ring", "temperature_c": 900.0}, "temperature_c", [-60.0, 400.0]),
+        ({"node": "cage", "temperature_c": 40.0}, "node", None),
+    ],
+)
+def test_a_measured_temperature_out_of_range_names_both_sides(client, body, field, allowed):
+    # TemperatureRequest declares [-60, 400] degC: the error states the whole range whichever
+    # side is crossed (pydantic names only that side), and a node the network has not is named
+    r = client.put("/v1/bearings/default/temperature", json=body)
+    assert r.status_code == 422, r.text
+    (err,) = detail(r)
+    assert err["field"] == field and err["allowed"] == allowed, err
+    if allowed is not None:
+        assert "allowed range [-60, 400] degC" in err["message"], err
+
+
+def test_a_measured_temperature_in_range_is_taken(client):
+    r = client.put("/v1/bearings/default/temperature", json={"node": "outer_ring", "temperature_c": 45.0})
+    assert r.status_code == 200, r.text
+    assert r.json() == {"bearing_id": "default", "node": "outer_ring", "temperature_c": 45.0}
+
+
 def test_unknown_twin_is_404(client):
     for method, url, body in (
         ("GET", "/v1/bearings/nope/state", None),
