@@ -19,6 +19,7 @@ from twin.faults import Fault, FaultKind
 from twin.friction_power import (
     REST_SPEED_RAD_S,
     FrictionPower,
+    contact_powers_w,
     frame_friction_torque_n_m,
     friction_power_by_source,
     seal_moment_n_m,
@@ -205,9 +206,11 @@ class Twin:
         drag_w = max(float(self.inlet.drag_power_w), 0.0)
         seal_w = self._seal_power_w()
         contacts_w = max(th.take_mean_power_w() - drag_w - seal_w, 0.0)
-        heat = friction_heat(s.contacts, self.model.ball_count, contacts_w, self._effective_mu)
+        rolling, sliding, spin_w = contact_powers_w(s.contacts, s.ball_angular_velocity_rad_s, self.model.ball_radius_m)
+        split = np.stack((rolling.ravel(), sliding.ravel(), spin_w.ravel()), axis=1)  # contact 2j + side
+        heat = friction_heat(split, contacts_w)
         heat = HeatSources(per_contact_w=heat.per_contact_w, drag_w=drag_w, seal_w=seal_w)
-        th.step(s.contacts, s.scalars, contacts_w, spin, self._effective_mu, self.time_s, heat=heat)
+        th.step(s.contacts, s.scalars, spin, self.time_s, heat=heat)
         write_groove_lanes(s.contacts, self._groove_lanes, th.expansion, self.model.ball_count)
         self._refresh_oil_viscosity()
 

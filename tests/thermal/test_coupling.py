@@ -81,6 +81,19 @@ def test_friction_heats_the_bearing_and_thins_the_oil(warmed):
     assert th.network_time_s == pytest.approx(300.0, rel=0.01)
 
 
+def test_the_heat_is_split_by_source_as_the_friction_power(warmed):
+    # one reading of rolling, sliding and spin (twin.friction_power.contact_powers_w): the network's
+    # heat by source has the shares of the snapshot's friction_power_w (both from the contact lanes;
+    # the network's at its last step, the snapshot's at the frame's end: 0.03 of the total apart)
+    _twin, _start, end = warmed
+    heat, power = end.thermal.heat_w, end.friction_power_w.model_dump()
+    contact_heat = sum(heat[k] for k in ("rolling", "sliding", "spin"))
+    contact_power = sum(power[k] for k in ("rolling", "sliding", "spin"))
+    assert heat["sliding"] / contact_heat > 0.05  # the DEM's sliding carries heat
+    for source in ("rolling", "sliding", "spin"):
+        assert heat[source] / contact_heat == pytest.approx(power[source] / contact_power, abs=0.03), source
+
+
 def test_ambient_change_shifts_every_node_and_bad_measurements_are_refused(warmed):
     twin, _, _ = warmed
     now = twin.snapshot().thermal  # the shared twin as the other tests of the module left it

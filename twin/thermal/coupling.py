@@ -46,7 +46,7 @@ from twin.thermal.network import (
     network_geometry,
 )
 from twin.thermal.settings import ThermalNetworkSettings
-from twin.thermal.sources import HeatSources, friction_heat
+from twin.thermal.sources import HeatSources
 
 MEASURABLE_NODES = ("outer_ring", "housing", "oil")
 
@@ -219,19 +219,17 @@ class ThermalCoupling:
         self,
         contacts: np.ndarray,
         scalars: np.ndarray,
-        drive_power_w: float,
         ball_spin_rad_s: float,
-        ellipse: bool,
         time_s: float,
-        heat: HeatSources | None = None,
+        heat: HeatSources,
     ) -> None:
         """Advance the network over the elapsed period with the heat of the engine's state
-        (`heat`: the friction laws' own split when given, else twin.thermal.sources from the lanes)."""
+        (`heat`: twin.thermal.sources.friction_heat of the engine's contact powers)."""
         elapsed = self.since_step_s
         self.since_step_s = 0.0
         if elapsed <= 0.0:
             return
-        self.heat = heat if heat is not None else friction_heat(contacts, self.model.ball_count, drive_power_w, ellipse)
+        self.heat = heat
         op = self.operating_point(contacts, scalars, ball_spin_rad_s)
         self.network = assemble(self.geometry, op, self.model.spec, self.settings)
         scale = self.settings.heat_capacity_scale

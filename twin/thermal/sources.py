@@ -1,21 +1,16 @@
 """The heat the bearing's friction makes, contact by contact and source by source, and where it goes.
 
-`friction_heat(contacts, z, drive_power_w, ellipse)` reads the per-contact lanes of the engine
-(twin.kernels.layout) once per network step:
+`friction_heat(contact_powers_w, drive_power_w)` takes the power of every ball-raceway contact by
+source, as the engine's friction powers compute it from the lanes of the last step
+(twin.friction_power.contact_powers_w: rolling, sliding, spin, the one reading of those sources
+that the snapshot's `friction_power_w` also gives), once per network step.
 
-* rolling: the seed 001 rolling force times the entrainment speed, F_R |u| [W];
-* sliding: the tangential force on the ball times the slip velocity, |F . v_s| [W];
-* spin: the moment about the contact normal times the relative spin rate, |M_n w_n| [W]
-  (the ellipse traction's lanes; 0 with the centre-point friction laws);
-* drag and seal: 0 until the engine states them (the friction laws add them; `HeatSources` has
-  their fields so that consumers do not change).
-
-The lane estimates split the heat; their total is the drive power, friction torque x shaft speed
-(the energy balance of the bearing at steady speed: the shaft's work is all turned into heat),
-floored at 0. The heat of a contact goes half to its ring, half to the ball: Blok's partition
-for two bodies of the same steel at comparable Peclet numbers (Blok 1937; Harris and Kotzalas,
-Advanced Concepts of Bearing Technology, 2007, ch. 7). Drag heats the oil, seal friction the
-outer ring.
+That split is instantaneous; its total is scaled to the mean drive power over the network's
+period, the contacts' share of friction torque x shaft speed (the energy balance of the bearing
+at steady speed: the shaft's work is all turned into heat), floored at 0. The heat of a contact
+goes half to its ring, half to the ball: Blok's partition for two bodies of the same steel at
+comparable Peclet numbers (Blok 1937; Harris and Kotzalas, Advanced Concepts of Bearing
+Technology, 2007, ch. 7). Drag heats the oil, seal friction the outer ring.
 """
 
 from __future__ import annotations
@@ -24,7 +19,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from twin.kernels import layout as L
 from twin.thermal.network import BALLS, INNER_RING, N_NODES, OIL, OUTER_RING
 
 SOURCE_NAMES = ("rolling", "sliding", "spin", "drag", "seal")
@@ -69,26 +63,17 @@ class HeatSources:
         return q
 
 
-def lane_heat_estimates_w(contacts: np.ndarray, ball_count: int, ellipse: bool) -> np.ndarray:
-    """(2Z, 3) rolling, sliding, spin heat of each contact from its lanes [W]."""
-    n = 2 * ball_count
-    c = contacts[:, :n]
-    loaded = c[L.C_LOAD] > 0.0
-    rolling = np.abs(c[L.C_ROLLING_FORCE] * c[L.C_ENTRAINMENT])
-    sliding = np.abs(c[L.O_FX] * c[L.O_SX] + c[L.O_FY] * c[L.O_SY] + c[L.O_FZ] * c[L.O_SZ])
-    spin = np.abs(c[L.E_SPIN_MOMENT] * c[L.E_SPIN_RATE]) if ellipse else np.zeros(n)
-    est = np.stack([rolling, sliding, spin], axis=1)
-    est[~loaded] = 0.0
-    return np.where(np.isfinite(est), est, 0.0)
-
-
-def friction_heat(contacts: np.ndarray, ball_count: int, drive_power_w: float, ellipse: bool) -> HeatSources:
-    """The bearing's friction heat from the engine's lanes, scaled to the drive power [W]."""
-    est = lane_heat_estimates_w(contacts, ball_count, ellipse)
+def friction_heat(contact_powers_w: np.ndarray, drive_power_w: float) -> HeatSources:
+    """The contacts' friction heat [W]: `contact_powers_w` (2Z, 3), the rolling, sliding and spin
+    power of contact k (2j inner, 2j + 1 outer of ball j; twin.friction_power.contact_powers_w),
+    scaled so that its total is `drive_power_w` (floored at 0; rolling at every contact alike
+    when no contact has power)."""
+    est = np.where(np.isfinite(contact_powers_w), np.asarray(contact_powers_w, dtype=float), 0.0)
     total = est.sum()
     power = max(float(drive_power_w), 0.0) if np.isfinite(drive_power_w) else 0.0
     if total > 0.0:
-        est *= power / total
-    elif power > 0.0:  # no lane estimate (no loaded contact): rolling at every contact alike
+        est = est * (power / total)
+    elif power > 0.0:  # no contact power (no loaded contact): rolling at every contact alike
+        est = np.zeros_like(est)
         est[:, 0] = power / est.shape[0]
     return HeatSources(per_contact_w=est)
