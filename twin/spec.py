@@ -440,7 +440,7 @@ class ModelOptions(BaseModel):
     time_step_s: float | Literal["auto"] = Field(
         default="auto",
         description="Integration step dt [s], or 'auto' (default): 0.8 x the critical step of the explicit "
-        "scheme at the bearing's static capacity, a divisor of 1 ms (twin.timestep; about 3.2 us for the "
+        "scheme at the bearing's static capacity, a divisor of 1 ms (twin.timestep; about 3.3 us for the "
         "6208). Seed 000 uses 1 us. A number must lie in [1e-08, 2e-05] s.",
     )
     film_formula: Literal["hamrock_dowson", "masjedi_khonsari"] = Field(

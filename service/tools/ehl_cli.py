@@ -9,9 +9,6 @@ maximum pressure, the temperature rise, convergence and the Hamrock-Dowson h_min
 inputs (exit code 1 when the solver did not converge: the numbers are then not a solution);
 `calibrate` regenerates the film-reduction table shipped with twin.ehl_solver; `bench` times
 the isothermal solve at the default speed (default 129 x 129, the solver's speed figure).
-
-service/tools/cli.py registers this with `add_ehl_command(sub)`; `python -m service.tools.ehl_cli ehl ...`
-runs it on its own.
 """
 
 from __future__ import annotations
@@ -45,8 +42,9 @@ def _grid(text: str) -> int:
 
 
 def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
-    """Register `ehl solve` and `ehl calibrate` on an argparse subparsers object; each sets
-    `func(args) -> exit code`."""
+    """Register `ehl solve`, `ehl calibrate` and `ehl bench` on an argparse subparsers object
+    (service/tools/cli.py does; `python -m service.tools.ehl_cli ehl ...` runs them on their own);
+    each sets `func(args) -> exit code`. The module docstring is the command's help."""
     from twin.ehl_solver import params as prm
 
     ehl = subparsers.add_parser(

@@ -10,10 +10,9 @@ The monitor is a zenoh client of the endpoint it connects to (a service or a rou
 with rich: the twin's key without the prefix when the prefix is concrete (`default`), its whole
 key under a pattern (`plant1/line2/motor7/de`). A twin whose liveliness token goes (its service
 stopped or lost) is shown gone, and dropped after --forget-after seconds. zenoh credentials
-come from the environment (BEARING_TWIN_ZENOH_USER / _PASSWORD, or _TLS_*). zenoh callbacks only
-push into a queue; the main thread parses, aggregates and renders. Alarm events `{prefix}/*/alarm` fill the `alarms`
-column (the active alarms seen since the
-monitor started, `id:severity`; GET /v1/bearings/{id}/alarms lists them all).
+come from the environment (BEARING_TWIN_ZENOH_USER / _PASSWORD, or _TLS_*). Alarm events
+`{prefix}/*/alarm` fill the `alarms` column (the active alarms seen since the monitor started,
+`id:severity`; GET /v1/bearings/{id}/alarms lists them all).
 """
 
 from __future__ import annotations
@@ -297,7 +296,7 @@ def run_monitor(
         interactive = bool(getattr(stream, "isatty", lambda: False)())
         console = Console(file=stream, width=None if interactive else 160)
     table = TwinTable(prefix, forget_gone_s)
-    inbox: queue.SimpleQueue = queue.SimpleQueue()
+    inbox: queue.SimpleQueue = queue.SimpleQueue()  # zenoh callbacks only push; this thread parses and renders
 
     def on_sample(sample: zenoh.Sample) -> None:  # zenoh thread: hand off only
         with contextlib.suppress(Exception):

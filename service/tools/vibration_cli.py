@@ -9,9 +9,6 @@ sample; --column picks the column, lines starting with '#' and a non-numeric hea
 skipped), `.wav` (scipy.io.wavfile: float samples as they are, integer PCM scaled to +-1 at full
 scale and multiplied by --full-scale; the file's rate is the sample rate, --sample-rate must
 agree when given). Units: --units g (x 9.80665) or m/s2.
-
-The analysis (scipy.signal) is imported by the command, not with the parser: every other
-`bearing-twin` command starts without it.
 """
 
 from __future__ import annotations
@@ -101,7 +98,8 @@ def _parse_line(text: str) -> tuple[str, float]:
 
 def analyse_file(args: argparse.Namespace) -> dict:
     """The JSON of `vibration analyse` (module docstring). Raises RecordError / ValueError naming
-    the option."""
+    the option. The analysis (scipy.signal) is imported here, not with the parser: every other
+    `bearing-twin` command starts without it."""
     from twin.vibration.analysis import MAX_SAMPLE_RATE_HZ, AnalysisInputError, analyse_signal, defect_multiples_of
 
     path = Path(args.file)
