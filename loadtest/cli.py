@@ -12,7 +12,8 @@ from pathlib import Path
 from loadtest.attack import add_attack_command
 from loadtest.benchmark import CLIENT_NICE, run_service_benchmark
 from loadtest.soak import add_soak_command
-from service.tools.cli import ArgumentParser, _positive_float, _positive_int
+from service.tools.arg_types import positive_float, positive_int
+from service.tools.cli import ArgumentParser
 
 SAVE_KIND = "servicebench"  # file kind: not matched by the engine bench's `*-bench*.json`
 EXTRA_HINT = "the load tools need httpx: pip install -c constraints.txt '.[loadtest]'"
@@ -35,8 +36,8 @@ def build_parser() -> argparse.ArgumentParser:
         "twins like the first (6208) as the service's capacity states once the first is calibrated and "
         "the service overhead per twin measured (/health capacity.max_twins)",
     )
-    bsv.add_argument("--seconds", type=_positive_float, default=10.0, help="measurement time [s of wall time]")
-    bsv.add_argument("--rate", type=_positive_float, default=20.0, help="setpoints per second, all twins [Hz]")
+    bsv.add_argument("--seconds", type=positive_float, default=10.0, help="measurement time [s of wall time]")
+    bsv.add_argument("--rate", type=positive_float, default=20.0, help="setpoints per second, all twins [Hz]")
     bsv.add_argument(
         "--force", action="store_true", help="admission off: run every twin even beyond the measured capacity"
     )
@@ -147,7 +148,7 @@ def _cmd_bench_service(args: argparse.Namespace) -> int:
 
 def _twins(text: str) -> int | str:
     """--twins: a positive count or 'auto'."""
-    return "auto" if text.strip().lower() == "auto" else _positive_int(text)
+    return "auto" if text.strip().lower() == "auto" else positive_int(text)
 
 
 def f(value: float | None, spec: str = "{:.2f}") -> str:

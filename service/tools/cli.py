@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import re
 import sys
 from pathlib import Path
 
 from service import __version__
+from service.tools.arg_types import non_negative_float, positive_float
 from service.tools.bench_results import save as save_result
 from service.tools.messages import error_text
 from service.tools.scenario_cli import add_scenario_command
@@ -34,13 +34,6 @@ class ArgumentParser(argparse.ArgumentParser):
         self._negative_number_matcher = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
 
 
-def _positive_float(text: str) -> float:
-    value = float(text)
-    if not value > 0:
-        raise argparse.ArgumentTypeError(f"must be > 0, got {text}")
-    return value
-
-
 def _time_step(text: str) -> float | str:
     from twin.timestep import parse_time_step
 
@@ -48,16 +41,6 @@ def _time_step(text: str) -> float | str:
         return parse_time_step(text)
     except ValueError as exc:
         raise argparse.ArgumentTypeError(str(exc)) from None
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be a whole number, got {text}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {text}")
-    return value
 
 
 def _cmd_simulate(args: argparse.Namespace) -> int:
@@ -68,9 +51,6 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
     from twin.setpoint import SetpointError, SetpointUpdate
     from twin.spec import ModelOptions
 
-    if not (math.isfinite(args.duration) and args.duration >= 0.0):
-        print(f"error: --duration = {args.duration!r}: must be a finite number of seconds >= 0", file=sys.stderr)
-        return 2
     try:
         options = ModelOptions(time_step_s=args.dt, film_formula=args.film_formula)
         update = SetpointUpdate(
@@ -247,7 +227,7 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument(
         "--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload (default 0)"
     )
-    sim.add_argument("--duration", type=float, default=0.05, help="simulated time [s] (default 0.05)")
+    sim.add_argument("--duration", type=non_negative_float, default=0.05, help="simulated time [s] (default 0.05)")
     sim.add_argument(
         "--dt",
         type=_time_step,
@@ -268,7 +248,7 @@ def build_parser() -> argparse.ArgumentParser:
         "bench", help="engine speed: real-time factor at the default step and at 1 us, further cases, per-pass timing"
     )
     bench.add_argument(
-        "--seconds", type=_positive_float, default=0.2, help="simulated seconds per repeat [s] (default 0.2)"
+        "--seconds", type=positive_float, default=0.2, help="simulated seconds per repeat [s] (default 0.2)"
     )
     bench.add_argument(
         "--repeats", type=int, default=5, help="repeats, at least 5 (best and median reported) (default 5)"
@@ -351,7 +331,7 @@ def build_parser() -> argparse.ArgumentParser:
         help="mounted diametral clearance [m], -50e-6 .. 200e-6, negative = preload (default: the bearing's; "
         "CWRU-DE 12.5e-6)",
     )
-    vib.add_argument("--duration", type=_positive_float, default=1.0, help="analysed simulated time [s] (default 1)")
+    vib.add_argument("--duration", type=positive_float, default=1.0, help="analysed simulated time [s] (default 1)")
     vib.add_argument(
         "--noise-density",
         type=float,

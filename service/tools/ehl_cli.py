@@ -19,19 +19,7 @@ import math
 import sys
 from typing import Any
 
-
-def _positive_float(text: str) -> float:
-    value = float(text)
-    if not (math.isfinite(value) and value > 0):
-        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
-    return value
-
-
-def _non_negative_float(text: str) -> float:
-    value = float(text)
-    if not (math.isfinite(value) and value >= 0):
-        raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text}")
-    return value
+from service.tools.arg_types import non_negative_float, positive_float
 
 
 def _grid(text: str) -> int:
@@ -57,18 +45,18 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
 
     solve = sub.add_parser("solve", help="solve one contact (defaults: seed 003 Appendix 2)")
     solve.add_argument(
-        "--load", type=_positive_float, default=prm.LOAD_N, help=f"load on the ball [N] (default {prm.LOAD_N})"
+        "--load", type=positive_float, default=prm.LOAD_N, help=f"load on the ball [N] (default {prm.LOAD_N})"
     )
     solve.add_argument(
         "--entrainment-speed",
-        type=_positive_float,
+        type=positive_float,
         default=prm.DEFAULT_ENTRAINMENT_SPEED_M_S,
         help=f"mean entrainment speed [m/s] (default {prm.DEFAULT_ENTRAINMENT_SPEED_M_S}; "
         "seed 003 Fig. 1 spans 0.832-4.16)",
     )
     solve.add_argument(
         "--current",
-        type=_non_negative_float,
+        type=non_negative_float,
         default=0.0,
         help="current through the contact [A] (default 0: isothermal unless --thermal)",
     )
@@ -86,7 +74,7 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
     )
     solve.add_argument(
         "--bearing-resistance",
-        type=_non_negative_float,
+        type=non_negative_float,
         default=prm.DEFAULT_BEARING_RESISTANCE_OHM,
         help=f"equivalent bearing resistance R_b of eq. 10 [ohm] "
         f"(default {prm.DEFAULT_BEARING_RESISTANCE_OHM:g}, anchored on seed 003 Fig. 2)",

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import argparse
 import contextlib
-import math
 import queue
 import sys
 import time
@@ -27,6 +26,7 @@ from typing import Any, Literal
 
 from service.core.alarm_inputs import finite_number
 from service.keys import ALIVE, DEFAULT_PREFIX, STATE, all_twins
+from service.tools.arg_types import positive_float
 from service.tools.client import strict_json
 from twin.snapshot import LAMBDA_KEY
 
@@ -409,13 +409,6 @@ def _cmd_monitor(args: argparse.Namespace) -> int:
     return 0
 
 
-def _positive(text: str) -> float:
-    value = float(text)
-    if not (value > 0 and math.isfinite(value)):
-        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text}")
-    return value
-
-
 def add_monitor_command(subparsers: Any) -> argparse.ArgumentParser:
     """Register `monitor` on an argparse subparsers object; its `func(args)` returns an exit code."""
     p = subparsers.add_parser(
@@ -435,7 +428,7 @@ def add_monitor_command(subparsers: Any) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--forget-after",
-        type=_positive,
+        type=positive_float,
         default=10.0,
         metavar="SECONDS",
         help="drop a gone twin's row after this long (default 10)",
@@ -456,7 +449,7 @@ def add_monitor_command(subparsers: Any) -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--duration",
-        type=_positive,
+        type=positive_float,
         default=None,
         metavar="SECONDS",
         help="stop after this many seconds (default: until Ctrl-C)",
