@@ -11,7 +11,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from service.core.errors import FieldError, InputError, field_bounds
+from service.core.errors import FieldError, InputError, models_bounds
 from service.core.runner import RunMode
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointUpdate
@@ -491,7 +491,6 @@ def request_bounds() -> dict[str, tuple[Any, Any]]:
     pydantic error names only the bound that was crossed)."""
     from service.core.scenarios import Scenario, ScenarioRun, ScenarioStep
 
-    bounds: dict[str, tuple[Any, Any]] = {}
     spec_parts = (
         BearingSpec,
         Geometry,
@@ -505,19 +504,16 @@ def request_bounds() -> dict[str, tuple[Any, Any]]:
         Accelerometer,
         SurfaceProfile,
     )
-    for model in (
-        BearingCreate,
-        RecordingRequest,
-        TemperatureRequest,
-        ScenarioRequest,
-        Scenario,
-        ScenarioRun,
-        ScenarioStep,
-        Thermal,
-        *spec_parts,
-    ):
-        for name, info in model.model_fields.items():
-            declared = field_bounds(info)
-            if declared is not None and name not in bounds:
-                bounds[name] = declared
-    return bounds
+    return models_bounds(
+        (
+            BearingCreate,
+            RecordingRequest,
+            TemperatureRequest,
+            ScenarioRequest,
+            Scenario,
+            ScenarioRun,
+            ScenarioStep,
+            Thermal,
+            *spec_parts,
+        )
+    )

@@ -22,7 +22,7 @@ from typing import Any
 
 from pydantic import ValidationError
 
-from service.core.errors import FieldError, InputError, field_bounds, field_errors
+from service.core.errors import InputError, field_errors, models_bounds
 from service.core.mailbox import LatestValue
 
 try:  # the engine's limit (twin.state, with the vibration engine)
@@ -61,35 +61,22 @@ def parse_defects(data: Any, geometry, *, prefix: str = "defects") -> tuple:
     if len(data) > MAX_DEFECTS:
         raise InputError.one(prefix, f"{len(data)} defects given: at most {MAX_DEFECTS} at once", [0, MAX_DEFECTS])
     items = [d.model_dump() if hasattr(d, "model_dump") else d for d in data]
-    from twin.vibration.defects import validate_defects
+    from twin.vibration.defects import BallDefect, InnerRaceSpall, OuterRaceSpall, validate_defects
 
     try:
         return tuple(validate_defects(items, geometry))
     except ValidationError as exc:
+        raw = exc.errors(include_url=False)
+        # the messages with both sides of a declared range (pydantic names only the side crossed)
+        described = field_errors(raw, bounds=models_bounds((OuterRaceSpall, InnerRaceSpall, BallDefect)))
         errors = []
-        bounds = _defect_bounds()
-        for e in exc.errors(include_url=False):
-            described = field_errors([e], bounds=bounds)[0]  # the message with both sides of the range
+        for e, error in zip(raw, described, strict=True):
             field = _loc(prefix, tuple(e.get("loc", ())))
-            named = _NAMED.match(described.message)  # a model-level check names its field first
+            named = _NAMED.match(error.message)  # a model-level check names its field first
             if named and not field.endswith(f".{named.group(1)}"):
                 field = f"{field}.{named.group(1)}"
-            errors.append(FieldError(field=field, message=described.message, allowed=described.allowed))
+            errors.append(error.model_copy(update={"field": field}))
         raise InputError(errors) from None
-
-
-def _defect_bounds() -> dict[str, tuple[Any, Any]]:
-    """field name -> (low, high) the defect models declare (twin.vibration.defects): a pydantic
-    error names only the side of a range that was crossed."""
-    from twin.vibration.defects import BallDefect, InnerRaceSpall, OuterRaceSpall
-
-    bounds: dict[str, tuple[Any, Any]] = {}
-    for model in (OuterRaceSpall, InnerRaceSpall, BallDefect):
-        for name, info in model.model_fields.items():
-            declared = field_bounds(info)
-            if declared is not None:
-                bounds.setdefault(name, declared)
-    return bounds
 
 
 class DefectBox:

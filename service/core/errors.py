@@ -137,6 +137,18 @@ def field_bounds(info: FieldInfo) -> tuple[Any, Any] | None:
     return None if low is None and high is None else (low, high)
 
 
+def models_bounds(models: Sequence[type[BaseModel]]) -> dict[str, tuple[Any, Any]]:
+    """field name -> (low, high) declared on `models` (`field_bounds`; the first model that
+    declares a name wins), for `field_errors(bounds=...)`."""
+    bounds: dict[str, tuple[Any, Any]] = {}
+    for model in models:
+        for name, info in model.model_fields.items():
+            declared = field_bounds(info)
+            if declared is not None:
+                bounds.setdefault(name, declared)
+    return bounds
+
+
 def _model_in(annotation: Any) -> type[BaseModel] | None:
     """The pydantic model a field's annotation holds (itself, or inside Optional / list / tuple)."""
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
