@@ -42,7 +42,7 @@ from twin.spec import BearingSpec, ModelOptions
 from twin.state import MAX_DEFECTS, TwinState, make_state
 from twin.thermal.coupling import ThermalCoupling
 from twin.thermal.expansion import write_groove_lanes
-from twin.thermal.sources import HeatSources, friction_heat
+from twin.thermal.sources import friction_heat
 from twin.vibration.defects import BallDefect, defect_row, validate_defects
 from twin.warmstart import place_on_housing, warm_start
 
@@ -207,9 +207,7 @@ class Twin:
         seal_w = self._seal_power_w()
         contacts_w = max(th.take_mean_power_w() - drag_w - seal_w, 0.0)
         rolling, sliding, spin_w = contact_powers_w(s.contacts, s.ball_angular_velocity_rad_s, self.model.ball_radius_m)
-        split = np.stack((rolling.ravel(), sliding.ravel(), spin_w.ravel()), axis=1)  # contact 2j + side
-        heat = friction_heat(split, contacts_w)
-        heat = HeatSources(per_contact_w=heat.per_contact_w, drag_w=drag_w, seal_w=seal_w)
+        heat = friction_heat(rolling, sliding, spin_w, contacts_w, drag_w=drag_w, seal_w=seal_w)
         th.step(s.contacts, s.scalars, spin, self.time_s, heat=heat)
         write_groove_lanes(s.contacts, self._groove_lanes, th.expansion, self.model.ball_count)
         self._refresh_oil_viscosity()

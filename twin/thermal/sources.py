@@ -1,7 +1,8 @@
 """The heat the bearing's friction makes, contact by contact and source by source, and where it goes.
 
-`friction_heat(contact_powers_w, drive_power_w)` takes the power of every ball-raceway contact by
-source, as the engine's friction powers compute it from the lanes of the last step
+`friction_heat(rolling_w, sliding_w, spin_w, drive_power_w, drag_w, seal_w)` takes the power of
+every ball-raceway contact by source, as the engine's friction powers compute it from the lanes of
+the last step
 (twin.friction_power.contact_powers_w: rolling, sliding, spin, the one reading of those sources
 that the snapshot's `friction_power_w` also gives), once per network step.
 
@@ -63,12 +64,20 @@ class HeatSources:
         return q
 
 
-def friction_heat(contact_powers_w: np.ndarray, drive_power_w: float) -> HeatSources:
-    """The contacts' friction heat [W]: `contact_powers_w` (2Z, 3), the rolling, sliding and spin
-    power of contact k (2j inner, 2j + 1 outer of ball j; twin.friction_power.contact_powers_w),
-    scaled so that its total is `drive_power_w` (floored at 0; rolling at every contact alike
-    when no contact has power)."""
-    est = np.where(np.isfinite(contact_powers_w), np.asarray(contact_powers_w, dtype=float), 0.0)
+def friction_heat(
+    rolling_w: np.ndarray,
+    sliding_w: np.ndarray,
+    spin_w: np.ndarray,
+    drive_power_w: float,
+    drag_w: float = 0.0,
+    seal_w: float = 0.0,
+) -> HeatSources:
+    """The friction heat [W]: the contacts' rolling, sliding and spin power, each (Z, 2) with
+    column 0 the inner, 1 the outer contact of each ball (twin.friction_power.contact_powers_w),
+    scaled so that their total is `drive_power_w` (floored at 0; rolling at every contact alike
+    when no contact has power), beside the balls' drag and the seals' rubbing."""
+    split = np.stack((np.ravel(rolling_w), np.ravel(sliding_w), np.ravel(spin_w)), axis=1)  # row 2j + side
+    est = np.where(np.isfinite(split), split, 0.0)
     total = est.sum()
     power = max(float(drive_power_w), 0.0) if np.isfinite(drive_power_w) else 0.0
     if total > 0.0:
@@ -76,4 +85,4 @@ def friction_heat(contact_powers_w: np.ndarray, drive_power_w: float) -> HeatSou
     elif power > 0.0:  # no contact power (no loaded contact): rolling at every contact alike
         est = np.zeros_like(est)
         est[:, 0] = power / est.shape[0]
-    return HeatSources(per_contact_w=est)
+    return HeatSources(per_contact_w=est, drag_w=drag_w, seal_w=seal_w)
