@@ -465,8 +465,7 @@ class RerunRecorder:
             self._drain_locked()
             self._send_locked(force_slow=True, timeout_s=timeout_s)
             if not self._closed:
-                if self._out.rotation_due():
-                    self._out.rotate()
+                self._rotate_if_due_locked()
                 self._out.retry(self._closed)
 
     def close(self) -> None:
@@ -507,13 +506,19 @@ class RerunRecorder:
                     self._drain_locked()
                     if time.monotonic() >= next_send:
                         self._send_locked()
-                        if self._out.rotation_due():
-                            self._out.rotate()
+                        self._rotate_if_due_locked()
                         self._out.retry(self._closed)
                         next_send = time.monotonic() + self.flush_interval_s
             except Exception:  # never let the worker die
                 self._errors += 1
                 log.exception("rerun recorder: send failed")
+
+    def _rotate_if_due_locked(self) -> None:
+        """Rotate the main file if its segment is due and a twin is registered: a segment opened
+        with no twin would hold neither static geometry nor blueprint (after the last twin is
+        removed, as at shutdown, the open segment stays the last one)."""
+        if self._rows.twins and self._out.rotation_due():
+            self._out.rotate()
 
     def _drain_locked(self) -> None:
         self._rows.drain(bool(self._out.outputs()))

@@ -516,6 +516,26 @@ def test_rotation_by_age_and_explicit(tmp_path, twin_a):
     ]
 
 
+def test_no_rotation_after_the_last_twin_is_removed(tmp_path, twin_a):
+    """The service's shutdown removes its twins, then closes the recorder: a segment falling due
+    in between must not open a segment that holds neither static geometry nor blueprint (every
+    segment is a complete recording, `service.recording.segments`)."""
+    twin, snaps = twin_a
+    path = tmp_path / "run.rrd"
+    rec = _segmented(path, twin, segment_s=1e-9)  # due as soon as a segment holds a row
+    for s in snaps[:5]:
+        rec.publish(s)
+    assert rec.remove_twin("a")  # its 5 rows are written to the open segment
+    rec.flush()  # due by age and rows, but no twin is left
+    assert rec.segments == [path]
+    rec.close()
+    segs = recording_segments(path)
+    assert segs == [path]
+    info = describe_recording(path)
+    assert info["blueprints"] >= 1 and info["entities"]["bearing/a/geometry/inner_raceway"]["static_rows"] == 1
+    assert list(read_index(path, "bearing/a/balls")) == [s.seq for s in snaps[:5]]
+
+
 def test_rotation_happens_in_the_worker(tmp_path, twin_a):
     """Without flush(): the worker sends every flush_interval_s and rotates when due."""
     twin, snaps = twin_a
