@@ -11,7 +11,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from service.core.errors import FieldError, InputError, models_bounds
+from service.core.errors import Bounds, FieldError, InputError, models_bounds
 from service.core.runner import RunMode
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointUpdate
@@ -486,7 +486,7 @@ class Health(BaseModel):
 
 
 @cache
-def request_bounds() -> dict[str, tuple[Any, Any]]:
+def request_bounds() -> dict[str, Bounds]:
     """field name -> (low, high) declared on the request models (both sides of a range, since a
     pydantic error names only the bound that was crossed)."""
     from service.core.scenarios import Scenario, ScenarioRun, ScenarioStep

@@ -76,6 +76,8 @@ def loc_text(loc: tuple | list, skip: tuple[str, ...] = ("body",)) -> str | None
 
 
 _UNIT_SUFFIXES = (
+    ("_m_s2_rthz", "m/s^2/sqrt(Hz)"),
+    ("_m_s2", "m/s^2"),
     ("_rad_s", "rad/s"),
     ("_m2_s", "m^2/s"),
     ("_pa_s", "Pa s"),
@@ -110,7 +112,7 @@ def _jsonable(value: Any) -> Any:
     return str(value)
 
 
-def declared_bounds(model: type[BaseModel], loc: Sequence[Any]) -> tuple[Any, Any] | None:
+def declared_bounds(model: type[BaseModel], loc: Sequence[Any]) -> Bounds | None:
     """Both sides of the range `model` declares for the field at `loc` (a pydantic error's path:
     nested models and list items followed), from its ge/gt and le/lt constraints; None when `loc`
     names no such field. pydantic's error names only the side that was crossed."""
@@ -127,20 +129,47 @@ def declared_bounds(model: type[BaseModel], loc: Sequence[Any]) -> tuple[Any, An
     return None if info is None else field_bounds(info)
 
 
-def field_bounds(info: FieldInfo) -> tuple[Any, Any] | None:
-    """(low, high) a pydantic field declares (its annotated_types Ge / Gt and Le / Lt; None for a
-    side it leaves open), or None when it declares neither."""
+class Bounds(tuple[Any, Any]):
+    """(low, high) a field declares (None for a side without a bound); `low_open` / `high_open`:
+    that side excludes its bound (gt / lt)."""
+
+    low_open: bool
+    high_open: bool
+
+    def __new__(cls, low: Any, high: Any, low_open: bool = False, high_open: bool = False) -> Bounds:
+        self = super().__new__(cls, (low, high))
+        self.low_open, self.high_open = low_open, high_open
+        return self
+
+
+def field_bounds(info: FieldInfo) -> Bounds | None:
+    """The range a pydantic field declares (its annotated_types Ge / Gt and Le / Lt), or None
+    when it declares neither side."""
     low = high = None
+    low_open = high_open = False
     for constraint in info.metadata:
-        low = getattr(constraint, "ge", getattr(constraint, "gt", low)) if low is None else low
-        high = getattr(constraint, "le", getattr(constraint, "lt", high)) if high is None else high
-    return None if low is None and high is None else (low, high)
+        if low is None and getattr(constraint, "ge", None) is not None:
+            low = constraint.ge
+        elif low is None and getattr(constraint, "gt", None) is not None:
+            low, low_open = constraint.gt, True
+        if high is None and getattr(constraint, "le", None) is not None:
+            high = constraint.le
+        elif high is None and getattr(constraint, "lt", None) is not None:
+            high, high_open = constraint.lt, True
+    return None if low is None and high is None else Bounds(low, high, low_open, high_open)
 
 
-def models_bounds(models: Sequence[type[BaseModel]]) -> dict[str, tuple[Any, Any]]:
+def range_text(low: Any, high: Any, low_open: bool = False, high_open: bool = False) -> str:
+    """'[0, 0.05]', '(0, 0.05]', '[1000, inf)': a side without a bound is open, at infinity."""
+    left = "(" if low_open or low is None else "["
+    right = ")" if high_open or high is None else "]"
+    return f"{left}{_fmt(low, '-inf')}, {_fmt(high, 'inf')}{right}"
+
+
+def models_bounds(models: Sequence[type[BaseModel]]) -> dict[str, Bounds]:
     """field name -> (low, high) declared on `models` (`field_bounds`; the first model that
     declares a name wins), for `field_errors(bounds=...)`."""
-    bounds: dict[str, tuple[Any, Any]] = {}
+    bounds: dict[str, Bounds] = {}
     for model in models:
         for name, info in model.model_fields.items():
             declared = field_bounds(info)
@@ -192,17 +221,20 @@ def field_errors(
         else:
             low_bound = ctx.get("ge", ctx.get("gt"))
             high_bound = ctx.get("le", ctx.get("lt"))
+            low_open, high_open = "gt" in ctx, "lt" in ctx
             if low_bound is not None or high_bound is not None:
                 known = (bounds or {}).get(leaf or "")
                 if known is None and model is not None:
                     known = declared_bounds(model, loc)
                 if known is not None:
-                    low_bound = known[0] if low_bound is None else low_bound
-                    high_bound = known[1] if high_bound is None else high_bound
+                    if low_bound is None:
+                        low_bound, low_open = known[0], getattr(known, "low_open", False)
+                    if high_bound is None:
+                        high_bound, high_open = known[1], getattr(known, "high_open", False)
                 allowed = [_jsonable(low_bound), _jsonable(high_bound)]
                 unit = unit_of(leaf or "")
-                low_text, high_text = _fmt(low_bound, "-inf"), _fmt(high_bound, "inf")
-                msg = f"{msg}; allowed range [{low_text}, {high_text}]{' ' + unit if unit else ''}"
+                text = range_text(low_bound, high_bound, low_open, high_open)
+                msg = f"{msg}; allowed range {text}{' ' + unit if unit else ''}"
         if e.get("type") == "extra_forbidden" and leaf is not None:
             msg = f"unknown field {leaf!r}"
             if limits is not None and len(loc) <= 2:

@@ -33,3 +33,21 @@ def non_negative_float(text: str) -> float:
     if not (math.isfinite(value) and value >= 0):
         raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text}")
     return value
+
+
+def float_in(low: float, high: float, unit: str, *, low_open: bool = False):
+    """A finite number in [low, high] (`low_open`: (low, high]) in `unit`; the refusal states the
+    range and unit."""
+    left = "(" if low_open else "["
+
+    def value_in_range(text: str) -> float:
+        try:
+            value = float(text)
+        except ValueError:
+            value = math.nan
+        above_low = value > low if low_open else value >= low
+        if not (math.isfinite(value) and above_low and value <= high):
+            raise argparse.ArgumentTypeError(f"must be in {left}{low:g}, {high:g}] {unit}, got {text}")
+        return value
+
+    return value_in_range

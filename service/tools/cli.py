@@ -14,13 +14,27 @@ import sys
 from pathlib import Path
 
 from service import __version__
-from service.tools.arg_types import non_negative_float, positive_float
+from service.tools.arg_types import float_in, positive_float
 from service.tools.bench_results import save as save_result
-from service.tools.messages import error_text
+from service.tools.messages import SETPOINT_FLAGS, error_text
 from service.tools.scenario_cli import add_scenario_command
 from service.tools.serve_cli import add_serve_command
 from service.tools.vibration_cli import add_analyse_command
 from twin.catalog import DEFAULT_DESIGNATION
+
+SIMULATE_FLAGS = {**SETPOINT_FLAGS, "time_step_s": "--dt", "film_formula": "--film-formula"}
+VIBRATION_FLAGS = {
+    **SETPOINT_FLAGS,
+    "width_m": "--defect-size",
+    "length_m": "--defect-length",
+    "depth_m": "--defect-depth",
+    "defect_angle_deg": "--defect-angle",
+    "noise_density_m_s2_rthz": "--noise-density",
+    "sample_rate_hz": "--sample-rate",
+}
+
+SIMULATE_MAX_S = 3600.0  # `simulate --duration` at most [s of simulated time]
+VIBRATION_MAX_S = 600.0  # `vibration --duration` at most [s]: 600 s at 51.2 kHz is 250 MB of samples
 
 
 class ArgumentParser(argparse.ArgumentParser):
@@ -66,7 +80,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         twin.reset()  # warm start at it
         twin.advance(args.duration)
     except (ValidationError, SetpointError, ValueError) as exc:
-        print(f"error: {error_text(exc)}", file=sys.stderr)
+        print(f"error: {error_text(exc, SIMULATE_FLAGS)}", file=sys.stderr)
         return 2
     snap = twin.snapshot()
     if args.json:
@@ -77,22 +91,29 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
 
 
 def _print_table(snap) -> None:
+    from rich import box
     from rich.console import Console
     from rich.table import Table
 
-    table = Table(title=f"{snap.designation} at t = {snap.time_s:.4f} s, status {snap.status}")
+    # two-line headers, no vertical rules: the nine columns fit an 80-column terminal uncut
+    table = Table(
+        title=f"{snap.designation} at t = {snap.time_s:.4f} s, status {snap.status}",
+        box=box.SIMPLE_HEAD,
+        padding=(0, 0, 0, 1),
+        pad_edge=False,
+    )
     for col in (
         "ball",
-        "azimuth deg",
-        "spin rad/s",
-        "Q in N",
-        "Q out N",
-        "Lambda in",
-        "Lambda out",
-        "regime in",
-        "regime out",
+        "azimuth\ndeg",
+        "spin\nrad/s",
+        "Q in\nN",
+        "Q out\nN",
+        "Lambda\nin",
+        "Lambda\nout",
+        "regime\nin",
+        "regime\nout",
     ):
-        table.add_column(col, justify="right")
+        table.add_column(col, justify="right", no_wrap=True)
     for b in snap.balls:
         lam = lambda c: "-" if c.lambda_ is None else f"{c.lambda_:.2f}"  # noqa: E731
         table.add_row(
@@ -167,10 +188,10 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
             diametral_clearance_m=args.clearance,
         )
     except (ValidationError, SetpointError, ValueError) as exc:
-        print(f"error: {error_text(exc)}", file=sys.stderr)
+        print(f"error: {error_text(exc, VIBRATION_FLAGS)}", file=sys.stderr)
         return 2
     except RuntimeError as exc:  # the twin halted: the setpoint cannot be held (its status says why)
-        print(f"error: {error_text(exc)}", file=sys.stderr)
+        print(f"error: {error_text(exc, VIBRATION_FLAGS)}", file=sys.stderr)
         return 1
     if args.waveform:
         import numpy as np
@@ -227,7 +248,12 @@ def build_parser() -> argparse.ArgumentParser:
     sim.add_argument(
         "--clearance", type=float, default=0.0, help="diametral clearance [m], negative = preload (default 0)"
     )
-    sim.add_argument("--duration", type=non_negative_float, default=0.05, help="simulated time [s] (default 0.05)")
+    sim.add_argument(
+        "--duration",
+        type=float_in(0.0, SIMULATE_MAX_S, "s"),
+        default=0.05,
+        help=f"simulated time [s] (default 0.05, at most {SIMULATE_MAX_S:g}; longer runs: `serve` or a scenario)",
+    )
     sim.add_argument(
         "--dt",
         type=_time_step,
@@ -331,7 +357,12 @@ def build_parser() -> argparse.ArgumentParser:
         help="mounted diametral clearance [m], -50e-6 .. 200e-6, negative = preload (default: the bearing's; "
         "CWRU-DE 12.5e-6)",
     )
-    vib.add_argument("--duration", type=positive_float, default=1.0, help="analysed simulated time [s] (default 1)")
+    vib.add_argument(
+        "--duration",
+        type=float_in(0.0, VIBRATION_MAX_S, "s", low_open=True),
+        default=1.0,
+        help=f"analysed simulated time [s] (default 1, at most {VIBRATION_MAX_S:g}: the waveform is kept in memory)",
+    )
     vib.add_argument(
         "--noise-density",
         type=float,

@@ -7,7 +7,7 @@ import argparse
 import json
 import sys
 
-from service.tools.messages import error_text
+from service.tools.messages import SETPOINT_FLAGS, error_text
 from twin.catalog import DEFAULT_DESIGNATION
 
 _CONTAMINATION = (
@@ -79,11 +79,8 @@ def _cmd_life(args: argparse.Namespace) -> int:
             diametral_clearance_m=clearance,
             settings=LifeSettings(contamination=args.contamination),
         )
-    except ValidationError as exc:
-        print(f"error: {error_text(exc)}", file=sys.stderr)
-        return 2
-    except (SetpointError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    except (ValidationError, SetpointError, ValueError) as exc:
+        print(f"error: {error_text(exc, SETPOINT_FLAGS)}", file=sys.stderr)
         return 2
     if args.json:
         print(json.dumps(result, allow_nan=False))

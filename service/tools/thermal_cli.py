@@ -7,7 +7,13 @@ import argparse
 import json
 import sys
 
-from service.tools.messages import error_text
+from service.tools.arg_types import float_in
+from service.tools.messages import SETPOINT_FLAGS, error_text
+from twin.setpoint import FIELD
+
+OIL = FIELD["oil_temperature_c"]  # the ambient / oil-inlet temperature takes the oil temperature's range
+
+THERMAL_FLAGS = {**SETPOINT_FLAGS, "oil_temperature_c": "--ambient"}
 
 
 def add_thermal_command(sub) -> None:
@@ -25,7 +31,12 @@ def add_thermal_command(sub) -> None:
     p.add_argument("--speed", type=float, required=True, help="shaft speed [rad/s]")
     p.add_argument("--radial-load", type=float, required=True, help="radial load [N]")
     p.add_argument("--axial-load", type=float, default=0.0, help="axial load [N] (default 0)")
-    p.add_argument("--ambient", type=float, default=20.0, help="ambient (oil bath) temperature [degC] (default 20)")
+    p.add_argument(
+        "--ambient",
+        type=float_in(OIL.low, OIL.high, OIL.unit),
+        default=20.0,
+        help="ambient (oil bath) temperature [degC] (default 20)",
+    )
     p.add_argument(
         "--lubricant", default=None, help="'seed-000' or 'ISO VG n' (default seed-000, or a spec file's own)"
     )
@@ -47,9 +58,6 @@ def _cmd_thermal(args: argparse.Namespace) -> int:
     from twin.thermal.settings import ThermalNetworkSettings
     from twin.validation.thermal_steady import steady_operating_point
 
-    if not -30.0 <= args.ambient <= 150.0:
-        print(f"error: ambient = {args.ambient!r}: must be in [-30, 150] degC", file=sys.stderr)
-        return 2
     try:
         spec = catalog.bearing_or_file(args.bearing)
         if args.lubricant is not None:
@@ -63,11 +71,8 @@ def _cmd_thermal(args: argparse.Namespace) -> int:
             ThermalNetworkSettings(dissipation=args.dissipation),
             spec=spec,
         )
-    except ValidationError as exc:
-        print(f"error: {error_text(exc)}", file=sys.stderr)
-        return 2
-    except (SetpointError, ValueError) as exc:
-        print(f"error: {exc}", file=sys.stderr)
+    except (ValidationError, SetpointError, ValueError) as exc:
+        print(f"error: {error_text(exc, THERMAL_FLAGS)}", file=sys.stderr)
         return 2
     if args.json:
         print(json.dumps(r, allow_nan=False))

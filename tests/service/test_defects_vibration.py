@@ -111,7 +111,7 @@ def test_bad_defects_are_refused_with_the_field_and_the_bearings_range(service):
     assert r.status_code == 422, r.text
     (err,) = r.json()["detail"]
     assert err["field"] == "defects[0].width_m" and err["allowed"] == [0.0, 0.05], err
-    assert "allowed range [0, 0.05] m" in err["message"], err
+    assert "allowed range (0, 0.05] m" in err["message"], err  # gt=0: the open side in parentheses
     r = http.put("/v1/bearings/vib/defects", json={"defects": [SPALL] * 9})
     assert r.status_code == 422 and _detail(r)[0][0] == "defects" and r.json()["detail"][0]["allowed"] == [0, 8]
     r = http.put("/v1/bearings/vib/defects", json={"defects": [{"kind": "crack", "width_m": 1e-3}]})

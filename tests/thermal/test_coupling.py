@@ -165,3 +165,27 @@ def test_the_block_is_made_again_exactly_when_the_network_changes():
         twin.advance(0.0005)
     measured = th.block()
     assert measured.measured_node == "outer_ring" and measured == th._make_block()
+
+
+def test_the_rate_of_rise_is_over_a_minute_from_the_start():
+    """`thermal.outer_ring_rate_k_per_min` is the rise over the last minute of thermal time; within
+    the first minute, the rise since the start over a minute (the bearing stood at its starting
+    temperature before it): a cold start's first seconds are not extrapolated into a runaway."""
+    twin = Twin(
+        "6208",
+        options=ACCELERATED,
+        setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0),
+    )
+    t0 = twin.snapshot().thermal.temperatures_c["outer_ring"]
+    twin.advance(0.01)  # 10 s of thermal time
+    early = twin.snapshot().thermal
+    rise = early.temperatures_c["outer_ring"] - t0
+    assert rise > 0.0
+    assert early.outer_ring_rate_k_per_min == pytest.approx(rise, rel=1e-6)  # [K per 60 s]
+    twin.advance(0.11)  # 120 s: a full minute behind, the rise over the last 60 s (+- one network step)
+    hist = twin.thermal._rate_history
+    late = twin.snapshot().thermal
+    assert hist[-1][0] - hist[0][0] >= 60.0
+    assert late.outer_ring_rate_k_per_min == pytest.approx(
+        60.0 * (hist[-1][1] - hist[0][1]) / (hist[-1][0] - hist[0][0]), rel=1e-9
+    )

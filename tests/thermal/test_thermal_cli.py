@@ -7,9 +7,12 @@ import pytest
 from service.cli import main
 
 
-def test_bad_ambient_names_the_field(capsys):
-    assert main(["thermal", "--speed", "1000", "--radial-load", "3000", "--ambient", "500"]) == 2
-    assert "ambient" in capsys.readouterr().err
+def test_bad_ambient_names_the_option_and_its_range(capsys):
+    # the ambient / oil-inlet range is the oil temperature's (twin.setpoint: [-30, 150] degC)
+    with pytest.raises(SystemExit) as exit_info:
+        main(["thermal", "--speed", "1000", "--radial-load", "3000", "--ambient", "500"])
+    assert exit_info.value.code == 2
+    assert "argument --ambient: must be in [-30, 150] degC, got 500" in capsys.readouterr().err
 
 
 @pytest.mark.slow

@@ -49,6 +49,7 @@ from twin.thermal.settings import ThermalNetworkSettings
 from twin.thermal.sources import HeatSources
 
 MEASURABLE_NODES = ("outer_ring", "housing", "oil")
+RATE_WINDOW_S = 60.0  # the outer ring's rate of rise is taken over this much network time [s]
 
 
 @dataclass(frozen=True)
@@ -84,7 +85,8 @@ class ThermalCoupling:
         self.since_step_s = 0.0
         self.pending: Measurement | None = None
         self.last_measurement: Measurement | None = None
-        self._rate_history: list[tuple[float, float]] = []
+        # (network time [s], outer ring [degC]) over the last RATE_WINDOW_S, from the start's temperature
+        self._rate_history: list[tuple[float, float]] = [(0.0, self.ambient_c)]
         self._time_constants: tuple[Network, float, np.ndarray] | None = None  # (network, s, tau) of the last call
         self._work_j = 0.0
         self._work_s = 0.0
@@ -97,11 +99,13 @@ class ThermalCoupling:
         return self.settings.heat_capacity_scale < 1.0
 
     def set_ambient(self, ambient_c: float) -> None:
-        """A new ambient / oil-inlet temperature [degC]: every node shifts by the change."""
+        """A new ambient / oil-inlet temperature [degC]: every node shifts by the change, and so
+        does the rate's history (the shift is the new reference, not a rise of the ring)."""
         shift = float(ambient_c) - self.ambient_c
         if shift != 0.0:
             self.filter.x[: len(NODE_NAMES)] += shift
             self.reference_c += shift
+            self._rate_history = [(t, c + shift) for t, c in self._rate_history]
             self.ambient_c = float(ambient_c)
 
     def measure(self, node: str, temperature_c: float, time_s: float) -> None:
@@ -166,12 +170,15 @@ class ThermalCoupling:
             )
         return memo[2].copy()
 
-    def rate_k_per_min(self, node: int = OUTER_RING) -> float:
-        """Rate of rise of a node over the last minute of network time [K/min] (0 before two steps)."""
+    def rate_k_per_min(self) -> float:
+        """Rise of the outer ring over the last minute of network time [K/min] (0 before two steps).
+        Within the first minute the bearing counts as having stood at its starting temperature
+        before the start (the rise since the start, over a minute): the first seconds of a warm-up
+        are not extrapolated to a minute, which would read as a runaway."""
         h = self._rate_history
         if len(h) < 2 or h[-1][0] <= h[0][0]:
             return 0.0
-        return 60.0 * (h[-1][1] - h[0][1]) / (h[-1][0] - h[0][0])
+        return 60.0 * (h[-1][1] - h[0][1]) / max(RATE_WINDOW_S, h[-1][0] - h[0][0])
 
     # ---- the step ---------------------------------------------------------------------------
     def add_work(self, drive_power_w: float, duration_s: float) -> None:
@@ -240,7 +247,7 @@ class ThermalCoupling:
             self.filter.update(NODE_NAMES.index(self.pending.node), self.pending.temperature_c)
             self.pending = None
         self._rate_history.append((self.network_time_s, float(self.temperature_c[OUTER_RING])))
-        while len(self._rate_history) > 2 and self._rate_history[-1][0] - self._rate_history[1][0] >= 60.0:
+        while len(self._rate_history) > 2 and self._rate_history[-1][0] - self._rate_history[1][0] >= RATE_WINDOW_S:
             self._rate_history.pop(0)
 
     def block(self) -> ThermalState:

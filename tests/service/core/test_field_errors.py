@@ -47,6 +47,17 @@ def test_a_twin_from_a_spec_names_the_spec_field_and_its_range():
     assert error.allowed == [-5e-05, 0.0002], error
 
 
+def test_open_bounds_read_in_parentheses():
+    """gt / lt exclude the bound: '(0, 0.05]' (twin.vibration.defects width_m: gt=0, le=0.05)."""
+    from service.core.errors import field_bounds, range_text
+    from twin.vibration.defects import OuterRaceSpall
+
+    bounds = field_bounds(OuterRaceSpall.model_fields["width_m"])
+    assert bounds == (0.0, 0.05) and bounds.low_open and not bounds.high_open
+    assert range_text(*bounds, bounds.low_open, bounds.high_open) == "(0, 0.05]"
+    assert range_text(None, 3) == "(-inf, 3]" and range_text(1, None) == "[1, inf)"
+
+
 def test_a_side_no_model_declares_reads_as_open_on_its_own_side():
     # a bound with no model to read the other side from (a measured temperature >= -60 degC): the
     # open side is -inf below and inf above, never -inf above
@@ -57,4 +68,4 @@ def test_a_side_no_model_declares_reads_as_open_on_its_own_side():
         Measured.model_validate({"temperature_c": -300.0})
     (error,) = field_errors(info.value.errors())
     assert error.allowed == [-60.0, None]
-    assert error.message.endswith("allowed range [-60, inf] degC"), error.message
+    assert error.message.endswith("allowed range [-60, inf) degC"), error.message

@@ -2,6 +2,7 @@
 numbers in scientific notation, a closed pipe and a busy zenoh port are handled cleanly."""
 
 import json
+import os
 import socket
 import subprocess
 import sys
@@ -36,13 +37,53 @@ def test_simulate_json_is_the_contract():
 
 
 def test_simulate_refuses_bad_input_by_name():
+    """The error names the option typed and the model's field, with the bearing's range (6208:
+    C0 = 21.86 kN is the radial limit, twin.setpoint; the clearance -50..200 um, twin.spec)."""
     res = _run("simulate", "--radial-load", "-10", "--duration", "0.001")
-    assert res.returncode == 2
-    assert "radial_load_n" in res.stderr and "Traceback" not in res.stderr
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert (
+        res.stderr.strip()
+        == "error: --radial-load: radial_load_n = -10 N is outside the allowed range [0, 21861.8] N for bearing 6208"
+    )
     res = _run("simulate", "--clearance", "0.01", "--duration", "0.001")
-    assert res.returncode == 2 and "diametral_clearance_m" in res.stderr
+    assert res.returncode == 2 and "--clearance: mounting.diametral_clearance_m" in res.stderr
+    assert "allowed range [-5e-05, 0.0002] m" in res.stderr
     res = _run("simulate", "--duration", "-1")
     assert res.returncode == 2 and "--duration" in res.stderr and "Traceback" not in res.stderr
+    res = _run("simulate", "--duration", "1e6")  # a typo would run for days: refused with the range
+    assert res.returncode == 2 and "argument --duration: must be in [0, 3600] s, got 1e6" in res.stderr
+
+
+def test_simulate_table_fits_80_columns_uncut():
+    """The table of a fast, loaded 6208 (spin above 1000 rad/s, regimes no_contact and full_film)
+    in an 80-column terminal: every value whole, no line longer than 80 characters."""
+    env = {**os.environ, "COLUMNS": "80"}
+    cmd = [sys.executable, "-m", "service.cli", "simulate", "--speed", "2000", "--radial-load", "20000"]
+    res = subprocess.run([*cmd, "--duration", "0.005"], capture_output=True, text=True, timeout=300, env=env)
+    assert res.returncode == 0, res.stderr
+    assert "\u2026" not in res.stdout and max(len(line) for line in res.stdout.splitlines()) <= 80, res.stdout
+    assert "no_contact" in res.stdout and "full_film" in res.stdout
+
+
+def test_other_commands_name_the_option_and_the_range():
+    """vibration, thermal and life: the option, the field and both sides of its range (twin.vibration.defects:
+    width_m in (0, 0.05] m; the accelerometer's noise density in [0, 1] m/s^2/sqrt(Hz), twin.vibration.housing)."""
+    vib = ("vibration", "--speed", "100", "--radial-load", "1000")
+    res = _run(*vib, "--defect", "outer", "--defect-size", "1")
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert res.stderr.strip().startswith("error: --defect-size: [0].outer.width_m: "), res.stderr
+    assert res.stderr.strip().endswith("allowed range (0, 0.05] m"), res.stderr
+    res = _run(*vib, "--noise-density", "1e9")
+    assert res.returncode == 2 and res.stderr.strip().endswith("allowed range [0, 1] m/s^2/sqrt(Hz)"), res.stderr
+    assert "--noise-density: " in res.stderr
+    res = _run(*vib, "--duration", "0")
+    assert res.returncode == 2 and "argument --duration: must be in (0, 600] s, got 0" in res.stderr
+    res = _run("thermal", "--speed", "100", "--radial-load", "1000", "--ambient", "900")
+    assert res.returncode == 2 and "argument --ambient: must be in [-30, 150] degC, got 900" in res.stderr
+    res = _run("thermal", "--speed", "1e5", "--radial-load", "1000")
+    assert res.returncode == 2 and "error: --speed: shaft_speed_rad_s = 100000 rad/s is outside" in res.stderr
+    res = _run("life", "--speed", "100", "--radial-load", "1000", "--oil-temperature", "900")
+    assert res.returncode == 2 and "error: --oil-temperature: oil_temperature_c = 900 degC" in res.stderr
 
 
 def test_report_quick(tmp_path):
