@@ -128,15 +128,16 @@ def _stats(values: np.ndarray, bounds: list[tuple[int, int]], band: tuple[int, .
     """Per window: the mean of every series, then the min and max of the series in `band`; NaN
     values are left out, and a window of NaN only stays NaN (fmin / fmax ignore NaN, and no
     warning is raised: this runs on the recorder's thread, where warnings filters are not safe)."""
+    starts = np.fromiter((a for a, _ in bounds), np.intp, len(bounds))  # contiguous, non-empty windows
     finite = ~np.isnan(values)
     zeroed = np.where(finite, values, 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
-        mean = np.array([zeroed[a:b].sum(axis=0) / finite[a:b].sum(axis=0) for a, b in bounds])
+        mean = np.add.reduceat(zeroed, starts, axis=0) / np.add.reduceat(finite, starts, axis=0)
     if not band:
         return mean
     sel = values[:, list(band)]
-    lo = np.array([np.fmin.reduce(sel[a:b], axis=0) for a, b in bounds])
-    hi = np.array([np.fmax.reduce(sel[a:b], axis=0) for a, b in bounds])
+    lo = np.fmin.reduceat(sel, starts, axis=0)
+    hi = np.fmax.reduceat(sel, starts, axis=0)
     return np.hstack([mean, lo, hi])
 
 
@@ -157,8 +158,10 @@ def trend_columns(tw: TwinLayout, windows: list[list], offset_s: float, bands: b
     for w in windows:
         bounds.append((a, a + len(w)))
         a += len(w)
-    w_t = np.array([int(np.round(t_ns[a:b].mean())) for a, b in bounds], dtype=np.int64)
-    w_seq = np.array([seq[b - 1] for _, b in bounds], dtype=np.int64)
+    starts = np.fromiter((a for a, _ in bounds), np.intp, len(bounds))
+    ends = np.fromiter((b for _, b in bounds), np.intp, len(bounds))
+    w_t = np.round(np.add.reduceat(t_ns, starts) / (ends - starts)).astype(np.int64)
+    w_seq = seq[ends - 1]
     out: list = []
     notes: list[tuple[int, str]] = []
     if CAPACITANCE_LEAF in values:
