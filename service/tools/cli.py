@@ -16,15 +16,15 @@ from pathlib import Path
 from service import __version__
 from service.tools.arg_types import float_in, positive_float
 from service.tools.bench_results import save as save_result
-from service.tools.messages import SETPOINT_FLAGS, error_text
+from service.tools.messages import OPERATING_FLAGS, error_text
 from service.tools.scenario_cli import add_scenario_command
 from service.tools.serve_cli import add_serve_command
 from service.tools.vibration_cli import add_analyse_command
 from twin.catalog import DEFAULT_DESIGNATION
 
-SIMULATE_FLAGS = {**SETPOINT_FLAGS, "time_step_s": "--dt", "film_formula": "--film-formula"}
+SIMULATE_FLAGS = {**OPERATING_FLAGS, "time_step_s": "--dt", "film_formula": "--film-formula"}
 VIBRATION_FLAGS = {
-    **SETPOINT_FLAGS,
+    **OPERATING_FLAGS,
     "width_m": "--defect-size",
     "length_m": "--defect-length",
     "depth_m": "--defect-depth",
@@ -138,7 +138,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     try:
         result = run_engine_benchmark(seconds=args.seconds, repeats=args.repeats)
     except ValueError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {error_text(exc, {'seconds': '--seconds', 'repeats': '--repeats'})}", file=sys.stderr)
         return 2
     print(json.dumps(result) if args.json else summary_text(result))
     if args.save is not None:
@@ -274,10 +274,10 @@ def build_parser() -> argparse.ArgumentParser:
         "bench", help="engine speed: real-time factor at the default step and at 1 us, further cases, per-pass timing"
     )
     bench.add_argument(
-        "--seconds", type=positive_float, default=0.2, help="simulated seconds per repeat [s] (default 0.2)"
+        "--seconds", type=positive_float, default=0.2, help="simulated seconds per repeat [s] (default 0.2, at most 60)"
     )
     bench.add_argument(
-        "--repeats", type=int, default=5, help="repeats, at least 5 (best and median reported) (default 5)"
+        "--repeats", type=int, default=5, help="repeats, 5 to 100 (best and median reported) (default 5)"
     )
     bench.add_argument("--json", action="store_true", help="print the result as JSON")
     bench.add_argument(

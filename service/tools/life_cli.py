@@ -7,7 +7,7 @@ import argparse
 import json
 import sys
 
-from service.tools.messages import SETPOINT_FLAGS, error_text
+from service.tools.messages import OPERATING_FLAGS, error_text
 from twin.catalog import DEFAULT_DESIGNATION
 
 _CONTAMINATION = (
@@ -80,7 +80,7 @@ def _cmd_life(args: argparse.Namespace) -> int:
             settings=LifeSettings(contamination=args.contamination),
         )
     except (ValidationError, SetpointError, ValueError) as exc:
-        print(f"error: {error_text(exc, SETPOINT_FLAGS)}", file=sys.stderr)
+        print(f"error: {error_text(exc, OPERATING_FLAGS)}", file=sys.stderr)
         return 2
     if args.json:
         print(json.dumps(result, allow_nan=False))

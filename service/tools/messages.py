@@ -24,8 +24,10 @@ MODEL_MODULES = (
     "twin.vibration.defects",
 )
 
-#: the options of the commands that take a setpoint, by the field they set (an error names both)
-SETPOINT_FLAGS = {
+#: the options of the commands that run a bearing at an operating point, by the field they set
+#: (an error names both)
+OPERATING_FLAGS = {
+    "designation": "--bearing",
     "shaft_speed_rad_s": "--speed",
     "radial_load_n": "--radial-load",
     "axial_load_n": "--axial-load",

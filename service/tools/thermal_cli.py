@@ -8,12 +8,12 @@ import json
 import sys
 
 from service.tools.arg_types import float_in
-from service.tools.messages import SETPOINT_FLAGS, error_text
+from service.tools.messages import OPERATING_FLAGS, error_text
 from twin.setpoint import FIELD
 
 OIL = FIELD["oil_temperature_c"]  # the ambient / oil-inlet temperature takes the oil temperature's range
 
-THERMAL_FLAGS = {**SETPOINT_FLAGS, "oil_temperature_c": "--ambient"}
+THERMAL_FLAGS = {**OPERATING_FLAGS, "oil_temperature_c": "--ambient"}
 
 
 def add_thermal_command(sub) -> None:

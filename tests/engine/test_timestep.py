@@ -208,4 +208,6 @@ def test_bench_json_keys_positive_and_finite():
             for passes in ("passes", "passes_ev"):
                 assert math.isfinite(r[passes][name][key]) and r[passes][name][key] > 0, (passes, name, key)
     res = _run_cli("bench", "--json", "--seconds", "0.01", "--repeats", "3")
-    assert res.returncode == 2 and "at least 5" in res.stderr
+    assert res.returncode == 2 and "error: --repeats: repeats = 3: must be in [5, 100]" in res.stderr
+    res = _run_cli("bench", "--json", "--seconds", "1e9")  # would run for years: refused with the range
+    assert res.returncode == 2 and "error: --seconds: seconds = 1000000000.0: must be in (0, 60] s" in res.stderr

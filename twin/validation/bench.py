@@ -51,6 +51,8 @@ from twin.validation.studies import EV_BEARING, EV_RADIAL_LOAD_N
 from twin.validation.vibration_simulation import defect_for
 
 MIN_REPEATS = 5
+MAX_REPEATS = 100
+MAX_SECONDS = 60.0  # simulated time per repeat and case, at most [s]
 
 
 @dataclass(frozen=True)
@@ -191,8 +193,10 @@ def run_engine_benchmark(
     seconds: float = 0.2, repeats: int = MIN_REPEATS, *, cases: bool = True, passes: bool = True
 ) -> dict:
     """The benchmark (module docstring). `cases` / `passes`: include those parts."""
-    if repeats < MIN_REPEATS:
-        raise ValueError(f"repeats = {repeats}: at least {MIN_REPEATS}")
+    if not MIN_REPEATS <= repeats <= MAX_REPEATS:
+        raise ValueError(f"repeats = {repeats}: must be in [{MIN_REPEATS}, {MAX_REPEATS}]")
+    if not (math.isfinite(seconds) and 0.0 < seconds <= MAX_SECONDS):
+        raise ValueError(f"seconds = {seconds!r}: must be in (0, {MAX_SECONDS:g}] s of simulated time per repeat")
     load_before = os.getloadavg()
     auto = measure(SERVE_DEFAULT, "auto", seconds, repeats)
     one = measure(SERVE_DEFAULT, 1e-6, seconds, repeats)

@@ -50,6 +50,8 @@ def test_simulate_refuses_bad_input_by_name():
     assert "allowed range [-5e-05, 0.0002] m" in res.stderr
     res = _run("simulate", "--duration", "-1")
     assert res.returncode == 2 and "--duration" in res.stderr and "Traceback" not in res.stderr
+    res = _run("simulate", "--bearing", "nosuch", "--duration", "0.001")
+    assert res.returncode == 2 and res.stderr.startswith("error: --bearing: designation: unknown bearing 'nosuch'")
     res = _run("simulate", "--duration", "1e6")  # a typo would run for days: refused with the range
     assert res.returncode == 2 and "argument --duration: must be in [0, 3600] s, got 1e6" in res.stderr
 
