@@ -300,7 +300,8 @@ class ThermalState(BaseModel):
         description="Change of the diametral clearance by thermal expansion (< 0: closes) [m]."
     )
     outer_ring_rate_k_per_min: float = Field(
-        description="Rate of rise of the outer ring over the last minute of thermal time [K/min]."
+        description="Rise of the outer ring over the last minute of thermal time (within the first minute: the "
+        "rise since the start, over a minute) [K/min]."
     )
     dissipation_factor: float = Field(
         description="Estimated factor on the dissipation to the surroundings [-] (1: the correlations)."
