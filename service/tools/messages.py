@@ -24,10 +24,28 @@ MODEL_MODULES = (
     "twin.vibration.defects",
 )
 
+#: the parts of a bearing spec (twin.spec.BearingSpec's fields but its designation; named here, as
+#: twin.spec loads numba): an error in one is in the `--bearing` file
+SPEC_PARTS = (
+    "kind",
+    "geometry",
+    "material",
+    "surface",
+    "lubricant",
+    "mounting",
+    "electrical",
+    "thermal",
+    "limiting_speed_rad_s",
+    "lubrication",
+    "housing",
+    "surface_profile",
+)
+
 #: the options of the commands that run a bearing at an operating point, by the field they set
 #: (an error names both)
 OPERATING_FLAGS = {
     "designation": "--bearing",
+    **{part: "--bearing" for part in SPEC_PARTS},
     "shaft_speed_rad_s": "--speed",
     "radial_load_n": "--radial-load",
     "axial_load_n": "--axial-load",
@@ -79,7 +97,9 @@ _LEADING_FIELD = re.compile(r"^([a-z_][a-z0-9_.]*)(?::| =)")
 
 
 def _with_flag(field: str | None, text: str, flags: Mapping[str, str] | None) -> str:
+    """`text` led by the option of `field`: the one of its name (the last part of its path), else
+    the one of its root (a part of the bearing spec file given with `--bearing`)."""
     if not flags or not field:
         return text
-    flag = flags.get(field.rsplit(".", 1)[-1])
+    flag = flags.get(field.rsplit(".", 1)[-1]) or flags.get(field.split(".", 1)[0])
     return f"{flag}: {text}" if flag else text

@@ -67,6 +67,24 @@ def test_simulate_table_fits_80_columns_uncut():
     assert "no_contact" in res.stdout and "full_film" in res.stdout
 
 
+def test_a_spec_file_error_is_named_as_the_bearing_option(tmp_path):
+    """A field of a `--bearing` spec file is led by `--bearing` (twin.spec.Geometry: 3 to 16 balls)."""
+    from service.tools.messages import SPEC_PARTS
+    from twin import catalog
+    from twin.spec import BearingSpec
+
+    assert set(SPEC_PARTS) == set(BearingSpec.model_fields) - {"designation"}
+    spec = catalog.bearing("6208").model_dump(mode="json")
+    spec["geometry"]["ball_count"] = 99
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(spec))
+    res = _run("simulate", "--bearing", str(path), "--duration", "0.001")
+    assert res.returncode == 2
+    assert res.stderr.strip() == (
+        "error: --bearing: geometry.ball_count: Input should be less than or equal to 16; allowed range [3, 16]"
+    )
+
+
 def test_other_commands_name_the_option_and_the_range():
     """vibration, thermal and life: the option, the field and both sides of its range (twin.vibration.defects:
     width_m in (0, 0.05] m; the accelerometer's noise density in [0, 1] m/s^2/sqrt(Hz), twin.vibration.housing)."""
