@@ -124,11 +124,11 @@ def _scalars(v: np.ndarray) -> rr.ComponentColumnList:
     return rr.Scalars.columns(scalars=v.reshape(-1)).partition(np.full(n, k))
 
 
-def _stats(values: np.ndarray, bounds: list[tuple[int, int]], band: tuple[int, ...]) -> np.ndarray:
-    """Per window: the mean of every series, then the min and max of the series in `band`; NaN
-    values are left out, and a window of NaN only stays NaN (fmin / fmax ignore NaN, and no
-    warning is raised: this runs on the recorder's thread, where warnings filters are not safe)."""
-    starts = np.fromiter((a for a, _ in bounds), np.intp, len(bounds))  # contiguous, non-empty windows
+def _stats(values: np.ndarray, starts: np.ndarray, band: tuple[int, ...]) -> np.ndarray:
+    """Per window (the contiguous, non-empty row ranges beginning at `starts`): the mean of every
+    series, then the min and max of the series in `band`; NaN values are left out, and a window of
+    NaN only stays NaN (fmin / fmax ignore NaN, and no warning is raised: this runs on the
+    recorder's thread, where warnings filters are not safe)."""
     finite = ~np.isnan(values)
     zeroed = np.where(finite, values, 0.0)
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -154,13 +154,10 @@ def trend_columns(tw: TwinLayout, windows: list[list], offset_s: float, bands: b
     n = len(rows)
     t_ns = np.round((np.fromiter((r.time_s for r in rows), np.float64, n) + offset_s) * 1e9).astype(np.int64)
     seq = np.fromiter((r.seq for r in rows), np.int64, n)
-    bounds, a = [], 0
-    for w in windows:
-        bounds.append((a, a + len(w)))
-        a += len(w)
-    starts = np.fromiter((a for a, _ in bounds), np.intp, len(bounds))
-    ends = np.fromiter((b for _, b in bounds), np.intp, len(bounds))
-    w_t = np.round(np.add.reduceat(t_ns, starts) / (ends - starts)).astype(np.int64)
+    sizes = np.fromiter((len(w) for w in windows), np.intp, len(windows))  # none empty (split_windows)
+    ends = np.cumsum(sizes)
+    starts = ends - sizes
+    w_t = np.round(np.add.reduceat(t_ns, starts) / sizes).astype(np.int64)
     w_seq = seq[ends - 1]
     out: list = []
     notes: list[tuple[int, str]] = []
@@ -170,7 +167,7 @@ def trend_columns(tw: TwinLayout, windows: list[list], offset_s: float, bands: b
     root = tw.root
     for leaf, v in values.items():
         band = TREND_BANDS.get(leaf, ()) if bands else ()
-        out.append((f"{root}/{leaf}", _index(w_t, w_seq), _scalars(_stats(v, bounds, band))))
+        out.append((f"{root}/{leaf}", _index(w_t, w_seq), _scalars(_stats(v, starts, band))))
     changed = _changes(tw, rows)
     if changed:
         sel = np.array(changed)
