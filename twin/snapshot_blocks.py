@@ -55,8 +55,6 @@ BALL_FIELDS: Final = (
 )
 """Columns of `BallArrays.balls`, in the contract's order of `BallState`."""
 B_AZIMUTH, B_SPIN, B_ORBITAL, B_CAGE, B_R, B_C = range(len(BALL_FIELDS))
-_NULLABLE_CONTACT: Final = (K_H_MIN, K_H_C, K_LAMBDA, K_R)  # NaN in these columns is null on the wire
-_NULLABLE_BALL: Final = (B_R,)
 
 _FLOATS = TypeAdapter(list[float])  # NaN and inf serialise as null (pydantic's default)
 
@@ -151,8 +149,6 @@ def ball_arrays(model: BearingModel, state: TwinState, net: ElectricalNetwork, e
     regimes = np.empty(2 * z, dtype=np.int8)
     scale = model.options.tangential_stiffness_ratio * 1.5 if effective_mu else 0.0
     capture_contacts(s.contacts, scale, out, regimes)
-    out[:, K_R] = net.contact_resistance_ohm
-    out[:, K_C] = net.contact_capacitance_f
     balls = np.empty((z, len(BALL_FIELDS)))
     balls[:, B_AZIMUTH] = ball_azimuths_rad(s)
     capture_balls(
@@ -162,25 +158,56 @@ def ball_arrays(model: BearingModel, state: TwinState, net: ElectricalNetwork, e
         s.cage_load_n,
         balls,
     )
-    balls[:, B_R] = net.ball_resistance_ohm
-    balls[:, B_C] = net.ball_capacitance_f
-    # null where the contract allows it (inf resistance: open circuit), an error elsewhere
-    for k in _NULLABLE_CONTACT:
-        col = out[:, k]
-        col[~np.isfinite(col)] = np.nan
-    col = balls[:, B_R]
-    col[~np.isfinite(col)] = np.nan
-    _check_finite(out, CONTACT_FIELDS, _NULLABLE_CONTACT, "contact")
-    _check_finite(balls, BALL_FIELDS, _NULLABLE_BALL, "ball")
+    bad = attach_network(
+        out,
+        balls,
+        net.contact_resistance_ohm,
+        net.contact_capacitance_f,
+        net.ball_resistance_ohm,
+        net.ball_capacitance_f,
+    )
+    if bad >= 0:
+        _raise_not_finite(out, balls, bad)
     return BallArrays(out, regimes, balls)
 
 
-def _check_finite(values: np.ndarray, names: tuple[str, ...], nullable: tuple[int, ...], what: str) -> None:
-    finite = np.isfinite(values)
-    finite[:, list(nullable)] = True
-    if not finite.all():
-        row, col = (int(i) for i in np.argwhere(~finite)[0])
-        raise ValueError(f"snapshot: {what} {row} {names[col]} = {values[row, col]!r} is not finite")
+@njit(**JIT)
+def attach_network(out, balls, r_contact, c_contact, r_ball, c_ball):
+    """Write the network's series R and C into the contacts' (`out`) and the balls' (`balls`)
+    columns, null (NaN) every non-finite value of a nullable column (an open circuit's infinite
+    resistance, an unloaded contact's film: the contacts' h_min, h_c, Lambda and R, the balls'
+    R), and return the flat index of the first non-finite value of a column that may not be null:
+    contacts first (row-major), then the balls offset by out.size; -1 when every such value is
+    finite."""
+    for k in range(out.shape[0]):
+        out[k, K_R] = r_contact[k]
+        out[k, K_C] = c_contact[k]
+    for j in range(balls.shape[0]):
+        balls[j, B_R] = r_ball[j]
+        balls[j, B_C] = c_ball[j]
+    first = -1
+    for k in range(out.shape[0]):
+        for i in range(out.shape[1]):
+            if not math.isfinite(out[k, i]):
+                if i == K_H_MIN or i == K_H_C or i == K_LAMBDA or i == K_R:
+                    out[k, i] = np.nan
+                elif first < 0:
+                    first = k * out.shape[1] + i
+    for j in range(balls.shape[0]):
+        for i in range(balls.shape[1]):
+            if not math.isfinite(balls[j, i]):
+                if i == B_R:
+                    balls[j, i] = np.nan
+                elif first < 0:
+                    first = out.size + j * balls.shape[1] + i
+    return first
+
+
+def _raise_not_finite(out: np.ndarray, balls: np.ndarray, flat: int) -> None:
+    """The ValueError naming the value `attach_network` found not finite (its flat index)."""
+    values, names, what = (out, CONTACT_FIELDS, "contact") if flat < out.size else (balls, BALL_FIELDS, "ball")
+    row, col = divmod(flat if flat < out.size else flat - out.size, values.shape[1])
+    raise ValueError(f"snapshot: {what} {row} {names[col]} = {values[row, col]!r} is not finite")
 
 
 def _value(v: float) -> float | None:

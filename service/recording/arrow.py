@@ -18,18 +18,35 @@ class ArrowColumn:
         return self.array
 
 
-_TENSOR_TYPE = None
+class _TensorLayout:
+    """The arrow pieces of rerun's TensorData that do not depend on the values, made once: the
+    struct's fields, the buffer union's type with its F32 member, and an empty array for every
+    other member of the union (arrow arrays are immutable, so one set serves every call)."""
+
+    def __init__(self) -> None:
+        tensor_type = (
+            rr.components.TensorDataBatch(rr.encodings.TensorData(array=np.zeros(1, np.float32))).as_arrow_array().type
+        )
+        self.shape_field, self.names_field, self.buffer_field = tensor_type[0], tensor_type[1], tensor_type[2]
+        union = self.buffer_field.type
+        self.union = union
+        self.f32_member = next(i for i in range(union.num_fields) if union.field(i).name == "F32")
+        self.f32_code = union.type_codes[self.f32_member]
+        self.f32_type = union.field(self.f32_member).type
+        self.empty_members = [pa.array([], type=union.field(i).type) for i in range(union.num_fields)]
+
+
+_LAYOUT: _TensorLayout | None = None
 
 
 def tensor_rows(values) -> pa.Array:
     """One rerun TensorData (1-D, float32) per row of `values` (n, k), or per array of a list of
     1-D arrays (rows of different lengths), built as one arrow array (rerun's own
     `BarChart.columns` takes one tensor for all rows)."""
-    global _TENSOR_TYPE
-    if _TENSOR_TYPE is None:
-        _TENSOR_TYPE = (
-            rr.components.TensorDataBatch(rr.encodings.TensorData(array=np.zeros(1, np.float32))).as_arrow_array().type
-        )
+    global _LAYOUT
+    layout = _LAYOUT
+    if layout is None:
+        layout = _LAYOUT = _TensorLayout()
     if isinstance(values, np.ndarray):
         values = np.ascontiguousarray(values, dtype=np.float32)
         n, k = values.shape
@@ -40,32 +57,26 @@ def tensor_rows(values) -> pa.Array:
         values = np.concatenate([np.asarray(v, dtype=np.float32) for v in values]) if n else np.zeros(0, np.float32)
     offsets = np.zeros(n + 1, dtype=np.int32)
     np.cumsum(sizes, out=offsets[1:])
-    f_shape, f_names, f_buffer = _TENSOR_TYPE[0], _TENSOR_TYPE[1], _TENSOR_TYPE[2]
     shape = pa.ListArray.from_arrays(
-        pa.array(np.arange(n + 1, dtype=np.int32)), pa.array(sizes.astype(np.uint64)), type=f_shape.type
+        pa.array(np.arange(n + 1, dtype=np.int32)), pa.array(sizes.astype(np.uint64)), type=layout.shape_field.type
     )
-    utype = f_buffer.type
-    children = []
-    code = None
-    for i in range(utype.num_fields):
-        ft = utype.field(i)
-        if ft.name == "F32":
-            code = utype.type_codes[i]
-            children.append(pa.ListArray.from_arrays(pa.array(offsets), pa.array(values.reshape(-1)), type=ft.type))
-        else:
-            children.append(pa.array([], type=ft.type))
+    children = list(layout.empty_members)
+    children[layout.f32_member] = pa.ListArray.from_arrays(
+        pa.array(offsets), pa.array(values.reshape(-1)), type=layout.f32_type
+    )
     buffer = pa.Array.from_buffers(
-        utype,
+        layout.union,
         n,
         [
             None,
-            pa.py_buffer(np.full(n, code, dtype=np.int8).tobytes()),
+            pa.py_buffer(np.full(n, layout.f32_code, dtype=np.int8).tobytes()),
             pa.py_buffer(np.arange(n, dtype=np.int32).tobytes()),
         ],
         children=children,
     )
     return pa.StructArray.from_arrays(
-        [shape, pa.nulls(n, type=f_names.type), buffer], fields=[f_shape, f_names, f_buffer]
+        [shape, pa.nulls(n, type=layout.names_field.type), buffer],
+        fields=[layout.shape_field, layout.names_field, layout.buffer_field],
     )
 
 

@@ -4,6 +4,7 @@ the lanes' values, and a value the contract forbids to be null is refused by nam
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
@@ -14,8 +15,11 @@ from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.snapshot import Snapshot
 from twin.snapshot_blocks import (
+    B_R,
     CONTACT_FIELDS,
+    K_C,
     K_MU,
+    K_R,
     ball_arrays,
     ball_json_items,
     ball_states,
@@ -81,6 +85,34 @@ def test_a_value_that_may_not_be_null_is_refused_by_name(twin):
     state.contacts[L.C_ENTRAINMENT, int(np.argmax(state.contacts[L.C_LOAD]))] = np.nan
     with pytest.raises(ValueError, match="entrainment_speed_m_s"):
         ball_arrays(twin.model, state, twin.electrical(), twin._effective_mu)
+
+
+def test_a_ball_value_that_may_not_be_null_is_refused_by_ball_and_name(twin):
+    state = twin.state.copy()
+    state.cage_load_n[4, :] = np.inf
+    with pytest.raises(ValueError, match=r"ball 4 cage_load_n = .*inf"):
+        ball_arrays(twin.model, state, twin.electrical(), twin._effective_mu)
+
+
+def test_an_open_circuit_is_null_and_a_closed_one_its_value(twin):
+    """The contract: an infinite resistance (no conduction path) is published as null, never as
+    a number; the capacitance beside it stays."""
+    net = twin.electrical()
+    r_contact = net.contact_resistance_ohm.copy()
+    r_contact[3] = np.inf
+    r_ball = net.ball_resistance_ohm.copy()
+    r_ball[1] = np.inf
+    open_net = dataclasses.replace(net, contact_resistance_ohm=r_contact, ball_resistance_ohm=r_ball)
+    arrays = ball_arrays(twin.model, twin.state, open_net, twin._effective_mu)
+    assert np.isnan(arrays.contacts[3, K_R]) and np.isnan(arrays.balls[1, B_R])
+    assert arrays.contacts[3, K_C] == net.contact_capacitance_f[3]
+    others = np.delete(np.arange(r_contact.size), 3)
+    np.testing.assert_array_equal(
+        arrays.contacts[others, K_R], np.where(np.isfinite(r_contact[others]), r_contact[others], np.nan)
+    )
+    tree = ball_states(arrays)
+    assert tree[1].resistance_ohm is None and tree[1].outer.resistance_ohm is None
+    assert tree[1].outer.capacitance_f == net.contact_capacitance_f[3]
 
 
 def test_head_attributes_read_alike_and_as_snapshot(twin):
