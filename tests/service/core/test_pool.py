@@ -385,6 +385,78 @@ def test_wake_releases_a_job_waiting_for_its_release():
         assert pool.close(timeout=10.0)
 
 
+class PacedJob:
+    """Real time: a frame every `period_s` from its first, `frames` of them, then it leaves; notes
+    how late each frame started after its release."""
+
+    def __init__(self, name, period_s, frames):
+        self.name, self.period_s, self.frames = name, period_s, frames
+        self.steps = 0
+        self.t0: float | None = None
+        self.lateness: list[float] = []
+        self.left = threading.Event()
+
+    def step(self, now):
+        if self.t0 is None:
+            self.t0 = now
+        self.lateness.append(now - (self.t0 + self.steps * self.period_s))
+        self.steps += 1
+        if self.steps >= self.frames:
+            return None
+        release = self.t0 + self.steps * self.period_s
+        return Schedule(release, release + self.period_s)
+
+    def left_pool(self):
+        self.left.set()
+
+
+class CountingCondition(threading.Condition):
+    """A condition that counts the returns from `wait` (a stepping thread's wake-ups)."""
+
+    def __init__(self):
+        super().__init__()
+        self.wakeups = 0
+
+    def wait(self, timeout=None):
+        try:
+            return super().wait(timeout)
+        finally:
+            self.wakeups += 1
+
+
+def test_idle_stepping_threads_sleep_while_one_job_is_paced():
+    # One free thread at a time times the next release: with one twin the other stepping threads
+    # sleep (each wake-up of an idle thread costs about 0.1 ms of CPU on the 2-core VMs). When every
+    # free thread timed it, three threads woke at every frame.
+    pool = SteppingPool(3, name="t-idle")
+    cond = pool._cond = CountingCondition()
+    job = PacedJob("paced", 0.005, 40)
+    try:
+        pool.add(job)
+        assert job.left.wait(WAIT_S)
+        assert job.steps == 40
+        assert cond.wakeups <= 40 + 10  # one per frame, and the start
+    finally:
+        assert pool.close(timeout=10.0)
+
+
+def test_a_paced_job_stays_timed_when_the_job_timed_before_it_leaves():
+    # The fast job's frames come first, so its release is the one a free thread times; the slow
+    # job's frames are timed once the fast one has left (else it would wait for a wake-up that never
+    # comes), and every job runs every frame, none before its release.
+    pool = SteppingPool(2, name="t-handover")
+    jobs = [PacedJob("fast", 0.002, 15), PacedJob("mid", 0.007, 10), PacedJob("slow", 0.03, 8)]
+    try:
+        for j in jobs:
+            pool.add(j)
+        for j in jobs:
+            assert j.left.wait(WAIT_S), j.name
+            assert j.steps == j.frames
+            assert min(j.lateness) >= -1e-3  # never started before its release (timer resolution)
+    finally:
+        assert pool.close(timeout=10.0)
+
+
 # ---- capacity: the rule ----------------------------------------------------------------------------
 def test_cpu_meter_reports_the_last_closed_window():
     m = CpuMeter(window=1.0)
