@@ -36,7 +36,9 @@ not all wake at every frame: one free thread at a time waits with a timeout, for
 release (`_timer`), the others until they are notified (with one twin and two stepping threads,
 the idle one sleeps until a second job arrives; two timed waiters for one release cost two
 wake-ups per frame, about 0.1 ms of CPU each on the 2-core VMs). A thread whose put-back job is
-released before the timed release times it as well. `add`, `wake` and `close` wake every thread.
+released before the timed release times it as well. `add` and `wake` wake one free thread (it
+takes the released job, or times the next release; the thread it takes a job from hands the
+timing on as above); `close` wakes every thread.
 
 The queue is plain data (no threads, no clock): the tests drive it with a fake clock.
 """
@@ -277,7 +279,7 @@ class SteppingPool:
                 raise RuntimeError("the stepping pool is closed")
             at = self.clock() if release is None else release
             self._queue.put(job, Schedule(at, at))
-            self._cond.notify_all()
+            self._cond.notify()  # one free thread takes it or times it
         return job
 
     def wake(self, job: Job | None, *, urgent: bool = False) -> None:
@@ -293,7 +295,7 @@ class SteppingPool:
                 if urgent:
                     job.wake_deadline = min(job.wake_deadline, now)
             elif self._queue.wake(job, now, now if urgent else math.inf):
-                self._cond.notify_all()
+                self._cond.notify()  # one free thread takes it
 
     def close(self, timeout: float = 5.0) -> bool:
         """Stop the stepping threads (jobs still in the pool are dropped without `left_pool`;

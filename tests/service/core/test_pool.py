@@ -440,6 +440,32 @@ def test_idle_stepping_threads_sleep_while_one_job_is_paced():
         assert pool.close(timeout=10.0)
 
 
+def test_a_setpoint_wakes_one_stepping_thread():
+    # An urgent wake (an outside setpoint) releases the job at once; one free thread takes it, the
+    # others sleep on. When every free thread was woken, each setpoint cost two more wake-ups.
+    pool = SteppingPool(3, name="t-wake-one")
+    cond = pool._cond = CountingCondition()
+    job = SleepyJob()
+    try:
+        handle = pool.add(job)
+        assert job.stepped.wait(WAIT_S)
+        woken = 0
+        for _ in range(20):
+            deadline = time.monotonic() + WAIT_S
+            while handle.state != "waiting" and time.monotonic() < deadline:
+                time.sleep(0.001)
+            job.stepped.clear()
+            before = cond.wakeups
+            pool.wake(handle, urgent=True)
+            assert job.stepped.wait(WAIT_S)
+            time.sleep(0.002)  # any other thread woken by it has returned from its wait by now
+            woken += cond.wakeups - before
+        assert job.steps == 21
+        assert woken <= 20 + 4
+    finally:
+        assert pool.close(timeout=10.0)
+
+
 def test_a_paced_job_stays_timed_when_the_job_timed_before_it_leaves():
     # The fast job's frames come first, so its release is the one a free thread times; the slow
     # job's frames are timed once the fast one has left (else it would wait for a wake-up that never
