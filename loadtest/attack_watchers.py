@@ -2,8 +2,10 @@
 
 * `squat`: an anonymous zenoh peer (no credentials) declares P/{id}/alive and answers P/{id}/owner
   with forged text for fresh ids; the attacker then creates each id over HTTP with the token and
-  deletes it again. Counted: `created` (201), `blocked` (409: a claim zenoh did not authenticate
-  blocked a create), `echoed` (an answer repeated the forged text). With zenoh access control on
+  deletes it again. Counted: `created` (201), `refused_capacity` (503 naming the host's
+  capacity: the admission, not the claim, refused it; a slow host under the floods has no room
+  for a second twin), `blocked` (409: a claim zenoh did not authenticate blocked a create),
+  `echoed` (an answer repeated the forged text), any other answer by status in `other`. With zenoh access control on
   the peer cannot even open a link; with only the token set the service does not trust it.
 * `opcua_logins`: password guesses on a secure OPC UA endpoint (a client certificate made here,
   Basic256Sha256 SignAndEncrypt), as fast as the server answers: `tried`, `refused`, `accepted`
@@ -127,6 +129,8 @@ def squat(spec: dict, go) -> dict:
                     if r.status_code == 201
                     else "blocked"
                     if r.status_code == 409
+                    else "refused_capacity"
+                    if r.status_code == 503 and "capacity" in r.text
                     else f"status_{r.status_code}"
                 ] += 1
                 counts["echoed"] += FORGED_HOST in r.text
@@ -142,7 +146,7 @@ def squat(spec: dict, go) -> dict:
         "mode": "squat",
         "seconds": round(time.monotonic() - t0, 2),
         "peer_linked": session is not None,
-        **{k: counts.get(k, 0) for k in ("attempts", "created", "blocked", "echoed")},
+        **{k: counts.get(k, 0) for k in ("attempts", "created", "refused_capacity", "blocked", "echoed")},
         "other": {k: v for k, v in counts.items() if k.startswith("status_")},
     }
 
@@ -336,7 +340,9 @@ def summary_lines(r: dict) -> list[str]:
     if sq and not sq.get("crashed"):
         lines.append(
             f"  squat: {sq['attempts']} ids claimed by an anonymous peer (linked: {sq['peer_linked']}), "
-            f"created {sq['created']}, blocked {sq['blocked']}, text echoed {sq['echoed']}"
+            f"created {sq['created']}, refused for the host's capacity {sq['refused_capacity']}, "
+            f"blocked {sq['blocked']}, text echoed {sq['echoed']}"
+            + (f", other answers {sq['other']}" if sq["other"] else "")
         )
     lg = r.get("opcua_logins")
     if lg and not lg.get("crashed"):

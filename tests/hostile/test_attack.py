@@ -47,7 +47,10 @@ def test_attack_short_run_with_its_own_service():
     # zenoh access control) blocks no create and no answer repeats it; no guessed password opens a
     # session; sessions, subscriptions and items stay within the default limits (service.opcua.guard)
     sq, logins, sessions, subs = (r[k] for k in ("squat", "opcua_logins", "opcua_sessions", "opcua_subscriptions"))
-    assert sq["attempts"] >= 1 and sq["created"] == sq["attempts"] and sq["blocked"] == sq["echoed"] == 0
+    # every create is admitted, or refused for the host's measured capacity (a slow host under the
+    # floods has no room for a second twin): the admission decides, never the squatter's claim
+    assert sq["attempts"] >= 1 and sq["created"] + sq["refused_capacity"] == sq["attempts"] and not sq["other"]
+    assert sq["blocked"] == sq["echoed"] == 0
     assert logins["tried"] >= 1 and logins["accepted"] == 0
     assert 1 <= sessions["opened"] <= 16
     assert subs["subscriptions"] == 8 and subs["refused"]["BadTooManySubscriptions"] == 42
