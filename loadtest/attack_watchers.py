@@ -2,11 +2,13 @@
 
 * `squat`: an anonymous zenoh peer (no credentials) declares P/{id}/alive and answers P/{id}/owner
   with forged text for fresh ids; the attacker then creates each id over HTTP with the token and
-  deletes it again. Counted: `created` (201), `refused_capacity` (503 naming the host's
-  capacity: the admission, not the claim, refused it; a slow host under the floods has no room
+  deletes it again. Counted: `created` (201), `refused_capacity` (503 from the admission by
+  measured capacity, either of its verdicts: no capacity left, or a twin costlier than a core's
+  share; the admission, not the claim, refused it, and a slow host under the floods has no room
   for a second twin), `blocked` (409: a claim zenoh did not authenticate blocked a create),
-  `echoed` (an answer repeated the forged text), any other answer by status in `other`. With zenoh access control on
-  the peer cannot even open a link; with only the token set the service does not trust it.
+  `echoed` (an answer repeated the forged text), any other answer by status in `other`. With
+  zenoh access control on the peer cannot even open a link; with only the token set the service
+  does not trust it.
 * `opcua_logins`: password guesses on a secure OPC UA endpoint (a client certificate made here,
   Basic256Sha256 SignAndEncrypt), as fast as the server answers: `tried`, `refused`, `accepted`
   (a guess that opened a session: never).
@@ -32,6 +34,9 @@ from service.keys import DEFAULT_PREFIX
 from service.settings import ZenohAccessSettings
 
 FORGED_HOST = "evil-squatter"  # the forged owner text; never to be found in an answer
+# how the registry words both verdicts of a refused admission ("... refused: this host has no
+# capacity left ..." / "... refused: this host cannot run the twin in real time ...")
+ADMISSION_REFUSAL = "refused: this host"
 WATCHERS = ("squat", "opcua_logins", "opcua_sessions", "opcua_subscriptions")
 
 
@@ -130,7 +135,7 @@ def squat(spec: dict, go) -> dict:
                     else "blocked"
                     if r.status_code == 409
                     else "refused_capacity"
-                    if r.status_code == 503 and "capacity" in r.text
+                    if r.status_code == 503 and ADMISSION_REFUSAL in r.text
                     else f"status_{r.status_code}"
                 ] += 1
                 counts["echoed"] += FORGED_HOST in r.text

@@ -15,6 +15,7 @@ import time
 
 import pytest
 
+from loadtest.attack_watchers import ADMISSION_REFUSAL
 from service.core.capacity import OVERHEAD_GOAL, Capacity, CpuMeter, ServiceOverheadMeter, TwinCost, calibrate
 from service.core.errors import InputError
 from service.core.pacing import PacingClock
@@ -613,11 +614,13 @@ def test_registry_refuses_a_twin_beyond_the_measured_capacity(monkeypatch):
         assert exc.value.status_code == 503
         err = exc.value.errors[0]
         assert "refused" in err.message and "cannot run the twin in real time" in err.message
+        assert ADMISSION_REFUSAL in err.message  # the attack counts it as the admission's refusal
         assert "0.950" in err.message and "0.850" in err.message
         assert [e.id for e in reg.entries()] == ["a", "b"]
         with pytest.raises(InputError) as exc:  # 1.3 + 0.65 > 1.7
             reg.create_twin(id="d", designation="6205")
         assert exc.value.status_code == 503 and "no capacity left" in exc.value.errors[0].message
+        assert ADMISSION_REFUSAL in exc.value.errors[0].message
         cap = reg.health()["capacity"]
         assert cap["admission"] == "measured" and cap["budget_cpu_s_per_s"] == pytest.approx(1.7)
         assert cap["used_cpu_s_per_s"] == pytest.approx(1.3)
