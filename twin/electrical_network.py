@@ -84,8 +84,7 @@ def contact_impedances(
     C_ball = C_in C_out / (C_in + C_out) (0 when both are 0).
 
     Returns (r_contact [ohm], c_contact [F], z_contact [ohm], r_ball [ohm], c_ball [F],
-    z_ball [ohm], y_ball [S]); z and y complex. Their moduli are numpy's (`np.abs`, whose
-    rounding depends on the host's vector instructions), taken by the caller."""
+    z_ball [ohm], y_ball [S]); z and y complex."""
     n = contacts.shape[1]
     z = n // 2
     r_c = np.empty(n)
@@ -166,36 +165,80 @@ def film_stress_maxima(
     return max_field, max_density
 
 
+@njit(**JIT_VECTOR)
+def network_solution(
+    contacts,
+    omega_rad_s,
+    relative_permittivity,
+    race_params,
+    gap_limit_inner_m,
+    gap_limit_outer_m,
+    rest_capacitance_f,
+    shaft_voltage_v,
+    shaft_current_a,
+):  # pragma: no cover - compiled
+    """The whole network at angular frequency `omega_rad_s` in one pass: the elements of
+    `contact_impedances`, the bearing's admittance Y = sum Y_ball + i omega C_rest, the drive (a
+    voltage setpoint wins, with the current it drives through |Z| = 1 / |Y| unless one is set; a
+    current alone develops I |Z|) and `film_stress_maxima` at that drive.
+
+    Returns (r_contact [ohm], c_contact [F], r_ball [ohm], c_ball [F], Re Y [S], Im Y [S],
+    voltage [V], current [A], largest film field [V/m], largest current density [A/m^2])."""
+    r_c, c_c, z_c, r_ball, c_ball, z_ball, y_ball = contact_impedances(
+        contacts, omega_rad_s, relative_permittivity, race_params, gap_limit_inner_m, gap_limit_outer_m
+    )
+    n = z_c.size
+    z = y_ball.size
+    y_re = 0.0
+    y_im = 0.0
+    abs_y_sum = 0.0
+    abs_y_ball = np.empty(z)
+    abs_z_ball = np.empty(z)
+    for j in range(z):
+        y_re += y_ball[j].real
+        y_im += y_ball[j].imag
+        abs_y_ball[j] = abs(y_ball[j])
+        abs_z_ball[j] = abs(z_ball[j])
+        abs_y_sum += abs_y_ball[j]
+    y_im += omega_rad_s * rest_capacitance_f
+    abs_z_total = 1.0 / math.hypot(y_re, y_im)
+    if shaft_voltage_v > 0.0:
+        voltage = shaft_voltage_v
+        current = shaft_current_a if shaft_current_a > 0.0 else voltage / abs_z_total
+    else:
+        current = shaft_current_a
+        voltage = current * abs_z_total
+    abs_z_contact = np.empty(n)
+    for k in range(n):
+        abs_z_contact[k] = abs(z_c[k])
+    max_field, max_density = film_stress_maxima(
+        contacts, abs_z_contact, abs_z_ball, abs_y_ball, abs_y_sum, voltage, current
+    )
+    return r_c, c_c, r_ball, c_ball, y_re, y_im, voltage, current, max_field, max_density
+
+
 def bearing_network(
     model: BearingModel, contacts: np.ndarray, shaft_voltage_v: float, shaft_current_a: float
 ) -> ElectricalNetwork:
-    """Evaluate the network for the contact rows `contacts` (TwinState.contacts view)."""
+    """Evaluate the network for the contact rows `contacts` (TwinState.contacts view): one
+    compiled pass (`network_solution`), then the indicators' verdicts and texts."""
     el = model.spec.electrical
     omega = 2.0 * math.pi * el.frequency_hz
-    r_c, c_c, z_c, r_ball, c_ball, z_ball, y_ball = contact_impedances(
+    r_c, c_c, r_ball, c_ball, y_re, y_im, voltage, current, max_field, max_density = network_solution(
         contacts,
         omega,
         el.oil_relative_permittivity,
         model.race_params,
         model.gap_limit_m[0],
         model.gap_limit_m[1],
+        model.rest_capacitance_f,
+        float(shaft_voltage_v),
+        float(shaft_current_a),
     )
-    y = complex(np.sum(y_ball)) + 1j * omega * model.rest_capacitance_f
-    z_total = 1.0 / y
-    # drive: a voltage setpoint wins; a current alone develops I |Z|
-    if shaft_voltage_v > 0.0:
-        voltage = shaft_voltage_v
-        current = shaft_current_a if shaft_current_a > 0.0 else voltage / abs(z_total)
-    else:
-        current = shaft_current_a
-        voltage = current * abs(z_total)
-    abs_y_ball = np.abs(y_ball)
-    max_field, max_density = film_stress_maxima(
-        contacts, np.abs(z_c), np.abs(z_ball), abs_y_ball, float(np.sum(abs_y_ball)), float(voltage), float(current)
-    )
+    z_total = 1.0 / complex(y_re, y_im)
     risk, reason = _risk(el, max_field, max_density, voltage, current)
     phase = math.atan2(z_total.imag, z_total.real)
-    capacitance: float | None = y.imag / omega
+    capacitance: float | None = y_im / omega
     capacitance_reason: str | None = None
     if phase > CAPACITIVE_PHASE_RAD:
         capacitance = None
@@ -209,7 +252,7 @@ def bearing_network(
         contact_capacitance_f=c_c,
         ball_resistance_ohm=r_ball,
         ball_capacitance_f=c_ball,
-        resistance_ohm=(1.0 / y.real) if y.real > 0 else math.inf,
+        resistance_ohm=(1.0 / y_re) if y_re > 0 else math.inf,
         capacitance_f=capacitance,
         capacitance_reason=capacitance_reason,
         impedance_ohm=abs(z_total),

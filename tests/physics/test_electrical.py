@@ -152,6 +152,31 @@ def _bearing(speed, load=3000.0, temperature=40.0, isothermal=False):
     return twin.snapshot().electrical
 
 
+def test_voltage_drive_by_hand():
+    # the network's drive (module twin.electrical_network): a voltage setpoint wins and drives
+    # I = V / |Z| through the bearing unless a current is also set, which is then kept as given
+    model = Twin("6208").model
+    z = model.ball_count
+    rows = np.zeros((L.N_ROWS, 2 * z))
+    rows[L.G_DELTA] = -20e-6
+    rows[L.G_DELTA, 0:2] = 1e-5
+    rows[L.C_LOAD, 0:2] = 1000.0
+    rows[L.C_RESISTANCE, 0:2] = 50.0, 2e8
+    rows[L.C_CAPACITANCE, 0:2] = 40e-12, 30e-12
+    rows[L.C_H_MIN, 0:2] = 1e-6
+    rows[L.C_SEMI_MAJOR, 0:2], rows[L.C_SEMI_MINOR, 0:2] = 1.7e-3, 0.19e-3
+    driven = bearing_network(model, rows, 3.0, 0.0)
+    assert driven.shaft_voltage_v == 3.0
+    assert driven.shaft_current_a == pytest.approx(3.0 / driven.impedance_ohm, rel=1e-12)
+    both = bearing_network(model, rows, 3.0, 0.5)
+    assert (both.shaft_voltage_v, both.shaft_current_a) == (3.0, 0.5)
+    # the film field scales with the drive voltage; the current density with the drive current
+    assert both.max_film_field_v_m == pytest.approx(driven.max_film_field_v_m, rel=1e-12)
+    assert both.current_density_a_m2 == pytest.approx(
+        driven.current_density_a_m2 * 0.5 / driven.shaft_current_a, rel=1e-12
+    )
+
+
 def test_capacitance_null_with_a_reason_whenever_the_phase_is_above_minus_45_deg():
     # Im(Y)/omega of a resistive network is not a capacitance, so none is published above -45 deg: boundary (20 rad/s),
     # mixed with asperity conduction (300 rad/s) and hot thin oil (100 degC at 1700 rad/s) are
