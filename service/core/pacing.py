@@ -29,8 +29,14 @@ frame that applied it even right after a tick (holding it to the interval would 
 ten by a frame at 50 Hz). Such a publication stands for the period's tick: the next regular one
 follows a period after it, so setpoints add no snapshots while they come slower than the publish
 rate (each snapshot costs its build, its messages, its alarm evaluation and its recording rows),
-and the gap between two publications never exceeds a period. In fast mode every 1/publish_rate_hz of SIMULATED time (a
-scenario's samples sit on a regular grid of simulated time however fast the machine is).
+and the gap between two publications never exceeds a period, but for one case: a frame that an
+outside input (a setpoint, defects, a measurement) cut short publishes nothing (the runner asks
+`tick_may_wait`), since the next step applies the input and publishes the tick with it, a
+fraction of a millisecond later. The state that carries the input then goes out without a
+snapshot built before it, and the setpoint's latency has no extra build (a gap of at most two
+periods: with the last publication older than that, the cut frame publishes). In fast mode
+every 1/publish_rate_hz of SIMULATED time (a scenario's samples sit on a regular grid of
+simulated time however fast the machine is).
 """
 
 from __future__ import annotations
@@ -94,10 +100,13 @@ class PacingClock:
         n = len(self._late)
         return self._late_in_window / n if n else None
 
-    def start(self, sim_s: float) -> None:
-        """Anchor the schedule at the loop's start."""
+    def start(self, sim_s: float, *, published: bool = False) -> None:
+        """Anchor the schedule at the loop's start (`published`: a snapshot went out just now, the
+        runner's initial one, and counts as the last publication's wall time)."""
         now = self.clock()
         self._anchor_wall, self._anchor_sim = now, sim_s
+        if published:
+            self.last_publish_wall = now
         self._next_publish_wall = now + self.publish_period_s
         self._next_publish_sim = sim_s + self.publish_period_s
 
@@ -150,6 +159,12 @@ class PacingClock:
             self._next_publish_wall = now + self.publish_period_s  # it stands for this period's tick
             return True
         return False
+
+    def tick_may_wait(self, now: float) -> bool:
+        """Whether a publication due now may wait for the next frame: true while the last one is
+        less than two periods old (real-time mode), so waiting never leaves a gap of more than
+        two periods."""
+        return not self.fast and now - self.last_publish_wall < 2.0 * self.publish_period_s
 
     def publish_soon(self) -> None:
         """Publish at the next frame (subject to the minimum interval)."""

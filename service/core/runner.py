@@ -370,7 +370,7 @@ class TwinRunner:
             self._pool = SteppingPool(1, name=self.name, clock=self._clock)
         self._pool.start()
         self.publisher.attach(self._pool.publisher)
-        self.pacing.start(self.sim_elapsed_s)
+        self.pacing.start(self.sim_elapsed_s, published=publish_initial)
         self._job = self._pool.add(self)
         return self
 
@@ -524,7 +524,11 @@ class TwinRunner:
         sim = self.sim_elapsed_s
         pacing.measure(now, sim)
         release = pacing.frame_done(now, sim)
-        if pacing.publish_due(now, sim, changed or event):
+        # a frame an outside input cut short publishes nothing: the input applies at the next
+        # step and its frame publishes the tick (service.core.pacing, "Publishing"); a stop
+        # cuts the frame too, and that one publishes as due
+        cut_for_input = self.faults.steps_left > 0 and not self._stop.is_set() and pacing.tick_may_wait(now)
+        if not cut_for_input and pacing.publish_due(now, sim, changed or event):
             self._safe_publish(now)
         self._notify_ended()
         return Schedule(release, math.inf if self.fast else release + self.frame_s)

@@ -249,6 +249,24 @@ def test_a_setpoint_is_published_at_the_end_of_its_frame_even_right_after_a_tick
     assert p.publish_due(0.0626, 0.0626, False)  # and on that grid from then on
 
 
+def test_a_tick_waits_for_an_input_frame_at_most_two_periods_after_the_last_publication():
+    """service.core.pacing ("Publishing"): the tick due at the end of a frame an outside input cut
+    short may wait for the input's frame while the last publication (the initial snapshot at
+    the start counts) is less than two periods old; never in fast mode."""
+    now = {"t": 0.0}
+    p = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: now["t"])
+    p.start(0.0, published=True)
+    assert p.tick_may_wait(0.0399) and not p.tick_may_wait(0.0401)
+    p.published(0.05, 0.05)
+    assert p.tick_may_wait(0.0899) and not p.tick_may_wait(0.0901)
+    unpublished = PacingClock(fast=False, publish_period_s=0.02, clock=lambda: 0.0)
+    unpublished.start(0.0)
+    assert not unpublished.tick_may_wait(0.001)  # nothing published yet: the tick goes out
+    fast = PacingClock(fast=True, publish_period_s=0.02, clock=lambda: 0.0)
+    fast.start(0.0, published=True)
+    assert not fast.tick_may_wait(0.0)
+
+
 def test_frames_as_long_as_the_publish_period_publish_every_frame_in_any_phase():
     """service.core.pacing: 20 ms frames (the service's default) and 50 Hz publishing. Frames
     that end just before their tick (0.1 ms, with a jitter of +-0.05 ms) publish every frame but

@@ -415,6 +415,34 @@ def test_a_setpoint_ends_the_frame_in_progress(twin, make_runner):
     assert runner.sim_elapsed_s == pytest.approx(twin.time_s - t_init, abs=0.5 * dt)
 
 
+def test_a_frame_cut_for_a_setpoint_publishes_nothing_before_it(twin, make_runner):
+    """Real time, a 20 Hz tick due when a setpoint ends the first frame (2 s of simulated time) 60 ms
+    after the initial snapshot: the tick due at the cut waits for the setpoint's frame
+    (service.core.pacing, "Publishing"): no snapshot is built at the cut with the old setpoint,
+    and the next snapshot carries the new one. Counted in steps, no wall-clock threshold."""
+    from twin.kernels import layout as L
+
+    sink = ListSink()
+    runner = make_runner(twin, publish_rate_hz=20.0, frame_s=2.0, setpoint_frame_s=0.001, sinks=[sink])
+    runner.start()
+    started = time.perf_counter()  # after the runner's clock started its schedule
+    (initial,) = sink.snapshots
+    step0 = int(twin.state.scalars[L.X_STEP])
+    # past the first tick (50 ms after the initial snapshot), within two periods of it
+    assert wait_until(lambda: time.perf_counter() - started > 0.06, interval=0.001)
+    assert runner.frames == 0 and int(twin.state.scalars[L.X_STEP]) > step0  # the 2 s frame still runs
+    before = len(sink.snapshots)
+    runner.submit(radial_load_n=4321.0)
+    snap = sink.wait_for(lambda s: s.setpoint.radial_load_n == 4321.0)
+    assert snap is not None
+    after = sink.snapshots[before:]
+    assert after[0] is snap  # nothing published between the setpoint and the state that carries it
+    dt = twin.model.dt_s
+    cut_s = snap.time_s - runner.setpoint_frame_steps * dt
+    assert all(abs(s.time_s - cut_s) > 0.5 * dt for s in sink.snapshots)  # no snapshot at the cut
+    assert runner.stop(timeout=10.0)
+
+
 def test_a_setpoint_is_published_at_the_end_of_the_frame_that_applied_it(twin, make_runner):
     """No 50 Hz tick involved (one tick every 1000 s here): the state carrying a setpoint is
     published because its frame applied it, once, right after that frame (counted in
