@@ -1,6 +1,6 @@
 # bearing-twin service image: `docker build -t bearing-twin .` then
 #   docker run --rm -p 8000:8000 -p 7447:7447 -v "$PWD/recordings:/home/twin/recordings" bearing-twin
-# The package is installed with README's command (`pip install -c constraints.txt .`, into a venv):
+# The package is installed as README's command does, without -e (`pip install -c constraints.txt .`, into a venv):
 # the tested versions, without the load tools' httpx; the numba kernels
 # are compiled at build time into a cache the runtime user owns, so the first twin starts at once.
 FROM python:3.11-slim

@@ -157,7 +157,7 @@ def open_live_viewer(settings: ServiceSettings, recorder):
     except Exception as exc:  # noqa: BLE001 - any failure of rerun's connection is reported as a wiring error
         live.close()
         raise WiringError(f"rerun web viewer: cannot connect the recording: {exc}") from None
-    log.warning("rerun web viewer: open %s", live.url())
+    log.warning("rerun web viewer: open %s (bound to %s)", live.url(), live.host)
     return live
 
 

@@ -112,6 +112,15 @@ def _engine_cache_dir() -> str:
 
 
 numba.config.CACHE_DIR = _engine_cache_dir()  # type: ignore[attr-defined]  # numba.config sets its options at run time
+
+
+def engine_cache_is_empty() -> bool:
+    """Whether no kernel of this engine version is in its cache yet (numba's index files, `.nbi`):
+    its first run then compiles them, a minute or two, which a command says before it waits."""
+    for _root, _dirs, files in os.walk(numba.config.CACHE_DIR):  # type: ignore[attr-defined]
+        if any(name.endswith(".nbi") for name in files):
+            return False
+    return True
 if StrippedSourceLocator not in _CACHE_IMPL._locator_classes:
     _CACHE_IMPL._locator_classes.insert(0, StrippedSourceLocator)
 

@@ -21,7 +21,6 @@ tunnel (`ssh -L PORT:127.0.0.1:PORT -L PORT+1:127.0.0.1:PORT+1 host`).
 from __future__ import annotations
 
 import ipaddress
-import logging
 import os
 import shutil
 import signal
@@ -33,8 +32,6 @@ import time
 import urllib.parse
 from pathlib import Path
 from typing import IO, Self
-
-log = logging.getLogger("service.recording")
 
 START_TIMEOUT_S = 30.0  # the rerun process must listen within this [s]
 
@@ -146,7 +143,6 @@ class LiveWebViewer:
                 self.close()
                 raise LiveViewerError(f"rerun --serve-web exited: {err[-1] if err else 'no message'}")
             if _listening(self._connect_host, self.grpc_port) and _listening(self._connect_host, self.web_port):
-                log.info("rerun web viewer: %s (bound to %s)", self.url(), self.host)
                 return self
             time.sleep(0.1)
         self.close()

@@ -19,6 +19,7 @@ from service.tools.bench_results import save as save_result
 from service.tools.messages import OPERATING_FLAGS, error_text
 from service.tools.scenario_cli import add_scenario_command
 from service.tools.serve_cli import add_serve_command
+from service.tools.stdout import print_document
 from service.tools.vibration_cli import add_analyse_command
 from twin.catalog import DEFAULT_DESIGNATION
 
@@ -84,7 +85,7 @@ def _cmd_simulate(args: argparse.Namespace) -> int:
         return 2
     snap = twin.snapshot()
     if args.json:
-        print(snap.to_json())
+        print_document(snap.to_json())
     else:
         _print_table(snap)
     return 0
@@ -140,7 +141,7 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     except ValueError as exc:
         print(f"error: {error_text(exc, {'seconds': '--seconds', 'repeats': '--repeats'})}", file=sys.stderr)
         return 2
-    print(json.dumps(result) if args.json else summary_text(result))
+    print_document(json.dumps(result) if args.json else summary_text(result))
     if args.save is not None:
         command = "bearing-twin " + " ".join(sys.argv[1:])
         print(f"saved: {save_result(result, 'bench', command, Path(args.save))}", file=sys.stderr)
@@ -203,7 +204,7 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
         plot_vibration(samples, result, args.plot)
     if args.json:
         result.pop("per_window", None)
-        print(json.dumps(result, allow_nan=False))
+        print_document(json.dumps(result, allow_nan=False))
         return 0
     f = result["defect_frequencies_hz"]
     print(

@@ -20,6 +20,7 @@ import sys
 from typing import Any
 
 from service.tools.arg_types import non_negative_float, positive_float
+from service.tools.stdout import print_document
 
 
 def _grid(text: str) -> int:
@@ -128,7 +129,7 @@ def benchmark_solve(grid: int = 129, repeats: int = 3) -> dict:
 def _cmd_bench(args: argparse.Namespace) -> int:
     doc = _finite(benchmark_solve(args.grid, args.repeats))
     if args.json:
-        print(json.dumps(doc, indent=1))
+        print_document(json.dumps(doc, indent=1))
     else:
         print(
             f"isothermal solve, {doc['grid']} x {doc['grid']}, default speed: median {doc['median_s']:.2f} s "
@@ -188,7 +189,7 @@ def _finite(obj):
 def _cmd_solve(args: argparse.Namespace) -> int:
     doc = solve_to_dict(args)
     if args.json:
-        print(json.dumps(doc, indent=1))
+        print_document(json.dumps(doc, indent=1))
     else:
         inp = doc["inputs"]
         print(

@@ -8,6 +8,7 @@ import json
 import sys
 
 from service.tools.messages import OPERATING_FLAGS, error_text
+from service.tools.stdout import print_document
 from twin.catalog import DEFAULT_DESIGNATION
 
 _CONTAMINATION = (
@@ -83,7 +84,7 @@ def _cmd_life(args: argparse.Namespace) -> int:
         print(f"error: {error_text(exc, OPERATING_FLAGS)}", file=sys.stderr)
         return 2
     if args.json:
-        print(json.dumps(result, allow_nan=False))
+        print_document(json.dumps(result, allow_nan=False))
         return 0
     r = result
     print(

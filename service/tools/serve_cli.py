@@ -134,7 +134,14 @@ def _cmd_serve(args: argparse.Namespace) -> int:
         )
     from service.core.errors import InputError
     from service.wiring import TwinService, WiringError
+    from twin.jit import engine_cache_is_empty
 
+    if engine_cache_is_empty():
+        print(
+            "bearing-twin: compiling the engine (numba), once per installed version: a minute or two "
+            "before HTTP answers",
+            flush=True,
+        )
     # open the twins, zenoh and the recording here, before uvicorn: what fails (a zenoh port in
     # use, a recording path that cannot be written) is one line, like a busy HTTP port
     try:

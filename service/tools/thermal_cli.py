@@ -9,6 +9,7 @@ import sys
 
 from service.tools.arg_types import float_in
 from service.tools.messages import OPERATING_FLAGS, error_text
+from service.tools.stdout import print_document
 from twin.setpoint import FIELD
 
 OIL = FIELD["oil_temperature_c"]  # the ambient / oil-inlet temperature takes the oil temperature's range
@@ -75,7 +76,7 @@ def _cmd_thermal(args: argparse.Namespace) -> int:
         print(f"error: {error_text(exc, THERMAL_FLAGS)}", file=sys.stderr)
         return 2
     if args.json:
-        print(json.dumps(r, allow_nan=False))
+        print_document(json.dumps(r, allow_nan=False))
         return 0
     print(
         f"{r['bearing']} at {r['shaft_speed_rad_s']:g} rad/s, Fr = {r['radial_load_n']:g} N, "

@@ -21,6 +21,8 @@ from pathlib import Path
 
 import numpy as np
 
+from service.tools.stdout import print_document
+
 STANDARD_GRAVITY_M_S2 = 9.80665
 UNITS = {"g": STANDARD_GRAVITY_M_S2, "m/s2": 1.0}
 FORMATS = (".npy", ".csv", ".wav")
@@ -162,7 +164,7 @@ def _cmd_analyse(args: argparse.Namespace) -> int:
         print(f"error: {exc}", file=sys.stderr)
         return 2
     if args.json:
-        print(json.dumps(result, allow_nan=False))
+        print_document(json.dumps(result, allow_nan=False))
         return 0
     g = STANDARD_GRAVITY_M_S2
     print(

@@ -83,3 +83,21 @@ def test_attack_is_bounded(field, value):
     setattr(cfg, field, value)
     with pytest.raises(ValueError, match=field):
         run_attack(cfg)
+
+
+def test_a_squat_blocks_fail_the_verdict_only_against_a_secured_service():
+    """docs/operations.md ("Twin-id claims on zenoh"): with nothing secured the service trusts
+    every zenoh peer's claim, so a create the squatter blocked is reported, not a failure; with a
+    token (or `--start`) it fails the verdict. An answer that repeats the squatter's text fails
+    either way."""
+    from loadtest.attack_watchers import failures, summary_lines
+
+    squat = {"attempts": 3, "peer_linked": True, "created": 2, "refused_capacity": 0, "other": {}}
+    open_service = {"squat": {**squat, "secure": False, "blocked": 1, "echoed": 0}}
+    assert failures(open_service) == []
+    assert "expected: with nothing secured" in summary_lines(open_service)[0]
+    secured = {"squat": {**squat, "secure": True, "blocked": 1, "echoed": 0}}
+    assert failures(secured) == ["1 twin creations blocked by a squatter zenoh did not authenticate"]
+    assert "expected" not in summary_lines(secured)[0]
+    echoed = {"squat": {**squat, "secure": False, "blocked": 0, "echoed": 1}}
+    assert failures(echoed) == ["1 answers repeated the squatter's text"]

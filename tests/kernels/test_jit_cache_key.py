@@ -108,3 +108,17 @@ def test_a_docstring_edit_loads_the_compiled_kernel_from_the_cache(tmp_path, mon
     assert _compile_and_call(tmp_path, "law_docs_edited") == (1, 0)  # loaded, not compiled
     law.write_text(KERNEL_DOCS_EDITED.replace("SCALE * stiffness_n_m", "stiffness_n_m * SCALE"))
     assert _compile_and_call(tmp_path, "law_code_edited") == (0, 1)
+
+
+def test_an_empty_engine_cache_is_told_apart(tmp_path, monkeypatch):
+    """`serve` says it compiles before its first start's minute of numba compilation
+    (twin.jit.engine_cache_is_empty): an engine cache directory without numba's index files
+    (`.nbi`), or none at all, is empty; one with an index file in a module's folder is not."""
+    monkeypatch.setattr(numba.config, "CACHE_DIR", str(tmp_path / "numba-none"))
+    assert jit.engine_cache_is_empty()
+    folder = tmp_path / "numba-none" / "kernels_0123"
+    folder.mkdir(parents=True)
+    (folder / "step.step_n-100.py311.1.nbc").write_bytes(b"")
+    assert jit.engine_cache_is_empty()  # a compiled object alone is no index
+    (folder / "step.step_n-100.py311.nbi").write_bytes(b"")
+    assert not jit.engine_cache_is_empty()

@@ -166,6 +166,33 @@ def test_a_closed_pipe_ends_quietly():
     assert b"Traceback" not in err and b"BrokenPipeError" not in err
 
 
+def test_a_document_goes_out_in_one_write(monkeypatch):
+    """README ("Units"): a command's JSON document that fits the pipe's buffer is in the pipe
+    before a reader that takes only its start (`simulate --json | head -c 200`) can go, so the
+    command ends with status 0: the document and its newline leave in one write to the OS
+    (`print` writes a document larger than the stream's 8 KiB buffer and its newline apart)."""
+    import io
+
+    from service.tools.stdout import print_document
+
+    class Raw(io.RawIOBase):
+        def __init__(self):
+            self.writes: list[bytes] = []
+
+        def writable(self):
+            return True
+
+        def write(self, b):
+            self.writes.append(bytes(b))
+            return len(b)
+
+    raw = Raw()
+    monkeypatch.setattr(sys, "stdout", io.TextIOWrapper(io.BufferedWriter(raw), encoding="utf-8"))
+    document = json.dumps({"balls": ["x" * 100] * 110})  # 11 kB, a snapshot's size
+    print_document(document)
+    assert raw.writes == [(document + "\n").encode()]
+
+
 def test_a_busy_zenoh_port_is_a_one_line_error(tmp_path):
     with socket.socket() as busy:
         busy.bind(("127.0.0.1", 0))
