@@ -30,7 +30,7 @@ ten by a frame at 50 Hz). Such a publication stands for the period's tick: the n
 follows a period after it, so setpoints add no snapshots while they come slower than the publish
 rate (each snapshot costs its build, its messages, its alarm evaluation and its recording rows),
 and the gap between two publications never exceeds a period, but for one case: a frame that an
-outside input (a setpoint, defects, a measurement) cut short publishes nothing (the runner asks
+outside input (a setpoint or defects) cut short publishes nothing (the runner asks
 `tick_may_wait`), since the next step applies the input and publishes the tick with it, a
 fraction of a millisecond later. The state that carries the input then goes out without a
 snapshot built before it, and the setpoint's latency has no extra build (a gap of at most two
