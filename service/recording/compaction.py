@@ -4,11 +4,12 @@ While a segment is open the recorder sends a chunk per entity and send (a live v
 crash lose at most a send); a viewer opening the file later pays for every chunk (each costs
 about 1.5 kB and its own decoding). Once a segment is closed, `compact(path)` rewrites it with
 `rerun rrd optimize` (rerun's own chunk compaction, in a process of its own, at low priority):
-about a tenth of the chunks, half to a third of the bytes (a file of a few seconds can grow by the
-footer), and rerun's current format with its footer (chunk manifest), so that readers neither
-scan the whole file nor warn about a legacy format. The result goes to a file created exclusively beside the segment and replaces it by
-`os.replace` (the same rows, never a partial file under the segment's name); on any failure the
-segment stays as it was and the temporary file is removed.
+about a tenth of the chunks, half to a third of the bytes (a file of a few seconds can grow by
+the footer), and rerun's current format with its footer (chunk manifest), so that readers
+neither scan the whole file nor warn about a legacy format. The result goes to a file created
+exclusively beside the segment and replaces it by `os.replace` (the same rows, never a partial
+file under the segment's name); on any failure the segment stays as it was and the temporary
+file is removed.
 """
 
 from __future__ import annotations
