@@ -121,6 +121,8 @@ def engine_cache_is_empty() -> bool:
         if any(name.endswith(".nbi") for name in files):
             return False
     return True
+
+
 if StrippedSourceLocator not in _CACHE_IMPL._locator_classes:
     _CACHE_IMPL._locator_classes.insert(0, StrippedSourceLocator)
 
