@@ -103,6 +103,11 @@ class DefectBox:
             self._slot.offer(self._target)
             return self._target
 
+    @property
+    def waiting(self) -> bool:
+        """Whether defects wait for the runner thread."""
+        return self._slot.waiting
+
     def take(self) -> tuple | None:
         """The pending defects or None (runner thread)."""
         pending = self._slot.take()

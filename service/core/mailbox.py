@@ -133,6 +133,13 @@ class Mailbox:
                 )
             return admitted.setpoint
 
+    @property
+    def waiting(self) -> bool:
+        """Whether an offer waits for the runner's next `take` (a setpoint or an outside offer's
+        timing)."""
+        with self._lock:
+            return self._pending is not None or bool(self._timings)
+
     def take(self) -> tuple[Admitted | None, list[SetpointTiming]]:
         """(the pending setpoint or None, the timings of the offers it merges) - runner thread."""
         with self._lock:
@@ -163,6 +170,12 @@ class LatestValue(Generic[T]):
     def offer(self, value: T) -> None:
         with self._lock:
             self._pending = value
+
+    @property
+    def waiting(self) -> bool:
+        """Whether a value waits to be taken."""
+        with self._lock:
+            return self._pending is not None
 
     def take(self) -> T | None:
         """The pending value, or None; the slot is empty afterwards."""

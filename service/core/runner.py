@@ -526,12 +526,24 @@ class TwinRunner:
         release = pacing.frame_done(now, sim)
         # a frame an outside input cut short publishes nothing: the input applies at the next
         # step and its frame publishes the tick (service.core.pacing, "Publishing"); a stop
-        # cuts the frame too, and that one publishes as due
-        cut_for_input = self.faults.steps_left > 0 and not self._stop.is_set() and pacing.tick_may_wait(now)
+        # cuts the frame too, and that one publishes as due. An input that was taken before its
+        # interrupt landed (offered, taken here, then the interrupt) cuts the frame that applies
+        # it with nothing waiting: that frame publishes as due, or the setpoint it carries would
+        # wait for the next tick
+        cut_for_input = (
+            self.faults.steps_left > 0
+            and not self._stop.is_set()
+            and self._input_waiting()
+            and pacing.tick_may_wait(now)
+        )
         if not cut_for_input and pacing.publish_due(now, sim, changed or event):
             self._safe_publish(now)
         self._notify_ended()
         return Schedule(release, math.inf if self.fast else release + self.frame_s)
+
+    def _input_waiting(self) -> bool:
+        """Whether an outside input (a setpoint or defects) waits for the next step."""
+        return self.mailbox.waiting or self.defect_box.waiting
 
     def _notify_ended(self) -> None:
         """A scenario ended in this step: its waiters wake once what it published is delivered."""

@@ -443,6 +443,33 @@ def test_a_frame_cut_for_a_setpoint_publishes_nothing_before_it(twin, make_runne
     assert runner.stop(timeout=10.0)
 
 
+def test_an_interrupt_landing_after_its_setpoint_was_taken_does_not_hold_the_setpoint_back(twin, make_runner):
+    """The race of `TwinRunner.submit` against the stepping thread: the setpoint is offered, the
+    stepping thread takes it, and only then does the submitter's interrupt land, cutting the very
+    frame that applies it with nothing left waiting. That frame publishes the setpoint at once
+    (no tick for 1000 s here: held back, it would not be published at all). Counted in
+    publications and steps, not in wall time."""
+    sink = ListSink()
+    runner = make_runner(twin, publish_rate_hz=0.001, frame_s=0.005, setpoint_frame_s=0.001, sinks=[sink]).start()
+    assert wait_until(lambda: runner.frames >= 3)
+    take = runner.mailbox.take
+
+    def take_then_interrupt():
+        pending, timings = take()
+        if timings:
+            twin.interrupt_frame()  # the submitter's interrupt, after the take
+        return pending, timings
+
+    runner.mailbox.take = take_then_interrupt
+    runner.submit(radial_load_n=4321.0)
+    snap = sink.wait_for(lambda s: s.setpoint.radial_load_n == 4321.0, timeout=10.0)
+    assert snap is not None  # published by the cut frame that applied it
+    assert snap.seq == sink.snapshots[0].seq + 1
+    (timing,) = runner.setpoint_latencies()
+    assert timing.seq == snap.seq
+    assert runner.stop(timeout=10.0)
+
+
 def test_a_setpoint_is_published_at_the_end_of_the_frame_that_applied_it(twin, make_runner):
     """No 50 Hz tick involved (one tick every 1000 s here): the state carrying a setpoint is
     published because its frame applied it, once, right after that frame (counted in
