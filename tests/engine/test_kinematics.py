@@ -82,3 +82,25 @@ def test_slide_to_roll_ratio_is_large_during_start_up(time_step):
     assert twin.snapshot().shaft_speed_rad_s == pytest.approx(500.0)
     c = twin.state.contacts
     assert np.max(np.abs(c[L.C_SRR][c[L.C_LOAD] > 50])) < 1e-3
+
+
+def test_kinetic_energy_by_hand():
+    """The frame's energy balance (`Twin.kinetic_energy_j`, twin.state_measures): rigid-body
+    kinetic energy 0.5 m |v|^2 + 0.5 I |omega|^2 per ball (solid sphere, I = 2/5 m r^2) plus the
+    cage's 0.5 I_c omega_c^2 (its mass at the pitch radius), from the spec's density and geometry.
+    Set velocities, so the sum is known exactly; relative tolerance 1e-12 (rounding)."""
+    twin = Twin("6208")
+    g, rho = twin.model.spec.geometry, twin.model.spec.material.density_kg_m3
+    s = twin.state
+    z = g.ball_count
+    s.ball_velocity_m_s[:] = np.arange(3 * z, dtype=float).reshape(z, 3) * 0.1
+    s.ball_angular_velocity_rad_s[:] = 100.0 + np.arange(3 * z, dtype=float).reshape(z, 3)
+    s.scalars[L.X_CAGE_SPEED] = 210.0
+    rb = g.ball_radius_m
+    m = rho * 4.0 / 3.0 * math.pi * rb**3
+    expected = (
+        0.5 * m * float(np.sum(s.ball_velocity_m_s**2))
+        + 0.5 * 0.4 * m * rb**2 * float(np.sum(s.ball_angular_velocity_rad_s**2))
+        + 0.5 * g.cage_mass_kg * g.pitch_radius_m**2 * 210.0**2
+    )
+    assert twin.kinetic_energy_j() == pytest.approx(expected, rel=1e-12)
