@@ -34,7 +34,9 @@ outside input (a setpoint or defects) cut short publishes nothing (the runner as
 `tick_may_wait`), since the next step applies the input and publishes the tick with it, a
 fraction of a millisecond later. The state that carries the input then goes out without a
 snapshot built before it, and the setpoint's latency has no extra build (a gap of at most two
-periods: with the last publication older than that, the cut frame publishes). In fast mode
+periods: with the last publication older than that, the cut frame publishes). A frame cut with
+no input waiting (the submitter's interrupt landed after the runner took the input, so it cuts
+the very frame that applies it) publishes as due. In fast mode
 every 1/publish_rate_hz of SIMULATED time (a scenario's samples sit on a regular grid of
 simulated time however fast the machine is).
 """
