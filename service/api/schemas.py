@@ -307,6 +307,12 @@ class Capacity(BaseModel):
     last_calibration: TwinCost | None = Field(
         default=None, description="The cost measured at the last twin creation [CPU s / s]; null before one."
     )
+    alike_engine_cpu_s_per_sim_s: float | None = Field(
+        default=None,
+        description="The mean measured engine cost of the running twins alike the last calibrated one (the same spec "
+        "and model options); a twin like it counts at the larger of this and its calibration; null while none is "
+        "measured [CPU s per simulated s].",
+    )
     over_capacity: str | None = Field(
         default=None, description="Why the configured twin runs although it does not fit; null when it fits [text]."
     )
@@ -322,7 +328,8 @@ class Capacity(BaseModel):
         default=None,
         description="How max_twins is reached, with the figures of the moment: budget = cores x core_fraction - "
         "reserve; max_twins = running + floor((budget - in use) / need of a twin like the last calibrated: its "
-        "engine plus the service overhead per twin) [text].",
+        "engine (the larger of its calibration and what the running twins alike it measure) plus the service overhead "
+        "per twin) [text].",
     )
     service_overhead: dict[str, float | None] | None = Field(
         default=None,

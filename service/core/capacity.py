@@ -17,6 +17,16 @@ The rule (docs/service.md "Runner pool"):
   share. Why the reserve: on the 2-core VM two default 6208 twins (0.74 and 0.76 CPU s per s by
   their calibration) fitted 2 x 0.85 = 1.7, were admitted, and ran at 0.97 and 0.93 of real time
   with 93-96 % of frames late (`bearing-twin bench-service --twins 4`, zenoh and recording on).
+* A calibration runs the twin ALONE (a warm model on an idle stepping thread, 20 ms of simulated
+  time); in the service the same engine may cost more, its frames sharing the caches with the
+  Python between them and the service's threads. On the 2-core Intel Xeon VM the default 6208
+  calibrates at 0.27-0.30 in some runs and 0.37-0.47 CPU s per simulated s in others, and
+  measures 0.34-0.46 running beside zenoh, the recorder and the HTTP client. So a new twin ALIKE
+  running ones (the same spec and model options) counts at the larger of its calibration and
+  their measured engine cost (`expected_engine_cost`: their mean, over the twins whose 2 s
+  window has closed); a twin unlike every running one counts at its calibration. Without it a
+  low calibration of the first twin let `--twins auto` start a third default twin there, and
+  the three ran 0.3-2.2 % of their frames late.
 * The SERVICE SHARE of a twin is what the service spends for it beside its engine: the measured
   service overhead per twin (`ThreadCpuMeter`: the stepping threads beside the engines, the zenoh,
   recording and alarm threads, over the last closed window, HTTP not counted), or its snapshots'
@@ -36,6 +46,8 @@ core_fraction, R the reserve, U the measured need of the running twins and c the
 like the last one calibrated (its engine plus the service share)::
 
     max_twins = running + floor((C f - R - U) / c)          (c <= f, else no more twin fits)
+
+with c's engine part the expected engine cost of a twin like the last calibrated one.
 
 and `Capacity.formula` writes it out with the figures of the moment.
 
@@ -113,6 +125,10 @@ class TwinCost:
         e = self.engine_cpu_s_per_sim_s
         return self.publish_cpu_s_per_s / e if e > 0 else None
 
+    def with_engine(self, engine_cpu_s_per_sim_s: float) -> TwinCost:
+        """This cost with another engine part (the expected one, `expected_engine_cost`)."""
+        return TwinCost(engine_cpu_s_per_sim_s, self.publish_cpu_s_per_s)
+
     def as_dict(self) -> dict:
         return {
             "engine_cpu_s_per_sim_s": self.engine_cpu_s_per_sim_s,
@@ -120,6 +136,15 @@ class TwinCost:
             "cpu_s_per_s": self.cpu_s_per_s,
             "publish_fraction": self.publish_fraction,
         }
+
+
+def expected_engine_cost(calibrated: float, alike_measured: Iterable[float]) -> float:
+    """The engine cost a new twin is counted at [CPU s per simulated s]: its lone calibration, or
+    the mean measured engine cost of the running twins alike it when that is larger (the
+    calibration is the least contended case there is; what alike twins measure in the service is
+    what this one will cost there). Non-positive or non-finite measurements are left out."""
+    rates = [r for r in alike_measured if r > 0.0 and math.isfinite(r)]
+    return max(calibrated, sum(rates) / len(rates)) if rates else calibrated
 
 
 def calibrate(
@@ -256,8 +281,11 @@ class Capacity:
         running: int,
         used_cpu_s_per_s: float,
         overhead_per_twin_cpu_s_per_s: float | None = None,
+        alike_engine: float | None = None,
     ) -> str:
-        """How `estimate_max_twins` reaches its number, with the figures of the moment."""
+        """How `estimate_max_twins` reaches its number, with the figures of the moment; `typical`
+        is a lone calibration, `alike_engine` the measured engine cost of the running twins alike
+        it (None: none measured)."""
         head = (
             f"budget = {self.usable_cores} cores x core_fraction {self.core_fraction:g} - reserve "
             f"{self.reserve_cores:g} = {self.budget_cpu_s_per_s:.3f} CPU s/s"
@@ -265,11 +293,18 @@ class Capacity:
         if typical is None or not (typical.cpu_s_per_s > 0 and math.isfinite(typical.cpu_s_per_s)):
             return head + "; no twin calibrated yet"
         overhead = overhead_per_twin_cpu_s_per_s
-        c = self.need(typical, overhead)
-        n = self.estimate_max_twins(typical, running, used_cpu_s_per_s, overhead)
+        cal = typical.engine_cpu_s_per_sim_s
+        expected = typical.with_engine(expected_engine_cost(cal, [] if alike_engine is None else [alike_engine]))
+        c = self.need(expected, overhead)
+        n = self.estimate_max_twins(expected, running, used_cpu_s_per_s, overhead)
+        engine = (
+            f"engine {cal:.3f} (calibrated)"
+            if alike_engine is None
+            else f"engine max(calibrated {cal:.3f}, running alike {alike_engine:.3f})"
+        )
         return (
-            f"{head}; a twin like the last calibrated needs c = engine {typical.engine_cpu_s_per_sim_s:.3f} + "
-            f"{self._share_text(typical, overhead)} = {c:.3f} CPU s/s; max_twins = "
+            f"{head}; a twin like the last calibrated needs c = {engine} + "
+            f"{self._share_text(expected, overhead)} = {c:.3f} CPU s/s; max_twins = "
             f"{running} running + floor(({self.budget_cpu_s_per_s:.3f} - {used_cpu_s_per_s:.3f} in use) / "
             f"{c:.3f}) = {n}"
         )

@@ -46,7 +46,14 @@ from pydantic import ValidationError
 from service.core.admission import AdmissionGate
 from service.core.alarm_hub import AlarmHub
 from service.core.alarms import AlarmEvent
-from service.core.capacity import Capacity, ServiceOverheadMeter, TwinCost, calibrate, usable_cores
+from service.core.capacity import (
+    Capacity,
+    ServiceOverheadMeter,
+    TwinCost,
+    calibrate,
+    expected_engine_cost,
+    usable_cores,
+)
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.heap import freeze_heap
 from service.core.intake import DefectIntake, SetpointIntake
@@ -177,6 +184,7 @@ class TwinRegistry:
             threads, settings.runner.capacity_core_fraction, reserve_cores=settings.runner.capacity_reserve_cores
         )
         self.last_calibration: TwinCost | None = None
+        self._last_calibrated: Twin | None = None  # the twin of last_calibration
         self.over_capacity: str | None = None  # why the configured twin runs over capacity
         self._over_capacity_id: str | None = None
         self._recording_lock = threading.RLock()
@@ -489,6 +497,9 @@ class TwinRegistry:
         )
         with self._lock:
             self.last_calibration = cost
+            self._last_calibrated = twin
+            alike = self._alike_engines(twin)
+            cost = cost.with_engine(expected_engine_cost(cost.engine_cpu_s_per_sim_s, alike))
             verdict = self.capacity.check(cost, self._running_costs(), self.thread_cpu.overhead_per_twin_cpu_s_per_s)
             if not verdict.admitted:
                 if not over_capacity_ok:
@@ -522,6 +533,21 @@ class TwinRegistry:
             self._admitting[bearing_id] = cost
         return cost
 
+    def _alike_engines(self, twin: Twin | None) -> list[float]:
+        """The measured engine cost of each running twin alike `twin` (the same spec and model
+        options) whose engine window has closed [CPU s per simulated s] (lock held)."""
+        if twin is None:
+            return []
+        m = twin.model
+        rates = []
+        for e in self._twins.values():
+            rate = e.runner.engine_cpu.rate
+            if rate is not None and (
+                e.twin is twin or (e.twin.model.spec == m.spec and e.twin.model.options == m.options)
+            ):
+                rates.append(rate)
+        return rates
+
     def _running_costs(self) -> list[TwinCost]:
         """What the twins running (and those admitted, still starting) need (lock held)."""
         costs = [c for c in (e.runner.cost for e in self._twins.values()) if c is not None]
@@ -538,9 +564,19 @@ class TwinRegistry:
         overhead = {**overhead, **by_role} if overhead is not None else (by_role or None)
         per_twin = self.thread_cpu.overhead_per_twin_cpu_s_per_s
         typical = self.last_calibration
+        with self._lock:
+            alike = self._alike_engines(self._last_calibrated)
+        alike_engine = sum(alike) / len(alike) if alike else None
         cap = self.capacity
         used = cap.used(costs, per_twin)
-        estimate = cap.estimate_max_twins(typical, running, used, per_twin)
+        estimate = cap.estimate_max_twins(
+            None
+            if typical is None
+            else typical.with_engine(expected_engine_cost(typical.engine_cpu_s_per_sim_s, alike)),
+            running,
+            used,
+            per_twin,
+        )
         if self.settings.runner.max_twins is not None:
             estimate = (
                 self.settings.runner.max_twins if estimate is None else min(estimate, self.settings.runner.max_twins)
@@ -557,9 +593,10 @@ class TwinRegistry:
             "max_twins": estimate,
             "max_twins_set": self.settings.runner.max_twins,
             "last_calibration": typical.as_dict() if typical is not None else None,
+            "alike_engine_cpu_s_per_sim_s": alike_engine,
             "over_capacity": self.over_capacity,
             "service_overhead_per_twin_cpu_s_per_s": per_twin,
-            "formula": cap.formula(typical, running, used, per_twin),
+            "formula": cap.formula(typical, running, used, per_twin, alike_engine),
             "service_overhead": overhead,
         }
 

@@ -16,7 +16,15 @@ import time
 import pytest
 
 from loadtest.attack_watchers import ADMISSION_REFUSAL
-from service.core.capacity import OVERHEAD_GOAL, Capacity, CpuMeter, ServiceOverheadMeter, TwinCost, calibrate
+from service.core.capacity import (
+    OVERHEAD_GOAL,
+    Capacity,
+    CpuMeter,
+    ServiceOverheadMeter,
+    TwinCost,
+    calibrate,
+    expected_engine_cost,
+)
 from service.core.errors import InputError
 from service.core.pacing import PacingClock
 from service.core.pool import EdfQueue, Job, Schedule, SteppingPool
@@ -546,7 +554,8 @@ def test_capacity_formula_states_the_figures_it_counts_with():
     text = cap.formula(twin, 1, 0.28)
     assert cap.estimate_max_twins(twin, 1, 0.28) == 4
     assert "= 1.200 CPU s/s" in text
-    assert "c = engine 0.250 + snapshots 0.030 (no service overhead measured yet) = 0.280" in text
+    assert "c = engine 0.250 (calibrated) + snapshots 0.030 (no service overhead measured yet)" in text
+    assert "(no service overhead measured yet) = 0.280" in text
     assert text.endswith("1 running + floor((1.200 - 0.280 in use) / 0.280) = 4")
     assert twin.publish_fraction == pytest.approx(0.12)
 
@@ -564,7 +573,8 @@ def test_capacity_counts_the_measured_service_overhead_per_twin():
     assert cap.estimate_max_twins(twin, 0, 0.0, 0.09) == 3  # floor(1.2 / 0.36)
     assert cap.estimate_max_twins(twin, 2, 0.72, 0.09) == 3  # 2 + floor(0.48 / 0.36)
     text = cap.formula(twin, 2, 0.72, 0.09)
-    assert "c = engine 0.270 + service 0.090 (measured per twin; its snapshots alone 0.020) = 0.360" in text
+    assert "c = engine 0.270 (calibrated) + service 0.090 (measured per twin" in text
+    assert "(measured per twin; its snapshots alone 0.020) = 0.360" in text
     assert text.endswith("2 running + floor((1.200 - 0.720 in use) / 0.360) = 3")
     verdict = cap.check(twin, [twin, twin, twin], 0.09)  # 1.08 + 0.36 > 1.2
     assert not verdict.admitted and "service 0.090" in verdict.reason
@@ -694,6 +704,64 @@ def test_health_counts_the_measured_service_overhead_in_the_capacity(monkeypatch
         assert cap["used_cpu_s_per_s"] == pytest.approx(0.1 + per_twin)
         assert f"service {per_twin:.3f} (measured per twin; its snapshots alone 0.000)" in cap["formula"]
         assert cap["formula"].endswith(f"= {cap['max_twins']}")
+    finally:
+        reg.close()
+
+
+def test_expected_engine_cost_is_the_calibration_or_what_twins_alike_measure():
+    """service.core.capacity.expected_engine_cost: the larger of the lone calibration and the mean
+    measured cost of the running twins alike (the calibration alone with none measured; non-positive
+    or non-finite measurements left out)."""
+    assert expected_engine_cost(0.28, [0.42, 0.46]) == pytest.approx(0.44)
+    assert expected_engine_cost(0.28, []) == 0.28
+    assert expected_engine_cost(0.40, [0.30]) == 0.40  # a calibration above what runs counts as it is
+    assert expected_engine_cost(0.28, [math.nan, 0.0, 0.42]) == pytest.approx(0.42)
+    assert TwinCost(0.28, 0.02).with_engine(0.42) == TwinCost(0.42, 0.02)
+
+
+def test_a_twin_alike_a_running_one_counts_at_what_that_one_measures(monkeypatch):
+    """service.core.registry: a running 6205 whose engine measures 0.45 CPU s per simulated s
+    against its calibration's 0.3 makes another 6205 count at 0.45, in max_twins and the
+    formula; at 0.9 measured, a 6205 whose lone cost (0.35 CPU s/s) fits one core's 0.85 is
+    refused (0.95), while a twin of another kind still counts at its own calibration. Measured
+    rates are set on the runner's meter, not measured, so the arithmetic holds on any machine."""
+    from types import SimpleNamespace
+
+    import service.core.registry as registry_module
+    from service.core.registry import TwinRegistry
+    from service.settings import ServiceSettings
+
+    monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: TwinCost(0.3, 0.05))
+    settings = ServiceSettings(
+        enable_zenoh=False,
+        enable_recording=False,
+        admission="measured",
+        stepping_threads=2,
+        capacity_core_fraction=0.85,
+        start_twin=False,
+        capacity_reserve_cores=0.0,
+    )
+    reg = TwinRegistry(settings)
+    reg.capacity.cores = 2
+    reg.open()
+    try:
+        reg.create_twin(id="a", designation="6205")
+        cap = reg.health()["capacity"]
+        assert cap["alike_engine_cpu_s_per_sim_s"] is None  # nothing measured yet: the calibration counts
+        meter = SimpleNamespace(rate=0.45, cpu_s=0.0, add=lambda cpu_s, work: None)
+        reg.get("a").runner.engine_cpu = meter
+        cap = reg.health()["capacity"]
+        assert cap["alike_engine_cpu_s_per_sim_s"] == pytest.approx(0.45)
+        # c = 0.45 + 0.05 = 0.5; in use 0.45 + 0.05 = 0.5: 1 + floor((1.7 - 0.5) / 0.5) = 3
+        assert cap["max_twins"] == 3
+        assert "engine max(calibrated 0.300, running alike 0.450)" in cap["formula"]
+        assert "= 0.500 CPU s/s" in cap["formula"]
+        meter.rate = 0.9
+        with pytest.raises(InputError) as exc:
+            reg.create_twin(id="b", designation="6205")
+        assert exc.value.status_code == 503 and "0.950" in exc.value.errors[0].message
+        reg.create_twin(id="c", designation="6208")  # unlike: 0.35 of what is left (1.7 - 0.95)
+        assert [e.id for e in reg.entries()] == ["a", "c"]
     finally:
         reg.close()
 
