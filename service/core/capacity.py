@@ -20,7 +20,7 @@ The rule (docs/service.md "Runner pool"):
 * A calibration runs the twin ALONE (a warm model on an idle stepping thread, 20 ms of simulated
   time); in the service the same engine may cost more, its frames sharing the caches with the
   Python between them and the service's threads. On the 2-core Intel Xeon VM the default 6208
-  calibrates at 0.27-0.30 in some runs and 0.37-0.47 CPU s per simulated s in others, and
+  calibrates at 0.27-0.31 in 6 of 28 runs and 0.35-0.54 CPU s per simulated s in the others, and
   measures 0.34-0.46 running beside zenoh, the recorder and the HTTP client. So a new twin ALIKE
   running ones (the same spec and model options) counts at the larger of its calibration and
   their measured engine cost (`expected_engine_cost`: their mean, over the twins whose 2 s
