@@ -138,13 +138,19 @@ class TwinCost:
         }
 
 
-def expected_engine_cost(calibrated: float, alike_measured: Iterable[float]) -> float:
+def mean_engine_cost(measured: Iterable[float]) -> float | None:
+    """The mean of measured engine costs [CPU s per simulated s], non-positive or non-finite ones
+    left out; None without one."""
+    rates = [r for r in measured if r > 0.0 and math.isfinite(r)]
+    return sum(rates) / len(rates) if rates else None
+
+
+def expected_engine_cost(calibrated: float, alike_engine: float | None) -> float:
     """The engine cost a new twin is counted at [CPU s per simulated s]: its lone calibration, or
-    the mean measured engine cost of the running twins alike it when that is larger (the
-    calibration is the least contended case there is; what alike twins measure in the service is
-    what this one will cost there). Non-positive or non-finite measurements are left out."""
-    rates = [r for r in alike_measured if r > 0.0 and math.isfinite(r)]
-    return max(calibrated, sum(rates) / len(rates)) if rates else calibrated
+    the measured engine cost of the running twins alike it (`mean_engine_cost`; None: none
+    measured) when that is larger (the calibration is the least contended case there is; what
+    alike twins measure in the service is what this one will cost there)."""
+    return calibrated if alike_engine is None else max(calibrated, alike_engine)
 
 
 def calibrate(
@@ -294,7 +300,7 @@ class Capacity:
             return head + "; no twin calibrated yet"
         overhead = overhead_per_twin_cpu_s_per_s
         cal = typical.engine_cpu_s_per_sim_s
-        expected = typical.with_engine(expected_engine_cost(cal, [] if alike_engine is None else [alike_engine]))
+        expected = typical.with_engine(expected_engine_cost(cal, alike_engine))
         c = self.need(expected, overhead)
         n = self.estimate_max_twins(expected, running, used_cpu_s_per_s, overhead)
         engine = (

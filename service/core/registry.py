@@ -52,6 +52,7 @@ from service.core.capacity import (
     TwinCost,
     calibrate,
     expected_engine_cost,
+    mean_engine_cost,
     usable_cores,
 )
 from service.core.errors import InputError, field_errors, setpoint_field_errors
@@ -498,8 +499,7 @@ class TwinRegistry:
         with self._lock:
             self.last_calibration = cost
             self._last_calibrated = twin
-            alike = self._alike_engines(twin)
-            cost = cost.with_engine(expected_engine_cost(cost.engine_cpu_s_per_sim_s, alike))
+            cost = cost.with_engine(expected_engine_cost(cost.engine_cpu_s_per_sim_s, self._alike_engine(twin)))
             verdict = self.capacity.check(cost, self._running_costs(), self.thread_cpu.overhead_per_twin_cpu_s_per_s)
             if not verdict.admitted:
                 if not over_capacity_ok:
@@ -533,20 +533,20 @@ class TwinRegistry:
             self._admitting[bearing_id] = cost
         return cost
 
-    def _alike_engines(self, twin: Twin | None) -> list[float]:
-        """The measured engine cost of each running twin alike `twin` (the same spec and model
-        options) whose engine window has closed [CPU s per simulated s] (lock held)."""
+    def _alike_engine(self, twin: Twin | None) -> float | None:
+        """The mean measured engine cost of the running twins alike `twin` (the same spec and model
+        options) whose engine window has closed [CPU s per simulated s]; None without one (lock
+        held)."""
         if twin is None:
-            return []
+            return None
         m = twin.model
-        rates = []
-        for e in self._twins.values():
-            rate = e.runner.engine_cpu.rate
-            if rate is not None and (
-                e.twin is twin or (e.twin.model.spec == m.spec and e.twin.model.options == m.options)
-            ):
-                rates.append(rate)
-        return rates
+        return mean_engine_cost(
+            rate
+            for e in self._twins.values()
+            if (rate := e.runner.engine_cpu.rate) is not None
+            and e.twin.model.spec == m.spec
+            and e.twin.model.options == m.options
+        )
 
     def _running_costs(self) -> list[TwinCost]:
         """What the twins running (and those admitted, still starting) need (lock held)."""
@@ -565,14 +565,13 @@ class TwinRegistry:
         per_twin = self.thread_cpu.overhead_per_twin_cpu_s_per_s
         typical = self.last_calibration
         with self._lock:
-            alike = self._alike_engines(self._last_calibrated)
-        alike_engine = sum(alike) / len(alike) if alike else None
+            alike_engine = self._alike_engine(self._last_calibrated)
         cap = self.capacity
         used = cap.used(costs, per_twin)
         estimate = cap.estimate_max_twins(
             None
             if typical is None
-            else typical.with_engine(expected_engine_cost(typical.engine_cpu_s_per_sim_s, alike)),
+            else typical.with_engine(expected_engine_cost(typical.engine_cpu_s_per_sim_s, alike_engine)),
             running,
             used,
             per_twin,

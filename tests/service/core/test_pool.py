@@ -24,6 +24,7 @@ from service.core.capacity import (
     TwinCost,
     calibrate,
     expected_engine_cost,
+    mean_engine_cost,
 )
 from service.core.errors import InputError
 from service.core.pacing import PacingClock
@@ -612,16 +613,13 @@ def test_calibration_measures_thread_cpu_per_simulated_second():
 
 
 # ---- the registry: 503 with the reason, the configured twin over capacity --------------------------
-def test_registry_refuses_a_twin_beyond_the_measured_capacity(monkeypatch):
-    import service.core.registry as registry_module
+def _open_registry_on_two_cores():
+    """A registry with measured admission, no start twin, zenoh and recording off, two stepping
+    threads on two cores (whatever runs the test) at core_fraction 0.85 and no reserve: a budget
+    of 1.7 CPU s/s, so the tests' arithmetic is the rule's alone."""
     from service.core.registry import TwinRegistry
-    from service.core.runner import TwinRunner
     from service.settings import ServiceSettings
 
-    costs = iter([TwinCost(0.6, 0.05), TwinCost(0.6, 0.05), TwinCost(0.9, 0.05), TwinCost(0.6, 0.05)])
-    monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: next(costs))
-    # the running twins' costs as calibrated (not as this machine's speed would measure them)
-    monkeypatch.setattr(TwinRunner, "cost", property(lambda self: self.calibration))
     settings = ServiceSettings(
         enable_zenoh=False,
         enable_recording=False,
@@ -630,10 +628,21 @@ def test_registry_refuses_a_twin_beyond_the_measured_capacity(monkeypatch):
         capacity_core_fraction=0.85,
         start_twin=False,
         capacity_reserve_cores=0.0,
-    )  # the arithmetic below without the reserve
+    )
     reg = TwinRegistry(settings)
-    reg.capacity.cores = 2  # this test's host has 2 cores, whatever runs it
-    reg.open()
+    reg.capacity.cores = 2
+    return reg.open()
+
+
+def test_registry_refuses_a_twin_beyond_the_measured_capacity(monkeypatch):
+    import service.core.registry as registry_module
+    from service.core.runner import TwinRunner
+
+    costs = iter([TwinCost(0.6, 0.05), TwinCost(0.6, 0.05), TwinCost(0.9, 0.05), TwinCost(0.6, 0.05)])
+    monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: next(costs))
+    # the running twins' costs as calibrated (not as this machine's speed would measure them)
+    monkeypatch.setattr(TwinRunner, "cost", property(lambda self: self.calibration))
+    reg = _open_registry_on_two_cores()
     try:
         reg.create_twin(id="a", designation="6205")  # 0.65 of 1.7
         reg.create_twin(id="b", designation="6205")  # 1.3 of 1.7
@@ -709,13 +718,13 @@ def test_health_counts_the_measured_service_overhead_in_the_capacity(monkeypatch
 
 
 def test_expected_engine_cost_is_the_calibration_or_what_twins_alike_measure():
-    """service.core.capacity.expected_engine_cost: the larger of the lone calibration and the mean
-    measured cost of the running twins alike (the calibration alone with none measured; non-positive
-    or non-finite measurements left out)."""
-    assert expected_engine_cost(0.28, [0.42, 0.46]) == pytest.approx(0.44)
-    assert expected_engine_cost(0.28, []) == 0.28
-    assert expected_engine_cost(0.40, [0.30]) == 0.40  # a calibration above what runs counts as it is
-    assert expected_engine_cost(0.28, [math.nan, 0.0, 0.42]) == pytest.approx(0.42)
+    """service.core.capacity.expected_engine_cost of mean_engine_cost: the larger of the lone
+    calibration and the mean measured cost of the running twins alike (the calibration alone with
+    none measured; non-positive or non-finite measurements left out)."""
+    assert expected_engine_cost(0.28, mean_engine_cost([0.42, 0.46])) == pytest.approx(0.44)
+    assert expected_engine_cost(0.28, mean_engine_cost([])) == 0.28
+    assert expected_engine_cost(0.40, mean_engine_cost([0.30])) == 0.40  # a calibration above what runs counts as it is
+    assert expected_engine_cost(0.28, mean_engine_cost([math.nan, 0.0, 0.42])) == pytest.approx(0.42)
     assert TwinCost(0.28, 0.02).with_engine(0.42) == TwinCost(0.42, 0.02)
 
 
@@ -728,22 +737,9 @@ def test_a_twin_alike_a_running_one_counts_at_what_that_one_measures(monkeypatch
     from types import SimpleNamespace
 
     import service.core.registry as registry_module
-    from service.core.registry import TwinRegistry
-    from service.settings import ServiceSettings
 
     monkeypatch.setattr(registry_module, "calibrate", lambda twin, **kw: TwinCost(0.3, 0.05))
-    settings = ServiceSettings(
-        enable_zenoh=False,
-        enable_recording=False,
-        admission="measured",
-        stepping_threads=2,
-        capacity_core_fraction=0.85,
-        start_twin=False,
-        capacity_reserve_cores=0.0,
-    )
-    reg = TwinRegistry(settings)
-    reg.capacity.cores = 2
-    reg.open()
+    reg = _open_registry_on_two_cores()
     try:
         reg.create_twin(id="a", designation="6205")
         cap = reg.health()["capacity"]
