@@ -453,7 +453,9 @@ class Twin:
 
     def advance(self, seconds: float, frame_steps: int | None = None, *, max_restarts: int | None = None) -> int:
         """Integrate `seconds` of simulated time (a whole number of steps, the nearest) in frames of
-        `frame_steps` steps (default: FRAME_S of simulated time).
+        `frame_steps` steps (default: FRAME_S of simulated time). With the thermal network on, a
+        frame also ends where the network's next step is due, so the network steps every period
+        it states (ThermalCoupling.period_s) whatever frames the caller asks for.
 
         A state the kernel cannot hold at the setpoint in force fails again right after its warm
         restart, i.e. at nearly every step (each restart costs a warm start): `max_restarts`
@@ -471,6 +473,8 @@ class Twin:
         self.frame_interrupted = False
         while remaining > 0:
             n = min(frame_steps, remaining)
+            if self.thermal is not None:  # no frame runs past a network step (its period is exact)
+                n = min(n, self.thermal.steps_to_due(self.model.dt_s))
             remaining -= max(self._frame(n), 1)  # a failing frame still consumes a step: no hang
             if max_restarts is not None and self.restarts - first >= max_restarts:
                 return max(remaining, 0)

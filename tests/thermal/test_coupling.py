@@ -189,3 +189,31 @@ def test_the_rate_of_rise_is_over_a_minute_from_the_start():
     assert late.outer_ring_rate_k_per_min == pytest.approx(
         60.0 * (hist[-1][1] - hist[0][1]) / (hist[-1][0] - hist[0][0]), rel=1e-9
     )
+
+
+def test_the_network_steps_at_its_period_whatever_the_callers_frames():
+    """The network steps every `thermal_period_s` of thermal time (1 s; ModelOptions, docs/physics.md
+    "Thermal network") also when the caller's frames are longer than that period: the service's
+    runner advances a twin in 20 ms frames, which at x1000 are 20 s of thermal time. A frame
+    ends where the network is due (Twin.advance), so 1 ms and 20 ms frames give the same
+    temperatures (to 1e-9 K). Stepped 20 s at a time instead, the balls' node ran up to 2.5 K
+    ahead within the first 100 s (the period study, twin.validation.thermal_studies: 20 s
+    steps move the nodes by 1.4 K over the whole start-up)."""
+
+    def run(frame_s: float | None):
+        twin = Twin(
+            "6208",
+            options=ACCELERATED,
+            setpoint=Setpoint(shaft_speed_rad_s=1000.0, radial_load_n=3000.0, oil_temperature_c=20.0),
+        )
+        temps = []
+        for _ in range(3):  # 60 s of thermal time
+            twin.advance(0.02, frame_steps=None if frame_s is None else round(frame_s / twin.model.dt_s))
+            temps.append(twin.thermal.temperature_c.copy())
+        return temps, twin.thermal.network_time_s
+
+    fine, t_fine = run(None)  # FRAME_S = 1 ms frames: one network step per frame at x1000
+    coarse, t_coarse = run(0.02)  # the runner's frame
+    assert t_coarse == pytest.approx(t_fine, abs=1e-9) == pytest.approx(60.0, abs=1e-6)
+    for a, b in zip(fine, coarse, strict=True):
+        assert abs(a - b).max() < 1e-9

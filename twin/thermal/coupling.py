@@ -1,7 +1,7 @@
 """`ThermalCoupling`: the thermal network in the loop of a `Twin`, at its own multirate period.
 
 Every `period_s` of simulated time (ModelOptions.thermal_period_s of thermal time times the
-heat-capacity scale, a whole number of frames) the twin hands it the
+heat-capacity scale, a whole number of frames; `Twin.advance` ends a frame there) the twin hands it the
 engine's contact lanes and its drive power; it turns them into heat by contact and source
 (twin.thermal.sources, or the friction laws' own split when the engine states it), assembles
 the network at the operating point (twin.thermal.network), advances the node temperatures by
@@ -197,6 +197,11 @@ class ThermalCoupling:
         """Count `elapsed_s` of simulated time; True when a network period is complete."""
         self.since_step_s += elapsed_s
         return self.since_step_s >= self.period_s - 0.5 * dt_s
+
+    def steps_to_due(self, dt_s: float) -> int:
+        """The fewest steps of `dt_s` [s] after which `due` holds (at least 1): a frame of the
+        engine ends there, so the network steps every `period_s` whatever the caller's frames."""
+        return max(1, math.ceil((self.period_s - self.since_step_s) / dt_s - 0.5 - 1e-9))
 
     def operating_point(self, contacts: np.ndarray, scalars: np.ndarray, ball_spin_rad_s: float) -> Operating:
         """The conductances' operating point from the engine's state."""
