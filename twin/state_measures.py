@@ -4,7 +4,7 @@ the loaded inner contacts' mean entrainment speed and the loaded zone's ball cou
 eq. 10).
 
 Plain functions of a `BearingModel` and a `TwinState`: they read, never write. numpy, but for the
-kinetic energy's sums, compiled: the frame loop takes it before and after each 1 ms compiled call.
+kinetic energy's sums, compiled: the frame loop takes it before and after each compiled call.
 """
 
 from __future__ import annotations
