@@ -36,7 +36,7 @@ from twin.vibration.signal import noise_sigma, read_ring
 WAVEFORM_QUEUE_S = 10.0  # undrained waveform kept for `drain_waveform` [s of signal]; older is dropped
 # The engine drains the ring after every frame only once this much signal has accumulated (or when
 # asked: `flush`, called by Twin.vibration and Twin.drain_waveform): a drain costs ~35 us of Python
-# (numpy calls), ~110 ns per step when done after every 1 ms frame.
+# (numpy calls), ~110 ns per step if it were done after every 1 ms of simulated time.
 DRAIN_EVERY_S = 0.01
 
 

@@ -43,13 +43,12 @@ from twin.state import MAX_DEFECTS, TwinState, make_state
 from twin.thermal.coupling import ThermalCoupling
 from twin.thermal.expansion import write_groove_lanes
 from twin.thermal.sources import friction_heat
+from twin.timestep import STEP_DIVISOR_S
 from twin.vibration.defects import BallDefect, defect_row, validate_defects
 from twin.warmstart import place_on_housing, warm_start
 
 FRAME_S = 1e-2  # simulated time per compiled call of `advance` by default [s]: the inlet's and the life's
-# refresh period, so each call ends where one is due (the Python between calls, ~40-60 us, is then
-# ~1 % of the engine instead of ~10 % at 1 ms calls; the service's runner asks for 20 ms)
-THERMAL_UNIT_S = 1e-3  # the thermal network's period is a whole number of these [s] (the auto step divides it)
+# refresh period, so each call ends where one is due and the Python between calls runs once per refresh
 RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
 
 
@@ -112,11 +111,11 @@ class Twin:
         if self.model.options.thermal == "network":
             opts = self.model.options
             period = opts.thermal_period_s * opts.thermal_network.heat_capacity_scale  # thermal -> simulated time
-            units = max(1, int(round(period / THERMAL_UNIT_S)))
+            units = max(1, int(round(period / STEP_DIVISOR_S)))  # a whole number of steps
             self.thermal = ThermalCoupling(
                 self.model,
                 opts.thermal_network,
-                units * THERMAL_UNIT_S,
+                units * STEP_DIVISOR_S,
                 (setpoint or self.default_setpoint()).oil_temperature_c,
             )
         c = self.state.contacts

@@ -528,8 +528,8 @@ class ModelOptions(BaseModel):
         ge=0.01,
         le=60.0,
         description="The thermal network's step [s of thermal time]: every thermal_period_s x heat_capacity_scale of "
-        "simulated time, a whole number of 1 ms engine frames (the nearest, at least 1); a longer frame asked of "
-        "Twin.advance (the service's 20 ms) ends there, so the step holds whatever the caller. The exponential "
+        "simulated time, a whole number of milliseconds (the nearest, at least 1); a frame of Twin.advance (10 ms "
+        "by default, the service's 20 ms) ends there, so the step holds whatever the caller. The exponential "
         "step is exact for any step; the heat is held over it while the friction falls with the temperature (an "
         "explicit coupling), so it stays short against the balls' time constants (2-10 s). "
         "twin.validation.thermal_studies.period_study (6208 start-up from cold, 1000 rad/s, 3000 N, accelerated "

@@ -34,8 +34,8 @@ of each mode phi^T C phi / (2 omega phi^T M phi)):
   mass, critical damping (seed 000 section 2.1).
 
 `time_step_s = "auto"` is `SAFETY_FACTOR` x the smallest critical step, rounded down to a whole
-divisor of the 1 ms frame (so a frame, the runner's 1 ms and every sampling period that is a
-multiple of it hold a whole number of steps).
+divisor of `STEP_DIVISOR_S` = 1 ms (so the engine's frames, the runner's and every period that is a
+whole number of milliseconds hold a whole number of steps).
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ AUTO: Final = "auto"
 # step for these. Accuracy is not what sets it: `twin.validation.timestep_study` shows that the outputs at
 # the auto step agree with 1 us within the study's tolerances over the operating envelope.
 SAFETY_FACTOR = 0.8
-FRAME_S = 1e-3  # the auto step divides the 1 ms frame
+STEP_DIVISOR_S = 1e-3  # the auto step divides 1 ms [s]
 REFERENCE_OIL_TEMPERATURE_C = 40.0  # ISO 3448 reference temperature, the seeds' oil temperature
 
 
@@ -111,7 +111,7 @@ class CriticalTimeStep:
 
     @property
     def auto_time_step_s(self) -> float:
-        """SAFETY_FACTOR x the critical step, rounded down to a divisor of the 1 ms frame [s]."""
+        """SAFETY_FACTOR x the critical step, rounded down to a divisor of STEP_DIVISOR_S [s]."""
         return auto_time_step_s(self.critical_step_s)
 
     def as_dict(self) -> dict:
@@ -228,10 +228,12 @@ def estimate(
     )
 
 
-def auto_time_step_s(critical_step_s: float, safety_factor: float = SAFETY_FACTOR, frame_s: float = FRAME_S) -> float:
-    """safety_factor x critical_step_s rounded down to frame_s / n, n a whole number [s]."""
+def auto_time_step_s(
+    critical_step_s: float, safety_factor: float = SAFETY_FACTOR, divisor_s: float = STEP_DIVISOR_S
+) -> float:
+    """safety_factor x critical_step_s rounded down to divisor_s / n, n a whole number [s]."""
     target = min(safety_factor * critical_step_s, TIME_STEP_RANGE_S[1])
-    return frame_s / math.ceil(frame_s / target - 1e-9)
+    return divisor_s / math.ceil(divisor_s / target - 1e-9)
 
 
 def resolve_time_step_s(requested: float | str, critical: CriticalTimeStep) -> float:

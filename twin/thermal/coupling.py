@@ -1,7 +1,7 @@
 """`ThermalCoupling`: the thermal network in the loop of a `Twin`, at its own multirate period.
 
 Every `period_s` of simulated time (ModelOptions.thermal_period_s of thermal time times the
-heat-capacity scale, a whole number of frames; `Twin.advance` ends a frame there) the twin hands it the
+heat-capacity scale, a whole number of milliseconds; `Twin.advance` ends a frame there) the twin hands it the
 engine's contact lanes and its drive power; it turns them into heat by contact and source
 (twin.thermal.sources, or the friction laws' own split when the engine states it), assembles
 the network at the operating point (twin.thermal.network), advances the node temperatures by

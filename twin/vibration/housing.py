@@ -52,7 +52,7 @@ _FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=Fal
 # Whether a bearing's outer ring rides on the housing unless its spec says otherwise. Off: with the
 # housing on, two seed checks leave their tolerances at the auto step (the 7208 B's inner-ring
 # displacement under Fr = Fa 3.1 % off Jones' for 3 %, the 5 A case of the timestep study 0.9 % on
-# mu for 0.5 %), the step no longer divides the 1 ms frame and a step costs ~10 % more (docs/physics.md,
+# mu for 0.5 %), the step no longer divides 1 ms and a step costs ~10 % more (docs/physics.md,
 # Vibration). `bearing-twin vibration` and the vibration bench case switch it on.
 HOUSING_ENABLED_BY_DEFAULT = False
 

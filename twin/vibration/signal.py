@@ -221,7 +221,7 @@ def add_sensor_noise(y, sigma):
 # history is always one contiguous slice, and computes an output every R-th input as one dot
 # product that LLVM vectorises (reassociation allowed for that sum only; the same outputs as the
 # polyphase form to rounding, tests/vibration/test_signal.py): K R / R = K multiply-adds per input
-# on average, in SIMD. Its outputs come in a burst every R steps, which a 1 ms frame does not see.
+# on average, in SIMD. Its outputs come in a burst every R steps, which a frame of the engine does not see.
 DD_POS = 0  # next history slot (input index modulo K R)
 DD_PHASE = 1  # input index modulo R
 DD_OUTPUTS = 2  # outputs produced since reset
