@@ -1,5 +1,7 @@
 """The `CWRU-DE` twin against the measured CWRU drive-end records: `python -m twin.validation.cwru
-[--json] [--duration S]` regenerates the table of docs/validation.md.
+[--json] [--duration S]` regenerates the table of docs/validation.md; `--data DIR` runs the same
+comparison on the records of any directory described by a `manifest.json` in the data set's form
+(other motor loads, larger faults: `records_from_manifest`), predicting each from its metadata.
 
 Measured: the 5 s float32 excerpts committed in tests/data/cwru (Case Western Reserve University
 Bearing Data Center, engineering.case.edu/bearingdatacenter, 0 hp, 0.007 in EDM faults; manifest
@@ -15,6 +17,16 @@ line's height in dB over the median of the envelope spectrum within +-20 Hz of i
 README's SNR). Nothing here is fitted to a fault record: the only rig values calibrated (on the
 healthy record 97) are the housing resonance and the sensor noise (`twin.catalog`,
 `calibrate_housing`).
+
+A record of another motor load runs the twin at that record's speed with the same radial load
+(the rotor's weight, `twin.catalog.default_radial_load_n`: the coupling's forces are not
+published); a larger fault is a pit of the record's diameter, 0.011 in deep (the data center's
+fault specifications; a depth given in the manifest as `fault_depth_in` is used instead: any
+depth beyond the ball's chord drop over the pit, 16 um at 0.028 in, gives the same twin), on the
+SKF 6205 geometry (the data center's 0.028 in faults are in an NTN equivalent). A record sampled
+at a multiple of 12 kHz (the 48 kHz healthy records) is decimated to 12 kHz (FIR, zero phase, as
+the committed 97 excerpt); each record's RMS is taken relative to the healthy record of the same
+motor load in the directory, else to the healthy record of the lowest load.
 """
 
 from __future__ import annotations
@@ -26,7 +38,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.signal import hilbert, welch
+from scipy.signal import decimate, hilbert, welch
 
 from twin.validation.vibration_simulation import simulate_vibration
 from twin.vibration import indicators as ind
@@ -41,9 +53,23 @@ SETTLE_S = 0.3  # simulated start-up discarded before the analysed window [s]
 PUBLISHED_MULTIPLES = {"BPFI": 5.4152, "BPFO": 3.5848, "FTF": 0.39828, "2xBSF": 4.7135}
 
 
+INCH_M = 0.0254
+FAULT_WIDTH_M = 0.007 * INCH_M  # 0.178 mm: the committed records' fault diameter
+FAULT_DEPTH_M = 0.011 * INCH_M  # 0.279 mm: the data center's depth of its 0.007-0.021 in faults
+SAMPLE_RATE_HZ = 12000.0
+# the manifest's fault kinds -> the twin's defect and its expected envelope line
+FAULT_KINDS: dict[str, tuple[str | None, str | None]] = {
+    "normal": (None, None),
+    "inner_race": ("inner", "BPFI"),
+    "outer_race": ("outer", "BPFO"),
+    "ball": ("ball", "2xBSF"),
+}
+OUTER_RACE_ANGLE_DEG = {"6:00": 0.0, "3:00": 90.0, "12:00": 180.0}  # from the centre of the load zone
+
+
 @dataclass(frozen=True)
 class Record:
-    """One committed CWRU excerpt and the twin case it stands for."""
+    """One CWRU record and the twin case it stands for."""
 
     number: int
     file: str
@@ -52,19 +78,82 @@ class Record:
     angle_deg: float  # outer race: from the centre of the load zone [deg]
     rpm: float
     expected: str | None  # the defect line: 'BPFI', 'BPFO', '2xBSF'
+    fault_diameter_m: float = FAULT_WIDTH_M  # the EDM pit's diameter [m]
+    fault_depth_m: float = FAULT_DEPTH_M  # its depth [m]
+    load_hp: float = 0.0  # the dynamometer's motor load [hp]
+    sample_rate_hz: float = SAMPLE_RATE_HZ  # the file's [Hz]
 
 
-RECORDS = (
-    Record(97, "97_DE_12k_5s.npy", "healthy", None, 0.0, 1796.0, None),
-    Record(105, "105_DE_5s.npy", "inner race", "inner", 0.0, 1797.0, "BPFI"),
-    Record(118, "118_DE_5s.npy", "ball", "ball", 0.0, 1796.0, "2xBSF"),
-    Record(130, "130_DE_5s.npy", "outer race 6:00", "outer", 0.0, 1796.0, "BPFO"),
-    Record(144, "144_DE_5s.npy", "outer race 3:00", "outer", 90.0, 1797.0, "BPFO"),
-    Record(156, "156_DE_5s.npy", "outer race 12:00", "outer", 180.0, 1797.0, "BPFO"),
-)
-FAULT_WIDTH_M = 0.007 * 0.0254  # 0.178 mm
-FAULT_DEPTH_M = 0.011 * 0.0254  # 0.279 mm
-SAMPLE_RATE_HZ = 12000.0
+def _field(entry: dict, name: str, where: str, kind=float, allowed=None):
+    """Manifest field `name` of `entry`, checked; ValueError naming the record and the field."""
+    value = entry.get(name)
+    if allowed is not None:
+        if value not in allowed:
+            raise ValueError(f"{where}: {name} = {value!r}, expected one of {sorted(map(str, allowed))}")
+        return value
+    try:
+        out = kind(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where}: {name} = {value!r} is not a {kind.__name__}") from None
+    if kind is float and not (math.isfinite(out) and out >= 0.0):
+        raise ValueError(f"{where}: {name} = {value!r} must be a finite number >= 0")
+    return out
+
+
+def records_from_manifest(path: Path) -> list[Record]:
+    """The records of a `manifest.json` in the CWRU data set's form (a list of entries with
+    `cwru_number`, `file`, `fs_hz`, `rpm`, `fault_kind` normal | inner_race | outer_race | ball,
+    `fault_size_in`, `outer_race_position` 6:00 | 3:00 | 12:00, `load_hp`; optional
+    `fault_depth_in`), by record number. An entry without a record number (a derived file
+    without the record's metadata) is left out. Raises ValueError naming the record and field."""
+    entries = json.loads(Path(path).read_text(encoding="utf-8"))
+    if not isinstance(entries, list):
+        raise ValueError(f"{path}: expected a list of record entries")
+    out = []
+    for k, e in enumerate(entries):
+        if not isinstance(e, dict) or e.get("cwru_number") is None:
+            continue
+        where = f"{path} entry {k} (record {e.get('cwru_number')})"
+        number = _field(e, "cwru_number", where, int)
+        kind = _field(e, "fault_kind", where, allowed=FAULT_KINDS)
+        defect, expected = FAULT_KINDS[kind]
+        angle, condition = 0.0, "healthy"
+        diameter, depth = FAULT_WIDTH_M, FAULT_DEPTH_M
+        if defect is not None:
+            size_in = _field(e, "fault_size_in", where)
+            diameter = size_in * INCH_M
+            depth = _field(e, "fault_depth_in", where) * INCH_M if e.get("fault_depth_in") is not None else depth
+            condition = f"{kind.replace('_', ' ')} {size_in:g} in"
+            if defect == "outer":
+                position = _field(e, "outer_race_position", where, allowed=OUTER_RACE_ANGLE_DEG)
+                angle = OUTER_RACE_ANGLE_DEG[position]
+                condition += f" at {position}"
+        load_hp = _field(e, "load_hp", where)
+        out.append(
+            Record(
+                number,
+                str(_field(e, "file", where, str)),
+                f"{condition}, {load_hp:g} hp",
+                defect,
+                angle,
+                _field(e, "rpm", where),
+                expected,
+                diameter,
+                depth,
+                load_hp,
+                _field(e, "fs_hz", where),
+            )
+        )
+    return sorted(out, key=lambda r: r.number)
+
+
+def committed_records() -> tuple[Record, ...]:
+    """The records of the committed excerpts (tests/data/cwru; () where the tests are not installed)."""
+    path = DATA_DIR / "manifest.json"
+    return tuple(records_from_manifest(path)) if path.exists() else ()
+
+
+RECORDS = committed_records()
 
 
 @dataclass(frozen=True)
@@ -127,6 +216,14 @@ def measured(record: Record, duration_s: float | None = None, data_dir: Path = D
     its analysis. Compare with a simulation of the same duration: a line's height over its
     background grows with the record's length (the background per bin falls as 1 / sqrt(length))."""
     x = np.load(data_dir / record.file).astype(float) * G_M_S2
+    factor = record.sample_rate_hz / SAMPLE_RATE_HZ
+    if abs(factor - round(factor)) > 1e-9 or round(factor) < 1:
+        raise ValueError(
+            f"record {record.number}: fs_hz = {record.sample_rate_hz:g} Hz is not a whole multiple of "
+            f"{SAMPLE_RATE_HZ:g} Hz"
+        )
+    if round(factor) > 1:
+        x = decimate(x, int(round(factor)), ftype="fir", zero_phase=True)
     if duration_s is not None:
         x = x[: int(round(duration_s * SAMPLE_RATE_HZ))]
     return analyse(x, SAMPLE_RATE_HZ, record.rpm, record.expected), x
@@ -139,9 +236,9 @@ def simulated(record: Record, duration_s: float = 1.0, settle_s: float = SETTLE_
         record.rpm * 2.0 * math.pi / 60.0,
         None,
         defect=record.defect,
-        defect_size_m=FAULT_WIDTH_M,
-        defect_length_m=FAULT_WIDTH_M,
-        defect_depth_m=FAULT_DEPTH_M,
+        defect_size_m=record.fault_diameter_m,
+        defect_length_m=record.fault_diameter_m,
+        defect_depth_m=record.fault_depth_m,
         defect_angle_deg=record.angle_deg,
         duration_s=duration_s,
         settle_s=settle_s,
@@ -151,18 +248,32 @@ def simulated(record: Record, duration_s: float = 1.0, settle_s: float = SETTLE_
     return analyse(x, SAMPLE_RATE_HZ, record.rpm, record.expected), x
 
 
-def compare(duration_s: float = 1.0, records=RECORDS) -> list[dict]:
-    """Per record: measured and twin analyses, and the RMS relative to each side's healthy."""
+def compare(duration_s: float = 1.0, records=RECORDS, data_dir: Path = DATA_DIR) -> list[dict]:
+    """Per record: its conditions, measured and twin analyses, and the RMS relative to the healthy
+    record of the same motor load (else of the lowest load), measured and twin each against its own."""
     rows = []
     for rec in records:
-        m, _ = measured(rec, duration_s)
+        m, _ = measured(rec, duration_s, data_dir)
         s, _ = simulated(rec, duration_s)
-        rows.append({"record": rec.number, "condition": rec.condition, "measured": asdict(m), "twin": asdict(s)})
-    healthy = next((r for r in rows if r["condition"] == "healthy"), None)
+        rows.append(
+            {
+                "record": rec.number,
+                "condition": rec.condition,
+                "rpm": rec.rpm,
+                "load_hp": rec.load_hp,
+                "fault_diameter_m": rec.fault_diameter_m if rec.defect else None,
+                "fault_depth_m": rec.fault_depth_m if rec.defect else None,
+                "measured": asdict(m),
+                "twin": asdict(s),
+            }
+        )
+    healthy = sorted((r for r in rows if r["condition"].startswith("healthy")), key=lambda r: r["load_hp"])
     for r in rows:
-        if healthy is not None:
-            r["measured"]["rms_ratio"] = r["measured"]["rms_g"] / healthy["measured"]["rms_g"]
-            r["twin"]["rms_ratio"] = r["twin"]["rms_g"] / healthy["twin"]["rms_g"]
+        ref = next((h for h in healthy if h["load_hp"] == r["load_hp"]), healthy[0] if healthy else None)
+        if ref is not None:
+            r["healthy_record"] = ref["record"]
+            r["measured"]["rms_ratio"] = r["measured"]["rms_g"] / ref["measured"]["rms_g"]
+            r["twin"]["rms_ratio"] = r["twin"]["rms_g"] / ref["twin"]["rms_g"]
     return rows
 
 
@@ -273,8 +384,21 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m twin.validation.cwru", description=__doc__.splitlines()[0])
     parser.add_argument("--duration", type=float, default=1.0, help="analysed simulated time per record [s]")
     parser.add_argument("--json", action="store_true")
+    parser.add_argument(
+        "--data",
+        type=Path,
+        default=None,
+        metavar="DIR",
+        help="a directory of CWRU drive-end records (.npy in g) with their manifest.json (default: the committed "
+        "excerpts, tests/data/cwru)",
+    )
     args = parser.parse_args(argv)
-    rows = compare(args.duration)
+    data_dir = args.data if args.data is not None else DATA_DIR
+    try:
+        records = records_from_manifest(data_dir / "manifest.json") if args.data is not None else list(RECORDS)
+    except (OSError, ValueError) as exc:
+        parser.error(str(exc))
+    rows = compare(args.duration, records, data_dir)
     print(json.dumps(rows, indent=1) if args.json else markdown(rows))
     return 0
 
