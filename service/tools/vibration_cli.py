@@ -8,7 +8,9 @@ Formats: `.npy` (a 1-D array, or 2-D with --column), `.csv` (numbers, comma sepa
 sample; --column picks the column, lines starting with '#' and a non-numeric header row are
 skipped), `.wav` (scipy.io.wavfile: float samples as they are, integer PCM scaled to +-1 at full
 scale and multiplied by --full-scale; the file's rate is the sample rate, --sample-rate must
-agree when given). Units: --units g (x 9.80665) or m/s2.
+agree when given), `.mat` (MATLAB 5, as the CWRU Bearing Data Center publishes its records:
+--variable names the channel, by default the one `*_DE_time` variable, or the file's only
+numeric vector). Units: --units g (x 9.80665) or m/s2.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ from service.tools.stdout import print_document
 
 STANDARD_GRAVITY_M_S2 = 9.80665
 UNITS = {"g": STANDARD_GRAVITY_M_S2, "m/s2": 1.0}
-FORMATS = (".npy", ".csv", ".wav")
+FORMATS = (".npy", ".csv", ".wav", ".mat")
 
 
 class RecordError(ValueError):
@@ -50,9 +52,44 @@ def _pick_column(data: np.ndarray, column: int, what: str) -> np.ndarray:
     return data[:, column]
 
 
-def read_record(path: Path, column: int = 0, full_scale: float = 1.0) -> tuple[np.ndarray, float | None]:
-    """(samples in the file's units, the file's sample rate [Hz] or None) of a .npy, .csv or .wav
-    record (module docstring). Raises RecordError naming FILE / --column."""
+def _mat_channel(path: Path, variable: str | None) -> np.ndarray:
+    """The channel of a .mat record: `variable`, else the one `*_DE_time` (the CWRU drive end's),
+    else the file's only numeric vector. RecordError naming --variable with the file's variables."""
+    import scipy.io
+
+    try:
+        data = scipy.io.loadmat(path)
+    except scipy.io.matlab.MatReadError as exc:
+        raise RecordError("FILE", f"{path.name} is not a readable .mat record ({exc})") from None
+    vectors = {
+        k: v
+        for k, v in data.items()
+        if not k.startswith("__") and isinstance(v, np.ndarray) and v.dtype.kind in "iuf" and v.size > 1
+    }
+    names = ", ".join(sorted(vectors)) or "none"
+    if variable is not None:
+        if variable not in vectors:
+            raise RecordError("--variable", f"{variable!r} is not a numeric vector of {path.name}; allowed: {names}")
+        chosen = variable
+    else:
+        drive_end = [k for k in vectors if k.endswith("_DE_time")]
+        candidates = drive_end if drive_end else list(vectors)
+        if len(candidates) != 1:
+            raise RecordError(
+                "--variable", f"{path.name} holds {len(candidates)} candidate channels; pick one of: {names}"
+            )
+        chosen = candidates[0]
+    v = np.asarray(vectors[chosen])
+    if v.ndim == 2 and 1 in v.shape:
+        v = v.reshape(-1)
+    return v
+
+
+def read_record(
+    path: Path, column: int = 0, full_scale: float = 1.0, variable: str | None = None
+) -> tuple[np.ndarray, float | None]:
+    """(samples in the file's units, the file's sample rate [Hz] or None) of a .npy, .csv, .wav or
+    .mat record (module docstring). Raises RecordError naming FILE / --column / --variable."""
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise RecordError("FILE", f"{path.name}: unknown format {suffix or '(none)'}; allowed {', '.join(FORMATS)}")
@@ -62,6 +99,8 @@ def read_record(path: Path, column: int = 0, full_scale: float = 1.0) -> tuple[n
     try:
         if suffix == ".npy":
             data = np.load(path, allow_pickle=False)
+        elif suffix == ".mat":
+            data = _mat_channel(path, variable)
         elif suffix == ".csv":
             try:
                 data = np.loadtxt(path, delimiter=",", comments="#", ndmin=1)
@@ -105,7 +144,7 @@ def analyse_file(args: argparse.Namespace) -> dict:
     from twin.vibration.analysis import MAX_SAMPLE_RATE_HZ, AnalysisInputError, analyse_signal, defect_multiples_of
 
     path = Path(args.file)
-    x, file_rate = read_record(path, args.column, args.full_scale)
+    x, file_rate = read_record(path, args.column, args.full_scale, args.variable)
     if file_rate is not None and args.sample_rate is not None and abs(file_rate - args.sample_rate) > 1e-9 * file_rate:
         raise RecordError("--sample-rate", f"{args.sample_rate:g} Hz disagrees with the file's {file_rate:g} Hz")
     rate = file_rate if file_rate is not None else args.sample_rate
@@ -194,11 +233,11 @@ def add_analyse_command(vibration_parser: argparse.ArgumentParser) -> None:
     sub = vibration_parser.add_subparsers(dest="vibration_command")
     an = sub.add_parser(
         "analyse",
-        help="analyse a measured accelerometer record (.npy, .csv, .wav)",
+        help="analyse a measured accelerometer record (.npy, .csv, .wav, .mat)",
         description=__doc__,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    an.add_argument("file", metavar="FILE", help="record: .npy, .csv or .wav")
+    an.add_argument("file", metavar="FILE", help="record: .npy, .csv, .wav or .mat")
     an.add_argument("--sample-rate", type=float, default=None, help="sample rate [Hz] (.wav: from the file)")
     an.add_argument("--rpm", type=float, required=True, help="shaft speed [rev/min]")
     an.add_argument(
@@ -223,6 +262,11 @@ def add_analyse_command(vibration_parser: argparse.ArgumentParser) -> None:
     )
     an.add_argument("--units", choices=sorted(UNITS), default="m/s2", help="units of the samples (default m/s2)")
     an.add_argument("--column", type=int, default=0, help="column of a 2-D .npy or .csv (default 0)")
+    an.add_argument(
+        "--variable",
+        default=None,
+        help="variable of a .mat record (default: the one *_DE_time, the CWRU drive end's, or the only vector)",
+    )
     an.add_argument(
         "--full-scale", type=float, default=1.0, help="value, in --units, of an integer .wav's full scale (default 1)"
     )

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import scipy.io
 import scipy.io.wavfile
 
 from service.tools.cli import main
@@ -101,3 +102,35 @@ def test_nan_in_the_record_is_refused(tmp_path, capsys):
     np.save(bad, x)
     code, _, err = _run(capsys, bad, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205")
     assert code == 2 and "FILE: 1 non-finite samples (first at index 100)" in err
+
+
+def test_a_cwru_mat_file_is_read_as_the_data_center_publishes_it(tmp_path, capsys):
+    """The data center's .mat files (MATLAB 5) hold the drive end, the fan end and the base as
+    column vectors `X105_DE_time`, `X105_FE_time`, `X105_BA_time` and the speed `X105RPM`: the drive
+    end is taken by default and gives the .npy's analysis exactly; --variable picks another; a file
+    with two drive-end channels (the data center's 99.mat also holds X098_DE_time) needs --variable,
+    and the error lists the file's channels."""
+    x = np.load(RECORD)
+    mat = tmp_path / "105.mat"
+    scipy.io.savemat(
+        mat, {"X105_DE_time": x[:, None], "X105_FE_time": 0.5 * x[:, None], "X105RPM": np.array([[1797.0]])}
+    )
+    args = ["--sample-rate", 12000, "--rpm", 1797, "--units", "g", *LINES, "--json"]
+    code, out, err = _run(capsys, mat, *args)
+    assert code == 0, err
+    code_npy, out_npy, _ = _run(capsys, RECORD, *args)
+    strip = lambda text: {k: v for k, v in json.loads(text).items() if k != "input"}  # noqa: E731
+    assert code_npy == 0 and strip(out) == strip(out_npy)
+    code, out, err = _run(capsys, mat, *args, "--variable", "X105_FE_time")
+    assert code == 0, err
+    assert json.loads(out)["rms_m_s2"] == pytest.approx(0.5 * json.loads(out_npy)["rms_m_s2"], rel=1e-6)
+    two = tmp_path / "99.mat"
+    scipy.io.savemat(two, {"X098_DE_time": x[:, None], "X099_DE_time": x[:, None]})
+    code, out, err = _run(capsys, two, *args)
+    assert code == 2 and "--variable: 99.mat holds 2 candidate channels; pick one of: X098_DE_time, X099_DE_time" in err
+    code, out, err = _run(capsys, mat, *args, "--variable", "X105RPM")
+    assert code == 2 and "--variable: 'X105RPM' is not a numeric vector of 105.mat" in err
+    bad = tmp_path / "bad.mat"
+    bad.write_text("not a mat file")
+    code, out, err = _run(capsys, bad, *args)
+    assert code == 2 and "FILE: bad.mat is not a readable .mat record" in err
