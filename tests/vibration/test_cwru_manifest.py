@@ -121,6 +121,7 @@ def test_the_comparison_runs_on_a_held_out_directory(held_out, capsys):
         ({"outer_race_position": None}, "outer_race_position"),
         ({"rpm": "fast"}, "rpm"),
         ({"fault_size_in": -0.007}, "fault_size_in"),
+        ({"file": None}, "file"),
     ],
 )
 def test_a_bad_manifest_entry_is_refused_naming_the_record_and_the_field(tmp_path, change, field, capsys):

@@ -100,6 +100,13 @@ def _field(entry: dict, name: str, where: str, kind=float, allowed=None):
     return out
 
 
+def _file_name(entry: dict, where: str) -> str:
+    name = entry.get("file")
+    if not isinstance(name, str) or not name.strip():
+        raise ValueError(f"{where}: file = {name!r}, expected the record's file name")
+    return name
+
+
 def records_from_manifest(path: Path) -> list[Record]:
     """The records of a `manifest.json` in the CWRU data set's form (a list of entries with
     `cwru_number`, `file`, `fs_hz`, `rpm`, `fault_kind` normal | inner_race | outer_race | ball,
@@ -132,7 +139,7 @@ def records_from_manifest(path: Path) -> list[Record]:
         out.append(
             Record(
                 number,
-                str(_field(e, "file", where, str)),
+                _file_name(e, where),
                 f"{condition}, {load_hp:g} hp",
                 defect,
                 angle,
