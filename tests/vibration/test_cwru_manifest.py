@@ -122,6 +122,8 @@ def test_the_comparison_runs_on_a_held_out_directory(held_out, capsys):
         ({"rpm": "fast"}, "rpm"),
         ({"fault_size_in": -0.007}, "fault_size_in"),
         ({"file": None}, "file"),
+        ({"rpm": 0}, "rpm"),
+        ({"load_hp": -1}, "load_hp"),
     ],
 )
 def test_a_bad_manifest_entry_is_refused_naming_the_record_and_the_field(tmp_path, change, field, capsys):

@@ -84,8 +84,9 @@ class Record:
     sample_rate_hz: float = SAMPLE_RATE_HZ  # the file's [Hz]
 
 
-def _field(entry: dict, name: str, where: str, kind=float, allowed=None):
-    """Manifest field `name` of `entry`, checked; ValueError naming the record and the field."""
+def _field(entry: dict, name: str, where: str, kind=float, allowed=None, zero_ok: bool = False):
+    """Manifest field `name` of `entry`, checked (a number > 0, or >= 0 with `zero_ok`; or one of
+    `allowed`); ValueError naming the record and the field."""
     value = entry.get(name)
     if allowed is not None:
         if value not in allowed:
@@ -95,8 +96,8 @@ def _field(entry: dict, name: str, where: str, kind=float, allowed=None):
         out = kind(value)
     except (TypeError, ValueError):
         raise ValueError(f"{where}: {name} = {value!r} is not a {kind.__name__}") from None
-    if kind is float and not (math.isfinite(out) and out >= 0.0):
-        raise ValueError(f"{where}: {name} = {value!r} must be a finite number >= 0")
+    if kind is float and not (math.isfinite(out) and (out >= 0.0 if zero_ok else out > 0.0)):
+        raise ValueError(f"{where}: {name} = {value!r} must be a finite number {'>=' if zero_ok else '>'} 0")
     return out
 
 
@@ -135,7 +136,7 @@ def records_from_manifest(path: Path) -> list[Record]:
                 position = _field(e, "outer_race_position", where, allowed=OUTER_RACE_ANGLE_DEG)
                 angle = OUTER_RACE_ANGLE_DEG[position]
                 condition += f" at {position}"
-        load_hp = _field(e, "load_hp", where)
+        load_hp = _field(e, "load_hp", where, zero_ok=True)
         out.append(
             Record(
                 number,
