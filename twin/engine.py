@@ -111,7 +111,7 @@ class Twin:
         if self.model.options.thermal == "network":
             opts = self.model.options
             period = opts.thermal_period_s * opts.thermal_network.heat_capacity_scale  # thermal -> simulated time
-            units = max(1, int(round(period / STEP_DIVISOR_S)))  # a whole number of steps
+            units = max(1, int(round(period / STEP_DIVISOR_S)))  # a whole number of auto steps
             self.thermal = ThermalCoupling(
                 self.model,
                 opts.thermal_network,

@@ -59,8 +59,8 @@ def _mat_channel(path: Path, variable: str | None) -> np.ndarray:
 
     try:
         data = scipy.io.loadmat(path)
-    except scipy.io.matlab.MatReadError as exc:
-        raise RecordError("FILE", f"{path.name} is not a readable .mat record ({exc})") from None
+    except (scipy.io.matlab.MatReadError, NotImplementedError, ValueError) as exc:  # NotImplementedError: v7.3 (HDF5)
+        raise RecordError("FILE", f"{path.name} is not a readable MATLAB 5 .mat record ({exc})") from None
     vectors = {
         k: v
         for k, v in data.items()

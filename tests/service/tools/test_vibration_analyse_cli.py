@@ -133,4 +133,9 @@ def test_a_cwru_mat_file_is_read_as_the_data_center_publishes_it(tmp_path, capsy
     bad = tmp_path / "bad.mat"
     bad.write_text("not a mat file")
     code, out, err = _run(capsys, bad, *args)
-    assert code == 2 and "FILE: bad.mat is not a readable .mat record" in err
+    assert code == 2 and "FILE: bad.mat is not a readable MATLAB 5 .mat record" in err
+    v73 = tmp_path / "v73.mat"  # MATLAB 7.3 (HDF5): the header of one, which scipy refuses
+    header = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 ."
+    v73.write_bytes(header.ljust(124) + b"\x00\x02IM" + bytes(400))
+    code, out, err = _run(capsys, v73, *args)
+    assert code == 2 and "FILE: v73.mat is not a readable MATLAB 5 .mat record (Please use HDF reader" in err
