@@ -10,7 +10,8 @@ skipped), `.wav` (scipy.io.wavfile: float samples as they are, integer PCM scale
 scale and multiplied by --full-scale; the file's rate is the sample rate, --sample-rate must
 agree when given), `.mat` (MATLAB 5, as the CWRU Bearing Data Center publishes its records:
 --variable names the channel, by default the one `*_DE_time` variable, or the file's only
-numeric vector). Units: --units g (x 9.80665) or m/s2.
+numeric vector; without --rpm the file's one `*RPM` value is the speed). Units: --units g
+(x 9.80665) or m/s2.
 """
 
 from __future__ import annotations
@@ -85,6 +86,23 @@ def _mat_channel(path: Path, variable: str | None) -> np.ndarray:
     return v
 
 
+def mat_rpm(path: Path) -> float | None:
+    """The speed a .mat record states [rev/min]: its one scalar `*RPM` variable (the CWRU data
+    center's `X105RPM`), else None."""
+    import scipy.io
+
+    try:
+        data = scipy.io.loadmat(path)
+    except (scipy.io.matlab.MatReadError, NotImplementedError, ValueError):
+        return None
+    found = [
+        float(np.asarray(v).reshape(-1)[0])
+        for k, v in data.items()
+        if k.upper().endswith("RPM") and isinstance(v, np.ndarray) and v.size == 1 and v.dtype.kind in "iuf"
+    ]
+    return found[0] if len(found) == 1 else None
+
+
 def read_record(
     path: Path, column: int = 0, full_scale: float = 1.0, variable: str | None = None
 ) -> tuple[np.ndarray, float | None]:
@@ -154,6 +172,10 @@ def analyse_file(args: argparse.Namespace) -> dict:
         )
     if not (math.isfinite(rate) and 0.0 < rate <= MAX_SAMPLE_RATE_HZ):
         raise RecordError("--sample-rate", f"{rate:g} is out of range; allowed (0, {MAX_SAMPLE_RATE_HZ:g}] Hz")
+    if args.rpm is None:
+        args.rpm = mat_rpm(path) if path.suffix.lower() == ".mat" else None
+        if args.rpm is None:
+            raise RecordError("--rpm", "required (a .mat record may state it as one *RPM value); allowed > 0 rev/min")
     if not (math.isfinite(args.rpm) and 0.0 < args.rpm <= 3.0 * rate):
         raise RecordError("--rpm", f"{args.rpm:g}; allowed (0, {3.0 * rate:g}] (the shaft at most fs / 20)")
     if args.line:
@@ -239,7 +261,9 @@ def add_analyse_command(vibration_parser: argparse.ArgumentParser) -> None:
     )
     an.add_argument("file", metavar="FILE", help="record: .npy, .csv, .wav or .mat")
     an.add_argument("--sample-rate", type=float, default=None, help="sample rate [Hz] (.wav: from the file)")
-    an.add_argument("--rpm", type=float, required=True, help="shaft speed [rev/min]")
+    an.add_argument(
+        "--rpm", type=float, default=None, help="shaft speed [rev/min] (a .mat record's own *RPM value when left out)"
+    )
     an.add_argument(
         "--bearing",
         default=None,

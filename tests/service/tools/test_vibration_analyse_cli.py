@@ -81,6 +81,7 @@ def test_given_band_and_text_output(capsys):
             "--sample-rate: -5 is out of range; allowed (0, 1e+06] Hz",
         ),
         ([RECORD, "--sample-rate", 12000, "--rpm", 0, "--bearing", "6205"], "--rpm: 0; allowed (0, 36000]"),
+        ([RECORD, "--sample-rate", 12000, "--bearing", "6205"], "--rpm: required (a .mat record may state it"),
         ([RECORD, "--sample-rate", 12000, "--rpm", 1e6, "--bearing", "6205"], "--rpm: "),
         ([RECORD, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "9999"], "--bearing: "),
         ([RECORD, "--sample-rate", 12000, "--rpm", 1797], "--bearing: required"),
@@ -107,7 +108,8 @@ def test_nan_in_the_record_is_refused(tmp_path, capsys):
 def test_a_cwru_mat_file_is_read_as_the_data_center_publishes_it(tmp_path, capsys):
     """The data center's .mat files (MATLAB 5) hold the drive end, the fan end and the base as
     column vectors `X105_DE_time`, `X105_FE_time`, `X105_BA_time` and the speed `X105RPM`: the drive
-    end is taken by default and gives the .npy's analysis exactly; --variable picks another; a file
+    end is taken by default and gives the .npy's analysis exactly, at the file's own speed when
+    --rpm is left out; --variable picks another channel; a file
     with two drive-end channels (the data center's 99.mat also holds X098_DE_time) needs --variable,
     and the error lists the file's channels."""
     x = np.load(RECORD)
@@ -121,6 +123,10 @@ def test_a_cwru_mat_file_is_read_as_the_data_center_publishes_it(tmp_path, capsy
     code_npy, out_npy, _ = _run(capsys, RECORD, *args)
     strip = lambda text: {k: v for k, v in json.loads(text).items() if k != "input"}  # noqa: E731
     assert code_npy == 0 and strip(out) == strip(out_npy)
+    no_rpm = [a for a in args if a not in ("--rpm", 1797)]  # the file's X105RPM is the speed
+    code, out, err = _run(capsys, mat, *no_rpm)
+    assert code == 0, err
+    assert json.loads(out)["input"]["rpm"] == 1797.0 and strip(out) == strip(out_npy)
     code, out, err = _run(capsys, mat, *args, "--variable", "X105_FE_time")
     assert code == 0, err
     assert json.loads(out)["rms_m_s2"] == pytest.approx(0.5 * json.loads(out_npy)["rms_m_s2"], rel=1e-6)
