@@ -5,11 +5,13 @@ Bearing Data Center's record metadata: record number, sample rate, speed, fault 
 outer-race position, motor load) is compared record by record, each predicted from its metadata.
 """
 
+import dataclasses
 import json
 import math
 
 import numpy as np
 import pytest
+from scipy.io import savemat
 from scipy.signal import resample_poly
 
 from twin.validation import cwru
@@ -51,7 +53,8 @@ def _entry(number, file, kind, rpm, load_hp, fs=12000, size_in=None, position=No
 def held_out(tmp_path_factory):
     """A held-out-like directory: a 48 kHz healthy record at 2 hp (the committed 97 excerpt
     upsampled 4x), a 0.021 in inner-race record at 2 hp, 1750 rpm (the data center's nominal speed
-    at 2 hp), a 0.014 in outer-race record at 6:00, 3 hp, with a stated depth, and a derived file without
+    at 2 hp), a 0.014 in outer-race record at 6:00, 3 hp, with a stated depth, as the data center's own
+    .mat file (its channel named by the manifest's `variable`), and a derived file without
     a record number (left out). The signals are the committed ones relabelled: what is checked
     is that the twin runs each record's own case."""
     d = tmp_path_factory.mktemp("cwru_held_out")
@@ -59,11 +62,21 @@ def held_out(tmp_path_factory):
     x97 = np.load(src / "97_DE_12k_5s.npy").astype(np.float64)[:12000]
     np.save(d / "99_DE.npy", resample_poly(x97, 4, 1).astype(np.float32))
     np.save(d / "171_DE.npy", np.load(src / "105_DE_5s.npy")[:12000])
-    np.save(d / "191_DE.npy", np.load(src / "130_DE_5s.npy")[:12000])
+    savemat(d / "191.mat", {"X191_DE_time": np.load(src / "130_DE_5s.npy")[:12000, None], "X191RPM": 1730.0})
     manifest = [
         _entry(171, "171_DE.npy", "inner_race", 1750.0, 2, size_in=0.021),
         _entry(99, "99_DE.npy", "normal", 1750.0, 2, fs=48000),
-        _entry(191, "191_DE.npy", "outer_race", 1730.0, 3, size_in=0.014, position="6:00", fault_depth_in=0.02),
+        _entry(
+            191,
+            "191.mat",
+            "outer_race",
+            1730.0,
+            3,
+            size_in=0.014,
+            position="6:00",
+            fault_depth_in=0.02,
+            variable="X191_DE_time",
+        ),
         {"file": "99_DE_12k.npy", "derived_from": "99_DE.npy"},
     ]
     (d / "manifest.json").write_text(json.dumps(manifest))
@@ -134,6 +147,19 @@ def test_a_bad_manifest_entry_is_refused_naming_the_record_and_the_field(tmp_pat
     with pytest.raises(SystemExit) as exc:  # the command line says the same, without a traceback
         cwru.main(["--data", str(tmp_path)])
     assert exc.value.code == 2 and field in capsys.readouterr().err
+
+
+def test_a_mat_record_is_read_from_the_manifests_variable(held_out):
+    """The .mat record gives the same samples as the .npy it was made from; a variable the file does
+    not hold is refused naming the record, the field and the file's variables."""
+    recs = {r.number: r for r in cwru.records_from_manifest(held_out / "manifest.json")}
+    _, x = cwru.measured(recs[191], None, held_out)
+    assert np.array_equal(x, np.load(cwru.DATA_DIR / "130_DE_5s.npy")[:12000].astype(float) * cwru.G_M_S2)
+    wrong = dataclasses.replace(recs[191], variable="X130_DE_time")
+    with pytest.raises(
+        ValueError, match=r"record 191: variable = 'X130_DE_time' is not in 191.mat \(X191RPM, X191_DE_time\)"
+    ):
+        cwru.measured(wrong, None, held_out)
 
 
 def test_a_sample_rate_that_is_not_a_multiple_of_12_khz_is_refused(tmp_path):

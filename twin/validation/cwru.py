@@ -38,6 +38,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
+from scipy.io import loadmat
 from scipy.signal import decimate, hilbert, welch
 
 from twin.validation.vibration_simulation import simulate_vibration
@@ -82,6 +83,7 @@ class Record:
     fault_depth_m: float = FAULT_DEPTH_M  # its depth [m]
     load_hp: float = 0.0  # the dynamometer's motor load [hp]
     sample_rate_hz: float = SAMPLE_RATE_HZ  # the file's [Hz]
+    variable: str | None = None  # the channel in a `.mat` file (`X105_DE_time`)
 
 
 def _field(entry: dict, name: str, where: str, kind=float, allowed=None, zero_ok: bool = False):
@@ -112,8 +114,9 @@ def records_from_manifest(path: Path) -> list[Record]:
     """The records of a `manifest.json` in the CWRU data set's form (a list of entries with
     `cwru_number`, `file`, `fs_hz`, `rpm`, `fault_kind` normal | inner_race | outer_race | ball,
     `fault_size_in`, `outer_race_position` 6:00 | 3:00 | 12:00, `load_hp`; optional
-    `fault_depth_in`), by record number. An entry without a record number (a derived file
-    without the record's metadata) is left out. Raises ValueError naming the record and field."""
+    `fault_depth_in`, and `variable` for a `.mat` file), by record number. An entry without a
+    record number (a derived file without the record's metadata) is left out. Raises ValueError
+    naming the record and field."""
     entries = json.loads(Path(path).read_text(encoding="utf-8"))
     if not isinstance(entries, list):
         raise ValueError(f"{path}: expected a list of record entries")
@@ -150,6 +153,7 @@ def records_from_manifest(path: Path) -> list[Record]:
                 depth,
                 load_hp,
                 _field(e, "fs_hz", where),
+                e.get("variable") if isinstance(e.get("variable"), str) else None,
             )
         )
     return sorted(out, key=lambda r: r.number)
@@ -219,11 +223,23 @@ def analyse(x_m_s2: np.ndarray, sample_rate_hz: float, rpm: float, expected: str
     )
 
 
+def _load_g(path: Path, record: Record) -> np.ndarray:
+    """A record's samples [g]: a `.npy` vector, or the `variable` (`X105_DE_time`) of the data
+    center's own `.mat` file (MATLAB 5)."""
+    if path.suffix.lower() != ".mat":
+        return np.load(path).reshape(-1)
+    data = loadmat(path)
+    if record.variable not in data:
+        names = ", ".join(sorted(k for k in data if not k.startswith("__")))
+        raise ValueError(f"record {record.number}: variable = {record.variable!r} is not in {path.name} ({names})")
+    return np.asarray(data[record.variable]).reshape(-1)
+
+
 def measured(record: Record, duration_s: float | None = None, data_dir: Path = DATA_DIR) -> tuple[Analysis, np.ndarray]:
     """The committed excerpt of `record` [m/s^2] (its first `duration_s`, all of it with None) and
     its analysis. Compare with a simulation of the same duration: a line's height over its
     background grows with the record's length (the background per bin falls as 1 / sqrt(length))."""
-    x = np.load(data_dir / record.file).astype(float) * G_M_S2
+    x = _load_g(data_dir / record.file, record).astype(float) * G_M_S2
     factor = record.sample_rate_hz / SAMPLE_RATE_HZ
     if abs(factor - round(factor)) > 1e-9 or round(factor) < 1:
         raise ValueError(
@@ -397,8 +413,8 @@ def main(argv=None) -> int:
         type=Path,
         default=None,
         metavar="DIR",
-        help="a directory of CWRU drive-end records (.npy in g) with their manifest.json (default: the committed "
-        "excerpts, tests/data/cwru)",
+        help="a directory of CWRU drive-end records (.npy in g, or the data center's .mat) with their "
+        "manifest.json (default: the committed excerpts, tests/data/cwru)",
     )
     args = parser.parse_args(argv)
     data_dir = args.data if args.data is not None else DATA_DIR
