@@ -69,12 +69,14 @@ def simulate_vibration(
     window_s: float | None = None,
     band: str | tuple[float, float] = "resonance",
     diametral_clearance_m: float | None = None,
+    noise_seed: int | None = None,
 ) -> tuple[dict, np.ndarray]:
     """Run the twin with its housing on (and a defect, `defect_for`) and analyse the accelerometer:
     `settle_s` of simulated time is discarded, then `duration_s` is sampled (in-kernel decimator)
     and passed to `run_vibration` with the loaded contact angle of the contacts at the end.
     `diametral_clearance_m`: the mounted clearance [m] in place of the spec's
     (`Mounting.diametral_clearance_m`; negative = preload), for a study of its unknown value.
+    `noise_seed`: the sensor noise's seed in place of the spec's (reproducible runs).
 
     bearing: designation or `BearingSpec` (its housing is switched on; noise density, sample rate
     and window override the spec's accelerometer when given); radial_load_n None: the rig's load of
@@ -99,6 +101,7 @@ def simulate_vibration(
         ("noise_density_m_s2_rthz", noise_density_m_s2_rthz),
         ("sample_rate_hz", sample_rate_hz),
         ("window_s", window_s),
+        ("noise_seed", noise_seed),
     ):
         if value is not None:
             acc[key] = value
