@@ -56,7 +56,7 @@ def plot_comparison(rows: list[dict[str, Any]], path: str | Path) -> None:
     from twin.vibration.indicators import envelope_spectrum
 
     plt = pyplot()
-    fig, axes = plt.subplots(len(rows), 3, figsize=(16, 2.6 * len(rows)), squeeze=False)
+    fig, axes = plt.subplots(len(rows), 3, figsize=(16, 2.9 * len(rows)), squeeze=False)
     fs = cwru.SAMPLE_RATE_HZ
     for ax, r in zip(axes, rows):
         rec = r["record"]
@@ -71,7 +71,9 @@ def plot_comparison(rows: list[dict[str, Any]], path: str | Path) -> None:
             ax[k].set(
                 ylim=(-lim, lim),
                 ylabel="acceleration [g]",
-                title=f"{rec.number} {rec.condition}, {who}: RMS {a.rms_g:.3f} g, kurtosis {a.kurtosis:.2f}",
+            )
+            ax[k].set_title(
+                f"{rec.number} {rec.condition}\n{who}: RMS {a.rms_g:.3f} g, kurtosis {a.kurtosis:.2f}", fontsize=9
             )
         ax[0].set_xlabel("time [ms]")
         ax[1].set_xlabel("time [ms]")
