@@ -53,15 +53,23 @@ def _pick_column(data: np.ndarray, column: int, what: str) -> np.ndarray:
     return data[:, column]
 
 
-def _mat_channel(path: Path, variable: str | None) -> np.ndarray:
-    """The channel of a .mat record: `variable`, else the one `*_DE_time` (the CWRU drive end's),
-    else the file's only numeric vector. RecordError naming --variable with the file's variables."""
+def _load_mat(path: Path) -> dict:
+    """The variables of a MATLAB 5 .mat file. RecordError naming FILE for anything else (a MATLAB
+    7.3 file is HDF5, which scipy does not read)."""
     import scipy.io
 
     try:
-        data = scipy.io.loadmat(path)
-    except (scipy.io.matlab.MatReadError, NotImplementedError, ValueError) as exc:  # NotImplementedError: v7.3 (HDF5)
+        if scipy.io.matlab.matfile_version(path)[0] == 2:
+            raise RecordError("FILE", f"{path.name} is not a readable MATLAB 5 .mat record (MATLAB 7.3, HDF5)")
+        return scipy.io.loadmat(path)
+    except (scipy.io.matlab.MatReadError, ValueError) as exc:
         raise RecordError("FILE", f"{path.name} is not a readable MATLAB 5 .mat record ({exc})") from None
+
+
+def _mat_channel(data: dict, name: str, variable: str | None) -> np.ndarray:
+    """The channel of a .mat record's variables `data` (of file `name`): `variable`, else the one
+    `*_DE_time` (the CWRU drive end's), else the file's only numeric vector. RecordError naming
+    --variable with the file's variables."""
     vectors = {
         k: v
         for k, v in data.items()
@@ -70,15 +78,13 @@ def _mat_channel(path: Path, variable: str | None) -> np.ndarray:
     names = ", ".join(sorted(vectors)) or "none"
     if variable is not None:
         if variable not in vectors:
-            raise RecordError("--variable", f"{variable!r} is not a numeric vector of {path.name}; allowed: {names}")
+            raise RecordError("--variable", f"{variable!r} is not a numeric vector of {name}; allowed: {names}")
         chosen = variable
     else:
         drive_end = [k for k in vectors if k.endswith("_DE_time")]
         candidates = drive_end if drive_end else list(vectors)
         if len(candidates) != 1:
-            raise RecordError(
-                "--variable", f"{path.name} holds {len(candidates)} candidate channels; pick one of: {names}"
-            )
+            raise RecordError("--variable", f"{name} holds {len(candidates)} candidate channels; pick one of: {names}")
         chosen = candidates[0]
     v = np.asarray(vectors[chosen])
     if v.ndim == 2 and 1 in v.shape:
@@ -86,15 +92,9 @@ def _mat_channel(path: Path, variable: str | None) -> np.ndarray:
     return v
 
 
-def mat_rpm(path: Path) -> float | None:
-    """The speed a .mat record states [rev/min]: its one scalar `*RPM` variable (the CWRU data
-    center's `X105RPM`), else None."""
-    import scipy.io
-
-    try:
-        data = scipy.io.loadmat(path)
-    except (scipy.io.matlab.MatReadError, NotImplementedError, ValueError):
-        return None
+def _mat_rpm(data: dict) -> float | None:
+    """The speed a .mat record's variables `data` state [rev/min]: its one scalar `*RPM` variable
+    (the CWRU data center's `X105RPM`), else None."""
     found = [
         float(np.asarray(v).reshape(-1)[0])
         for k, v in data.items()
@@ -105,20 +105,22 @@ def mat_rpm(path: Path) -> float | None:
 
 def read_record(
     path: Path, column: int = 0, full_scale: float = 1.0, variable: str | None = None
-) -> tuple[np.ndarray, float | None]:
-    """(samples in the file's units, the file's sample rate [Hz] or None) of a .npy, .csv, .wav or
-    .mat record (module docstring). Raises RecordError naming FILE / --column / --variable."""
+) -> tuple[np.ndarray, float | None, float | None]:
+    """(samples in the file's units, the file's sample rate [Hz] or None, the speed it states
+    [rev/min] or None) of a .npy, .csv, .wav or .mat record (module docstring). Raises
+    RecordError naming FILE / --column / --variable."""
     suffix = path.suffix.lower()
     if suffix not in FORMATS:
         raise RecordError("FILE", f"{path.name}: unknown format {suffix or '(none)'}; allowed {', '.join(FORMATS)}")
     if not path.is_file():
         raise RecordError("FILE", f"{path}: no such file")
-    rate = None
+    rate = rpm = None
     try:
         if suffix == ".npy":
             data = np.load(path, allow_pickle=False)
         elif suffix == ".mat":
-            data = _mat_channel(path, variable)
+            variables = _load_mat(path)
+            data, rpm = _mat_channel(variables, path.name, variable), _mat_rpm(variables)
         elif suffix == ".csv":
             try:
                 data = np.loadtxt(path, delimiter=",", comments="#", ndmin=1)
@@ -141,7 +143,7 @@ def read_record(
     data = np.asarray(data)
     if data.dtype.kind not in "iuf":
         raise RecordError("FILE", f"{path.name} holds {data.dtype} values; need real numbers")
-    return _pick_column(data.astype(float), column, f"{suffix} record"), rate
+    return _pick_column(data.astype(float), column, f"{suffix} record"), rate, rpm
 
 
 def _parse_line(text: str) -> tuple[str, float]:
@@ -162,7 +164,7 @@ def analyse_file(args: argparse.Namespace) -> dict:
     from twin.vibration.analysis import MAX_SAMPLE_RATE_HZ, AnalysisInputError, analyse_signal, defect_multiples_of
 
     path = Path(args.file)
-    x, file_rate = read_record(path, args.column, args.full_scale, args.variable)
+    x, file_rate, file_rpm = read_record(path, args.column, args.full_scale, args.variable)
     if file_rate is not None and args.sample_rate is not None and abs(file_rate - args.sample_rate) > 1e-9 * file_rate:
         raise RecordError("--sample-rate", f"{args.sample_rate:g} Hz disagrees with the file's {file_rate:g} Hz")
     rate = file_rate if file_rate is not None else args.sample_rate
@@ -173,7 +175,7 @@ def analyse_file(args: argparse.Namespace) -> dict:
     if not (math.isfinite(rate) and 0.0 < rate <= MAX_SAMPLE_RATE_HZ):
         raise RecordError("--sample-rate", f"{rate:g} is out of range; allowed (0, {MAX_SAMPLE_RATE_HZ:g}] Hz")
     if args.rpm is None:
-        args.rpm = mat_rpm(path) if path.suffix.lower() == ".mat" else None
+        args.rpm = file_rpm
         if args.rpm is None:
             raise RecordError("--rpm", "required (a .mat record may state it as one *RPM value); allowed > 0 rev/min")
     if not (math.isfinite(args.rpm) and 0.0 < args.rpm <= 3.0 * rate):

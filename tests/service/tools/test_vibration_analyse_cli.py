@@ -144,4 +144,4 @@ def test_a_cwru_mat_file_is_read_as_the_data_center_publishes_it(tmp_path, capsy
     header = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 ."
     v73.write_bytes(header.ljust(124) + b"\x00\x02IM" + bytes(400))
     code, out, err = _run(capsys, v73, *args)
-    assert code == 2 and "FILE: v73.mat is not a readable MATLAB 5 .mat record (Please use HDF reader" in err
+    assert code == 2 and "FILE: v73.mat is not a readable MATLAB 5 .mat record (MATLAB 7.3, HDF5)" in err
