@@ -162,6 +162,19 @@ def test_a_mat_record_is_read_from_the_manifests_variable(held_out):
         cwru.measured(wrong, None, held_out)
 
 
+def test_an_unreadable_mat_record_is_refused_naming_the_record(tmp_path, capsys):
+    """A .mat that is not MATLAB 5 (here a MATLAB 7.3, HDF5, header) ends the command with the
+    record's number and the file's name, not a traceback."""
+    header = b"MATLAB 7.3 MAT-file, Platform: GLNXA64, HDF5 schema 1.00 ."
+    (tmp_path / "7.mat").write_bytes(header.ljust(124) + b"\x00\x02IM" + bytes(400))
+    entry = _entry(7, "7.mat", "normal", 1797.0, 0, variable="X007_DE_time")
+    (tmp_path / "manifest.json").write_text(json.dumps([entry]))
+    with pytest.raises(SystemExit) as exc:
+        cwru.main(["--data", str(tmp_path)])
+    assert exc.value.code == 2
+    assert "record 7: 7.mat is not a readable MATLAB 5 .mat file (MATLAB 7.3, HDF5)" in capsys.readouterr().err
+
+
 def test_a_sample_rate_that_is_not_a_multiple_of_12_khz_is_refused(tmp_path):
     np.save(tmp_path / "x.npy", np.zeros(100, dtype=np.float32))
     (tmp_path / "manifest.json").write_text(json.dumps([_entry(1, "x.npy", "normal", 1797.0, 0, fs=44100)]))

@@ -39,6 +39,7 @@ from pathlib import Path
 
 import numpy as np
 from scipy.io import loadmat
+from scipy.io.matlab import MatReadError, matfile_version
 from scipy.signal import decimate, hilbert, welch
 
 from twin.validation.vibration_simulation import simulate_vibration
@@ -225,10 +226,15 @@ def analyse(x_m_s2: np.ndarray, sample_rate_hz: float, rpm: float, expected: str
 
 def _load_g(path: Path, record: Record) -> np.ndarray:
     """A record's samples [g]: a `.npy` vector, or the `variable` (`X105_DE_time`) of the data
-    center's own `.mat` file (MATLAB 5)."""
+    center's own `.mat` file (MATLAB 5). ValueError naming the record for a file it cannot read."""
     if path.suffix.lower() != ".mat":
         return np.load(path).reshape(-1)
-    data = loadmat(path)
+    try:
+        if matfile_version(path)[0] == 2:
+            raise ValueError("MATLAB 7.3, HDF5")
+        data = loadmat(path)
+    except (MatReadError, ValueError) as exc:
+        raise ValueError(f"record {record.number}: {path.name} is not a readable MATLAB 5 .mat file ({exc})") from None
     if record.variable not in data:
         names = ", ".join(sorted(k for k in data if not k.startswith("__")))
         raise ValueError(f"record {record.number}: variable = {record.variable!r} is not in {path.name} ({names})")
@@ -278,6 +284,7 @@ def simulated(record: Record, duration_s: float = 1.0, settle_s: float = SETTLE_
 def compare(duration_s: float = 1.0, records=RECORDS, data_dir: Path = DATA_DIR) -> list[dict]:
     """Per record: its conditions, measured and twin analyses, and the RMS relative to the healthy
     record of the same motor load (else of the lowest load), measured and twin each against its own."""
+    records = list(records)
     rows = []
     for rec in records:
         m, _ = measured(rec, duration_s, data_dir)
@@ -294,7 +301,7 @@ def compare(duration_s: float = 1.0, records=RECORDS, data_dir: Path = DATA_DIR)
                 "twin": asdict(s),
             }
         )
-    healthy = sorted((r for r in rows if r["condition"].startswith("healthy")), key=lambda r: r["load_hp"])
+    healthy = sorted((r for r, rec in zip(rows, records) if rec.defect is None), key=lambda r: r["load_hp"])
     for r in rows:
         ref = next((h for h in healthy if h["load_hp"] == r["load_hp"]), healthy[0] if healthy else None)
         if ref is not None:
@@ -425,7 +432,10 @@ def main(argv=None) -> int:
         records = records_from_manifest(data_dir / "manifest.json") if args.data is not None else list(RECORDS)
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
-    rows = compare(args.duration, records, data_dir)
+    try:
+        rows = compare(args.duration, records, data_dir)
+    except (OSError, ValueError) as exc:  # a record's file missing or unreadable
+        parser.error(str(exc))
     print(json.dumps(rows, indent=1) if args.json else markdown(rows))
     return 0
 
