@@ -25,7 +25,7 @@ from twin.friction_power import (
     seal_moment_n_m,
     seal_power_w,
 )
-from twin.inlet_film import InletFilm
+from twin.inlet_film import COUPLING_PERIOD_S, InletFilm
 from twin.kernels import layout as L
 from twin.kernels.step import evaluate, step_n
 from twin.kernels.structures import ModelArrays, StateArrays
@@ -47,8 +47,10 @@ from twin.timestep import STEP_DIVISOR_S
 from twin.vibration.defects import BallDefect, defect_row, validate_defects
 from twin.warmstart import place_on_housing, warm_start
 
-FRAME_S = 1e-2  # simulated time per compiled call of `advance` by default [s]: the inlet's and the life's
-# refresh period, so each call ends where one is due and the Python between calls runs once per refresh
+# simulated time per compiled call of `advance` by default [s]: the inlet's refresh period (also the
+# life's default refresh_s), so each call ends where one is due and the Python between calls runs
+# once per refresh
+FRAME_S = COUPLING_PERIOD_S
 RESTART_WINDOW_S = 0.01  # a second failure this soon after a restart halts the twin
 
 
