@@ -198,6 +198,34 @@ def test_inlet_shear_heating_laws_by_hand_and_cross_check():
     assert thermal.roelands_temperature_viscosity_coefficient_k_inv(0.04, 313.15, 353.15, 0.047) < 0.047
 
 
+@pytest.mark.parametrize("film_factor", [0.999, 0.9, 0.8, 0.5, 0.1, 1e-3])
+@pytest.mark.parametrize("eta0, theta0, beta", [(0.04, 313.15, 0.047), (0.0035, 373.15, 0.03), (0.4, 263.15, 0.07)])
+def test_equivalent_inlet_rise_inverts_the_hamrock_dowson_ratio(film_factor, eta0, theta0, beta):
+    # the closed Newton solve against an independent bisection of g(dT) = film_factor, with g the
+    # Hamrock-Dowson film ratio under Roelands' law at ambient pressure (seed 003 eq. 3): within
+    # 1e-9 K, and g of the result equals the factor to 1e-12 (relative)
+    def g(rise: float) -> float:
+        return thermal.hamrock_dowson_temperature_film_ratio(rise, eta0, theta0, beta)
+
+    lo, hi = 0.0, 500.0
+    while hi - lo > 1e-11:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if g(mid) > film_factor else (lo, mid)
+    rise = thermal.equivalent_inlet_temperature_rise_k(film_factor, eta0, theta0, beta)
+    if g(500.0) > film_factor:  # not reached within the 500 K cap: the cap
+        assert rise == 500.0
+    else:
+        assert rise == pytest.approx(0.5 * (lo + hi), abs=1e-9)
+        assert g(rise) == pytest.approx(film_factor, rel=1e-12)
+
+
+def test_equivalent_inlet_rise_limits():
+    # no reduction: no rise; a reduction no rise up to the cap reaches: the cap
+    assert thermal.equivalent_inlet_temperature_rise_k(1.0, 0.04, 313.15, 0.047) == 0.0
+    assert thermal.equivalent_inlet_temperature_rise_k(1e-9, 0.04, 313.15, 0.047, max_rise_k=50.0) == 50.0
+    assert thermal.equivalent_inlet_temperature_rise_k(0.0, 0.04, 313.15, 0.047) == 500.0
+
+
 @pytest.mark.parametrize(
     "speed, band", [(100.0, (0.95, 1.0)), (500.0, (0.8, 0.95)), (1000.0, (0.6, 0.85)), (1700.0, (0.5, 0.8))]
 )

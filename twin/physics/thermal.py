@@ -153,22 +153,33 @@ def equivalent_inlet_temperature_rise_k(
 ) -> float:
     """The uniform inlet temperature rise dT whose Hamrock-Dowson film ratio g(dT)
     (hamrock_dowson_temperature_film_ratio) equals `film_factor` [K]: the temperature the
-    isothermal film formula would need at the inlet to give the same film (bisection; g falls
-    monotonically with dT). 0 for a factor >= 1."""
+    isothermal film formula would need at the inlet to give the same film; `max_rise_k` where
+    even that rise leaves a larger ratio, 0 for a factor >= 1.
+
+    With f = ((T0 + dT - 138)/(T0 - 138))^-S0 the ratio is g = exp(0.68 lnk (f - 1)) f^0.49, so
+    u = ln f solves psi(u) = 0.68 lnk (e^u - 1) + 0.49 u - ln g = 0, and dT = (T0 - 138)(e^(-u/S0) - 1).
+    psi is increasing and convex, so Newton's method from u = 0 (where psi >= 0) falls monotonically
+    onto the root, to machine precision in a few steps. An oil so thin that lnk <= 0 (eta0 under
+    6.3e-5 Pa s) has no such root: it gets `max_rise_k`."""
     if film_factor >= 1.0:
         return 0.0
-    lo, hi = 0.0, max_rise_k
-    if hamrock_dowson_temperature_film_ratio(hi, eta0_pa_s, theta0_k, beta_k_inv) > film_factor:
+    lnk = math.log(eta0_pa_s) + ROELANDS_LN_ETA_INF
+    if not (film_factor > 0.0 and lnk > 0.0):
         return max_rise_k
-    for _ in range(80):
-        mid = 0.5 * (lo + hi)
-        if hamrock_dowson_temperature_film_ratio(mid, eta0_pa_s, theta0_k, beta_k_inv) > film_factor:
-            lo = mid
-        else:
-            hi = mid
-        if hi - lo < 1e-6:
+    s0 = beta_k_inv * (theta0_k - ROELANDS_T_K) / lnk
+    a = 0.68 * lnk
+    target = math.log(film_factor)
+    u = 0.0
+    for _ in range(60):
+        eu = math.exp(u)
+        step = (a * (eu - 1.0) + 0.49 * u - target) / (a * eu + 0.49)
+        u -= step
+        if abs(step) <= 1e-15 * (1.0 + abs(u)):
             break
-    return 0.5 * (lo + hi)
+    exponent = -u / s0
+    if exponent >= math.log1p(max_rise_k / (theta0_k - ROELANDS_T_K)):
+        return max_rise_k
+    return (theta0_k - ROELANDS_T_K) * math.expm1(exponent)
 
 
 def thermal_film_factor(
