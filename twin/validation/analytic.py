@@ -100,7 +100,8 @@ class JonesSolution:
     azimuths [rad]; inner_load_n / outer_load_n [N]; inner_angle_rad / outer_angle_rad: contact
     angles, the angle between the contact normal and the radial plane, positive in the bearing's
     nominal sense [rad]; ball_axial_m / ball_radial_m: ball-centre positions (z, distance from the
-    axis) [m]; centrifugal_force_n [N]; epsilon: the load parameter (1 + delta_a tan(alpha0) /
+    axis) [m]; centrifugal_force_n [N]; gyroscopic_moment_n_m: each ball's M_g under outer raceway
+    control [N m] (zeros without it); epsilon: the load parameter (1 + delta_a tan(alpha0) /
     delta_r) / 2 of seed 004 section 3.1 (Harris) with the nominal angle alpha0 [-]; converged."""
 
     ring_displacement_m: np.ndarray
@@ -114,6 +115,7 @@ class JonesSolution:
     centrifugal_force_n: float
     epsilon: float
     converged: bool
+    gyroscopic_moment_n_m: np.ndarray | None = None
 
     @property
     def qmax_n(self) -> float:
@@ -142,9 +144,58 @@ class _Geometry:
         ]
 
 
-def _ball_forces(geo: _Geometry, ball: np.ndarray, inner_centre: np.ndarray, m_omega2: float):
-    """Net force on a ball at `ball` (z, rho) [N] and its two contacts (Q [N], unit normal);
-    m_omega2 = m omega_c^2 [N/m] makes the centrifugal force m omega_c^2 rho."""
+def outer_control_kinematics(
+    ball_rho_m: float, ball_radius_m: float, inner_normal, outer_normal, shaft_speed_rad_s: float
+) -> tuple[float, float, float]:
+    """(omega_rho, omega_z, omega_m) [rad/s] of a ball under outer raceway control (Jones 1960;
+    Harris and Kotzalas, Advanced Concepts of Bearing Technology, 5th ed. 2007, ch. 2, "Ball
+    bearings: kinematics"): the ball rolls without sliding at the centres of both contacts and does
+    not spin at the outer one, the inner ring turning at `shaft_speed_rad_s`, the outer fixed.
+
+    `inner_normal` and `outer_normal` are the (z, rho) unit vectors of `_ball_forces` (ball ->
+    inner groove centre, outer groove centre -> ball), so the contact points lie at -R n_i and
+    +R n_o from the ball's centre at radius `ball_rho_m`. Written in the frame that turns with the
+    ball's orbit omega_m, the three conditions are linear in the ball's angular velocity
+    (omega_rho, 0, omega_z) relative to that frame and in omega_m: with c the contact point's
+    direction and r = rho + R c_rho its distance from the axis,
+    R (omega_z c_rho - omega_rho c_z) = (Omega_ring - omega_m) r at each contact, and
+    omega_rho c_rho + (omega_z + omega_m) c_z = 0 at the outer. omega_rho is the ball's absolute
+    angular velocity along e_rho, omega_R sin(beta) in Harris' notation (beta: the pitch of the
+    spin axis; tan beta = sin(alpha_o) / (cos(alpha_o) + D / d_m) at the pitch radius)."""
+    ci_z, ci_r = -float(inner_normal[0]), -float(inner_normal[1])
+    co_z, co_r = float(outer_normal[0]), float(outer_normal[1])
+    r_ci = ball_rho_m + ball_radius_m * ci_r
+    r_co = ball_rho_m + ball_radius_m * co_r
+    a = np.array(
+        [
+            [-ball_radius_m * ci_z, ball_radius_m * ci_r, r_ci],
+            [-ball_radius_m * co_z, ball_radius_m * co_r, r_co],
+            [co_r, co_z, co_z],
+        ]
+    )
+    w_rho, w_z, w_m = np.linalg.solve(a, np.array([shaft_speed_rad_s * r_ci, 0.0, 0.0]))
+    return float(w_rho), float(w_z), float(w_m)
+
+
+def gyroscopic_moment_n_m(ball_inertia_kg_m2: float, omega_rho_rad_s: float, omega_m_rad_s: float) -> float:
+    """M_g = J omega_m omega_R sin(beta) = J omega_m omega_rho [N m] (Harris and Kotzalas vol. 2
+    ch. 3): the moment about e_phi that turns the ball's angular momentum J omega with its orbit
+    (dH/dt = omega_m e_z x J omega), to be supplied by contact friction."""
+    return ball_inertia_kg_m2 * omega_m_rad_s * omega_rho_rad_s
+
+
+def _ball_forces(geo: _Geometry, ball: np.ndarray, inner_centre: np.ndarray, m_omega2: float, gyro=None):
+    """Net force on a ball at `ball` (z, rho) [N], its two contacts (Q [N], unit normal), the
+    gyroscopic moment it carries [N m] and the friction force its inner contact puts on the inner
+    ring [N] (z, rho); m_omega2 = m omega_c^2 [N/m] makes the centrifugal force m omega_c^2 rho.
+
+    `gyro` = (J [kg m^2], shaft speed [rad/s], traction limit gamma [-]): the moment M_g of outer
+    raceway control (`outer_control_kinematics`, `gyroscopic_moment_n_m`) is held by friction
+    forces tangent to the contacts in the ball's (z, rho) plane, whose moments about the centre add
+    to M_g e_phi: at the outer contact up to gamma Q_o (Jones' outer raceway control, Harris'
+    lambda_o = 2), the remainder at the inner contact up to gamma Q_i; beyond both the ball pivots
+    and both contacts slide at the limit. A ball the inner race does not touch is not driven and
+    carries none."""
     to_inner = inner_centre - ball
     d_i = float(np.hypot(*to_inner))
     n_i = to_inner / d_i  # ball -> inner groove centre
@@ -156,25 +207,48 @@ def _ball_forces(geo: _Geometry, ball: np.ndarray, inner_centre: np.ndarray, m_o
     q_i = geo.stiffness(0, n_i[0]) * delta_i**1.5 if delta_i > 0.0 else 0.0
     q_o = geo.stiffness(1, n_o[0]) * delta_o**1.5 if delta_o > 0.0 else 0.0
     force = q_i * n_i - q_o * n_o + np.array([0.0, m_omega2 * ball[1]])
-    return force, q_i, n_i, q_o, n_o
+    m_g = 0.0
+    on_ring = np.zeros(2)
+    if gyro is not None and q_i > 0.0 and q_o > 0.0:
+        inertia, shaft_speed, traction = gyro
+        w_rho, _, w_m = outer_control_kinematics(float(ball[1]), geo.rb, n_i, n_o, shaft_speed)
+        m_g = gyroscopic_moment_n_m(inertia, w_rho, w_m)
+        need = abs(m_g) / geo.rb  # the friction whose moment R F is |M_g| [N]
+        f_o = min(need, traction * q_o)
+        f_i = min(need - f_o, traction * q_i)
+        sign = math.copysign(1.0, m_g)
+        # e_phi x c for the contact direction c from the centre (-n_i inner, +n_o outer), in
+        # (z, rho): the tangent whose moment R c x t is +e_phi
+        t_o = np.array([-n_o[1], n_o[0]])
+        t_i = np.array([n_i[1], -n_i[0]])
+        inner_friction = sign * f_i * t_i
+        force = force + sign * f_o * t_o + inner_friction
+        on_ring = -inner_friction
+    return force, q_i, n_i, q_o, n_o, m_g, on_ring
 
 
-def _solve_ball(geo: _Geometry, inner_centre: np.ndarray, m_omega2: float, scale: float):
+def _solve_ball(geo: _Geometry, inner_centre: np.ndarray, m_omega2: float, scale: float, gyro=None):
     """Equilibrium position (z, rho) of one ball between the displaced inner groove centre and
-    the fixed outer one: Qi n_i - Qo n_o + Fc e_rho = 0 (Harris vol. 2 eqs. 3.x, no gyroscopic
-    moment). A ball that the inner race does not reach rests in the bottom of the outer groove."""
+    the fixed outer one: Qi n_i - Qo n_o + Fc e_rho (+ the friction that holds the gyroscopic
+    moment, `gyro`) = 0 (Harris vol. 2 ch. 3). A ball that the inner race does not reach rests in
+    the bottom of the outer groove. With `gyro` the solve continues from the equilibrium without
+    it, so the ball stays on the branch that grows out of the frictionless one (the friction
+    vanishes where the inner contact opens, so a search from afar can stop on that edge)."""
     k_o0 = geo.stiffness(1, 0.0)
     fc = m_omega2 * (geo.outer_centre[1] + geo.outer_free)
     rest = geo.outer_centre + np.array([0.0, geo.outer_free + (fc / k_o0) ** (2.0 / 3.0)])
     if np.hypot(*(inner_centre - rest)) <= geo.inner_free:
         return rest
-    axis = inner_centre - geo.outer_centre
-    span = float(np.hypot(*axis))
-    overlap = max(span - geo.inner_free - geo.outer_free, 0.0)
-    guess = geo.outer_centre + axis / span * (geo.outer_free + 0.5 * overlap)
+    if gyro is not None:
+        guess = _solve_ball(geo, inner_centre, m_omega2, scale)
+    else:
+        axis = inner_centre - geo.outer_centre
+        span = float(np.hypot(*axis))
+        overlap = max(span - geo.inner_free - geo.outer_free, 0.0)
+        guess = geo.outer_centre + axis / span * (geo.outer_free + 0.5 * overlap)
 
     def residual(x_um):
-        return _ball_forces(geo, x_um * 1e-6, inner_centre, m_omega2)[0] / scale
+        return _ball_forces(geo, x_um * 1e-6, inner_centre, m_omega2, gyro)[0] / scale
 
     sol = optimize.root(residual, guess * 1e6, method="hybr", options={"xtol": 1e-13})
     if np.max(np.abs(residual(sol.x))) > 1e-10:
@@ -190,6 +264,8 @@ def jones_equilibrium(
     azimuths_rad=None,
     centrifugal: bool = True,
     initial_displacement_m=None,
+    gyroscopic: bool = False,
+    traction_limit: float | None = None,
 ) -> JonesSolution:
     """Jones' quasi-static solution (Jones 1960, "A general theory for elastically constrained
     ball and radial roller bearings under arbitrary load and speed conditions", J. Basic Eng. 82;
@@ -197,9 +273,18 @@ def jones_equilibrium(
     (delta_x, delta_y, delta_z) without tilt (as in the twin), each ball in equilibrium between its
     inner and outer contacts and its centrifugal force m omega_c^2 rho (omega_c the cage speed of
     the rolling kinematics), each contact Q = K(alpha) delta^1.5 with the EXACT Hertz constants of
-    its own contact angle. Gyroscopic moments and friction are neglected (Jones' "outer raceway
-    control" moment is small at the twin's speeds). Works for deep-groove bearings too (nominal
-    angle 0, with clearance or preload through the model's mounting).
+    its own contact angle, and with `gyroscopic` (Jones-Harris) the gyroscopic moment of outer raceway control held by
+    contact friction up to `traction_limit` x Q (`_ball_forces`; by default the lubricant's
+    limiting shear coefficient, the largest traction its film carries; inf: Jones' unlimited
+    outer raceway control); no other friction. The centrifugal force uses the cage speed of the
+    rolling kinematics for every ball (the cage holds the balls to one orbit speed); the gyroscopic
+    moment each ball's own outer-control orbit and spin. Works for deep-groove bearings too
+    (nominal angle 0, with clearance or preload through the model's mounting; their spin axis
+    lies along the bearing's, so they carry no gyroscopic moment). Without `gyroscopic` (the
+    default) no friction at all: Jones' solution with centrifugal force. The gyroscopic friction
+    acts mostly through the lightly loaded balls, which cannot hold the moment and slide at the
+    traction limit, all of it here in the ball's (z, rho) plane (docs/validation.md, the 7208 at
+    speed).
 
     azimuths_rad: the balls' azimuths (default evenly spaced from 0); radial load along +x,
     axial load along +z on the inner ring [N]."""
@@ -212,22 +297,32 @@ def jones_equilibrium(
     c, s = np.cos(psi), np.sin(psi)
 
     m_omega2 = mass * omega_c**2
+    # a solid sphere's J = m D^2 / 10
+    traction = model.spec.lubricant.limiting_shear_coefficient if traction_limit is None else traction_limit
+    gyro = None
+    if gyroscopic and shaft_speed_rad_s != 0.0:
+        if initial_displacement_m is None:  # continue from the frictionless solution (see _solve_ball)
+            initial_displacement_m = jones_equilibrium(
+                model, radial_load_n, axial_load_n, shaft_speed_rad_s, psi, centrifugal, gyroscopic=False
+            ).ring_displacement_m
+        gyro = (0.4 * mass * model.ball_radius_m**2, shaft_speed_rad_s, traction)  # J = m D^2 / 10
 
     def solve_balls(shift):
         out = []
         for j in range(z):
             centre = geo.inner_centre + np.array([shift[2], shift[0] * c[j] + shift[1] * s[j]])
-            out.append((centre, _solve_ball(geo, centre, m_omega2, scale)))
+            out.append((centre, _solve_ball(geo, centre, m_omega2, scale, gyro)))
         return out
 
     def ring_residual(shift_um):
         shift = shift_um * 1e-6
         force = np.array([radial_load_n, 0.0, axial_load_n])
         for j, (centre, ball) in enumerate(solve_balls(shift)):
-            _, q_i, n_i, _, _ = _ball_forces(geo, ball, centre, m_omega2)
-            force[0] -= q_i * n_i[1] * c[j]
-            force[1] -= q_i * n_i[1] * s[j]
-            force[2] -= q_i * n_i[0]
+            _, q_i, n_i, _, _, _, friction = _ball_forces(geo, ball, centre, m_omega2, gyro)
+            radial = q_i * n_i[1] - friction[1]
+            force[0] -= radial * c[j]
+            force[1] -= radial * s[j]
+            force[2] -= q_i * n_i[0] - friction[0]
         return force / scale
 
     if initial_displacement_m is None:
@@ -245,9 +340,9 @@ def jones_equilibrium(
         sol = optimize.root(ring_residual, sol.x, method="lm", options={"xtol": 1e-15, "ftol": 1e-15})
     converged = bool(np.max(np.abs(ring_residual(sol.x))) <= 1e-8)
     shift = sol.x * 1e-6
-    q_in, q_out, a_in, a_out, zb, rho = (np.zeros(z) for _ in range(6))
+    q_in, q_out, a_in, a_out, zb, rho, m_g = (np.zeros(z) for _ in range(7))
     for j, (centre, ball) in enumerate(solve_balls(shift)):
-        _, q_i, n_i, q_o, n_o = _ball_forces(geo, ball, centre, m_omega2)
+        _, q_i, n_i, q_o, n_o, m_g[j], _ = _ball_forces(geo, ball, centre, m_omega2, gyro)
         q_in[j], q_out[j] = q_i, q_o
         a_in[j] = math.atan2(n_i[0], n_i[1])
         a_out[j] = math.atan2(n_o[0], n_o[1])
@@ -267,4 +362,5 @@ def jones_equilibrium(
         centrifugal_force_n=float(m_omega2 * model.pitch_radius_m),
         epsilon=eps,
         converged=converged,
+        gyroscopic_moment_n_m=m_g,
     )
