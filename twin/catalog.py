@@ -83,11 +83,12 @@ _ISO_VG_NU100_MM2_S = {
 
 
 # ISO 15312 thermal reference speed [r/min] of the SKF executions (SKF Rolling bearings catalogue,
-# PUB BU/P1 10000/2 EN, 2016, deep-groove ball bearing product tables, column 'Reference speed'):
+# PUB BU/P1 17000/1 EN, 2018, deep-groove ball bearing product tables of the 62 series, SKF
+# Explorer, column 'Reference speed'):
 # the speed at which, under the standard's reference conditions (P = 0.05 C0, ISO VG 32 at an outer
 # ring of 70 degC over an ambient of 20 degC, oil bath to the centre of the lowest ball), the
 # bearing's friction power equals the reference heat flow 0.016 W/mm^2 over A_r = pi B (D + d).
-_THERMAL_REFERENCE_SPEED_RPM = {"6205": 28000.0, "6208": 22000.0, "6210": 20000.0}
+_THERMAL_REFERENCE_SPEED_RPM = {"6205": 28000.0, "6208": 20000.0, "6210": 17000.0}
 
 
 def thermal_reference_speed_rad_s(designation: str) -> float:

@@ -5,8 +5,9 @@ standard's dissipation q_r A_r per 50 K (twin.thermal.correlations), must settle
 70 +- 10 degC (the network's half of the check; the friction's magnitude at these
 speeds is the friction laws' half).
 
-Reference speeds: SKF Rolling bearings catalogue PUB BU/P1 17000/1 EN (2018), product tables of
-the 62 series (SKF Explorer): 6205 28 000 r/min, 6208 20 000 r/min, 6210 17 000 r/min. The
+Reference speeds (twin.catalog.thermal_reference_speed_rad_s): SKF Rolling bearings catalogue PUB
+BU/P1 17000/1 EN (2018), product tables of the 62 series (SKF Explorer): 6205 28 000 r/min, 6208
+20 000 r/min, 6210 17 000 r/min. The
 twin's speed limit (n d_m <= 1.2e6 mm r/min, twin.model) stops the seed 6208 (d_m = 60.6 mm) at
 19 800 r/min: it runs there, 1 % below its reference speed.
 
@@ -19,12 +20,11 @@ ball) the drag of the balls alone exceeds it at these speeds, by the SKF model's
 (twin.physics.drag.oil_bath_drag_moment_n_m: 6208 at 19 800 r/min and 70 degC, 195 W against
 q_r A_r = 110 W; `test_skf_drag_alone_exceeds_the_reference_heat_flow`)."""
 
-import math
-
 import pytest
 
 from twin import catalog
 from twin.friction_power import boundary_dimensions_m, oil_level_m
+from twin.model import make_model
 from twin.physics import drag, viscosity
 from twin.spec import BearingSpec, Lubrication, Thermal
 from twin.thermal.network import network_geometry
@@ -33,13 +33,14 @@ from twin.validation.thermal_steady import steady_operating_point
 
 pytestmark = pytest.mark.slow
 
-REFERENCE_SPEED_RPM = {"6205": 28_000.0, "6208": 20_000.0, "6210": 17_000.0}
+BEARINGS = ("6205", "6208", "6210")
 
 
 def _reference_speed_rad_s(designation):
-    spec = catalog.bearing(designation)
-    limit_rpm = 1.2e6 / (2.0 * spec.geometry.pitch_radius_m * 1e3)
-    return min(REFERENCE_SPEED_RPM[designation], limit_rpm) * 2.0 * math.pi / 60.0
+    return min(
+        catalog.thermal_reference_speed_rad_s(designation),
+        make_model(catalog.bearing(designation)).max_shaft_speed_rad_s,
+    )
 
 
 def _reference_point(designation):
@@ -54,7 +55,7 @@ def _reference_point(designation):
     return r, phi_r
 
 
-@pytest.mark.parametrize("designation", sorted(REFERENCE_SPEED_RPM))
+@pytest.mark.parametrize("designation", BEARINGS)
 def test_network_carries_the_standards_rise_for_the_heat_it_gets(designation):
     # the network's half: with the standard's dissipation the outer ring rises 50 K x heat / (q_r A_r) over the
     # ambient (ISO 15312 clauses 4-5), within 5 % (the rings' and balls' internal gradients)
@@ -64,7 +65,7 @@ def test_network_carries_the_standards_rise_for_the_heat_it_gets(designation):
     assert rise == pytest.approx(50.0 * r["heat_total_w"] / phi_r, rel=0.05), (rise, r["heat_total_w"], phi_r)
 
 
-@pytest.mark.parametrize("designation", sorted(REFERENCE_SPEED_RPM))
+@pytest.mark.parametrize("designation", BEARINGS)
 def test_outer_ring_settles_at_70_with_the_standard_dissipation(designation):
     # the acceptance band (ISO 15312 clause 4: the outer ring at 70 degC at the reference speed), 70 +- 10 degC, and
     # the friction power at the reference point against the reference heat flow q_r A_r within 30 % (measured 1.01 /
@@ -75,7 +76,7 @@ def test_outer_ring_settles_at_70_with_the_standard_dissipation(designation):
     assert r["temperatures_c"]["outer_ring"] == pytest.approx(70.0, abs=10.0), r
 
 
-@pytest.mark.parametrize("designation", sorted(REFERENCE_SPEED_RPM))
+@pytest.mark.parametrize("designation", BEARINGS)
 def test_skf_drag_alone_exceeds_the_reference_heat_flow(designation):
     # why the reference point runs without churning: the SKF model's drag term (SKF catalogue 2018, 'Drag losses in
     # oil bath lubrication'; twin.physics.drag) at the standard's oil level (the centre of the lowest ball) and its
