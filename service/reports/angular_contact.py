@@ -38,6 +38,15 @@ def _case(designation: str, radial: float, axial: float, settle_s: float, window
     snap = twin.snapshot()
     psi = twin.ball_azimuths_rad()
     jones = analytic.jones_equilibrium(twin.model, radial, axial, snap.shaft_speed_rad_s, azimuths_rad=psi)
+    harris = analytic.jones_equilibrium(
+        twin.model,
+        radial,
+        axial,
+        snap.shaft_speed_rad_s,
+        azimuths_rad=psi,
+        initial_displacement_m=jones.ring_displacement_m,
+        gyroscopic=True,
+    )
     mag = np.linalg.norm(disp, axis=1)
     period = 2 * math.pi / (twin.model.ball_count * abs(snap.cage_speed_rad_s))
     n = max(1, min(len(mag), int(round(period / 1e-4))))
@@ -54,6 +63,7 @@ def _case(designation: str, radial: float, axial: float, settle_s: float, window
         "ai": np.degrees(np.abs([b.inner.contact_angle_rad for b in snap.balls])),
         "ao": np.degrees(np.abs([b.outer.contact_angle_rad for b in snap.balls])),
         "jones": jones,
+        "harris_qmax_n": harris.qmax_n,
         "status": snap.status,
         "disp_mean_m": float(mag.mean()),
         "jones_disp_m": float(np.linalg.norm(jones.ring_displacement_m)),
@@ -103,11 +113,13 @@ def angular_contact_section(out_dir: Path, quick: bool) -> list[str]:
         "(Z = 13, ball radius 6.3 mm, groove radii 0.57 D), 500 rad/s, seed-000 oil. Jones' solution "
         "(Jones 1960; Harris & Kotzalas ch. 7-8): rigid rings, each ball in equilibrium between its two "
         "contacts and its centrifugal force, exact Hertz constants at each contact's own angle, solved "
-        "at the DEM's ball azimuths. Loads: largest |DEM - Jones| over all balls; angles: over the balls "
+        "at the DEM's ball azimuths; Jones-Harris adds each ball's gyroscopic moment of outer raceway control, "
+        "held by contact friction up to the film's traction limit (twin.validation.analytic). Loads: "
+        "largest |DEM - Jones| over all balls; angles: over the balls "
         "carrying >= 20 % of Qmax; drift: change of the inner-ring displacement averaged over one ball "
         "pass across the window; vibration: its peak-to-peak at the ball-pass frequency.\n",
         "![angular contact](angular_contact_jones.png)\n",
-        "| bearing | Fr / Fa [N] | Qmax DEM / Jones [N] | max dQ / Qmax | max d(alpha) in / out [deg] "
+        "| bearing | Fr / Fa [N] | Qmax DEM / Jones / Jones-Harris [N] | max dQ / Qmax | max d(alpha) in / out [deg] "
         "| eps DEM / Jones | displacement DEM / Jones [um] | drift | vibration p-p | status |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
@@ -117,7 +129,8 @@ def angular_contact_section(out_dir: Path, quick: bool) -> list[str]:
         dai = np.max(np.abs(c["ai"] - np.degrees(j.inner_angle_rad))[loaded])
         dao = np.max(np.abs(c["ao"] - np.degrees(j.outer_angle_rad))[loaded])
         lines.append(
-            f"| {c['designation']} | {c['radial']:g} / {c['axial']:g} | {c['qi'].max():.0f} / {j.qmax_n:.0f} "
+            f"| {c['designation']} | {c['radial']:g} / {c['axial']:g} "
+            f"| {c['qi'].max():.0f} / {j.qmax_n:.0f} / {c['harris_qmax_n']:.0f} "
             f"| {np.max(np.abs(c['qi'] - j.inner_load_n)) / j.qmax_n * 100:.1f} % | {dai:.2f} / {dao:.2f} "
             f"| {_fmt_eps(c['eps'])} / {_fmt_eps(j.epsilon)} | {c['disp_mean_m'] * 1e6:.1f} / "
             f"{c['jones_disp_m'] * 1e6:.1f} | {c['drift'] * 100:.2f} % | {c['ptp'] * 100:.1f} % | {c['status']} |"

@@ -106,6 +106,11 @@ def test_bad_defects_are_refused_with_the_field_and_the_bearings_range(service):
         assert r.status_code == 422, (name, r.text)
         ((got_field, message),) = _detail(r)
         assert got_field == field and words in message, (name, got_field, message)
+        # the bearing's own range is in `allowed` too, not only in the message
+        allowed = r.json()["detail"][0]["allowed"]
+        assert isinstance(allowed, list) and len(allowed) == 2 and allowed[0] <= allowed[1], (name, allowed)
+    r = http.put("/v1/bearings/vib/defects", json={"defects": [{**SPALL, "width_m": 1.1 * outer["width_m"]}]})
+    assert r.json()["detail"][0]["allowed"] == [0.0, pytest.approx(outer["width_m"], rel=1e-5)]
     # beyond the models' own cap (twin.vibration.defects: width_m in (0, 0.05] m) both sides are stated
     r = http.put("/v1/bearings/vib/defects", json={"defects": [{**SPALL, "width_m": 5.0}]})
     assert r.status_code == 422, r.text

@@ -117,12 +117,11 @@ def test_outer_race_spall_full_spectra_of_the_window(runs):
     """The window's full spectra (VibrationState.envelope_spectrum / amplitude_spectrum, left out
     of the snapshot's JSON). Envelope: 0 Hz to the peak search's limit min(half the envelope band,
     5 x max(BPFI, 2 x BSF)) at 1 / window = 2 Hz; its largest bin within one bin of BPFO; at each
-    of the five published peaks, the parabolic refinement of its own bins (the peaks' computation,
-    twin.vibration.indicators._refine) gives the published frequency and amplitude (rel 1e-9).
+    of the five published peaks, the parabola through its own bin and the two beside it (vertex
+    d = (a - c) / (2 (a - 2 b + c)) bins, height b - (a - c) d / 4) gives the published frequency and
+    amplitude (rel 1e-9).
     Acceleration: 0 - fs/2 in at most 2000 power-summed bins; Parseval (Oppenheim & Schafer Table
     8.2, one-sided): sum A^2 / 2 = rms_m_s2^2 (rel 1e-9: the same samples, rounding only)."""
-    from twin.vibration.indicators import _refine
-
     twin, v = runs("outer")
     env, acc = v.envelope_spectrum, v.amplitude_spectrum
     assert "envelope_spectrum" not in v.model_dump() and "amplitude_spectrum" not in twin.snapshot().to_json()
@@ -136,7 +135,9 @@ def test_outer_race_spall_full_spectra_of_the_window(runs):
     for peak in v.envelope_peaks_hz:
         i = int(np.rint((peak.frequency_hz - env.start_hz) / env.step_hz))
         i = max((i - 1, i, i + 1), key=lambda k: amp[k])  # the local maximum it was refined from
-        got_f, got_a = _refine(freqs, amp, i)
+        a, b, c = amp[i - 1], amp[i], amp[i + 1]
+        d = 0.5 * (a - c) / (a - 2.0 * b + c)
+        got_f, got_a = freqs[i] + d * (freqs[1] - freqs[0]), b - 0.25 * (a - c) * d
         assert (got_f, got_a) == pytest.approx((peak.frequency_hz, peak.amplitude), rel=1e-9)
     fs = v.sample_rate_hz
     assert acc.start_hz == pytest.approx(0.5 * (acc.step_hz * WINDOW - 1.0) / WINDOW, rel=1e-9)

@@ -69,6 +69,23 @@ def test_envelope_spectrum_of_an_am_carrier():
     assert peaks[0]["amplitude"] == pytest.approx(1.0, rel=0.02)
 
 
+def test_envelope_peaks_rank_by_interpolated_height():
+    """Two lines: one at bins 9-11 (0.60, 0.90, 0.85), whose parabola through the three peaks at
+    bin 10.357 with 0.922, and one at bins 19-21 (0.50, 0.91, 0.50), 0.91 at bin 20. The first has
+    the lower raw bin and the higher interpolated height, so it comes first."""
+    f = np.arange(64, dtype=float)
+    a = np.zeros(64)
+    a[9:12] = (0.60, 0.90, 0.85)
+    a[19:22] = (0.50, 0.91, 0.50)
+    peaks = ind.envelope_peaks(f, a, 2)
+    # by hand: vertex d = (a - c) / (2 (a - 2 b + c)) bins, height b - (a - c) d / 4
+    d = 0.5 * (0.60 - 0.85) / (0.60 - 1.80 + 0.85)
+    assert peaks[0]["frequency_hz"] == pytest.approx(10.0 + d, abs=1e-12)
+    assert peaks[0]["amplitude"] == pytest.approx(0.90 - 0.25 * (0.60 - 0.85) * d, abs=1e-12)
+    assert peaks[1]["frequency_hz"] == pytest.approx(20.0, abs=1e-12)
+    assert peaks[1]["amplitude"] == pytest.approx(0.91, abs=1e-12)
+
+
 def test_outer_race_impulses_give_bpfo_and_its_harmonics(fault_signal):
     """Impulses at BPFO (1 % random slip) ringing a 6 kHz, 5 % damped resonance in noise: the
     kurtogram band holds 6 kHz, the largest envelope peak is within 1 % of BPFO, 2x and 3x BPFO

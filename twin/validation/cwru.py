@@ -415,7 +415,10 @@ def calibrate_background(x_m_s2: np.ndarray, sample_rate_hz: float = SAMPLE_RATE
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m twin.validation.cwru", description=__doc__.splitlines()[0])
+    parser = argparse.ArgumentParser(
+        prog="python -m twin.validation.cwru",
+        description="The CWRU-DE twin against the measured CWRU drive-end records (docs/validation.md).",
+    )
     parser.add_argument("--duration", type=float, default=1.0, help="analysed simulated time per record [s]")
     parser.add_argument("--json", action="store_true")
     parser.add_argument(
