@@ -283,8 +283,8 @@ def jones_equilibrium(
     lies along the bearing's, so they carry no gyroscopic moment). Without `gyroscopic` (the
     default) no friction at all: Jones' solution with centrifugal force. The gyroscopic friction
     acts mostly through the lightly loaded balls, which cannot hold the moment and slide at the
-    traction limit, all of it here in the ball's (z, rho) plane (docs/validation.md, the 7208 at
-    speed).
+    traction limit, all of it here in the ball's (z, rho) plane (docs/physics.md, Limits: the 7208
+    at speed).
 
     azimuths_rad: the balls' azimuths (default evenly spaced from 0); radial load along +x,
     axial load along +z on the inner ring [N]."""
