@@ -273,8 +273,8 @@ def jones_equilibrium(
     (delta_x, delta_y, delta_z) without tilt (as in the twin), each ball in equilibrium between its
     inner and outer contacts and its centrifugal force m omega_c^2 rho (omega_c the cage speed of
     the rolling kinematics), each contact Q = K(alpha) delta^1.5 with the EXACT Hertz constants of
-    its own contact angle, and with `gyroscopic` (Jones-Harris) the gyroscopic moment of outer raceway control held by
-    contact friction up to `traction_limit` x Q (`_ball_forces`; by default the lubricant's
+    its own contact angle, and with `gyroscopic` (Jones-Harris) the gyroscopic moment of outer
+    raceway control held by contact friction up to `traction_limit` x Q (`_ball_forces`; by default the lubricant's
     limiting shear coefficient, the largest traction its film carries; inf: Jones' unlimited
     outer raceway control); no other friction. The centrifugal force uses the cage speed of the
     rolling kinematics for every ball (the cage holds the balls to one orbit speed); the gyroscopic
@@ -297,7 +297,6 @@ def jones_equilibrium(
     c, s = np.cos(psi), np.sin(psi)
 
     m_omega2 = mass * omega_c**2
-    # a solid sphere's J = m D^2 / 10
     traction = model.spec.lubricant.limiting_shear_coefficient if traction_limit is None else traction_limit
     gyro = None
     if gyroscopic and shaft_speed_rad_s != 0.0:
