@@ -118,18 +118,21 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
         return 2
     if bar is not None:
         bar.close()
+    from twin.friction_power import REST_SPEED_RAD_S
+
     status = 0
     for r in results:
         snap = r.final
         lam = [c.lambda_ for b in (snap.balls if snap else ()) for c in (b.inner, b.outer) if c.lambda_ is not None]
-        summary = (
-            (
-                f"min Lambda {min(lam):.2f}, friction torque {snap.friction_torque_n_m * 1e3:.2f} mN m, "
-                f"status {snap.status}"
+        summary = f"status {snap.status}" if snap else ""
+        if snap is not None and lam:
+            # the last sample's state; a shaft at rest holds only the tangential springs' elastic torque
+            at_rest = abs(snap.shaft_speed_rad_s) < REST_SPEED_RAD_S
+            torque = "holding torque at rest" if at_rest else "friction torque"
+            summary = (
+                f"at the end ({snap.time_s:.3f} s, {snap.shaft_speed_rad_s:.1f} rad/s): min Lambda {min(lam):.2f}, "
+                f"{torque} {snap.friction_torque_n_m * 1e3:.2f} mN m, status {snap.status}"
             )
-            if snap is not None and lam
-            else (f"status {snap.status}" if snap else "")
-        )
         print(
             f"  {r.run.id} ({r.run.label}): {r.state}, {r.rows} samples, {r.wall_s:.1f} s wall; {summary}"
             + (f"; error: {r.error}" if r.error else "")

@@ -472,3 +472,13 @@ def test_limits_are_the_spec_bearings():
         scenario.check_bearing_limits()
     assert exc.value.field == "initial.shaft_speed_rad_s" and exc.value.allowed[1] == pytest.approx(300.0)
     scenario_from_dict(base(bearing="6205", initial={"shaft_speed_rad_s": 400.0})).check_bearing_limits()
+
+
+def test_the_run_summary_names_a_torque_at_rest_as_a_holding_torque(capsys):
+    # seed 000 Figs. 7-8's start-up, steady run and slow-down ends with the shaft at rest: the summary states the
+    # end's time and speed and calls the torque there what it is (the tangential springs' elastic torque, which
+    # tests/engine/test_friction_power.py bounds at 3 mN m), not a friction torque
+    assert main(["scenario", "run", str(SCENARIOS / "seed000_startup_steady_slowdown.yaml"), "--no-progress"]) == 0
+    line = capsys.readouterr().out.strip().splitlines()[-1]
+    assert "at the end (0.400 s, 0.0 rad/s)" in line and "holding torque at rest" in line, line
+    assert "friction torque" not in line, line
