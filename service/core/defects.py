@@ -33,8 +33,6 @@ except ImportError:  # pragma: no cover - an engine without defects
 __all__ = ["MAX_DEFECTS", "DefectBox", "parse_defects"]
 
 _NAMED = re.compile(r"^([a-z_]+) = ")
-_NUMBER = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
-_RANGE = re.compile(r"must be in [\[(]" + _NUMBER + ", " + _NUMBER + r"[\])]")
 
 
 def _loc(prefix: str, loc: tuple) -> str:
@@ -77,11 +75,7 @@ def parse_defects(data: Any, geometry, *, prefix: str = "defects") -> tuple:
             named = _NAMED.match(error.message)  # a model-level check names its field first
             if named and not field.endswith(f".{named.group(1)}"):
                 field = f"{field}.{named.group(1)}"
-            update: dict[str, Any] = {"field": field}
-            bounds = _RANGE.search(error.message) if error.allowed is None else None
-            if bounds:  # a model-level check states the bearing's own range in its message
-                update["allowed"] = [float(bounds.group(1)), float(bounds.group(2))]
-            errors.append(error.model_copy(update=update))
+            errors.append(error.model_copy(update={"field": field}))
         raise InputError(errors) from None
 
 

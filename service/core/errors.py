@@ -6,6 +6,7 @@ vocabulary's errors. Messages never echo the input (it may hold NaN, which JSON 
 from __future__ import annotations
 
 import math
+import re
 import typing
 from collections.abc import Mapping, Sequence
 from typing import Any
@@ -74,6 +75,10 @@ def loc_text(loc: tuple | list, skip: tuple[str, ...] = ("body",)) -> str | None
             out += ("." if out else "") + str(part)
     return out or None
 
+
+_NUMBER = r"([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)"
+# "x = 0.03 m: must be in (0, 0.0255516] m ...": the range a model-level check states (both ends numbers)
+_STATED_RANGE = re.compile(r"must be in [\[(]" + _NUMBER + ", " + _NUMBER + r"[\])]")
 
 _UNIT_SUFFIXES = (
     ("_m_s2_rthz", "m/s^2/sqrt(Hz)"),
@@ -235,6 +240,10 @@ def field_errors(
                 unit = unit_of(leaf or "")
                 text = range_text(low_bound, high_bound, low_open, high_open)
                 msg = f"{msg}; allowed range {text}{' ' + unit if unit else ''}"
+        if allowed is None:  # a model-level check that states the range in its message
+            stated = _STATED_RANGE.search(msg)
+            if stated:
+                allowed = [float(stated.group(1)), float(stated.group(2))]
         if e.get("type") == "extra_forbidden" and leaf is not None:
             msg = f"unknown field {leaf!r}"
             if limits is not None and len(loc) <= 2:

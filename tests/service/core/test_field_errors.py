@@ -69,3 +69,16 @@ def test_a_side_no_model_declares_reads_as_open_on_its_own_side():
     (error,) = field_errors(info.value.errors())
     assert error.allowed == [-60.0, None]
     assert error.message.endswith("allowed range [-60, inf) degC"), error.message
+
+
+def test_a_range_a_model_check_states_in_its_message_is_in_allowed():
+    # a model-level check (no declared bound) that states "must be in [low, high]" or "(low, high]" gives both ends
+    # in `allowed` as numbers; a message without a numeric range leaves it null
+    def check(msg: str):
+        return field_errors([{"loc": ("x_m",), "msg": f"Value error, {msg}", "type": "value_error"}])[0].allowed
+
+    assert check("x_m = 0.03 m: must be in (0, 0.0255516] m for this bearing") == [0.0, 0.0255516]
+    assert check("n = 20: must be in [0, 12] for this bearing") == [0.0, 12.0]
+    assert check("x_m = -1e-05 m: must be in [-2.5e-05, 1.5e-4] m") == [-2.5e-05, 1.5e-4]
+    assert check("contact_angle_rad = 2: must be in [0, pi/2)") is None
+    assert check("the balls do not fit on the pitch circle") is None
