@@ -54,15 +54,13 @@ def _pick_column(data: np.ndarray, column: int, what: str) -> np.ndarray:
 
 
 def _load_mat(path: Path) -> dict:
-    """The variables of a MATLAB 5 .mat file. RecordError naming FILE for anything else (a MATLAB
-    7.3 file is HDF5, which scipy does not read)."""
-    import scipy.io
+    """The variables of a MATLAB 5 .mat file (twin.vibration.analysis.read_matlab5). RecordError
+    naming FILE for anything else."""
+    from twin.vibration.analysis import read_matlab5
 
     try:
-        if scipy.io.matlab.matfile_version(path)[0] == 2:
-            raise RecordError("FILE", f"{path.name} is not a readable MATLAB 5 .mat record (MATLAB 7.3, HDF5)")
-        return scipy.io.loadmat(path)
-    except (scipy.io.matlab.MatReadError, ValueError) as exc:
+        return read_matlab5(path)
+    except ValueError as exc:
         raise RecordError("FILE", f"{path.name} is not a readable MATLAB 5 .mat record ({exc})") from None
 
 

@@ -38,12 +38,11 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 import numpy as np
-from scipy.io import loadmat
-from scipy.io.matlab import MatReadError, matfile_version
 from scipy.signal import decimate, hilbert, welch
 
 from twin.validation.vibration_simulation import simulate_vibration
 from twin.vibration import indicators as ind
+from twin.vibration.analysis import read_matlab5
 
 G_M_S2 = 9.80665
 DATA_DIR = Path(__file__).resolve().parents[2] / "tests" / "data" / "cwru"
@@ -230,10 +229,8 @@ def _load_g(path: Path, record: Record) -> np.ndarray:
     if path.suffix.lower() != ".mat":
         return np.load(path).reshape(-1)
     try:
-        if matfile_version(path)[0] == 2:
-            raise ValueError("MATLAB 7.3, HDF5")
-        data = loadmat(path)
-    except (MatReadError, ValueError) as exc:
+        data = read_matlab5(path)
+    except ValueError as exc:
         raise ValueError(f"record {record.number}: {path.name} is not a readable MATLAB 5 .mat file ({exc})") from None
     if record.variable not in data:
         names = ", ".join(sorted(k for k in data if not k.startswith("__")))

@@ -153,6 +153,19 @@ class VibrationAnalysis:
         return out
 
 
+def read_matlab5(path) -> dict:
+    """The variables of a MATLAB 5 .mat record (the CWRU data center's files). ValueError with the
+    reason for any other file (a MATLAB 7.3 file is HDF5, which scipy does not read)."""
+    import scipy.io
+
+    try:
+        if scipy.io.matlab.matfile_version(path)[0] == 2:
+            raise ValueError("MATLAB 7.3, HDF5")
+        return scipy.io.loadmat(path)
+    except scipy.io.matlab.MatReadError as exc:
+        raise ValueError(str(exc)) from None
+
+
 def _finite_positive(name: str, value, upper: float) -> float:
     try:
         v = float(value)
