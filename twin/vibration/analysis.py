@@ -34,6 +34,7 @@ import re
 from dataclasses import dataclass, field
 
 import numpy as np
+import scipy.io
 
 from twin.vibration import indicators
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
@@ -156,8 +157,6 @@ class VibrationAnalysis:
 def read_matlab5(path) -> dict:
     """The variables of a MATLAB 5 .mat record (the CWRU data center's files). ValueError with the
     reason for any other file (a MATLAB 7.3 file is HDF5, which scipy does not read)."""
-    import scipy.io
-
     try:
         if scipy.io.matlab.matfile_version(path)[0] == 2:
             raise ValueError("MATLAB 7.3, HDF5")
