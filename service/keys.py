@@ -8,7 +8,9 @@ A twin with id `ID` under the prefix `P` (1-8 chunks, e.g. plant1/line2/motor7) 
     P/ID/defects/result    answer to each defect set       P/ID/snapshot          queryable: latest state
     P/ID/owner             queryable: the owning process   P/ID/alive             liveliness token
     P/ID/alarm             alarm events                    P/ID/ball/N            per-ball stream
-    P/ID/<stream>          further streams (vibration ...)
+    P/ID/temperature       measured temperatures in        P/ID/temperature/result  answer to each
+    P/ID/vibration/measured  measured windows in           P/ID/vibration/comparison  answer to each
+    P/ID/vibration         vibration block and spectra     P/ID/vibration/waveform  accelerometer samples
 
 An id and every prefix chunk take letters, digits, '_', '.', '-' (an id starts with a letter or a
 digit): one key-expression chunk, with none of zenoh's special characters ('/', '*', '$', '?',
@@ -54,6 +56,7 @@ PREFIX_PATTERN_WILDCARD = (
 PREFIX_WILDCARD_RE = re.compile(PREFIX_PATTERN_WILDCARD)
 
 STATE = "state"
+BALL = "ball"
 SETPOINT = "setpoint"
 SETPOINT_RESULT = "setpoint/result"
 DEFECTS = "defects"
@@ -66,6 +69,8 @@ VIBRATION = "vibration"
 VIBRATION_WAVEFORM = "vibration/waveform"
 VIBRATION_MEASURED = "vibration/measured"
 VIBRATION_COMPARISON = "vibration/comparison"
+TEMPERATURE = "temperature"
+TEMPERATURE_RESULT = "temperature/result"
 
 
 def check_prefix(prefix: str) -> str:
@@ -92,7 +97,7 @@ def twin_key(prefix: str, twin_id: str, suffix: str | None = None) -> str:
 
 def ball_key(prefix: str, twin_id: str, index: int) -> str:
     """The per-ball stream `prefix/twin_id/ball/index`."""
-    return f"{prefix}/{twin_id}/ball/{index}"
+    return f"{prefix}/{twin_id}/{BALL}/{index}"
 
 
 def all_twins(prefix: str, suffix: str) -> str:

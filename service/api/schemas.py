@@ -12,6 +12,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, ConfigDict, Field
 
 from service.core.errors import Bounds, FieldError, InputError, models_bounds
+from service.core.measured_temperature import MeasuredTemperature
 from service.core.runner import RunMode
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointUpdate
@@ -236,14 +237,6 @@ class ScenarioList(BaseModel):
 
 
 # ---- recording ----------------------------------------------------------------------------------
-class TemperatureRequest(BaseModel):
-    """One measured node temperature (PUT /v1/bearings/{id}/temperature)."""
-
-    model_config = ConfigDict(extra="forbid", allow_inf_nan=False)
-    node: Literal["outer_ring", "housing", "oil"] = Field(default="outer_ring", description="Measured node [text].")
-    temperature_c: float = Field(ge=-60.0, le=400.0, description="Measured temperature [degC].")
-
-
 class RecordingRequest(BaseModel):
     """Start or stop a rerun recording of one twin."""
 
@@ -515,7 +508,7 @@ def request_bounds() -> dict[str, Bounds]:
         (
             BearingCreate,
             RecordingRequest,
-            TemperatureRequest,
+            MeasuredTemperature,
             ScenarioRequest,
             Scenario,
             ScenarioRun,

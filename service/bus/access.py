@@ -17,10 +17,12 @@ control"):
   role      may (keys under the prefix P, one twin id `*`)
   ========  ==================================================================================
   readers   subscribe to P/*/state, P/*/ball/*, P/*/setpoint/result, P/*/defects/result,
-            P/*/alarm, P/*/vibration, P/*/vibration/waveform; query P/*/snapshot and
-            P/*/owner; watch and query the liveliness tokens P/*/alive
-  writers   what readers may, and put P/*/setpoint and P/*/defects
-  services  put what readers subscribe to; subscribe to P/*/setpoint, P/*/defects; declare
+            P/*/temperature/result, P/*/alarm, P/*/vibration, P/*/vibration/waveform,
+            P/*/vibration/comparison; query P/*/snapshot and P/*/owner; watch and query the
+            liveliness tokens P/*/alive
+  writers   what readers may, and put P/*/setpoint, P/*/defects, P/*/temperature and
+            P/*/vibration/measured
+  services  put what readers subscribe to; subscribe to what writers put; declare
             and answer the queryables P/*/snapshot and P/*/owner; declare the liveliness tokens
             P/*/alive; query P/*/owner and the liveliness of P/*/alive (the id clash check)
   ========  ==================================================================================
@@ -43,7 +45,7 @@ What zenoh (eclipse-zenoh 1.10) cannot do, and what we do instead:
   prefix; a service may publish for any twin id (two prefixes with different writer lists need
   two routers or two prefixes' rules, see `acl_config(prefixes=...)`).
 * a subscriber never learns who sent a sample, so the service cannot tell writers apart: who may
-  write is decided entirely by the rules (the setpoint intake no longer checks any token).
+  write is decided entirely by the rules (no payload carries a token).
 """
 
 from __future__ import annotations
@@ -54,38 +56,69 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from service.keys import all_twins
+from service.keys import (
+    ALARM,
+    ALIVE,
+    BALL,
+    DEFECTS,
+    DEFECTS_RESULT,
+    OWNER,
+    SETPOINT,
+    SETPOINT_RESULT,
+    SNAPSHOT,
+    STATE,
+    TEMPERATURE,
+    TEMPERATURE_RESULT,
+    VIBRATION,
+    VIBRATION_COMPARISON,
+    VIBRATION_MEASURED,
+    VIBRATION_WAVEFORM,
+    all_twins,
+)
 from service.settings import zenoh_access_enabled
 
 # what each role may do: (messages, flow, key suffixes under P/*)
-# what a twin publishes (besides its state): results, alarm events, vibration
-_OUT = ["state", "ball/*", "setpoint/result", "defects/result", "alarm", "vibration", "vibration/waveform"]
+# what a twin publishes: its state, balls, the results of what was written to it, alarm events,
+# vibration and the comparisons of measured windows
+_OUT = [
+    STATE,
+    f"{BALL}/*",
+    SETPOINT_RESULT,
+    DEFECTS_RESULT,
+    TEMPERATURE_RESULT,
+    ALARM,
+    VIBRATION,
+    VIBRATION_WAVEFORM,
+    VIBRATION_COMPARISON,
+]
+# what a writer puts to a twin (and a service subscribes to)
+_IN = [SETPOINT, DEFECTS, TEMPERATURE, VIBRATION_MEASURED]
 _READ_IN = [
     (["declare_subscriber"], "ingress", _OUT),
-    (["query"], "ingress", ["snapshot", "owner"]),
-    (["declare_liveliness_subscriber", "liveliness_query"], "ingress", ["alive"]),
+    (["query"], "ingress", [SNAPSHOT, OWNER]),
+    (["declare_liveliness_subscriber", "liveliness_query"], "ingress", [ALIVE]),
 ]
 _READ_OUT = [
     (["put"], "egress", _OUT),
-    (["declare_queryable", "reply"], "egress", ["snapshot", "owner"]),
-    (["liveliness_token"], "egress", ["alive"]),
+    (["declare_queryable", "reply"], "egress", [SNAPSHOT, OWNER]),
+    (["liveliness_token"], "egress", [ALIVE]),
 ]
 _WRITE = [
-    (["put"], "ingress", ["setpoint", "defects"]),
-    (["declare_subscriber"], "egress", ["setpoint", "defects"]),
+    (["put"], "ingress", _IN),
+    (["declare_subscriber"], "egress", _IN),
 ]
 _SERVICE = [
     (["put"], "ingress", _OUT),
-    (["declare_subscriber"], "ingress", ["setpoint", "defects"]),
-    (["declare_queryable", "reply"], "ingress", ["snapshot", "owner"]),
-    (["liveliness_token"], "ingress", ["alive"]),
-    (["query"], "ingress", ["owner"]),
-    (["liveliness_query"], "ingress", ["alive"]),
-    (["put"], "egress", ["setpoint", "defects"]),
+    (["declare_subscriber"], "ingress", _IN),
+    (["declare_queryable", "reply"], "ingress", [SNAPSHOT, OWNER]),
+    (["liveliness_token"], "ingress", [ALIVE]),
+    (["query"], "ingress", [OWNER]),
+    (["liveliness_query"], "ingress", [ALIVE]),
+    (["put"], "egress", _IN),
     (["declare_subscriber"], "egress", _OUT),
-    (["query"], "egress", ["snapshot", "owner"]),
-    (["declare_queryable", "reply"], "egress", ["owner"]),
-    (["declare_liveliness_subscriber", "liveliness_query", "liveliness_token"], "egress", ["alive"]),
+    (["query"], "egress", [SNAPSHOT, OWNER]),
+    (["declare_queryable", "reply"], "egress", [OWNER]),
+    (["declare_liveliness_subscriber", "liveliness_query", "liveliness_token"], "egress", [ALIVE]),
 ]
 ROLE_RULES = {"readers": _READ_IN + _READ_OUT, "writers": _READ_IN + _READ_OUT + _WRITE, "services": _SERVICE}
 

@@ -1,5 +1,5 @@
-"""What reaches a twin from the zenoh bus: setpoints, defects, measured accelerometer windows,
-snapshot and owner queries, each answered (the incoming half of
+"""What reaches a twin from the zenoh bus: setpoints, defects, measured accelerometer windows and
+temperatures, snapshot and owner queries, each answered (the incoming half of
 `service.bus.zenoh_bus.TwinChannel`).
 
 zenoh runs its callbacks on its own threads; those only append to a bounded queue and return.
@@ -30,6 +30,8 @@ from service.keys import (
     SETPOINT,
     SETPOINT_RESULT,
     SNAPSHOT,
+    TEMPERATURE,
+    TEMPERATURE_RESULT,
     VIBRATION_COMPARISON,
     VIBRATION_MEASURED,
     twin_key,
@@ -55,6 +57,7 @@ class TwinInbox:
         *,
         on_defects: Handler | None = None,
         on_measured: Handler | None = None,
+        on_temperature: Handler | None = None,
         known_state: Callable[[Snapshot], str | None] = lambda _s: None,
     ):
         self.bus = bus
@@ -65,7 +68,9 @@ class TwinInbox:
         self._on_setpoint = on_setpoint
         self._on_defects = on_defects
         self._on_measured = on_measured
+        self._on_temperature = on_temperature
         self.setpoints_received = 0
+        self.writes_received: collections.Counter[str] = collections.Counter()  # defects, measured, temperature
         self.setpoints_refused_busy = 0  # setpoints refused (429 on the result key): control queue full
         self.queries_answered = 0
         self._busy_pending = 0  # of those, refusals not yet published
@@ -102,6 +107,21 @@ class TwinInbox:
             self._measured_sub = session.declare_subscriber(
                 key(VIBRATION_MEASURED), lambda sample: self._enqueue(("measured", payload(sample)))
             )
+        # measured temperatures (service.core.intake.TemperatureIntake: JSON in, result out)
+        self._temperature_sub = self._temperature_result_pub = None
+        if on_temperature is not None:
+            self._temperature_result_pub = session.declare_publisher(
+                key(TEMPERATURE_RESULT), encoding=JSON_ENCODING, congestion_control=zenoh.CongestionControl.BLOCK
+            )
+            self._temperature_sub = session.declare_subscriber(
+                key(TEMPERATURE), lambda sample: self._enqueue(("temperature", payload(sample)))
+            )
+        # the writes besides setpoints: kind -> (handler, result publisher)
+        self._writes: dict[str, tuple[Handler | None, Any]] = {
+            "defects": (on_defects, self._defects_result_pub),
+            "measured": (on_measured, self._comparison_pub),
+            "temperature": (on_temperature, self._temperature_result_pub),
+        }
         self._queryable = session.declare_queryable(key(SNAPSHOT), lambda query: self._enqueue(("query", query)))
         self._owner_queryable = session.declare_queryable(key(OWNER), lambda query: self._enqueue(("owner", query)))
         self._thread = threading.Thread(target=self._loop, name=f"zenoh-ctl-{bearing_id}", daemon=True)
@@ -116,6 +136,7 @@ class TwinInbox:
             self._setpoint_sub,
             self._defects_sub,
             self._measured_sub,
+            self._temperature_sub,
             self._queryable,
             self._owner_queryable,
         ):
@@ -131,7 +152,7 @@ class TwinInbox:
         if self._thread is not threading.current_thread():  # e.g. detach from inside on_setpoint
             self._thread.join(timeout_s)
         self._gone = True
-        for pub in (self._result_pub, self._defects_result_pub, self._comparison_pub):
+        for pub in (self._result_pub, self._defects_result_pub, self._comparison_pub, self._temperature_result_pub):
             if pub is not None:
                 undeclare(pub)
 
@@ -150,11 +171,12 @@ class TwinInbox:
                         self._busy_marked = 1
                         self._control.append(("busy", None))
                         self._control_cond.notify()
-                elif item[0] == "defects":  # rare: refused at once on its result key
+                elif item[0] in ("defects", "temperature"):  # rare: refused at once on its result key
                     self.setpoints_refused_busy += 1
-                    if not self._gone and self._defects_result_pub is not None:
+                    pub = self._defects_result_pub if item[0] == "defects" else self._temperature_result_pub
+                    if not self._gone and pub is not None:
                         with contextlib.suppress(Exception):
-                            self._defects_result_pub.put(self._busy_refusal("messages"))
+                            pub.put(self._busy_refusal("messages"))
                 else:
                     finish_query(item, error="busy: too many requests waiting, retry")
                 return
@@ -181,10 +203,9 @@ class TwinInbox:
                 elif kind == "setpoint":
                     self.setpoints_received += 1
                     self._handle_write(value, self._on_setpoint, self._result_pub)
-                elif kind == "defects":
-                    self._handle_write(value, self._on_defects, self._defects_result_pub)
-                elif kind == "measured":
-                    self._handle_write(value, self._on_measured, self._comparison_pub)
+                elif kind in self._writes:
+                    self.writes_received[kind] += 1
+                    self._handle_write(value, *self._writes[kind])
                 elif kind == "owner":
                     self._handle_owner_query(value)
                 else:

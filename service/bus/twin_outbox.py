@@ -37,7 +37,7 @@ from typing import Any
 import zenoh
 
 from service.bus.wire import JSON_ENCODING, Bus, Waveform, dumps, one_line, spectrum_json
-from service.keys import ALARM, STATE, ball_key, twin_key
+from service.keys import ALARM, STATE, VIBRATION, VIBRATION_WAVEFORM, ball_key, twin_key
 from twin.snapshot import Snapshot
 from twin.snapshot_blocks import ball_json_items
 from twin.snapshot_frame import SnapshotFrame
@@ -123,7 +123,7 @@ class TwinOutbox:
     def publish_waveform(self, blocks: list) -> None:
         """Queue accelerometer blocks for `P/{id}/vibration/waveform`; returns at once (counted
         in `unmatched` and not queued while nobody subscribes)."""
-        pub = self._lazy_publisher("_waveform_pub", "vibration/waveform", "application/octet-stream")
+        pub = self._lazy_publisher("_waveform_pub", VIBRATION_WAVEFORM, "application/octet-stream")
         if pub is not None and not self._matched(pub):
             with self._cond:
                 self.unmatched += 1
@@ -152,7 +152,7 @@ class TwinOutbox:
         window_end = None if block is None else block.window_end_s
         new_window = window_end is not None and window_end != self._last_window_end_s
         if new_window:
-            pub = self._lazy_publisher("_vibration_pub", "vibration", JSON_ENCODING)
+            pub = self._lazy_publisher("_vibration_pub", VIBRATION, JSON_ENCODING)
             if pub is None or self._matched(pub):
                 return False
             self._last_window_end_s = window_end
@@ -301,7 +301,7 @@ class TwinOutbox:
         if end == self._last_window_end_s:
             return
         self._last_window_end_s = end
-        pub = self._lazy_publisher("_vibration_pub", "vibration", JSON_ENCODING)
+        pub = self._lazy_publisher("_vibration_pub", VIBRATION, JSON_ENCODING)
         if pub is not None and not self._matched(pub):
             self.unmatched += 1
             return
@@ -329,7 +329,7 @@ class TwinOutbox:
         """One binary chunk per block on `P/{id}/vibration/waveform` (twin.vibration.waveform)."""
         from twin.vibration.waveform import encode_chunk
 
-        pub = self._lazy_publisher("_waveform_pub", "vibration/waveform", "application/octet-stream")
+        pub = self._lazy_publisher("_waveform_pub", VIBRATION_WAVEFORM, "application/octet-stream")
         if pub is None:
             return
         if not self._matched(pub):

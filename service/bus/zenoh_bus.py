@@ -38,6 +38,11 @@ prefix P (`zenoh_prefix`, default `bearing`; site / line / asset, e.g. `plant1/l
                              admission as a setpoint
     P/{id}/vibration/comparison  its analysis beside the twin's prediction, residual and alarms
                              (JSON), or the refusal (accepted false, status, field)
+    P/{id}/temperature       a measured node temperature in (subscriber): JSON {"node":
+                             "outer_ring" | "housing" | "oil", "temperature_c": ...} as PUT
+                             /v1/bearings/{id}/temperature; same admission as a setpoint
+    P/{id}/temperature/result  what became of it (JSON: accepted, node, temperature_c, or
+                             the refusal: accepted false, status, field)
     P/{id}/alive             liveliness token while the twin is attached
 
 One id per prefix in the whole zenoh network: `attach_twin` first asks for the liveliness token
@@ -214,6 +219,7 @@ class TwinChannel:
         flush_timeout_s: float = 2.0,
         on_defects: Callable[[bytes], dict] | None = None,
         on_measured: Callable[[bytes], dict] | None = None,
+        on_temperature: Callable[[bytes], dict] | None = None,
     ):
         self.bus = bus
         self.bearing_id = bearing_id
@@ -229,6 +235,7 @@ class TwinChannel:
             on_setpoint,
             on_defects=on_defects,
             on_measured=on_measured,
+            on_temperature=on_temperature,
             known_state=self.outbox.last_state,
         )
         self._token = bus.session.liveliness().declare_token(twin_key(bus.prefix, bearing_id, ALIVE))
@@ -395,6 +402,7 @@ class ZenohBus:
         queue_size: int = DEFAULT_QUEUE_SIZE,
         on_defects: Callable[[bytes], dict] | None = None,
         on_measured: Callable[[bytes], dict] | None = None,
+        on_temperature: Callable[[bytes], dict] | None = None,
     ) -> TwinChannel:
         """Declare the twin's publishers, setpoint subscriber, snapshot and owner queryables and
         liveliness token; return its channel (a SnapshotSink: hand it to the runner).
@@ -432,6 +440,7 @@ class ZenohBus:
                 queue_size=queue_size,
                 on_defects=on_defects,
                 on_measured=on_measured,
+                on_temperature=on_temperature,
             )
             others = self._claimants(key) if self.trust_claims else []
             if others:  # claimed at the same moment elsewhere: withdraw

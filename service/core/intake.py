@@ -1,5 +1,6 @@
-"""Setpoints (and local defects, `DefectIntake`) that arrive as raw payloads (zenoh
-`{prefix}/{id}/setpoint`): the admission gate, then the same validation and mailbox as HTTP.
+"""Setpoints (and local defects, `DefectIntake`; measured temperatures, `TemperatureIntake`)
+that arrive as raw payloads (zenoh `{prefix}/{id}/setpoint`): the admission gate, then the same
+validation and mailbox as HTTP.
 
 `SetpointIntake(bearing_id, gate, runner)(payload) -> dict` never raises. In order: whether the
 bus may write at all (403 when the HTTP API needs a token but zenoh access control is off: see
@@ -19,6 +20,7 @@ from typing import Any
 
 from service.core.admission import AdmissionGate, Refusal
 from service.core.errors import InputError
+from service.core.measured_temperature import parse_measured_temperature
 from service.core.runner import TwinRunner, parse_update
 
 _TOKEN_FIELD = (
@@ -86,6 +88,20 @@ class DefectIntake(SetpointIntake):
     def _apply(self, data: Any) -> dict:
         items = self.runner.submit_defects(data)
         return {"defects": [d.model_dump() for d in items]}
+
+
+class TemperatureIntake(SetpointIntake):
+    """Measured temperatures as raw payloads (zenoh `{prefix}/{id}/temperature`): the same gate
+    (bus writer, size, the twin's setpoint budget), then the vocabulary of PUT
+    `/v1/bearings/{id}/temperature` (service.core.measured_temperature: 422 naming the field and
+    its range) and `TwinRunner.submit_temperature` (409 with the fixed oil temperature). A payload
+    is {"node": "outer_ring", "temperature_c": 62.5}; the answer carries "node" and
+    "temperature_c" when accepted."""
+
+    def _apply(self, data: Any) -> dict:
+        measured = parse_measured_temperature(data)
+        self.runner.submit_temperature(measured.node, measured.temperature_c)
+        return measured.model_dump()
 
 
 _INVALID = object()

@@ -57,7 +57,7 @@ from service.core.capacity import (
 )
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.heap import freeze_heap
-from service.core.intake import DefectIntake, SetpointIntake
+from service.core.intake import DefectIntake, SetpointIntake, TemperatureIntake
 from service.core.measured import MeasuredComparator, MeasuredIntake
 from service.core.pool import SteppingPool
 from service.core.priority import EGRESS_THREAD_NAMES, ThreadPriority
@@ -119,6 +119,7 @@ class Bus(Protocol):
         *,
         on_defects: Callable[[bytes], dict] | None = None,
         on_measured: Callable[[bytes], dict] | None = None,
+        on_temperature: Callable[[bytes], dict] | None = None,
     ) -> Channel: ...
 
     def close(self) -> None: ...
@@ -445,6 +446,7 @@ class TwinRegistry:
                     entry.intake,
                     on_defects=DefectIntake(bearing_id, self.gate, runner),
                     on_measured=MeasuredIntake(bearing_id, self.gate, entry.measured),
+                    on_temperature=TemperatureIntake(bearing_id, self.gate, runner),
                 )
                 runner.add_sink(entry.channel)
             if self.recorder is not None:

@@ -54,6 +54,7 @@ from service.core.defects import DefectBox, parse_defects
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.faults import ErrorStreak, Fallback, FaultPolicy
 from service.core.mailbox import LatestValue, Mailbox, SetpointTiming
+from service.core.measured_temperature import TEMPERATURE_RANGE_C
 from service.core.pacing import PacingClock
 from service.core.pool import Job, Schedule, SteppingPool
 from service.core.publishing import Publisher
@@ -317,8 +318,11 @@ class TwinRunner:
             )
         if node not in MEASURABLE_NODES:
             raise InputError.one("node", f"{node!r} cannot be measured", allowed=list(MEASURABLE_NODES))
-        if not (math.isfinite(temperature_c) and -60.0 <= temperature_c <= 400.0):
-            raise InputError.one("temperature_c", f"{temperature_c!r}: must be finite, in [-60, 400] degC")
+        low, high = TEMPERATURE_RANGE_C
+        if not (math.isfinite(temperature_c) and low <= temperature_c <= high):
+            raise InputError.one(
+                "temperature_c", f"{temperature_c!r}: must be finite, in [{low:g}, {high:g}] degC", [low, high]
+            )
         self.measured_temperature.offer((node, float(temperature_c)))
         self._wake()
 

@@ -60,10 +60,11 @@ Reading and validating a scenario (`load_scenario`, `scenario_from_dict`): servi
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any
 
 from pydantic import BaseModel, ConfigDict, Discriminator, Field, Tag, field_validator, model_validator
 
+from service.core.measured_temperature import MeasuredTemperature
 from service.keys import TWIN_ID_PATTERN
 from twin import catalog
 from twin.setpoint import Setpoint, SetpointLimits, SetpointUpdate
@@ -100,14 +101,6 @@ class ScenarioError(ValueError):
         self.field, self.message, self.allowed = field, message, allowed
         # the message may already start with the field (several errors, each with its path)
         super().__init__(message if message.startswith(f"{field}: ") else f"{field}: {message}")
-
-
-class MeasuredTemperature(BaseModel):
-    """A measured node temperature handed to the twin's thermal network (twin.thermal.estimator)."""
-
-    model_config = _FROZEN
-    node: Literal["outer_ring", "housing", "oil"] = Field(default="outer_ring", description="Measured node [text].")
-    temperature_c: float = Field(ge=-60.0, le=400.0, description="Measured temperature [degC].")
 
 
 class ScenarioStep(BaseModel):

@@ -16,12 +16,15 @@ import queue
 import secrets
 import threading
 import time
+from pathlib import Path
 
 import httpx
+import numpy as np
 import pytest
 
 from service.core.admission import AdmissionGate
 from service.core.intake import SetpointIntake
+from service.core.measured import encode_frame
 from service.core.runner import TwinRunner
 from service.settings import RouterSettings, ServiceSettings
 
@@ -144,7 +147,12 @@ def test_acl_rules_are_default_deny_and_per_role():
         return {k for r in by_role[role] if message in r["messages"] and flow in r["flows"] for k in r["key_exprs"]}
 
     # canonical keys: `**/*` is written `*/**`
-    assert allowed("writers", "put", "ingress") == {"plant1/*/**/setpoint", "plant1/*/**/defects"}
+    assert allowed("writers", "put", "ingress") == {
+        "plant1/*/**/setpoint",
+        "plant1/*/**/defects",
+        "plant1/*/**/temperature",
+        "plant1/*/**/vibration/measured",
+    }
     assert allowed("readers", "put", "ingress") == set()  # a reader never writes
     assert "plant1/*/**/setpoint" not in allowed("readers", "put", "egress")  # nor sees setpoints
     assert allowed("readers", "liveliness_token", "ingress") == set()  # nor declares a twin
@@ -155,10 +163,14 @@ def test_acl_rules_are_default_deny_and_per_role():
         "plant1/*/**/ball/*",
         "plant1/*/**/setpoint/result",
         "plant1/*/**/defects/result",
+        "plant1/*/**/temperature/result",
         "plant1/*/**/alarm",
         "plant1/*/**/vibration",
         "plant1/*/**/vibration/waveform",
+        "plant1/*/**/vibration/comparison",
     }
+    # what a service subscribes to is exactly what a writer may put
+    assert allowed("services", "declare_subscriber", "ingress") == allowed("writers", "put", "ingress")
     assert "plant1/*/**/defects" not in allowed("readers", "put", "egress")  # nor sees defect writes
     assert {s["id"] for s in acl["subjects"]} >= {"writers-users", "writers-certs"}
     assert set(ROLE_RULES) == {"services", "writers", "readers"}
@@ -305,6 +317,46 @@ def test_secured_service_anonymous_gets_nothing_reader_cannot_write(hostile, use
             assert _no_token(*spies) >= CONTROL_N
         finally:
             for spy in spies:
+                spy.close()
+
+
+def test_secured_service_takes_measurements_from_writers_only(hostile, users):
+    """Measured temperatures and accelerometer windows are writes like setpoints: with zenoh
+    access control on, the writer's reach the twin and are answered on their result keys (which
+    a reader may follow); a reader's and an anonymous peer's never reach the service."""
+    path, pw = users
+    endpoint = f"tcp/127.0.0.1:{hostile.free_port()}"
+    settings = _service_settings(
+        hostile, zenoh_listen=[endpoint], zenoh_usersfile=path, zenoh_writers=["op"], zenoh_readers=["viewer"]
+    )
+    window = np.load(Path(__file__).resolve().parents[1] / "data" / "cwru" / "97_DE_12k_5s.npy")[:12000]
+    frame = encode_frame(window, 12000.0, "g")
+    results = ("bearing/*/temperature/result", "bearing/*/vibration/comparison")
+    with hostile.ThreadServer(settings) as srv:
+        inbox = srv.service.find("default").channel.inbox
+        anon = Spy(endpoint, mode="peer")
+        viewer = Spy(endpoint, user="viewer", password=pw["viewer"])
+        op = Spy(endpoint, user="op", password=pw["op"])
+        try:
+            viewer.subscribe(*results)
+            op.subscribe(*results)
+            _wait(lambda: srv.service.find("default").runner.latest is not None, what="the first snapshot")
+            for spy in (anon, viewer):
+                spy.session.put("bearing/default/temperature", json.dumps({"temperature_c": 90.0}))
+                spy.session.put("bearing/default/vibration/measured", frame)
+            op.session.put("bearing/default/temperature", json.dumps({"temperature_c": 41.5}))
+            op.session.put("bearing/default/vibration/measured", frame)
+            for spy in (op, viewer):  # the answers reach the writer and the reader
+                _wait(lambda s=spy: s.count(lambda k, p: k.endswith("/temperature/result")) >= 1, what="result")
+                _wait(lambda s=spy: s.count(lambda k, p: k.endswith("/vibration/comparison")) >= 1, what="comparison")
+            time.sleep(0.5)
+            temps = [json.loads(p) for k, p in op.seen if k.endswith("/temperature/result")]
+            assert [(r["accepted"], r["temperature_c"]) for r in temps] == [(True, 41.5)]
+            comparisons = [json.loads(p) for k, p in op.seen if k.endswith("/vibration/comparison")]
+            assert [r["accepted"] for r in comparisons] == [True]
+            assert inbox.writes_received == {"temperature": 1, "measured": 1}  # none of the others'
+        finally:
+            for spy in (anon, viewer, op):
                 spy.close()
 
 

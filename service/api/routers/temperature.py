@@ -9,7 +9,7 @@ from pydantic import BaseModel, Field
 from service.api.deps import TwinDep, setpoint_rate
 from service.api.routers.bearings import INVALID, UNKNOWN_TWIN
 from service.api.routers.setpoint import TOO_MANY
-from service.api.schemas import TemperatureRequest
+from service.core.measured_temperature import MeasuredTemperature
 
 write = APIRouter(prefix="/v1/bearings", tags=["thermal"])
 
@@ -28,7 +28,7 @@ class TemperatureResponse(BaseModel):
     dependencies=[Depends(setpoint_rate)],
     responses={**UNKNOWN_TWIN, **INVALID, **TOO_MANY},
 )
-def put_temperature(entry: TwinDep, body: TemperatureRequest) -> TemperatureResponse:
+def put_temperature(entry: TwinDep, body: MeasuredTemperature) -> TemperatureResponse:
     """Hand a measured temperature to the twin's dissipation estimator; the snapshot's `thermal`
     block then carries the estimate, its uncertainty and the residual (409 with the fixed oil
     temperature, 422 naming the field and its range)."""

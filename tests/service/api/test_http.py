@@ -236,7 +236,7 @@ def test_garbage_is_a_clean_4xx_never_a_500(client, raw):
     ],
 )
 def test_a_measured_temperature_out_of_range_names_both_sides(client, body, field, allowed):
-    # TemperatureRequest declares [-60, 400] degC: the error states the whole range whichever
+    # MeasuredTemperature declares [-60, 400] degC: the error states the whole range whichever
     # side is crossed (pydantic names only that side), and a node the network has not is named
     r = client.put("/v1/bearings/default/temperature", json=body)
     assert r.status_code == 422, r.text
