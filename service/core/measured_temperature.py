@@ -5,7 +5,7 @@ step `temperature`."""
 
 from __future__ import annotations
 
-from typing import Any, Literal
+from typing import Any, Literal, get_args
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
@@ -16,6 +16,8 @@ TEMPERATURE_RANGE_C = (-60.0, 400.0)
 a bearing, wide of any oil's."""
 
 MeasurableNode = Literal["outer_ring", "housing", "oil"]
+MEASURABLE_NODES: tuple[str, ...] = get_args(MeasurableNode)
+"""The nodes a measurement may name: twin.thermal.coupling.MEASURABLE_NODES."""
 
 
 class MeasuredTemperature(BaseModel):

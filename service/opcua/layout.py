@@ -19,6 +19,7 @@ from typing import Any, Literal
 from service.core.alarm_inputs import AlarmInputs
 from service.core.alarm_rules import ALARM_IDS, vibration_zone
 from service.core.alarms import Alarm
+from service.core.measured_temperature import MEASURABLE_NODES, TEMPERATURE_RANGE_C
 from service.settings import AlarmSettings
 from twin.life.iso281 import ratings_for
 from twin.setpoint import FIELDS as SETPOINT_FIELDS
@@ -29,7 +30,7 @@ NAMESPACE_URI = "urn:bearing-twin:opcua"  # the twins' nodes
 APPLICATION_URI = "urn:bearing-twin:server"  # the server application (namespace 1)
 ROOT_FOLDER = "BearingTwins"  # under Objects: one object per twin
 EVENT_TYPE = "BearingAlarmEventType"  # under BaseEventType
-LAST_RESULT = "last_result"  # Setpoint/last_result: what became of the latest write
+LAST_RESULT = "last_result"  # <input folder>/last_result: what became of its latest write
 
 UaType = Literal["Double", "String", "UInt32", "Int64", "Boolean"]
 
@@ -501,6 +502,32 @@ SETPOINT_VARS: tuple[Var, ...] = tuple(
         (lambda name: lambda v: getattr(v.target, name) if v.target is not None else None)(f.name),
     )
     for f in SETPOINT_FIELDS
+)
+
+
+MEASURED_TEMPERATURE = "MeasuredTemperature"  # folder of the writable measured temperatures
+
+
+def _measured_c(node: str) -> Callable[[View], Any]:
+    """The last measured temperature of `node` the thermal block shows [degC], or None."""
+
+    def read(v: View) -> Any:
+        thermal = v.snapshot.thermal if v.snapshot is not None else None
+        return thermal.measured_c if thermal is not None and thermal.measured_node == node else None
+
+    return read
+
+
+MEASURED_TEMPERATURE_VARS: tuple[Var, ...] = tuple(
+    Var(
+        f"{node}_c",
+        "Double",
+        f"Measured {node.replace('_', ' ')} temperature [degC]: write it for the thermal network to follow "
+        f"(as PUT /v1/bearings/{{id}}/temperature; [{TEMPERATURE_RANGE_C[0]:g}, {TEMPERATURE_RANGE_C[1]:g}] "
+        "degC); reads the last measurement the twin took.",
+        _measured_c(node),
+    )
+    for node in MEASURABLE_NODES
 )
 
 

@@ -62,4 +62,4 @@ class TwinNodes:
         self.last: dict[str, Any] = {}
         self.seq: int | None = None
         self.generators: list[EventGenerator] = []
-        self.last_result: ua.NodeId | None = None
+        self.last_results: dict[str, ua.NodeId] = {}  # input folder -> its last_result variable

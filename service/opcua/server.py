@@ -10,14 +10,16 @@ the snapshot is new, writes the variables that changed; twins created or deleted
 registry appear or disappear at the same pace. Address space: service.opcua.layout (docs/service.md
 "OPC UA"); the nodes of a twin: service.opcua.nodes; the users: service.opcua.identity.
 
-Writes. The Setpoint variables are answered by `_GatedAttributeService` (it replaces asyncua's
-attribute service and passes every other write on): the same admission gate and setpoint path as
-HTTP and zenoh (service.core.admission, `runner.submit` -> `SetpointLimits.admit`). Status codes:
-BadUserAccessDenied (a token is set and the session is anonymous), BadTooManyOperations (the
-twin's setpoint rate), BadTypeMismatch (not a number), BadOutOfRange (outside the bearing's
-range, or not finite). The OPC UA write response carries only the status code, so the words
-(naming the field and the bearing's range, as the HTTP 422) go to the twin's
-`Setpoint/last_result` variable, JSON like the zenoh result key:
+Writes. The Setpoint variables, and with a thermal network the MeasuredTemperature variables
+(`outer_ring_c`, `housing_c`, `oil_c`), are answered by `_GatedAttributeService` (it replaces
+asyncua's attribute service and passes every other write on): the same admission gate and paths
+as HTTP and zenoh (service.core.admission; `runner.submit` -> `SetpointLimits.admit`, or
+`runner.submit_temperature`). Status codes: BadUserAccessDenied (a token is set and the session
+is anonymous), BadTooManyOperations (the twin's setpoint rate, which measurements share),
+BadTypeMismatch (not a number), BadOutOfRange (outside the bearing's range or the measurement's,
+or not finite). The OPC UA write response carries only the status code, so the words (naming the
+field and its range, as the HTTP 422) go to the folder's `last_result` variable, JSON like the
+zenoh result key:
 {"accepted": false, "status": "BadOutOfRange", "field": "radial_load_n", "error": "..."}.
 
 Users. The bearer token is the password of a user-name identity (any user name); a wrong
@@ -70,6 +72,7 @@ from asyncua.server.event_generator import EventGenerator
 from service.core.alarm_inputs import inputs_from_snapshot
 from service.core.alarms import AlarmEvent
 from service.core.errors import InputError
+from service.core.measured_temperature import TEMPERATURE_RANGE_C
 from service.opcua.guard import OpcUaGuard
 from service.opcua.identity import TokenServer, TokenUserManager
 from service.opcua.layout import (
@@ -77,9 +80,12 @@ from service.opcua.layout import (
     EVENT_TYPE,
     FOLDERS,
     LAST_RESULT,
+    MEASURED_TEMPERATURE,
+    MEASURED_TEMPERATURE_VARS,
     NAMESPACE_URI,
     ROOT_FOLDER,
     SETPOINT_VARS,
+    Var,
     View,
     identification,
 )
@@ -97,20 +103,21 @@ _ADMIN = User(role=UserRole.Admin)  # asyncua's default user of a server-side wr
 
 
 class _GatedAttributeService(AttributeService):
-    """asyncua's attribute service with the Setpoint variables answered by the facade."""
+    """asyncua's attribute service with the input variables (Setpoint, MeasuredTemperature)
+    answered by the facade."""
 
     def __init__(self, aspace: Any, facade: OpcUaFacade):
         super().__init__(aspace)
         self._facade = facade
 
     async def write(self, params: ua.WriteParameters, user: User = _ADMIN) -> list[ua.StatusCode]:
-        setpoints = self._facade._setpoint_nodes
-        if user.role == UserRole.Admin or not any(w.NodeId in setpoints for w in params.NodesToWrite):
+        inputs = self._facade._input_nodes
+        if user.role == UserRole.Admin or not any(w.NodeId in inputs for w in params.NodesToWrite):
             return await super().write(params, user)  # the server's own writes, other nodes
         results: list[ua.StatusCode] = []
         for w in params.NodesToWrite:
-            if w.NodeId in setpoints:
-                results.append(await self._facade._write_setpoint(w, setpoints[w.NodeId], user))
+            if w.NodeId in inputs:
+                results.append(await self._facade._write_input(w, inputs[w.NodeId], user))
             else:
                 results.extend(await super().write(ua.WriteParameters(NodesToWrite=[w]), user))
         return results
@@ -156,7 +163,7 @@ class OpcUaFacade:
         self.namespace_index: int | None = None
         self.updates = 0
         self.events_sent = 0
-        self._setpoint_nodes: dict[ua.NodeId, tuple[str, str]] = {}
+        self._input_nodes: dict[ua.NodeId, tuple[str, str, str]] = {}  # -> (twin id, folder, name)
         self._twins: dict[str, TwinNodes] = {}
         self._loop: asyncio.AbstractEventLoop | None = None
         self._alarms: asyncio.Queue | None = None
@@ -344,8 +351,7 @@ class OpcUaFacade:
         try:
             return await self._populate(entry, obj)
         except BaseException:
-            for nid in [n for n, (b, _) in self._setpoint_nodes.items() if b == entry.id]:
-                del self._setpoint_nodes[nid]
+            self._forget_inputs(entry.id)
             await self.server.delete_nodes([obj], recursive=True)  # tried again next time
             raise
 
@@ -365,7 +371,10 @@ class OpcUaFacade:
             await node.write_attribute(ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(desc))))
             if value is None:
                 await self.server.write_attribute_value(node.nodeid, ua.DataValue(StatusCode=status_code("BadNoValue")))
-        for folder, variables in (*FOLDERS.items(), ("Setpoint", SETPOINT_VARS)):
+        inputs: dict[str, tuple[Var, ...]] = {"Setpoint": SETPOINT_VARS}
+        if entry.runner.twin.thermal is not None:  # a thermal network to follow a measurement
+            inputs[MEASURED_TEMPERATURE] = MEASURED_TEMPERATURE_VARS
+        for folder, variables in (*FOLDERS.items(), *inputs.items()):
             fnode = await obj.add_folder(self._nid(bid, folder), qn(folder))
             for var in variables:
                 vt = VARIANT_TYPES[var.type]
@@ -382,14 +391,14 @@ class OpcUaFacade:
                     ua.AttributeIds.Description, ua.DataValue(ua.Variant(ua.LocalizedText(var.description)))
                 )
                 nodes.vars[f"{folder}/{var.name}"] = (node.nodeid, vt, var.read)
-                if folder == "Setpoint":
+                if folder in inputs:
                     await node.set_writable(True)
-                    low, high = entry.runner.limits[var.name]
+                    low, high = entry.runner.limits[var.name] if folder == "Setpoint" else TEMPERATURE_RANGE_C
                     await node.add_property(
                         self._nid(bid, folder, var.name, "EURange"), qn("EURange"), ua.Range(low, high)
                     )
-                    self._setpoint_nodes[node.nodeid] = (bid, var.name)
-            if folder == "Setpoint":
+                    self._input_nodes[node.nodeid] = (bid, folder, var.name)
+            if folder in inputs:
                 last = await fnode.add_variable(
                     self._nid(bid, folder, LAST_RESULT), qn(LAST_RESULT), "", varianttype=ua.VariantType.String
                 )
@@ -398,13 +407,13 @@ class OpcUaFacade:
                     ua.DataValue(
                         ua.Variant(
                             ua.LocalizedText(
-                                "What became of the latest write to a Setpoint variable, JSON: accepted, status, "
-                                "field, error naming the field and the bearing's range [text]."
+                                f"What became of the latest write to a {folder} variable, JSON: accepted, status, "
+                                "field, error naming the field and its range [text]."
                             )
                         )
                     ),
                 )
-                nodes.last_result = last.nodeid
+                nodes.last_results[folder] = last.nodeid
         # alarm events: from the twin object, and from the Server object (SourceNode = the twin)
         isession = self.server.iserver.isession
         for emitter, add_ref in ((obj.nodeid, True), (node_id(ua.ObjectIds.Server), False)):
@@ -418,10 +427,13 @@ class OpcUaFacade:
 
     async def _remove_twin(self, bearing_id: str) -> None:
         nodes = self._twins.pop(bearing_id)
-        for nid in [n for n, (b, _) in self._setpoint_nodes.items() if b == bearing_id]:
-            del self._setpoint_nodes[nid]
+        self._forget_inputs(bearing_id)
         await self.server.delete_nodes([nodes.obj], recursive=True)
         log.info("OPC UA: twin %s removed", bearing_id)
+
+    def _forget_inputs(self, bearing_id: str) -> None:
+        for nid in [n for n, (b, _f, _n) in self._input_nodes.items() if b == bearing_id]:
+            del self._input_nodes[nid]
 
     async def _update(self, nodes: TwinNodes, entry: Any) -> None:
         snap = entry.runner.latest
@@ -484,17 +496,21 @@ class OpcUaFacade:
             self.events_sent += 1
 
     # ---- setpoint writes (server loop) ---------------------------------------------------------
-    async def _write_setpoint(self, w: ua.WriteValue, target: tuple[str, str], user: User) -> ua.StatusCode:
-        bearing_id, name = target
+    async def _write_input(self, w: ua.WriteValue, target: tuple[str, str, str], user: User) -> ua.StatusCode:
+        """A write to a Setpoint or MeasuredTemperature variable: the token, the number, the
+        twin's setpoint budget, then `runner.submit` or `runner.submit_temperature` (module
+        docstring, "Writes"); the words go to the folder's `last_result`."""
+        bearing_id, folder, name = target
         nodes = self._twins.get(bearing_id)
+        result_node = nodes.last_results.get(folder) if nodes is not None else None
 
         async def answer(status: str, message: str | None = None, **extra: Any) -> ua.StatusCode:
-            if nodes is not None and nodes.last_result is not None:
+            if result_node is not None:
                 body = {"accepted": status == "Good", "status": status, "field": name, **extra}
                 if message is not None:
                     body["error"] = message
                 await self.server.write_attribute_value(
-                    nodes.last_result,
+                    result_node,
                     ua.DataValue(ua.Variant(json.dumps(body, allow_nan=False), ua.VariantType.String)),
                 )
             return status_code(status) if status != "Good" else ua.StatusCode()
@@ -512,7 +528,7 @@ class OpcUaFacade:
         variant = w.Value.Value if w.Value is not None else None
         if variant is None or variant.VariantType not in NUMERIC_TYPES or variant.is_array:
             kind = "nothing" if variant is None else variant.VariantType.name
-            return await answer("BadTypeMismatch", f"{name}: a setpoint is a number (Double), got {kind}")
+            return await answer("BadTypeMismatch", f"{name}: a number (Double), got {kind}")
         value = variant.Value
         entry = self.registry.find(bearing_id)
         if entry is None:
@@ -521,6 +537,8 @@ class OpcUaFacade:
         if refusal is not None:
             return await answer("BadTooManyOperations", refusal.message, retry_after_s=refusal.retry_after_s)
         number = float(value) if variant.VariantType in (ua.VariantType.Double, ua.VariantType.Float) else int(value)
+        if folder == MEASURED_TEMPERATURE:
+            return await self._measure_temperature(entry, nodes, name, float(number), answer)
         try:
             setpoint = entry.runner.submit({name: number})
         except InputError as exc:
@@ -533,3 +551,19 @@ class OpcUaFacade:
             )
             nodes.last[f"Setpoint/{name}"] = getattr(setpoint, name)
         return await answer("Good", setpoint=setpoint.model_dump())
+
+    async def _measure_temperature(
+        self, entry: Any, nodes: TwinNodes | None, name: str, value_c: float, answer: Any
+    ) -> ua.StatusCode:
+        """`runner.submit_temperature` of the node `name` names (`outer_ring_c` -> outer_ring)."""
+        node = name.removesuffix("_c")
+        try:
+            entry.runner.submit_temperature(node, value_c)
+        except InputError as exc:
+            status = "BadOutOfRange" if exc.status_code == 422 else "BadInvalidState"
+            return await answer(status, str(exc))
+        if nodes is not None:
+            nid = self._nid(entry.id, MEASURED_TEMPERATURE, name)
+            await self.server.write_attribute_value(nid, ua.DataValue(ua.Variant(value_c, ua.VariantType.Double)))
+            nodes.last[f"{MEASURED_TEMPERATURE}/{name}"] = value_c
+        return await answer("Good", node=node, temperature_c=value_c)

@@ -98,3 +98,12 @@ def test_zenoh_temperature_that_is_not_json_is_refused(service, support):
         assert "not valid JSON" in result["error"]
     finally:
         peer.close()
+
+
+def test_the_vocabulary_names_the_nodes_of_the_thermal_network():
+    """The nodes a measurement may name are the thermal network's measurable ones
+    (twin.thermal.coupling.MEASURABLE_NODES), in one list for HTTP, zenoh, OPC UA and scenarios."""
+    from service.core.measured_temperature import MEASURABLE_NODES
+    from twin.thermal.coupling import MEASURABLE_NODES as NETWORK_NODES
+
+    assert MEASURABLE_NODES == NETWORK_NODES

@@ -17,7 +17,13 @@ import pytest
 asyncua = pytest.importorskip("asyncua")
 from asyncua import Client, ua  # noqa: E402
 
-from service.opcua.layout import FOLDERS, LAST_RESULT, NAMESPACE_URI, ROOT_FOLDER  # noqa: E402
+from service.opcua.layout import (  # noqa: E402
+    FOLDERS,
+    LAST_RESULT,
+    MEASURED_TEMPERATURE,
+    NAMESPACE_URI,
+    ROOT_FOLDER,
+)
 from service.settings import ServiceSettings  # noqa: E402
 from twin.setpoint import NAMES as SETPOINT_NAMES  # noqa: E402
 
@@ -78,7 +84,7 @@ def test_browse_the_namespace_folders_and_setpoint(url):
             idx, twin = await twin_node(c)
             folders = [(await n.read_browse_name()) for n in await twin.get_children()]
             assert all(q.NamespaceIndex == idx for q in folders)
-            assert [q.Name for q in folders] == ["Identification", *FOLDERS, "Setpoint"]
+            assert [q.Name for q in folders] == ["Identification", *FOLDERS, "Setpoint", MEASURED_TEMPERATURE]
             setpoint = await twin.get_child(f"{idx}:Setpoint")
             names = [(await n.read_browse_name()).Name for n in await setpoint.get_children()]
             assert names == [*SETPOINT_NAMES, LAST_RESULT]
@@ -193,6 +199,42 @@ def test_out_of_range_write_is_refused_with_bad_out_of_range_and_a_message_namin
     assert results["bool"][0] == ua.StatusCodes.BadTypeMismatch
     assert value == before
     assert http.get("/v1/bearings/default").json()["setpoint"]["radial_load_n"] == before
+
+
+def test_measured_temperature_write_goes_the_http_way(url, http, support):
+    """A write to MeasuredTemperature/outer_ring_c is the measurement of PUT .../temperature
+    (service.core.measured_temperature): taken into the snapshot's thermal block, and outside
+    [-60, 400] degC refused with BadOutOfRange and the words naming the field and its range."""
+
+    async def main():
+        async with client(url) as c:
+            idx, twin = await twin_node(c)
+            node = await twin.get_child([f"{idx}:{MEASURED_TEMPERATURE}", f"{idx}:outer_ring_c"])
+            eu = await (await node.get_child(f"{idx}:EURange")).read_value()
+            await node.write_value(46.5)
+            good = json.loads(await read(c, MEASURED_TEMPERATURE, LAST_RESULT))
+            with pytest.raises(ua.UaStatusCodeError) as err:
+                await node.write_value(900.0)
+            bad = json.loads(await read(c, MEASURED_TEMPERATURE, LAST_RESULT))
+            return eu, good, err.value.code, bad
+
+    eu, good, code, bad = run(main())
+    assert (eu.Low, eu.High) == (-60.0, 400.0)
+    assert good == {
+        "accepted": True,
+        "status": "Good",
+        "field": "outer_ring_c",
+        "node": "outer_ring",
+        "temperature_c": 46.5,
+    }
+    assert code == ua.StatusCodes.BadOutOfRange
+    assert bad["accepted"] is False and bad["field"] == "outer_ring_c" and "[-60, 400] degC" in bad["error"], bad
+    thermal = support.wait_for(
+        lambda: http.get("/v1/bearings/default/state").json()["thermal"],
+        lambda t: t["measured_c"] == 46.5,
+        timeout=WAIT_S,
+    )
+    assert thermal["measured_node"] == "outer_ring"
 
 
 def test_anonymous_write_is_refused_when_a_token_is_set(url, http, server):
