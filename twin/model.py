@@ -36,7 +36,6 @@ from twin.vibration.signal import DecimatorDesign, design_decimator, integer_rat
 # rating C0 of the bearing: 21 kN radial for the 6208 of seed 000, SKF lists 19 kN).
 STATIC_PRESSURE_LIMIT_PA = 4.2e9
 MODEL_PRESSURE_FACTOR = 1.0
-DEFAULT_SHOULDER_DEPTH_RATIO = 0.18  # groove depth / ball diameter when the geometry gives none
 GAP_LIMIT_REFERENCE_GAP_M = 1e-6  # central gap at which the exact gap integral is matched
 
 
@@ -109,24 +108,6 @@ class BearingModel:
     def ball_radius_m(self) -> float:
         """Ball radius Rb [m]."""
         return float(self.params[L.P_BALL_RADIUS])
-
-    def defect_frequencies_hz(self, shaft_speed_rad_s: float) -> dict[str, float]:
-        """FTF, BPFO, BPFI, BSF [Hz] for a fixed outer ring (Harris, Rolling Bearing Analysis)."""
-        fs = shaft_speed_rad_s / (2.0 * math.pi)
-        g = self.ball_radius_m * math.cos(self.contact_angle_rad) / self.pitch_radius_m
-        z = self.ball_count
-        return {
-            "ftf_hz": 0.5 * fs * (1.0 - g),
-            "bpfo_hz": 0.5 * z * fs * (1.0 - g),
-            "bpfi_hz": 0.5 * z * fs * (1.0 + g),
-            "bsf_hz": fs * self.pitch_radius_m / (2.0 * self.ball_radius_m) * (1.0 - g * g),
-        }
-
-    def ball_spin_rad_s(self, shaft_speed_rad_s: float) -> float:
-        """|omega_ball| in pure rolling, the fixed-frame magnitude (seed 000: omega Ri / (2 Rb) at
-        zero contact angle, 952.38 rad/s for the 6208 at 500 rad/s)."""
-        wc = self.cage_speed_rad_s(shaft_speed_rad_s)
-        return abs(wc) * self.pitch_radius_m / self.ball_radius_m
 
 
 def raceway_radii_m(spec: BearingSpec, inner: bool, sin_alpha: float) -> tuple[float, float]:
@@ -333,7 +314,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_STRIP_TABLE : L.P_STRIP_TABLE + strips.size] = strips.ravel()
 
     race = np.stack([_race_row(spec, True, alpha, e_prime), _race_row(spec, False, alpha, e_prime)])
-    shoulder = g.shoulder_depth_m if g.shoulder_depth_m is not None else DEFAULT_SHOULDER_DEPTH_RATIO * 2.0 * rb
+    shoulder = g.shoulder_depth_or_typical_m
     gap_in, gap_out, rest = _geometry_capacitance(
         rb,
         g.inner_groove_radius_m,

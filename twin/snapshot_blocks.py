@@ -24,7 +24,7 @@ from twin.inlet_film import InletFilm
 from twin.jit import JIT
 from twin.kernels import layout as L
 from twin.model import BearingModel
-from twin.physics.friction import REGIME_NAMES
+from twin.physics.friction import REGIME_NAMES, REGIME_NO_CONTACT
 from twin.snapshot import LAMBDA_KEY, BallState, ContactState, ElectricalState
 from twin.state import TwinState
 from twin.state_measures import ball_azimuths_rad
@@ -116,7 +116,7 @@ def capture_contacts(contacts, loaded_mu_scale, out, regimes):
             out[k, K_ENTRAINMENT] = 0.0
             out[k, K_SRR] = 0.0
             out[k, K_ANGLE] = 0.0
-            regimes[k] = 0
+            regimes[k] = REGIME_NO_CONTACT
         a, b = contacts[L.C_SEMI_MAJOR, k], contacts[L.C_SEMI_MINOR, k]
         out[k, K_P_MAX] = 1.5 * load / (math.pi * a * b) if a > 0.0 and b > 0.0 else 0.0
 

@@ -82,10 +82,6 @@ class SnapshotFrame:
         """Plain dict with the contract's field names (`Snapshot.to_dict`)."""
         return self.snapshot.to_dict()
 
-    def updated(self, **fields: Any) -> SnapshotFrame:
-        """A frame with head fields replaced (no validation, as `model_copy`; not `balls`)."""
-        return SnapshotFrame(self.head.model_copy(update=fields), self.ball_arrays)
-
 
 def as_snapshot(item: Snapshot | SnapshotFrame) -> Snapshot:
     """The `Snapshot` of a frame, or the snapshot itself."""

@@ -44,6 +44,12 @@ BearingKind = Literal["deep_groove", "angular_contact"]
 """The bearing types the engine models."""
 
 
+TYPICAL_SHOULDER_DEPTH_OVER_BALL = 0.18
+"""Shoulder height / ball diameter of a deep-groove ring when the spec gives none: a typical
+proportion (the capacitance of the lands moves by under 3 % between 0.15 and 0.22,
+tests/physics/test_electrical.py)."""
+
+
 class Geometry(BaseModel):
     """Internal geometry of the bearing (seed 000 Table 1 names in brackets)."""
 
@@ -87,8 +93,9 @@ class Geometry(BaseModel):
         gt=0.0,
         le=0.05,
         description="Depth of the groove below the ring's land (shoulder height) [m], for the capacitance of the gap "
-        "around the contacts; null: 0.18 ball diameters, a typical deep-groove proportion (an assumption: between "
-        "0.15 and 0.22 the contact capacitance moves by under 3 %, tests/physics/test_electrical.py).",
+        "around the contacts and the rings' cross-sections of the thermal network; null: 0.18 ball diameters, a "
+        "typical deep-groove proportion (an assumption: between 0.15 and 0.22 the contact capacitance moves by "
+        "under 3 %, tests/physics/test_electrical.py).",
     )
     bore_diameter_m: float | None = Field(
         default=None,
@@ -149,6 +156,14 @@ class Geometry(BaseModel):
     def pitch_radius_m(self) -> float:
         """Pitch radius [m], (Ri + Ro) / 2."""
         return 0.5 * (self.inner_raceway_radius_m + self.outer_raceway_radius_m)
+
+    @property
+    def shoulder_depth_or_typical_m(self) -> float:
+        """The groove's depth below the land [m]: `shoulder_depth_m`, or when the spec gives none
+        TYPICAL_SHOULDER_DEPTH_OVER_BALL ball diameters."""
+        if self.shoulder_depth_m is not None:
+            return self.shoulder_depth_m
+        return TYPICAL_SHOULDER_DEPTH_OVER_BALL * 2.0 * self.ball_radius_m
 
 
 class Material(BaseModel):

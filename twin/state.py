@@ -72,11 +72,6 @@ class TwinState:
         return self.ball_velocity_m_s - self.housing_velocity_m_s[:3]
 
     @property
-    def active_defect_rows(self) -> np.ndarray:
-        """The active defect rows (a view; 0 rows when there is none)."""
-        return self.defect_rows[: self.defect_count]
-
-    @property
     def contacts(self) -> np.ndarray:
         """(N_ROWS, 2Z) view of the contact lanes: contacts[layout.C_LOAD] is every contact's
         load, contacts[:, 2 * ball + race] one contact (race 0 inner, 1 outer)."""

@@ -525,11 +525,6 @@ class ZenohBus:
             status_code=409,
         )
 
-    def detach_twin(self, bearing_id: str) -> None:
-        channel = self.channels.get(bearing_id)
-        if channel is not None:
-            channel.detach()
-
     def _forget(self, channel: TwinChannel) -> None:
         with self._lock:
             if self._channels.get(channel.bearing_id) is channel:

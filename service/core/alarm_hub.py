@@ -93,11 +93,6 @@ class AlarmHub:
             if callback not in self._subscribers:
                 self._subscribers.append(callback)
 
-    def unsubscribe(self, callback: AlarmSubscriber) -> None:
-        with self._lock:
-            if callback in self._subscribers:
-                self._subscribers.remove(callback)
-
     # ---- reads, any thread -------------------------------------------------------------------
     def states(self, bearing_id: str) -> list[Alarm]:
         """Every alarm of the twin (active or not); [] for an unknown twin."""

@@ -70,8 +70,6 @@ from twin import catalog
 from twin.setpoint import Setpoint, SetpointLimits, SetpointUpdate
 from twin.spec import BearingSpec, Clearance, Thermal
 
-SCENARIO_SCHEMA = "bearing-twin/scenario/1"
-
 _NAME_RE = TWIN_ID_PATTERN  # a scenario or run name names the twin of an offline run
 _FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 

@@ -55,8 +55,6 @@ __all__ = sorted(_NAMES)
 
 
 def __getattr__(name: str):
-    if name == "_reader":  # the name the tools used before the package
-        name = "open_reader"
     module = _NAMES.get(name)
     if module is None:
         raise AttributeError(f"module 'service.recording' has no attribute {name!r}")

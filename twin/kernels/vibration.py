@@ -69,6 +69,8 @@ from twin.vibration.defects import (
     KIND_INNER,
     KIND_OUTER,
     N_DEFECT_PARAMS,
+    RACE_INNER,
+    RACE_OUTER,
     contact_defect_drop_m,
     quat_integrate,
 )
@@ -135,7 +137,7 @@ def defect_drops(w, nc, defects, bq, shaft_angle, vp, rb):
                     w[G_DEFECT_DROP * CW + c] = max(w[G_DEFECT_DROP * CW + c], h)
                     found = found or h > 0.0
         elif kind == KIND_OUTER or kind == KIND_INNER:
-            r = 1 if kind == KIND_OUTER else 0
+            r = RACE_OUTER if kind == KIND_OUTER else RACE_INNER
             cos_reach = defects[k, D_REACH_COS]
             cx = defects[k, D_CENTRE_COS]
             cy = defects[k, D_CENTRE_SIN]

@@ -93,12 +93,6 @@ class DissipationEstimator:
         """Standard deviation of s, s sigma_theta to first order [-]."""
         return self.dissipation_factor * math.sqrt(max(self.p[N_NODES, N_NODES], 0.0))
 
-    def reset_temperatures(self, temperature_c: np.ndarray) -> None:
-        """Set the node temperatures (a restart of the network), keeping the dissipation estimate."""
-        self.x[:N_NODES] = temperature_c
-        self.p[:N_NODES, :] = 0.0
-        self.p[:, :N_NODES] = 0.0
-
     def _propagate(self, net: Network, theta: float, temps: np.ndarray, b_args: tuple, h: float):
         s = math.exp(theta)
         t_inf = steady_state_c(net, s, *b_args)

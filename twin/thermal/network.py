@@ -40,7 +40,6 @@ NODE_NAMES = ("shaft", "inner_ring", "balls", "outer_ring", "housing", "oil")
 SHAFT, INNER_RING, BALLS, OUTER_RING, HOUSING, OIL = range(6)
 N_NODES = 6
 RING_SPAN_OVER_BALL = 1.0 / 0.3  # (D - d) / D_w of series-02 deep-groove bearings [-]
-SHOULDER_OVER_BALL = 0.2  # shoulder height / ball diameter when the spec has none [-]
 CAST_IRON_DENSITY_KG_M3 = 7200.0
 CAST_IRON_SPECIFIC_HEAT_J_KG_K = 460.0  # grey cast iron (Incropera and DeWitt Table A.1)
 
@@ -84,7 +83,7 @@ def network_geometry(spec, settings: ThermalNetworkSettings) -> NetworkGeometry:
     span = RING_SPAN_OVER_BALL * dw
     bore, od = dm - 0.5 * span, dm + 0.5 * span
     width = g.ring_width_m or 0.25 * span + 0.5 * dw  # ISO 15 series 02: B ~ (D - d) / 4 + D_w / 2
-    shoulder = g.shoulder_depth_m or SHOULDER_OVER_BALL * dw
+    shoulder = g.shoulder_depth_or_typical_m
     r_i, r_o = g.inner_raceway_radius_m, g.outer_raceway_radius_m
     r_is, r_os = min(r_i + shoulder, g.pitch_radius_m), max(r_o - shoulder, g.pitch_radius_m)
     rho = spec.material.density_kg_m3

@@ -38,14 +38,8 @@ class HeatSources:
     @property
     def by_source_w(self) -> dict[str, float]:
         """Total heat of each source [W]."""
-        s = self.per_contact_w.sum(axis=0)
-        return {
-            "rolling": float(s[0]),
-            "sliding": float(s[1]),
-            "spin": float(s[2]),
-            "drag": float(self.drag_w),
-            "seal": float(self.seal_w),
-        }
+        contacts = self.per_contact_w.sum(axis=0)
+        return dict(zip(SOURCE_NAMES, (*map(float, contacts), float(self.drag_w), float(self.seal_w)), strict=True))
 
     @property
     def total_w(self) -> float:

@@ -85,7 +85,6 @@ N_DEFECT_PARAMS = 14
 # reach (`pit_drop_m`); the margin only saves the atan2 / asin of the far lanes.
 REACH_MARGIN = 1.5
 
-KIND_NONE = 0
 KIND_OUTER = 1
 KIND_INNER = 2
 KIND_BALL = 3
