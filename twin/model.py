@@ -293,9 +293,7 @@ def make_model(spec: BearingSpec, options: ModelOptions | None = None) -> Bearin
     p[L.P_ALPHA_E] = options.restitution_coefficient_s_m
     p[L.P_RAMP] = options.speed_ramp_rad_s2
     p[L.P_FILM_FORMULA] = 0.0 if options.film_formula == "hamrock_dowson" else 1.0
-    p[L.P_FRICTION_MODEL] = {"stribeck_line": 0.0, "asperity_share": 1.0, "ellipse_traction": 2.0}[
-        options.friction_model
-    ]
+    p[L.P_FRICTION_MODEL] = L.FRICTION_MODEL_CODES[options.friction_model]
     p[L.P_ROLLING] = 1.0 if options.rolling_resistance else 0.0
     p[L.P_BALL_REDUCED_TANGENT_MASS] = ball_mass / (1.0 + ball_mass * rb * rb / ball_inertia)
     p[L.P_MAX_PENETRATION] = 0.01 * rb

@@ -528,7 +528,7 @@ class ModelOptions(BaseModel):
         description="Evaluate each tribology refresh at the load, entrainment speed and contact angle of the middle of "
         "the period it is held for (extrapolated from the previous refresh and the step's rates, "
         "twin.kernels.step.centred_inputs): the held values' error becomes second order in tribology_period_s "
-        "instead of first. False: at the refresh's own step (the engine before it; "
+        "instead of first. False: at the refresh's own step (first order; the configuration of the step reference, "
         "tests/engine/test_step_reference.py).",
     )
     thermal: Literal["network", "fixed"] = Field(

@@ -45,7 +45,7 @@ thumbprint is logged at start and kept in `facade.pki`). Rules of a secure serve
   certificate announced at CreateSession, and `TokenUserManager` checks again, at
   ActivateSession, the certificate the secure channel was really opened with (asyncua does not
   compare the two).
-`opcua_security = none` with a token is the old behaviour, password in clear: an explicit choice,
+`opcua_security = none` with a token sends the password in clear: an explicit choice,
 warned about in the log.
 
 Limits (service.opcua.guard): sessions, subscriptions and monitored items per session, the

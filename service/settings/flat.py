@@ -3,9 +3,9 @@
 A settings root (`ServiceSettings`, `RouterSettings`, `ZenohAccessSettings`) holds groups
 (`http`, `zenoh`, ...). pydantic-settings reads a group's field from `BEARING_TWIN_<GROUP>__<FIELD>`
 (`BEARING_TWIN_HTTP__PORT`). Every field also has a flat name, stored once in its
-`json_schema_extra` by `flat()`: the environment name of unit files written before the groups
-(`BEARING_TWIN_PORT`), the keyword a root accepts (`ServiceSettings(port=8001)`) and the default
-name of its `serve` flag (`--port`). The nested environment name wins over the flat one.
+`json_schema_extra` by `flat()`: the short environment name (`BEARING_TWIN_PORT`), the keyword
+a root accepts (`ServiceSettings(port=8001)`) and the default name of its `serve` flag
+(`--port`). The nested environment name wins over the flat one.
 
 A field's `description` is one line (what it is, its unit in brackets, what 0 or unset means): the
 `--help` of its flag and the Meaning column of docs/configuration.md. The reason, trade-offs,

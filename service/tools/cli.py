@@ -410,9 +410,9 @@ LOAD_TOOLS = ("bench-service", "soak", "attack")
 
 def _add_moved_load_tools(sub) -> None:
     """The load tools live in the `loadtest` package (`bearing-twin-loadtest`, extra `loadtest`):
-    their old subcommand names answer with where to find them."""
+    `bearing-twin NAME` answers with where to find them."""
     for name in LOAD_TOOLS:
-        sub.add_parser(name, help=f"moved: `bearing-twin-loadtest {name}` (pip install '.[loadtest]')")
+        sub.add_parser(name, help=f"a load tool: `bearing-twin-loadtest {name}` (pip install '.[loadtest]')")
 
 
 def _moved_load_tool(name: str) -> int:

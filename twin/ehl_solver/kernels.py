@@ -28,6 +28,8 @@ import numpy as np
 from numba import njit
 
 from twin.jit import JIT
+from twin.physics.electrical import dowson_higginson_density_ratio
+from twin.physics.thermal import ROELANDS_LN_ETA_INF, ROELANDS_PRESSURE_PA_INV, ROELANDS_T_K
 
 LN_ETA_CAP = 690.0  # exp(690) ~ 1e300: viscosity ratio cap, never reached at physical pressures
 # Relaxation keeps 0 <= P <= P_CAP (P = p / p_hertz): a safety net against a transient blow-up on
@@ -41,17 +43,17 @@ def roelands_ln_eta_ratio(p_pa, dtheta_k, ln_eta0, z, s0, theta_i_k):
     (ln eta0 + 9.67) [-1 + (1 + 5.1e-9 p)^z ((theta - 138) / (theta_i - 138))^-S0],
     theta = theta_i + dtheta [K]."""
     p_pa = max(p_pa, 0.0)
-    tfac = ((theta_i_k + dtheta_k - 138.0) / (theta_i_k - 138.0)) ** (-s0)
-    val = (ln_eta0 + 9.67) * (-1.0 + (1.0 + 5.1e-9 * p_pa) ** z * tfac)
+    tfac = ((theta_i_k + dtheta_k - ROELANDS_T_K) / (theta_i_k - ROELANDS_T_K)) ** (-s0)
+    val = (ln_eta0 + ROELANDS_LN_ETA_INF) * (-1.0 + (1.0 + ROELANDS_PRESSURE_PA_INV * p_pa) ** z * tfac)
     val = min(val, LN_ETA_CAP)
     return val
 
 
 @njit(**JIT)
 def dowson_higginson_rho_bar(p_pa, dtheta_k, dt_rel):
-    """rho / rho0 of seed 003 eq. 2: 1 + 0.6e-9 p / (1 + 1.7e-9 p) - (Dt / rho0) dtheta."""
-    p_pa = max(p_pa, 0.0)
-    return 1.0 + 0.6e-9 * p_pa / (1.0 + 1.7e-9 * p_pa) - dt_rel * dtheta_k
+    """rho / rho0 of seed 003 eq. 2: 1 + 0.6e-9 p / (1 + 1.7e-9 p) - (Dt / rho0) dtheta
+    (twin.physics.electrical.dowson_higginson_density_ratio, then the thermal term)."""
+    return dowson_higginson_density_ratio(p_pa) - dt_rel * dtheta_k
 
 
 @njit(**JIT)

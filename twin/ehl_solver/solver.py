@@ -9,11 +9,11 @@ eq. 4), D the elastic deflection by rectangle influence coefficients computed on
 applied by FFT convolution (elastic.py), H0 the rigid gap set by the load balance (eq. 11).
 
 Domain: at the Moes loads of seed 003 Fig. 1 (M = 130-435) the inlet pressure build-up starts
-near X = -1.8 (P < 1e-3 p_h beyond X = -2.5 and |Y| = 2 on the old [-4.5, 1.5] x [-3, 3] domain,
-whose results it changes by < 1.2 % in h_c). The smaller domain gives a 1.5x finer lateral
-spacing on the same grid, and the lateral spacing is what the minimum film needs: the side lobes
-(|Y| ~ 0.9, the global film minimum) narrow as M grows. On 257 nodes, refining Y alone raised
-h_min at 0.832 m/s from 53.7 to 55.0 nm, refining X alone changed it by < 1 %.
+near X = -1.8 (P < 1e-3 p_h beyond X = -2.5 and |Y| = 2 on a [-4.5, 1.5] x [-3, 3] domain, whose
+h_c differs by < 1.2 %). The smaller domain gives a 1.5x finer lateral spacing on the same grid,
+and the lateral spacing is what the minimum film needs: the side lobes (|Y| ~ 0.9, the global
+film minimum) narrow as M grows. On 257 nodes, refining Y alone raises
+h_min at 0.832 m/s from 53.7 to 55.0 nm, refining X alone changes it by < 1 %.
 
 The discrete Reynolds equation (seed 003 eq. 1, kernels.py; cavitation by P >= 0) is solved by
 Full Approximation Storage multigrid (Venner & Lubrecht, "Multilevel methods in lubrication",
@@ -53,26 +53,27 @@ model's accuracy "diminishes when the entrainment speed falls below 2.5 m/s". HD
 k = a/b = 1 for the circle (k = 1.03 (Ry/Rx)^0.64 is HD's approximate fit; it would raise HD's
 h_min by 2 %).
 
-513 nodes. A multigrid without the two smoother corrections below stagnates there (pressure change ~7e-4 per
-cycle at 0.832 m/s, ~1e-2 at 3.3-4.2 m/s). Two smoother defects, both invisible on 129/257 because the Poiseuille
-coefficient eps/hx^2 of a given point grows 4x per refinement:
-(1) the Jacobi distributive line model truncated the distributed influence kernel Kt at two
-nodes, so its row sum was (Kt(2) - Kt(3))/hx < 0 instead of 0. For a change smooth along X and
-alternating from line to line, whose only response is the lateral Poiseuille term, the line
-model then had the wrong sign: local Fourier analysis gives growth 1 + 4 omega xi (hx/hy)^2 /
-0.01 per sweep for 0 < xi = eps/hx^2 < ~5e-3: the exit side of the Hertzian zone, which only
-on 513 nodes holds many nodes with xi in that range. The 513 pressure grew a line-to-line checkerboard (10 %
-of p_h at X = 0.8, 0.832 m/s) that each cycle re-pumped. Fix: the tail beyond the band is lumped
-onto its edges (exact row sum; the fixed point, i.e. the discrete solution, is unchanged).
+513 nodes. Two details of the smoother keep the multigrid converging there (without them the
+pressure change stagnates at ~7e-4 per cycle at 0.832 m/s, ~1e-2 at 3.3-4.2 m/s); both are
+invisible on 129/257 nodes because the Poiseuille coefficient eps/hx^2 of a given point grows 4x
+per refinement:
+(1) The Jacobi distributive line model lumps the tail of the distributed influence kernel Kt
+beyond its two-node band onto the band's edges, so its row sum is exact (0). Truncated, the row
+sum is (Kt(2) - Kt(3))/hx < 0, and for a change smooth along X and alternating from line to line,
+whose only response is the lateral Poiseuille term, the line model has the wrong sign: local
+Fourier analysis gives growth 1 + 4 omega xi (hx/hy)^2 / 0.01 per sweep for 0 < xi = eps/hx^2 <
+~5e-3, the exit side of the Hertzian zone, which only on 513 nodes holds many nodes with xi in
+that range; the pressure grows a line-to-line checkerboard (10 % of p_h at X = 0.8, 0.832 m/s).
+The fixed point, i.e. the discrete solution, is the same either way.
 (2) Gauss-Seidel lines use the film of the start of the sweep, i.e. they are Jacobi in the
 elastic coupling between lines; just above the switch xi = 0.3 that amplifies smooth modes
 (Fourier: 2.2 per sweep at omega 0.7, 1.5 at 0.5), and at 3.3-4.2 m/s the nodes at the lateral
-edge of the Hertzian zone flipped between the two smoothers with a residual limit cycle near
-dp ~ 2e-4. omega_gs 0.7 -> 0.5 removes it (xi_lim 0.3 -> 1 does too, at 30 % more cycles).
-Measured now (isothermal, this machine, 2 shared cores): 513 converges at 0.832 / 1.664 / 2.496 /
-3.328 / 4.16 m/s in 13 / 16 / 20 / 18 / 22 cycles, 11 / 14 / 17 / 15 / 19 s; 257 in 14-20
-cycles, 3-4 s; 129 in 20-26 cycles, ~1 s. 129 and 257 results moved by < 0.05 % (the
-discretisation is unchanged, only the path to it).
+edge of the Hertzian zone flip between the two smoothers in a residual limit cycle near
+dp ~ 2e-4. omega_gs = 0.5 removes it (xi_lim = 1 does too, at 30 % more cycles).
+Measured (isothermal, 2 shared cores): 513 converges at 0.832 / 1.664 / 2.496 / 3.328 / 4.16 m/s
+in 13 / 16 / 20 / 18 / 22 cycles, 11 / 14 / 17 / 15 / 19 s; 257 in 14-20 cycles, 3-4 s; 129 in
+20-26 cycles, ~1 s. With or without the two details the 129 and 257 results agree within 0.05 %
+(the discretisation is the same, only the path to it).
 
 Thermal case: the temperature field of eq. 6 (local h and p) + eq. 10 (current, uniform) is
 recomputed on the finest grid before every cycle (under-relaxed by 1/2) and enters Roelands
@@ -98,6 +99,7 @@ from twin.ehl_solver import kernels as K
 from twin.ehl_solver import params as prm
 from twin.ehl_solver.multigrid import GridLevel, prolong_bilinear, restrict_full_weighting
 from twin.ehl_solver.result import EHLResult
+from twin.physics.thermal import ROELANDS_LN_ETA_INF, ROELANDS_PRESSURE_PA_INV, ROELANDS_T_K
 
 DEFAULT_DOMAIN = (-3.0, 1.5, -2.0, 2.0)  # X = x/ax, Y = y/ay (see the module docstring)
 TEMPERATURE_CAP_K = 1000.0
@@ -349,10 +351,10 @@ def solve_point_contact(
         beta_k_inv = prm.oil_temperature_viscosity_coefficient(base_temperature_c)
     hz = prm.hertz_scales(load_n, rx_m, ry_m, e_prime_pa)
     ln_eta0 = math.log(eta0_pa_s)
-    if ln_eta0 + 9.67 <= 0.0:
+    if ln_eta0 + ROELANDS_LN_ETA_INF <= 0.0:
         raise ValueError("Roelands needs eta0 > exp(-9.67) Pa s = 6.3e-5 Pa s")
-    z = alpha_pa_inv / (5.1e-9 * (ln_eta0 + 9.67))
-    s0 = beta_k_inv * (theta_i_k - 138.0) / (ln_eta0 + 9.67)
+    z = alpha_pa_inv / (ROELANDS_PRESSURE_PA_INV * (ln_eta0 + ROELANDS_LN_ETA_INF))
+    s0 = beta_k_inv * (theta_i_k - ROELANDS_T_K) / (ln_eta0 + ROELANDS_LN_ETA_INF)
     lam = 12.0 * eta0_pa_s * entrainment_speed_m_s * rx_m**2 / (hz.ax_m**3 * hz.p_hertz_pa)
     dt_rel = prm.DENSITY_TEMPERATURE_KG_M3_K / prm.OIL_DENSITY_KG_M3
     h_scale = hz.ax_m**2 / rx_m  # h [m] = H h_scale

@@ -65,6 +65,7 @@ from twin.kernels.layout import (
     T_XI1,
     T_XI2,
 )
+from twin.physics.friction import BOUNDARY_LAMBDA_MAX, MIXED_LAMBDA_MAX
 
 
 @njit(**JIT)
@@ -133,8 +134,8 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
       u / L + spin term, twin.kernels.step), integrated by backward Euler, xi <- (xi + v dt) /
       (1 + r dt) (C_XI_DECAY = 1 / (1 + r dt)): unconditionally stable, and its steady state
       under a constant slip is the creep law xi = v / r at any dt (decaying before adding the
-      slip gave v (1 / r + dt), (1 + r dt) times too stiff, and r dt reaches 1-15 at the auto step on
-      the spinning contacts of a 40 deg 7208): a rolling contact renews its material continuously, so its
+      slip would give v (1 / r + dt), (1 + r dt) times too stiff, and r dt reaches 1-15 at the auto
+      step on the spinning contacts of a 40 deg 7208): a rolling contact renews its material continuously, so its
       tangential force follows the creepage v_slip / u with a creep coefficient Kt L of the order
       of Kalker's linear one, G a b C11 (7.8e4 N against 7e4-1.2e5 N at the 6208's inner
       contact under 1457 N), instead of holding a static-friction memory of past lateral motion
@@ -146,10 +147,10 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
     Reads the G_*, K_*, M_STIFFNESS rows and the cached C_* rows; writes the O_* rows (with
     O_NORMAL_RATE between its two loops) and the spring T_XI* (reset where the contact is
     open)."""
-    # two loops, not one: the kinematics (slip, entrainment, normal rate, kept in
-    # their rows), then the forces; one loop held more values than the 16 vector registers and
-    # went to the stack 77 times per 4 lanes, two go 40 times (with the moment pass 504 -> 461 ns
-    # in one process, same operations, bitwise the same results; a third loop was slower)
+    # two loops, not one: the kinematics (slip, entrainment, normal rate, kept in their rows),
+    # then the forces; one loop holds more values than the 16 vector registers and goes to the
+    # stack 77 times per 4 lanes, two go 40 times (with the moment pass 461 ns against 504 in one
+    # process, same operations, bitwise the same results; three loops are slower)
     for c in range(nc):
         nx = w[G_NX * CW + c]
         ny = w[G_NY * CW + c]
@@ -203,8 +204,8 @@ def raceway_forces(w, nc, rb, dt, kt_ratio, alpha_e):
         c_fluid = w[C_FLUID_DAMPING * CW + c]
         c_hyst = 1.5 * alpha_e * q_el
         c_series = c_hyst * c_fluid / (c_hyst + c_fluid + 1e-300)
-        c_n = c_fluid if lam > 3.0 else c_series
-        c_n = c_hyst if (lam <= 1.0 or c_fluid <= 0.0) else c_n
+        c_n = c_fluid if lam > MIXED_LAMBDA_MAX else c_series
+        c_n = c_hyst if (lam <= BOUNDARY_LAMBDA_MAX or c_fluid <= 0.0) else c_n
         fn = loaded * max(q_el + c_n * w[O_NORMAL_RATE * CW + c], 0.0)
         # tangential spring with Coulomb limit
         kt = kt_ratio * 1.5 * w[M_STIFFNESS * CW + c] * w[G_SQRT_DELTA * CW + c]

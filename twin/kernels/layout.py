@@ -23,7 +23,7 @@ P_CT_RATIO = 14
 P_ALPHA_E = 15
 P_RAMP = 16
 P_FILM_FORMULA = 17  # 0 Hamrock-Dowson, 1 Masjedi-Khonsari
-P_FRICTION_MODEL = 18  # 0 Stribeck line, 1 asperity share
+P_FRICTION_MODEL = 18  # FRICTION_STRIBECK_LINE, FRICTION_ASPERITY_SHARE or FRICTION_ELLIPSE
 P_SUBSTEPS = 19
 P_ROLLING = 20  # 1: seed 001 rolling resistance on
 P_BALL_REDUCED_TANGENT_MASS = 21  # m / (1 + m Rb^2 / I) [kg]
@@ -250,3 +250,13 @@ V_INNER_RX = 6  # relative radius of curvature along the rolling direction [m]
 V_OUTER_RX = 7
 V_INNER_FOOTPRINT = 8  # semi-major axis of the contact ellipse per root deflection, a / sqrt(delta) [m^0.5]
 V_OUTER_FOOTPRINT = 9
+
+# codes of P_FRICTION_MODEL (twin.spec.ModelOptions.friction_model)
+FRICTION_STRIBECK_LINE = 0  # seed 000 Table 2's line mu(Lambda)
+FRICTION_ASPERITY_SHARE = 1  # seed 001's asperity share of the load
+FRICTION_ELLIPSE = 2  # traction over the contact ellipse (twin.kernels.traction)
+FRICTION_MODEL_CODES = {
+    "stribeck_line": FRICTION_STRIBECK_LINE,
+    "asperity_share": FRICTION_ASPERITY_SHARE,
+    "ellipse_traction": FRICTION_ELLIPSE,
+}

@@ -39,6 +39,7 @@ from twin.kernels.layout import (
     C_TANGENT_DAMPING,
     C_XI_DECAY,
     CW,
+    FRICTION_ELLIPSE,
     G_DELTA,
     G_LOAD,
     G_NX,
@@ -156,8 +157,8 @@ from twin.vibration.signal import sensor_push_direct
 
 # Below this entrainment speed [m/s] the rolling resistance (applied as (F_R / u) times the
 # entrainment vector) turns into a bounded viscous drag, F_R / 0.01 N s/m at most, instead of a
-# force of fixed size along an undefined direction; dividing by the actual u there made a
-# damper stiff enough to destabilise the explicit integration (seen at 1 rad/s).
+# force of fixed size along an undefined direction; dividing by the actual u there would make a
+# damper stiff enough to destabilise the explicit integration (at 1 rad/s).
 ROLLING_REGULARISATION_SPEED = 0.01
 
 # Linearising the fully sliding Coulomb traction mu p v/|v| of a spinning Hertz ellipse about pure
@@ -167,17 +168,12 @@ ROLLING_REGULARISATION_SPEED = 0.01
 SPIN_CREEP_FACTOR = 1.3
 
 # The contacts' parallel RC is refreshed every ELECTRICAL_EVERY tribology refreshes (200 us at
-# the default 40 us, twin.validation.subrate_study): it only feeds the network evaluated between frames (1 ms) and the
-# 10 ms
-# electro-thermal coupling, and refreshing it every 10 us cost ~90 ns per step (10 % of the
-# budget). A contact that has just closed gets its RC at once.
+# the default 40 us, twin.validation.subrate_study): it only feeds the network evaluated between
+# frames (1 ms) and the 10 ms electro-thermal coupling, and a refresh every 10 us costs ~90 ns
+# per step (10 % of the budget). A contact that has just closed gets its RC at once.
 ELECTRICAL_EVERY = 5
 
-FRICTION_ELLIPSE = 2
-
-SMALL_ANGLE = (
-    1e-2  # [rad] below it `_cos_sin` takes the series  # P_FRICTION_MODEL code of the friction over the contact ellipse
-)
+SMALL_ANGLE = 1e-2  # [rad] below it `_cos_sin` takes the series
 
 
 @njit(inline="always", **JIT)
@@ -192,7 +188,7 @@ def _at_angle(table, r, i, f, col):
 def _cos_sin(x):
     """(cos x, sin x); for |x| <= SMALL_ANGLE their Taylor series to x^7, exact to the last bit
     there (the next terms are below 3e-21), without the library call: the step's half turn of
-    the cage is ~3e-4 rad at the auto step (a sincos call was ~2 % of the step)."""
+    the cage is ~3e-4 rad at the auto step (a sincos call costs ~2 % of the step)."""
     if abs(x) <= SMALL_ANGLE:
         x2 = x * x
         c = 1.0 - x2 * (0.5 - x2 * (1.0 / 24.0 - x2 * (1.0 / 720.0)))

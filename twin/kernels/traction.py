@@ -17,7 +17,7 @@ mu(Lambda)) plus (1 - Qa/Q) min(tau0 asinh(eta(p) s / (h tau0)), gamma p) sgn(s)
 
 Net force and moments. The net tangential force of a contact is carried by the tangential spring
 of seed 000 (contacts.raceway_forces: the ball's rolling constraint with the contact's
-compliance), now limited by the traction capacity of the ellipse; the centre slip s0 is the one
+compliance), limited by the traction capacity of the ellipse; the centre slip s0 is the one
 at which the strips transmit that net force (safeguarded Newton, warm-started). The strips' moment
 about the contact centre,
 

@@ -16,6 +16,7 @@ import numpy as np
 from numba import njit
 
 from twin.jit import JIT
+from twin.kernels.layout import FRICTION_ASPERITY_SHARE
 from twin.physics import ehl, rolling
 from twin.physics.electrical import (
     asperity_resistance_ohm,
@@ -150,10 +151,10 @@ def contact_tribology(
 
 @njit(**JIT)
 def _mu(film_parameter, friction_model):
-    # 0: seed 000's line; 2 (friction over the ellipse): not used (the refresh takes the contact's
-    # traction capacity, twin.kernels.traction.limiting_traction_coefficient, and seed 001's
-    # pivoting moment is off): the line, without powers
-    if friction_model != 1:
+    # the Stribeck line; with the friction over the ellipse mu is not used (the refresh takes the
+    # contact's traction capacity, twin.kernels.traction.limiting_traction_coefficient, and seed
+    # 001's pivoting moment is off): the line, without powers
+    if friction_model != FRICTION_ASPERITY_SHARE:
         return stribeck_line_mu(film_parameter)
     return sliding_friction_coefficient_asperity_share(asperity_load_share(film_parameter), 0.03, 0.11)
 

@@ -5,6 +5,7 @@ import math
 from numba import njit
 
 from twin.jit import JIT
+from twin.physics.friction import BOUNDARY_LAMBDA_MAX, MIXED_LAMBDA_MAX
 
 
 @njit(**JIT)
@@ -27,9 +28,9 @@ def fluid_damping_n_s_m(viscosity_pa_s, semi_major_m, ball_radius_m, h_min_m):
 @njit(**JIT)
 def regime_damping_n_s_m(film_parameter, c_hyst, c_fluid):
     """C_n(Lambda) of seed 000 Table 2: C_hyst (Lambda <= 1), series (1, 3], C_fluid above."""
-    if film_parameter <= 1.0 or c_fluid <= 0.0:
+    if film_parameter <= BOUNDARY_LAMBDA_MAX or c_fluid <= 0.0:
         return c_hyst
-    if film_parameter <= 3.0:
+    if film_parameter <= MIXED_LAMBDA_MAX:
         if c_hyst <= 0.0:
             return 0.0
         return c_hyst * c_fluid / (c_hyst + c_fluid)

@@ -31,8 +31,8 @@ def regime_code(film_parameter):
 def stribeck_line_mu(film_parameter):
     """mu(Lambda) of seed 000 section 2.3: 0.1 for Lambda <= 1, linear down to 0.01 at
     Lambda = 3, 0.01 above (the 'linear fitting made on the Stribeck curve', Fig. 5)."""
-    if film_parameter <= 1.0:
+    if film_parameter <= BOUNDARY_LAMBDA_MAX:
         return 0.1
-    if film_parameter >= 3.0:
+    if film_parameter >= MIXED_LAMBDA_MAX:
         return 0.01
-    return 0.1 - 0.045 * (film_parameter - 1.0)
+    return 0.1 - 0.045 * (film_parameter - BOUNDARY_LAMBDA_MAX)

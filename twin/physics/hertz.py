@@ -12,7 +12,7 @@ the hot loop). The kernels read the results from the compiled model.
 The Brewe-Hamrock closed forms (Brewe & Hamrock 1977, NASA TM X-3452 / J. Lubr. Technol. 99;
 Hamrock & Dowson, Ball Bearing Lubrication, 1981, ch. 5) stay as documented approximations:
 k ~ (Ry/Rx)^(2/pi), Fbar ~ pi/2 + (pi/2 - 1) ln(Ry/Rx), Ebar ~ 1 + (pi/2 - 1) Rx/Ry (the first
-kind is pi/2 for a circle; an earlier reading with 1 + ... made K 32 % too stiff for the 6208).
+kind is pi/2 for a circle; a reading with 1 + ... would make K 32 % too stiff for the 6208).
 `tests/physics/test_hertz.py` bounds their error against the exact solution.
 
 Ball-ball (cage element) contacts, eq. 3: Q = 4 G sqrt(Req) / (3 (1 - nu)) delta^1.5.

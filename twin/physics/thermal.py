@@ -11,6 +11,7 @@ import math
 
 ROELANDS_T_K = 138.0  # the 138 K of Roelands' temperature term (seed 003 eq. 3)
 ROELANDS_LN_ETA_INF = 9.67  # ln(eta_inf) = -9.67 with eta in Pa s (seed 003 eq. 3)
+ROELANDS_PRESSURE_PA_INV = 5.1e-9  # the 1 / (1.96e8 Pa) of Roelands' pressure term (seed 003 eq. 3) [1/Pa]
 MIN_CONTACT_ANGLE_RAD = math.radians(15.0)
 MAX_CURRENT_HEATING_K = 250.0  # beyond this the oil has broken down; the twin caps the rise
 

@@ -3,10 +3,11 @@
 `reference_outputs(case)` runs one twin from its warm start for `settle_s`, then samples every
 1 ms frame for `window_s` and returns the window means of: the load and Lambda of every contact
 (lane order c = 2 ball + race; Lambda -1 where a contact is open at a sample), the friction
-torque the shaft supplies, the cage speed, and the inner ring's displacement. The figures of the
-engine before the step's speed optimisation are stored in tests/engine/data/step_reference.json
-(`python -m twin.validation.step_reference > tests/engine/data/step_reference.json`, run on that
-engine); tests/engine/test_step_reference.py compares the current engine with them.
+torque the shaft supplies, the cage speed, and the inner ring's displacement.
+tests/engine/data/step_reference.json holds them for the plain, unoptimised step of commit 5454e19
+(`python -m twin.validation.step_reference > tests/engine/data/step_reference.json` on that
+commit); tests/engine/test_step_reference.py compares the current engine with them under the
+reference's configuration (`reference_outputs`).
 """
 
 from __future__ import annotations
@@ -40,18 +41,18 @@ REFERENCE_TRACTION_REFRESHES = 20
 def reference_outputs(case: tuple, settle_s: float = 0.01, window_s: float = 0.01) -> dict:
     """Window means of one case (module docstring), as plain lists and floats (SI)."""
     _, designation, dt, speed, fr, fa = case
-    # the sub-rates the reference was made with (commit 5454e19: tribology every 10 us, strip solve
-    # every 200 us), so that the comparison isolates the step's code from the sub-rate study's defaults
-    # (the strip solve then every 20 refreshes: 178 us at the 7208's 4.444 us auto step)
-    # the inlet that engine had: isothermal (seed 000's Hamrock-Dowson film), Thermal.shear_heating off
+    # the reference's sub-rates (tribology every 10 us, strip solve every 200 us), so that the
+    # comparison isolates the step's code from the sub-rate study's defaults (the strip solve every
+    # 20 refreshes: 178 us at the 7208's 4.444 us auto step), and its inlet: isothermal (seed 000's
+    # Hamrock-Dowson film), Thermal.shear_heating off
     base = catalog.bearing(designation)
     spec = BearingSpec.model_validate(
         {**base.model_dump(), "thermal": {**base.thermal.model_dump(), "shear_heating": False}}
     )
     step_s = make_model(spec, ModelOptions(time_step_s=dt)).dt_s
     traction_s = REFERENCE_TRACTION_REFRESHES * steps_per_period(REFERENCE_TRIBOLOGY_PERIOD_S, step_s) * step_s
-    # and with the refresh at its own step (centred_refresh=False), as that engine had it: the
-    # centred refresh is a change of the numerics (measured: load 2e-4 of the largest, Lambda 4e-4,
+    # and the refresh at its own step (centred_refresh=False), as in the reference: the centred
+    # refresh is a change of the numerics (measured: load 2e-4 of the largest, Lambda 4e-4,
     # torque 5e-5 at these 10 us), proven by the sub-rate study (twin.validation.subrate_study), not
     # a change of operations this comparison is made to catch
     twin = Twin(

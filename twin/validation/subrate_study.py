@@ -15,16 +15,15 @@ With `against_1us`, the candidates are also compared with the run at seed 000's 
 
 What moves: Lambda and h_min. Held over a period while the ball rolls on, a refresh made from the
 inputs of its own step lags by half a period, an error first order in the period (0.30 % at 20 us,
-0.64 % at 30 us, 0.95 % at 40 us on the 7208 at 1700 rad/s, 7500 N + 3000 N, before the centred
-refresh); `ModelOptions.centred_refresh` (twin.kernels.step.centred_inputs) evaluates each refresh
+0.64 % at 30 us, 0.95 % at 40 us on the 7208 at 1700 rad/s, 7500 N + 3000 N, with
+centred_refresh off); `ModelOptions.centred_refresh` (twin.kernels.step.centred_inputs) evaluates each refresh
 at the load, entrainment speed and contact angle of the middle of its period, second order: 0.15,
 0.14, 0.31, 0.41 % at 20, 30, 40, 60 us (largest over the cases), where the steep ends of the loaded zone
 (the load levels off at the centrifugal load within a period) and the rattling of the unloaded balls
-(0.2-0.3 % on the loads whatever the period: the noise floor of the comparison) remain. The RC (with
-10 refreshes per RC refresh, the 6208's impedance at 750 N moved by 1.5 % at 20 us, i.e. an RC every
-200 us; now 5 refreshes of 40 us, again 200 us: 1.2 %); the strip solve's period moves the 7208's
-spin and torque (400 us: torque 1.1 % at 1700 rad/s; 800 us, measured before the centring: 1.2 %
-spin, 3.1 % torque).
+(0.2-0.3 % on the loads whatever the period: the noise floor of the comparison) remain. The RC
+every 200 us (10 refreshes of 20 us: the 6208's impedance at 750 N within 1.5 %; 5 of 40 us, the
+default: 1.2 %); the strip solve's period moves the 7208's spin and torque (400 us: torque 1.1 %
+at 1700 rad/s; 800 us, with centred_refresh off: 1.2 % spin, 3.1 % torque).
 
 No I/O here: `bearing-twin timestep-study --subrates` prints the table.
 """
@@ -36,7 +35,7 @@ from dataclasses import asdict
 
 from twin.validation import timestep_study as ts
 
-REFERENCE = (1e-5, 2e-4)  # (tribology_period_s, traction_period_s) before the study [s]
+REFERENCE = (1e-5, 2e-4)  # (tribology_period_s, traction_period_s) of the reference runs [s]
 # the candidates: tribology periods with the reference traction period, traction periods with the
 # reference tribology period, and one combination
 PERIODS = (
