@@ -102,5 +102,5 @@ def ball_key(prefix: str, twin_id: str, index: int) -> str:
 
 def all_twins(prefix: str, suffix: str) -> str:
     """`prefix/*/suffix`: that key of every twin under `prefix` (a prefix pattern may hold '*' or
-    '**'; zenoh's canonical form of the result is `service.bus.access.twin_key`'s job)."""
+    '**'; zenoh's canonical form of the result is `service.bus.access.all_twins_canonical`'s job)."""
     return f"{prefix}/*/{suffix}"

@@ -25,6 +25,7 @@ from twin.jit import JIT
 from twin.kernels import layout as L
 from twin.model import BearingModel
 from twin.physics.friction import REGIME_NAMES, REGIME_NO_CONTACT
+from twin.physics.hertz import max_pressure_pa
 from twin.snapshot import LAMBDA_KEY, BallState, ContactState, ElectricalState
 from twin.state import TwinState
 from twin.state_measures import ball_azimuths_rad
@@ -118,7 +119,7 @@ def capture_contacts(contacts, loaded_mu_scale, out, regimes):
             out[k, K_ANGLE] = 0.0
             regimes[k] = REGIME_NO_CONTACT
         a, b = contacts[L.C_SEMI_MAJOR, k], contacts[L.C_SEMI_MINOR, k]
-        out[k, K_P_MAX] = 1.5 * load / (math.pi * a * b) if a > 0.0 and b > 0.0 else 0.0
+        out[k, K_P_MAX] = max_pressure_pa(load, a, b)
 
 
 @njit(**JIT)

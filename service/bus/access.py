@@ -135,7 +135,7 @@ class Roles:
         return [("services", self.services), ("writers", self.writers), ("readers", self.readers)]
 
 
-def twin_key(prefix: str, suffix: str) -> str:
+def all_twins_canonical(prefix: str, suffix: str) -> str:
     """`{prefix}/*/{suffix}` in zenoh's canonical form (`**/*` is written `*/**`)."""
     import zenoh
 
@@ -162,7 +162,7 @@ def acl_config(prefixes: str | Sequence[str], roles: Roles, *, tls: bool = False
                     "messages": messages,
                     "flows": [flow],
                     "permission": "allow",
-                    "key_exprs": sorted({twin_key(p, s) for p in prefixes for s in suffixes}),
+                    "key_exprs": sorted({all_twins_canonical(p, s) for p in prefixes for s in suffixes}),
                 }
             )
             ids.append(rule_id)

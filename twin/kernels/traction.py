@@ -95,6 +95,7 @@ from twin.kernels.layout import (
     T_XI2,
 )
 from twin.physics.friction import stribeck_line_mu
+from twin.physics.hertz import max_pressure_pa
 from twin.physics.rolling import asperity_load_share
 from twin.physics.traction import barus_viscosity_pa_s, eyring_saturation_slip_m_s, traction_capacity
 
@@ -164,7 +165,7 @@ def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
         h = w[C_H_C * CW + c]
         if not (q > 0.0 and a > 0.0 and b > 0.0):
             continue
-        p_h = 1.5 * q / (math.pi * a * b)
+        p_h = max_pressure_pa(q, a, b)
         # contact frame: n, t1 along the entrainment (or the orbit when there is none), t2 = n x t1
         nx = w[G_NX * CW + c]
         ny = w[G_NY * CW + c]
