@@ -128,17 +128,17 @@ def limiting_traction_coefficient_share(film_parameter, asperity_share, limiting
 
 
 @njit(**JIT)
-def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia, dt):
+def ellipse_traction(w, nc, p, viscosity_pa_s, kt_ratio, ball_inertia_kg_m2, dt_s):
     """For every loaded contact: the traction capacity (the tangential spring's Coulomb limit,
-    C_MU, `limiting_traction_coefficient`) and the strip integration of the module docstring, written to the E_* rows.
-    Open
-    contacts get zero moments. Reads the contact lanes after the tribology refresh."""
+    C_MU, `limiting_traction_coefficient`) and the strip integration of the module docstring,
+    written to the E_* rows. Open contacts get zero moments. Reads the contact lanes after the
+    tribology refresh."""
     n_strips = int(p[P_TRACTION_STRIPS])
     gamma = p[P_LIMITING_SHEAR]
     tau0 = p[P_EYRING_STRESS]
     alpha = p[P_PRESSURE_VISCOSITY]
     s_a = p[P_ASPERITY_SLIP]
-    max_slope = ball_inertia / dt  # spin-moment slope the explicit step resolves
+    max_slope = ball_inertia_kg_m2 / dt_s  # spin-moment slope the explicit step resolves
     for c in range(nc):
         if w[G_DELTA * CW + c] <= 0.0:
             w[E_MOMENT_T2 * CW + c] = 0.0

@@ -144,62 +144,62 @@ def brewe_hamrock_second_kind(rx_m, ry_m):
 
 
 @njit(**JIT)
-def stiffness_from_constants(k, fbar, ebar, r_m, effective_modulus):
+def stiffness_from_constants(k, fbar, ebar, r_m, effective_modulus_pa):
     """K = pi k E' sqrt(2 Ebar R / (9 Fbar^3)) [N/m^1.5] (seed 000 eq. 2, docs/physics.md)."""
-    return math.pi * k * effective_modulus * math.sqrt(2.0 * ebar * r_m / (9.0 * fbar**3))
+    return math.pi * k * effective_modulus_pa * math.sqrt(2.0 * ebar * r_m / (9.0 * fbar**3))
 
 
 @njit(**JIT)
-def semi_major_from_constants(load_n, k, ebar, r_m, effective_modulus):
+def semi_major_from_constants(load_n, k, ebar, r_m, effective_modulus_pa):
     """a = (6 k^2 Ebar Q R / (pi E'))^(1/3) [m], transverse semi-axis (Hamrock & Brewe 1983)."""
     if load_n <= 0.0:
         return 0.0
-    return (6.0 * k * k * ebar * load_n * r_m / (math.pi * effective_modulus)) ** (1.0 / 3.0)
+    return (6.0 * k * k * ebar * load_n * r_m / (math.pi * effective_modulus_pa)) ** (1.0 / 3.0)
 
 
 @njit(**JIT)
-def semi_minor_from_constants(load_n, k, ebar, r_m, effective_modulus):
+def semi_minor_from_constants(load_n, k, ebar, r_m, effective_modulus_pa):
     """b = (6 Ebar Q R / (pi k E'))^(1/3) [m], rolling-direction semi-axis (Hamrock & Brewe 1983)."""
     if load_n <= 0.0:
         return 0.0
-    return (6.0 * ebar * load_n * r_m / (math.pi * k * effective_modulus)) ** (1.0 / 3.0)
+    return (6.0 * ebar * load_n * r_m / (math.pi * k * effective_modulus_pa)) ** (1.0 / 3.0)
 
 
-def raceway_stiffness_n_m15(rx_m, ry_m, effective_modulus):
+def raceway_stiffness_n_m15(rx_m, ry_m, effective_modulus_pa):
     """K [N/m^1.5] in Q = K delta^1.5 of a ball-raceway contact, exact constants (seed 000 eq. 2)."""
     c = elliptic_constants(rx_m, ry_m)
     return stiffness_from_constants(
-        c.ellipticity, c.first_kind, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus
+        c.ellipticity, c.first_kind, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus_pa
     )
 
 
-def semi_major_axis_m(load_n, rx_m, ry_m, effective_modulus):
+def semi_major_axis_m(load_n, rx_m, ry_m, effective_modulus_pa):
     """a [m], transverse semi-axis of the Hertz ellipse, exact constants (Hamrock & Brewe 1983,
     the ref. [9] that seed 000 eq. 5 uses)."""
     c = elliptic_constants(rx_m, ry_m)
     return semi_major_from_constants(
-        load_n, c.ellipticity, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus
+        load_n, c.ellipticity, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus_pa
     )
 
 
-def semi_minor_axis_m(load_n, rx_m, ry_m, effective_modulus):
+def semi_minor_axis_m(load_n, rx_m, ry_m, effective_modulus_pa):
     """b [m], rolling-direction semi-axis of the Hertz ellipse, exact constants."""
     c = elliptic_constants(rx_m, ry_m)
     return semi_minor_from_constants(
-        load_n, c.ellipticity, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus
+        load_n, c.ellipticity, c.second_kind, curvature_sum_radius_m(rx_m, ry_m), effective_modulus_pa
     )
 
 
-def approach_m(load_n, rx_m, ry_m, effective_modulus):
+def approach_m(load_n, rx_m, ry_m, effective_modulus_pa):
     """Mutual approach delta = (Q / K)^(2/3) [m] of the two bodies (seed 000 eq. 2 inverted)."""
-    return (max(load_n, 0.0) / raceway_stiffness_n_m15(rx_m, ry_m, effective_modulus)) ** (2.0 / 3.0)
+    return (max(load_n, 0.0) / raceway_stiffness_n_m15(rx_m, ry_m, effective_modulus_pa)) ** (2.0 / 3.0)
 
 
 @njit(**JIT)
-def ball_ball_stiffness_n_m15(r1_m, r2_m, shear_modulus, poisson_ratio):
+def ball_ball_stiffness_n_m15(r1_m, r2_m, shear_modulus_pa, poisson_ratio):
     """K [N/m^1.5] for two spheres (ball-cage element), 4 G sqrt(Req) / (3 (1 - nu)) (seed 000 eq. 3)."""
     req = convex_radius_m(r1_m, r2_m)
-    return 4.0 * shear_modulus * math.sqrt(req) / (3.0 * (1.0 - poisson_ratio))
+    return 4.0 * shear_modulus_pa * math.sqrt(req) / (3.0 * (1.0 - poisson_ratio))
 
 
 @njit(**JIT)
