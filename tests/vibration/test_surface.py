@@ -9,7 +9,7 @@ from pydantic import ValidationError
 
 from twin import catalog
 from twin.kernels import layout as L
-from twin.kernels.profile import profile_height_m
+from twin.kernels.profile import profile_drops, profile_height_m
 from twin.validation.vibration_simulation import defect_for
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
 from twin.vibration.housing import sensor_resonance
@@ -51,6 +51,41 @@ def test_profile_at_a_tiny_negative_angle_is_the_height_at_zero():
     for angle in (-1e-17, -5e-17, -1e-300, -0.0, 0.0):
         assert profile_height_m(p, L.P_PROFILE_INNER, angle) == pytest.approx(h[0], abs=1e-18)
     assert profile_height_m(p, L.P_PROFILE_INNER, math.atan2(-1.05e-12, 19.5e-3)) == pytest.approx(h[0], abs=1e-14)
+
+
+@pytest.mark.parametrize("shaft_angle", [0.0, 2.5, -7.0, 4.0e4])
+def test_profile_drops_read_each_lane_where_its_ball_is(shaft_angle):
+    """`profile_drops` (one azimuth per ball, the inner lane's by the small angle between the
+    lanes) against the definition lane by lane: libm's atan2 of each lane's own centre and
+    `profile_height_m` (the inner race turned with the shaft), plus the ball's radius offset.
+    Balls anywhere on the circle (with one at azimuth -1e-17 rad), the inner ring 80 um off the
+    outer's centre: within the azimuth's 2e-8 rad times the table's steepest slope (the read point
+    moves by 1e-5 of a table step)."""
+    z = 9
+    rng = np.random.default_rng(4)
+    p = np.zeros(L.N_PARAMS)
+    p[L.P_PROFILE_INNER : L.P_PROFILE_INNER + L.PROFILE_POINTS] = race_profile_m(1e-7, 0.024, 0.3e-3, rng)
+    p[L.P_PROFILE_OUTER : L.P_PROFILE_OUTER + L.PROFILE_POINTS] = race_profile_m(1e-7, 0.0366, 0.3e-3, rng)
+    p[L.P_BALL_SIZE : L.P_BALL_SIZE + z] = ball_radius_offsets_m(0.125e-6, z, rng)
+    w = np.zeros(L.N_ROWS * L.CW)
+    azimuths = np.concatenate([[-1e-17], rng.uniform(-math.pi, math.pi, z - 1)])
+    offset = np.array([60e-6, -50e-6])  # the inner ring's centre relative to the outer's [m]
+    for j, phi in enumerate(azimuths):
+        centre = 30.3e-3 * np.array([math.cos(phi), math.sin(phi)])
+        for c, xy in ((2 * j, centre - offset), (2 * j + 1, centre)):
+            w[L.K_PX * L.CW + c], w[L.K_PY * L.CW + c] = xy
+    step = 2 * math.pi / L.PROFILE_POINTS
+    tables = p[L.P_PROFILE_INNER : L.P_PROFILE_OUTER + L.PROFILE_POINTS].reshape(2, -1)
+    tol_m = 2e-8 * np.max(np.abs(np.diff(tables, axis=1, append=tables[:, :1]))) / step
+    profile_drops(w, 2 * z, p, shaft_angle)
+    got = w[L.G_DEFECT_DROP * L.CW : L.G_DEFECT_DROP * L.CW + 2 * z]
+    for c in range(2 * z):
+        x, y = w[L.K_PX * L.CW + c], w[L.K_PY * L.CW + c]
+        if c % 2:
+            h = profile_height_m(p, L.P_PROFILE_OUTER, math.atan2(y, x))
+        else:
+            h = profile_height_m(p, L.P_PROFILE_INNER, math.atan2(y, x) - shaft_angle)
+        assert got[c] == pytest.approx(-(h + p[L.P_BALL_SIZE + c // 2]), abs=tol_m), c
 
 
 def test_ball_offsets_have_zero_mean_and_the_spread():
