@@ -71,7 +71,7 @@ class TwinInbox:
         self._on_temperature = on_temperature
         self.setpoints_received = 0
         self.writes_received: collections.Counter[str] = collections.Counter()  # defects, measured, temperature
-        self.setpoints_refused_busy = 0  # setpoints refused (429 on the result key): control queue full
+        self.setpoints_refused_busy = 0  # writes refused (429 on their result key): control queue full
         self.queries_answered = 0
         self._busy_pending = 0  # of those, refusals not yet published
         self._busy_marked = 0  # 1 while a ("busy", None) marker waits in the control queue
@@ -90,33 +90,19 @@ class TwinInbox:
         self._setpoint_sub = session.declare_subscriber(
             key(SETPOINT), lambda sample: self._enqueue(("setpoint", payload(sample)))
         )
-        self._defects_sub = self._defects_result_pub = None
-        if on_defects is not None:
-            self._defects_result_pub = session.declare_publisher(
-                key(DEFECTS_RESULT), encoding=JSON_ENCODING, congestion_control=zenoh.CongestionControl.BLOCK
-            )
-            self._defects_sub = session.declare_subscriber(
-                key(DEFECTS), lambda sample: self._enqueue(("defects", payload(sample)))
-            )
-        # measured accelerometer windows (service.core.measured: binary frame in, comparison out)
-        self._measured_sub = self._comparison_pub = None
-        if on_measured is not None:
-            self._comparison_pub = session.declare_publisher(
-                key(VIBRATION_COMPARISON), encoding=JSON_ENCODING, congestion_control=zenoh.CongestionControl.BLOCK
-            )
-            self._measured_sub = session.declare_subscriber(
-                key(VIBRATION_MEASURED), lambda sample: self._enqueue(("measured", payload(sample)))
-            )
-        # measured temperatures (service.core.intake.TemperatureIntake: JSON in, result out)
-        self._temperature_sub = self._temperature_result_pub = None
-        if on_temperature is not None:
-            self._temperature_result_pub = session.declare_publisher(
-                key(TEMPERATURE_RESULT), encoding=JSON_ENCODING, congestion_control=zenoh.CongestionControl.BLOCK
-            )
-            self._temperature_sub = session.declare_subscriber(
-                key(TEMPERATURE), lambda sample: self._enqueue(("temperature", payload(sample)))
-            )
-        # the writes besides setpoints: kind -> (handler, result publisher)
+        # the writes besides setpoints: defects (service.core.intake.DefectIntake), measured
+        # accelerometer windows (service.core.measured: binary frame in, comparison out) and
+        # measured temperatures (service.core.intake.TemperatureIntake)
+        self._defects_sub, self._defects_result_pub = self._declare_write(
+            "defects", DEFECTS, DEFECTS_RESULT, on_defects
+        )
+        self._measured_sub, self._comparison_pub = self._declare_write(
+            "measured", VIBRATION_MEASURED, VIBRATION_COMPARISON, on_measured
+        )
+        self._temperature_sub, self._temperature_result_pub = self._declare_write(
+            "temperature", TEMPERATURE, TEMPERATURE_RESULT, on_temperature
+        )
+        # kind -> (handler, result publisher)
         self._writes: dict[str, tuple[Handler | None, Any]] = {
             "defects": (on_defects, self._defects_result_pub),
             "measured": (on_measured, self._comparison_pub),
@@ -126,6 +112,22 @@ class TwinInbox:
         self._owner_queryable = session.declare_queryable(key(OWNER), lambda query: self._enqueue(("owner", query)))
         self._thread = threading.Thread(target=self._loop, name=f"zenoh-ctl-{bearing_id}", daemon=True)
         self._thread.start()
+
+    def _declare_write(self, kind: str, suffix: str, result_suffix: str, handler: Handler | None) -> tuple[Any, Any]:
+        """(subscriber, result publisher) of one kind of write (None, None without a handler); the
+        result publisher BLOCKs as the setpoint result's does."""
+        if handler is None:
+            return None, None
+        session = self.bus.session
+        result_pub = session.declare_publisher(
+            twin_key(self.bus.prefix, self.bearing_id, result_suffix),
+            encoding=JSON_ENCODING,
+            congestion_control=zenoh.CongestionControl.BLOCK,
+        )
+        sub = session.declare_subscriber(
+            twin_key(self.bus.prefix, self.bearing_id, suffix), lambda sample: self._enqueue((kind, payload(sample)))
+        )
+        return sub, result_pub
 
     def close_entrances(self) -> None:
         """Stop taking messages: undeclare the subscribers and queryables; what waits is still
@@ -171,9 +173,9 @@ class TwinInbox:
                         self._busy_marked = 1
                         self._control.append(("busy", None))
                         self._control_cond.notify()
-                elif item[0] in ("defects", "temperature"):  # rare: refused at once on its result key
+                elif item[0] in self._writes:  # rare: refused at once on its result key
                     self.setpoints_refused_busy += 1
-                    pub = self._defects_result_pub if item[0] == "defects" else self._temperature_result_pub
+                    pub = self._writes[item[0]][1]
                     if not self._gone and pub is not None:
                         with contextlib.suppress(Exception):
                             pub.put(self._busy_refusal("messages"))

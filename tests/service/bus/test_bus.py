@@ -738,3 +738,55 @@ def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
     assert len(refused) == over
     assert all(r["status"] == 429 and r["retry_after_s"] > 0 and "retry" in r["error"] for r in refused)
     pub.undeclare()
+
+
+def test_a_full_queue_refuses_measured_windows_with_429_on_their_answer_key(bus, client):
+    """Every write, not only setpoints, is answered when the control queue is full: with the
+    control thread held inside a setpoint handler, 256 measured windows fill the queue
+    (_CONTROL_QUEUE_SIZE) and each of the next 10 is refused with status 429 on
+    `.../vibration/comparison`, none dropped unanswered."""
+    from service.bus.zenoh_bus import _CONTROL_QUEUE_SIZE
+
+    entered, release = threading.Event(), threading.Event()
+
+    def on_setpoint(payload: bytes) -> dict:
+        if payload == b"hold":
+            entered.set()
+            release.wait(WAIT_S)
+        return {"accepted": True}
+
+    channel = bus.attach_twin("t2", lambda: None, on_setpoint, on_measured=lambda payload: {"accepted": True})
+    client.subscribe("bearing/t2/vibration/comparison")
+    setpoints = client.session.declare_publisher(
+        "bearing/t2/setpoint", congestion_control=zenoh.CongestionControl.BLOCK
+    )
+    windows = client.session.declare_publisher(
+        "bearing/t2/vibration/measured", congestion_control=zenoh.CongestionControl.BLOCK
+    )
+    client.wait_for(lambda item: True, poke=lambda: windows.put(b"warm"), poke_every_s=0.5)  # routes up
+    deadline = time.monotonic() + WAIT_S
+    while not entered.is_set() and time.monotonic() < deadline:
+        setpoints.put(b"hold")
+        entered.wait(0.5)
+    assert entered.is_set()
+    time.sleep(0.5)
+    client.drain()
+    over = 10
+    for i in range(_CONTROL_QUEUE_SIZE + over):
+        windows.put(f"w{i}".encode())
+    deadline = time.monotonic() + WAIT_S
+    while channel.inbox.setpoints_refused_busy < over and time.monotonic() < deadline:
+        time.sleep(0.02)
+    release.set()
+    results = []
+    deadline = time.monotonic() + WAIT_S
+    while len(results) < _CONTROL_QUEUE_SIZE + over and time.monotonic() < deadline:
+        try:
+            results.append(loads(client.inbox.get(timeout=0.2).payload))
+        except queue.Empty:
+            pass
+    refused = [r for r in results if not r["accepted"]]
+    assert len(results) == _CONTROL_QUEUE_SIZE + over  # every window answered
+    assert len(refused) == over and all(r["status"] == 429 for r in refused)
+    setpoints.undeclare()
+    windows.undeclare()
