@@ -538,7 +538,7 @@ class OpcUaFacade:
             return await answer("BadTooManyOperations", refusal.message, retry_after_s=refusal.retry_after_s)
         number = float(value) if variant.VariantType in (ua.VariantType.Double, ua.VariantType.Float) else int(value)
         if folder == MEASURED_TEMPERATURE:
-            return await self._measure_temperature(entry, nodes, name, float(number), answer)
+            return await self._measure_temperature(entry, name, float(number), answer)
         try:
             setpoint = entry.runner.submit({name: number})
         except InputError as exc:
@@ -552,9 +552,7 @@ class OpcUaFacade:
             nodes.last[f"Setpoint/{name}"] = getattr(setpoint, name)
         return await answer("Good", setpoint=setpoint.model_dump())
 
-    async def _measure_temperature(
-        self, entry: Any, nodes: TwinNodes | None, name: str, value_c: float, answer: Any
-    ) -> ua.StatusCode:
+    async def _measure_temperature(self, entry: Any, name: str, value_c: float, answer: Any) -> ua.StatusCode:
         """`runner.submit_temperature` of the node `name` names (`outer_ring_c` -> outer_ring)."""
         node = name.removesuffix("_c")
         try:
@@ -562,8 +560,6 @@ class OpcUaFacade:
         except InputError as exc:
             status = "BadOutOfRange" if exc.status_code == 422 else "BadInvalidState"
             return await answer(status, str(exc))
-        if nodes is not None:
-            nid = self._nid(entry.id, MEASURED_TEMPERATURE, name)
-            await self.server.write_attribute_value(nid, ua.DataValue(ua.Variant(value_c, ua.VariantType.Double)))
-            nodes.last[f"{MEASURED_TEMPERATURE}/{name}"] = value_c
+        # the variable then reads the measurement once the twin has taken it (the snapshot's
+        # thermal block), as every other variable reads the snapshot
         return await answer("Good", node=node, temperature_c=value_c)

@@ -236,6 +236,19 @@ def test_measured_temperature_write_goes_the_http_way(url, http, support):
     )
     assert thermal["measured_node"] == "outer_ring"
 
+    async def shown():  # the variable reads the measurement the twin took (its snapshot)
+        async with client(url, password=None) as c:
+            for _ in range(200):
+                try:  # BadNoValue until the facade's next update copies the snapshot
+                    if await read(c, MEASURED_TEMPERATURE, "outer_ring_c") == 46.5:
+                        return True
+                except ua.UaStatusCodeError as err:
+                    assert err.code == ua.StatusCodes.BadNoValue, err
+                await asyncio.sleep(0.05)
+            return False
+
+    assert run(shown())
+
 
 def test_anonymous_write_is_refused_when_a_token_is_set(url, http, server):
     gate = server.service.gate
