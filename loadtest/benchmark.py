@@ -40,7 +40,6 @@ from __future__ import annotations
 import os
 import queue
 import re
-import socket
 import statistics
 import subprocess
 import sys
@@ -49,6 +48,7 @@ import threading
 import time
 from pathlib import Path
 
+from loadtest.ports import free_ports
 from service.keys import STATE, all_twins, twin_key
 
 #: (designation, initial setpoint) of the twins, in order
@@ -75,12 +75,6 @@ def client_priority(nice: int | None) -> tuple[int, int]:
     except OSError:  # lowering the nice needs root or CAP_SYS_NICE
         pass
     return before, os.getpriority(os.PRIO_PROCESS, 0)
-
-
-def _free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def _percentile(values: list[float], q: float) -> float | None:
@@ -150,7 +144,7 @@ def run_service_benchmark(
     if not auto and not (isinstance(twins, int) and twins >= 1):
         raise ValueError(f"twins = {twins!r}: at least 1, or 'auto'")
     plan = twin_plan(1 if auto else int(twins))
-    port, zport = _free_port(), _free_port()
+    port, zport = free_ports(2)
     endpoint = f"tcp/127.0.0.1:{zport}"
     repo = Path(__file__).resolve().parents[1]
     env = {

@@ -56,7 +56,6 @@ import random
 import secrets
 import shutil
 import signal
-import socket
 import statistics
 import subprocess
 import sys
@@ -68,6 +67,7 @@ from pathlib import Path
 from typing import Any
 
 import service
+from loadtest.ports import free_ports
 from service.keys import DEFAULT_PREFIX, SETPOINT, SETPOINT_RESULT, STATE, all_twins, twin_key
 from service.recording.reader import snapshots_per_trend_window, window_seq_gaps
 from service.recording.recorder import RerunRecorder
@@ -99,12 +99,6 @@ class SoakConfig(TargetConfig):
     publish_rate_hz: float | None = None
     keep_dir: bool = False
     record_segment_s: float | None = None  # with start: the service's BEARING_TWIN_RECORD_SEGMENT_S [s]
-
-
-def _free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def _rss_bytes(pid: int) -> tuple[int | None, str]:
@@ -146,8 +140,8 @@ class _Started:
         fd = os.open(users, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
         with os.fdopen(fd, "w") as f:
             f.write(f"{self.zenoh_user}:{self.zenoh_password}\n")
-        self.port = _free_port()
-        self.zenoh_endpoint = f"tcp/127.0.0.1:{_free_port()}"
+        self.port, zenoh_port, opcua_port = free_ports(3)
+        self.zenoh_endpoint = f"tcp/127.0.0.1:{zenoh_port}"
         self.rrd = self.dir / "soak.rrd" if record else None
         self.log_path = self.dir / "serve.log"
         cmd = [
@@ -165,7 +159,7 @@ class _Started:
             "warning",
         ]
         cmd += ["--record", str(self.rrd)] if self.rrd is not None else ["--no-record"]
-        self.opcua_url = f"opc.tcp://127.0.0.1:{_free_port()}" if opcua else None
+        self.opcua_url = f"opc.tcp://127.0.0.1:{opcua_port}" if opcua else None
         if self.opcua_url:
             cmd += ["--opcua", self.opcua_url]
         if publish_rate_hz:

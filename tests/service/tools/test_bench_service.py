@@ -74,3 +74,18 @@ def test_overhead_over_the_run_is_the_totals_difference_over_the_wall_time():
     for key, value in expected.items():
         assert run[key] == pytest.approx(value, abs=1e-12), key
     assert overhead_over_run({}, after, 10.0, 2) is None
+
+
+def test_free_ports_are_distinct_and_free():
+    """The load tools' ports for one service (HTTP, zenoh, OPC UA) are asked for together, so
+    they are never the same port (asked one at a time, the kernel can hand a released ephemeral
+    port out again: the service's HTTP and zenoh then collided, 'address already in use')."""
+    import socket
+
+    from loadtest.ports import free_ports
+
+    for _ in range(50):
+        ports = free_ports(3)
+        assert len(set(ports)) == 3
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
+            s.bind(("127.0.0.1", ports[0]))  # free again once returned
