@@ -100,7 +100,7 @@ class TemperatureIntake(SetpointIntake):
 
     def _apply(self, data: Any) -> dict:
         measured = parse_measured_temperature(data)
-        self.runner.submit_temperature(measured.node, measured.temperature_c)
+        self.runner.submit_temperature(measured)
         return measured.model_dump()
 
 

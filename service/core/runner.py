@@ -54,7 +54,7 @@ from service.core.defects import DefectBox, parse_defects
 from service.core.errors import InputError, field_errors, setpoint_field_errors
 from service.core.faults import ErrorStreak, Fallback, FaultPolicy
 from service.core.mailbox import LatestValue, Mailbox, SetpointTiming
-from service.core.measured_temperature import TEMPERATURE_RANGE_C
+from service.core.measured_temperature import MeasuredTemperature
 from service.core.pacing import PacingClock
 from service.core.pool import Job, Schedule, SteppingPool
 from service.core.publishing import Publisher
@@ -65,7 +65,6 @@ from service.core.stats import LoopCounters, health_record
 from twin.engine import Twin
 from twin.setpoint import Setpoint, SetpointError, SetpointLimits, SetpointUpdate
 from twin.snapshot import Snapshot
-from twin.thermal.coupling import MEASURABLE_NODES
 
 log = logging.getLogger(__name__)
 
@@ -304,11 +303,11 @@ class TwinRunner:
         self._wake(urgent=True)
         return items
 
-    def submit_temperature(self, node: str, temperature_c: float) -> None:
-        """A measured temperature of a node ('outer_ring', 'housing', 'oil') [degC] for the twin's
-        dissipation estimator (twin.thermal.estimator): checked here (InputError 422 naming the
-        field and its range; 409 with the fixed oil temperature), handed to the twin at the next
-        frame boundary (the latest wins)."""
+    def submit_temperature(self, measured: MeasuredTemperature) -> None:
+        """A measured node temperature for the twin's dissipation estimator
+        (twin.thermal.estimator), its node and range already checked by the model
+        (service.core.measured_temperature); InputError 409 with the fixed oil temperature. Handed
+        to the twin at the next frame boundary (the latest wins)."""
         if self.twin.thermal is None:
             raise InputError.one(
                 "node",
@@ -316,14 +315,7 @@ class TwinRunner:
                 "'fixed'): no thermal network to follow a measurement",
                 status_code=409,
             )
-        if node not in MEASURABLE_NODES:
-            raise InputError.one("node", f"{node!r} cannot be measured", allowed=list(MEASURABLE_NODES))
-        low, high = TEMPERATURE_RANGE_C
-        if not (math.isfinite(temperature_c) and low <= temperature_c <= high):
-            raise InputError.one(
-                "temperature_c", f"{temperature_c!r}: must be finite, in [{low:g}, {high:g}] degC", [low, high]
-            )
-        self.measured_temperature.offer((node, float(temperature_c)))
+        self.measured_temperature.offer((measured.node, measured.temperature_c))
         self._wake()
 
     def _take_measurement(self) -> None:

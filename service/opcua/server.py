@@ -72,7 +72,7 @@ from asyncua.server.event_generator import EventGenerator
 from service.core.alarm_inputs import inputs_from_snapshot
 from service.core.alarms import AlarmEvent
 from service.core.errors import InputError
-from service.core.measured_temperature import TEMPERATURE_RANGE_C
+from service.core.measured_temperature import TEMPERATURE_RANGE_C, parse_measured_temperature
 from service.opcua.guard import OpcUaGuard
 from service.opcua.identity import TokenServer, TokenUserManager
 from service.opcua.layout import (
@@ -556,7 +556,7 @@ class OpcUaFacade:
         """`runner.submit_temperature` of the node `name` names (`outer_ring_c` -> outer_ring)."""
         node = name.removesuffix("_c")
         try:
-            entry.runner.submit_temperature(node, value_c)
+            entry.runner.submit_temperature(parse_measured_temperature({"node": node, "temperature_c": value_c}))
         except InputError as exc:
             status = "BadOutOfRange" if exc.status_code == 422 else "BadInvalidState"
             return await answer(status, str(exc))

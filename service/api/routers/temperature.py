@@ -32,5 +32,5 @@ def put_temperature(entry: TwinDep, body: MeasuredTemperature) -> TemperatureRes
     """Hand a measured temperature to the twin's dissipation estimator; the snapshot's `thermal`
     block then carries the estimate, its uncertainty and the residual (409 with the fixed oil
     temperature, 422 naming the field and its range)."""
-    entry.runner.submit_temperature(body.node, body.temperature_c)
+    entry.runner.submit_temperature(body)
     return TemperatureResponse(bearing_id=entry.id, node=body.node, temperature_c=body.temperature_c)
