@@ -66,9 +66,6 @@ class TwinInbox:
         self._get_snapshot = get_snapshot
         self._known_state = known_state
         self._on_setpoint = on_setpoint
-        self._on_defects = on_defects
-        self._on_measured = on_measured
-        self._on_temperature = on_temperature
         self.setpoints_received = 0
         self.writes_received: collections.Counter[str] = collections.Counter()  # defects, measured, temperature
         self.setpoints_refused_busy = 0  # writes refused (429 on their result key): control queue full
