@@ -99,16 +99,10 @@ def _table_height_m(p, base, u):
 @njit(**JIT_INLINE)
 def profile_height_m(p, base, angle_rad):
     """Height [m] of the profile table at p[base:base + PROFILE_POINTS] at `angle_rad` (any
-    real angle; periodic), linearly interpolated."""
-    u = angle_rad * _INV_TWO_PI * PROFILE_POINTS
-    u -= math.floor(u / PROFILE_POINTS) * PROFILE_POINTS
-    i = int(u)
-    if i >= PROFILE_POINTS:  # a tiny negative angle wraps to u = PROFILE_POINTS exactly: that is point 0
-        i = 0
-        u = 0.0
-    f = u - i
-    i1 = i + 1 if i + 1 < PROFILE_POINTS else 0
-    return p[base + i] + f * (p[base + i1] - p[base + i])
+    real angle; periodic), linearly interpolated. A tiny negative angle wraps to u =
+    PROFILE_POINTS exactly, which the bit mask of `_table_height_m` reads as point 0."""
+    u = angle_rad * _POINTS_PER_RAD
+    return _table_height_m(p, base, u - math.floor(u / PROFILE_POINTS) * PROFILE_POINTS)
 
 
 @njit(**JIT_INLINE)
