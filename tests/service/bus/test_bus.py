@@ -691,13 +691,9 @@ def test_a_burst_nobody_subscribes_to_queues_nothing_and_close_is_prompt(bus, tw
     assert channel.published + channel.dropped + channel.errors <= 5000
 
 
-def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
-    """Zenoh setpoint results are never silently dropped. The twin's control thread is
-    held inside the handler; 256 setpoints fill its queue (_CONTROL_QUEUE_SIZE) and each of the
-    next 40 gets a refusal with status 429 and retry_after_s on the result key: one result for
-    every setpoint sent, none lost."""
-    from service.bus.zenoh_bus import _CONTROL_QUEUE_SIZE
-
+def _holding_setpoint_handler():
+    """(on_setpoint, entered, release): a setpoint handler that holds the twin's control thread
+    on the payload b"hold" until `release` is set (at most WAIT_S)."""
     entered, release = threading.Event(), threading.Event()
 
     def on_setpoint(payload: bytes) -> dict:
@@ -706,16 +702,32 @@ def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
             release.wait(WAIT_S)
         return {"accepted": True}
 
+    return on_setpoint, entered, release
+
+
+def _hold(client, setpoints, entered) -> None:
+    """Put b"hold" on `setpoints` until the control thread holds it (at most WAIT_S)."""
+    deadline = time.monotonic() + WAIT_S
+    while not entered.is_set() and time.monotonic() < deadline:
+        client.drain()
+        setpoints.put(b"hold")
+        entered.wait(0.5)
+    assert entered.is_set()
+
+
+def test_a_full_setpoint_queue_refuses_with_429_never_drops(bus, client):
+    """Zenoh setpoint results are never silently dropped. The twin's control thread is
+    held inside the handler; 256 setpoints fill its queue (_CONTROL_QUEUE_SIZE) and each of the
+    next 40 gets a refusal with status 429 and retry_after_s on the result key: one result for
+    every setpoint sent, none lost."""
+    from service.bus.zenoh_bus import _CONTROL_QUEUE_SIZE
+
+    on_setpoint, entered, release = _holding_setpoint_handler()
     channel = bus.attach_twin("t1", lambda: None, on_setpoint)
     client.subscribe("bearing/t1/setpoint/result")
     pub = client.session.declare_publisher("bearing/t1/setpoint", congestion_control=zenoh.CongestionControl.BLOCK)
     client.wait_for(lambda item: True, poke=lambda: pub.put(b"warm"), poke_every_s=0.5)  # routes up
-    deadline = time.monotonic() + WAIT_S
-    while not entered.is_set() and time.monotonic() < deadline:
-        client.drain()
-        pub.put(b"hold")
-        entered.wait(0.5)
-    assert entered.is_set()
+    _hold(client, pub, entered)
     time.sleep(0.5)
     client.drain()  # warm-up results (the held setpoint's comes later)
     over = 40
@@ -747,14 +759,7 @@ def test_a_full_queue_refuses_measured_windows_with_429_on_their_answer_key(bus,
     `.../vibration/comparison`, none dropped unanswered."""
     from service.bus.zenoh_bus import _CONTROL_QUEUE_SIZE
 
-    entered, release = threading.Event(), threading.Event()
-
-    def on_setpoint(payload: bytes) -> dict:
-        if payload == b"hold":
-            entered.set()
-            release.wait(WAIT_S)
-        return {"accepted": True}
-
+    on_setpoint, entered, release = _holding_setpoint_handler()
     channel = bus.attach_twin("t2", lambda: None, on_setpoint, on_measured=lambda payload: {"accepted": True})
     client.subscribe("bearing/t2/vibration/comparison")
     setpoints = client.session.declare_publisher(
@@ -764,11 +769,7 @@ def test_a_full_queue_refuses_measured_windows_with_429_on_their_answer_key(bus,
         "bearing/t2/vibration/measured", congestion_control=zenoh.CongestionControl.BLOCK
     )
     client.wait_for(lambda item: True, poke=lambda: windows.put(b"warm"), poke_every_s=0.5)  # routes up
-    deadline = time.monotonic() + WAIT_S
-    while not entered.is_set() and time.monotonic() < deadline:
-        setpoints.put(b"hold")
-        entered.wait(0.5)
-    assert entered.is_set()
+    _hold(client, setpoints, entered)
     time.sleep(0.5)
     client.drain()
     over = 10
