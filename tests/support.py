@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import json
 import queue
-import socket
 import threading
 import time
 from collections.abc import Callable
@@ -20,10 +19,11 @@ PEER_WAIT_S = 30.0
 
 
 def free_port() -> int:
-    """A free TCP port on 127.0.0.1 (bound, read back, released)."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
+    """A free TCP port on 127.0.0.1 that this test process has not been given before
+    (loadtest.ports.free_port: a released port can come back for the next ask)."""
+    from loadtest.ports import free_port as one_free_port
+
+    return one_free_port()
 
 
 def free_endpoint() -> str:

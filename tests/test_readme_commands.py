@@ -18,13 +18,14 @@ import os
 import re
 import shutil
 import signal
-import socket
 import subprocess
 import sys
 import time
 from pathlib import Path
 
 import pytest
+
+from loadtest.ports import free_port
 
 ROOT = Path(__file__).resolve().parents[1]
 DOC_FILES = (ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md")))
@@ -79,12 +80,6 @@ def _cli(
         timeout=timeout,
         env={**os.environ, "PYTHONPATH": str(ROOT), **(env or {})},
     )
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def _scenario_files() -> list[str]:
@@ -278,7 +273,7 @@ class _Serve:
     """`bearing-twin serve` as the README starts it, on free loopback ports, in `cwd`."""
 
     def __init__(self, cwd: Path, env: dict | None = None, extra: tuple[str, ...] = ()):
-        self.port, self.zenoh = _free_port(), f"tcp/127.0.0.1:{_free_port()}"
+        self.port, self.zenoh = free_port(), f"tcp/127.0.0.1:{free_port()}"
         self.proc = subprocess.Popen(
             [
                 sys.executable,
@@ -381,7 +376,7 @@ def test_token_and_opcua_commands(tmp_path):
     blocks = [b for b in _blocks("python") if b.startswith("import asyncio")]
     assert len(blocks) == 2 and "setup_self_signed_certificate" in blocks[0] and "Client(" in blocks[1]
     env = {"BEARING_TWIN_TOKEN": _documented_token()}
-    opcua = f"opc.tcp://127.0.0.1:{_free_port()}"
+    opcua = f"opc.tcp://127.0.0.1:{free_port()}"
     serve = _Serve(tmp_path, env, extra=("--opcua", opcua, "--no-record"))
     try:
         serve.wait_healthy()

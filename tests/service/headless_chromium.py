@@ -12,21 +12,16 @@ import json
 import os
 import shutil
 import signal
-import socket
 import subprocess
 import tempfile
 import time
 import urllib.request
 
+from loadtest.ports import free_port
+
 
 def chromium_path() -> str | None:
     return shutil.which("chromium") or shutil.which("chromium-browser") or shutil.which("google-chrome")
-
-
-def _free_port() -> int:
-    with socket.socket() as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 class HeadlessChromium:
@@ -34,7 +29,7 @@ class HeadlessChromium:
         import websocket  # websocket-client
 
         self.profile = tempfile.mkdtemp(prefix="bt-chromium-")
-        dbg = _free_port()
+        dbg = free_port()
         self.proc = subprocess.Popen(
             [
                 chromium_path(),

@@ -11,7 +11,6 @@ import os
 import queue
 import re
 import signal
-import socket
 import subprocess
 import sys
 import threading
@@ -19,6 +18,8 @@ import time
 from pathlib import Path
 
 import pytest
+
+from loadtest.ports import free_port
 
 zenoh = pytest.importorskip("zenoh")
 pytest.importorskip("rerun")
@@ -28,12 +29,6 @@ from twin.snapshot import Snapshot  # noqa: E402
 
 REPO = Path(__file__).resolve().parents[2]
 WAIT_S = 30.0
-
-
-def free_port() -> int:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
-        s.bind(("127.0.0.1", 0))
-        return s.getsockname()[1]
 
 
 def strict_loads(payload: bytes) -> dict:

@@ -84,8 +84,20 @@ def test_free_ports_are_distinct_and_free():
 
     from loadtest.ports import free_ports
 
+    given: list[int] = []
     for _ in range(50):
         ports = free_ports(3)
         assert len(set(ports)) == 3
         with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as s:
             s.bind(("127.0.0.1", ports[0]))  # free again once returned
+        given += ports
+    assert len(set(given)) == len(given)  # never handed out twice in one process
+
+
+def test_free_port_never_repeats_within_a_process():
+    """The tests' one-port asks (`loadtest.ports.free_port`, used by every test that starts a
+    server) never hand a port out twice in one process, whatever the kernel recycles."""
+    from loadtest.ports import free_port
+
+    ports = [free_port() for _ in range(200)]
+    assert len(set(ports)) == 200
