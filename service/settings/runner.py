@@ -106,7 +106,8 @@ class RunnerSettings(BaseModel):
             "setpoint_frame_s",
             details="It applies when shorter than frame_s, and a twin waiting for its next frame starts it at once, "
             "so the state carrying the setpoint is published sooner. 0.25 ms costs about 0.07 ms of engine CPU for "
-            "the default twin on the 2-core EPYC VM, 1 ms about 0.27 ms (the `step` stage of the setpoint latency).",
+            "the default twin on the 2-core EPYC VM, 1 ms about 0.27 ms (the `step` stage of the setpoint latency, "
+            "with its waits for a core, is in docs/performance.md).",
         ),
         description="Real-time mode: length of the frame that applies an outside setpoint (HTTP, zenoh) [s].",
     )
