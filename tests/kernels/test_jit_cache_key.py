@@ -4,6 +4,7 @@ A docstring edit in twin/ must not cost a recompilation of the engine, and any c
 must (the cache directory is named after the digest of every source file of twin/)."""
 
 import importlib.util
+import os
 
 import numba
 
@@ -122,3 +123,47 @@ def test_an_empty_engine_cache_is_told_apart(tmp_path, monkeypatch):
     assert jit.engine_cache_is_empty()  # a compiled object alone is no index
     (folder / "step.step_n-100.py311.nbi").write_bytes(b"")
     assert not jit.engine_cache_is_empty()
+
+
+def test_source_digests_are_kept_between_runs(tmp_path, monkeypatch):
+    """The cache directory's name needs the code digest of every source file of twin/; a run
+    takes them from the memo an earlier run wrote (twin.jit.DIGEST_MEMO_FILE) while a file's
+    (mtime, size) stamp is unchanged, parses none of them, and digests an edited file again."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(jit, "_digests", {})
+    monkeypatch.setattr(jit, "_digests_changed", False)
+    first = jit._engine_cache_dir()
+    assert (tmp_path / jit.DIGEST_MEMO_FILE).is_file()
+
+    # a later run: a fresh memo in memory, loaded from the file; no file is parsed
+    monkeypatch.setattr(jit, "_digests", {})
+    monkeypatch.setattr(jit, "_digests_changed", False)
+    parsed: list[str] = []
+    real_digest = jit.code_digest
+
+    def counting_digest(source: str) -> bytes:
+        parsed.append(source)
+        return real_digest(source)
+
+    monkeypatch.setattr(jit, "code_digest", counting_digest)
+    assert jit._engine_cache_dir() == first
+    assert parsed == []
+
+    # an edited file (another stamp) is digested again, and only that one
+    one = sorted(jit.ENGINE_ROOT.rglob("*.py"))[0]
+    stamp = one.stat()
+    memo = jit._digests[str(one)]
+    jit._digests[str(one)] = (memo[0] - 1, memo[1], "00" * 32)  # as if the file had changed since
+    assert jit._file_digest(str(one), stamp.st_mtime_ns, stamp.st_size) == real_digest(one.read_text("utf-8"))
+    assert len(parsed) == 1
+
+
+def test_an_unreadable_digest_memo_is_rebuilt(tmp_path, monkeypatch):
+    """A memo that is not JSON (a crash while another version wrote it) is ignored and replaced."""
+    monkeypatch.setenv("NUMBA_CACHE_DIR", str(tmp_path))
+    monkeypatch.setattr(jit, "_digests", {})
+    monkeypatch.setattr(jit, "_digests_changed", False)
+    (tmp_path / jit.DIGEST_MEMO_FILE).write_text("{not json", encoding="utf-8")
+    name = jit._engine_cache_dir()
+    assert os.path.basename(name) == os.path.basename(jit.numba.config.CACHE_DIR)  # the same digest
+    assert len(jit._load_digest_memo(str(tmp_path / jit.DIGEST_MEMO_FILE))) >= 90
