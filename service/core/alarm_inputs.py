@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from service.core.alarm_rules import DEFECT_LINES
+from service.core.json_numbers import finite_number
 from service.settings import AlarmSettings
 from twin.snapshot import LAMBDA_KEY
 from twin.snapshot_blocks import K_LAMBDA, K_LOAD
@@ -55,14 +56,6 @@ def _get(obj: Any, name: str) -> Any:
     if isinstance(obj, Mapping):
         return obj.get(LAMBDA_KEY if name == "lambda_" else name)
     return getattr(obj, name, None)
-
-
-def finite_number(value: Any) -> float | None:
-    """A JSON or model value as a finite float; None for anything else (None, bool, text, NaN, inf)."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        return None
-    value = float(value)
-    return value if math.isfinite(value) else None
 
 
 def _line_amplitude(entry: Any) -> float | None:

@@ -70,7 +70,7 @@ from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field
 
-from service.core.alarm_inputs import AlarmInputs, VibrationInputs, finite_number
+from service.core.alarm_inputs import AlarmInputs, VibrationInputs
 from service.core.alarm_rules import (
     DEFECT_LINES,
     DISCHARGE_LEVELS,
@@ -85,6 +85,7 @@ from service.core.alarm_rules import (
     vibration_zone,
     zone_boundaries,
 )
+from service.core.json_numbers import finite_number
 from service.core.measured import KURTOSIS_MARGIN, LINE_ALARM_DB
 from service.settings import AlarmSettings
 

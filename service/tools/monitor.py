@@ -24,7 +24,7 @@ import sys
 import time
 from typing import Any, Literal
 
-from service.core.alarm_inputs import finite_number
+from service.core.json_numbers import finite_number
 from service.keys import ALIVE, DEFAULT_PREFIX, STATE, all_twins
 from service.tools.arg_types import positive_float
 from service.tools.client import strict_json
