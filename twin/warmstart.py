@@ -18,11 +18,33 @@ from twin.state import TwinState
 from twin.vibration.housing import housing_equilibrium
 
 _REG_SPRING_N_M = 1e3  # keeps floating (unloaded) balls and the free axial mode well posed
+_ORIGIN = np.zeros(3)  # the outer ring's centre (fixed) [m]
+
+
+def race_contacts(model: BearingModel, ring_m, ball_m) -> tuple[tuple[float, float, float, float, float], ...]:
+    """A ball's two raceway contacts, the ball's centre at `ball_m` and the inner ring's at
+    `ring_m` [m] (the outer ring's at the origin): per race (0 inner, 1 outer) the penetration
+    delta [m] (<= 0: no contact), the contact normal's unit components (nx, ny, nz) and the
+    Hertz stiffness K [N/m^1.5] at the contact's own angle (`BearingModel.stiffness_at`, as
+    the kernel interpolates it); the contact load is K delta^1.5 (seed 000 eq. 2)."""
+    race, rb = model.race_params, model.ball_radius_m
+    contacts = []
+    for r, centre in ((0, ring_m), (1, _ORIGIN)):
+        delta, nx, ny, nz = groove_penetration(
+            ball_m[0] - centre[0],
+            ball_m[1] - centre[1],
+            ball_m[2] - centre[2],
+            race[r, L.R_GROOVE_CENTRE_RADIUS],
+            race[r, L.R_GROOVE_CENTRE_Z],
+            race[r, L.R_GROOVE_RADIUS],
+            rb,
+        )
+        contacts.append((delta, nx, ny, nz, model.stiffness_at(r, nz)))
+    return tuple(contacts)
 
 
 def _equilibrium_residual(x_um, model: BearingModel, azimuths, fr, fa, cage_speed):
-    p, race = model.params, model.race_params
-    rb, m = p[L.P_BALL_RADIUS], p[L.P_BALL_MASS]
+    m = model.params[L.P_BALL_MASS]
     z = model.ball_count
     x = x_um * 1e-6
     ring = x[:3]
@@ -34,19 +56,9 @@ def _equilibrium_residual(x_um, model: BearingModel, azimuths, fr, fa, cage_spee
         c, s = math.cos(azimuths[j]), math.sin(azimuths[j])
         ball = np.array([rho * c, rho * s, zb])
         fball = np.zeros(3)
-        for r, centre in ((0, ring), (1, np.zeros(3))):
-            rel = ball - centre
-            delta, nx, ny, nz = groove_penetration(
-                rel[0],
-                rel[1],
-                rel[2],
-                race[r, L.R_GROOVE_CENTRE_RADIUS],
-                race[r, L.R_GROOVE_CENTRE_Z],
-                race[r, L.R_GROOVE_RADIUS],
-                rb,
-            )
+        for r, (delta, nx, ny, nz, k) in enumerate(race_contacts(model, ring, ball)):
             if delta > 0.0:
-                q = model.stiffness_at(r, nz) * delta**1.5
+                q = k * delta**1.5
                 f = -q * np.array([nx, ny, nz])
                 fball += f
                 if r == 0:
@@ -129,25 +141,14 @@ def warm_start(
     state.ring_velocity_m_s[:] = 0.0
     state.clear_contacts()
     rows = state.lanes.reshape(L.N_ROWS, L.CW)
-    race = model.race_params
     for j in range(z):
         c, s = math.cos(azimuths[j]), math.sin(azimuths[j])
         rho = model.pitch_radius_m + d_rho[j]
         ball = np.array([rho * c, rho * s, zb[j]])
         state.ball_position_m[j] = ball
         normals = []
-        for r, centre in ((0, ring), (1, np.zeros(3))):
-            rel = ball - centre
-            _, nx, ny, nz = groove_penetration(
-                rel[0],
-                rel[1],
-                rel[2],
-                race[r, L.R_GROOVE_CENTRE_RADIUS],
-                race[r, L.R_GROOVE_CENTRE_Z],
-                race[r, L.R_GROOVE_RADIUS],
-                rb,
-            )
-            rows[L.M_STIFFNESS, 2 * j + r] = model.stiffness_at(r, nz)
+        for r, (_, nx, ny, nz, k) in enumerate(race_contacts(model, ring, ball)):
+            rows[L.M_STIFFNESS, 2 * j + r] = k
             normals.append(np.array([nx, ny, nz]))
         e_t = np.array([-s, c, 0.0])
         speed = cage_speed * rho

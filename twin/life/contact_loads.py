@@ -15,9 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from twin.kernels import layout as L
-from twin.kernels.contacts import groove_penetration
 from twin.life.iso281 import raceway_load_rating_n
-from twin.warmstart import solve_equilibrium
+from twin.warmstart import race_contacts, solve_equilibrium
 
 
 @dataclass(frozen=True)
@@ -106,24 +105,13 @@ def contact_loads_from_equilibrium(
     )
     if not ok:
         raise ValueError("the quasi-static equilibrium did not converge for these loads")
-    race, rb = model.race_params, model.ball_radius_m
     q, ang = np.zeros((2, z)), np.zeros((2, z))
     for j in range(z):
         rho = model.pitch_radius_m + d_rho[j]
         ball = np.array([rho * math.cos(azimuths[j]), rho * math.sin(azimuths[j]), zb[j]])
-        for r, centre in ((0, ring), (1, np.zeros(3))):
-            rel = ball - centre
-            delta, _nx, _ny, nz = groove_penetration(
-                rel[0],
-                rel[1],
-                rel[2],
-                race[r, L.R_GROOVE_CENTRE_RADIUS],
-                race[r, L.R_GROOVE_CENTRE_Z],
-                race[r, L.R_GROOVE_RADIUS],
-                rb,
-            )
+        for r, (delta, _nx, _ny, nz, k) in enumerate(race_contacts(model, ring, ball)):
             if delta > 0.0:
-                q[r, j] = race[r, L.R_STIFFNESS] * delta**1.5
+                q[r, j] = k * delta**1.5
                 ang[r, j] = math.asin(min(1.0, abs(nz)))
     return q[0], q[1], ang[0], ang[1]
 
