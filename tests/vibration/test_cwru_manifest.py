@@ -162,6 +162,23 @@ def test_a_mat_record_is_read_from_the_manifests_variable(held_out):
         cwru.measured(wrong, None, held_out)
 
 
+def test_a_mat_record_without_a_variable_reads_its_drive_end_channel(held_out, tmp_path):
+    """An entry that names no `variable` reads the record's own drive-end channel
+    (`X191_DE_time` beside `X191RPM`), else the file's only `*_DE_time` (a file whose variables
+    carry another record's number); with two candidates it is refused listing the variables."""
+    recs = {r.number: r for r in cwru.records_from_manifest(held_out / "manifest.json")}
+    expected = np.load(cwru.DATA_DIR / "130_DE_5s.npy")[:12000].astype(float) * cwru.G_M_S2
+    _, x = cwru.measured(dataclasses.replace(recs[191], variable=None), None, held_out)
+    assert np.array_equal(x, expected)
+    samples = np.load(cwru.DATA_DIR / "130_DE_5s.npy")[:12000, None]
+    savemat(tmp_path / "174.mat", {"X173_DE_time": samples, "X173_FE_time": samples, "X173RPM": 1797.0})
+    _, x = cwru.measured(dataclasses.replace(recs[191], number=174, file="174.mat", variable=None), None, tmp_path)
+    assert np.array_equal(x, expected)
+    savemat(tmp_path / "99.mat", {"X098_DE_time": samples, "X097_DE_time": samples})
+    with pytest.raises(ValueError, match=r"record 99: variable = None is not in 99.mat \(X097_DE_time, X098_DE_time\)"):
+        cwru.measured(dataclasses.replace(recs[191], number=99, file="99.mat", variable=None), None, tmp_path)
+
+
 def test_an_unreadable_mat_record_is_refused_naming_the_record(tmp_path, capsys):
     """A .mat that is not MATLAB 5 (here a MATLAB 7.3, HDF5, header) ends the command with the
     record's number and the file's name, not a traceback."""

@@ -232,10 +232,24 @@ def _load_g(path: Path, record: Record) -> np.ndarray:
         data = read_matlab5(path)
     except ValueError as exc:
         raise ValueError(f"record {record.number}: {path.name} is not a readable MATLAB 5 .mat file ({exc})") from None
-    if record.variable not in data:
-        names = ", ".join(sorted(k for k in data if not k.startswith("__")))
-        raise ValueError(f"record {record.number}: variable = {record.variable!r} is not in {path.name} ({names})")
-    return np.asarray(data[record.variable]).reshape(-1)
+    names = sorted(k for k in data if not k.startswith("__"))
+    variable = record.variable if record.variable is not None else drive_end_channel(record.number, names)
+    if variable not in data:
+        listed = ", ".join(names)
+        raise ValueError(f"record {record.number}: variable = {variable!r} is not in {path.name} ({listed})")
+    return np.asarray(data[variable]).reshape(-1)
+
+
+def drive_end_channel(number: int, names: list[str]) -> str | None:
+    """The drive-end channel of a data center .mat file whose manifest entry names none: the
+    record's own `X<number, 3 digits>_DE_time`, else the file's only `*_DE_time` (a few files
+    carry another record's number in their variables' names); None when neither is there (the
+    caller then names the file's variables)."""
+    own = f"X{number:03d}_DE_time"
+    if own in names:
+        return own
+    drive_end = [n for n in names if n.endswith("_DE_time")]
+    return drive_end[0] if len(drive_end) == 1 else None
 
 
 def measured(record: Record, duration_s: float | None = None, data_dir: Path = DATA_DIR) -> tuple[Analysis, np.ndarray]:
