@@ -179,6 +179,23 @@ def test_a_mat_record_without_a_variable_reads_its_drive_end_channel(held_out, t
         cwru.measured(dataclasses.replace(recs[191], number=99, file="99.mat", variable=None), None, tmp_path)
 
 
+def test_fan_end_records_are_left_out_with_the_reason(tmp_path, capsys):
+    """The CWRU-DE twin models the drive-end 6205; a record of the fan-end 6203 (its `bearing`, or
+    an `_FE_time` channel) is left out of the comparison, and the command says so on stderr."""
+    manifest = [
+        _entry(97, "97.npy", "normal", 1797.0, 0),
+        {**_entry(278, "278.mat", "inner_race", 1797.0, 0, size_in=0.007), "bearing": "fan-end SKF 6203-2RS JEM"},
+        _entry(282, "282.mat", "ball", 1797.0, 0, size_in=0.007, variable="X282_FE_time"),
+    ]
+    (tmp_path / "manifest.json").write_text(json.dumps(manifest))
+    left_out: list[str] = []
+    recs = cwru.records_from_manifest(tmp_path / "manifest.json", left_out)
+    assert [r.number for r in recs] == [97]
+    assert len(left_out) == 2
+    assert left_out[0].startswith("record 278 left out: bearing = 'fan-end SKF 6203-2RS JEM'")
+    assert "the CWRU-DE twin models the drive-end 6205 only" in left_out[1]
+
+
 def test_an_unreadable_mat_record_is_refused_naming_the_record(tmp_path, capsys):
     """A .mat that is not MATLAB 5 (here a MATLAB 7.3, HDF5, header) ends the command with the
     record's number and the file's name, not a traceback."""

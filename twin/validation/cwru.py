@@ -34,6 +34,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -110,13 +111,24 @@ def _file_name(entry: dict, where: str) -> str:
     return name
 
 
-def records_from_manifest(path: Path) -> list[Record]:
+def _fan_end(entry: dict) -> bool:
+    """Whether a manifest entry is of the rig's fan-end bearing (its `bearing` text, or an `_FE_`
+    channel), which the `CWRU-DE` twin does not model."""
+    bearing = entry.get("bearing")
+    variable = entry.get("variable")
+    return (isinstance(bearing, str) and ("fan" in bearing.lower() or "6203" in bearing)) or (
+        isinstance(variable, str) and "_FE_" in variable
+    )
+
+
+def records_from_manifest(path: Path, left_out: list[str] | None = None) -> list[Record]:
     """The records of a `manifest.json` in the CWRU data set's form (a list of entries with
     `cwru_number`, `file`, `fs_hz`, `rpm`, `fault_kind` normal | inner_race | outer_race | ball,
     `fault_size_in`, `outer_race_position` 6:00 | 3:00 | 12:00, `load_hp`; optional
     `fault_depth_in`, and `variable` for a `.mat` file), by record number. An entry without a
-    record number (a derived file without the record's metadata) is left out. Raises ValueError
-    naming the record and field."""
+    record number (a derived file without the record's metadata) is left out, and so is a record
+    of the fan-end bearing (a 6203, not the drive end's 6205: its `bearing` or `variable` says so),
+    with the reason appended to `left_out`. Raises ValueError naming the record and field."""
     entries = json.loads(Path(path).read_text(encoding="utf-8"))
     if not isinstance(entries, list):
         raise ValueError(f"{path}: expected a list of record entries")
@@ -125,6 +137,13 @@ def records_from_manifest(path: Path) -> list[Record]:
         if not isinstance(e, dict) or e.get("cwru_number") is None:
             continue
         where = f"{path} entry {k} (record {e.get('cwru_number')})"
+        if _fan_end(e):
+            if left_out is not None:
+                left_out.append(
+                    f"record {e.get('cwru_number')} left out: bearing = {e.get('bearing')!r}, variable = "
+                    f"{e.get('variable')!r}: the CWRU-DE twin models the drive-end 6205 only"
+                )
+            continue
         number = _field(e, "cwru_number", where, int)
         kind = _field(e, "fault_kind", where, allowed=FAULT_KINDS)
         defect, expected = FAULT_KINDS[kind]
@@ -442,10 +461,15 @@ def main(argv=None) -> int:
     )
     args = parser.parse_args(argv)
     data_dir = args.data if args.data is not None else DATA_DIR
+    left_out: list[str] = []
     try:
-        records = records_from_manifest(data_dir / "manifest.json") if args.data is not None else list(RECORDS)
+        records = (
+            records_from_manifest(data_dir / "manifest.json", left_out) if args.data is not None else list(RECORDS)
+        )
     except (OSError, ValueError) as exc:
         parser.error(str(exc))
+    for note in left_out:
+        print(note, file=sys.stderr)
     try:
         rows = compare(args.duration, records, data_dir)
     except (OSError, ValueError) as exc:  # a record's file missing or unreadable
