@@ -88,6 +88,8 @@ class MeasuredWindow:
 
 
 def _rate(value) -> float:
+    if isinstance(value, bool):
+        value = float("nan")  # refused below
     try:
         fs = float(value)
     except (TypeError, ValueError):
@@ -100,7 +102,7 @@ def _rate(value) -> float:
 
 
 def _units(value) -> str:
-    if value not in UNITS:
+    if not isinstance(value, str) or value not in UNITS:
         raise InputError.one("units", f"must be one of {', '.join(UNITS)}", list(UNITS))
     return value
 
@@ -108,6 +110,8 @@ def _units(value) -> str:
 def _shaft(value, fs: float) -> float | None:
     if value is None:
         return None
+    if isinstance(value, bool):
+        value = float("nan")  # refused below
     try:
         f = float(value)
     except (TypeError, ValueError):
@@ -145,6 +149,10 @@ def window_from_json(data) -> MeasuredWindow:
     for name in ("sample_rate_hz", "samples"):
         if name not in data:
             raise InputError.one(name, "required")
+    for name in ("sample_rate_hz", "shaft_hz"):  # JSON numbers, not text or true/false
+        value = data.get(name)
+        if value is not None and (isinstance(value, bool) or not isinstance(value, (int, float))):
+            raise InputError.one(name, f"must be a JSON number, got {type(value).__name__}")
     fs = _rate(data["sample_rate_hz"])
     units = _units(data.get("units", "m/s2"))
     raw = data["samples"]

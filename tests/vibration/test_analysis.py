@@ -141,6 +141,8 @@ def test_json_is_finite_and_carries_units():
         ({"signal_m_s2": np.zeros(100)}, "signal_m_s2"),
         ({"signal_m_s2": np.r_[np.zeros(5000), np.nan]}, "signal_m_s2"),
         ({"signal_m_s2": np.zeros((2, 4096))}, "signal_m_s2"),
+        # finite but beyond any accelerometer (about 1e5 g): its squares would overflow to inf
+        ({"signal_m_s2": np.r_[np.zeros(5000), 1e100]}, "signal_m_s2"),
         ({"sample_rate_hz": -1.0}, "sample_rate_hz"),
         ({"sample_rate_hz": float("inf")}, "sample_rate_hz"),
         ({"shaft_hz": 0.0}, "shaft_hz"),

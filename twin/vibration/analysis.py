@@ -46,6 +46,9 @@ SHAFT_HARMONICS = 3  # 1x, 2x, 3x shaft among the defect lines
 LABEL_DEFECT_HARMONICS = 5
 LABEL_SHAFT_HARMONICS = 10
 MIN_SAMPLES = 1024
+# the largest sample magnitude taken [m/s^2]: about 1e5 g, the top of shock accelerometers' ranges;
+# beyond it a record is corrupt or in the wrong units, and its squares would overflow the statistics
+MAX_ABS_SIGNAL_M_S2 = 1.0e6
 MAX_SAMPLE_RATE_HZ = 1.0e6
 MAX_BAND_FRACTION = 0.45  # of fs: the highest envelope-band edge (anti-aliasing passband)
 DEFAULT_MAX_MULTIPLE = 10.0  # highest line multiple assumed when no defect line is given
@@ -188,6 +191,13 @@ def _checked_signal(signal_m_s2) -> np.ndarray:
     if bad.size:
         raise AnalysisInputError(
             "signal_m_s2", f"{bad.size} non-finite samples (first at index {bad[0]}); all samples must be finite"
+        )
+    big = np.flatnonzero(np.abs(x) > MAX_ABS_SIGNAL_M_S2)
+    if big.size:
+        raise AnalysisInputError(
+            "signal_m_s2",
+            f"{big.size} samples beyond {MAX_ABS_SIGNAL_M_S2:g} m/s2 (first at index {big[0]}: {x[big[0]]:.3g}); "
+            f"allowed [-{MAX_ABS_SIGNAL_M_S2:g}, {MAX_ABS_SIGNAL_M_S2:g}] m/s2 (about 1e5 g): check the units",
         )
     return x
 

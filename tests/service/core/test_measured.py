@@ -58,12 +58,34 @@ def test_frame_round_trip():
         (lambda: window_from_json({"sample_rate_hz": 12000.0, "samples": ["a"] * 2000}), "samples"),
         (lambda: window_from_float32(b"\0" * 4098, 12000.0), "samples"),
         (lambda: window_from_float32(b"\0" * 8192, float("nan")), "sample_rate_hz"),
+        # a JSON list or object for the units (unhashable: once a 500), text and true for numbers
+        (lambda: window_from_json({"sample_rate_hz": 12000.0, "units": ["g"], "samples": [0.0] * 2000}), "units"),
+        (lambda: window_from_json({"sample_rate_hz": 12000.0, "units": {}, "samples": [0.0] * 2000}), "units"),
+        (lambda: window_from_json({"sample_rate_hz": "12000", "samples": [0.0] * 2000}), "sample_rate_hz"),
+        (lambda: window_from_json({"sample_rate_hz": True, "samples": [0.0] * 2000}), "sample_rate_hz"),
+        (lambda: window_from_json({"sample_rate_hz": 12000.0, "samples": [0.0] * 2000, "shaft_hz": "30"}), "shaft_hz"),
+        (lambda: window_from_json({"sample_rate_hz": 12000.0, "samples": [0.0] * 2000, "shaft_hz": True}), "shaft_hz"),
+        (lambda: window_from_float32(b"\0" * 8192, 12000.0, shaft_hz=True), "shaft_hz"),
     ],
 )
 def test_bad_windows_name_the_field(make, field):
     with pytest.raises(InputError) as err:
         make()
     assert err.value.status_code == 422 and err.value.errors[0].field == field
+
+
+def test_a_window_beyond_any_accelerometer_is_refused_naming_samples():
+    """Finite samples of 1e160 m/s2 (a corrupt record, or wrong units) would overflow the
+    statistics into null indicators; the analysis refuses samples beyond 1e6 m/s2 (about 1e5 g,
+    twin.vibration.analysis.MAX_ABS_SIGNAL_M_S2) with a 422 on `samples` naming the range."""
+    comparator = MeasuredComparator("b", catalog.bearing("CWRU-DE").geometry)
+    window = window_from_json(
+        {"sample_rate_hz": 12000.0, "units": "g", "samples": (WINDOW_G.astype(float) * 1e160).tolist()}
+    )
+    with pytest.raises(InputError) as err:
+        comparator.compare(window, _snapshot(), ())
+    assert err.value.status_code == 422 and err.value.errors[0].field == "samples"
+    assert "allowed [-1e+06, 1e+06] m/s2" in err.value.errors[0].message
 
 
 def test_twin_with_matching_defect_and_vibration_window_explains_the_measurement():
