@@ -27,6 +27,21 @@ def positive_int(text: str) -> int:
     return value
 
 
+def int_in(low: int, high: int):
+    """A whole number in [low, high]; the refusal states the range."""
+
+    def int_in_range(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be a whole number in [{low}, {high}], got {text}") from None
+        if not low <= value <= high:
+            raise argparse.ArgumentTypeError(f"must be in [{low}, {high}], got {text}")
+        return value
+
+    return int_in_range
+
+
 def non_negative_float(text: str) -> float:
     """A finite number >= 0."""
     value = float(text)

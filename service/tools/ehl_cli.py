@@ -19,14 +19,20 @@ import math
 import sys
 from typing import Any
 
-from service.tools.arg_types import non_negative_float, positive_float
+from service.tools.arg_types import float_in, int_in, non_negative_float
 from service.tools.stdout import print_document
+
+GRIDS = (17, 33, 65, 129, 257, 513)  # nodes per direction the solver takes (2^k + 1; 513: minutes per solve)
+OIL_TEMPERATURE_RANGE_C = (-30.0, 150.0)  # the twin's setpoint range (twin.setpoint), where the oil laws hold
 
 
 def _grid(text: str) -> int:
-    value = int(text)
-    if value < 17 or (value - 1) & (value - 2) != 0:
-        raise argparse.ArgumentTypeError(f"grid must be 2^k + 1 >= 17 (17, 33, 65, 129, 257, 513), got {text}")
+    try:
+        value = int(text)
+    except ValueError:
+        value = 0
+    if value not in GRIDS:
+        raise argparse.ArgumentTypeError(f"must be one of {', '.join(map(str, GRIDS))} (2^k + 1), got {text}")
     return value
 
 
@@ -46,18 +52,21 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
 
     solve = sub.add_parser("solve", help="solve one contact (defaults: seed 003 Appendix 2)")
     solve.add_argument(
-        "--load", type=positive_float, default=prm.LOAD_N, help=f"load on the ball [N] (default {prm.LOAD_N})"
+        "--load",
+        type=float_in(0.0, 1.0e5, "N", low_open=True),
+        default=prm.LOAD_N,
+        help=f"load on the ball [N] (default {prm.LOAD_N})",
     )
     solve.add_argument(
         "--entrainment-speed",
-        type=positive_float,
+        type=float_in(0.0, 100.0, "m/s", low_open=True),
         default=prm.DEFAULT_ENTRAINMENT_SPEED_M_S,
         help=f"mean entrainment speed [m/s] (default {prm.DEFAULT_ENTRAINMENT_SPEED_M_S}; "
         "seed 003 Fig. 1 spans 0.832-4.16)",
     )
     solve.add_argument(
         "--current",
-        type=non_negative_float,
+        type=float_in(0.0, 100.0, "A"),
         default=0.0,
         help="current through the contact [A] (default 0: isothermal unless --thermal)",
     )
@@ -69,7 +78,7 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
     )
     solve.add_argument(
         "--base-temperature",
-        type=float,
+        type=float_in(*OIL_TEMPERATURE_RANGE_C, "degC"),
         default=prm.BASE_TEMPERATURE_C,
         help=f"oil (boundary) temperature [degC] (default {prm.BASE_TEMPERATURE_C})",
     )
@@ -80,7 +89,9 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
         help=f"equivalent bearing resistance R_b of eq. 10 [ohm] "
         f"(default {prm.DEFAULT_BEARING_RESISTANCE_OHM:g}, anchored on seed 003 Fig. 2)",
     )
-    solve.add_argument("--max-iter", type=int, default=200, help="multigrid cycle cap (default 200)")
+    solve.add_argument(
+        "--max-iter", type=int_in(1, 10000), default=200, help="multigrid cycle cap, 1-10000 (default 200)"
+    )
     solve.add_argument("--json", action="store_true", help="print JSON instead of a table")
     solve.set_defaults(func=_cmd_solve)
 
@@ -94,7 +105,7 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
 
     bench = sub.add_parser("bench", help="time the isothermal solve at the default speed (after a warm-up)")
     bench.add_argument("--grid", type=_grid, default=129, help="nodes per direction (default 129)")
-    bench.add_argument("--repeats", type=int, default=3, help="timed solves (default 3)")
+    bench.add_argument("--repeats", type=int_in(1, 1000), default=3, help="timed solves, 1-1000 (default 3)")
     bench.add_argument("--json", action="store_true", help="print JSON instead of text")
     bench.set_defaults(func=_cmd_bench)
     return ehl

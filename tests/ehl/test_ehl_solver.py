@@ -436,3 +436,29 @@ def test_report_section_writes_the_figures_and_the_table(tmp_path):
         assert f"]({name})" in md
     assert "Fig. 1" in md and "Fig. 5" in md
     assert "| 0.832 |" in md and "| 30 |" in md and "HD h_min" in md
+
+
+@pytest.mark.parametrize(
+    "argv, flag, says",
+    [
+        (["solve", "--base-temperature=-100"], "--base-temperature", "[-30, 150] degC"),
+        (["solve", "--base-temperature", "nan"], "--base-temperature", "[-30, 150] degC"),
+        (["solve", "--grid", "4097"], "--grid", "17, 33, 65, 129, 257, 513"),
+        (["solve", "--grid", "x"], "--grid", "17, 33, 65, 129, 257, 513"),
+        (["solve", "--load", "1e30"], "--load", "(0, 100000] N"),
+        (["solve", "--current", "1e30"], "--current", "[0, 100] A"),
+        (["solve", "--entrainment-speed", "0"], "--entrainment-speed", "(0, 100] m/s"),
+        (["solve", "--max-iter", "0"], "--max-iter", "[1, 10000]"),
+        (["bench", "--repeats", "0"], "--repeats", "[1, 1000]"),
+    ],
+)
+def test_cli_refuses_bad_flags_naming_them_and_their_range(argv, flag, says, capsys):
+    """`bearing-twin ehl ...`: a value outside the solver's domain ends with status 2 and a line
+    naming the flag and its range, before any solve (a base temperature below Roelands' 138 K
+    was a traceback, a 4097 grid a solve of hours)."""
+    from service.tools.ehl_cli import main
+
+    with pytest.raises(SystemExit) as exc:
+        main(["ehl", *argv])
+    err = capsys.readouterr().err
+    assert exc.value.code == 2 and f"argument {flag}" in err and says in err and "Traceback" not in err
