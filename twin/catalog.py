@@ -402,9 +402,11 @@ def load_spec_file(path: str) -> BearingSpec:
     if file.suffix.lower() not in SPEC_FILE_SUFFIXES:
         raise ValueError(f"bearing: spec file {path!r} must end in {', '.join(SPEC_FILE_SUFFIXES)}")
     try:
-        text = file.read_text()
+        text = file.read_text(encoding="utf-8")
     except OSError as exc:
         raise ValueError(f"bearing: cannot read spec file {path!r}: {exc.strerror}") from None
+    except UnicodeDecodeError as exc:
+        raise ValueError(f"bearing: spec file {path!r} is not UTF-8 text (byte {exc.start})") from None
     try:
         data = json.loads(text) if file.suffix.lower() == ".json" else yaml.safe_load(text)
     except (json.JSONDecodeError, yaml.YAMLError) as exc:

@@ -76,6 +76,8 @@ def load_scenario(path: str | Path) -> Scenario:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise ScenarioError(str(path), f"cannot read: {exc.strerror or exc}") from exc
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(str(path), f"not UTF-8 text (byte {exc.start}): a scenario is a YAML file") from None
     try:
         data = yaml.load(text, Loader=ScenarioLoader)
     except yaml.YAMLError as exc:

@@ -182,12 +182,15 @@ def analyse_file(args: argparse.Namespace) -> dict:
         multiples = dict(args.line)
         bearing = args.bearing
     elif args.bearing:
+        from service.tools.messages import error_text
         from twin import catalog
 
         try:
             spec = catalog.bearing_or_file(args.bearing)
-        except (KeyError, ValueError) as exc:
+        except KeyError as exc:
             raise RecordError("--bearing", str(exc).strip("'\"")) from None
+        except ValueError as exc:  # a spec file's field (pydantic's ValidationError is one), or the file itself
+            raise RecordError("--bearing", error_text(exc)) from None
         multiples = defect_multiples_of(spec.geometry)
         bearing = spec.designation
     else:

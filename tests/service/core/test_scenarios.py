@@ -395,6 +395,18 @@ def test_yaml_integer_designation_and_errors_name_the_field_once(tmp_path):
             load_scenario(bad)
 
 
+def test_a_binary_file_is_refused_naming_the_file(tmp_path, capsys):
+    """A scenario file that is not text (here bytes that are not UTF-8) is a ScenarioError naming
+    the file, and `scenario check` ends with status 2 and one line, not a traceback."""
+    path = tmp_path / "binary.yaml"
+    path.write_bytes(b"\xbb\x00\xff" * 40)
+    with pytest.raises(ScenarioError, match="not UTF-8 text"):
+        load_scenario(path)
+    assert main(["scenario", "check", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert "binary.yaml" in err and "not UTF-8 text" in err and "Traceback" not in err
+
+
 @pytest.mark.parametrize("value", ['"3000"', "true"])
 def test_yaml_setpoint_values_are_numbers(tmp_path, value):
     path = tmp_path / "s.yaml"

@@ -58,6 +58,23 @@ def test_a_bad_spec_file_names_the_field(tmp_path, capsys):
     assert "geometry.ball_count" in err and "16" in err and "Traceback" not in err
     assert main(["thermal", "--bearing", str(tmp_path / "none.yaml"), "--speed", "300", "--radial-load", "800"]) == 2
     assert "cannot read spec file" in capsys.readouterr().err
+    binary = tmp_path / "binary.yaml"
+    binary.write_bytes(b"\x00\xde\xad\xbe\xef" * 20)
+    assert main(["simulate", "--bearing", str(binary), "--duration", "0.001"]) == 2
+    err = capsys.readouterr().err
+    assert f"spec file {str(binary)!r} is not UTF-8 text" in err and "Traceback" not in err
+
+
+def test_vibration_analyse_names_the_spec_files_field(tmp_path, capsys):
+    """`vibration analyse --bearing FILE` reports a spec file's bad field as the other commands
+    do (one line naming the field and its range), not pydantic's whole report."""
+    path = tmp_path / "bad.yaml"
+    path.write_text(yaml.safe_dump(_own_spec(ball_count=20)))
+    argv = ["vibration", "analyse", str(RECORD), "--sample-rate", "12000", "--rpm", "1797", "--bearing", str(path)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert "--bearing" in err and "geometry.ball_count" in err and "16" in err
+    assert "errors.pydantic.dev" not in err and "Traceback" not in err
 
 
 def test_vibration_analyse_takes_the_lines_from_a_spec_file(tmp_path, capsys):
