@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from pathlib import Path
 
 
 def positive_float(text: str) -> float:
@@ -66,3 +67,26 @@ def float_in(low: float, high: float, unit: str, *, low_open: bool = False):
         return value
 
     return value_in_range
+
+
+def output_file(*suffixes: str):
+    """A file the command will write, checked before it runs: its name ends in one of `suffixes`
+    and the file can be created (its folder is made when missing); a command that would fail to
+    save only after minutes of simulation is refused at once, naming the option."""
+
+    def writable(text: str) -> str:
+        path = Path(text)
+        if path.suffix.lower() not in suffixes:
+            raise argparse.ArgumentTypeError(f"must end in {' or '.join(suffixes)}, got {text}")
+        existed = path.exists()
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            with open(path, "ab"):
+                pass
+        except OSError as exc:
+            raise argparse.ArgumentTypeError(f"cannot write {text}: {exc.strerror or exc}") from None
+        if not existed:
+            path.unlink(missing_ok=True)
+        return text
+
+    return writable

@@ -14,7 +14,7 @@ import sys
 from pathlib import Path
 
 from service import __version__
-from service.tools.arg_types import float_in, positive_float
+from service.tools.arg_types import float_in, output_file, positive_float
 from service.tools.bench_results import save as save_result
 from service.tools.messages import OPERATING_FLAGS, error_text
 from service.tools.scenario_cli import add_scenario_command
@@ -380,10 +380,14 @@ def build_parser() -> argparse.ArgumentParser:
     vib.add_argument(
         "--waveform",
         metavar="FILE.npy",
+        type=output_file(".npy"),
         help="write the analysed accelerometer signal [m/s2] at the sample rate (float64 .npy)",
     )
     vib.add_argument(
-        "--plot", metavar="FILE.png", help="waveform, spectrum and envelope spectrum with the defect frequencies marked"
+        "--plot",
+        metavar="FILE.png",
+        type=output_file(".png", ".pdf", ".svg", ".jpg", ".jpeg", ".webp"),
+        help="waveform, spectrum and envelope spectrum with the defect frequencies marked (.png, .pdf, .svg, ...)",
     )
     vib.set_defaults(func=_cmd_vibration)
     add_analyse_command(vib)

@@ -7,6 +7,7 @@ import argparse
 import sys
 from typing import TYPE_CHECKING, Any
 
+from service.tools.arg_types import output_file
 from service.tools.messages import error_text
 
 if TYPE_CHECKING:
@@ -19,8 +20,13 @@ def add_scenario_command(sub: Any) -> None:
     scenario_sub = scenario.add_subparsers(dest="scenario_command", required=True)
     run = scenario_sub.add_parser("run", help="run a scenario file in fast mode (fresh twin per run)")
     run.add_argument("file", help="scenario YAML file (see scenarios/ and service/core/scenarios.py)")
-    run.add_argument("--record", metavar="OUT.rrd", help="write a rerun recording")
-    run.add_argument("--table", metavar="OUT.parquet", help="write the per-sample table (Parquet; .csv for CSV)")
+    run.add_argument("--record", metavar="OUT.rrd", type=output_file(".rrd"), help="write a rerun recording")
+    run.add_argument(
+        "--table",
+        metavar="OUT.parquet",
+        type=output_file(".parquet", ".pq", ".csv"),
+        help="write the per-sample table (Parquet; .csv for CSV)",
+    )
     run.add_argument("--no-progress", action="store_true", help="no progress bar")
     run.set_defaults(func=_cmd_scenario_run)
     check = scenario_sub.add_parser("check", help="validate scenario files and print what they do")
@@ -76,10 +82,6 @@ def _cmd_scenario_run(args: argparse.Namespace) -> int:
     except ValueError as exc:  # pydantic's ValidationError is a ValueError
         print(f"error: BEARING_TWIN_ALARMS: {error_text(exc)[:300]}", file=sys.stderr)
         return 2
-    for path, suffixes in ((args.record, (".rrd",)), (args.table, (".parquet", ".pq", ".csv"))):
-        if path is not None and not path.lower().endswith(suffixes):
-            print(f"error: {path}: expected a file ending in {' or '.join(suffixes)}", file=sys.stderr)
-            return 2
     total = scenario.total_duration_s
     runs = scenario.resolved_runs()
     print(f"{scenario.name}: {len(runs)} run(s), {total:g} s of simulated time, fast mode", file=sys.stderr)

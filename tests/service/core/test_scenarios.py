@@ -328,7 +328,9 @@ def test_scenario_run_refuses_bad_input(tmp_path, capsys):
     assert main(["scenario", "run", str(path), "--no-progress"]) == 2
     err = capsys.readouterr().err
     assert "shaft_speed_rad_s" in err and "allowed range" in err
-    assert main(["scenario", "run", str(path), "--table", "x.txt", "--no-progress"]) == 2
+    with pytest.raises(SystemExit) as exc:  # refused by the option's type, before the run
+        main(["scenario", "run", str(path), "--table", "x.txt", "--no-progress"])
+    assert exc.value.code == 2 and "argument --table: must end in .parquet or .pq or .csv" in capsys.readouterr().err
     assert main(["scenario", "check", str(SCENARIOS / "ev_motor_current_ramp.yaml")]) == 0
 
 

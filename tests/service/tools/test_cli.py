@@ -254,3 +254,29 @@ def test_scenario_run_names_the_recording_it_wrote(tmp_path):
     written = tmp_path / "x.run2.rrd"
     assert f"recording: {written}" in res.stdout, res.stdout
     assert written.stat().st_size > 0 and taken.read_bytes() == b"an earlier run"
+
+
+def test_an_output_file_that_cannot_be_written_is_refused_before_the_run(tmp_path):
+    """`vibration --waveform/--plot` and `scenario run --record/--table` check the file they will
+    write before simulating (its suffix, and that it can be created: /proc takes no new file), and
+    name the option; the run, which would otherwise end in a traceback after it, never starts."""
+    from service.tools.arg_types import output_file
+
+    scenario = os.path.join(
+        os.path.dirname(__file__), "..", "..", "..", "scenarios", "seed000_startup_steady_slowdown.yaml"
+    )
+    cases = [
+        (["vibration", "--waveform", "/proc/nope.npy"], "--waveform", "cannot write /proc/nope.npy"),
+        (["vibration", "--waveform", str(tmp_path / "w.txt")], "--waveform", "must end in .npy"),
+        (["vibration", "--plot", str(tmp_path / "p.txt")], "--plot", "must end in .png or .pdf"),
+        (["vibration", "--plot", "/proc/x.png"], "--plot", "cannot write /proc/x.png"),
+        (["scenario", "run", scenario, "--table", "/proc/nope/x.parquet"], "--table", "cannot write"),
+        (["scenario", "run", scenario, "--record", "/proc/nope/x.rrd"], "--record", "cannot write"),
+    ]
+    for argv, flag, says in cases:
+        res = _run(*argv, timeout=120)
+        assert res.returncode == 2, (argv, res.stderr)
+        assert f"argument {flag}: {says}" in res.stderr and "Traceback" not in res.stderr, res.stderr
+    assert not (tmp_path / "w.txt").exists() and not (tmp_path / "p.txt").exists()
+    ok = tmp_path / "new" / "w.npy"  # a missing folder is made; the file is not left behind
+    assert output_file(".npy")(str(ok)) == str(ok) and ok.parent.is_dir() and not ok.exists()
