@@ -30,6 +30,7 @@ import yaml
 from twin.spec import BearingKind, BearingSpec, Geometry, Lubricant, Mounting
 from twin.vibration.housing import Accelerometer, Housing
 from twin.vibration.surface import SurfaceProfile
+from twin.yaml_numbers import load_yaml
 
 # designation: (bore mm, outside diameter mm, ball count, ball diameter mm)
 _DEEP_GROOVE_MM = {
@@ -408,7 +409,7 @@ def load_spec_file(path: str) -> BearingSpec:
     except UnicodeDecodeError as exc:
         raise ValueError(f"bearing: spec file {path!r} is not UTF-8 text (byte {exc.start})") from None
     try:
-        data = json.loads(text) if file.suffix.lower() == ".json" else yaml.safe_load(text)
+        data = json.loads(text) if file.suffix.lower() == ".json" else load_yaml(text)
     except (json.JSONDecodeError, yaml.YAMLError) as exc:
         raise ValueError(
             f"bearing: spec file {path!r} is not valid {file.suffix[1:].upper()}: {str(exc).splitlines()[0]}"

@@ -19,7 +19,7 @@ from twin.vibration.surface import SurfaceProfile
 # the range of an explicit ModelOptions.time_step_s [s] (twin.timestep.TIME_STEP_RANGE_S)
 TIME_STEP_RANGE_S = (1e-8, 2e-5)
 
-_FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+_FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
 TWIN_ID_PATTERN = r"^[A-Za-z0-9][A-Za-z0-9_.-]{0,63}$"
 TwinId = Annotated[

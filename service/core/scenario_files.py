@@ -16,6 +16,7 @@ from pydantic import ValidationError
 from service.core.errors import loc_text
 from service.core.scenarios import DESIGNATION_TAG, SPEC_TAG, Scenario, ScenarioError
 from twin import catalog
+from twin.yaml_numbers import Yaml12NumbersLoader
 
 
 # ---- loading ----------------------------------------------------------------------------------
@@ -50,23 +51,7 @@ def locate_error(error: Mapping[str, Any]) -> tuple[str, str]:
     return where, msg
 
 
-class ScenarioLoader(yaml.SafeLoader):
-    """YAML 1.2's numbers: `5e-4` is a float (YAML 1.1, PyYAML's default, reads it as a string,
-    which the strict scenario models refuse)."""
-
-
-ScenarioLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(
-        r"""^(?:[-+]?(?:[0-9][0-9_]*)\.[0-9_]*(?:[eE][-+]?[0-9]+)?
-                |[-+]?(?:[0-9][0-9_]*)(?:[eE][-+]?[0-9]+)
-                |\.[0-9_]+(?:[eE][-+]?[0-9]+)?
-                |[-+]?\.(?:inf|Inf|INF)
-                |\.(?:nan|NaN|NAN))$""",
-        re.X,
-    ),
-    list("-+0123456789."),
-)
+ScenarioLoader = Yaml12NumbersLoader  # YAML 1.2's numbers (twin.yaml_numbers): `5e-4` is a float
 
 
 def load_scenario(path: str | Path) -> Scenario:

@@ -38,7 +38,7 @@ import math
 import numpy as np
 from pydantic import BaseModel, ConfigDict, Field
 
-_FROZEN = ConfigDict(frozen=True, extra="forbid", allow_inf_nan=False)
+_FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
 PROFILE_POINTS = 4096  # points of a race profile over its circumference (the kernel's table length)
 

@@ -91,6 +91,25 @@ def test_an_invalid_spec_is_refused_naming_the_field_and_range(client, own_spec)
 
 
 @pytest.mark.parametrize(
+    "part, name, value",
+    [
+        ("mounting", "rotor_mass_kg", True),  # a JSON true is not 1 kg
+        ("mounting", "rotor_mass_kg", "2.0"),  # nor is text a number
+        ("mounting", "diametral_clearance_m", "1e-5"),
+        ("geometry", "ball_count", "8"),
+        ("geometry", "ball_count", True),
+    ],
+)
+def test_a_spec_takes_numbers_only_as_json_numbers(client, own_spec, part, name, value):
+    """The spec models are strict (twin.spec): a JSON string or true/false where a number goes is
+    refused naming the field, never converted."""
+    bad = copy.deepcopy(own_spec)
+    bad[part][name] = value
+    err = only_error(client.post("/v1/bearings", json={"spec": bad}))
+    assert err["field"] == f"spec.{part}.{name}", err
+
+
+@pytest.mark.parametrize(
     "extra, field, inside",
     [
         ({"designation": "6208"}, "designation", "not both"),

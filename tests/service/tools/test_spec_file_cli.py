@@ -65,6 +65,24 @@ def test_a_bad_spec_file_names_the_field(tmp_path, capsys):
     assert f"spec file {str(binary)!r} is not UTF-8 text" in err and "Traceback" not in err
 
 
+def test_a_spec_file_takes_numbers_as_yaml_writes_them_and_nothing_else(tmp_path, capsys):
+    """In a YAML spec file `1e-5` is a number (YAML 1.2, twin.yaml_numbers; PyYAML's YAML 1.1 reads
+    it as text), while `true` or a quoted "2.0" where a number goes is refused naming the field."""
+    spec = _own_spec()
+    text = yaml.safe_dump(spec).replace(
+        f"diametral_clearance_m: {spec['mounting']['diametral_clearance_m']}", "diametral_clearance_m: 1e-5"
+    )
+    assert "diametral_clearance_m: 1e-5" in text
+    path = tmp_path / "own.yaml"
+    path.write_text(text)
+    assert catalog.load_spec_file(str(path)).mounting.diametral_clearance_m == 1e-5
+    for value in ("true", '"2.0"'):
+        path.write_text(text.replace(f"rotor_mass_kg: {spec['mounting']['rotor_mass_kg']}", f"rotor_mass_kg: {value}"))
+        assert main(["simulate", "--bearing", str(path), "--duration", "0.001"]) == 2
+        err = capsys.readouterr().err
+        assert "--bearing: mounting.rotor_mass_kg" in err and "Traceback" not in err, err
+
+
 def test_vibration_analyse_names_the_spec_files_field(tmp_path, capsys):
     """`vibration analyse --bearing FILE` reports a spec file's bad field as the other commands
     do (one line naming the field and its range), not pydantic's whole report."""
