@@ -40,7 +40,10 @@ async def _input_error(request: Request, exc: InputError):
 
 
 async def _request_validation(request: Request, exc: RequestValidationError):
-    return error_response(422, field_errors(list(exc.errors()), _limits_of(request), request_bounds()))
+    setpoint_body = request.url.path.rstrip("/").endswith("/setpoint")  # PUT /v1/bearings/{id}/setpoint
+    return error_response(
+        422, field_errors(list(exc.errors()), _limits_of(request), request_bounds(), setpoint_body=setpoint_body)
+    )
 
 
 async def _validation(request: Request, exc: ValidationError):

@@ -200,12 +200,15 @@ def field_errors(
     bounds: Mapping[str, tuple[Any, Any]] | None = None,
     model: type[BaseModel] | None = None,
     prefix: str = "",
+    setpoint_body: bool = True,
 ) -> list[FieldError]:
     """pydantic error dicts -> FieldErrors naming the field and its allowed range: for setpoint
     fields the bearing's (`limits`) or else the vocabulary's static bounds, for other fields
     both sides of the declared range (`bounds` by field name, or what `model`, the validated
     model, declares at the error's path; pydantic names only the side crossed). `prefix`: put
-    before each field's path (the input nested in a request, as `setpoint_field_errors`)."""
+    before each field's path (the input nested in a request, as `setpoint_field_errors`).
+    `setpoint_body`: the validated body is a setpoint, so an unknown top-level field is answered
+    with the setpoint's fields as the allowed names (False for other bodies of a twin's routes)."""
     out = []
     for e in errors:
         loc = tuple(e.get("loc", ()))
@@ -246,7 +249,7 @@ def field_errors(
                 allowed = [float(stated.group(1)), float(stated.group(2))]
         if e.get("type") == "extra_forbidden" and leaf is not None:
             msg = f"unknown field {leaf!r}"
-            if limits is not None and len(loc) <= 2:
+            if limits is not None and setpoint_body and len(loc) <= 2:
                 allowed = sorted(limits.ranges)
         if e.get("type") == "json_invalid":
             field = None

@@ -185,3 +185,26 @@ def test_every_spec_field_in_the_openapi_carries_its_unit(client):
         if "[" not in p.get("description", "")
     ]
     assert not missing, f"fields without a [unit] in their description: {missing}"
+
+
+def test_an_unknown_field_lists_the_setpoint_fields_only_for_a_setpoint(client):
+    """An unknown field in a twin's setpoint body is answered with the setpoint's fields as the
+    allowed names; in its other bodies (defects, measured temperature, scenario, recording) with
+    none of them (they were offered the setpoint's fields, the wrong list)."""
+    r = client.post("/v1/bearings", json={"id": "fields-1", "designation": "6208"})
+    assert r.status_code == 201, r.text
+    try:
+        err = only_error(client.put("/v1/bearings/fields-1/setpoint", json={"radial_load": 1.0}))
+        assert err["field"] == "radial_load" and "radial_load_n" in err["allowed"]
+        for method, path, body in (
+            ("PUT", "defects", {"defects": [], "x": 1}),
+            ("PUT", "temperature", {"node": "outer_ring", "temperature_c": 50.0, "x": 1}),
+            ("POST", "recording", {"x": 1}),
+        ):
+            r = client.request(method, f"/v1/bearings/fields-1/{path}", json=body)
+            assert r.status_code == 422, (path, r.text)
+            (err,) = [e for e in r.json()["detail"] if e["field"] == "x"]
+            assert "unknown field" in err["message"], (path, err)
+            assert err["allowed"] is None or "radial_load_n" not in err["allowed"], (path, err)
+    finally:
+        assert client.delete("/v1/bearings/fields-1").status_code == 200
