@@ -36,7 +36,7 @@ from starlette.concurrency import run_in_threadpool
 from service import __version__
 from service.api.deps import require_token
 from service.api.errors import install_error_handlers
-from service.api.middleware import BodySizeLimit, ReadRateLimit, Tarpit, TarpitStats, TokenGate
+from service.api.middleware import BodySizeLimit, NoSniff, ReadRateLimit, Tarpit, TarpitStats, TokenGate
 from service.api.routers import (
     alarms,
     bearings,
@@ -122,7 +122,8 @@ def create_app(settings: ServiceSettings | None = None, *, service: TwinRegistry
         delay_s=settings.security.tarpit_delay_s,
         max_held=settings.security.tarpit_max_held,
         stats=app.state.tarpit,
-    )  # outermost: sees every refusal
+    )  # sees every refusal
+    app.add_middleware(NoSniff)  # outermost: marks every answer, the tarpit's too
     install_error_handlers(app)
 
     token = [Depends(require_token)] if gate.requires_token else []

@@ -208,3 +208,13 @@ def test_an_unknown_field_lists_the_setpoint_fields_only_for_a_setpoint(client):
             assert err["allowed"] is None or "radial_load_n" not in err["allowed"], (path, err)
     finally:
         assert client.delete("/v1/bearings/fields-1").status_code == 200
+
+
+def test_every_answer_says_nosniff(client):
+    """An error that quotes the request (here an unknown twin id that looks like HTML) is JSON, and
+    every answer, a success or a refusal, carries `X-Content-Type-Options: nosniff`
+    (service.api.middleware.NoSniff) so that a browser never renders it as HTML."""
+    r = client.get("/v1/bearings/%3Cimg%20src%3Dx%3E")
+    assert r.status_code in (404, 422) and r.headers["content-type"].startswith("application/json")
+    assert r.headers["x-content-type-options"] == "nosniff"
+    assert client.get("/health").headers["x-content-type-options"] == "nosniff"
