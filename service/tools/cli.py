@@ -34,6 +34,7 @@ VIBRATION_FLAGS = {
     "sample_rate_hz": "--sample-rate",
 }
 
+DEFECT_DEFAULTS = {"defect_size": 0.5e-3, "defect_depth": 50e-6, "defect_angle": 0.0}  # `vibration` [m, m, deg]
 SIMULATE_MAX_S = 3600.0  # `simulate --duration` at most [s of simulated time]
 VIBRATION_MAX_S = 600.0  # `vibration --duration` at most [s]: 600 s at 51.2 kHz is 250 MB of samples
 
@@ -172,6 +173,18 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
     if args.speed is None:
         print("error: vibration: --speed required (or `vibration analyse FILE`)", file=sys.stderr)
         return 2
+    given = [
+        name
+        for name in ("defect_size", "defect_length", "defect_depth", "defect_angle")
+        if getattr(args, name) is not None
+    ]
+    if args.defect is None and given:
+        flag = "--" + given[0].replace("_", "-")
+        print(f"error: {flag}: describes a defect; give --defect outer, inner or ball with it", file=sys.stderr)
+        return 2
+    for name, value in DEFECT_DEFAULTS.items():
+        if getattr(args, name) is None:
+            setattr(args, name, value)
     try:
         result, samples = simulate_vibration(
             catalog.bearing_or_file(args.bearing),
@@ -334,8 +347,8 @@ def build_parser() -> argparse.ArgumentParser:
     vib.add_argument(
         "--defect-size",
         type=float,
-        default=0.5e-3,
-        help="defect width along the rolling direction, width_m [m] (default 0.5e-3)",
+        default=None,
+        help=f"defect width along the rolling direction, width_m [m] (default {DEFECT_DEFAULTS['defect_size']:g})",
     )
     vib.add_argument(
         "--defect-length",
@@ -343,11 +356,16 @@ def build_parser() -> argparse.ArgumentParser:
         default=None,
         help="defect length across the rolling direction, length_m [m] (default 0.6 x ball radius)",
     )
-    vib.add_argument("--defect-depth", type=float, default=50e-6, help="defect depth, depth_m [m] (default 50e-6)")
+    vib.add_argument(
+        "--defect-depth",
+        type=float,
+        default=None,
+        help=f"defect depth, depth_m [m] (default {DEFECT_DEFAULTS['defect_depth']:g})",
+    )
     vib.add_argument(
         "--defect-angle",
         type=float,
-        default=0.0,
+        default=None,
         help="defect position [deg]: outer race from the centre of the load zone (CWRU 6:00, 3:00, "
         "12:00 = 0, 90, 180), inner race from the ring's mark (default 0)",
     )

@@ -24,6 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
+from service.tools.arg_types import positive_float
 from service.tools.stdout import print_document
 
 STANDARD_GRAVITY_M_S2 = 9.80665
@@ -295,7 +296,10 @@ def add_analyse_command(vibration_parser: argparse.ArgumentParser) -> None:
         help="variable of a .mat record (default: the one *_DE_time, the CWRU drive end's, or the only vector)",
     )
     an.add_argument(
-        "--full-scale", type=float, default=1.0, help="value, in --units, of an integer .wav's full scale (default 1)"
+        "--full-scale",
+        type=positive_float,
+        default=1.0,
+        help="value, in --units, of an integer .wav's full scale, > 0 (default 1)",
     )
     an.add_argument("--spectrum", action="store_true", help="include the envelope spectrum in the JSON")
     an.add_argument("--json", action="store_true", help="print the result as JSON")

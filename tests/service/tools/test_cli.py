@@ -280,3 +280,12 @@ def test_an_output_file_that_cannot_be_written_is_refused_before_the_run(tmp_pat
     assert not (tmp_path / "w.txt").exists() and not (tmp_path / "p.txt").exists()
     ok = tmp_path / "new" / "w.npy"  # a missing folder is made; the file is not left behind
     assert output_file(".npy")(str(ok)) == str(ok) and ok.parent.is_dir() and not ok.exists()
+
+
+def test_defect_flags_without_a_defect_are_refused():
+    """`vibration --defect-size ...` without `--defect`: the defect's description would be dropped
+    without a word and a healthy bearing simulated; it is refused naming the flag."""
+    res = _run("vibration", "--speed", "500", "--radial-load", "3000", "--defect-angle", "90", timeout=120)
+    assert res.returncode == 2 and "--defect-angle: describes a defect; give --defect" in res.stderr
+    res = _run("vibration", "analyse", "x.wav", "--full-scale", "0", "--rpm", "1797", "--sample-rate", "12000")
+    assert res.returncode == 2 and "argument --full-scale: must be a finite number > 0" in res.stderr
