@@ -45,6 +45,9 @@ class SteadyState:
     time_constants_s: tuple[float, ...]  # the network's, real heat capacities, slowest first [s]
 
 
+RUNAWAY_C = 400.0  # the network's node range ends here (Twin.hold_thermal_state): beyond it, no steady state
+
+
 def steady_state(
     twin: Twin,
     *,
@@ -71,6 +74,13 @@ def steady_state(
         target = steady_state_c(th.network, th.filter.dissipation_factor, ambient, ambient, th.heat.node_heat_w())
         before = th.inlet_temperature_c
         temps = temps + relaxation * (target - temps)
+        if not (np.all(np.isfinite(temps)) and temps.max() <= RUNAWAY_C):
+            hottest = NODE_NAMES[int(np.nanargmax(np.where(np.isfinite(temps), temps, np.inf)))]
+            raise ValueError(
+                f"no thermal steady state at this operating point: the friction heat "
+                f"({th.heat.total_w:.0f} W) drives the {hottest} past {RUNAWAY_C:g} degC, a thermal runaway "
+                "(lower the speed or the load, or cool the bearing: jet or circulating oil)"
+            )
         twin.hold_thermal_state(temps)
         if abs(th.inlet_temperature_c - before) < tolerance_k and np.max(np.abs(target - temps)) < 2 * tolerance_k:
             converged = True
