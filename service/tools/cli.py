@@ -32,6 +32,7 @@ VIBRATION_FLAGS = {
     "defect_angle_deg": "--defect-angle",
     "noise_density_m_s2_rthz": "--noise-density",
     "sample_rate_hz": "--sample-rate",
+    "duration_s": "--duration",
 }
 
 DEFECT_DEFAULTS = {"defect_size": 0.5e-3, "defect_depth": 50e-6, "defect_angle": 0.0}  # `vibration` [m, m, deg]

@@ -51,6 +51,9 @@ def defect_for(
     return out
 
 
+MIN_ANALYSED_SAMPLES = 1024  # the shortest window twin.vibration.run analyses
+
+
 def simulate_vibration(
     bearing="6208",
     shaft_speed_rad_s: float = 500.0,
@@ -108,6 +111,12 @@ def simulate_vibration(
     if diametral_clearance_m is not None:
         data["mounting"]["diametral_clearance_m"] = diametral_clearance_m
     spec = BearingSpec.model_validate(data)
+    rate = spec.housing.accelerometer.sample_rate_hz
+    if duration_s * rate < MIN_ANALYSED_SAMPLES:
+        raise ValueError(
+            f"duration_s = {duration_s:g} s: {duration_s * rate:.0f} samples at {rate:g} Hz; the analysis needs "
+            f"at least {MIN_ANALYSED_SAMPLES}, a duration of at least {MIN_ANALYSED_SAMPLES / rate:.4g} s"
+        )
     twin = Twin(
         spec,
         setpoint=Setpoint(shaft_speed_rad_s=shaft_speed_rad_s, radial_load_n=radial_load_n, axial_load_n=axial_load_n),

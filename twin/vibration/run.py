@@ -65,7 +65,7 @@ def run_vibration(
     count = max(1, x.size // n_win)
     n_win = min(n_win, x.size)
     if n_win < 1024:
-        raise ValueError(f"{n_win} samples per window: need at least 1024 (1/50 s at 51.2 kHz)")
+        raise ValueError(f"{n_win} samples per window at {fs:g} Hz: need at least 1024 ({1024 / fs:.4g} s)")
     top = max(freq.bpfi_hz, freq.two_bsf_hz)
     min_bw = 2.0 * 4.0 * top  # room for 3 harmonics and their sidebands in the envelope
     if isinstance(band, str) and band == "resonance":

@@ -289,3 +289,12 @@ def test_defect_flags_without_a_defect_are_refused():
     assert res.returncode == 2 and "--defect-angle: describes a defect; give --defect" in res.stderr
     res = _run("vibration", "analyse", "x.wav", "--full-scale", "0", "--rpm", "1797", "--sample-rate", "12000")
     assert res.returncode == 2 and "argument --full-scale: must be a finite number > 0" in res.stderr
+
+
+def test_a_vibration_run_too_short_to_analyse_names_the_duration_it_needs():
+    """The analysis takes windows of at least 1024 samples: at the CWRU-DE's 12 kHz a 0.05 s run
+    has 600; the command says so before simulating, with the least duration at that rate."""
+    res = _run("vibration", "--bearing", "CWRU-DE", "--speed", "188", "--duration", "0.05", timeout=120)
+    assert res.returncode == 2 and "Traceback" not in res.stderr
+    assert "--duration: duration_s = 0.05 s: 600 samples at 12000 Hz" in res.stderr
+    assert "at least 0.08533 s" in res.stderr
