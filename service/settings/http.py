@@ -3,6 +3,7 @@ settings groups of `bearing-twin serve` (docs/operations.md)."""
 
 from __future__ import annotations
 
+import socket
 from typing import Any
 
 from pydantic import BaseModel, ConfigDict, Field, SecretStr, field_validator
@@ -63,6 +64,17 @@ class HttpSettings(BaseModel):
         ),
         description="Open HTTP connections (or running requests) beyond which a new request gets 503 [count].",
     )
+
+    @field_validator("host")
+    @classmethod
+    def _bindable_host(cls, value: str) -> str:
+        """An address the server can bind: an IP address or a name that resolves (checked here, so
+        a typo is refused naming the setting, not reported by the server after the start)."""
+        try:
+            socket.getaddrinfo(value, None, type=socket.SOCK_STREAM)
+        except (OSError, UnicodeError):
+            raise ValueError(f"{value!r} is not an IP address nor a host name that resolves") from None
+        return value
 
 
 class SecuritySettings(BaseModel):

@@ -389,3 +389,14 @@ def test_a_check_across_fields_of_a_group_is_one_line_naming_its_setting(clean_e
         "error: zenoh_password: zenoh credentials are a user and a password "
         "together (BEARING_TWIN_ZENOH_USER, BEARING_TWIN_ZENOH_PASSWORD)\n"
     )
+
+
+def test_an_http_host_that_cannot_be_bound_is_refused_naming_it(clean_env):
+    """`--host 999.1.1.1` (a typo) is refused when the settings are read, naming the setting, its
+    environment name and its flag, rather than by the server after the twins started; an IP
+    address, a wildcard or a name that resolves is taken."""
+    with pytest.raises(ValidationError) as info:
+        ServiceSettings(http={"host": "999.1.1.1"})
+    assert "is not an IP address nor a host name that resolves" in str(info.value)
+    for host in ("127.0.0.1", "0.0.0.0", "localhost"):
+        assert ServiceSettings(http={"host": host}).http.host == host
