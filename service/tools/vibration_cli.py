@@ -20,6 +20,7 @@ import argparse
 import json
 import math
 import sys
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -121,10 +122,12 @@ def read_record(
             variables = _load_mat(path)
             data, rpm = _mat_channel(variables, path.name, variable), _mat_rpm(variables)
         elif suffix == ".csv":
-            try:
-                data = np.loadtxt(path, delimiter=",", comments="#", ndmin=1)
-            except ValueError:
-                data = np.loadtxt(path, delimiter=",", comments="#", ndmin=1, skiprows=1)
+            with warnings.catch_warnings():  # an empty file: refused below by its sample count, in one line
+                warnings.simplefilter("ignore", UserWarning)
+                try:
+                    data = np.loadtxt(path, delimiter=",", comments="#", ndmin=1)
+                except ValueError:
+                    data = np.loadtxt(path, delimiter=",", comments="#", ndmin=1, skiprows=1)
         else:
             import scipy.io.wavfile
 

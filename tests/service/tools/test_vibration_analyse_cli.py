@@ -105,6 +105,15 @@ def test_nan_in_the_record_is_refused(tmp_path, capsys):
     assert code == 2 and "FILE: 1 non-finite samples (first at index 100)" in err
 
 
+def test_an_empty_csv_is_refused_in_one_line(tmp_path, capsys, recwarn):
+    """An empty .csv is refused by its sample count, one line, without numpy's warning on stderr."""
+    empty = tmp_path / "empty.csv"
+    empty.write_text("")
+    code, _, err = _run(capsys, empty, "--sample-rate", 12000, "--rpm", 1797, "--bearing", "6205")
+    assert code == 2 and err.strip() == "error: FILE: 0 samples; at least 1024 needed"
+    assert not [w for w in recwarn if "no data" in str(w.message)]
+
+
 def test_a_cwru_mat_file_is_read_as_the_data_center_publishes_it(tmp_path, capsys):
     """The data center's .mat files (MATLAB 5) hold the drive end, the fan end and the base as
     column vectors `X105_DE_time`, `X105_FE_time`, `X105_BA_time` and the speed `X105RPM`: the drive
