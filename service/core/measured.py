@@ -240,6 +240,13 @@ class MeasuredComparator:
                     "the twin's shaft stands still: give the window's shaft_hz",
                     [0.0, window.sample_rate_hz / 20.0],
                 )
+            if shaft_hz > window.sample_rate_hz / 20.0:  # the window's rate, not a shaft_hz it did not give
+                raise InputError.one(
+                    "sample_rate_hz",
+                    f"{window.sample_rate_hz:g} Hz is too low for the twin's shaft at {shaft_hz:.4g} Hz: at least "
+                    f"{20.0 * shaft_hz:.4g} Hz (20 x the shaft), or give the window's own shaft_hz",
+                    [20.0 * shaft_hz, MAX_RATE_HZ],
+                )
         try:
             analysis = analyse_signal(window.samples_m_s2, window.sample_rate_hz, shaft_hz, self.multiples)
         except AnalysisInputError as exc:

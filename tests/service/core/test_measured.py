@@ -109,6 +109,17 @@ def test_kurtosis_well_above_the_twins_raises_its_alarm():
     assert [a["code"] for a in out["alarms"]] == ["kurtosis_above_twin"]
 
 
+def test_a_rate_too_low_for_the_twins_shaft_names_the_rate():
+    """A window sampled at 500 Hz beside a twin turning at 1797 rpm (30 Hz, more than fs / 20): the
+    refusal names `sample_rate_hz` and the least rate, not a `shaft_hz` the window did not give."""
+    comparator = MeasuredComparator("b", catalog.bearing("CWRU-DE").geometry)
+    window = window_from_json({"sample_rate_hz": 500.0, "samples": [0.0] * 2000})
+    with pytest.raises(InputError) as err:
+        comparator.compare(window, _snapshot(), ())
+    e = err.value.errors[0]
+    assert e.field == "sample_rate_hz" and "at least 599 Hz" in e.message, e
+
+
 def test_standing_twin_needs_a_shaft_frequency():
     c = MeasuredComparator("t", catalog.bearing("6205").geometry)
     w = window_from_float32(WINDOW_G.astype("<f4").tobytes(), 12000.0, "g")
