@@ -35,7 +35,12 @@ VIBRATION_FLAGS = {
     "duration_s": "--duration",
 }
 
-DEFECT_DEFAULTS = {"defect_size": 0.5e-3, "defect_depth": 50e-6, "defect_angle": 0.0}  # `vibration` [m, m, deg]
+DEFECT_FLAGS = {  # `vibration`'s defect options -> simulate_vibration's keywords (its defaults apply when not given)
+    "defect_size": "defect_size_m",
+    "defect_length": "defect_length_m",
+    "defect_depth": "defect_depth_m",
+    "defect_angle": "defect_angle_deg",
+}
 SIMULATE_MAX_S = 3600.0  # `simulate --duration` at most [s of simulated time]
 VIBRATION_MAX_S = 600.0  # `vibration --duration` at most [s]: 600 s at 51.2 kHz is 250 MB of samples
 
@@ -174,18 +179,14 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
     if args.speed is None:
         print("error: vibration: --speed required (or `vibration analyse FILE`)", file=sys.stderr)
         return 2
-    given = [
-        name
-        for name in ("defect_size", "defect_length", "defect_depth", "defect_angle")
-        if getattr(args, name) is not None
-    ]
+    given = {keyword: getattr(args, flag) for flag, keyword in DEFECT_FLAGS.items() if getattr(args, flag) is not None}
     if args.defect is None and given:
-        flag = "--" + given[0].replace("_", "-")
-        print(f"error: {flag}: describes a defect; give --defect outer, inner or ball with it", file=sys.stderr)
+        flag = next(f for f, k in DEFECT_FLAGS.items() if k in given)
+        print(
+            f"error: --{flag.replace('_', '-')}: describes a defect; give --defect outer, inner or ball with it",
+            file=sys.stderr,
+        )
         return 2
-    for name, value in DEFECT_DEFAULTS.items():
-        if getattr(args, name) is None:
-            setattr(args, name, value)
     try:
         result, samples = simulate_vibration(
             catalog.bearing_or_file(args.bearing),
@@ -193,10 +194,7 @@ def _cmd_vibration(args: argparse.Namespace) -> int:
             args.radial_load,
             args.axial_load,
             defect=args.defect,
-            defect_size_m=args.defect_size,
-            defect_length_m=args.defect_length,
-            defect_depth_m=args.defect_depth,
-            defect_angle_deg=args.defect_angle,
+            **given,
             duration_s=args.duration,
             noise_density_m_s2_rthz=args.noise_density,
             sample_rate_hz=args.sample_rate,
@@ -349,7 +347,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--defect-size",
         type=float,
         default=None,
-        help=f"defect width along the rolling direction, width_m [m] (default {DEFECT_DEFAULTS['defect_size']:g})",
+        help="defect width along the rolling direction, width_m [m] (default 0.5e-3)",
     )
     vib.add_argument(
         "--defect-length",
@@ -361,7 +359,7 @@ def build_parser() -> argparse.ArgumentParser:
         "--defect-depth",
         type=float,
         default=None,
-        help=f"defect depth, depth_m [m] (default {DEFECT_DEFAULTS['defect_depth']:g})",
+        help="defect depth, depth_m [m] (default 50e-6)",
     )
     vib.add_argument(
         "--defect-angle",
