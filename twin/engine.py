@@ -40,7 +40,7 @@ from twin.snapshot_blocks import ball_arrays, electrical_state, finite_or_none
 from twin.snapshot_frame import SnapshotFrame
 from twin.spec import BearingSpec, ModelOptions
 from twin.state import MAX_DEFECTS, TwinState, make_state
-from twin.thermal.coupling import ThermalCoupling
+from twin.thermal.coupling import TEMPERATURE_RANGE_C, ThermalCoupling
 from twin.thermal.expansion import write_groove_lanes
 from twin.thermal.sources import friction_heat
 from twin.timestep import STEP_DIVISOR_S
@@ -192,8 +192,11 @@ class Twin:
         if th is None:
             raise ValueError("thermal: node temperatures need ModelOptions.thermal = 'network'")
         t = np.asarray(temperature_c, dtype=float)
-        if t.shape != th.temperature_c.shape or not np.all(np.isfinite(t)) or t.min() < -60.0 or t.max() > 400.0:
-            raise ValueError(f"temperature_c: {th.temperature_c.size} finite node temperatures in [-60, 400] degC")
+        low, high = TEMPERATURE_RANGE_C
+        if t.shape != th.temperature_c.shape or not np.all(np.isfinite(t)) or t.min() < low or t.max() > high:
+            raise ValueError(
+                f"temperature_c: {th.temperature_c.size} finite node temperatures in [{low:g}, {high:g}] degC"
+            )
         th.filter.x[: t.size] = t
         write_groove_lanes(self.state.contacts, self._groove_lanes, th.expansion, self.model.ball_count)
         self._refresh_oil_viscosity()

@@ -49,6 +49,9 @@ from twin.thermal.settings import ThermalNetworkSettings
 from twin.thermal.sources import HeatSources
 
 MEASURABLE_NODES = ("outer_ring", "housing", "oil")
+TEMPERATURE_RANGE_C = (-60.0, 400.0)
+"""The temperatures the network takes, measured or held [degC]: the range of an industrial RTD or
+thermocouple on a bearing, wide of any oil's; beyond it a node has run away."""
 RATE_WINDOW_S = 60.0  # the outer ring's rate of rise is taken over this much network time [s]
 
 
@@ -113,8 +116,9 @@ class ThermalCoupling:
         next network step. Raises ValueError naming the field and its range."""
         if node not in MEASURABLE_NODES:
             raise ValueError(f"node: {node!r} cannot be measured; one of {', '.join(MEASURABLE_NODES)}")
-        if not (math.isfinite(temperature_c) and -60.0 <= temperature_c <= 400.0):
-            raise ValueError(f"temperature_c = {temperature_c!r}: must be finite, in [-60, 400] degC")
+        low, high = TEMPERATURE_RANGE_C
+        if not (math.isfinite(temperature_c) and low <= temperature_c <= high):
+            raise ValueError(f"temperature_c = {temperature_c!r}: must be finite, in [{low:g}, {high:g}] degC")
         self.pending = Measurement(node, float(temperature_c), float(time_s))
 
     # ---- outputs ----------------------------------------------------------------------------

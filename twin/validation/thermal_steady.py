@@ -21,6 +21,7 @@ from twin import catalog
 from twin.engine import Twin
 from twin.setpoint import Setpoint
 from twin.spec import BearingSpec, ModelOptions
+from twin.thermal.coupling import TEMPERATURE_RANGE_C
 from twin.thermal.integrator import steady_state_c
 from twin.thermal.network import NODE_NAMES
 from twin.thermal.settings import ThermalNetworkSettings
@@ -45,7 +46,7 @@ class SteadyState:
     time_constants_s: tuple[float, ...]  # the network's, real heat capacities, slowest first [s]
 
 
-RUNAWAY_C = 400.0  # the network's node range ends here (Twin.hold_thermal_state): beyond it, no steady state
+RUNAWAY_C = TEMPERATURE_RANGE_C[1]  # the network's node range ends here: beyond it, no steady state
 
 
 def steady_state(

@@ -16,6 +16,7 @@ from twin.engine import Twin
 from twin.kernels import layout as L
 from twin.setpoint import Setpoint
 from twin.spec import BearingSpec
+from twin.vibration.housing import MIN_WINDOW_SAMPLES
 from twin.vibration.run import run_vibration
 
 DEFAULT_DEFECT_SIZE_M = 0.5e-3  # width along the rolling direction [m]
@@ -49,9 +50,6 @@ def defect_for(
     angle = angle_deg % 360.0
     out[{"outer": "azimuth_deg", "inner": "ring_angle_deg", "ball": "longitude_deg"}[kind]] = angle
     return out
-
-
-MIN_ANALYSED_SAMPLES = 1024  # the shortest window twin.vibration.run analyses
 
 
 def simulate_vibration(
@@ -112,10 +110,10 @@ def simulate_vibration(
         data["mounting"]["diametral_clearance_m"] = diametral_clearance_m
     spec = BearingSpec.model_validate(data)
     rate = spec.housing.accelerometer.sample_rate_hz
-    if duration_s * rate < MIN_ANALYSED_SAMPLES:
+    if duration_s * rate < MIN_WINDOW_SAMPLES:
         raise ValueError(
             f"duration_s = {duration_s:g} s: {duration_s * rate:.0f} samples at {rate:g} Hz; the analysis needs "
-            f"at least {MIN_ANALYSED_SAMPLES}, a duration of at least {MIN_ANALYSED_SAMPLES / rate:.4g} s"
+            f"at least {MIN_WINDOW_SAMPLES}, a duration of at least {MIN_WINDOW_SAMPLES / rate:.4g} s"
         )
     twin = Twin(
         spec,

@@ -38,6 +38,7 @@ import scipy.io
 
 from twin.vibration import indicators
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
+from twin.vibration.housing import MIN_WINDOW_SAMPLES
 from twin.vibration.kurtogram import fast_kurtogram
 
 LINE_TOLERANCE = 0.01  # relative half-width of the search around a line [-]
@@ -45,7 +46,7 @@ BACKGROUND_HALF_WIDTH_HZ = 20.0  # the local background: median of +-20 Hz aroun
 SHAFT_HARMONICS = 3  # 1x, 2x, 3x shaft among the defect lines
 LABEL_DEFECT_HARMONICS = 5
 LABEL_SHAFT_HARMONICS = 10
-MIN_SAMPLES = 1024
+MIN_SAMPLES = MIN_WINDOW_SAMPLES
 # the largest sample magnitude taken [m/s^2]: about 1e5 g, the top of shock accelerometers' ranges;
 # beyond it a record is corrupt or in the wrong units, and its squares would overflow the statistics
 MAX_ABS_SIGNAL_M_S2 = 1.0e6

@@ -47,6 +47,8 @@ from twin.jit import JIT
 # costs reference counting of each array (measured ~100 ns per step for these on the test machine).
 JIT_INLINE = dict(JIT, inline="always")
 
+MIN_WINDOW_SAMPLES = 1024  # the fewest samples an analysed window holds (indicators, envelope, kurtogram)
+
 _FROZEN = ConfigDict(frozen=True, extra="forbid", strict=True, allow_inf_nan=False)
 
 # Whether a bearing's outer ring rides on the housing unless its spec says otherwise. Off: with the
@@ -187,11 +189,11 @@ class Housing(BaseModel):
                 "sprung_stiffness_n_m"
             )
         acc = self.accelerometer
-        if acc.window_s * acc.sample_rate_hz < 1024:
+        if acc.window_s * acc.sample_rate_hz < MIN_WINDOW_SAMPLES:
             raise ValueError(
                 f"accelerometer.window_s = {acc.window_s:g} s holds {acc.window_s * acc.sample_rate_hz:.0f} "
-                f"samples at {acc.sample_rate_hz:g} Hz: must be in [{1024 / acc.sample_rate_hz:g}, 60] s "
-                "(at least 1024 samples per indicator window)"
+                f"samples at {acc.sample_rate_hz:g} Hz: must be in [{MIN_WINDOW_SAMPLES / acc.sample_rate_hz:g}, 60] s "
+                f"(at least {MIN_WINDOW_SAMPLES} samples per indicator window)"
             )
         return self
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from twin.vibration import indicators as ind
 from twin.vibration.defect_frequencies import bearing_defect_frequencies
-from twin.vibration.housing import Housing, sensor_resonance
+from twin.vibration.housing import MIN_WINDOW_SAMPLES, Housing, sensor_resonance
 
 
 def run_vibration(
@@ -64,8 +64,11 @@ def run_vibration(
     n_win = int(round(window_s * fs))
     count = max(1, x.size // n_win)
     n_win = min(n_win, x.size)
-    if n_win < 1024:
-        raise ValueError(f"{n_win} samples per window at {fs:g} Hz: need at least 1024 ({1024 / fs:.4g} s)")
+    if n_win < MIN_WINDOW_SAMPLES:
+        raise ValueError(
+            f"{n_win} samples per window at {fs:g} Hz: "
+            f"need at least {MIN_WINDOW_SAMPLES} ({MIN_WINDOW_SAMPLES / fs:.4g} s)"
+        )
     top = max(freq.bpfi_hz, freq.two_bsf_hz)
     min_bw = 2.0 * 4.0 * top  # room for 3 harmonics and their sidebands in the envelope
     if isinstance(band, str) and band == "resonance":
