@@ -86,8 +86,8 @@ def test_speed_lowers_it_through_the_centrifugal_force():
 
 @pytest.mark.parametrize("designation", ["7208", "7208C", "6208"])
 def test_equilibrium_contact_loads_carry_the_applied_load(designation):
-    """Statics (Harris & Kotzalas, Rolling Bearing Analysis, 5th ed., vol. 1, ch. 7, eq. 7.43 for
-    the radial and axial equilibrium of the inner ring): the inner-raceway contact loads the life
+    """Statics (Harris & Kotzalas, Rolling Bearing Analysis, 5th ed., vol. 1, ch. 7: the radial
+    and axial equilibrium of the inner ring under its contact loads): the inner-raceway contact loads the life
     model takes from the warm start's equilibrium sum to the applied loads, each contact's Hertz
     stiffness at its own angle as in the equilibrium itself. At 1 rad/s the balls' centrifugal
     force is negligible. Axially within 1e-4 of the load (the solver's residual is 1e-6; the
