@@ -21,9 +21,10 @@ from typing import Any
 
 from service.tools.arg_types import float_in, int_in, non_negative_float
 from service.tools.stdout import print_document
+from twin.setpoint import FIELD
 
 GRIDS = (17, 33, 65, 129, 257, 513)  # nodes per direction the solver takes (2^k + 1; 513: minutes per solve)
-OIL_TEMPERATURE_RANGE_C = (-30.0, 150.0)  # the twin's setpoint range (twin.setpoint), where the oil laws hold
+OIL = FIELD["oil_temperature_c"]  # the base temperature takes the twin's oil range, where the oil laws hold
 
 
 def _grid(text: str) -> int:
@@ -78,7 +79,7 @@ def add_ehl_command(subparsers: Any) -> argparse.ArgumentParser:
     )
     solve.add_argument(
         "--base-temperature",
-        type=float_in(*OIL_TEMPERATURE_RANGE_C, "degC"),
+        type=float_in(OIL.low, OIL.high, OIL.unit),
         default=prm.BASE_TEMPERATURE_C,
         help=f"oil (boundary) temperature [degC] (default {prm.BASE_TEMPERATURE_C})",
     )
