@@ -16,7 +16,7 @@ from pydantic import ValidationError
 from service.core.errors import loc_text
 from service.core.scenarios import DESIGNATION_TAG, SPEC_TAG, Scenario, ScenarioError
 from twin import catalog
-from twin.yaml_numbers import Yaml12NumbersLoader
+from twin.yaml_numbers import load_yaml
 
 
 # ---- loading ----------------------------------------------------------------------------------
@@ -51,9 +51,6 @@ def locate_error(error: Mapping[str, Any]) -> tuple[str, str]:
     return where, msg
 
 
-ScenarioLoader = Yaml12NumbersLoader  # YAML 1.2's numbers (twin.yaml_numbers): `5e-4` is a float
-
-
 def load_scenario(path: str | Path) -> Scenario:
     """Read and validate a scenario YAML file."""
     path = Path(path)
@@ -64,7 +61,7 @@ def load_scenario(path: str | Path) -> Scenario:
     except UnicodeDecodeError as exc:
         raise ScenarioError(str(path), f"not UTF-8 text (byte {exc.start}): a scenario is a YAML file") from None
     try:
-        data = yaml.load(text, Loader=ScenarioLoader)
+        data = load_yaml(text)  # YAML 1.2's numbers (twin.yaml_numbers): `5e-4` is a float
     except yaml.YAMLError as exc:
         raise ScenarioError(str(path), f"not valid YAML: {' '.join(str(exc).split())}") from exc
     if isinstance(data, dict):

@@ -7,17 +7,17 @@ recordings), the setpoint and the scenario files."""
 from __future__ import annotations
 
 import pytest
-import yaml
 from pydantic import ValidationError
 
 from service.api.routers.defects import DefectsRequest
 from service.api.schemas import BearingCreate, RecordingRequest, ScenarioRequest
 from service.core.defects import parse_defects
 from service.core.errors import InputError
-from service.core.scenario_files import ScenarioLoader, scenario_from_dict
+from service.core.scenario_files import scenario_from_dict
 from twin import catalog
 from twin.setpoint import SetpointUpdate
 from twin.vibration.housing import Housing
+from twin.yaml_numbers import load_yaml
 
 GEOMETRY = catalog.bearing("6208").geometry
 SPALL = {"kind": "outer", "width_m": 5e-4, "length_m": 6e-4, "depth_m": 5e-5, "azimuth_deg": 0.0}
@@ -122,9 +122,8 @@ def test_scenarios_are_strict(patch, field):
 
 
 def test_scenario_files_read_exponents_as_numbers():
-    """YAML 1.2 numbers: `5e-4` in a scenario file is a float, `1` an int (a valid float)."""
-    data = yaml.load(
-        "name: s\nduration_s: 1e-2\nsample_every_s: 1\ninitial: {radial_load_n: 2e3}\n", Loader=ScenarioLoader
-    )
+    """YAML 1.2 numbers: `5e-4` in a scenario file is a float, `1` an int (a valid float); the
+    loader of scenario and spec files (twin.yaml_numbers)."""
+    data = load_yaml("name: s\nduration_s: 1e-2\nsample_every_s: 1\ninitial: {radial_load_n: 2e3}\n")
     scenario = scenario_from_dict(data)
     assert scenario.duration_s == 0.01 and scenario.sample_every_s == 1.0
