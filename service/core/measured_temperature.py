@@ -10,10 +10,7 @@ from typing import Any, Literal, get_args
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from service.core.errors import InputError, field_errors
-from twin.thermal.coupling import TEMPERATURE_RANGE_C as THERMAL_NETWORK_RANGE_C
-
-TEMPERATURE_RANGE_C = THERMAL_NETWORK_RANGE_C
-"""What a measured temperature may be [degC]: what the network takes (twin.thermal.coupling)."""
+from twin.thermal.coupling import TEMPERATURE_RANGE_C  # what a measured temperature may be [degC]
 
 MeasurableNode = Literal["outer_ring", "housing", "oil"]
 MEASURABLE_NODES: tuple[str, ...] = get_args(MeasurableNode)
